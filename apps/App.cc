@@ -1,0 +1,91 @@
+#include "Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Version.h>
+
+#include <openvdb/Exceptions.h>
+#include <tbb/global_control.h>
+
+#include <memory>
+
+namespace vdbhair::app {
+
+void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson)
+{
+    sub->add_option("--threads", common.threads, "Worker threads (0: all cores); results do not depend on it")
+        ->check(CLI::NonNegativeNumber);
+    if (withJson) sub->add_flag("--json", common.json, "Print one JSON object on stdout instead of prose");
+    sub->add_flag("--quiet,-q", common.quiet, "No progress and no warnings on stderr");
+}
+
+void printWarnings(const std::string& verb, const ReadReport& report, const CommonOptions& common)
+{
+    if (common.quiet) return;
+    for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << w << "\n";
+}
+
+void printJson(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
+
+int run(int argc, char** argv)
+{
+    CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
+                 ": hair geometry on OpenVDB - strands, tangent fields and generalized helicoids.\n"
+                 "Formats: .hair .data .obj .ply .vdb (read and write), .tfx .bin .convdata (read).",
+                 "vdbhair"};
+    app.set_version_flag("--version", "vdbhair " VDBHAIR_VERSION_STRING);
+    app.require_subcommand(1, 1);
+    app.footer("Run 'vdbhair <verb> --help' for a verb's options. Errors go to stderr as\n"
+               "'vdbhair <verb>: <what, the value, the rule>' with a non-zero exit status.");
+    CommonOptions common;
+    std::vector<Command> commands;
+    commands.push_back(addInfoCommand(app, common));
+    commands.push_back(addConvertCommand(app, common));
+    commands.push_back(addDemoCommand(app, common));
+
+    std::string verb = "";
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        for (const Command& c : commands) if (c.sub->parsed()) verb = c.sub->get_name();
+        std::cerr << "vdbhair" << (verb.empty() ? "" : " " + verb) << ": " << e.what() << "\n"
+                  << "Run 'vdbhair" << (verb.empty() ? "" : " " + verb) << " --help' for usage.\n";
+        return 2;
+    }
+
+    for (const Command& c : commands) {
+        if (!c.sub->parsed()) continue;
+        verb = c.sub->get_name();
+        std::unique_ptr<tbb::global_control> threads;
+        if (common.threads > 0) {
+            threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                            std::size_t(common.threads));
+        }
+        try {
+            return c.run();
+        } catch (const ValueError& e) {
+            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
+            return 2;
+        } catch (const Error& e) {
+            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
+            return 1;
+        } catch (const openvdb::Exception& e) {
+            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
+            return 1;
+        } catch (const std::bad_alloc&) {
+            std::cerr << "vdbhair " << verb << ": out of memory\n";
+            return 1;
+        } catch (const std::exception& e) {
+            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
+            return 1;
+        }
+    }
+    return 2;
+}
+
+} // namespace vdbhair::app

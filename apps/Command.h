@@ -1,0 +1,53 @@
+/// @file Command.h
+/// @brief What every `vdbhair` subcommand shares: the common options, how it registers, and
+/// how it reports. Each subcommand lives in its own file under commands/, fills a plain
+/// parameter struct from the command line and calls the library.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <vdbhair/io/ReadOptions.h>
+
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace vdbhair::app {
+
+/// Options every verb shares (DESIGN.md, "The vdbhair command").
+struct CommonOptions
+{
+    int threads = 0;      ///< 0: all cores
+    bool json = false;    ///< one JSON object on stdout instead of prose
+    bool quiet = false;   ///< no progress, no warnings
+};
+
+/// A registered subcommand: its CLI11 node and the function that runs it (returns the exit code).
+struct Command
+{
+    CLI::App* sub = nullptr;
+    std::function<int()> run;
+};
+
+/// @brief Add --threads, --json and --quiet to @a sub.
+void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson = true);
+
+/// @brief Print a reader's warnings on stderr as `vdbhair <verb>: warning: ...` (unless quiet).
+void printWarnings(const std::string& verb, const ReadReport& report, const CommonOptions& common);
+
+/// @brief Print @a j on stdout as one line.
+void printJson(const nlohmann::json& j);
+
+// One function per subcommand file, each returning the registered command.
+Command addInfoCommand(CLI::App& app, CommonOptions& common);
+Command addConvertCommand(CLI::App& app, CommonOptions& common);
+Command addDemoCommand(CLI::App& app, CommonOptions& common);
+
+/// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
+/// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line.
+int run(int argc, char** argv);
+
+} // namespace vdbhair::app

@@ -1,0 +1,88 @@
+// vdbhair convert IN [IN...] OUT: strands from any readable format to any writable one.
+#include "../Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/strands/Measures.h>
+#include <vdbhair/strands/Resample.h>
+
+#include <cmath>
+
+namespace vdbhair::app {
+
+namespace {
+
+struct ConvertParams
+{
+    std::vector<std::string> files;
+    std::string output;
+    std::size_t resample = 0;  ///< vertices per strand; 0 keeps them
+    double scale = 1.0;
+    std::string plyEncoding = "binary";
+    std::string codec = "float";
+    double voxelSize = 0.0;
+    bool strict = false;
+};
+
+int runConvert(ConvertParams p, const CommonOptions& common)
+{
+    // Inputs and output: `convert IN OUT`, `convert IN... -o OUT`.
+    std::vector<std::string> inputs = p.files;
+    if (p.output.empty()) {
+        if (inputs.size() < 2) throw ValueError("needs an output: 'convert IN OUT' or 'convert IN -o OUT'");
+        p.output = inputs.back();
+        inputs.pop_back();
+    }
+    // Check everything about the command line before reading anything.
+    WriteOptions wopts;
+    strandFormatFromPath(p.output, /*forWriting=*/true);
+    for (const std::string& in : inputs) strandFormatFromPath(in);
+    if (p.resample == 1) throw ValueError("--resample 1: a strand needs at least 2 vertices");
+    if (!std::isfinite(p.scale) || p.scale == 0.0) throw ValueError("--scale " + std::to_string(p.scale) + ": must be finite and non-zero");
+    if (p.plyEncoding == "ascii") wopts.plyEncoding = PlyEncoding::Ascii;
+    else if (p.plyEncoding != "binary") throw ValueError("--ply-encoding '" + p.plyEncoding + "': must be ascii or binary");
+    wopts.vdb.codec = positionCodecFromName(p.codec);
+    if (p.voxelSize < 0.0 || !std::isfinite(p.voxelSize)) throw ValueError("--voxel-size " + std::to_string(p.voxelSize) + ": must be a positive length (0 chooses it)");
+    wopts.vdb.voxelSize = p.voxelSize;
+
+    ReadOptions ropts;
+    if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
+    StrandSet strands;
+    ReadReport report;
+    for (const std::string& in : inputs) strands.append(readStrands(in, ropts, &report));
+    printWarnings("convert", report, common);
+    if (strands.empty()) throw FormatError("the input has no strands; nothing to write to " + p.output);
+    if (p.scale != 1.0) scaleStrands(strands, float(p.scale));
+    if (p.resample >= 2) strands = resampleStrands(strands, p.resample);
+    writeStrands(p.output, strands, wopts);
+
+    if (common.json) {
+        printJson({{"inputs", inputs}, {"output", p.output}, {"strands", strands.numStrands()},
+                   {"vertices", strands.numVertices()}, {"dropped_strands", report.droppedStrands}});
+    } else if (!common.quiet) {
+        std::cout << "wrote " << p.output << ": " << strands.numStrands() << " strands, "
+                  << strands.numVertices() << " vertices\n";
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addConvertCommand(CLI::App& app, CommonOptions& common)
+{
+    auto params = std::make_shared<ConvertParams>();
+    CLI::App* sub = app.add_subcommand("convert", "Convert strands between formats (several inputs are concatenated)");
+    sub->add_option("files", params->files, "IN [IN...] OUT, or IN [IN...] with -o OUT")->required();
+    sub->add_option("-o,--output", params->output, "Output file; its extension picks the format (.hair .data .obj .ply .vdb)");
+    sub->add_option("--resample", params->resample, "Resample every strand to N vertices, equally spaced in arc length")->check(CLI::NonNegativeNumber);
+    sub->add_option("--scale", params->scale, "Multiply every position (and thickness) by S");
+    sub->add_option("--ply-encoding", params->plyEncoding, "PLY output encoding: binary (little-endian) or ascii")->capture_default_str();
+    sub->add_option("--codec", params->codec, "VDB position codec: float (exact), fixed16, fixed8")->capture_default_str();
+    sub->add_option("--voxel-size", params->voxelSize, "VDB points voxel size in world units (default: about 8 points per voxel)");
+    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");
+    return {sub, [params, &common] { return runConvert(*params, common); }};
+}
+
+} // namespace vdbhair::app

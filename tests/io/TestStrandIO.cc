@@ -1,0 +1,58 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/StrandIO.h>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+TEST_CASE("readStrands/writeStrands: every writable format round-trips", "[io]")
+{
+    const StrandSet s = test::sampleStrands(false);
+    for (const char* ext : {".hair", ".data", ".obj", ".ply", ".vdb"}) {
+        CAPTURE(ext);
+        const std::string path = test::tempPath(std::string("any") + ext);
+        writeStrands(path, s);
+        const float tol = std::string(ext) == ".vdb" ? 1e-6f * computeBBox(s).extent().length() : 0.f;
+        test::requireSameStrands(s, readStrands(path), tol);
+    }
+    WriteOptions ascii;
+    ascii.plyEncoding = PlyEncoding::Ascii;
+    writeStrands(test::tempPath("ascii.ply"), s, ascii);
+    test::requireSameStrands(s, readStrands(test::tempPath("ascii.ply")));
+}
+
+TEST_CASE("strandFormatFromPath: by extension, case-insensitive, with clear errors", "[io]")
+{
+    REQUIRE(strandFormatFromPath("a/b/HAIR.HAIR") == StrandFormat::Hair);
+    REQUIRE(strandFormatFromPath("x.tfx") == StrandFormat::Tfx);
+    REQUIRE_THROWS_WITH(strandFormatFromPath("x.abc"), Contains("unknown strand format '.abc'; supported extensions are .hair"));
+    REQUIRE_THROWS_WITH(strandFormatFromPath("x.tfx", true), Contains("is read-only in vdbhair"));
+    REQUIRE_THROWS_AS(writeStrands(test::tempPath("x.bin"), test::sampleStrands()), ValueError);
+}
+
+TEST_CASE("writeStrands: a failed write leaves an existing file untouched and no temporary", "[io]")
+{
+    const std::string path = test::tempPath("keep.vdb");
+    writeStrands(path, test::sampleStrands(false));
+    const std::string before = test::readBytes(path);
+    REQUIRE_THROWS(writeStrands(path, StrandSet{}));
+    REQUIRE(test::readBytes(path) == before);
+    for (const auto& e : std::filesystem::directory_iterator(test::tempDir())) {
+        REQUIRE(e.path().filename().string().find(".vdbhair-tmp-") == std::string::npos);
+    }
+    REQUIRE_THROWS_AS(writeStrands(test::tempPath("no/such/folder/x.hair"), test::sampleStrands()), IoError);
+}
+
+TEST_CASE("readStrands: the same hairstyle in five formats reads to the same strands", "[io][data]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string dir = test::sharedData() + "/hair/";
+    const StrandSet ref = readStrands(dir + "cyhair/Bangs_100.hair");
+    for (const char* f : {"usc_data/Bangs_100.data", "ply/Bangs_100_binary.ply", "ct2hair_bin/Bangs_100.bin"}) {
+        CAPTURE(f);
+        test::requireSameStrands(ref, readStrands(dir + f));
+    }
+    test::requireSameStrands(ref, readStrands(dir + "ply/Bangs_100_ascii.ply"), 1e-3f);
+}

@@ -1,0 +1,139 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/HairFile.h>
+#include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbInfo.h>
+#include <vdbhair/io/VdbStrandGrid.h>
+
+#include <openvdb/points/PointAttribute.h>
+#include <openvdb/points/PointConversion.h>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+TEST_CASE("writeVdbStrands/readVdbStrands: topology survives OpenVDB's reordering", "[io][vdb]")
+{
+    const StrandSet s = test::sampleStrands(true);
+    const std::string path = test::tempPath("rt.vdb");
+    writeVdbStrands(path, s);
+    const StrandSet r = readVdbStrands(path);
+    // Float codec: within float rounding of the voxel-relative offset (see VdbStrands.h).
+    const BBox box = computeBBox(s);
+    test::requireSameStrands(s, r, 1e-6f * box.extent().length());
+    REQUIRE(r.thickness == s.thickness);
+    REQUIRE(r.color == s.color);
+    for (std::size_t v = 0; v < s.numVertices(); ++v) REQUIRE(r.transparency[v] == Approx(s.transparency[v]).margin(1e-7));
+}
+
+TEST_CASE("writeVdbStrands: fixed-point codecs stay within their stated precision", "[io][vdb]")
+{
+    const StrandSet s = test::sampleStrands(false);
+    for (PositionCodec codec : {PositionCodec::Fixed16, PositionCodec::Fixed8}) {
+        VdbPointsOptions opts;
+        opts.codec = codec;
+        opts.voxelSize = 0.25;
+        const std::string path = test::tempPath("codec.vdb");
+        writeVdbStrands(path, s, opts);
+        // OpenVDB's FixedPointCodec truncates: a component is off by less than one step.
+        const double bound = codec == PositionCodec::Fixed16 ? 0.25 / 65535.0 : 0.25 / 255.0;
+        // Per component at most the bound: a vector at most sqrt(3) times it (plus float rounding).
+        test::requireSameStrands(s, readVdbStrands(path), float(std::sqrt(3.0) * bound + 1e-5));
+    }
+}
+
+TEST_CASE("createStrandGrid: attributes, root group and metadata", "[io][vdb]")
+{
+    const StrandSet s = test::sampleStrands(false);
+    const auto grid = createStrandGrid(s);
+    REQUIRE(grid->getName() == "strands");
+    REQUIRE(grid->metaValue<std::int64_t>("vdbhair:strand_count") == 3);
+    REQUIRE(grid->metaValue<std::string>("creator").rfind("vdbhair ", 0) == 0);
+    const auto& desc = grid->tree().cbeginLeaf()->attributeSet().descriptor();
+    REQUIRE(desc.find("strand") != openvdb::points::AttributeSet::INVALID_POS);
+    REQUIRE(desc.find("vertex") != openvdb::points::AttributeSet::INVALID_POS);
+    REQUIRE(desc.hasGroup("root"));
+    std::size_t roots = 0;
+    for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+        openvdb::points::GroupHandle root = leaf->groupHandle("root");
+        openvdb::points::AttributeHandle<std::int32_t> vertex(leaf->constAttributeArray("vertex"));
+        for (auto it = leaf->beginIndexOn(); it; ++it) {
+            REQUIRE(root.get(*it) == (vertex.get(*it) == 0));
+            roots += root.get(*it);
+        }
+    }
+    REQUIRE(roots == 3);
+}
+
+TEST_CASE("readVdbStrands: Bangs_100 round-trips through .vdb", "[io][vdb][data]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const StrandSet s = readHair(test::sharedData() + "/hair/cyhair/Bangs_100.hair");
+    const std::string path = test::tempPath("bangs.vdb");
+    writeVdbStrands(path, s);
+    test::requireSameStrands(s, readVdbStrands(path), 1e-6f * computeBBox(s).extent().length());
+    const std::vector<GridInfo> info = describeVdbFile(path);
+    REQUIRE(info.size() == 1);
+    REQUIRE(info[0].isPoints);
+    REQUIRE(info[0].pointCount == 1165);
+    REQUIRE(info[0].groups == std::vector<std::string>{"root"});
+}
+
+TEST_CASE("readVdbStrands: each kind of bad input has its own error", "[io][vdb]")
+{
+    initializeOpenVdb();
+    SECTION("not a VDB file")
+    {
+        REQUIRE_THROWS_AS(readVdbStrands(test::writeBytes("junk.vdb", "this is not a vdb file")), FormatError);
+    }
+    SECTION("no grid named strands: the message lists the grids")
+    {
+        openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create();
+        g->setName("density");
+        const std::string path = test::tempPath("density.vdb");
+        writeVdbGrids(path, {g}, "test");
+        REQUIRE_THROWS_AS(readVdbStrands(path), LookupError);
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("no grid named 'strands'; the file has 'density'"));
+    }
+    SECTION("a grid named strands of the wrong type")
+    {
+        openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create();
+        g->setName("strands");
+        const std::string path = test::tempPath("wrongtype.vdb");
+        writeVdbGrids(path, {g}, "test");
+        REQUIRE_THROWS_AS(readVdbStrands(path), TypeError);
+    }
+    SECTION("points without topology attributes (as another tool writes them)")
+    {
+        std::vector<openvdb::Vec3f> p{{0, 0, 0}, {1, 1, 1}};
+        auto g = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, openvdb::points::PointDataGrid>(
+            p, *openvdb::math::Transform::createLinearTransform(0.5));
+        g->setName("strands");
+        const std::string path = test::tempPath("plainpoints.vdb");
+        writeVdbGrids(path, {g}, "test");
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("has no 'strand' attribute"));
+    }
+    SECTION("an impossible strand count and a repeated vertex")
+    {
+        StrandSet s = test::sampleStrands(false);
+        auto g = createStrandGrid(s);
+        g->insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(1000000));
+        std::string path = test::tempPath("count.vdb");
+        writeVdbGrids(path, {g}, "test");
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("vdbhair:strand_count 1000000 is impossible for 52 points"));
+
+        g = createStrandGrid(s);
+        for (auto leaf = g->tree().beginLeaf(); leaf; ++leaf) {
+            openvdb::points::AttributeWriteHandle<std::int32_t> vertex(leaf->attributeArray("vertex"));
+            for (auto it = leaf->beginIndexOn(); it; ++it) if (vertex.get(*it) == 1) vertex.set(*it, 0);
+        }
+        path = test::tempPath("dup.vdb");
+        writeVdbGrids(path, {g}, "test");
+        REQUIRE_THROWS_AS(readVdbStrands(path), FormatError);
+    }
+    SECTION("writing an empty set")
+    {
+        REQUIRE_THROWS_WITH(writeVdbStrands(test::tempPath("empty.vdb"), StrandSet{}), Contains("no strands"));
+        REQUIRE_FALSE(std::filesystem::exists(test::tempPath("empty.vdb")));
+    }
+}

@@ -1,0 +1,57 @@
+#include "BinFile.h"
+
+#include <vdbhair/io/ByteReader.h>
+#include <vdbhair/io/FileUtil.h>
+
+#include <limits>
+
+namespace vdbhair {
+
+StrandSet readBin(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    const std::string where = "readBin(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where);
+    ByteReader in(bytes, where);
+    constexpr std::size_t kVertexBytes = 7 * 4;
+    const std::int32_t nS = in.read<std::int32_t>("strand count");
+    if (nS < 0) in.failAt(0, "strand count " + std::to_string(nS) + " is negative");
+    in.require(std::uint64_t(nS), 4, "the declared " + std::to_string(nS) + " strands");
+
+    StrandSet out;
+    out.offsets.reserve(std::size_t(nS) + 1);
+    out.positions.reserve(in.remaining() / kVertexBytes);
+    ShortStrandFilter filter(opts, report, where);
+    float vertex[7];
+    for (std::int32_t i = 0; i < nS; ++i) {
+        const std::size_t at = in.offset();
+        const std::int32_t nV = in.read<std::int32_t>("vertex count");
+        if (nV < 0) in.failAt(at, "strand " + std::to_string(i) + " declares " + std::to_string(nV) + " vertices; counts must not be negative");
+        if (std::uint64_t(nV) > in.remaining() / kVertexBytes) {
+            in.failAt(at, "strand " + std::to_string(i) + " declares " + std::to_string(nV) +
+                              " vertices (" + std::to_string(kVertexBytes * std::uint64_t(nV)) +
+                              " bytes) but only " + std::to_string(in.remaining()) + " bytes remain");
+        }
+        const std::size_t first = out.positions.size();
+        for (std::int32_t k = 0; k < nV; ++k) {
+            const std::size_t vAt = in.offset();
+            in.readArray(vertex, 7, "vertex");
+            const Vec3f p(vertex[0], vertex[1], vertex[2]);
+            checkFinite(p, first + std::size_t(k), where, "at byte " + std::to_string(vAt));
+            out.positions.push_back(p);
+        }
+        if (filter.keep(std::size_t(i), std::size_t(nV), "at byte " + std::to_string(at))) {
+            if (out.positions.size() > std::numeric_limits<std::uint32_t>::max()) in.fail("more than 2^32-1 vertices");
+            out.offsets.push_back(std::uint32_t(out.positions.size()));
+        } else {
+            out.positions.resize(first);
+        }
+    }
+    if (in.remaining() && report) {
+        report->warnings.push_back(where + ": " + std::to_string(in.remaining()) +
+                                   " bytes after the last strand were ignored");
+    }
+    filter.finish();
+    return out;
+}
+
+} // namespace vdbhair

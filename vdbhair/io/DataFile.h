@@ -1,0 +1,19 @@
+/// @file DataFile.h
+/// @brief The USC-HairSalon / Hair Photobooth binary format (`.data`): little-endian i32 strand
+/// count, then per strand an i32 vertex count and that many f32[3] positions.
+#pragma once
+
+#include <vdbhair/io/ReadOptions.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <string>
+
+namespace vdbhair {
+
+/// @throw IoError, FormatError (negative or impossible counts, truncation, non-finite values).
+StrandSet readData(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
+
+/// @brief Write positions only (the format has no attributes).
+void writeData(const std::string& path, const StrandSet& strands);
+
+} // namespace vdbhair

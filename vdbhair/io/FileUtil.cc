@@ -1,0 +1,94 @@
+#include "FileUtil.h"
+
+#include <vdbhair/Exceptions.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+namespace vdbhair {
+
+namespace fs = std::filesystem;
+
+std::vector<char> readFileBytes(const std::string& path, const std::string& where)
+{
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw IoError(where + ": is a directory, not a file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw IoError(where + ": cannot open for reading: " + std::strerror(errno));
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    if (size < 0) throw IoError(where + ": cannot determine the file size");
+    in.seekg(0, std::ios::beg);
+    std::vector<char> bytes(static_cast<std::size_t>(size));
+    if (size > 0 && !in.read(bytes.data(), size)) {
+        throw IoError(where + ": read failed after " + std::to_string(in.gcount()) + " of " +
+                      std::to_string(size) + " bytes");
+    }
+    return bytes;
+}
+
+std::string fileExtension(const std::string& path)
+{
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+AtomicOutput::AtomicOutput(std::string target) : mTarget(std::move(target))
+{
+    static std::atomic<unsigned> counter{0};
+    const fs::path p(mTarget);
+    fs::path dir = p.parent_path();
+    std::error_code ec;
+    if (!dir.empty() && !fs::is_directory(dir, ec)) {
+        throw IoError(mTarget + ": cannot write: folder '" + dir.string() + "' does not exist");
+    }
+    if (fs::is_directory(p, ec)) throw IoError(mTarget + ": cannot write: is a directory");
+    const std::string name = "." + p.stem().string() + ".vdbhair-tmp-" +
+                             std::to_string(::getpid()) + "-" + std::to_string(counter++) +
+                             p.extension().string();
+    mTemp = (dir.empty() ? fs::path(name) : dir / name).string();
+}
+
+AtomicOutput::~AtomicOutput()
+{
+    if (!mCommitted) {
+        std::error_code ec;
+        fs::remove(mTemp, ec);
+    }
+}
+
+void AtomicOutput::commit()
+{
+    if (std::rename(mTemp.c_str(), mTarget.c_str()) != 0) {
+        const std::string reason = std::strerror(errno);
+        std::error_code ec;
+        fs::remove(mTemp, ec);
+        throw IoError(mTarget + ": cannot move the finished output into place: " + reason);
+    }
+    mCommitted = true;
+}
+
+void writeFileAtomic(const std::string& path, const std::string& bytes, const std::string& where)
+{
+    AtomicOutput out(path);
+    {
+        std::ofstream f(out.tempPath(), std::ios::binary | std::ios::trunc);
+        if (!f) throw IoError(where + ": cannot open '" + out.tempPath() + "' for writing: " + std::strerror(errno));
+        f.write(bytes.data(), std::streamsize(bytes.size()));
+        f.flush();
+        if (!f) throw IoError(where + ": write failed (disk full?): " + std::strerror(errno));
+    }
+    out.commit();
+}
+
+} // namespace vdbhair

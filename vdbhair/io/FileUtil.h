@@ -1,0 +1,48 @@
+/// @file FileUtil.h
+/// @brief Reading whole files and writing outputs safely (temporary file, then rename).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vdbhair {
+
+/// @brief The whole content of @a path.
+/// @param where prefix of error messages, e.g. "readHair(a.hair)"
+/// @throw IoError if the file cannot be opened or read.
+std::vector<char> readFileBytes(const std::string& path, const std::string& where);
+
+/// @brief Lower-case extension of @a path including the dot (".hair"), or "" if none.
+std::string fileExtension(const std::string& path);
+
+/// @brief An output written to a temporary file next to its target and renamed into place by
+/// commit(), so that a failed run never leaves a half-written file nor destroys an existing one.
+///
+/// The temporary keeps the target's extension (some writers, such as OpenImageIO, choose the
+/// format by it). If commit() is not called, the destructor removes the temporary.
+class AtomicOutput
+{
+public:
+    /// @throw IoError if the target's folder does not exist.
+    explicit AtomicOutput(std::string target);
+    ~AtomicOutput();
+    AtomicOutput(const AtomicOutput&) = delete;
+    AtomicOutput& operator=(const AtomicOutput&) = delete;
+
+    const std::string& target() const { return mTarget; }
+    /// Where to write: a path in the target's folder.
+    const std::string& tempPath() const { return mTemp; }
+    /// @brief Rename the temporary onto the target.
+    /// @throw IoError with the operating system's reason.
+    void commit();
+
+private:
+    std::string mTarget, mTemp;
+    bool mCommitted = false;
+};
+
+/// @brief Write @a bytes to @a path atomically (see AtomicOutput).
+void writeFileAtomic(const std::string& path, const std::string& bytes, const std::string& where);
+
+} // namespace vdbhair

@@ -1,0 +1,169 @@
+#include "HairFile.h"
+
+#include <vdbhair/Version.h>
+#include <vdbhair/io/ByteReader.h>
+#include <vdbhair/io/FileUtil.h>
+
+#include <algorithm>
+#include <cstring>
+
+namespace vdbhair {
+
+namespace {
+enum : std::uint32_t { kSegments = 1, kPoints = 2, kThickness = 4, kTransparency = 8, kColors = 16 };
+}
+
+StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    const std::string where = "readHair(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where);
+    ByteReader in(bytes, where);
+
+    // Header
+    if (bytes.size() < 4 || std::memcmp(bytes.data(), "HAIR", 4) != 0) {
+        in.fail("not a cyHair file: the first 4 bytes must be \"HAIR\"");
+    }
+    if (bytes.size() < 128) {
+        in.fail("the file has " + std::to_string(bytes.size()) +
+                " bytes, shorter than the 128-byte cyHair header");
+    }
+    in.skip(4, "magic");
+    const std::uint32_t hairCount = in.read<std::uint32_t>("strand count");
+    const std::uint32_t pointCount = in.read<std::uint32_t>("point count");
+    const std::uint32_t arrays = in.read<std::uint32_t>("array bits");
+    const std::uint32_t defSegments = in.read<std::uint32_t>("default segments");
+    StrandDefaults defaults;
+    defaults.thickness = in.read<float>("default thickness");
+    defaults.transparency = in.read<float>("default transparency");
+    in.readArray(&defaults.color[0], 3, "default colour");
+    in.seek(128, "header end");
+
+    if (arrays & ~std::uint32_t(31)) {
+        in.failAt(12, "array bits " + std::to_string(arrays) +
+                          " set unknown bits; only 1, 2, 4, 8 and 16 are defined");
+    }
+    if (!(arrays & kPoints)) in.failAt(12, "the array bits have no points array (bit 2); there are no positions to read");
+
+    // The file size must be exactly what the header describes (checked before allocating).
+    const std::uint64_t nS = hairCount, nP = pointCount;
+    std::uint64_t expected = 128;
+    if (arrays & kSegments) expected += 2 * nS;
+    expected += 12 * nP;
+    if (arrays & kThickness) expected += 4 * nP;
+    if (arrays & kTransparency) expected += 4 * nP;
+    if (arrays & kColors) expected += 12 * nP;
+    if (expected > bytes.size()) {
+        in.failAt(4, "the header declares " + std::to_string(nS) + " strands and " +
+                         std::to_string(nP) + " points, which need " + std::to_string(expected) +
+                         " bytes, but the file has only " + std::to_string(bytes.size()));
+    }
+    if (expected < bytes.size() && report) {
+        report->warnings.push_back(where + ": " + std::to_string(bytes.size() - expected) +
+                                   " bytes after the arrays the header describes were ignored");
+    }
+
+    // Points per strand
+    std::vector<std::uint32_t> counts(nS);
+    if (arrays & kSegments) {
+        std::vector<std::uint16_t> seg(nS);
+        in.readArray(seg.data(), nS, "segments array");
+        for (std::size_t i = 0; i < nS; ++i) counts[i] = std::uint32_t(seg[i]) + 1;
+    } else {
+        if (defSegments >= 65536u) {
+            in.failAt(16, "default segments " + std::to_string(defSegments) +
+                              " exceeds the format's limit of 65535");
+        }
+        std::fill(counts.begin(), counts.end(), defSegments + 1);
+    }
+    std::uint64_t sum = 0;
+    for (std::uint32_t c : counts) sum += c;
+    if (sum != nP) {
+        in.failAt(8, "the strands' point counts add up to " + std::to_string(sum) +
+                         " but the header declares " + std::to_string(nP) + " points" +
+                         ((arrays & kSegments) ? "" : " (no segments array: every strand has default segments " +
+                                                          std::to_string(defSegments) + " + 1 points)"));
+    }
+
+    // Arrays
+    const std::size_t pointsAt = in.offset();
+    std::vector<Vec3f> points(nP);
+    in.readArray(reinterpret_cast<float*>(points.data()), 3 * nP, "points array");
+    std::vector<float> thickness, transparency;
+    std::vector<Vec3f> colors;
+    if (arrays & kThickness) { thickness.resize(nP); in.readArray(thickness.data(), nP, "thickness array"); }
+    if (arrays & kTransparency) { transparency.resize(nP); in.readArray(transparency.data(), nP, "transparency array"); }
+    if (arrays & kColors) { colors.resize(nP); in.readArray(reinterpret_cast<float*>(colors.data()), 3 * nP, "colours array"); }
+
+    // Strands
+    StrandSet out;
+    out.defaults = defaults;
+    out.reserve(nS, nP);
+    ShortStrandFilter filter(opts, report, where);
+    std::size_t v = 0;
+    for (std::size_t i = 0; i < nS; ++i) {
+        const std::size_t n = counts[i];
+        for (std::size_t k = v; k < v + n; ++k) {
+            checkFinite(points[k], k, where, "at byte " + std::to_string(pointsAt + 12 * k));
+        }
+        if (filter.keep(i, n, "strand at point " + std::to_string(v))) {
+            out.positions.insert(out.positions.end(), points.begin() + v, points.begin() + v + n);
+            out.offsets.push_back(std::uint32_t(out.positions.size()));
+            if (!thickness.empty()) out.thickness.insert(out.thickness.end(), thickness.begin() + v, thickness.begin() + v + n);
+            if (!transparency.empty()) out.transparency.insert(out.transparency.end(), transparency.begin() + v, transparency.begin() + v + n);
+            if (!colors.empty()) out.color.insert(out.color.end(), colors.begin() + v, colors.begin() + v + n);
+        }
+        v += n;
+    }
+    filter.finish();
+    return out;
+}
+
+void writeHair(const std::string& path, const StrandSet& strands)
+{
+    const std::string where = "writeHair(" + path + ")";
+    const std::size_t nS = strands.numStrands(), nP = strands.numVertices();
+    if (nS > 0xffffffffu || nP > 0xffffffffu) throw ValueError(where + ": too many strands or points for 32-bit counts");
+    bool uniform = nS > 0;
+    for (std::size_t i = 0; i < nS; ++i) {
+        if (strands.size(i) > 65536) {
+            throw ValueError(where + ": strand " + std::to_string(i) + " has " +
+                             std::to_string(strands.size(i)) +
+                             " points; cyHair stores at most 65536 points per strand");
+        }
+        if (strands.size(i) != strands.size(0)) uniform = false;
+    }
+    std::uint32_t arrays = kPoints;
+    if (!uniform) arrays |= kSegments;
+    if (!strands.thickness.empty()) arrays |= kThickness;
+    if (!strands.transparency.empty()) arrays |= kTransparency;
+    if (!strands.color.empty()) arrays |= kColors;
+
+    std::string out;
+    auto put = [&out](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+    auto putU32 = [&](std::uint32_t v) { put(&v, 4); };
+    out.reserve(128 + 2 * nS + 28 * nP);
+    put("HAIR", 4);
+    putU32(std::uint32_t(nS));
+    putU32(std::uint32_t(nP));
+    putU32(arrays);
+    putU32(uniform ? std::uint32_t(strands.size(0) - 1) : 0u);
+    put(&strands.defaults.thickness, 4);
+    put(&strands.defaults.transparency, 4);
+    put(strands.defaults.color.asPointer(), 12);
+    char info[88] = {};
+    std::snprintf(info, sizeof info, "%s", creatorString());
+    put(info, 88);
+    if (arrays & kSegments) {
+        for (std::size_t i = 0; i < nS; ++i) {
+            const std::uint16_t seg = std::uint16_t(strands.size(i) - 1);
+            put(&seg, 2);
+        }
+    }
+    if (nP) put(strands.positions.data(), 12 * nP);
+    if (arrays & kThickness) put(strands.thickness.data(), 4 * nP);
+    if (arrays & kTransparency) put(strands.transparency.data(), 4 * nP);
+    if (arrays & kColors) put(strands.color.data(), 12 * nP);
+    writeFileAtomic(path, out, where);
+}
+
+} // namespace vdbhair

@@ -1,0 +1,318 @@
+#include "PlyFile.h"
+
+#include <vdbhair/Version.h>
+#include <vdbhair/io/ByteReader.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/TextScanner.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+namespace vdbhair {
+
+namespace {
+
+enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64, Invalid };
+
+PlyType plyType(std::string_view s)
+{
+    if (s == "char" || s == "int8") return PlyType::Int8;
+    if (s == "uchar" || s == "uint8") return PlyType::UInt8;
+    if (s == "short" || s == "int16") return PlyType::Int16;
+    if (s == "ushort" || s == "uint16") return PlyType::UInt16;
+    if (s == "int" || s == "int32") return PlyType::Int32;
+    if (s == "uint" || s == "uint32") return PlyType::UInt32;
+    if (s == "float" || s == "float32") return PlyType::Float32;
+    if (s == "double" || s == "float64") return PlyType::Float64;
+    return PlyType::Invalid;
+}
+
+std::size_t plySize(PlyType t)
+{
+    switch (t) {
+    case PlyType::Int8: case PlyType::UInt8: return 1;
+    case PlyType::Int16: case PlyType::UInt16: return 2;
+    case PlyType::Int32: case PlyType::UInt32: case PlyType::Float32: return 4;
+    case PlyType::Float64: return 8;
+    default: return 0;
+    }
+}
+
+struct Property
+{
+    std::string name;
+    PlyType type = PlyType::Invalid;
+    bool isList = false;
+    PlyType countType = PlyType::Invalid;
+};
+
+struct Element
+{
+    std::string name;
+    std::uint64_t count = 0;
+    std::vector<Property> props;
+    std::size_t line = 0;
+};
+
+/// Reads values in either encoding; binary reads are bounds-checked by ByteReader.
+class ValueSource
+{
+public:
+    ValueSource(ByteReader* bin, TextScanner* text) : mBin(bin), mText(text) {}
+
+    double read(PlyType t, const char* what)
+    {
+        if (mBin) {
+            switch (t) {
+            case PlyType::Int8: return mBin->read<std::int8_t>(what);
+            case PlyType::UInt8: return mBin->read<std::uint8_t>(what);
+            case PlyType::Int16: return mBin->read<std::int16_t>(what);
+            case PlyType::UInt16: return mBin->read<std::uint16_t>(what);
+            case PlyType::Int32: return mBin->read<std::int32_t>(what);
+            case PlyType::UInt32: return mBin->read<std::uint32_t>(what);
+            case PlyType::Float32: return mBin->read<float>(what);
+            case PlyType::Float64: return mBin->read<double>(what);
+            default: mBin->fail("invalid property type");
+            }
+        }
+        while (mTok >= mTokens.size()) {
+            if (!mText->nextLine(mTokens)) mText->fail(std::string("file ends before ") + what);
+            mTok = 0;
+        }
+        return mText->toDouble(mTokens[mTok++], what);
+    }
+
+    std::string location() const
+    {
+        return mBin ? "at byte " + std::to_string(mBin->offset()) : "line " + std::to_string(mText->line());
+    }
+    std::uint64_t remainingBytes() const { return mBin ? mBin->remaining() : mText->remainingBytes(); }
+    [[noreturn]] void fail(const std::string& msg) const
+    {
+        if (mBin) mBin->fail(msg);
+        mText->fail(msg);
+    }
+
+private:
+    ByteReader* mBin;
+    TextScanner* mText;
+    std::vector<std::string_view> mTokens;
+    std::size_t mTok = 0;
+};
+
+} // namespace
+
+StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    const std::string where = "readPly(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where);
+
+    // Header
+    TextScanner header(bytes, where);
+    std::vector<std::string_view> tok;
+    if (!header.nextLine(tok) || tok.size() != 1 || tok[0] != "ply") header.fail("not a PLY file: the first line must be 'ply'");
+    bool binary = false, sawFormat = false;
+    std::vector<Element> elements;
+    bool ended = false;
+    while (header.nextLine(tok)) {
+        if (tok.empty()) continue;
+        if (tok[0] == "format") {
+            if (tok.size() < 3) header.fail("'format' needs an encoding and a version");
+            if (tok[1] == "ascii") binary = false;
+            else if (tok[1] == "binary_little_endian") binary = true;
+            else if (tok[1] == "binary_big_endian") throw UnsupportedError(where + ": line " + std::to_string(header.line()) + ": binary_big_endian PLY is not supported (ascii and binary_little_endian are)");
+            else header.fail("unknown format '" + std::string(tok[1]) + "'");
+            sawFormat = true;
+        } else if (tok[0] == "element") {
+            if (tok.size() != 3) header.fail("'element' needs a name and a count");
+            const std::int64_t count = header.toInt(tok[2], "element count");
+            if (count < 0) header.fail("element '" + std::string(tok[1]) + "' has a negative count " + std::to_string(count));
+            elements.push_back({std::string(tok[1]), std::uint64_t(count), {}, header.line()});
+        } else if (tok[0] == "property") {
+            if (elements.empty()) header.fail("'property' before any 'element'");
+            Property p;
+            if (tok.size() == 5 && tok[1] == "list") {
+                p.isList = true;
+                p.countType = plyType(tok[2]);
+                p.type = plyType(tok[3]);
+                p.name = std::string(tok[4]);
+                if (p.countType == PlyType::Invalid || p.countType == PlyType::Float32 || p.countType == PlyType::Float64) {
+                    header.fail("list count type '" + std::string(tok[2]) + "' must be an integer type");
+                }
+            } else if (tok.size() == 3) {
+                p.type = plyType(tok[1]);
+                p.name = std::string(tok[2]);
+            } else {
+                header.fail("'property' needs a type and a name");
+            }
+            if (p.type == PlyType::Invalid) header.fail("unknown property type in '" + std::string(tok[1]) + "'");
+            elements.back().props.push_back(p);
+        } else if (tok[0] == "end_header") {
+            ended = true;
+            break;
+        } else if (tok[0] == "comment" || tok[0] == "obj_info") {
+            continue;
+        } else {
+            header.fail("unexpected header keyword '" + std::string(tok[0]) + "'");
+        }
+    }
+    if (!ended) header.fail("the header has no 'end_header'");
+    if (!sawFormat) header.fail("the header has no 'format' line");
+
+    const Element* vertexEl = nullptr;
+    const Element* strandEl = nullptr;
+    for (const Element& e : elements) {
+        if (e.name == "vertex") vertexEl = &e;
+        if (e.name == "strand") strandEl = &e;
+    }
+    auto findProp = [](const Element* e, const char* name) -> int {
+        if (!e) return -1;
+        for (std::size_t i = 0; i < e->props.size(); ++i) {
+            if (e->props[i].name == name && !e->props[i].isList) return int(i);
+        }
+        return -1;
+    };
+    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    const int ix = findProp(vertexEl, "x"), iy = findProp(vertexEl, "y"), iz = findProp(vertexEl, "z");
+    if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
+    if (!strandEl) throw FormatError(where + ": the header has no 'strand' element (hairutil layout: element strand with property nsegs)");
+    const int iseg = findProp(strandEl, "nsegs");
+    if (iseg < 0) throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the 'strand' element needs an integer property 'nsegs'");
+    const int ir = findProp(vertexEl, "red"), ig = findProp(vertexEl, "green"), ib = findProp(vertexEl, "blue");
+    const bool hasColor = ir >= 0 && ig >= 0 && ib >= 0;
+    const float colorScale = hasColor && vertexEl->props[std::size_t(ir)].type == PlyType::UInt8 ? 1.f / 255.f : 1.f;
+
+    // Body
+    ByteReader bin(bytes, where);
+    TextScanner text(bytes, where, header.offset());
+    text.setLine(header.line());  // body line numbers continue the header's
+    bin.seek(header.offset(), "end_header");
+    ValueSource src(binary ? &bin : nullptr, binary ? nullptr : &text);
+
+    std::vector<Vec3f> positions, colors;
+    std::vector<std::uint64_t> counts;
+    std::vector<double> values;
+    for (const Element& e : elements) {
+        // Each instance needs at least one byte per property (binary) or two (ascii "0 ").
+        std::size_t minBytes = 0;
+        for (const Property& p : e.props) minBytes += binary ? (p.isList ? plySize(p.countType) : plySize(p.type)) : 2;
+        if (minBytes && e.count > src.remainingBytes() / minBytes) {
+            src.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
+                     std::to_string(minBytes) + " bytes but only " + std::to_string(src.remainingBytes()) + " bytes remain");
+        }
+        const bool isVertex = (&e == vertexEl), isStrand = (&e == strandEl);
+        if (isVertex) { positions.reserve(e.count); if (hasColor) colors.reserve(e.count); }
+        if (isStrand) counts.reserve(e.count);
+        values.assign(e.props.size(), 0.0);
+        for (std::uint64_t n = 0; n < e.count; ++n) {
+            for (std::size_t k = 0; k < e.props.size(); ++k) {
+                const Property& p = e.props[k];
+                if (p.isList) {
+                    const double c = src.read(p.countType, "list count");
+                    if (c < 0) src.fail("list '" + p.name + "' has a negative count");
+                    const std::uint64_t cnt = std::uint64_t(c);
+                    if (cnt > src.remainingBytes()) src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
+                    for (std::uint64_t j = 0; j < cnt; ++j) src.read(p.type, "list item");
+                } else {
+                    values[k] = src.read(p.type, p.name.c_str());
+                }
+            }
+            if (isVertex) {
+                const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
+                checkFinite(pos, positions.size(), where, src.location());
+                positions.push_back(pos);
+                if (hasColor) colors.emplace_back(float(values[std::size_t(ir)]) * colorScale, float(values[std::size_t(ig)]) * colorScale, float(values[std::size_t(ib)]) * colorScale);
+            } else if (isStrand) {
+                const double s = values[std::size_t(iseg)];
+                if (s < 0 || s != std::floor(s)) src.fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
+                counts.push_back(std::uint64_t(s) + 1);
+            }
+        }
+    }
+    std::uint64_t sum = 0;
+    for (std::uint64_t c : counts) sum += c;
+    if (sum != positions.size()) {
+        throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " + std::to_string(sum) +
+                          " vertices but the 'vertex' element has " + std::to_string(positions.size()));
+    }
+
+    StrandSet out;
+    out.reserve(counts.size(), positions.size());
+    ShortStrandFilter filter(opts, report, where);
+    std::size_t v = 0;
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+        const std::size_t n = std::size_t(counts[i]);
+        if (filter.keep(i, n, "vertex " + std::to_string(v))) {
+            out.positions.insert(out.positions.end(), positions.begin() + std::ptrdiff_t(v), positions.begin() + std::ptrdiff_t(v + n));
+            if (hasColor) out.color.insert(out.color.end(), colors.begin() + std::ptrdiff_t(v), colors.begin() + std::ptrdiff_t(v + n));
+            out.offsets.push_back(std::uint32_t(out.positions.size()));
+        }
+        v += n;
+    }
+    filter.finish();
+    return out;
+}
+
+void writePly(const std::string& path, const StrandSet& strands, PlyEncoding encoding)
+{
+    const std::string where = "writePly(" + path + ")";
+    const std::size_t nS = strands.numStrands(), nV = strands.numVertices();
+    if (nV > std::size_t(std::numeric_limits<std::int32_t>::max())) {
+        throw ValueError(where + ": " + std::to_string(nV) + " vertices exceed the int32 edge indices of the layout");
+    }
+    std::size_t maxSegs = 0;
+    for (std::size_t i = 0; i < nS; ++i) maxSegs = std::max(maxSegs, strands.size(i) - 1);
+    const bool wideSegs = maxSegs > 65535;
+    const bool hasColor = !strands.color.empty();
+    const bool binary = encoding == PlyEncoding::Binary;
+
+    std::string out;
+    out.reserve(256 + (binary ? 15 : 40) * nV + 16 * nV);
+    out += "ply\nformat ";
+    out += binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
+    out += std::string("comment ") + creatorString() + "\n";
+    out += "element vertex " + std::to_string(nV) + "\nproperty float x\nproperty float y\nproperty float z\n";
+    if (hasColor) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    out += "element strand " + std::to_string(nS) + "\nproperty " + (wideSegs ? "uint" : "ushort") + " nsegs\n";
+    out += "element edge " + std::to_string(nV - nS) + "\nproperty int vertex1\nproperty int vertex2\nend_header\n";
+
+    char buf[32];
+    auto putText = [&](auto v, char sep) {
+        const auto res = std::to_chars(buf, buf + sizeof buf, v);
+        out.append(buf, res.ptr);
+        out.push_back(sep);
+    };
+    auto putBin = [&](const auto& v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); };
+    auto toByte = [](float c) { return std::uint8_t(std::lround(std::min(1.f, std::max(0.f, c)) * 255.f)); };
+
+    for (std::size_t v = 0; v < nV; ++v) {
+        const Vec3f& p = strands.positions[v];
+        if (binary) {
+            putBin(p.x()); putBin(p.y()); putBin(p.z());
+            if (hasColor) for (int c = 0; c < 3; ++c) putBin(toByte(strands.color[v][c]));
+        } else {
+            putText(p.x(), ' '); putText(p.y(), ' '); putText(p.z(), hasColor ? ' ' : '\n');
+            if (hasColor) for (int c = 0; c < 3; ++c) putText(unsigned(toByte(strands.color[v][c])), c == 2 ? '\n' : ' ');
+        }
+    }
+    for (std::size_t i = 0; i < nS; ++i) {
+        const std::size_t segs = strands.size(i) - 1;
+        if (binary) {
+            if (wideSegs) putBin(std::uint32_t(segs));
+            else putBin(std::uint16_t(segs));
+        } else {
+            putText(segs, '\n');
+        }
+    }
+    for (std::size_t i = 0; i < nS; ++i) {
+        for (std::size_t v = strands.begin(i); v + 1 < strands.end(i); ++v) {
+            if (binary) { putBin(std::int32_t(v)); putBin(std::int32_t(v + 1)); }
+            else { putText(v, ' '); putText(v + 1, '\n'); }
+        }
+    }
+    writeFileAtomic(path, out, where);
+}
+
+} // namespace vdbhair

@@ -1,0 +1,85 @@
+/// @file ReadOptions.h
+/// @brief What every strand reader accepts and reports.
+#pragma once
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Types.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace vdbhair {
+
+/// @brief What a reader does with a strand of fewer than two vertices (a polyline needs two).
+///
+/// The default is Drop: such strands carry no direction, and real data has them (scalp samples
+/// without hair in the USC-HairSalon database, empty slots in HairNet's grids), so they are
+/// skipped, counted and reported as a warning. Reject makes them an error instead.
+enum class ShortStrandPolicy { Drop, Reject };
+
+struct ReadOptions
+{
+    ShortStrandPolicy shortStrands = ShortStrandPolicy::Drop;
+};
+
+/// @brief What a reader noticed but did not fail on.
+struct ReadReport
+{
+    std::size_t droppedStrands = 0;     ///< strands of fewer than two vertices, skipped
+    std::vector<std::string> warnings;  ///< one line each, prefixed with the reader and file
+};
+
+/// @brief Applies the short-strand policy and counts what it drops (shared by every reader).
+class ShortStrandFilter
+{
+public:
+    ShortStrandFilter(const ReadOptions& opts, ReadReport* report, std::string where)
+        : mOpts(opts), mReport(report), mWhere(std::move(where)) {}
+
+    /// @brief Whether strand @a index of @a vertexCount vertices is kept.
+    /// @param location "at byte 1234" or "line 17", for the message
+    /// @throw FormatError under ShortStrandPolicy::Reject.
+    bool keep(std::size_t index, std::size_t vertexCount, const std::string& location)
+    {
+        if (vertexCount >= 2) return true;
+        if (mOpts.shortStrands == ShortStrandPolicy::Reject) {
+            throw FormatError(mWhere + ": " + location + ": strand " + std::to_string(index) +
+                              " has " + std::to_string(vertexCount) +
+                              " vertices; a strand needs at least 2");
+        }
+        if (mDropped++ == 0) mFirst = index;
+        return false;
+    }
+
+    /// @brief Record the warning for what was dropped.
+    void finish()
+    {
+        if (mDropped == 0 || !mReport) return;
+        mReport->droppedStrands += mDropped;
+        mReport->warnings.push_back(mWhere + ": dropped " + std::to_string(mDropped) +
+                                    " strand(s) with fewer than 2 vertices (first: strand " +
+                                    std::to_string(mFirst) + ")");
+    }
+
+private:
+    const ReadOptions& mOpts;
+    ReadReport* mReport;
+    std::string mWhere;
+    std::size_t mDropped = 0, mFirst = 0;
+};
+
+/// @brief Throw unless @a p is finite.
+inline void checkFinite(const Vec3f& p, std::size_t vertex, const std::string& where,
+                        const std::string& location)
+{
+    if (std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z())) return;
+    throw FormatError(where + ": " + location + ": vertex " + std::to_string(vertex) +
+                      " has a non-finite coordinate (" + std::to_string(p.x()) + ", " +
+                      std::to_string(p.y()) + ", " + std::to_string(p.z()) +
+                      "); coordinates must be finite");
+}
+
+} // namespace vdbhair

@@ -1,0 +1,52 @@
+/// @file StrandIO.h
+/// @brief Reading and writing strands in any supported format, chosen by extension (and checked
+/// by magic where the format has one).
+///
+/// | extension | format | read | write |
+/// |---|---|---|---|
+/// | .hair | cyHair (HairFile.h) | yes | yes |
+/// | .data | USC-HairSalon (DataFile.h) | yes | yes |
+/// | .obj | OBJ polylines (ObjFile.h) | yes | yes |
+/// | .ply | hairutil PLY, ascii / binary LE (PlyFile.h) | yes | yes |
+/// | .vdb | OpenVDB points grid `strands` (VdbStrands.h) | yes | yes |
+/// | .tfx | TressFX binary 3/4, ASCII 1/2 (TfxFile.h) | yes | no |
+/// | .bin | CT2Hair (BinFile.h) | yes | no |
+/// | .convdata | HairNet (ConvdataFile.h) | yes | no |
+#pragma once
+
+#include <vdbhair/io/PlyFile.h>
+#include <vdbhair/io/ReadOptions.h>
+#include <vdbhair/io/VdbStrands.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <string>
+
+namespace vdbhair {
+
+enum class StrandFormat { Hair, Data, Obj, Ply, Vdb, Tfx, Bin, Convdata };
+
+/// @brief The format of @a path from its extension.
+/// @param forWriting also require a writable format
+/// @throw ValueError naming the extension and the supported ones.
+StrandFormat strandFormatFromPath(const std::string& path, bool forWriting = false);
+
+bool isWritable(StrandFormat format);
+const char* formatName(StrandFormat format);
+
+/// @brief Whether @a path has an extension vdbhair reads as strands.
+bool isStrandFile(const std::string& path);
+
+/// @brief Read strands from any supported file.
+StrandSet readStrands(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
+
+struct WriteOptions
+{
+    PlyEncoding plyEncoding = PlyEncoding::Binary;
+    VdbPointsOptions vdb;
+};
+
+/// @brief Write strands in the format of @a path's extension, atomically.
+/// @throw ValueError (unwritable format, empty set where the format needs strands), IoError.
+void writeStrands(const std::string& path, const StrandSet& strands, const WriteOptions& opts = {});
+
+} // namespace vdbhair

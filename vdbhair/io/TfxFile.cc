@@ -1,0 +1,174 @@
+#include "TfxFile.h"
+
+#include <vdbhair/io/ByteReader.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/TextScanner.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace vdbhair {
+
+namespace {
+
+/// Shared by binary 3.0 and 4.x: @a nS strands of @a nV vertices of @a stride floats at @a posAt.
+StrandSet readBinaryStrands(ByteReader& in, std::uint32_t nS, std::uint32_t nV, std::size_t stride,
+                            std::uint64_t posAt, std::uint64_t uvAt, std::uint64_t thicknessAt,
+                            const ReadOptions& opts, ReadReport* report)
+{
+    const std::string& where = in.where();
+    const std::uint64_t total = std::uint64_t(nS) * nV;
+    if (total > std::numeric_limits<std::uint32_t>::max()) {
+        in.failAt(4, std::to_string(nS) + " strands of " + std::to_string(nV) + " vertices exceed 2^32-1 vertices");
+    }
+    in.seek(posAt, "the vertex position offset");
+    in.require(total, stride * 4, std::to_string(nS) + " strands of " + std::to_string(nV) + " vertices");
+    std::vector<float> raw(total * stride);
+    in.readArray(raw.data(), total * stride, "vertex positions");
+
+    std::vector<Vec2f> uv;
+    if (uvAt) {
+        in.seek(uvAt, "the strand texcoord offset");
+        uv.resize(nS);
+        in.readArray(reinterpret_cast<float*>(uv.data()), 2 * std::uint64_t(nS), "strand texcoords");
+    }
+    std::vector<float> thickness;
+    if (thicknessAt) {
+        in.seek(thicknessAt, "the strand thickness offset");
+        thickness.resize(nS);
+        in.readArray(thickness.data(), nS, "strand thickness");
+    }
+
+    StrandSet out;
+    out.reserve(nS, total);
+    ShortStrandFilter filter(opts, report, where);
+    for (std::uint32_t i = 0; i < nS; ++i) {
+        if (!filter.keep(i, nV, "at byte " + std::to_string(posAt + std::uint64_t(i) * nV * stride * 4))) continue;
+        for (std::uint32_t k = 0; k < nV; ++k) {
+            const std::size_t v = std::size_t(i) * nV + k;
+            const Vec3f p(raw[v * stride], raw[v * stride + 1], raw[v * stride + 2]);
+            checkFinite(p, v, where, "at byte " + std::to_string(posAt + v * stride * 4));
+            out.positions.push_back(p);
+        }
+        out.offsets.push_back(std::uint32_t(out.positions.size()));
+        if (!uv.empty()) out.rootUV.push_back(uv[i]);
+        if (!thickness.empty()) out.thickness.insert(out.thickness.end(), nV, thickness[i]);
+    }
+    filter.finish();
+    return out;
+}
+
+StrandSet readAscii(const std::vector<char>& bytes, const std::string& where,
+                    const ReadOptions& opts, ReadReport* report)
+{
+    TextScanner text(bytes, where);
+    StrandSet out;
+    ShortStrandFilter filter(opts, report, where);
+    std::int64_t declared = -1;
+    std::size_t strandsSeen = 0;
+    std::vector<std::string_view> tok;
+    while (text.nextLine(tok)) {
+        if (tok.empty() || tok[0][0] == '#') continue;
+        const std::string_view key = tok[0];
+        if (key == "strand") {
+            // strand i numVerts k texcoord u v
+            if (tok.size() < 4 || tok[2] != "numVerts") text.fail("expected 'strand <i> numVerts <k> ...'");
+            if (declared < 0) text.fail("a strand appears before 'numStrands'");
+            if (std::int64_t(strandsSeen) >= declared) {
+                text.fail("more strands than the " + std::to_string(declared) + " declared by numStrands");
+            }
+            const std::int64_t k = text.toInt(tok[3], "numVerts");
+            if (k < 0) text.fail("numVerts " + std::to_string(k) + " is negative");
+            // Each vertex needs a line of at least 6 bytes ("0 0 0\n").
+            if (std::uint64_t(k) > text.remainingBytes() / 6) {
+                text.fail("strand declares " + std::to_string(k) + " vertices but only " +
+                          std::to_string(text.remainingBytes()) + " bytes remain");
+            }
+            Vec2f uv(0.f);
+            if (tok.size() >= 7 && tok[4] == "texcoord") uv = Vec2f(text.toFloat(tok[5], "u"), text.toFloat(tok[6], "v"));
+            const std::size_t headerLine = text.line();
+            const std::size_t first = out.positions.size();
+            for (std::int64_t j = 0; j < k; ++j) {
+                if (!text.nextLine(tok)) text.fail("file ends inside strand " + std::to_string(strandsSeen) + " (" + std::to_string(j) + " of " + std::to_string(k) + " vertices read)");
+                if (tok.size() < 3) text.fail("a vertex line needs 3 numbers");
+                const Vec3f p(text.toFloat(tok[0], "x"), text.toFloat(tok[1], "y"), text.toFloat(tok[2], "z"));
+                checkFinite(p, out.positions.size(), where, "line " + std::to_string(text.line()));
+                out.positions.push_back(p);
+            }
+            if (filter.keep(strandsSeen, std::size_t(k), "line " + std::to_string(headerLine))) {
+                out.offsets.push_back(std::uint32_t(out.positions.size()));
+                out.rootUV.push_back(uv);
+            } else {
+                out.positions.resize(first);
+            }
+            ++strandsSeen;
+        } else if (key == "numStrands") {
+            if (tok.size() < 2) text.fail("numStrands needs a value");
+            declared = text.toInt(tok[1], "numStrands");
+            if (declared < 0) text.fail("numStrands " + std::to_string(declared) + " is negative");
+            if (std::uint64_t(declared) > text.remainingBytes() / 8) {
+                text.fail("numStrands " + std::to_string(declared) + " cannot fit in the " +
+                          std::to_string(text.remainingBytes()) + " bytes that remain");
+            }
+            out.offsets.reserve(std::size_t(declared) + 1);
+        } else if (key == "version") {
+            if (tok.size() < 2) text.fail("version needs a value");
+            const float v = text.toFloat(tok[1], "version");
+            if (v != 1.f && v != 2.f) throw UnsupportedError(where + ": line " + std::to_string(text.line()) + ": ASCII version " + std::string(tok[1]) + " is not supported (1.0 and 2.0 are)");
+        } else if (key == "scale" || key == "rotation" || key == "translation") {
+            const float identity = (key == "scale") ? 1.f : 0.f;
+            for (std::size_t j = 1; j < tok.size(); ++j) {
+                if (text.toFloat(tok[j], std::string(key).c_str()) != identity) {
+                    throw UnsupportedError(where + ": line " + std::to_string(text.line()) + ": a non-identity '" +
+                                           std::string(key) + "' is not supported; bake the transform into the vertices");
+                }
+            }
+        }
+        // Other header keys (bothEndsImmovable, maxNumVerticesInStrand, ...) describe simulation.
+    }
+    if (declared < 0) text.fail("no 'numStrands' line: not a TressFX ASCII file");
+    if (std::int64_t(strandsSeen) != declared) {
+        text.fail("numStrands declares " + std::to_string(declared) + " strands but the file has " + std::to_string(strandsSeen));
+    }
+    filter.finish();
+    return out;
+}
+
+} // namespace
+
+StrandSet readTfx(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    const std::string where = "readTfx(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where);
+    ByteReader in(bytes, where);
+    if (bytes.size() >= 4 && std::isalpha(static_cast<unsigned char>(bytes[0]))) {
+        return readAscii(bytes, where, opts, report);
+    }
+    const float version = in.read<float>("version");
+    if (version == 3.f) {
+        if (bytes.size() < 296) in.failAt(0, "the file has " + std::to_string(bytes.size()) + " bytes, shorter than the 296-byte TressFX 3 header");
+        const std::uint32_t nS = in.read<std::uint32_t>("strand count");
+        const std::uint32_t nV = in.read<std::uint32_t>("vertices per strand");
+        in.seek(144, "header");
+        const std::uint32_t posAt = in.read<std::uint32_t>("vertex offset");
+        const std::uint32_t thicknessAt = in.read<std::uint32_t>("thickness offset");
+        const std::uint32_t uvAt = in.read<std::uint32_t>("texcoord offset");
+        return readBinaryStrands(in, nS, nV, 3, posAt ? posAt : 296, uvAt, thicknessAt, opts, report);
+    }
+    if (version >= 4.f && version < 5.f) {
+        if (bytes.size() < 160) in.failAt(0, "the file has " + std::to_string(bytes.size()) + " bytes, shorter than the 160-byte TressFX 4 header");
+        const std::uint32_t nS = in.read<std::uint32_t>("strand count");
+        const std::uint32_t nV = in.read<std::uint32_t>("vertices per strand");
+        const std::uint32_t posAt = in.read<std::uint32_t>("position offset");
+        const std::uint32_t uvAt = in.read<std::uint32_t>("strand UV offset");
+        in.read<std::uint32_t>("vertex UV offset");
+        const std::uint32_t thicknessAt = in.read<std::uint32_t>("strand thickness offset");
+        return readBinaryStrands(in, nS, nV, 4, posAt ? posAt : 160, uvAt, thicknessAt, opts, report);
+    }
+    throw UnsupportedError(where + ": at byte 0: version " + std::to_string(version) +
+                           " is not supported; vdbhair reads TressFX binary 3.0 and 4.x and ASCII 1.0/2.0");
+}
+
+} // namespace vdbhair

@@ -1,0 +1,244 @@
+#include "VdbStrandGrid.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Version.h>
+#include <vdbhair/io/VdbFile.h>
+
+#include <openvdb/points/PointAttribute.h>
+#include <openvdb/points/PointConversion.h>
+#include <openvdb/points/PointCount.h>
+#include <openvdb/points/PointGroup.h>
+#include <openvdb/tools/PointIndexGrid.h>
+
+#include <cmath>
+#include <limits>
+
+namespace vdbhair {
+
+namespace pts = openvdb::points;
+
+namespace {
+std::string toString(const openvdb::Coord& c)
+{
+    return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ")";
+}
+} // namespace
+
+PositionCodec positionCodecFromName(const std::string& name)
+{
+    if (name == "float") return PositionCodec::Float;
+    if (name == "fixed16") return PositionCodec::Fixed16;
+    if (name == "fixed8") return PositionCodec::Fixed8;
+    throw ValueError("position codec '" + name + "' is not one of float, fixed16, fixed8");
+}
+
+const char* positionCodecName(PositionCodec codec)
+{
+    switch (codec) {
+    case PositionCodec::Fixed16: return "fixed16";
+    case PositionCodec::Fixed8: return "fixed8";
+    default: return "float";
+    }
+}
+
+openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, const VdbPointsOptions& opts,
+                                                     const std::string& where)
+{
+    initializeOpenVdb();
+    if (strands.empty()) throw ValueError(where + ": the hairstyle has no strands; there is nothing to write");
+    if (strands.numVertices() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
+        throw ValueError(where + ": " + std::to_string(strands.numVertices()) + " vertices exceed the int32 attributes");
+    }
+    const pts::PointAttributeVector<openvdb::Vec3f> positions(strands.positions);
+    double voxelSize = opts.voxelSize;
+    if (voxelSize == 0.0) {
+        voxelSize = pts::computeVoxelSize(positions, std::max(1u, opts.pointsPerVoxel));
+    }
+    if (!(voxelSize > 0.0) || !std::isfinite(voxelSize)) {
+        throw ValueError(where + ": voxel size " + std::to_string(voxelSize) + " must be a positive finite length");
+    }
+    const openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(voxelSize);
+    const openvdb::tools::PointIndexGrid::Ptr index =
+        openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *xform);
+
+    pts::PointDataGrid::Ptr grid;
+    switch (opts.codec) {
+    case PositionCodec::Fixed16:
+        grid = pts::createPointDataGrid<pts::FixedPointCodec<false>, pts::PointDataGrid>(*index, positions, *xform);
+        break;
+    case PositionCodec::Fixed8:
+        grid = pts::createPointDataGrid<pts::FixedPointCodec<true>, pts::PointDataGrid>(*index, positions, *xform);
+        break;
+    default:
+        grid = pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, positions, *xform);
+    }
+    pts::PointDataTree& tree = grid->tree();
+
+    // Topology: strand and vertex index of every point, and the root group.
+    const std::size_t nV = strands.numVertices();
+    std::vector<std::int32_t> strandOf(nV), vertexOf(nV);
+    std::vector<short> isRoot(nV, 0);
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
+        for (std::size_t v = strands.begin(i); v < strands.end(i); ++v) {
+            strandOf[v] = std::int32_t(i);
+            vertexOf[v] = std::int32_t(v - strands.begin(i));
+        }
+        isRoot[strands.begin(i)] = 1;
+    }
+    pts::appendAttribute<std::int32_t>(tree, "strand");
+    pts::populateAttribute(tree, index->tree(), "strand", pts::PointAttributeVector<std::int32_t>(strandOf));
+    pts::appendAttribute<std::int32_t>(tree, "vertex");
+    pts::populateAttribute(tree, index->tree(), "vertex", pts::PointAttributeVector<std::int32_t>(vertexOf));
+    pts::appendGroup(tree, "root");
+    pts::setGroup(tree, index->tree(), isRoot, "root");
+
+    if (!strands.color.empty()) {
+        pts::appendAttribute<openvdb::Vec3f>(tree, "Cd");
+        pts::populateAttribute(tree, index->tree(), "Cd", pts::PointAttributeVector<openvdb::Vec3f>(strands.color));
+    }
+    if (!strands.thickness.empty()) {
+        pts::appendAttribute<float>(tree, "width");
+        pts::populateAttribute(tree, index->tree(), "width", pts::PointAttributeVector<float>(strands.thickness));
+    }
+    if (!strands.transparency.empty()) {
+        std::vector<float> alpha(nV);
+        for (std::size_t v = 0; v < nV; ++v) alpha[v] = 1.f - strands.transparency[v];
+        pts::appendAttribute<float>(tree, "Alpha");
+        pts::populateAttribute(tree, index->tree(), "Alpha", pts::PointAttributeVector<float>(alpha));
+    }
+
+    grid->setName("strands");
+    grid->insertMeta("creator", openvdb::StringMetadata(creatorString()));
+    grid->insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(std::int64_t(strands.numStrands())));
+    grid->insertMeta("vdbhair:position_codec", openvdb::StringMetadata(positionCodecName(opts.codec)));
+    return grid;
+}
+
+StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std::string& where,
+                          const ReadOptions& opts, ReadReport* report)
+{
+    const pts::PointDataTree& tree = grid.tree();
+    const auto leaf0 = tree.cbeginLeaf();
+    const std::uint64_t nPoints = pts::pointCount(tree);
+    if (!leaf0 || nPoints == 0) throw FormatError(where + ": grid '" + grid.getName() + "' has no points");
+    const pts::AttributeSet::Descriptor& desc = leaf0->attributeSet().descriptor();
+    for (const char* name : {"P", "strand", "vertex"}) {
+        if (desc.find(name) == pts::AttributeSet::INVALID_POS) {
+            throw FormatError(where + ": grid '" + grid.getName() + "' has no '" + name +
+                              "' attribute; a vdbhair strands grid has P, strand and vertex");
+        }
+    }
+    auto checkType = [&](const char* name, const char* type) {
+        const std::string got = desc.valueType(desc.find(name));
+        if (got != type) throw FormatError(where + ": attribute '" + std::string(name) + "' has type " + got + ", expected " + type);
+    };
+    checkType("strand", "int32");
+    checkType("vertex", "int32");
+    const std::size_t iP = desc.find("P"), iS = desc.find("strand"), iV = desc.find("vertex");
+    const std::size_t iCd = desc.find("Cd"), iW = desc.find("width"), iA = desc.find("Alpha");
+    const bool hasCd = iCd != pts::AttributeSet::INVALID_POS && desc.valueType(iCd) == "vec3s";
+    const bool hasW = iW != pts::AttributeSet::INVALID_POS && desc.valueType(iW) == "float";
+    const bool hasA = iA != pts::AttributeSet::INVALID_POS && desc.valueType(iA) == "float";
+
+    // The declared strand count must be possible before anything is sized by it.
+    std::int64_t declared = -1;
+    if (const auto meta = grid.getMetadata<openvdb::Int64Metadata>("vdbhair:strand_count")) {
+        declared = meta->value();
+        if (declared < 0 || std::uint64_t(declared) > nPoints) {
+            throw FormatError(where + ": metadata vdbhair:strand_count " + std::to_string(declared) +
+                              " is impossible for " + std::to_string(nPoints) + " points");
+        }
+    }
+
+    // Gather every point (the tree already holds them: sizes come from real data).
+    std::vector<Vec3f> pos(nPoints), cd(hasCd ? nPoints : 0);
+    std::vector<float> width(hasW ? nPoints : 0), alpha(hasA ? nPoints : 0);
+    std::vector<std::int32_t> sid(nPoints), vid(nPoints);
+    std::size_t k = 0;
+    std::int64_t maxStrand = -1;
+    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+        pts::AttributeHandle<openvdb::Vec3f> hP(leaf->constAttributeArray(iP));
+        pts::AttributeHandle<std::int32_t> hS(leaf->constAttributeArray(iS)), hV(leaf->constAttributeArray(iV));
+        std::unique_ptr<pts::AttributeHandle<openvdb::Vec3f>> hCd;
+        std::unique_ptr<pts::AttributeHandle<float>> hW, hA;
+        if (hasCd) hCd.reset(new pts::AttributeHandle<openvdb::Vec3f>(leaf->constAttributeArray(iCd)));
+        if (hasW) hW.reset(new pts::AttributeHandle<float>(leaf->constAttributeArray(iW)));
+        if (hasA) hA.reset(new pts::AttributeHandle<float>(leaf->constAttributeArray(iA)));
+        for (auto it = leaf->beginIndexOn(); it; ++it) {
+            const openvdb::Vec3d ijk = it.getCoord().asVec3d();
+            const openvdb::Vec3d world = grid.transform().indexToWorld(ijk + hP.get(*it));
+            pos[k] = Vec3f(float(world.x()), float(world.y()), float(world.z()));
+            sid[k] = hS.get(*it);
+            vid[k] = hV.get(*it);
+            if (hasCd) cd[k] = hCd->get(*it);
+            if (hasW) width[k] = hW->get(*it);
+            if (hasA) alpha[k] = hA->get(*it);
+            if (sid[k] < 0 || sid[k] >= (declared >= 0 ? declared : std::int64_t(nPoints)) || vid[k] < 0 || std::uint64_t(vid[k]) >= nPoints) {
+                throw FormatError(where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + std::to_string(sid[k]) +
+                                  " and vertex " + std::to_string(vid[k]) + "; strand must be in [0, " +
+                                  std::to_string(declared >= 0 ? declared : std::int64_t(nPoints)) +
+                                  ") and vertex in [0, " + std::to_string(nPoints) + ")");
+            }
+            maxStrand = std::max<std::int64_t>(maxStrand, sid[k]);
+            ++k;
+        }
+    }
+    if (k != nPoints) throw FormatError(where + ": counted " + std::to_string(k) + " points, expected " + std::to_string(nPoints));
+    const std::size_t nS = std::size_t(declared >= 0 ? declared : maxStrand + 1);
+
+    // Vertices per strand = 1 + highest vertex index; every index below must appear exactly once.
+    std::vector<std::uint32_t> count(nS, 0);
+    for (std::size_t p = 0; p < nPoints; ++p) count[std::size_t(sid[p])] = std::max(count[std::size_t(sid[p])], std::uint32_t(vid[p]) + 1);
+    std::vector<std::uint64_t> start(nS + 1, 0);
+    for (std::size_t s = 0; s < nS; ++s) start[s + 1] = start[s] + count[s];
+    if (start[nS] != nPoints) {
+        throw FormatError(where + ": the strands' vertex indices leave gaps or repeat: " + std::to_string(start[nS]) +
+                          " vertex slots for " + std::to_string(nPoints) + " points (each strand needs vertices 0..n-1 exactly once)");
+    }
+    std::vector<std::uint32_t> slot(nPoints, std::numeric_limits<std::uint32_t>::max());
+    std::vector<char> filled(nPoints, 0);
+    for (std::size_t p = 0; p < nPoints; ++p) {
+        const std::uint64_t at = start[std::size_t(sid[p])] + std::uint64_t(vid[p]);
+        if (filled[at]) throw FormatError(where + ": strand " + std::to_string(sid[p]) + " has vertex " + std::to_string(vid[p]) + " twice");
+        filled[at] = 1;
+        slot[at] = std::uint32_t(p);
+    }
+
+    StrandSet out;
+    out.reserve(nS, nPoints);
+    ShortStrandFilter filter(opts, report, where);
+    for (std::size_t s = 0; s < nS; ++s) {
+        if (!filter.keep(s, count[s], "grid '" + grid.getName() + "'")) continue;
+        for (std::uint64_t a = start[s]; a < start[s + 1]; ++a) {
+            const std::uint32_t p = slot[a];
+            out.positions.push_back(pos[p]);
+            if (hasCd) out.color.push_back(cd[p]);
+            if (hasW) out.thickness.push_back(width[p]);
+            if (hasA) out.transparency.push_back(1.f - alpha[p]);
+        }
+        out.offsets.push_back(std::uint32_t(out.positions.size()));
+    }
+    filter.finish();
+    return out;
+}
+
+void writeVdbStrands(const std::string& path, const StrandSet& strands, const VdbPointsOptions& opts)
+{
+    const std::string where = "writeVdbStrands(" + path + ")";
+    const pts::PointDataGrid::Ptr grid = createStrandGrid(strands, opts, where);
+    writeVdbGrids(path, {grid}, where);
+}
+
+StrandSet readVdbStrands(const std::string& path, const ReadOptions& opts, ReadReport* report,
+                         const std::string& gridName)
+{
+    const std::string where = "readVdbStrands(" + path + ")";
+    const openvdb::GridBase::Ptr base = readVdbGrid(path, gridName, where);
+    const auto grid = openvdb::GridBase::grid<pts::PointDataGrid>(base);
+    if (!grid) {
+        throw TypeError(where + ": grid '" + gridName + "' is a " + base->type() + ", not a PointDataGrid of strands");
+    }
+    return strandsFromGrid(*grid, where, opts, report);
+}
+
+} // namespace vdbhair

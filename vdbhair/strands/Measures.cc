@@ -1,0 +1,183 @@
+#include "Measures.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace vdbhair {
+
+namespace {
+
+inline Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
+
+/// Tangent of the circle through a (before), 0 (the vertex) and b (after), given as offsets
+/// from the vertex: |a|² b - |b|² a is perpendicular to the circle's radius at 0 and points
+/// towards b (see Measures.h). Degenerates to the chord direction when a point repeats.
+Vec3d circleTangent(const Vec3d& a, const Vec3d& b)
+{
+    const double aa = a.lengthSqr(), bb = b.lengthSqr();
+    if (aa == 0.0) return b;
+    if (bb == 0.0) return -a;
+    return aa * b - bb * a;
+}
+
+template<typename Fn>
+void forEachStrand(const StrandSet& strands, Fn&& fn)
+{
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, strands.numStrands(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
+                      });
+}
+
+} // namespace
+
+double polylineLength(const Vec3f* points, std::size_t n)
+{
+    double len = 0.0;
+    for (std::size_t i = 1; i < n; ++i) len += (toD(points[i]) - toD(points[i - 1])).length();
+    return len;
+}
+
+void arcLengths(const Vec3f* points, std::size_t n, double* out)
+{
+    if (n == 0) return;
+    out[0] = 0.0;
+    for (std::size_t i = 1; i < n; ++i) {
+        out[i] = out[i - 1] + (toD(points[i]) - toD(points[i - 1])).length();
+    }
+}
+
+std::vector<float> strandLengths(const StrandSet& strands)
+{
+    std::vector<float> out(strands.numStrands());
+    forEachStrand(strands, [&](std::size_t i) {
+        out[i] = float(polylineLength(strands.data(i), strands.size(i)));
+    });
+    return out;
+}
+
+void computeTangents(const Vec3f* points, std::size_t n, Vec3f* out)
+{
+    if (n == 0) return;
+    if (n == 1) { out[0] = Vec3f(0.f); return; }
+    // Index of the nearest point distinct from point i, searching backwards / forwards.
+    auto prevDistinct = [&](std::size_t i) -> std::ptrdiff_t {
+        for (std::ptrdiff_t j = std::ptrdiff_t(i) - 1; j >= 0; --j) {
+            if (points[j] != points[i]) return j;
+        }
+        return -1;
+    };
+    auto nextDistinct = [&](std::size_t i) -> std::ptrdiff_t {
+        for (std::size_t j = i + 1; j < n; ++j) {
+            if (points[j] != points[i]) return std::ptrdiff_t(j);
+        }
+        return -1;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::ptrdiff_t ip = prevDistinct(i), in = nextDistinct(i);
+        const Vec3d p = toD(points[i]);
+        Vec3d t(0.0);
+        if (ip >= 0 && in >= 0) {
+            t = circleTangent(toD(points[ip]) - p, toD(points[in]) - p);
+        } else if (in >= 0) {
+            // Root: tangent at p of the circle through p, the next and the one after.
+            const std::ptrdiff_t in2 = nextDistinct(std::size_t(in));
+            const Vec3d a = toD(points[in]) - p;
+            t = (in2 >= 0) ? -circleTangent(a, toD(points[in2]) - p) : a;
+            if (t.dot(a) <= 0.0) t = a;  // collinear fold-back: keep the chord
+        } else if (ip >= 0) {
+            const std::ptrdiff_t ip2 = prevDistinct(std::size_t(ip));
+            const Vec3d a = p - toD(points[ip]);
+            t = (ip2 >= 0) ? circleTangent(-a, toD(points[ip2]) - p) : a;
+            if (t.dot(a) <= 0.0) t = a;
+        }
+        const double len = t.length();
+        out[i] = len > 0.0 ? Vec3f(float(t.x() / len), float(t.y() / len), float(t.z() / len))
+                           : Vec3f(0.f);
+    }
+}
+
+std::vector<Vec3f> computeTangents(const StrandSet& strands)
+{
+    std::vector<Vec3f> out(strands.numVertices());
+    forEachStrand(strands, [&](std::size_t i) {
+        computeTangents(strands.data(i), strands.size(i), out.data() + strands.begin(i));
+    });
+    return out;
+}
+
+void curvatureProfile(const Vec3f* points, std::size_t n, float* out)
+{
+    if (n == 0) return;
+    if (n < 3) { std::fill(out, out + n, 0.f); return; }
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+        const Vec3d a = toD(points[i]) - toD(points[i - 1]);
+        const Vec3d b = toD(points[i + 1]) - toD(points[i]);
+        const double denom = a.length() * b.length() * (a + b).length();
+        out[i] = denom > 0.0 ? float(2.0 * a.cross(b).length() / denom) : 0.f;
+    }
+    out[0] = out[1];
+    out[n - 1] = out[n - 2];
+}
+
+void torsionProfile(const Vec3f* points, std::size_t n, float* out)
+{
+    if (n == 0) return;
+    if (n < 4) { std::fill(out, out + n, 0.f); return; }
+    // Discrete binormal at interior vertex i: unit (e_{i-1} x e_i); zero where straight.
+    std::vector<Vec3d> binormal(n, Vec3d(0.0));
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+        const Vec3d a = toD(points[i]) - toD(points[i - 1]);
+        const Vec3d b = toD(points[i + 1]) - toD(points[i]);
+        const Vec3d c = a.cross(b);
+        const double len = c.length();
+        if (len > 1e-12 * a.length() * b.length() && len > 0.0) binormal[i] = c / len;
+    }
+    // Edge i joins vertices i and i+1 (interior edges only: 1 .. n-3).
+    std::vector<double> edgeTorsion(n - 1, 0.0);
+    for (std::size_t i = 1; i + 2 < n; ++i) {
+        const Vec3d& b0 = binormal[i];
+        const Vec3d& b1 = binormal[i + 1];
+        const Vec3d e = toD(points[i + 1]) - toD(points[i]);
+        const double len = e.length();
+        if (b0.lengthSqr() == 0.0 || b1.lengthSqr() == 0.0 || len == 0.0) continue;
+        const double angle = std::atan2(b0.cross(b1).dot(e / len), b0.dot(b1));
+        edgeTorsion[i] = angle / len;
+    }
+    for (std::size_t i = 2; i + 2 < n; ++i) {
+        out[i] = float(0.5 * (edgeTorsion[i - 1] + edgeTorsion[i]));
+    }
+    out[1] = float(edgeTorsion[1]);
+    out[n - 2] = float(edgeTorsion[n - 3]);
+    out[0] = out[1];
+    out[n - 1] = out[n - 2];
+}
+
+StrandSummary summarizeStrands(const StrandSet& strands)
+{
+    StrandSummary s;
+    s.strands = strands.numStrands();
+    s.vertices = strands.numVertices();
+    s.bbox = computeBBox(strands);
+    if (s.strands == 0) return s;
+    const std::vector<float> lengths = strandLengths(strands);
+    s.length.min = s.verticesPerStrand.min = std::numeric_limits<double>::max();
+    s.length.max = s.verticesPerStrand.max = -std::numeric_limits<double>::max();
+    double lenSum = 0.0;
+    for (std::size_t i = 0; i < s.strands; ++i) {  // fixed order: deterministic sums
+        const double len = lengths[i], nv = double(strands.size(i));
+        lenSum += len;
+        s.length.min = std::min(s.length.min, len);
+        s.length.max = std::max(s.length.max, len);
+        s.verticesPerStrand.min = std::min(s.verticesPerStrand.min, nv);
+        s.verticesPerStrand.max = std::max(s.verticesPerStrand.max, nv);
+    }
+    s.length.mean = lenSum / double(s.strands);
+    s.verticesPerStrand.mean = double(s.vertices) / double(s.strands);
+    return s;
+}
+
+} // namespace vdbhair

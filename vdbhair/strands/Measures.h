@@ -1,0 +1,67 @@
+/// @file Measures.h
+/// @brief Discrete differential measures of polylines: arc length, unit tangents, curvature,
+/// torsion, and a whole-hairstyle summary.
+///
+/// The estimators are chosen to be exact on circles and second-order accurate on smooth curves
+/// (tested against a helix of radius r and pitch c: curvature r/(r²+c²), torsion c/(r²+c²)):
+/// - tangent at a vertex: the tangent of the circle through it and its two neighbours;
+/// - curvature: the inverse radius of that circle, 2|a×b| / (|a||b||a+b|);
+/// - torsion on an edge: the signed angle between the discrete binormals of its end vertices
+///   (right-handed positive) over the edge length; at a vertex, the mean of its two edges.
+/// All are second-order accurate in the sampling step (tested). Torsion is a third difference
+/// of positions and amplifies their float rounding and any capture noise: on finely sampled or
+/// noisy strands, resample (Resample.h) to a coarser spacing before reading torsion.
+#pragma once
+
+#include <vdbhair/Types.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <cstddef>
+#include <vector>
+
+namespace vdbhair {
+
+/// @brief Length of a polyline of @a n points (world units), summed in double precision.
+double polylineLength(const Vec3f* points, std::size_t n);
+
+/// @brief Cumulative arc length at each vertex: #n values, the first 0, the last the length.
+void arcLengths(const Vec3f* points, std::size_t n, double* out);
+
+/// @brief Length of every strand (#S values, world units); parallel over strands.
+std::vector<float> strandLengths(const StrandSet& strands);
+
+/// @brief Unit tangent at each of the @a n points (root to tip), written to @a out.
+/// Repeated points are skipped over; a polyline of zero length gets zero tangents.
+void computeTangents(const Vec3f* points, std::size_t n, Vec3f* out);
+
+/// @brief Unit tangent at every vertex of every strand (#V values); parallel over strands.
+std::vector<Vec3f> computeTangents(const StrandSet& strands);
+
+/// @brief Curvature (1 / world units) at each of the @a n points; endpoints copy their
+/// neighbour. A polyline of two points has curvature 0.
+void curvatureProfile(const Vec3f* points, std::size_t n, float* out);
+
+/// @brief Signed torsion (1 / world units) at each of the @a n points; 0 where the binormal is
+/// undefined (straight parts), endpoints copy their neighbour.
+void torsionProfile(const Vec3f* points, std::size_t n, float* out);
+
+/// @brief min / mean / max of a quantity over strands.
+struct RangeStats
+{
+    double min = 0.0, mean = 0.0, max = 0.0;
+};
+
+/// @brief The summary `vdbhair info` prints for strands.
+struct StrandSummary
+{
+    std::size_t strands = 0;
+    std::size_t vertices = 0;
+    BBox bbox;
+    RangeStats length;             ///< world units
+    RangeStats verticesPerStrand;
+};
+
+/// @brief Counts, bounding box and the ranges of strand length and vertices per strand.
+StrandSummary summarizeStrands(const StrandSet& strands);
+
+} // namespace vdbhair

@@ -1,0 +1,132 @@
+#include "Resample.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace vdbhair {
+
+namespace {
+
+/// For each of @a count equally spaced arc lengths, the segment index and the fraction along it.
+void arcParameters(const Vec3f* points, std::size_t n, std::size_t count,
+                   std::vector<std::size_t>& seg, std::vector<float>& frac)
+{
+    std::vector<double> s(n);
+    arcLengths(points, n, s.data());
+    const double total = s[n - 1];
+    seg.resize(count);
+    frac.resize(count);
+    std::size_t j = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+        const double target = (k + 1 == count) ? total : total * double(k) / double(count - 1);
+        while (j + 2 < n && s[j + 1] < target) ++j;
+        const double len = s[j + 1] - s[j];
+        double f = len > 0.0 ? (target - s[j]) / len : 0.0;
+        if (k + 1 == count) f = (total > 0.0) ? 1.0 : 0.0;
+        seg[k] = j;
+        frac[k] = float(std::min(1.0, std::max(0.0, f)));
+    }
+    if (total == 0.0) {  // zero length: every sample is the root
+        std::fill(seg.begin(), seg.end(), std::size_t(0));
+        std::fill(frac.begin(), frac.end(), 0.f);
+    }
+}
+
+template<typename T>
+T lerp(const T& a, const T& b, float f) { return a + (b - a) * f; }
+
+StrandSet resampleWithCounts(const StrandSet& in, const std::vector<std::uint32_t>& offsets)
+{
+    StrandSet out;
+    out.defaults = in.defaults;
+    out.offsets = offsets;
+    const std::size_t nV = offsets.back();
+    out.positions.resize(nV);
+    if (!in.thickness.empty()) out.thickness.resize(nV);
+    if (!in.transparency.empty()) out.transparency.resize(nV);
+    if (!in.color.empty()) out.color.resize(nV);
+    out.rootUV = in.rootUV;
+    out.strandId = in.strandId;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, in.numStrands(), 64),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            std::vector<std::size_t> seg;
+            std::vector<float> frac;
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const std::size_t count = out.size(i), b = in.begin(i), ob = out.begin(i);
+                arcParameters(in.data(i), in.size(i), count, seg, frac);
+                for (std::size_t k = 0; k < count; ++k) {
+                    const std::size_t v0 = b + seg[k], v1 = v0 + 1;
+                    const float f = frac[k];
+                    out.positions[ob + k] = lerp(in.positions[v0], in.positions[v1], f);
+                    if (!in.thickness.empty()) out.thickness[ob + k] = lerp(in.thickness[v0], in.thickness[v1], f);
+                    if (!in.transparency.empty()) out.transparency[ob + k] = lerp(in.transparency[v0], in.transparency[v1], f);
+                    if (!in.color.empty()) out.color[ob + k] = lerp(in.color[v0], in.color[v1], f);
+                }
+                out.positions[ob] = in.positions[b];  // the root stays exactly where it was
+            }
+        });
+    return out;
+}
+
+} // namespace
+
+void resamplePolyline(const Vec3f* points, std::size_t n, std::size_t count, Vec3f* out)
+{
+    if (count == 0 || n == 0) return;
+    if (n == 1 || count == 1) {
+        std::fill(out, out + count, points[0]);
+        return;
+    }
+    std::vector<std::size_t> seg;
+    std::vector<float> frac;
+    arcParameters(points, n, count, seg, frac);
+    for (std::size_t k = 0; k < count; ++k) out[k] = lerp(points[seg[k]], points[seg[k] + 1], frac[k]);
+    out[0] = points[0];
+}
+
+StrandSet resampleStrands(const StrandSet& strands, std::size_t verticesPerStrand)
+{
+    if (verticesPerStrand < 2) {
+        throw ValueError("resampleStrands: " + std::to_string(verticesPerStrand) +
+                         " vertices per strand requested; a strand needs at least 2");
+    }
+    const std::size_t total = strands.numStrands() * verticesPerStrand;
+    if (total > std::numeric_limits<std::uint32_t>::max()) {
+        throw ValueError("resampleStrands: " + std::to_string(total) +
+                         " vertices would exceed the limit of 2^32-1");
+    }
+    std::vector<std::uint32_t> offsets(strands.numStrands() + 1);
+    for (std::size_t i = 0; i < offsets.size(); ++i) offsets[i] = std::uint32_t(i * verticesPerStrand);
+    return resampleWithCounts(strands, offsets);
+}
+
+StrandSet resampleStrandsBySpacing(const StrandSet& strands, float spacing, std::size_t maxVertices)
+{
+    if (!(spacing > 0.f) || !std::isfinite(spacing)) {
+        throw ValueError("resampleStrandsBySpacing: spacing " + std::to_string(spacing) +
+                         " must be a positive finite length");
+    }
+    const std::vector<float> lengths = strandLengths(strands);
+    std::vector<std::uint32_t> offsets(strands.numStrands() + 1, 0);
+    std::size_t total = 0;
+    for (std::size_t i = 0; i < lengths.size(); ++i) {
+        const double n = std::max(2.0, std::round(double(lengths[i]) / spacing) + 1.0);
+        total += std::size_t(std::min(n, double(maxVertices) + 1.0));
+        if (total > maxVertices || total > std::numeric_limits<std::uint32_t>::max()) {
+            throw LimitError("resampleStrandsBySpacing: spacing " + std::to_string(spacing) +
+                             " would give more than " + std::to_string(maxVertices) + " vertices");
+        }
+        offsets[i + 1] = std::uint32_t(total);
+    }
+    return resampleWithCounts(strands, offsets);
+}
+
+} // namespace vdbhair
