@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Writes the inputs of the command-line tests into $2 using the vdbhair binary $1:
+# good files made by vdbhair itself and bad files, one per kind of error.
+set -eu
+bin="$1"; dir="$2"; src="$3"
+rm -rf "$dir"; mkdir -p "$dir"; cd "$dir"
+"$bin" convert "$src/scenes/default/ponytail.hair" good.hair --resample 8 --quiet
+"$bin" convert good.hair good.vdb --quiet
+"$bin" convert good.hair good.data --quiet
+"$bin" convert good.hair good.obj --quiet
+cp good.hair existing.hair
+# Bad inputs, one rule each.
+{ printf 'HAIX'; head -c 124 /dev/zero; } > bad_magic.hair
+head -c 200 good.hair > truncated.hair
+printf '\xff\xff\xff\x7f' > huge_count.data
+printf 'v 0 nan 0\nv 1 1 1\nl 1 2\n' > nan.obj
+printf 'v 0 0 0\nv 1 1 1\nl 1 5\n' > bad_index.obj
+printf 'this is not a vdb file\n' > not_a.vdb
+printf 'ply\nformat binary_big_endian 1.0\nend_header\n' > big_endian.ply
+{ printf '\x00\x00\x18\x41'; head -c 400 /dev/zero; } > version9.tfx
+printf 'some text\n' > unknown.abc
+: > empty.obj
+# A .vdb written by another OpenVDB client (pyopenvdb) without a strands grid.
+/usr/bin/python3 -c "import pyopenvdb as vdb; g = vdb.FloatGrid(); g.name = 'density'; g.fill((0, 0, 0), (3, 3, 3), 1.0); vdb.write('density.vdb', grids=[g])"
