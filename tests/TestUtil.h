@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -123,10 +124,12 @@ inline void requireSameStrands(const StrandSet& a, const StrandSet& b, float tol
 } // namespace vdbhair::test
 
 /// Skip the rest of a test case, saying so, when the shared real data is not available.
+/// ctest reports such a case as skipped (SKIP_REGULAR_EXPRESSION "SKIPPED:" in tests/CMakeLists.txt).
 #define VDBHAIR_REQUIRE_SHARED_DATA()                                                          \
     do {                                                                                       \
         if (vdbhair::test::sharedData().empty()) {                                             \
-            WARN("skipped: the shared real data (../shared/data) is not available here");     \
+            std::cout << "SKIPPED: the shared real data (../shared/data) is not available\n";  \
+            WARN("SKIPPED: the shared real data (../shared/data) is not available");           \
             return;                                                                            \
         }                                                                                      \
     } while (0)
