@@ -2,6 +2,8 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/io/StrandIO.h>
 
 #include <openvdb/Exceptions.h>
 #include <tbb/global_control.h>
@@ -26,6 +28,49 @@ void printWarnings(const std::string& verb, const ReadReport& report, const Comm
 
 void printJson(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 
+StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict)
+{
+    ReadOptions opts;
+    if (strict) opts.shortStrands = ShortStrandPolicy::Reject;
+    ReadReport report;
+    StrandSet strands = readStrands(path, opts, &report);
+    printWarnings(verb, report, common);
+    if (strands.empty()) throw FormatError(path + ": the file has no strands");
+    return strands;
+}
+
+void addScalpOptions(CLI::App* sub, ScalpOptions& opts)
+{
+    sub->add_option("--space", opts.space, "Grid space: world (default; any hairstyle) or scalp (Wang et al.'s (u,v,w); hair over the scalp)")
+        ->capture_default_str();
+    sub->add_option("--scalp", opts.sphere, "Scalp sphere for --space scalp: CX,CY,CZ,R in world units (default: fitted to the roots)")
+        ->delimiter(',')->expected(4);
+    sub->add_option("--up", opts.up, "The scalp's up axis for --space scalp: x, y, z, -x, -y or -z")->capture_default_str();
+}
+
+void applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params)
+{
+    params.space = fieldSpaceFromName(opts.space);
+    Vec3d up(0.0);
+    const std::string axis = opts.up.size() == 2 && opts.up[0] == '-' ? opts.up.substr(1) : opts.up;
+    const double sign = opts.up.size() == 2 && opts.up[0] == '-' ? -1.0 : 1.0;
+    if (axis == "x") up = Vec3d(sign, 0.0, 0.0);
+    else if (axis == "y") up = Vec3d(0.0, sign, 0.0);
+    else if (axis == "z") up = Vec3d(0.0, 0.0, sign);
+    else throw ValueError("--up '" + opts.up + "' is not one of x, y, z, -x, -y, -z");
+    if (params.space != FieldSpace::Scalp) return;
+    if (opts.sphere.empty()) {
+        std::vector<Vec3f> roots;
+        for (std::size_t i = 0; i < strands.numStrands(); ++i) roots.push_back(strands.root(i));
+        params.scalp = fitScalpSphere(roots, up);
+    } else {
+        if (opts.sphere.size() != 4 || !(opts.sphere[3] > 0.0)) throw ValueError("--scalp needs CX,CY,CZ,R with R > 0");
+        params.scalp.center = Vec3d(opts.sphere[0], opts.sphere[1], opts.sphere[2]);
+        params.scalp.radius = opts.sphere[3];
+        params.scalp.up = up;
+    }
+}
+
 int run(int argc, char** argv)
 {
     CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
@@ -40,6 +85,9 @@ int run(int argc, char** argv)
     std::vector<Command> commands;
     commands.push_back(addInfoCommand(app, common));
     commands.push_back(addConvertCommand(app, common));
+    commands.push_back(addFieldCommand(app, common));
+    commands.push_back(addRetraceCommand(app, common));
+    commands.push_back(addRefineCommand(app, common));
     commands.push_back(addDemoCommand(app, common));
 
     std::string verb = "";

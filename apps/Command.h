@@ -8,12 +8,17 @@
 #include <nlohmann/json.hpp>
 
 #include <vdbhair/io/ReadOptions.h>
+#include <vdbhair/strands/StrandSet.h>
 
 #include <functional>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
+
+namespace vdbhair {
+struct FieldParams;
+}
 
 namespace vdbhair::app {
 
@@ -41,10 +46,30 @@ void printWarnings(const std::string& verb, const ReadReport& report, const Comm
 /// @brief Print @a j on stdout as one line.
 void printJson(const nlohmann::json& j);
 
+/// @brief Read strands from any supported file, printing the reader's warnings for @a verb.
+/// @param strict reject strands of fewer than two vertices instead of dropping them
+StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common,
+                      bool strict = false);
+
+/// @brief The scalp sphere options of `field` and `refine` (`--space scalp`).
+struct ScalpOptions
+{
+    std::string space = "world";
+    std::vector<double> sphere;  ///< cx, cy, cz, r; empty: fit to the roots
+    std::string up = "y";
+};
+void addScalpOptions(CLI::App* sub, ScalpOptions& opts);
+/// @brief Fill @a params' space and scalp from @a opts (fitting the sphere to the roots if needed).
+/// @throw ValueError for a bad space, sphere or up axis.
+void applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params);
+
 // One function per subcommand file, each returning the registered command.
 Command addInfoCommand(CLI::App& app, CommonOptions& common);
 Command addConvertCommand(CLI::App& app, CommonOptions& common);
 Command addDemoCommand(CLI::App& app, CommonOptions& common);
+Command addFieldCommand(CLI::App& app, CommonOptions& common);
+Command addRetraceCommand(CLI::App& app, CommonOptions& common);
+Command addRefineCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line.

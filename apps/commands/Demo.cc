@@ -1,10 +1,15 @@
-// vdbhair demo [SCENE] -o DIR: the README's main job on the bundled default hairstyle.
-#include "../Command.h"
+// vdbhair demo SCENE -o DIR: the README's main job: refine the bundled hairstyle through its own
+// tangent field and write the strands, the field and the report into one folder.
+#include "../RefineOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbStrandGrid.h>
 #include <vdbhair/strands/Measures.h>
 
+#include <chrono>
 #include <filesystem>
 
 namespace vdbhair::app {
@@ -13,32 +18,57 @@ namespace {
 
 struct DemoParams
 {
-    std::string scene;
     std::string outDir = "vdbhair-demo";
+    RefineCmdParams refine;
 };
 
 int runDemo(const DemoParams& p, const CommonOptions& common)
 {
     namespace fs = std::filesystem;
-    ReadReport report;
-    const StrandSet strands = readStrands(p.scene, {}, &report);
-    printWarnings("demo", report, common);
-    if (strands.empty()) throw FormatError(p.scene + ": the scene has no strands");
+    const auto t0 = std::chrono::steady_clock::now();
+    const StrandSet strands = loadStrands("demo", p.refine.input, common);
+    const RefineParams rp = refineParamsFrom(p.refine, strands);
     std::error_code ec;
     fs::create_directories(p.outDir, ec);
     if (ec) throw IoError(p.outDir + ": cannot create the output folder: " + ec.message());
 
+    const RefineResult r = refineStrands(strands, rp);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    const std::string dir = p.outDir;
+    const std::string refinedPath = (fs::path(dir) / "refined.hair").string();
+    const std::string fieldPath = (fs::path(dir) / "field.vdb").string();
+    const std::string strandsPath = (fs::path(dir) / "strands.vdb").string();
+    const std::string reportPath = (fs::path(dir) / "report.json").string();
+    writeStrands(refinedPath, r.strands);
+    writeVdbGrids(fieldPath, fieldGrids(r), "demo(" + fieldPath + ")");
+    {
+        // The input and refined strands as points grids, for side-by-side viewing in Houdini/Blender.
+        auto before = createStrandGrid(strands);
+        before->setName("strands_input");
+        auto after = createStrandGrid(r.strands);
+        writeVdbGrids(strandsPath, {after, before}, "demo(" + strandsPath + ")");
+    }
     const StrandSummary s = summarizeStrands(strands);
-    const std::string vdbPath = (fs::path(p.outDir) / "strands.vdb").string();
-    writeStrands(vdbPath, strands);
+    nlohmann::json report = refineReportJson(r, rp);
+    report["scene"] = p.refine.input;
+    report["vertices"] = s.vertices;
+    report["seconds"] = seconds;
+    report["outputs"] = {refinedPath, fieldPath, strandsPath, reportPath};
+    writeFileAtomic(reportPath, report.dump(2) + "\n", "demo(" + reportPath + ")");
+
     if (common.json) {
-        printJson({{"scene", p.scene}, {"strands", s.strands}, {"vertices", s.vertices},
-                   {"length", {{"min", s.length.min}, {"mean", s.length.mean}, {"max", s.length.max}}},
-                   {"outputs", {vdbPath}}});
+        printJson(report);
     } else {
-        std::cout << "scene " << p.scene << ": " << s.strands << " strands, " << s.vertices << " vertices, "
-                  << "length " << s.length.min << " .. " << s.length.max << " (mean " << s.length.mean << ")\n"
-                  << "wrote " << vdbPath << " (OpenVDB points grid 'strands'; open it in Houdini or Blender)\n";
+        std::cout << "scene " << p.refine.input << ": " << s.strands << " strands, " << s.vertices << " vertices, length "
+                  << s.length.min << " .. " << s.length.max << " (mean " << s.length.mean << ")\n"
+                  << "refined through its own tangent field (" << rp.levels << " level(s), finest voxel size " << r.voxelSize
+                  << ", " << rp.field.iterations << " iterations of Wang et al. Eq. 9) in " << seconds << " s\n";
+        printTraceReport(r.stats, r.angleBefore, r.angleAfter, r.meanDisplacement);
+        std::cout << "wrote " << refinedPath << " (refined strands)\n"
+                  << "wrote " << fieldPath << " (grids 'tangent' and 'density')\n"
+                  << "wrote " << strandsPath << " (points grids 'strands' and 'strands_input', for Houdini or Blender)\n"
+                  << "wrote " << reportPath << "\n";
     }
     return 0;
 }
@@ -48,10 +78,12 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
 Command addDemoCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<DemoParams>();
-    CLI::App* sub = app.add_subcommand("demo", "Run the main job on a hairstyle and write every result into one folder");
-    sub->add_option("scene", params->scene, "The hairstyle (the README passes the bundled default)")->required();
+    CLI::App* sub = app.add_subcommand("demo", "The main job: refine a hairstyle through its own tangent field, all results in one folder");
+    sub->add_option("scene", params->refine.input, "The hairstyle (the README passes the bundled default)")->required();
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing)")->capture_default_str();
+    addRefineOptions(sub, params->refine);
     addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair demo scenes/default/ponytail.hair -o out --levels 2");
     return {sub, [params, &common] { return runDemo(*params, common); }};
 }
 

@@ -53,9 +53,11 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
     double voxelSize = opts.voxelSize;
     if (voxelSize == 0.0) {
         voxelSize = pts::computeVoxelSize(positions, std::max(1u, opts.pointsPerVoxel));
+        voxelSize = std::max(voxelSize, 2e-5);  // OpenVDB's smallest (its transforms refuse less)
     }
-    if (!(voxelSize > 0.0) || !std::isfinite(voxelSize)) {
-        throw ValueError(where + ": voxel size " + std::to_string(voxelSize) + " must be a positive finite length");
+    if (!(voxelSize >= 2e-5) || !std::isfinite(voxelSize)) {
+        throw ValueError(where + ": voxel size " + std::to_string(voxelSize) +
+                         " must be a finite length of at least 2e-5 (OpenVDB's smallest)");
     }
     const openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(voxelSize);
     const openvdb::tools::PointIndexGrid::Ptr index =

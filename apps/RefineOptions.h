@@ -1,0 +1,37 @@
+/// @file RefineOptions.h
+/// @brief What `refine` and `demo` share: the refinement options and their reports
+/// (defined in commands/Refine.cc and commands/Retrace.cc).
+#pragma once
+
+#include "Command.h"
+
+#include <vdbhair/field/Refine.h>
+
+#include <openvdb/Grid.h>
+
+namespace vdbhair::app {
+
+struct RefineCmdParams
+{
+    std::string input, output, saveField;
+    double voxelSize = -1.0;  ///< < 0: not given
+    int levels = 1, iterations = 2;
+    double step = -1.0;       ///< < 0: not given
+    std::string integrator = "euler";
+    int margin = 2;
+    std::uint64_t maxVoxels = std::uint64_t(1) << 26;
+    bool strict = false;
+    ScalpOptions scalp;
+};
+
+void addRefineOptions(CLI::App* sub, RefineCmdParams& p);
+/// @throw ValueError for out-of-range options.
+RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands);
+openvdb::GridCPtrVec fieldGrids(const RefineResult& r);
+nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp);
+
+/// The report of retrace and refine: {"strands","full_length","stopped":{...},"tangent_angle_deg":{...},"mean_displacement"}.
+nlohmann::json traceReportJson(const TraceStats& s, double before, double after, double displacement);
+void printTraceReport(const TraceStats& s, double before, double after, double displacement);
+
+} // namespace vdbhair::app

@@ -1,0 +1,102 @@
+// vdbhair field IN -o OUT.vdb: strands to the robust tangent field (Wang et al. 2009, Eq. 9).
+#include "../Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbStrandGrid.h>
+
+#include <chrono>
+
+namespace vdbhair::app {
+
+namespace {
+
+struct FieldCmdParams
+{
+    std::string input, output;
+    double voxelSize = -1.0;  ///< < 0: not given
+    int iterations = 2;
+    int levels = 1;
+    std::uint64_t maxVoxels = std::uint64_t(1) << 26;
+    bool withStrands = false;
+    bool strict = false;
+    ScalpOptions scalp;
+};
+
+int runField(const FieldCmdParams& p, const CommonOptions& common)
+{
+    if (p.output.empty()) throw ValueError("needs an output: -o OUT.vdb");
+    if (fileExtension(p.output) != ".vdb") throw ValueError(p.output + ": the field is written as OpenVDB; the output must end in .vdb");
+    if (p.voxelSize != -1.0 && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
+        throw ValueError("--voxel-size " + std::to_string(p.voxelSize) + ": must be a positive finite length");
+    }
+    if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
+    if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");
+
+    const StrandSet strands = loadStrands("field", p.input, common, p.strict);
+    FieldParams fp;
+    fp.voxelSize = p.voxelSize > 0.0 ? p.voxelSize : suggestVoxelSize(strands);
+    fp.iterations = p.iterations;
+    fp.maxVoxels = p.maxVoxels;
+    applyScalpOptions(p.scalp, strands, fp);
+
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<TangentField> fields = estimateTangentFieldLevels(strands, fp, p.levels);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    openvdb::GridCPtrVec grids;
+    nlohmann::json gridsJson = nlohmann::json::array();
+    for (const TangentField& f : fields) {
+        for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density)}) {
+            g->insertMeta("vdbhair:source", openvdb::StringMetadata(p.input));
+            grids.push_back(g);
+            gridsJson.push_back({{"name", g->getName()}, {"voxel_size", g->voxelSize().x()}, {"active_voxels", g->activeVoxelCount()}});
+        }
+    }
+    if (p.withStrands) grids.push_back(createStrandGrid(strands));
+    writeVdbGrids(p.output, grids, "field(" + p.output + ")");
+
+    if (common.json) {
+        nlohmann::json j = {{"output", p.output}, {"strands", strands.numStrands()}, {"voxel_size", fp.voxelSize},
+                            {"iterations", fp.iterations}, {"levels", p.levels}, {"space", fieldSpaceName(fp.space)},
+                            {"grids", gridsJson}, {"seconds", seconds}};
+        if (fp.space == FieldSpace::Scalp) {
+            j["scalp"] = {{"center", {fp.scalp.center.x(), fp.scalp.center.y(), fp.scalp.center.z()}}, {"radius", fp.scalp.radius}};
+        }
+        printJson(j);
+    } else if (!common.quiet) {
+        std::cout << "field of " << strands.numStrands() << " strands, voxel size " << fp.voxelSize << " ("
+                  << fieldSpaceName(fp.space) << " space), " << fp.iterations << " iteration(s), " << p.levels << " level(s):\n";
+        for (const auto& g : gridsJson) {
+            std::cout << "  " << g["name"].get<std::string>() << ": " << g["active_voxels"].get<std::uint64_t>()
+                      << " active voxels of size " << g["voxel_size"].get<double>() << "\n";
+        }
+        std::cout << "wrote " << p.output << "\n";
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addFieldCommand(CLI::App& app, CommonOptions& common)
+{
+    auto params = std::make_shared<FieldCmdParams>();
+    CLI::App* sub = app.add_subcommand("field", "Estimate the robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9) as VDB grids");
+    sub->add_option("input", params->input, "Strand file")->required();
+    sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent' and 'density' (or *_level_<l>)")->required();
+    sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: twice the mean segment length)");
+    sub->add_option("--iterations", params->iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
+    sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
+    sub->add_option("--max-voxels", params->maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
+    sub->add_flag("--with-strands", params->withStrands, "Also write the strands as the points grid 'strands'");
+    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addScalpOptions(sub, params->scalp);
+    addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair field hair.hair -o field.vdb --voxel-size 0.5 --levels 3");
+    return {sub, [params, &common] { return runField(*params, common); }};
+}
+
+} // namespace vdbhair::app

@@ -1,0 +1,113 @@
+// vdbhair retrace IN --field F.vdb -o OUT: every strand restarts at its root and follows the field.
+#include "../RefineOptions.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/StreamlineTracer.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/io/VdbFile.h>
+
+#include <openvdb/openvdb.h>
+
+#include <cmath>
+
+namespace vdbhair::app {
+
+/// The JSON report of retrace and refine (the schema).
+nlohmann::json traceReportJson(const TraceStats& s, double before, double after, double displacement)
+{
+    return {{"strands", s.strands},
+            {"full_length", s.fullLength},
+            {"stopped", {{"vanished", s.vanished}, {"left_field", s.leftField}, {"max_steps", s.maxSteps}}},
+            {"tangent_angle_deg", {{"before", before}, {"after", after}}},
+            {"mean_displacement", displacement}};
+}
+
+void printTraceReport(const TraceStats& s, double before, double after, double displacement)
+{
+    std::cout << "retraced " << s.strands << " strands: " << s.fullLength << " full length, " << s.vanished
+              << " stopped where the field vanished, " << s.leftField << " left the field, " << s.maxSteps
+              << " hit the step limit (" << s.steps << " steps)\n"
+              << "mean angle between strand tangents and the field: " << before << " deg before, " << after << " deg after\n"
+              << "mean vertex displacement: " << displacement << "\n";
+}
+
+namespace {
+
+struct RetraceParams
+{
+    std::string input, output, field, grid = "tangent";
+    double step = -1.0;
+    std::string integrator = "euler", vertices = "input";
+    double vanish = 1e-3;
+    std::size_t maxSteps = 0;
+    int margin = 2;
+    bool strict = false;
+};
+
+int runRetrace(const RetraceParams& p, const CommonOptions& common)
+{
+    TraceParams tp;
+    tp.integrator = integratorFromName(p.integrator);
+    if (p.step != -1.0 && (!(p.step > 0.0) || !std::isfinite(p.step))) {
+        throw ValueError("--step " + std::to_string(p.step) + ": must be a positive finite length");
+    }
+    tp.step = p.step > 0.0 ? p.step : 0.0;
+    if (!(p.vanish >= 0.0 && p.vanish < 1.0)) throw ValueError("--vanish " + std::to_string(p.vanish) + ": must be in [0, 1)");
+    tp.vanishThreshold = p.vanish;
+    tp.maxSteps = p.maxSteps;
+    if (p.margin < 0 || p.margin > 16) throw ValueError("--margin " + std::to_string(p.margin) + ": must be between 0 and 16 voxels");
+    tp.margin = p.margin;
+    if (p.vertices == "input") tp.vertices = RetraceVertices::Input;
+    else if (p.vertices == "steps") tp.vertices = RetraceVertices::Steps;
+    else throw ValueError("--vertices '" + p.vertices + "' is not one of input, steps");
+    strandFormatFromPath(p.output, /*forWriting=*/true);
+
+    const openvdb::GridBase::Ptr grid = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
+    if (!grid->isType<openvdb::Vec3SGrid>() && !grid->isType<openvdb::Vec3DGrid>()) {
+        throw TypeError(p.field + ": grid '" + p.grid + "' holds " + grid->valueType() +
+                        " values; retrace needs a vector grid (vec3s or vec3d), such as 'tangent'");
+    }
+    const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
+
+    TraceStats stats;
+    const StrandSet out = retraceStrands(strands, *grid, tp, &stats);
+    const double before = meanTangentAngleDeg(strands, *grid);
+    const double after = meanTangentAngleDeg(out, *grid);
+    const double disp = meanVertexDisplacement(strands, out);
+    writeStrands(p.output, out);
+    if (common.json) {
+        nlohmann::json j = traceReportJson(stats, before, after, disp);
+        j["output"] = p.output;
+        j["step"] = resolveStep(*grid, tp);
+        j["integrator"] = integratorName(tp.integrator);
+        printJson(j);
+    } else if (!common.quiet) {
+        printTraceReport(stats, before, after, disp);
+        std::cout << "wrote " << p.output << "\n";
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addRetraceCommand(CLI::App& app, CommonOptions& common)
+{
+    auto params = std::make_shared<RetraceParams>();
+    CLI::App* sub = app.add_subcommand("retrace", "Retrace every strand through a vector field from its root, for its own length");
+    sub->add_option("input", params->input, "Strand file (roots, lengths and vertex spacing to follow)")->required();
+    sub->add_option("--field", params->field, "A .vdb file holding the field")->required();
+    sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
+    sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
+    sub->add_option("--step", params->step, "Integration step in world units (default: half a voxel)");
+    sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
+    sub->add_option("--vanish", params->vanish, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
+    sub->add_option("--max-steps", params->maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
+    sub->add_option("--margin", params->margin, "Voxels past the field's active region where its direction is extrapolated (0: stop at the region, the papers' rule)")->capture_default_str();
+    sub->add_option("--vertices", params->vertices, "input: the input's vertex count and arc lengths; steps: every step")->capture_default_str();
+    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --json");
+    return {sub, [params, &common] { return runRetrace(*params, common); }};
+}
+
+} // namespace vdbhair::app

@@ -1,0 +1,219 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/field/StreamlineTracer.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <tbb/global_control.h>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+/// Concentric circles about the z axis (radii r0, r0 + dr, ...), stacked in z, sampled finely.
+StrandSet concentricCircles(double r0, double dr, int rings, int layers, double arc)
+{
+    StrandSet s;
+    for (int l = 0; l < layers; ++l) {
+        for (int k = 0; k < rings; ++k) {
+            const double r = r0 + dr * k;
+            std::vector<Vec3f> pts;
+            const int n = int(arc * r / 0.05) + 2;
+            for (int i = 0; i < n; ++i) {
+                const double a = arc * double(i) / double(n - 1);
+                pts.emplace_back(float(r * std::cos(a)), float(r * std::sin(a)), float(0.2 * l));
+            }
+            s.addStrand(pts);
+        }
+    }
+    return s;
+}
+
+/// Largest distance of any vertex of strand i from the circle of radius r about the z axis.
+double radialError(const StrandSet& s, std::size_t i, double r)
+{
+    double worst = 0.0;
+    for (std::size_t v = s.begin(i); v < s.end(i); ++v) {
+        const Vec3f p = s.positions[v];
+        worst = std::max(worst, std::abs(std::hypot(double(p.x()), double(p.y())) - r));
+    }
+    return worst;
+}
+
+} // namespace
+
+TEST_CASE("retraceStrands: a uniform field retraces straight strands exactly", "[field]")
+{
+    StrandSet s;
+    const Vec3f dir = Vec3f(0.3f, -1.f, 0.2f).unitSafe();
+    for (int i = 0; i < 6; ++i) {
+        std::vector<Vec3f> pts;
+        const Vec3f root(0.37f * float(i), 0.11f, -0.23f * float(i));
+        for (int k = 0; k < 17; ++k) pts.push_back(root + dir * (0.6f * float(k)));
+        s.addStrand(pts);
+    }
+    FieldParams p;
+    p.voxelSize = 0.4;
+    const TangentField f = estimateTangentField(s, p);
+    for (Integrator integ : {Integrator::Euler, Integrator::RK2, Integrator::RK4}) {
+        TraceParams tp;
+        tp.integrator = integ;
+        TraceStats stats;
+        const StrandSet r = retraceStrands(s, *f.tangent, tp, &stats);
+        CAPTURE(integratorName(integ));
+        REQUIRE(stats.fullLength == s.numStrands());
+        test::requireSameStrands(s, r, 2e-5f);
+        REQUIRE(meanVertexDisplacement(s, r) < 1e-5);
+        REQUIRE(meanTangentAngleDeg(r, *f.tangent) < 1e-2);
+    }
+}
+
+TEST_CASE("retraceStrands: concentric circles stay on their circles, RK4 closer than Euler, error falling with the step", "[field]")
+{
+    const StrandSet circles = concentricCircles(3.0, 0.25, 13, 3, 1.5 * M_PI);
+    FieldParams p;
+    p.voxelSize = 0.2;
+    const TangentField f = estimateTangentField(circles, p);
+    auto worst = [&](Integrator integ, double step) {
+        TraceParams tp;
+        tp.integrator = integ;
+        tp.step = step;
+        TraceStats stats;
+        const StrandSet r = retraceStrands(circles, *f.tangent, tp, &stats);
+        REQUIRE(stats.fullLength == circles.numStrands());
+        double e = 0.0;
+        // The middle layer, away from the hair volume's top and bottom faces.
+        for (std::size_t i = 13; i < 26; ++i) e = std::max(e, radialError(r, i, 3.0 + 0.25 * double(i - 13)));
+        return e;
+    };
+    const double euler1 = worst(Integrator::Euler, 0.2), euler2 = worst(Integrator::Euler, 0.1), euler3 = worst(Integrator::Euler, 0.05);
+    const double rk4 = worst(Integrator::RK4, 0.1);
+    CAPTURE(euler1, euler2, euler3, rk4);
+    // Forward Euler on a circle spirals out: each step of length h adds h²/2r to the radius, so
+    // after an arc of angle theta the radius has grown by theta·h/2, whatever the radius. Stated
+    // tolerance: within 10% of that plus 0.01 for the field's discretization, and first order
+    // (halving the step halves the error). RK4 stays within 0.5% of the smallest radius.
+    const double theta = 1.5 * M_PI;
+    REQUIRE(euler1 < 1.1 * theta * 0.2 / 2 + 0.01);
+    REQUIRE(euler2 < 1.1 * theta * 0.1 / 2 + 0.01);
+    REQUIRE(euler3 < 1.1 * theta * 0.05 / 2 + 0.01);
+    REQUIRE(euler1 / euler2 == Approx(2.0).epsilon(0.1));
+    REQUIRE(euler2 / euler3 == Approx(2.0).epsilon(0.1));
+    REQUIRE(rk4 < 0.005 * 3.0);
+    REQUIRE(rk4 < euler3 / 10);
+}
+
+TEST_CASE("retraceStrands: every stop reason is counted", "[field]")
+{
+    // A field made of one short strand along x.
+    StrandSet shortOne;
+    shortOne.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(2.f, 0.f, 0.f)});
+    FieldParams p;
+    p.voxelSize = 0.5;
+    const TangentField f = estimateTangentField(shortOne, p);
+    StrandSet longOne;
+    longOne.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(5.f, 0.f, 0.f), Vec3f(10.f, 0.f, 0.f)});
+
+    TraceParams tp;
+    tp.margin = 0;
+    TraceStats stats;
+    std::vector<StopReason> reasons;
+    StrandSet r = retraceStrands(longOne, *f.tangent, tp, &stats, &reasons);
+    REQUIRE(stats.leftField == 1);
+    REQUIRE(reasons[0] == StopReason::LeftField);
+    // It keeps what it traced: the root, then the point where it stopped, past the field's end.
+    REQUIRE(r.size(0) == 2);
+    REQUIRE(r.tip(0).x() == Approx(2.5).margin(0.25));
+
+    tp.margin = 2;  // extrapolated two voxels further
+    r = retraceStrands(longOne, *f.tangent, tp, &stats);
+    REQUIRE(stats.leftField == 1);
+    REQUIRE(r.tip(0).x() == Approx(3.5).margin(0.25));
+
+    tp.maxSteps = 3;
+    r = retraceStrands(longOne, *f.tangent, tp, &stats, &reasons);
+    REQUIRE(stats.maxSteps == 1);
+    REQUIRE(r.tip(0).x() == Approx(0.75));
+
+    // Opposing strands cancel: the field vanishes there.
+    StrandSet opposing;
+    opposing.addStrand(std::vector<Vec3f>{Vec3f(-3.f, 0.f, 0.f), Vec3f(3.f, 0.f, 0.f)});
+    opposing.addStrand(std::vector<Vec3f>{Vec3f(3.f, 0.f, 0.f), Vec3f(-3.f, 0.f, 0.f)});
+    const TangentField g = estimateTangentField(opposing, p);
+    r = retraceStrands(opposing, *g.tangent, TraceParams{}, &stats);
+    REQUIRE(stats.vanished == 2);
+    REQUIRE(stats.fullLength == 0);
+    REQUIRE(r.numStrands() == 2);
+    REQUIRE(r.size(0) == 2);  // at least the root twice
+}
+
+TEST_CASE("retraceStrands: input vertex counts, or every step", "[field]")
+{
+    const StrandSet circles = concentricCircles(3.0, 0.5, 3, 2, 1.0);
+    FieldParams p;
+    p.voxelSize = 0.25;
+    const TangentField f = estimateTangentField(circles, p);
+    TraceParams tp;
+    TraceStats stats;
+    StrandSet r = retraceStrands(circles, *f.tangent, tp, &stats);
+    REQUIRE(r.offsets == circles.offsets);
+    tp.vertices = RetraceVertices::Steps;
+    tp.step = 0.1;
+    r = retraceStrands(circles, *f.tangent, tp, &stats);
+    REQUIRE(r.numVertices() == stats.steps + r.numStrands());
+    const std::vector<float> lin = strandLengths(circles), lout = strandLengths(r);
+    for (std::size_t i = 0; i < lin.size(); ++i) REQUIRE(lout[i] == Approx(lin[i]).epsilon(1e-4));
+}
+
+TEST_CASE("retraceStrands: bitwise identical with 1 and 2 threads", "[field]")
+{
+    const StrandSet circles = concentricCircles(2.0, 0.3, 10, 4, 4.0);
+    FieldParams p;
+    p.voxelSize = 0.3;
+    const TangentField f = estimateTangentField(circles, p);
+    StrandSet one, two;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        one = retraceStrands(circles, *f.tangent, TraceParams{});
+    }
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        two = retraceStrands(circles, *f.tangent, TraceParams{});
+    }
+    REQUIRE(one.offsets == two.offsets);
+    REQUIRE(std::memcmp(one.positions.data(), two.positions.data(), one.positions.size() * sizeof(Vec3f)) == 0);
+}
+
+TEST_CASE("retraceStrands: bad parameters and grids", "[field]")
+{
+    const StrandSet circles = concentricCircles(2.0, 0.3, 2, 1, 1.0);
+    FieldParams p;
+    p.voxelSize = 0.3;
+    const TangentField f = estimateTangentField(circles, p);
+    TraceParams tp;
+    tp.step = -1.0;
+    REQUIRE_THROWS_AS(retraceStrands(circles, *f.tangent, tp), ValueError);
+    tp.step = 0.0;
+    tp.vanishThreshold = 1.5;
+    REQUIRE_THROWS_AS(retraceStrands(circles, *f.tangent, tp), ValueError);
+    REQUIRE_THROWS_WITH(retraceStrands(circles, *f.density, TraceParams{}), Contains("holds float values; tracing needs a vector grid"));
+}
+
+TEST_CASE("refineStrands: draped long hair retraces to full length in world space", "[field][data]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string dir = test::sharedData() + "/hair/";
+    for (const char* file : {"usc_data/harolongo.data", "tressfx/ascii_v2/hair_tail_16_guide.tfx"}) {
+        CAPTURE(file);
+        const StrandSet s = readStrands(dir + file);
+        const RefineResult r = refineStrands(s, RefineParams{});
+        CAPTURE(r.voxelSize, r.stats.fullLength, r.stats.leftField, r.stats.vanished);
+        REQUIRE(double(r.stats.fullLength) >= 0.99 * double(s.numStrands()));
+        REQUIRE(r.angleAfter < r.angleBefore);
+        REQUIRE(r.strands.offsets == s.offsets);
+    }
+}

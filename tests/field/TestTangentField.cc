@@ -1,0 +1,189 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/strands/Frames.h>
+
+#include <openvdb/tools/Count.h>
+#include <tbb/global_control.h>
+
+#include <random>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+/// A bundle of parallel straight strands along @a dir, rooted on a grid in the plane through the origin.
+StrandSet parallelStrands(const Vec3f& dir, int side, float spacing, float length, std::size_t vertices)
+{
+    StrandSet s;
+    const Vec3f a = perpendicularTo(dir), b = dir.cross(a);
+    for (int i = 0; i < side; ++i) {
+        for (int j = 0; j < side; ++j) {
+            const Vec3f root = a * (float(i) * spacing) + b * (float(j) * spacing) + Vec3f(0.013f, 0.027f, 0.041f);
+            std::vector<Vec3f> pts;
+            for (std::size_t k = 0; k < vertices; ++k) pts.push_back(root + dir * (length * float(k) / float(vertices - 1)));
+            s.addStrand(pts);
+        }
+    }
+    return s;
+}
+
+} // namespace
+
+TEST_CASE("estimateTangentField: a straight parallel hairstyle gives a uniform field", "[field]")
+{
+    const Vec3f dir = Vec3f(1.f, 2.f, -0.5f).unitSafe();
+    const StrandSet s = parallelStrands(dir, 5, 0.7f, 10.f, 6);  // segments of 2 cross several voxels
+    FieldParams p;
+    p.voxelSize = 0.5;
+    const TangentField f = estimateTangentField(s, p);
+    REQUIRE(f.tangent->activeVoxelCount() > 0);
+    for (auto it = f.tangent->cbeginValueOn(); it; ++it) REQUIRE(((*it) - dir).length() < 1e-6f);
+    // Density: the total length, distributed over the voxels the strands pass.
+    double total = 0.0;
+    for (auto it = f.density->cbeginValueOn(); it; ++it) total += *it;
+    REQUIRE(total == Approx(25 * 10.0).epsilon(1e-5));
+    REQUIRE(f.tangent->activeVoxelCount() == f.density->activeVoxelCount());
+    REQUIRE(f.tangent->getName() == "tangent");
+    REQUIRE(f.density->getName() == "density");
+    REQUIRE(f.tangent->getVectorType() == openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    REQUIRE(f.density->getGridClass() == openvdb::GRID_FOG_VOLUME);
+    REQUIRE(f.tangent->metaValue<double>("vdbhair:voxel_size") == 0.5);
+    REQUIRE(f.tangent->metaValue<int>("vdbhair:iterations") == 2);
+    REQUIRE(f.tangent->metaValue<std::string>("vdbhair:space") == "world");
+}
+
+TEST_CASE("estimateTangentField: a segment marks every voxel it passes, and no other", "[field]")
+{
+    StrandSet s;
+    s.addStrand(std::vector<Vec3f>{Vec3f(0.1f, 0.2f, 0.3f), Vec3f(10.1f, 0.2f, 0.3f)});  // one segment, 11 voxels
+    FieldParams p;
+    p.voxelSize = 1.0;
+    const TangentField f = estimateTangentField(s, p);
+    REQUIRE(f.tangent->activeVoxelCount() == 11);
+    for (int i = 0; i <= 10; ++i) REQUIRE(f.tangent->tree().isValueOn(openvdb::Coord(i, 0, 0)));
+    REQUIRE(f.density->tree().getValue(openvdb::Coord(5, 0, 0)) == Approx(1.0));
+    REQUIRE(f.density->tree().getValue(openvdb::Coord(0, 0, 0)) == Approx(0.4));
+    REQUIRE_FALSE(f.tangent->tree().isValueOn(openvdb::Coord(0, 1, 0)));
+}
+
+TEST_CASE("estimateTangentField: Eq. 9 suppresses an outlier crossing a coherent bundle", "[field]")
+{
+    // A bundle along x and one strand along y through it: the voxels they share get a plain
+    // average tilted towards y; the reweighted estimate stays closer to x.
+    StrandSet s;
+    for (int k = 0; k < 4; ++k) {
+        s.addStrand(std::vector<Vec3f>{Vec3f(-5.f, 0.05f * float(k), 0.f), Vec3f(5.f, 0.05f * float(k), 0.f)});
+    }
+    s.addStrand(std::vector<Vec3f>{Vec3f(0.f, -5.f, 0.f), Vec3f(0.f, 5.f, 0.f)});
+    FieldParams plain, robust;
+    plain.voxelSize = robust.voxelSize = 1.0;
+    plain.iterations = 1;  // v1: the plain (length-weighted) average
+    robust.iterations = 2;
+    const auto vp = estimateTangentField(s, plain).tangent->tree().getValue(openvdb::Coord(0, 0, 0));
+    const auto vr = estimateTangentField(s, robust).tangent->tree().getValue(openvdb::Coord(0, 0, 0));
+    const double anglePlain = std::acos(std::min(1.f, vp.x())), angleRobust = std::acos(std::min(1.f, vr.x()));
+    CAPTURE(vp, vr, anglePlain, angleRobust);
+    // Plain average of four x and one y of equal length: atan(1/4).
+    REQUIRE(anglePlain == Approx(std::atan(0.25)).epsilon(1e-5));
+    REQUIRE(angleRobust < 0.75 * anglePlain);
+    // Eq. 9 by hand: weights 0.5(T.v1 + 1) for the 4 x and the 1 y strands.
+    const double c = std::cos(anglePlain), s1 = std::sin(anglePlain);
+    const double wx = 0.5 * (c + 1.0), wy = 0.5 * (s1 + 1.0);
+    REQUIRE(std::atan2(wy, 4.0 * wx) == Approx(angleRobust).epsilon(1e-5));
+    // And more iterations move further from the outlier.
+    FieldParams more = robust;
+    more.iterations = 5;
+    const auto v5 = estimateTangentField(s, more).tangent->tree().getValue(openvdb::Coord(0, 0, 0));
+    REQUIRE(std::acos(std::min(1.f, v5.x())) < angleRobust);
+}
+
+TEST_CASE("estimateTangentField: opposing strands cancel to a zero vector in an active voxel", "[field]")
+{
+    StrandSet s;
+    s.addStrand(std::vector<Vec3f>{Vec3f(-0.4f, 0.f, 0.f), Vec3f(0.4f, 0.f, 0.f)});
+    s.addStrand(std::vector<Vec3f>{Vec3f(0.4f, 0.f, 0.f), Vec3f(-0.4f, 0.f, 0.f)});
+    FieldParams p;
+    p.voxelSize = 1.0;
+    const TangentField f = estimateTangentField(s, p);
+    REQUIRE(f.tangent->tree().isValueOn(openvdb::Coord(0)));
+    REQUIRE(f.tangent->tree().getValue(openvdb::Coord(0)) == openvdb::Vec3f(0.f));
+    REQUIRE(f.density->tree().getValue(openvdb::Coord(0)) == Approx(1.6));
+}
+
+TEST_CASE("estimateTangentField: bitwise identical with 1 and 2 threads", "[field]")
+{
+    StrandSet s;
+    std::mt19937 rng(11);
+    std::normal_distribution<float> n(0.f, 1.f);
+    for (int i = 0; i < 3000; ++i) {
+        std::vector<Vec3f> pts{Vec3f(n(rng), n(rng), n(rng))};
+        for (int k = 0; k < 12; ++k) pts.push_back(pts.back() + Vec3f(0.3f + 0.1f * n(rng), 0.1f * n(rng), 0.1f * n(rng)));
+        s.addStrand(pts);
+    }
+    FieldParams p;
+    p.voxelSize = 0.25;
+    TangentField one, two;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        one = estimateTangentField(s, p);
+    }
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        two = estimateTangentField(s, p);
+    }
+    REQUIRE(one.tangent->activeVoxelCount() == two.tangent->activeVoxelCount());
+    auto acc = two.tangent->getConstAccessor();
+    auto dacc = two.density->getConstAccessor();
+    for (auto it = one.tangent->cbeginValueOn(); it; ++it) {
+        REQUIRE(acc.isValueOn(it.getCoord()));
+        REQUIRE(std::memcmp(&(*it), &acc.getValue(it.getCoord()), sizeof(openvdb::Vec3f)) == 0);
+        const float d1 = one.density->tree().getValue(it.getCoord()), d2 = dacc.getValue(it.getCoord());
+        REQUIRE(std::memcmp(&d1, &d2, sizeof(float)) == 0);
+    }
+}
+
+TEST_CASE("estimateTangentFieldLevels: level l has voxel size h*2^l and its own names", "[field]")
+{
+    const StrandSet s = parallelStrands(Vec3f(0, 0, 1), 3, 0.5f, 8.f, 9);
+    FieldParams p;
+    p.voxelSize = 0.25;
+    const auto levels = estimateTangentFieldLevels(s, p, 3);
+    REQUIRE(levels.size() == 3);
+    for (int l = 0; l < 3; ++l) {
+        REQUIRE(levels[std::size_t(l)].tangent->getName() == "tangent_level_" + std::to_string(l));
+        REQUIRE(levels[std::size_t(l)].density->getName() == "density_level_" + std::to_string(l));
+        REQUIRE(levels[std::size_t(l)].tangent->voxelSize().x() == Approx(0.25 * (1 << l)));
+        REQUIRE(levels[std::size_t(l)].tangent->metaValue<int>("vdbhair:level") == l);
+    }
+    REQUIRE(levels[2].tangent->activeVoxelCount() < levels[0].tangent->activeVoxelCount());
+}
+
+TEST_CASE("estimateTangentField: bad parameters are clear errors before any work", "[field]")
+{
+    const StrandSet s = parallelStrands(Vec3f(1, 0, 0), 2, 1.f, 100.f, 3);
+    FieldParams p;
+    p.voxelSize = 0.0;
+    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("voxel size 0.000000 must be a positive finite length"));
+    p.voxelSize = -1.0;
+    REQUIRE_THROWS_AS(estimateTangentField(s, p), ValueError);
+    p.voxelSize = 1e-4;  // 4 strands of 2 segments of 50: 8 x (5e5 + 1) visits
+    p.maxVoxels = 1000000;
+    REQUIRE_THROWS_AS(estimateTangentField(s, p), LimitError);
+    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("voxel size 0.000100 needs up to 4000008 voxel visits, more than the cap of 1000000"));
+    p.maxVoxels = FieldParams().maxVoxels;
+    p.voxelSize = 1e-6;
+    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("below OpenVDB's smallest voxel size"));
+    p.voxelSize = 1.0;
+    p.iterations = 0;
+    REQUIRE_THROWS_AS(estimateTangentField(s, p), ValueError);
+    p.iterations = 2;
+    REQUIRE_THROWS_WITH(estimateTangentField(StrandSet{}, p), Contains("the hairstyle has no strands"));
+    StrandSet far = s;
+    for (Vec3f& v : far.positions) v += Vec3f(1e6f, 0.f, 0.f);
+    p.voxelSize = 1e-4;
+    p.maxVoxels = std::uint64_t(1) << 62;
+    REQUIRE_THROWS_WITH(estimateTangentField(far, p), Contains("beyond the grid's index range"));
+}

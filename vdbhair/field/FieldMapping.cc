@@ -1,0 +1,99 @@
+#include "FieldMapping.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Version.h>
+
+#include <openvdb/Metadata.h>
+
+#include <cmath>
+
+namespace vdbhair {
+
+const char* fieldSpaceName(FieldSpace space) { return space == FieldSpace::Scalp ? "scalp" : "world"; }
+
+FieldSpace fieldSpaceFromName(const std::string& name)
+{
+    if (name == "world") return FieldSpace::World;
+    if (name == "scalp") return FieldSpace::Scalp;
+    throw ValueError("space '" + name + "' is not one of world, scalp");
+}
+
+std::string tangentGridName(int level, int levels)
+{
+    return levels <= 1 ? "tangent" : "tangent_level_" + std::to_string(level);
+}
+
+std::string densityGridName(int level, int levels)
+{
+    return levels <= 1 ? "density" : "density_level_" + std::to_string(level);
+}
+
+FieldMapping::FieldMapping(openvdb::math::Transform::ConstPtr xform) : mXform(std::move(xform))
+{
+    // Axis-aligned linear transforms (scale and translation only) take the fast path.
+    if (mXform->isLinear()) {
+        const openvdb::Mat4d m = mXform->baseMap()->getAffineMap()->getMat4();
+        const bool diagonal = m(0, 1) == 0.0 && m(0, 2) == 0.0 && m(1, 0) == 0.0 && m(1, 2) == 0.0 &&
+                              m(2, 0) == 0.0 && m(2, 1) == 0.0;
+        if (diagonal && m(0, 0) != 0.0 && m(1, 1) != 0.0 && m(2, 2) != 0.0) {
+            mDiagonal = true;
+            mInvScale = openvdb::Vec3d(1.0 / m(0, 0), 1.0 / m(1, 1), 1.0 / m(2, 2));
+            mOffset = openvdb::Vec3d(m(3, 0), m(3, 1), m(3, 2));
+        }
+    }
+}
+
+FieldMapping::FieldMapping(openvdb::math::Transform::ConstPtr xform, const ScalpSphere& scalp)
+    : FieldMapping(std::move(xform))
+{
+    mSpace = FieldSpace::Scalp;
+    mScalp = scalp;
+}
+
+openvdb::Vec3d FieldMapping::toScalp(const openvdb::Vec3d& world) const
+{
+    return worldToScalp(mScalp, Vec3d(world.x(), world.y(), world.z()));
+}
+
+double FieldMapping::worldVoxelSize() const
+{
+    const double h = mXform->voxelSize().x();
+    return mSpace == FieldSpace::Scalp ? h * mScalp.radius : h;
+}
+
+FieldMapping FieldMapping::fromGrid(const openvdb::GridBase& grid)
+{
+    const auto space = grid.getMetadata<openvdb::StringMetadata>("vdbhair:space");
+    if (!space || space->value() != "scalp") return FieldMapping(grid.constTransformPtr());
+    const auto center = grid.getMetadata<openvdb::Vec3DMetadata>("vdbhair:scalp_center");
+    const auto radius = grid.getMetadata<openvdb::DoubleMetadata>("vdbhair:scalp_radius");
+    const auto up = grid.getMetadata<openvdb::Vec3DMetadata>("vdbhair:scalp_up");
+    if (!center || !radius || !up || !(radius->value() > 0.0)) {
+        throw FormatError("grid '" + grid.getName() + "' is in scalp space but lacks a valid vdbhair:scalp_center, "
+                          "vdbhair:scalp_radius (> 0) and vdbhair:scalp_up");
+    }
+    ScalpSphere s;
+    s.center = Vec3d(center->value().x(), center->value().y(), center->value().z());
+    s.radius = radius->value();
+    s.up = Vec3d(up->value().x(), up->value().y(), up->value().z()).unitSafe();
+    return FieldMapping(grid.constTransformPtr(), s);
+}
+
+void setFieldMetadata(openvdb::GridBase& grid, double voxelSize, int iterations, FieldSpace space,
+                      const ScalpSphere& scalp, int level, int levels, std::size_t strandCount)
+{
+    grid.insertMeta("creator", openvdb::StringMetadata(creatorString()));
+    grid.insertMeta("vdbhair:voxel_size", openvdb::DoubleMetadata(voxelSize));
+    grid.insertMeta("vdbhair:iterations", openvdb::Int32Metadata(iterations));
+    grid.insertMeta("vdbhair:space", openvdb::StringMetadata(fieldSpaceName(space)));
+    grid.insertMeta("vdbhair:level", openvdb::Int32Metadata(level));
+    grid.insertMeta("vdbhair:levels", openvdb::Int32Metadata(levels));
+    grid.insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(std::int64_t(strandCount)));
+    if (space == FieldSpace::Scalp) {
+        grid.insertMeta("vdbhair:scalp_center", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.center.x(), scalp.center.y(), scalp.center.z())));
+        grid.insertMeta("vdbhair:scalp_radius", openvdb::DoubleMetadata(scalp.radius));
+        grid.insertMeta("vdbhair:scalp_up", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.up.x(), scalp.up.y(), scalp.up.z())));
+    }
+}
+
+} // namespace vdbhair

@@ -1,0 +1,71 @@
+/// @file TangentField.h
+/// @brief Strands to a sparse tangent field: the robust, iteratively reweighted estimate of
+/// Wang et al. 2009, Eq. 9, on an OpenVDB grid in world space (or scalp space).
+///
+/// Every strand segment contributes its unit tangent T to **every voxel it passes through**
+/// (SegmentWalk.h), weighted by its length ℓ inside that voxel. Iteration t (Eq. 9) weights each
+/// contribution by ω = 0.5 (T · v̄_{t-1} + 1) and renormalizes, from v̄_0 = 0. Because ω is linear
+/// in T, the weighted sum is exactly 0.5 (s + M v̄_{t-1}) with the per-voxel moments
+/// s = Σ ℓ T and M = Σ ℓ T Tᵀ, so vdbhair walks the segments once, accumulates s and M, and
+/// iterates per voxel: v̄_t = normalize(s + M v̄_{t-1}) — the same estimate, at the cost of one
+/// pass however many iterations are asked for. The density is Σ ℓ = trace(M).
+///
+/// Voxels no segment passes stay inactive; a voxel whose contributions cancel keeps a zero vector
+/// (tracing stops there, "vanished"). Two iterations is the default, as in the paper (more did
+/// not change their results).
+///
+/// Determinism: strands are split into a fixed number of chunks (independent of the thread
+/// count), each summed in strand order, and the chunks are merged in chunk order, so the grids
+/// are bitwise identical with any number of threads.
+#pragma once
+
+#include <vdbhair/field/FieldTypes.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <openvdb/Grid.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace vdbhair {
+
+struct FieldParams
+{
+    double voxelSize = 0.0;   ///< world units (>= 2e-5, OpenVDB's limit); in scalp space, world units at the scalp
+    int iterations = 2;       ///< Eq. 9 iterations (>= 1)
+    FieldSpace space = FieldSpace::World;
+    ScalpSphere scalp;        ///< used in scalp space
+    /// Cap on the voxel visits the segments could need (an upper bound computed before any
+    /// allocation); about 40 bytes each at most. A voxel size too small for the hairstyle fails
+    /// with LimitError instead of exhausting memory.
+    std::uint64_t maxVoxels = std::uint64_t(1) << 26;
+};
+
+/// @brief The grids of one level.
+struct TangentField
+{
+    openvdb::Vec3SGrid::Ptr tangent;  ///< unit directions, root to tip; class unknown, contravariant relative
+    openvdb::FloatGrid::Ptr density;  ///< summed segment length per voxel (world units); fog volume
+};
+
+/// @brief Estimate the field of @a strands at one voxel size.
+/// @throw ValueError (empty hairstyle, voxel size not positive and finite, iterations < 1),
+/// LimitError (the voxel bound exceeds params.maxVoxels; the message says the estimate and the
+/// cap), InterruptedError.
+/// @warning Thread-safe for concurrent calls on different outputs.
+TangentField estimateTangentField(const StrandSet& strands, const FieldParams& params,
+                                  bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// @brief Multi-level fields: level l has voxel size params.voxelSize · 2^l (Wang et al. halve the
+/// spacing from level to level); element l of the result is level l (0 the finest). Grids are
+/// named with tangentGridName(l, levels) / densityGridName(l, levels).
+std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, const FieldParams& params,
+                                                     int levels, bool threaded = true,
+                                                     openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// @brief An upper bound on the voxel visits of estimating at @a params (what maxVoxels caps).
+std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params);
+
+} // namespace vdbhair
