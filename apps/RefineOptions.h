@@ -18,7 +18,7 @@ struct RefineCmdParams
     int levels = 1, iterations = 2;
     double step = -1.0;       ///< < 0: not given
     std::string integrator = "euler";
-    int margin = 2;
+    int margin = 3;
     std::uint64_t maxVoxels = std::uint64_t(1) << 26;
     bool strict = false;
     ScalpOptions scalp;

@@ -91,7 +91,7 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
     sub->add_option("--iterations", p.iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
     sub->add_option("--step", p.step, "Integration step in world units (default: half of each level's voxel)");
     sub->add_option("--integrator", p.integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
-    sub->add_option("--margin", p.margin, "Voxels past the field's active region where its direction is extrapolated (0: the papers' rule)")->capture_default_str();
+    sub->add_option("--margin", p.margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
     sub->add_option("--max-voxels", p.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
     sub->add_flag("--strict", p.strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addScalpOptions(sub, p.scalp);

@@ -40,7 +40,7 @@ struct RetraceParams
     std::string integrator = "euler", vertices = "input";
     double vanish = 1e-3;
     std::size_t maxSteps = 0;
-    int margin = 2;
+    int margin = 3;
     bool strict = false;
 };
 
@@ -102,7 +102,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
     sub->add_option("--vanish", params->vanish, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
     sub->add_option("--max-steps", params->maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
-    sub->add_option("--margin", params->margin, "Voxels past the field's active region where its direction is extrapolated (0: stop at the region, the papers' rule)")->capture_default_str();
+    sub->add_option("--margin", params->margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
     sub->add_option("--vertices", params->vertices, "input: the input's vertex count and arc lengths; steps: every step")->capture_default_str();
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);

@@ -36,6 +36,11 @@ public:
         return mXform->worldToIndex(p);
     }
 
+    /// @brief Whether worldToIndex() is (world - offset()) * invScale() (world space, axis-aligned).
+    bool isAxisAlignedWorld() const { return mSpace == FieldSpace::World && mDiagonal; }
+    const openvdb::Vec3d& offset() const { return mOffset; }
+    const openvdb::Vec3d& invScale() const { return mInvScale; }
+
     /// @brief The world length of one voxel near the scalp (world grids: the voxel size; scalp
     /// grids: radius times the (u, v, w) voxel size). The default tracing step is half of it.
     double worldVoxelSize() const;

@@ -12,6 +12,13 @@
 
 namespace vdbhair {
 
+/// @brief floor(x) as an int, without a libm call (|x| < 2^31; callers check the index range).
+inline int floorToInt(double x)
+{
+    const int i = int(x);
+    return i - int(x < double(i));
+}
+
 /// @brief Walk the segment from @a a to @a b (index space: voxel ijk spans [ijk - 0.5, ijk + 0.5)
 /// on each axis, OpenVDB's cell-centred convention) and call `fn(ijk, t0, t1)` for every voxel it
 /// passes through, in order, where [t0, t1] ⊂ [0, 1] is the segment parameter range inside it.
@@ -21,20 +28,24 @@ template<typename Fn>
 inline std::uint64_t walkSegment(const openvdb::Vec3d& a, const openvdb::Vec3d& b, Fn&& fn)
 {
     const openvdb::Vec3d d = b - a;
-    openvdb::Coord ijk(int(std::floor(a.x() + 0.5)), int(std::floor(a.y() + 0.5)), int(std::floor(a.z() + 0.5)));
-    const openvdb::Coord last(int(std::floor(b.x() + 0.5)), int(std::floor(b.y() + 0.5)), int(std::floor(b.z() + 0.5)));
+    openvdb::Coord ijk(floorToInt(a.x() + 0.5), floorToInt(a.y() + 0.5), floorToInt(a.z() + 0.5));
+    const openvdb::Coord last(floorToInt(b.x() + 0.5), floorToInt(b.y() + 0.5), floorToInt(b.z() + 0.5));
+    if (ijk == last) {  // the common case for segments shorter than a voxel
+        fn(ijk, 0.0, 1.0);
+        return 1;
+    }
     int step[3];
     double tMax[3], tDelta[3];
     constexpr double inf = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 3; ++k) {
         if (d[k] > 0.0) {
             step[k] = 1;
-            tMax[k] = (double(ijk[k]) + 0.5 - a[k]) / d[k];
             tDelta[k] = 1.0 / d[k];
+            tMax[k] = (double(ijk[k]) + 0.5 - a[k]) * tDelta[k];
         } else if (d[k] < 0.0) {
             step[k] = -1;
-            tMax[k] = (double(ijk[k]) - 0.5 - a[k]) / d[k];
             tDelta[k] = -1.0 / d[k];
+            tMax[k] = (a[k] - double(ijk[k]) + 0.5) * tDelta[k];
         } else {
             step[k] = 0;
             tMax[k] = inf;
@@ -64,11 +75,11 @@ inline std::uint64_t walkSegment(const openvdb::Vec3d& a, const openvdb::Vec3d& 
     }
 }
 
-/// @brief The number of voxels walkSegment() visits at most: one plus the crossed boundaries.
+/// @brief An upper bound on the voxels walkSegment() visits, cheap enough to compute for every
+/// segment before any allocation: the first voxel plus at most |Δ| + 1 boundary crossings per axis.
 inline std::uint64_t segmentVoxelBound(const openvdb::Vec3d& a, const openvdb::Vec3d& b)
 {
-    double n = 1.0;
-    for (int k = 0; k < 3; ++k) n += std::abs(std::floor(b[k] + 0.5) - std::floor(a[k] + 0.5));
+    const double n = 4.0 + std::abs(b.x() - a.x()) + std::abs(b.y() - a.y()) + std::abs(b.z() - a.z());
     return n < 1e18 ? std::uint64_t(n) : std::uint64_t(1e18);  // saturate: callers compare to a cap
 }
 

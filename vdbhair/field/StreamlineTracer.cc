@@ -10,7 +10,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
+#include <limits>
+#include <memory>
 #include <cmath>
 #include <numeric>
 
@@ -44,23 +47,20 @@ template<typename TreeT>
 class Tracer
 {
 public:
-    Tracer(const TreeT& tree, const FieldMapping& map, double threshold, int margin)
-        : mSampler(tree), mMap(map), mThreshold(threshold), mMargin(margin) {}
+    Tracer(const BrickedField<TreeT>& bricks, const FieldMapping& map, double threshold)
+        : mSampler(bricks), mMap(map), mThreshold(threshold) {}
 
     /// Unit field direction at a world point.
     Sample direction(const Vec3d& world, Vec3d& dir)
     {
-        Vec3d v;
         const Vec3d ip = mMap.worldToIndex(world);
-        double active = mSampler.sample(ip, v);
-        if (!(active > 0.0)) {
-            if (mMargin <= 0) return kLeft;
-            active = mSampler.extrapolate(ip, mMargin, v);
-            if (!(active > 0.0)) return kLeft;
-        }
-        const double len = v.length();
-        if (!(len > mThreshold * active)) return kVanished;
-        dir = v / len;
+        const Float4 r = mSampler.sample(ip);
+        if (!(r[3] > 0.f)) return kLeft;
+        const float len2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        const float limit = float(mThreshold) * r[3];
+        if (!(len2 > limit * limit)) return kVanished;
+        const float inv = 1.f / std::sqrt(len2);
+        dir = Vec3d(r[0] * inv, r[1] * inv, r[2] * inv);
         return kOk;
     }
 
@@ -92,7 +92,6 @@ private:
     FieldSampler<TreeT> mSampler;
     const FieldMapping& mMap;
     double mThreshold;
-    int mMargin;
 };
 
 StopReason toReason(Sample s) { return s == kLeft ? StopReason::LeftField : StopReason::Vanished; }
@@ -105,7 +104,10 @@ StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams
 {
     using TreeT = typename GridT::TreeType;
     const FieldMapping map = FieldMapping::fromGrid(grid);
+    const BrickedField<TreeT> bricks(grid.tree());
     const std::size_t nS = in.numStrands();
+    // Strands in spatial order: consecutive strands share bricks, which stay in cache.
+    const std::vector<std::uint32_t> order = spatialOrder(in);
     const bool inputMode = params.vertices == RetraceVertices::Input;
 
     // Input mode writes into the input's layout (compacted afterwards if a strand stops early);
@@ -117,67 +119,190 @@ StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams
     std::vector<std::size_t> steps(nS, 0);
     std::atomic<bool> stop{false};
 
+    // Each thread traces kLanes strands at once, one step of each in turn. A step is a chain of
+    // dependent operations (map, sample, normalize, move); independent lanes let the processor
+    // overlap their latencies, provided the loop has no unpredictable branches. So a lane only
+    // records its step points; the arc-length bookkeeping (output vertices at the input's arc
+    // lengths) happens once per strand, afterwards. Step k lies at arc length k·h along the
+    // streamline (the integrators move at unit speed), the last step being shortened to land on
+    // the strand's length.
+    constexpr int kLanes = 8;
+    struct Lane
+    {
+        bool busy = false;
+        std::size_t strand = 0;
+        std::size_t k = 0;       ///< steps taken
+        std::size_t needed = 0;  ///< steps to the full length
+        std::size_t limit = 0;   ///< steps allowed: needed, or fewer under maxSteps
+        double length = 0.0, lastStep = 0.0;
+        Vec3d p{0.0};
+        Vec3d dir{0.0};        ///< direction of the last step
+        double outside = 0.0;  ///< length travelled in a row past the active region
+        std::vector<double> target;  ///< the input's vertex arc lengths
+        std::vector<Vec3f> points;   ///< points[m] at arc length m·step (points[needed]: the length)
+    };
+
     auto traceRange = [&](const tbb::blocked_range<std::size_t>& r) {
-        Tracer<TreeT> tracer(grid.tree(), map, params.vanishThreshold, params.margin);
-        std::vector<double> target;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            if (interrupter && (i & 255) == 0 && interrupter->wasInterrupted()) { stop = true; return; }
-            if (stop) return;
-            const std::size_t n = in.size(i), b = in.begin(i);
-            target.resize(n);
-            arcLengths(in.data(i), n, target.data());
-            const double length = target[n - 1];
-            Vec3f* out = inputMode ? positions.data() + b : nullptr;
-            std::vector<Vec3f>* pts = inputMode ? nullptr : &stepPoints[i];
-            auto emit = [&](const Vec3d& p) {
-                const Vec3f v(float(p.x()), float(p.y()), float(p.z()));
-                if (inputMode) out[used[i]++] = v;
-                else pts->push_back(v);
-            };
-            Vec3d p(in.root(i));
-            emit(p);
-            std::size_t j = 1;  // next input vertex (input mode)
-            double s = 0.0;
-            std::size_t k = 0;
-            const double eps = 1e-9 * std::max(length, step);
-            StopReason reason = StopReason::FullLength;
-            while (length - s > eps) {
-                if (params.maxSteps && k >= params.maxSteps) { reason = StopReason::MaxSteps; break; }
-                const double h = std::min(step, length - s);
-                Vec3d q;
-                const Sample st = tracer.advance(params.integrator, p, h, q);
-                if (st != kOk) { reason = toReason(st); break; }
-                const double ds = (q - p).length();
-                ++k;
-                if (inputMode) {
-                    while (j < n && target[j] <= s + ds) {
-                        const double f = ds > 0.0 ? (target[j] - s) / ds : 1.0;
-                        emit(p + f * (q - p));
-                        ++j;
-                    }
+        std::vector<std::unique_ptr<Tracer<TreeT>>> tracers;
+        for (int l = 0; l < kLanes; ++l) tracers.emplace_back(new Tracer<TreeT>(bricks, map, params.vanishThreshold));
+        Lane lanes[kLanes];
+        std::size_t next = r.begin();
+
+        auto start = [&](Lane& lane) {
+            lane.busy = false;
+            if (next >= r.end() || stop) return;
+            const std::size_t i = order[next++];
+            if (interrupter && (next & 255) == 0 && interrupter->wasInterrupted()) { stop = true; return; }
+            lane.target.resize(in.size(i));
+            arcLengths(in.data(i), in.size(i), lane.target.data());
+            lane.length = lane.target.back();
+            // Whole steps, the last one shortened to land on the length (none for zero length).
+            lane.needed = lane.length > 0.0 ? std::max<std::size_t>(1, std::size_t(std::ceil(lane.length / step - 1e-9))) : 0;
+            lane.limit = params.maxSteps ? std::min(lane.needed, params.maxSteps) : lane.needed;
+            lane.lastStep = lane.needed ? lane.length - double(lane.needed - 1) * step : 0.0;
+            lane.busy = true;
+            lane.strand = i;
+            lane.k = 0;
+            lane.p = Vec3d(in.root(i));
+            lane.dir = Vec3d(0.0);
+            lane.outside = 0.0;
+            if (lane.points.size() < lane.limit + 1) lane.points.resize(lane.limit + 1);
+            lane.points[0] = in.root(i);
+        };
+        // Arc length of step point m, and of the step that starts there.
+        auto arcAt = [&](const Lane& lane, std::size_t m) { return m == lane.needed ? lane.length : double(m) * step; };
+        auto stepAt = [&](const Lane& lane, std::size_t m) { return m + 1 == lane.needed ? lane.lastStep : step; };
+
+        auto finish = [&](Lane& lane, StopReason reason) {
+            const std::size_t i = lane.strand;
+            const Vec3f* pts = lane.points.data();  // pts[0 .. taken]
+            const std::size_t taken = lane.k;
+            if (!inputMode) {
+                stepPoints[i].assign(pts, pts + taken + 1);
+                if (taken == 0) stepPoints[i].push_back(pts[0]);
+            } else {
+                const std::size_t n = in.size(i);
+                const std::vector<double>& target = lane.target;
+                const double reached = arcAt(lane, taken);
+                Vec3f* out = positions.data() + in.begin(i);
+                std::size_t u = 0;
+                if (taken == 0) {
+                    out[u++] = pts[0];
                 } else {
-                    emit(q);
+                    // Vertices on whole steps: step m spans [m·step, (m+1)·step]. The last step of
+                    // a full-length trace is shorter; vertices on it are placed separately.
+                    const bool shortLast = taken == lane.needed;
+                    const std::size_t whole = shortLast ? taken - 1 : taken;
+                    const double wholeEnd = double(whole) * step, invStep = 1.0 / step;
+                    std::size_t j = 0;
+                    for (; j < n && target[j] <= wholeEnd; ++j) {
+                        const double x = target[j] * invStep;
+                        const std::size_t m = std::min(std::size_t(x), whole - (whole > 0));
+                        out[u++] = pts[m] + (pts[m + 1] - pts[m]) * float(x - double(m));
+                    }
+                    for (; j < n && target[j] <= reached; ++j) {  // on the last, shorter step
+                        const double f = std::min(1.0, (target[j] - wholeEnd) / lane.lastStep);
+                        out[u++] = pts[whole] + (pts[whole + 1] - pts[whole]) * float(f);
+                    }
                 }
-                p = q;
-                s += ds;
-                if (ds <= 0.0) { reason = StopReason::Vanished; break; }
-            }
-            if (reason == StopReason::FullLength) {
-                while (inputMode && j < n) { emit(p); ++j; }  // rounding at the tip
-            } else if (inputMode) {
-                // Keep what was traced: the vertices passed (fewer than n, since the length was
-                // not reached), then the point where it stopped; at least two vertices.
-                const Vec3f last(float(p.x()), float(p.y()), float(p.z()));
-                if (out[used[i] - 1] != last) out[used[i]++] = last;
-                if (used[i] < 2) out[used[i]++] = last;
-            } else if (pts->size() < 2) {
-                pts->push_back(pts->back());
+                if (reason == StopReason::FullLength) {
+                    out[n - 1] = pts[taken];  // exactly the traced tip
+                } else {
+                    // Keep what was traced: the vertices passed, then the point where it stopped
+                    // (fewer than n vertices, since the length was not reached), at least two.
+                    const Vec3f last = pts[taken];
+                    if (out[u - 1] != last) out[u++] = last;
+                    if (u < 2) out[u++] = last;
+                }
+                used[i] = std::uint32_t(u);
             }
             reasons[i] = reason;
-            steps[i] = k;
+            steps[i] = taken;
+            start(lane);
+        };
+
+        // Forward Euler in an axis-aligned world grid takes a branch-free path over the lanes:
+        // each stage runs for all lanes before the next, so their chains overlap. Anything
+        // unusual (outside a brick, past the active region, a vanishing field) falls back to the
+        // lane's Tracer, which handles every case.
+        const bool fast = params.integrator == Integrator::Euler && map.isAxisAlignedWorld();
+        const Vec3d off = map.offset(), inv = map.invScale();
+        const float threshold = float(params.vanishThreshold);
+        openvdb::Coord origin[kLanes];
+        const typename BrickedField<TreeT>::Brick* brick[kLanes] = {};
+        for (int l = 0; l < kLanes; ++l) origin[l] = openvdb::Coord(std::numeric_limits<int>::max());
+
+        const double marginLength = double(params.margin) * map.worldVoxelSize();
+        auto slowStep = [&](int l) {
+            Lane& lane = lanes[l];
+            const double h = stepAt(lane, lane.k);
+            Vec3d q;
+            const Sample st = tracers[std::size_t(l)]->advance(params.integrator, lane.p, h, q);
+            if (st == kOk) {
+                lane.outside = 0.0;
+                lane.dir = (q - lane.p) / h;
+            } else if (st == kLeft && lane.k > 0 && lane.outside + h <= marginLength * (1.0 + 1e-9)) {
+                // Past the active region, within the margin: continue straight.
+                q = lane.p + h * lane.dir;
+                lane.outside += h;
+            } else {
+                finish(lane, toReason(st));
+                return;
+            }
+            ++lane.k;
+            lane.p = q;
+            lane.points[lane.k] = Vec3f(float(q.x()), float(q.y()), float(q.z()));
+        };
+
+        for (Lane& lane : lanes) start(lane);
+        for (bool any = true; any;) {
+            any = false;
+            bool go[kLanes];
+            for (int l = 0; l < kLanes; ++l) {
+                Lane& lane = lanes[l];
+                go[l] = false;
+                if (!lane.busy) continue;
+                any = true;
+                if (lane.k == lane.limit) {
+                    finish(lane, lane.limit == lane.needed ? StopReason::FullLength : StopReason::MaxSteps);
+                    if (!lane.busy) continue;
+                }
+                go[l] = true;
+            }
+            if (!fast) {
+                for (int l = 0; l < kLanes; ++l) if (go[l]) slowStep(l);
+                continue;
+            }
+            Float4 r[kLanes];
+            bool slow[kLanes];
+            for (int l = 0; l < kLanes; ++l) {
+                slow[l] = false;
+                if (!go[l]) continue;
+                if (lanes[l].k + 1 == lanes[l].needed) { slow[l] = true; continue; }  // the shortened last step
+                const Vec3d& p = lanes[l].p;
+                const double ix = (p.x() - off.x()) * inv.x(), iy = (p.y() - off.y()) * inv.y(), iz = (p.z() - off.z()) * inv.z();
+                const int bx = floorToInt(ix), by = floorToInt(iy), bz = floorToInt(iz);
+                const Float4* c = bricks.cell(bx, by, bz, origin[l], brick[l]);
+                if (!c) { slow[l] = true; continue; }
+                r[l] = BrickedField<TreeT>::blend(c, float(ix - bx), float(iy - by), float(iz - bz));
+            }
+            for (int l = 0; l < kLanes; ++l) {
+                if (!go[l] || slow[l]) continue;
+                const Float4 v = r[l];
+                const float len2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2], limit = threshold * v[3];
+                if (!(v[3] > 0.f) || !(len2 > limit * limit)) { slow[l] = true; continue; }
+                Lane& lane = lanes[l];
+                const double s = 1.0 / std::sqrt(double(len2));
+                lane.dir = Vec3d(s * v[0], s * v[1], s * v[2]);
+                lane.p += step * lane.dir;
+                lane.outside = 0.0;
+                ++lane.k;
+                lane.points[lane.k] = Vec3f(float(lane.p.x()), float(lane.p.y()), float(lane.p.z()));
+            }
+            for (int l = 0; l < kLanes; ++l) if (slow[l]) slowStep(l);
         }
     };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 64), traceRange);
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 256), traceRange);
     else traceRange(tbb::blocked_range<std::size_t>(0, nS));
     if (stop) throw InterruptedError("retraceStrands: interrupted");
 
@@ -196,14 +321,23 @@ StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams
             out.transparency = in.transparency;
             out.color = in.color;
         } else {
-            for (std::size_t i = 0; i < nS; ++i) {
-                const std::size_t b = in.begin(i), u = used[i];
-                out.positions.insert(out.positions.end(), positions.begin() + std::ptrdiff_t(b), positions.begin() + std::ptrdiff_t(b + u));
-                out.offsets.push_back(std::uint32_t(out.positions.size()));
-                if (!in.thickness.empty()) out.thickness.insert(out.thickness.end(), in.thickness.begin() + std::ptrdiff_t(b), in.thickness.begin() + std::ptrdiff_t(b + u));
-                if (!in.transparency.empty()) out.transparency.insert(out.transparency.end(), in.transparency.begin() + std::ptrdiff_t(b), in.transparency.begin() + std::ptrdiff_t(b + u));
-                if (!in.color.empty()) out.color.insert(out.color.end(), in.color.begin() + std::ptrdiff_t(b), in.color.begin() + std::ptrdiff_t(b + u));
-            }
+            // Each strand keeps the prefix of its vertices it traced.
+            out.offsets.assign(nS + 1, 0);
+            for (std::size_t i = 0; i < nS; ++i) out.offsets[i + 1] = out.offsets[i] + used[i];
+            const std::size_t total = out.offsets[nS];
+            out.positions.resize(total);
+            if (!in.thickness.empty()) out.thickness.resize(total);
+            if (!in.transparency.empty()) out.transparency.resize(total);
+            if (!in.color.empty()) out.color.resize(total);
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    const std::size_t b = in.begin(i), o = out.offsets[i], u = used[i];
+                    std::copy_n(positions.begin() + std::ptrdiff_t(b), u, out.positions.begin() + std::ptrdiff_t(o));
+                    if (!in.thickness.empty()) std::copy_n(in.thickness.begin() + std::ptrdiff_t(b), u, out.thickness.begin() + std::ptrdiff_t(o));
+                    if (!in.transparency.empty()) std::copy_n(in.transparency.begin() + std::ptrdiff_t(b), u, out.transparency.begin() + std::ptrdiff_t(o));
+                    if (!in.color.empty()) std::copy_n(in.color.begin() + std::ptrdiff_t(b), u, out.color.begin() + std::ptrdiff_t(o));
+                }
+            });
         }
     } else {
         for (std::size_t i = 0; i < nS; ++i) out.addStrand(stepPoints[i]);
@@ -272,8 +406,9 @@ double meanTangentAngleDeg(const StrandSet& strands, const openvdb::GridBase& fi
     applyVec3(field, "meanTangentAngleDeg", [&](const auto& grid) {
         using TreeT = typename std::decay_t<decltype(grid)>::TreeType;
         const FieldMapping map = FieldMapping::fromGrid(grid);
+        const BrickedField<TreeT> bricks(grid.tree());
         auto body = [&](const tbb::blocked_range<std::size_t>& r) {
-            Tracer<TreeT> tracer(grid.tree(), map, 1e-3, 0);  // the field where it is defined
+            Tracer<TreeT> tracer(bricks, map, 1e-3);
             std::vector<Vec3f> t;
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 t.resize(strands.size(i));

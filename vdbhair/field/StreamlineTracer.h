@@ -9,11 +9,10 @@
 /// - it reaches the requested length (the last step is shortened to land on it exactly);
 /// - the field vanishes: the blended vector's length over the active corners' weight is below
 ///   `vanishThreshold` (opposing directions cancel, or zero vectors);
-/// - it leaves the field: no corner of the sampling cell is active and no active voxel lies
-///   within `margin` voxels (within the margin the direction is extrapolated from the nearest
-///   active voxels, inverse-square weighted — the field is continued a short way past the hair,
-///   as velocities are extrapolated past a fluid's surface; margin 0 is the papers' rule, which
-///   stops smoothed strands that overshoot the tips of noisy hair);
+/// - it leaves the field: no corner of the sampling cell is active, and it has already continued
+///   straight along its last direction for `margin` voxels past the active region (a short
+///   linear extrapolation: smoothed strands of noisy hair travel further than the originals and
+///   overshoot the tips of the hair volume; margin 0 is the papers' rule, stop at once);
 /// - it has taken `maxSteps` steps.
 /// Each stop reason is counted. Streamlines are independent, so results do not depend on the
 /// thread count.
@@ -50,7 +49,7 @@ struct TraceParams
     Integrator integrator = Integrator::Euler;
     double vanishThreshold = 1e-3;  ///< see the file comment
     std::size_t maxSteps = 0;       ///< 0: as many as the length needs
-    int margin = 2;                 ///< voxels of extrapolation past the active region (0: none)
+    int margin = 3;                 ///< voxels a strand may continue straight past the active region (0: none)
     RetraceVertices vertices = RetraceVertices::Input;
 };
 

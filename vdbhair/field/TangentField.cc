@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/strands/Measures.h>
 
 #include <openvdb/tree/LeafManager.h>
 #include <openvdb/tree/ValueAccessor.h>
@@ -14,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
 
 namespace vdbhair {
 
@@ -29,12 +31,12 @@ struct Moments
     float s[3] = {0.f, 0.f, 0.f};
     float m[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
 
-    void add(const Vec3d& t, double len)
+    /// Add a piece of length @a l of a segment whose tangent T gives @a t = T and
+    /// @a tt = (xx, yy, zz, xy, xz, yz) of T Tᵀ (computed once per segment).
+    void add(const float* t, const float* tt, float l)
     {
-        const float l = float(len), x = float(t.x()), y = float(t.y()), z = float(t.z());
-        s[0] += l * x; s[1] += l * y; s[2] += l * z;
-        m[0] += l * x * x; m[1] += l * y * y; m[2] += l * z * z;
-        m[3] += l * x * y; m[4] += l * x * z; m[5] += l * y * z;
+        for (int k = 0; k < 3; ++k) s[k] += l * t[k];
+        for (int k = 0; k < 6; ++k) m[k] += l * tt[k];
     }
     void add(const Moments& o)
     {
@@ -60,11 +62,66 @@ openvdb::Vec3f robustDirection(const Moments& mo, int iterations)
     return openvdb::Vec3f(float(v.x()), float(v.y()), float(v.z()));
 }
 
-/// The accumulation of one chunk of strands: voxel -> index into its moments.
+/// The accumulation of one chunk of strands. Moments live in one array; each touched leaf-sized
+/// block (8³ voxels) maps its voxels to slots in it. Consecutive flushes of a strand mostly hit
+/// the same block, which is cached, so a flush costs a compare, an index and nine adds.
 struct Chunk
 {
-    openvdb::Int32Tree index{-1};
+    static constexpr std::uint32_t kEmpty = 0xffffffffu;
+    struct Block
+    {
+        std::uint32_t slot[512];
+    };
+    std::unordered_map<std::uint64_t, std::uint32_t> blockOf;  // packed block coordinate -> block index
+    std::vector<Block> blocks;
+    std::vector<Coord> origins;
     std::vector<Moments> moments;
+
+    static std::uint64_t key(const Coord& origin)
+    {
+        return (std::uint64_t(std::uint32_t(origin.x()) >> 3) << 42) ^ (std::uint64_t(std::uint32_t(origin.y()) >> 3) << 21) ^
+               std::uint64_t(std::uint32_t(origin.z()) >> 3);
+    }
+    /// The block of @a origin, or nullptr.
+    const Block* find(const Coord& origin) const
+    {
+        const auto it = blockOf.find(key(origin));
+        return it == blockOf.end() ? nullptr : &blocks[it->second];
+    }
+};
+
+/// Adds moments to a chunk, caching the block of the last voxel.
+class ChunkWriter
+{
+public:
+    explicit ChunkWriter(Chunk& c) : mChunk(c) {}
+
+    void add(const Coord& ijk, const Moments& m)
+    {
+        const Coord origin(ijk.x() & ~7, ijk.y() & ~7, ijk.z() & ~7);
+        if (mBlock == Chunk::kEmpty || origin != mOrigin) {
+            mOrigin = origin;
+            const auto [it, inserted] = mChunk.blockOf.try_emplace(Chunk::key(origin), std::uint32_t(mChunk.blocks.size()));
+            if (inserted) {
+                mChunk.blocks.emplace_back();
+                std::fill(std::begin(mChunk.blocks.back().slot), std::end(mChunk.blocks.back().slot), Chunk::kEmpty);
+                mChunk.origins.push_back(origin);
+            }
+            mBlock = it->second;
+        }
+        std::uint32_t& slot = mChunk.blocks[mBlock].slot[((ijk.x() & 7) << 6) | ((ijk.y() & 7) << 3) | (ijk.z() & 7)];
+        if (slot == Chunk::kEmpty) {
+            slot = std::uint32_t(mChunk.moments.size());
+            mChunk.moments.push_back(m);
+        } else {
+            mChunk.moments[slot].add(m);
+        }
+    }
+
+private:
+    Chunk& mChunk;
+    Coord mOrigin;
+    std::uint32_t mBlock = Chunk::kEmpty;
 };
 
 /// Strands are split into this many chunks whatever the thread count (determinism).
@@ -146,39 +203,43 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
 
     // Accumulate the moments, chunk by chunk (each chunk in strand order).
     const std::size_t nS = strands.numStrands(), nChunks = chunkCount(nS);
+    // Chunks of spatially sorted strands: neighbouring strands share voxels, so a chunk's
+    // moments stay small and in cache.
+    const std::vector<std::uint32_t> order = spatialOrder(strands);
     std::vector<Chunk> chunks(nChunks);
     auto accumulateChunk = [&](std::size_t c) {
-        Chunk& chunk = chunks[c];
-        openvdb::tree::ValueAccessor<openvdb::Int32Tree> acc(chunk.index);
+        ChunkWriter writer(chunks[c]);
         Coord current(std::numeric_limits<int>::max());
         Moments pending;
         auto flush = [&]() {
             if (pending.empty()) return;
-            int idx;
-            if (acc.probeValue(current, idx)) {
-                chunk.moments[std::size_t(idx)].add(pending);
-            } else {
-                acc.setValue(current, int(chunk.moments.size()));
-                chunk.moments.push_back(pending);
-            }
+            writer.add(current, pending);
             pending = Moments();
         };
         const std::size_t first = nS * c / nChunks, last = nS * (c + 1) / nChunks;
-        for (std::size_t i = first; i < last; ++i) {
-            if (interrupter && (i & 255) == 0 && interrupter->wasInterrupted()) return;
-            for (std::size_t v = strands.begin(i); v + 1 < strands.end(i); ++v) {
-                const Vec3d pa(strands.positions[v]), pb(strands.positions[v + 1]);
+        for (std::size_t o = first; o < last; ++o) {
+            if (interrupter && (o & 255) == 0 && interrupter->wasInterrupted()) return;
+            const std::size_t i = order[o];
+            Vec3d pa(strands.root(i));
+            Vec3d ia = map.worldToIndex(pa);
+            for (std::size_t v = strands.begin(i) + 1; v < strands.end(i); ++v) {
+                const Vec3d pb(strands.positions[v]);
+                const Vec3d ib = map.worldToIndex(pb);
                 const Vec3d seg = pb - pa;
                 const double len = seg.length();
-                if (len == 0.0) continue;
-                const Vec3d t = seg / len;
-                walkSegment(map.worldToIndex(pa), map.worldToIndex(pb), [&](const Coord& ijk, double t0, double t1) {
-                    if (ijk != current) {
-                        flush();
-                        current = ijk;
-                    }
-                    pending.add(t, (t1 - t0) * len);
-                });
+                if (len > 0.0) {
+                    const float t[3] = {float(seg.x() / len), float(seg.y() / len), float(seg.z() / len)};
+                    const float tt[6] = {t[0] * t[0], t[1] * t[1], t[2] * t[2], t[0] * t[1], t[0] * t[2], t[1] * t[2]};
+                    walkSegment(ia, ib, [&](const Coord& ijk, double t0, double t1) {
+                        if (ijk != current) {
+                            flush();
+                            current = ijk;
+                        }
+                        pending.add(t, tt, float((t1 - t0) * len));
+                    });
+                }
+                pa = pb;
+                ia = ib;
             }
         }
         flush();
@@ -192,26 +253,36 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     }
     if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("estimateTangentField: interrupted");
 
-    // Topology: every voxel any chunk touched.
-    openvdb::Int32Tree topology(-1);
-    for (const Chunk& c : chunks) topology.topologyUnion(c.index);
+    // Topology: every block any chunk touched, as leaves of the output trees.
+    openvdb::Vec3STree::Ptr tangentTree(new openvdb::Vec3STree(openvdb::Vec3f(0.f)));
+    openvdb::FloatTree::Ptr densityTree(new openvdb::FloatTree(0.f));
+    for (const Chunk& c : chunks) {
+        for (const Coord& origin : c.origins) {
+            tangentTree->touchLeaf(origin);
+            densityTree->touchLeaf(origin);
+        }
+    }
 
     // Per leaf: merge the chunks in order, then Eq. 9 and the density.
-    openvdb::Vec3STree::Ptr tangentTree(new openvdb::Vec3STree(topology, openvdb::Vec3f(0.f), openvdb::TopologyCopy()));
-    openvdb::FloatTree::Ptr densityTree(new openvdb::FloatTree(topology, 0.f, openvdb::TopologyCopy()));
     openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(*tangentTree);
     leaves.foreach([&](openvdb::Vec3STree::LeafNodeType& leaf, std::size_t) {
-        std::array<Moments, openvdb::Vec3STree::LeafNodeType::SIZE> sum{};
+        std::array<Moments, 512> sum{};
+        std::array<bool, 512> hit{};
         for (const Chunk& c : chunks) {
-            const auto* cl = c.index.probeConstLeaf(leaf.origin());
-            if (!cl) continue;
-            for (auto it = cl->cbeginValueOn(); it; ++it) sum[it.pos()].add(c.moments[std::size_t(*it)]);
+            const Chunk::Block* block = c.find(leaf.origin());
+            if (!block) continue;
+            for (int k = 0; k < 512; ++k) {
+                if (block->slot[k] == Chunk::kEmpty) continue;
+                sum[std::size_t(k)].add(c.moments[block->slot[k]]);
+                hit[std::size_t(k)] = true;
+            }
         }
         auto* dl = densityTree->probeLeaf(leaf.origin());
-        for (auto it = leaf.beginValueOn(); it; ++it) {
-            const Moments& mo = sum[it.pos()];
-            it.setValue(robustDirection(mo, p.iterations));
-            dl->setValueOnly(it.pos(), mo.m[0] + mo.m[1] + mo.m[2]);
+        for (openvdb::Index k = 0; k < 512; ++k) {
+            if (!hit[k]) continue;
+            const Moments& mo = sum[k];
+            leaf.setValueOn(k, robustDirection(mo, p.iterations));
+            dl->setValueOn(k, mo.m[0] + mo.m[1] + mo.m[2]);
         }
     }, threaded);
 

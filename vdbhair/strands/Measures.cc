@@ -181,3 +181,42 @@ StrandSummary summarizeStrands(const StrandSet& strands)
 }
 
 } // namespace vdbhair
+
+namespace vdbhair {
+
+namespace {
+/// Spread the low 10 bits of @a v to every third bit.
+std::uint32_t spreadBits(std::uint32_t v)
+{
+    v &= 0x3ff;
+    v = (v | (v << 16)) & 0x030000ff;
+    v = (v | (v << 8)) & 0x0300f00f;
+    v = (v | (v << 4)) & 0x030c30c3;
+    v = (v | (v << 2)) & 0x09249249;
+    return v;
+}
+} // namespace
+
+std::vector<std::uint32_t> spatialOrder(const StrandSet& strands)
+{
+    const std::size_t nS = strands.numStrands();
+    BBox box;
+    for (std::size_t i = 0; i < nS; ++i) box.expand(strands.root(i));
+    const Vec3f e = box.extent();
+    std::vector<std::uint64_t> keys(nS);
+    for (std::size_t i = 0; i < nS; ++i) {
+        std::uint32_t code = 0;
+        for (int k = 0; k < 3; ++k) {
+            const float f = e[k] > 0.f ? (strands.root(i)[k] - box.min[k]) / e[k] : 0.f;
+            const std::uint32_t q = std::uint32_t(std::min(1023.f, std::max(0.f, f * 1024.f)));
+            code |= spreadBits(q) << k;
+        }
+        keys[i] = (std::uint64_t(code) << 32) | std::uint64_t(i);
+    }
+    std::sort(keys.begin(), keys.end());
+    std::vector<std::uint32_t> order(nS);
+    for (std::size_t i = 0; i < nS; ++i) order[i] = std::uint32_t(keys[i] & 0xffffffffu);
+    return order;
+}
+
+} // namespace vdbhair

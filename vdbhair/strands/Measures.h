@@ -65,3 +65,13 @@ struct StrandSummary
 StrandSummary summarizeStrands(const StrandSet& strands);
 
 } // namespace vdbhair
+
+namespace vdbhair {
+
+/// @brief The strand indices sorted along a Morton (Z-order) curve of their roots, quantized to
+/// 2^10 cells per axis of the roots' bounding box (ties keep index order). Processing strands in
+/// this order keeps neighbouring strands together, which keeps the grid data they touch in cache.
+/// A deterministic function of the roots only.
+std::vector<std::uint32_t> spatialOrder(const StrandSet& strands);
+
+} // namespace vdbhair
