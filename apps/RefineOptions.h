@@ -14,9 +14,11 @@ namespace vdbhair::app {
 struct RefineCmdParams
 {
     std::string input, output, saveField;
-    double voxelSize = -1.0;  ///< < 0: not given
+    double voxelSize = 0.0;
+    CLI::Option* voxelOpt = nullptr;  ///< whether --voxel-size was given
     int levels = 1, iterations = 2;
-    double step = -1.0;       ///< < 0: not given
+    double step = 0.0;
+    CLI::Option* stepOpt = nullptr;   ///< whether --step was given
     std::string integrator = "euler";
     int margin = 3;
     std::uint64_t maxVoxels = std::uint64_t(1) << 26;

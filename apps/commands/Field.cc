@@ -17,7 +17,8 @@ namespace {
 struct FieldCmdParams
 {
     std::string input, output;
-    double voxelSize = -1.0;  ///< < 0: not given
+    double voxelSize = 0.0;
+    CLI::Option* voxelOpt = nullptr;  ///< whether --voxel-size was given
     int iterations = 2;
     int levels = 1;
     std::uint64_t maxVoxels = std::uint64_t(1) << 26;
@@ -30,7 +31,8 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
 {
     if (p.output.empty()) throw ValueError("needs an output: -o OUT.vdb");
     if (fileExtension(p.output) != ".vdb") throw ValueError(p.output + ": the field is written as OpenVDB; the output must end in .vdb");
-    if (p.voxelSize != -1.0 && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
+    const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0;
+    if (voxelGiven && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
         throw ValueError("--voxel-size " + std::to_string(p.voxelSize) + ": must be a positive finite length");
     }
     if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
@@ -38,7 +40,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
 
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
     FieldParams fp;
-    fp.voxelSize = p.voxelSize > 0.0 ? p.voxelSize : suggestVoxelSize(strands);
+    fp.voxelSize = voxelGiven ? p.voxelSize : suggestVoxelSize(strands);
     fp.iterations = p.iterations;
     fp.maxVoxels = p.maxVoxels;
     applyScalpOptions(p.scalp, strands, fp);
@@ -87,7 +89,7 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = app.add_subcommand("field", "Estimate the robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9) as VDB grids");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent' and 'density' (or *_level_<l>)")->required();
-    sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: twice the mean segment length)");
+    params->voxelOpt = sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: twice the mean segment length)");
     sub->add_option("--iterations", params->iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
     sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
     sub->add_option("--max-voxels", params->maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();

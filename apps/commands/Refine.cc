@@ -14,19 +14,20 @@ namespace vdbhair::app {
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands)
 {
     RefineParams rp;
-    if (p.voxelSize != -1.0 && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
+    const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0, stepGiven = p.stepOpt && p.stepOpt->count() > 0;
+    if (voxelGiven && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
         throw ValueError("--voxel-size " + std::to_string(p.voxelSize) + ": must be a positive finite length");
     }
-    if (p.step != -1.0 && (!(p.step > 0.0) || !std::isfinite(p.step))) {
+    if (stepGiven && (!(p.step > 0.0) || !std::isfinite(p.step))) {
         throw ValueError("--step " + std::to_string(p.step) + ": must be a positive finite length");
     }
     if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
     if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");
-    rp.field.voxelSize = p.voxelSize > 0.0 ? p.voxelSize : 0.0;
+    rp.field.voxelSize = voxelGiven ? p.voxelSize : 0.0;
     rp.field.iterations = p.iterations;
     rp.field.maxVoxels = p.maxVoxels;
     rp.levels = p.levels;
-    rp.trace.step = p.step > 0.0 ? p.step : 0.0;
+    rp.trace.step = stepGiven ? p.step : 0.0;
     rp.trace.integrator = integratorFromName(p.integrator);
     if (p.margin < 0 || p.margin > 16) throw ValueError("--margin " + std::to_string(p.margin) + ": must be between 0 and 16 voxels");
     rp.trace.margin = p.margin;
@@ -86,10 +87,10 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
 
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
 {
-    sub->add_option("--voxel-size", p.voxelSize, "Finest voxel size in world units (default: twice the mean segment length)");
+    p.voxelOpt = sub->add_option("--voxel-size", p.voxelSize, "Finest voxel size in world units (default: twice the mean segment length)");
     sub->add_option("--levels", p.levels, "Levels, coarse (h*2^(n-1)) to fine (h)")->capture_default_str();
     sub->add_option("--iterations", p.iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
-    sub->add_option("--step", p.step, "Integration step in world units (default: half of each level's voxel)");
+    p.stepOpt = sub->add_option("--step", p.step, "Integration step in world units (default: half of each level's voxel)");
     sub->add_option("--integrator", p.integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
     sub->add_option("--margin", p.margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
     sub->add_option("--max-voxels", p.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();

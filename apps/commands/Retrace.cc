@@ -36,7 +36,8 @@ namespace {
 struct RetraceParams
 {
     std::string input, output, field, grid = "tangent";
-    double step = -1.0;
+    double step = 0.0;
+    CLI::Option* stepOpt = nullptr;
     std::string integrator = "euler", vertices = "input";
     double vanish = 1e-3;
     std::size_t maxSteps = 0;
@@ -48,10 +49,11 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 {
     TraceParams tp;
     tp.integrator = integratorFromName(p.integrator);
-    if (p.step != -1.0 && (!(p.step > 0.0) || !std::isfinite(p.step))) {
+    const bool stepGiven = p.stepOpt && p.stepOpt->count() > 0;
+    if (stepGiven && (!(p.step > 0.0) || !std::isfinite(p.step))) {
         throw ValueError("--step " + std::to_string(p.step) + ": must be a positive finite length");
     }
-    tp.step = p.step > 0.0 ? p.step : 0.0;
+    tp.step = stepGiven ? p.step : 0.0;
     if (!(p.vanish >= 0.0 && p.vanish < 1.0)) throw ValueError("--vanish " + std::to_string(p.vanish) + ": must be in [0, 1)");
     tp.vanishThreshold = p.vanish;
     tp.maxSteps = p.maxSteps;
@@ -98,7 +100,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--field", params->field, "A .vdb file holding the field")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
     sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
-    sub->add_option("--step", params->step, "Integration step in world units (default: half a voxel)");
+    params->stepOpt = sub->add_option("--step", params->step, "Integration step in world units (default: half a voxel)");
     sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
     sub->add_option("--vanish", params->vanish, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
     sub->add_option("--max-steps", params->maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
