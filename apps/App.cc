@@ -4,6 +4,8 @@
 #include <vdbhair/Version.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/helicoid/Scene.h>
 
 #include <openvdb/Exceptions.h>
 #include <tbb/global_control.h>
@@ -37,6 +39,16 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
     printWarnings(verb, report, common);
     if (strands.empty()) throw FormatError(path + ": the file has no strands");
     return strands;
+}
+
+StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common)
+{
+    if (fileExtension(path) == ".json") {
+        StrandSet s = growScene(readScene(path));
+        if (s.empty()) throw FormatError(path + ": the scene has no guides");
+        return s;
+    }
+    return loadStrands(verb, path, common);
 }
 
 void addScalpOptions(CLI::App* sub, ScalpOptions& opts)
@@ -88,6 +100,8 @@ int run(int argc, char** argv)
     commands.push_back(addFieldCommand(app, common));
     commands.push_back(addRetraceCommand(app, common));
     commands.push_back(addRefineCommand(app, common));
+    commands.push_back(addGrowCommand(app, common));
+    commands.push_back(addRenderCommand(app, common));
     commands.push_back(addDemoCommand(app, common));
 
     std::string verb = "";

@@ -51,6 +51,9 @@ void printJson(const nlohmann::json& j);
 StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common,
                       bool strict = false);
 
+/// @brief As loadStrands(), and a helicoid scene (.json) is grown first.
+StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common);
+
 /// @brief The scalp sphere options of `field` and `refine` (`--space scalp`).
 struct ScalpOptions
 {
@@ -70,6 +73,8 @@ Command addDemoCommand(CLI::App& app, CommonOptions& common);
 Command addFieldCommand(CLI::App& app, CommonOptions& common);
 Command addRetraceCommand(CLI::App& app, CommonOptions& common);
 Command addRefineCommand(CLI::App& app, CommonOptions& common);
+Command addGrowCommand(CLI::App& app, CommonOptions& common);
+Command addRenderCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line.

@@ -5,4 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-vdbhair-demo}"
 ./scripts/build.sh
-./build/bin/vdbhair demo scenes/default/ponytail.hair -o "$out"
+./build/bin/vdbhair demo scenes/default/head.json -o "$out"

@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake pkg-config ccache
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libeigen3-dev libopenimageio-dev
   catch2 libcli11-dev nlohmann-json3-dev libnanoflann-dev libnlopt-dev libnlopt-cxx-dev
-  libopenvdb-tools python3-openvdb python3-numpy
+  libopenvdb-tools python3-openvdb python3-numpy fonts-dejavu-core
 )
 
 missing=()

@@ -7,6 +7,7 @@
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrandGrid.h>
+#include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <chrono>
@@ -26,7 +27,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
 {
     namespace fs = std::filesystem;
     const auto t0 = std::chrono::steady_clock::now();
-    const StrandSet strands = loadStrands("demo", p.refine.input, common);
+    const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common);
     const RefineParams rp = refineParamsFrom(p.refine, strands);
     std::error_code ec;
     fs::create_directories(p.outDir, ec);
@@ -40,6 +41,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     const std::string fieldPath = (fs::path(dir) / "field.vdb").string();
     const std::string strandsPath = (fs::path(dir) / "strands.vdb").string();
     const std::string reportPath = (fs::path(dir) / "report.json").string();
+    const std::string previewPath = (fs::path(dir) / "preview.png").string();
     writeStrands(refinedPath, r.strands);
     writeVdbGrids(fieldPath, fieldGrids(r), "demo(" + fieldPath + ")");
     {
@@ -49,12 +51,33 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
         auto after = createStrandGrid(r.strands);
         writeVdbGrids(strandsPath, {after, before}, "demo(" + strandsPath + ")");
     }
+    {
+        // Before (top row) and after (bottom row): front, side and three-quarter views, one framing.
+        RenderParams rp;
+        rp.width = 480;
+        rp.height = 480;
+        BBox box = computeBBox(strands);
+        const BBox after = computeBBox(r.strands);
+        box.expand(after.min);
+        box.expand(after.max);
+        rp.frame = box;
+        Image sheet(3 * rp.width, 2 * rp.height, rp.background);
+        const View views[3] = {View::Front, View::Side, View::ThreeQuarter};
+        for (int row = 0; row < 2; ++row) {
+            for (int i = 0; i < 3; ++i) {
+                rp.view = views[i];
+                rp.title = std::string(row == 0 ? "input" : "refined") + ": " + viewName(views[i]);
+                sheet.paste(renderStrands(row == 0 ? strands : r.strands, rp), i * rp.width, row * rp.height);
+            }
+        }
+        writeImage(previewPath, sheet);
+    }
     const StrandSummary s = summarizeStrands(strands);
     nlohmann::json report = refineReportJson(r, rp);
     report["scene"] = p.refine.input;
     report["vertices"] = s.vertices;
     report["seconds"] = seconds;
-    report["outputs"] = {refinedPath, fieldPath, strandsPath, reportPath};
+    report["outputs"] = {refinedPath, fieldPath, strandsPath, previewPath, reportPath};
     writeFileAtomic(reportPath, report.dump(2) + "\n", "demo(" + reportPath + ")");
 
     if (common.json) {
@@ -68,6 +91,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
         std::cout << "wrote " << refinedPath << " (refined strands)\n"
                   << "wrote " << fieldPath << " (grids 'tangent' and 'density')\n"
                   << "wrote " << strandsPath << " (points grids 'strands' and 'strands_input', for Houdini or Blender)\n"
+                  << "wrote " << previewPath << " (before and after)\n"
                   << "wrote " << reportPath << "\n";
     }
     return 0;
@@ -79,11 +103,11 @@ Command addDemoCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<DemoParams>();
     CLI::App* sub = app.add_subcommand("demo", "The main job: refine a hairstyle through its own tangent field, all results in one folder");
-    sub->add_option("scene", params->refine.input, "The hairstyle (the README passes the bundled default)")->required();
+    sub->add_option("scene", params->refine.input, "The hairstyle: strands, or a helicoid scene .json (the README passes the bundled default)")->required();
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing)")->capture_default_str();
     addRefineOptions(sub, params->refine);
     addCommonOptions(sub, common);
-    sub->footer("Example: vdbhair demo scenes/default/ponytail.hair -o out --levels 2");
+    sub->footer("Example: vdbhair demo scenes/default/head.json -o out --levels 2");
     return {sub, [params, &common] { return runDemo(*params, common); }};
 }
 

@@ -1,0 +1,60 @@
+// vdbhair grow SCENE.json -o OUT: helicoid scenes (Piuze et al. 2011) to strands.
+#include "../Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <chrono>
+
+namespace vdbhair::app {
+
+namespace {
+
+struct GrowParams
+{
+    std::string scene, output, integrator = "euler";
+    std::size_t maxVertices = std::size_t(1) << 30;
+};
+
+int runGrow(const GrowParams& p, const CommonOptions& common)
+{
+    strandFormatFromPath(p.output, /*forWriting=*/true);
+    GrowOptions opts;
+    if (p.integrator == "euler") opts.integrator = HelicoidIntegrator::Euler;
+    else if (p.integrator == "rk4") opts.integrator = HelicoidIntegrator::RK4;
+    else throw ValueError("--integrator '" + p.integrator + "' is not one of euler, rk4");
+    opts.maxVertices = p.maxVertices;
+    const Scene scene = readScene(p.scene);
+    const auto t0 = std::chrono::steady_clock::now();
+    const StrandSet strands = growScene(scene, opts);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (strands.empty()) throw FormatError(p.scene + ": the scene has no guides; nothing to write");
+    writeStrands(p.output, strands);
+    if (common.json) {
+        printJson({{"scene", p.scene}, {"output", p.output}, {"guides", scene.guides.size()},
+                   {"strands", strands.numStrands()}, {"vertices", strands.numVertices()}, {"seconds", seconds}});
+    } else if (!common.quiet) {
+        std::cout << "grew " << strands.numStrands() << " strands (" << scene.guides.size() << " guides and their wisps), "
+                  << strands.numVertices() << " vertices in " << seconds << " s\nwrote " << p.output << "\n";
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addGrowCommand(CLI::App& app, CommonOptions& common)
+{
+    auto params = std::make_shared<GrowParams>();
+    CLI::App* sub = app.add_subcommand("grow", "Grow the strands of a helicoid scene (guides, p-helicoid pieces, waviness, wisps)");
+    sub->add_option("scene", params->scene, "Scene file (JSON, \"vdbhair\": \"scene/1\")")->required();
+    sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
+    sub->add_option("--integrator", params->integrator, "euler (Eq. 3, the paper's) or rk4")->capture_default_str();
+    sub->add_option("--max-vertices", params->maxVertices, "Refuse scenes that would grow more vertices")->capture_default_str();
+    addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair grow scenes/figures/fig3_wisp.json -o wisp.hair");
+    return {sub, [params, &common] { return runGrow(*params, common); }};
+}
+
+} // namespace vdbhair::app

@@ -1,0 +1,153 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/Helicoid.h>
+#include <vdbhair/helicoid/Waviness.h>
+#include <vdbhair/helicoid/Wisp.h>
+
+using namespace vdbhair;
+
+namespace {
+HelicoidTrace trace(const HelicoidParams& k, double length, double step, HelicoidIntegrator integ = HelicoidIntegrator::Euler,
+                    const FrameD& frame = FrameD::fromTangentNormal(Vec3d(1, 0, 0), Vec3d(0, 1, 0)), const Vec3d& root = Vec3d(0.0))
+{
+    HelicoidTrace t;
+    tracePHelicoid(root, frame, {HelicoidPiece{k, length, 0.0}}, step, integ, t);
+    return t;
+}
+} // namespace
+
+TEST_CASE("tracePHelicoid: k = 0 traces a straight line of length L", "[helicoid]")
+{
+    const FrameD f = FrameD::fromTangentNormal(Vec3d(1, 2, 2), Vec3d(0, 0, 1));
+    const HelicoidTrace t = trace({}, 3.05, 0.1, HelicoidIntegrator::Euler, f, Vec3d(1, 1, 1));
+    REQUIRE(t.points.size() == 32);  // 30 steps of 0.1 and a last one of 0.05
+    REQUIRE(t.arc.back() == Approx(3.05));
+    REQUIRE((t.points.back() - (Vec3d(1, 1, 1) + 3.05 * f.t)).length() < 1e-12);
+    for (const FrameD& fr : t.frames) REQUIRE((fr.t - f.t).length() < 1e-12);
+}
+
+TEST_CASE("tracePHelicoid: k = (kT,0,0,0) traces the circle of radius 1/kT about p0 + E_N/kT, through full turns", "[helicoid]")
+{
+    const double kT = 2.0, r = 1.0 / kT, turns = 3.0, L = turns * 2.0 * M_PI * r;
+    const FrameD f = FrameD::fromTangentNormal(Vec3d(0, 0, 1), Vec3d(1, 0, 0));
+    const Vec3d root(0.5, -1.0, 2.0), centre = root + f.n * r;
+    double errEuler[2];
+    for (int level = 0; level < 2; ++level) {
+        const double step = level == 0 ? 0.01 : 0.005;
+        const HelicoidTrace t = trace({kT, 0, 0, 0}, L, step, HelicoidIntegrator::Euler, f, root);
+        double worst = 0.0;
+        for (const Vec3d& p : t.points) {
+            REQUIRE(std::abs((p - root).dot(f.b)) < 1e-12);  // stays in the E_T–E_N plane
+            worst = std::max(worst, std::abs((p - centre).length() - r));
+        }
+        errEuler[level] = worst;
+    }
+    // Euler spirals out by theta·h/2 (theta = 6π here); halving the step halves it.
+    CAPTURE(errEuler[0], errEuler[1]);
+    REQUIRE(errEuler[0] < 1.05 * 6.0 * M_PI * 0.01 / 2.0);
+    REQUIRE(errEuler[0] / errEuler[1] == Approx(2.0).epsilon(0.05));
+    // RK4 stays on the circle, and after three turns it is back at the root.
+    const HelicoidTrace rk = trace({kT, 0, 0, 0}, L, 0.01, HelicoidIntegrator::RK4, f, root);
+    for (const Vec3d& p : rk.points) REQUIRE(std::abs((p - centre).length() - r) < 1e-9);
+    REQUIRE((rk.points.back() - root).length() < 1e-8);
+}
+
+TEST_CASE("tracePHelicoid: k = (0,kN,0,0) gives straight streamlines fanning out from p0 - E_T/kN", "[helicoid]")
+// (in each plane parallel to E_T–E_N: the fan's centre is the line through p0 - E_T/kN along E_B)
+{
+    const double kN = 0.5;
+    const FrameD f = FrameD::fromTangentNormal(Vec3d(1, 0, 0), Vec3d(0, 1, 0));
+    Helicoid h;
+    h.k = {0, kN, 0, 0};
+    h.q = f;
+    for (const Vec3d& start : {Vec3d(0, 0.3, 0.0), Vec3d(0.2, -0.4, 0.0), Vec3d(-0.1, 0.0, 0.5), Vec3d(0.0, 0.3, 0.1)}) {
+        const Vec3d sink = h.p0 - f.t / kN + f.b * start.dot(f.b);
+        HelicoidTrace t;
+        const std::vector<Helicoid> field{h};
+        tracePHelicoid(start, f, {HelicoidPiece{h.k, 2.0, 0.0}}, 0.01, HelicoidIntegrator::Euler, t, &field);
+        const Vec3d dir = (start - sink).unit();
+        for (const Vec3d& p : t.points) {
+            CAPTURE(start, p);
+            const Vec3d d = p - sink;
+            REQUIRE((d - dir * d.dot(dir)).length() < 1e-9);  // on the ray from the sink through the start
+        }
+    }
+}
+
+TEST_CASE("tracePHelicoid: theta unwraps through full turns, so phi = alpha·theta stays continuous", "[helicoid]")
+{
+    // Large alpha makes any 2π jump of theta a visible jump of the frame.
+    const HelicoidTrace t = trace({2.0, 0.0, 0.0, 0.25}, 4.0 * 2.0 * M_PI * 0.5, 0.005, HelicoidIntegrator::RK4);
+    for (std::size_t i = 1; i < t.frames.size(); ++i) {
+        CAPTURE(i);
+        REQUIRE(t.frames[i].t.dot(t.frames[i - 1].t) > std::cos(0.05));
+        REQUIRE(t.frames[i].b.dot(t.frames[i - 1].b) > std::cos(0.05));
+    }
+    // phi grew past 2π·alpha: the strand has left the plane far more than one turn would allow.
+    REQUIRE(std::abs(t.frames.back().t.z()) > 0.5);
+}
+
+TEST_CASE("tracePHelicoid: p-helicoid joints keep the frame (C1, and more)", "[helicoid]")
+{
+    const std::vector<HelicoidPiece> pieces{{{1.0, -0.1, 0.3, 1.0}, 1.5, 0.0}, {{-2.0, 0.4, 1.0, 0.2}, 1.0, 0.0}, {{0.5, 0.5, -0.5, 0.0}, 0.7, 0.0}};
+    HelicoidTrace t;
+    tracePHelicoid(Vec3d(0.0), FrameD::fromTangentNormal(Vec3d(0, 1, 0), Vec3d(1, 0, 0)), pieces, 0.001, HelicoidIntegrator::Euler, t);
+    REQUIRE(t.joints.size() == 3);
+    REQUIRE(t.arc.back() == Approx(3.2));
+    for (std::size_t j = 1; j < t.joints.size(); ++j) {
+        const std::size_t i = t.joints[j];
+        // The new piece starts at the joint with the frame of Eq. 2 there.
+        REQUIRE((t.pieces[j].p0 - t.points[i]).length() < 1e-12);
+        const Vec3d before = (t.points[i] - t.points[i - 1]).unit(), after = (t.points[i + 1] - t.points[i]).unit();
+        CAPTURE(j, before, after);
+        REQUIRE(before.dot(after) > std::cos(0.01));  // one step's turn at most
+        REQUIRE((t.pieces[j].q.t - after).length() < 1e-9);
+    }
+    // A roll turns the next piece's frame about the tangent, keeping the tangent.
+    std::vector<HelicoidPiece> rolled = pieces;
+    rolled[1].roll = 0.7;
+    HelicoidTrace tr;
+    tracePHelicoid(Vec3d(0.0), FrameD::fromTangentNormal(Vec3d(0, 1, 0), Vec3d(1, 0, 0)), rolled, 0.001, HelicoidIntegrator::Euler, tr);
+    REQUIRE((tr.pieces[1].q.t - t.pieces[1].q.t).length() < 1e-12);
+    REQUIRE(tr.pieces[1].q.n.dot(t.pieces[1].q.n) == Approx(std::cos(0.7)));
+}
+
+TEST_CASE("traceWisp: wisp strands follow the guide's field at their own points", "[helicoid]")
+{
+    const std::vector<HelicoidPiece> pieces{{{1.0, -0.1, 0.3, 1.0}, 1.0, 0.0}, {{0.5, 0.2, -0.4, 0.5}, 1.0, 0.3}};
+    HelicoidTrace guide, wisp;
+    tracePHelicoid(Vec3d(0.0), FrameD::fromTangentNormal(Vec3d(1, 0, 0), Vec3d(0, 1, 0)), pieces, 0.01, HelicoidIntegrator::Euler, guide);
+    for (int w = 0; w < 20; ++w) {
+        Rng rng(7, 0, std::uint64_t(w + 1));
+        traceWisp(guide, pieces, WispParams{20, 0.05, 0.0}, 0.01, HelicoidIntegrator::Euler, rng, wisp);
+        REQUIRE(wisp.points.size() == guide.points.size());
+        const Vec3d off = wisp.points[0] - guide.points[0];
+        REQUIRE(off.length() <= 0.05 + 1e-12);
+        REQUIRE(std::abs(off.dot(guide.frames[0].t)) < 1e-12);  // in the E_N–E_B plane
+        REQUIRE(off.length() > 0.0);  // not a copy of the guide
+        for (std::size_t i = 0; i + 1 < wisp.points.size(); ++i) {
+            const std::size_t piece = i >= guide.joints[1] ? 1 : 0;
+            double th = guide.pieces[piece].theta(wisp.points[i], 0.0);
+            const Vec3d expected = guide.pieces[piece].tangent(wisp.points[i], th);
+            const Vec3d d = (wisp.points[i + 1] - wisp.points[i]).unit();
+            CAPTURE(w, i);
+            REQUIRE(d.dot(expected) > 1.0 - 1e-9);
+        }
+    }
+}
+
+TEST_CASE("applyWaviness: the offset is exactly the amplitude, in the normal plane", "[helicoid]")
+{
+    const HelicoidTrace t = trace({1.0, -0.1, 0.3, 1.0}, 2.0, 0.01);
+    std::vector<Vec3f> wavy(t.points.size());
+    Rng rng(1);
+    applyWaviness(t, WavinessParams{0.02, 40.0, 0.0, 0.0}, rng, wavy.data());
+    for (std::size_t i = 0; i < t.points.size(); ++i) {
+        const Vec3d d = Vec3d(wavy[i]) - t.points[i];
+        REQUIRE(d.length() == Approx(0.02).epsilon(1e-4));
+        REQUIRE(std::abs(d.dot(t.frames[i].t)) < 1e-6);
+    }
+    // Eq. 4 at s = 0: a·E_B.
+    REQUIRE((Vec3d(wavy[0]) - (t.points[0] + 0.02 * t.frames[0].b)).length() < 1e-6);
+}

@@ -1,0 +1,102 @@
+/// @file Helicoid.h
+/// @brief The generalized helicoid of Piuze, Kry & Siddiqi 2011 (§3): a parameter vector
+/// k = (kT, kN, kB, alpha) with a frame Q and an origin p0 describes an orientation field around
+/// p0; hair strands are its streamlines (Eq. 3), p-helicoids chain pieces (§3.4).
+///
+/// At a world point x, in the local coordinates y = Qᵀ (x - p0) (Q's columns are the world
+/// directions of the local x, y, z axes: E_T, E_N, E_B at the origin),
+///   theta = atan2(kT y1 + kN y2, 1 + kN y1 - kT y2) + kB y3,    phi = alpha · theta    (Eq. 1)
+/// and the frame is (Eq. 2, mapped to world space by Q)
+///   E_T = (cos phi cos theta, cos phi sin theta, sin phi),  E_N = (-sin theta, cos theta, 0),
+///   E_B = (-sin phi cos theta, -sin phi sin theta, cos phi).
+/// theta is **unwrapped along a trace**: atan2 jumps by 2π when a streamline circles the axis,
+/// and the multiple of 2π that keeps theta closest to its previous value is added (the paper's
+/// "counting the 2π cycles theta completes"), so phi stays continuous through full turns.
+///
+/// Analytic cases (tested): k = 0 traces a straight line; k = (kT, 0, 0, 0) traces the circle of
+/// radius 1/kT about p0 + E_N/kT in the E_T–E_N plane; k = (0, kN, 0, 0) gives straight
+/// streamlines fanning out from p0 - E_T/kN.
+#pragma once
+
+#include <vdbhair/Types.h>
+
+#include <cstddef>
+#include <vector>
+
+namespace vdbhair {
+
+/// @brief k = (kT, kN, kB, alpha): curvatures in 1 / world units, alpha dimensionless.
+struct HelicoidParams
+{
+    double kT = 0.0, kN = 0.0, kB = 0.0, alpha = 0.0;
+};
+
+/// @brief An orthonormal right-handed frame in double precision: Q = [t n b].
+struct FrameD
+{
+    Vec3d t{1.0, 0.0, 0.0}, n{0.0, 1.0, 0.0}, b{0.0, 0.0, 1.0};
+
+    /// @brief The frame with tangent @a t and the part of @a n orthogonal to it.
+    /// @throw ValueError if @a t is zero or @a n is parallel to it.
+    static FrameD fromTangentNormal(const Vec3d& t, const Vec3d& n);
+    /// @brief This frame rolled by @a angle (radians) about t: n' = cos·n + sin·b.
+    FrameD rolled(double angle) const;
+    /// @brief This frame rotated by π about n (t and b flip; the kT sign symmetry of §4.1).
+    FrameD flippedAboutNormal() const { return FrameD{-t, n, -b}; }
+};
+
+/// @brief One generalized helicoid: parameters, frame and origin.
+struct Helicoid
+{
+    HelicoidParams k;
+    FrameD q;
+    Vec3d p0{0.0};
+
+    /// @brief theta at @a world, unwrapped to the value closest to @a thetaRef.
+    double theta(const Vec3d& world, double thetaRef) const;
+
+    /// @brief The world frame (E_T, E_N, E_B) for a given (unwrapped) theta.
+    FrameD frameFromTheta(double theta) const;
+
+    /// @brief Unit tangent E_T at @a world; updates @a thetaRef to the unwrapped theta there.
+    Vec3d tangent(const Vec3d& world, double& thetaRef) const;
+};
+
+/// @brief Integrators for helicoid streamlines: forward Euler is Eq. 3, the paper's choice;
+/// RK4 (with theta unwrapped at every stage) is for when the streamline must be exact.
+enum class HelicoidIntegrator { Euler, RK4 };
+
+/// @brief One piece of a p-helicoid: parameters, length (world units) and a roll about E_T applied
+/// to the frame it starts with.
+struct HelicoidPiece
+{
+    HelicoidParams k;
+    double length = 0.0;
+    double roll = 0.0;
+};
+
+/// @brief The traced points of a p-helicoid, with the frame of Eq. 2 at each point and the arc
+/// length of each point from the root.
+struct HelicoidTrace
+{
+    std::vector<Vec3d> points;
+    std::vector<FrameD> frames;
+    std::vector<double> arc;
+    std::vector<Helicoid> pieces;    ///< each piece's helicoid (its p0 and Q)
+    std::vector<std::size_t> joints; ///< index of each piece's first point
+};
+
+/// @brief Number of steps of @a step that trace @a length: ceil(length / step) (the last step
+/// shortened), 0 for a zero length.
+std::size_t stepCount(double length, double step);
+
+/// @brief Trace a p-helicoid from @a root with @a frame (Eq. 3, piece by piece, §3.4): piece i+1
+/// starts at the end of piece i with the frame of Eq. 2 there (then rolled by its roll), so
+/// tangents — and whole frames — are continuous at the joints.
+/// @param field optional: trace through these pieces' helicoids (their p0 and Q) instead of
+/// building them from @a root and @a frame; wisps use the guide's field this way.
+void tracePHelicoid(const Vec3d& root, const FrameD& frame, const std::vector<HelicoidPiece>& pieces,
+                    double step, HelicoidIntegrator integrator, HelicoidTrace& out,
+                    const std::vector<Helicoid>* field = nullptr);
+
+} // namespace vdbhair

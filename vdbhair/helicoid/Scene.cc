@@ -1,0 +1,279 @@
+#include "Scene.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <limits>
+#include <set>
+
+namespace vdbhair {
+
+namespace {
+
+using json = nlohmann::json;
+
+/// Parses with key paths in every message.
+struct Parser
+{
+    std::string where;
+
+    [[noreturn]] void fail(const std::string& path, const std::string& rule) const
+    {
+        throw FormatError(where + ": " + path + ": " + rule);
+    }
+    void allowOnly(const json& j, const std::string& path, const std::set<std::string>& keys) const
+    {
+        if (!j.is_object()) fail(path, "expected an object");
+        for (auto it = j.begin(); it != j.end(); ++it) {
+            if (!keys.count(it.key())) {
+                std::string list;
+                for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+                fail(path.empty() ? it.key() : path + "." + it.key(), "unknown key (allowed here: " + list + ")");
+            }
+        }
+    }
+    const json& require(const json& j, const std::string& path, const std::string& key) const
+    {
+        if (!j.contains(key)) fail(path.empty() ? key : path + "." + key, "missing");
+        return j.at(key);
+    }
+    double number(const json& j, const std::string& path) const
+    {
+        if (!j.is_number()) fail(path, "expected a number, got " + std::string(j.type_name()));
+        const double v = j.get<double>();
+        if (!std::isfinite(v)) fail(path, "expected a finite number");
+        return v;
+    }
+    Vec3d vec3(const json& j, const std::string& path) const
+    {
+        if (!j.is_array() || j.size() != 3) fail(path, "expected 3 numbers");
+        return Vec3d(number(j[0], path + "[0]"), number(j[1], path + "[1]"), number(j[2], path + "[2]"));
+    }
+    std::uint64_t count(const json& j, const std::string& path) const
+    {
+        if (!j.is_number_integer() || j.get<std::int64_t>() < 0) fail(path, "expected a non-negative integer");
+        return j.get<std::uint64_t>();
+    }
+};
+
+std::string idx(const std::string& base, std::size_t i) { return base + "[" + std::to_string(i) + "]"; }
+
+} // namespace
+
+Scene sceneFromJson(const json& j, const std::string& where)
+{
+    Parser P{where};
+    P.allowOnly(j, "", {"vdbhair", "seed", "step", "guides"});
+    const json& tag = P.require(j, "", "vdbhair");
+    if (!tag.is_string() || tag.get<std::string>() != "scene/1") P.fail("vdbhair", "expected \"scene/1\"");
+    Scene s;
+    if (j.contains("seed")) s.seed = P.count(j["seed"], "seed");
+    if (j.contains("step")) {
+        s.step = P.number(j["step"], "step");
+        if (!(s.step > 0.0)) P.fail("step", "must be positive");
+    }
+    const json& guides = P.require(j, "", "guides");
+    if (!guides.is_array()) P.fail("guides", "expected an array");
+    for (std::size_t g = 0; g < guides.size(); ++g) {
+        const std::string gp = idx("guides", g);
+        const json& gj = guides[g];
+        P.allowOnly(gj, gp, {"root", "frame", "pieces", "waviness", "wisp", "fit"});
+        SceneGuide guide;
+        guide.root = P.vec3(P.require(gj, gp, "root"), gp + ".root");
+        const json& fj = P.require(gj, gp, "frame");
+        P.allowOnly(fj, gp + ".frame", {"tangent", "normal"});
+        const Vec3d t = P.vec3(P.require(fj, gp + ".frame", "tangent"), gp + ".frame.tangent");
+        const Vec3d n = P.vec3(P.require(fj, gp + ".frame", "normal"), gp + ".frame.normal");
+        try {
+            guide.frame = FrameD::fromTangentNormal(t, n);
+        } catch (const ValueError& e) {
+            P.fail(gp + ".frame", e.what());
+        }
+        const json& pj = P.require(gj, gp, "pieces");
+        if (!pj.is_array() || pj.empty()) P.fail(gp + ".pieces", "expected a non-empty array");
+        for (std::size_t i = 0; i < pj.size(); ++i) {
+            const std::string pp = idx(gp + ".pieces", i);
+            P.allowOnly(pj[i], pp, {"k", "length", "roll"});
+            const json& kj = P.require(pj[i], pp, "k");
+            if (!kj.is_array() || kj.size() != 4) P.fail(pp + ".k", "expected 4 numbers (kT, kN, kB, alpha)");
+            HelicoidPiece piece;
+            piece.k = {P.number(kj[0], pp + ".k[0]"), P.number(kj[1], pp + ".k[1]"), P.number(kj[2], pp + ".k[2]"),
+                       P.number(kj[3], pp + ".k[3]")};
+            piece.length = P.number(P.require(pj[i], pp, "length"), pp + ".length");
+            if (piece.length < 0.0) P.fail(pp + ".length", "must not be negative");
+            if (pj[i].contains("roll")) piece.roll = P.number(pj[i]["roll"], pp + ".roll");
+            guide.pieces.push_back(piece);
+        }
+        double total = 0.0;
+        for (const HelicoidPiece& piece : guide.pieces) total += piece.length;
+        if (!(total > 0.0)) P.fail(gp + ".pieces", "the pieces' lengths add up to 0; a strand needs a positive length");
+        if (gj.contains("waviness")) {
+            const json& wj = gj["waviness"];
+            const std::string wp = gp + ".waviness";
+            P.allowOnly(wj, wp, {"amplitude", "frequency", "phase", "noise"});
+            WavinessParams w;
+            w.amplitude = P.number(P.require(wj, wp, "amplitude"), wp + ".amplitude");
+            w.frequency = P.number(P.require(wj, wp, "frequency"), wp + ".frequency");
+            if (wj.contains("phase")) w.phase = P.number(wj["phase"], wp + ".phase");
+            if (wj.contains("noise")) w.noise = P.number(wj["noise"], wp + ".noise");
+            if (w.amplitude < 0.0) P.fail(wp + ".amplitude", "must not be negative");
+            if (w.noise < 0.0) P.fail(wp + ".noise", "must not be negative");
+            guide.waviness = w;
+        }
+        if (gj.contains("wisp")) {
+            const json& wj = gj["wisp"];
+            const std::string wp = gp + ".wisp";
+            P.allowOnly(wj, wp, {"count", "radius", "fanning"});
+            WispParams w;
+            w.count = std::size_t(P.count(P.require(wj, wp, "count"), wp + ".count"));
+            w.radius = P.number(P.require(wj, wp, "radius"), wp + ".radius");
+            if (wj.contains("fanning")) w.fanning = P.number(wj["fanning"], wp + ".fanning");
+            if (w.radius < 0.0) P.fail(wp + ".radius", "must not be negative");
+            if (w.fanning < 0.0) P.fail(wp + ".fanning", "must not be negative");
+            guide.wisp = w;
+        }
+        if (gj.contains("fit")) guide.fit = gj["fit"];
+        s.guides.push_back(std::move(guide));
+    }
+    return s;
+}
+
+json sceneToJson(const Scene& s)
+{
+    json guides = json::array();
+    for (const SceneGuide& g : s.guides) {
+        json pieces = json::array();
+        for (const HelicoidPiece& p : g.pieces) {
+            json pj = {{"k", {p.k.kT, p.k.kN, p.k.kB, p.k.alpha}}, {"length", p.length}};
+            if (p.roll != 0.0) pj["roll"] = p.roll;
+            pieces.push_back(pj);
+        }
+        json gj = {{"root", {g.root.x(), g.root.y(), g.root.z()}},
+                   {"frame", {{"tangent", {g.frame.t.x(), g.frame.t.y(), g.frame.t.z()}},
+                              {"normal", {g.frame.n.x(), g.frame.n.y(), g.frame.n.z()}}}},
+                   {"pieces", pieces}};
+        if (g.waviness) {
+            gj["waviness"] = {{"amplitude", g.waviness->amplitude}, {"frequency", g.waviness->frequency}};
+            if (g.waviness->phase != 0.0) gj["waviness"]["phase"] = g.waviness->phase;
+            if (g.waviness->noise != 0.0) gj["waviness"]["noise"] = g.waviness->noise;
+        }
+        if (g.wisp) gj["wisp"] = {{"count", g.wisp->count}, {"radius", g.wisp->radius}, {"fanning", g.wisp->fanning}};
+        if (!g.fit.is_null()) gj["fit"] = g.fit;
+        guides.push_back(gj);
+    }
+    return {{"vdbhair", "scene/1"}, {"seed", s.seed}, {"step", s.step}, {"guides", guides}};
+}
+
+Scene readScene(const std::string& path)
+{
+    const std::vector<char> bytes = readFileBytes(path, path);
+    json j;
+    try {
+        j = json::parse(bytes.begin(), bytes.end());
+    } catch (const json::parse_error& e) {
+        throw FormatError(path + ": not valid JSON (" + std::string(e.what()) + ")");
+    }
+    return sceneFromJson(j, path);
+}
+
+void writeScene(const std::string& path, const Scene& scene)
+{
+    const json j = sceneToJson(scene);
+    // One guide per line: readable, diffable, and still one JSON document.
+    std::string out = "{\"vdbhair\": \"scene/1\", \"seed\": " + std::to_string(scene.seed) + ", \"step\": " +
+                      j["step"].dump() + ",\n \"guides\": [\n";
+    for (std::size_t i = 0; i < j["guides"].size(); ++i) {
+        out += "  " + j["guides"][i].dump() + (i + 1 < j["guides"].size() ? ",\n" : "\n");
+    }
+    out += " ]}\n";
+    writeFileAtomic(path, out, "writeScene(" + path + ")");
+}
+
+std::size_t sceneVertexCount(const Scene& scene)
+{
+    std::size_t total = 0;
+    constexpr std::size_t kMax = std::numeric_limits<std::size_t>::max() / 4;
+    for (const SceneGuide& g : scene.guides) {
+        double perStrand = 1.0;
+        for (const HelicoidPiece& p : g.pieces) perStrand += std::ceil(p.length / scene.step);
+        const double strands = 1.0 + (g.wisp ? double(g.wisp->count) : 0.0);
+        const double v = perStrand * strands;
+        if (v > double(kMax) || double(total) + v > double(kMax)) return kMax;
+        total += std::size_t(v);
+    }
+    return total;
+}
+
+StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded)
+{
+    if (!(scene.step > 0.0) || !std::isfinite(scene.step)) {
+        throw ValueError("growScene: step " + std::to_string(scene.step) + " must be a positive length");
+    }
+    const std::size_t estimate = sceneVertexCount(scene);
+    if (estimate > options.maxVertices) {
+        throw LimitError("growScene: the scene would grow about " + std::to_string(estimate) +
+                         " vertices, more than the cap of " + std::to_string(options.maxVertices) +
+                         " (fewer wisps, shorter pieces or a larger step)");
+    }
+    // Layout: guide g, then its wisps; every strand of a guide has the guide's vertex count.
+    struct Item { std::size_t guide, wisp; };  // wisp 0: the guide itself
+    std::vector<Item> items;
+    std::vector<std::uint32_t> offsets{0};
+    for (std::size_t g = 0; g < scene.guides.size(); ++g) {
+        const SceneGuide& guide = scene.guides[g];
+        std::size_t n = 1;
+        for (const HelicoidPiece& p : guide.pieces) n += stepCount(p.length, scene.step);
+        const std::size_t strands = 1 + (guide.wisp ? guide.wisp->count : 0);
+        for (std::size_t w = 0; w < strands; ++w) {
+            items.push_back({g, w});
+            offsets.push_back(std::uint32_t(offsets.back() + n));
+        }
+    }
+    StrandSet out;
+    out.offsets = offsets;
+    out.positions.resize(offsets.back());
+
+    // Guides first (wisps need their traces), then all strands in parallel.
+    std::vector<HelicoidTrace> guideTraces(scene.guides.size());
+    auto traceGuides = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t g = r.begin(); g != r.end(); ++g) {
+            tracePHelicoid(scene.guides[g].root, scene.guides[g].frame, scene.guides[g].pieces, scene.step,
+                           options.integrator, guideTraces[g]);
+        }
+    };
+    auto growItems = [&](const tbb::blocked_range<std::size_t>& r) {
+        HelicoidTrace wispTrace;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Item& it = items[i];
+            const SceneGuide& guide = scene.guides[it.guide];
+            Rng rng(scene.seed, it.guide, it.wisp);
+            const HelicoidTrace* trace = &guideTraces[it.guide];
+            if (it.wisp > 0) {
+                traceWisp(guideTraces[it.guide], guide.pieces, *guide.wisp, scene.step, options.integrator, rng, wispTrace);
+                trace = &wispTrace;
+            }
+            Vec3f* dst = out.positions.data() + out.offsets[i];
+            if (guide.waviness) {
+                applyWaviness(*trace, *guide.waviness, rng, dst);
+            } else {
+                for (std::size_t k = 0; k < trace->points.size(); ++k) {
+                    dst[k] = Vec3f(float(trace->points[k].x()), float(trace->points[k].y()), float(trace->points[k].z()));
+                }
+            }
+        }
+    };
+    if (threaded) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.guides.size(), 1), traceGuides);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size(), 16), growItems);
+    } else {
+        traceGuides(tbb::blocked_range<std::size_t>(0, scene.guides.size()));
+        growItems(tbb::blocked_range<std::size_t>(0, items.size()));
+    }
+    return out;
+}
+
+} // namespace vdbhair

@@ -1,0 +1,74 @@
+/// @file Scene.h
+/// @brief Helicoid scene files (`scene/1` JSON) and growing them into strands.
+///
+/// ```json
+/// {"vdbhair": "scene/1", "seed": 7, "step": 0.01,
+///  "guides": [
+///   {"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]},
+///    "pieces": [{"k": [1.0, -0.1, 0.3, 1.0], "length": 2.0, "roll": 0.0}],
+///    "waviness": {"amplitude": 0.02, "frequency": 40.0, "phase": 0.0, "noise": 0.0},
+///    "wisp": {"count": 256, "radius": 0.05, "fanning": 0.0},
+///    "fit": {...}}]}
+/// ```
+/// `step` is the tracing step in world units (Eq. 3). `roll`, `waviness` (and its `phase` and
+/// `noise`), `wisp` and `fit` are optional; `fit` (written by `vdbhair fit`) is kept but ignored
+/// by growing. Unknown keys and malformed values are errors that name the key path:
+/// `scene.json: guides[3].pieces[0].k: expected 4 numbers`.
+#pragma once
+
+#include <vdbhair/helicoid/Helicoid.h>
+#include <vdbhair/helicoid/Waviness.h>
+#include <vdbhair/helicoid/Wisp.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vdbhair {
+
+struct SceneGuide
+{
+    Vec3d root{0.0};
+    FrameD frame;
+    std::vector<HelicoidPiece> pieces;
+    std::optional<WavinessParams> waviness;
+    std::optional<WispParams> wisp;
+    nlohmann::json fit;  ///< null when absent; kept as written
+};
+
+struct Scene
+{
+    std::uint64_t seed = 0;
+    double step = 0.01;
+    std::vector<SceneGuide> guides;
+};
+
+/// @brief Parse a scene from JSON. @param where message prefix (the file name).
+/// @throw FormatError naming the key path and the rule.
+Scene sceneFromJson(const nlohmann::json& j, const std::string& where);
+nlohmann::json sceneToJson(const Scene& scene);
+
+/// @throw IoError, FormatError (also for invalid JSON, with its line and column).
+Scene readScene(const std::string& path);
+/// @brief Write atomically, one guide per line.
+void writeScene(const std::string& path, const Scene& scene);
+
+struct GrowOptions
+{
+    HelicoidIntegrator integrator = HelicoidIntegrator::Euler;
+    std::size_t maxVertices = std::size_t(1) << 30;  ///< refuse scenes that would grow more
+};
+
+/// @brief Strands of a scene: each guide, then its wisp strands. Bitwise identical for any
+/// thread count (each strand's randomness comes from (seed, guide, strand)).
+/// @throw LimitError if the scene would exceed options.maxVertices vertices.
+StrandSet growScene(const Scene& scene, const GrowOptions& options = {}, bool threaded = true);
+
+/// @brief The vertex count growScene() would produce (checked against overflow).
+std::size_t sceneVertexCount(const Scene& scene);
+
+} // namespace vdbhair

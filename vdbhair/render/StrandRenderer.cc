@@ -1,0 +1,328 @@
+#include "StrandRenderer.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vdbhair {
+
+View viewFromName(const std::string& name)
+{
+    if (name == "front") return View::Front;
+    if (name == "side") return View::Side;
+    if (name == "top") return View::Top;
+    if (name == "back") return View::Back;
+    if (name == "three-quarter") return View::ThreeQuarter;
+    throw ValueError("view '" + name + "' is not one of front, side, top, back, three-quarter");
+}
+
+const char* viewName(View v)
+{
+    switch (v) {
+    case View::Front: return "front";
+    case View::Side: return "side";
+    case View::Top: return "top";
+    case View::Back: return "back";
+    default: return "three-quarter";
+    }
+}
+
+ColorBy colorByFromName(const std::string& name)
+{
+    if (name == "shaded") return ColorBy::Shaded;
+    if (name == "root") return ColorBy::Root;
+    if (name == "tangent") return ColorBy::Tangent;
+    if (name == "depth") return ColorBy::Depth;
+    if (name == "curvature") return ColorBy::Curvature;
+    if (name == "strand") return ColorBy::Strand;
+    throw ValueError("--color-by '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand");
+}
+
+namespace {
+
+/// A camera: world to (image x, image y, depth), x right, y down, in output pixels.
+struct Camera
+{
+    Vec3d right, up, forward, eye;
+    bool perspective = false;
+    double scale = 1.0, cx = 0.0, cy = 0.0;  // image = centre + scale * projected
+
+    Vec3d project(const Vec3d& p) const
+    {
+        const Vec3d d = p - eye;
+        double u = d.dot(right), v = d.dot(up);
+        const double z = d.dot(forward);
+        if (perspective) {
+            const double zz = std::max(z, 1e-9);
+            u /= zz;
+            v /= zz;
+        }
+        return Vec3d(cx + scale * u, cy - scale * v, z);
+    }
+};
+
+Camera makeCamera(View view, const BBox& box, int width, int height)
+{
+    const Vec3d lo(box.min), hi(box.max);
+    const Vec3d centre = 0.5 * (lo + hi);
+    const double radius = std::max(1e-9, 0.5 * (hi - lo).length());
+    Camera c;
+    switch (view) {
+    case View::Front: c.forward = Vec3d(0, 0, -1); c.up = Vec3d(0, 1, 0); break;
+    case View::Back: c.forward = Vec3d(0, 0, 1); c.up = Vec3d(0, 1, 0); break;
+    case View::Side: c.forward = Vec3d(-1, 0, 0); c.up = Vec3d(0, 1, 0); break;
+    case View::Top: c.forward = Vec3d(0, -1, 0); c.up = Vec3d(0, 0, -1); break;
+    case View::ThreeQuarter: c.forward = -Vec3d(1.0, 0.6, 1.0).unit(); c.up = Vec3d(0, 1, 0); c.perspective = true; break;
+    }
+    c.right = c.forward.cross(c.up).unit();
+    c.up = c.right.cross(c.forward);
+    c.eye = centre - c.forward * (c.perspective ? 3.5 * radius : 2.0 * radius);
+    // Fit the box's corners with a 6% margin.
+    double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
+    c.scale = 1.0;
+    for (int i = 0; i < 8; ++i) {
+        const Vec3d p((i & 1) ? hi.x() : lo.x(), (i & 2) ? hi.y() : lo.y(), (i & 4) ? hi.z() : lo.z());
+        const Vec3d q = c.project(p);
+        umin = std::min(umin, q.x()); umax = std::max(umax, q.x());
+        vmin = std::min(vmin, -q.y()); vmax = std::max(vmax, -q.y());
+    }
+    const double su = (umax - umin) > 0 ? 0.88 * width / (umax - umin) : 1.0;
+    const double sv = (vmax - vmin) > 0 ? 0.88 * height / (vmax - vmin) : 1.0;
+    c.scale = std::min(su, sv);
+    c.cx = 0.5 * width - c.scale * 0.5 * (umin + umax);
+    c.cy = 0.5 * height + c.scale * 0.5 * (vmin + vmax);
+    return c;
+}
+
+struct Raster
+{
+    int w, h;
+    std::vector<float> depth;
+    std::vector<Vec3f> color;
+};
+
+/// Per-vertex base colour and whether to light it.
+std::vector<Vec3f> baseColors(const StrandSet& s, const RenderParams& p, const Camera& cam, double& lo, double& hi, bool& lit)
+{
+    const std::size_t nV = s.numVertices();
+    std::vector<Vec3f> c(nV, p.hairColor);
+    lit = true;
+    lo = hi = 0.0;
+    switch (p.colorBy) {
+    case ColorBy::Shaded:
+        if (!s.color.empty()) c = s.color;
+        break;
+    case ColorBy::Root: {
+        const BBox box = computeBBox(s);
+        const Vec3f e = box.extent();
+        for (std::size_t i = 0; i < s.numStrands(); ++i) {
+            Vec3f t = s.root(i) - box.min;
+            for (int k = 0; k < 3; ++k) t[k] = e[k] > 0.f ? t[k] / e[k] : 0.5f;
+            const Vec3f col(0.15f + 0.8f * t.x(), 0.15f + 0.8f * t.y(), 0.15f + 0.8f * t.z());
+            std::fill(c.begin() + std::ptrdiff_t(s.begin(i)), c.begin() + std::ptrdiff_t(s.end(i)), col);
+        }
+        break;
+    }
+    case ColorBy::Strand:
+        for (std::size_t i = 0; i < s.numStrands(); ++i) {
+            std::fill(c.begin() + std::ptrdiff_t(s.begin(i)), c.begin() + std::ptrdiff_t(s.end(i)), idColor(i));
+        }
+        break;
+    case ColorBy::Tangent: {
+        lit = false;
+        const std::vector<Vec3f> t = computeTangents(s);
+        for (std::size_t v = 0; v < nV; ++v) c[v] = Vec3f(std::abs(t[v].x()), std::abs(t[v].y()), std::abs(t[v].z()));
+        break;
+    }
+    case ColorBy::Depth: {
+        lit = false;
+        std::vector<float> d(nV);
+        lo = 1e300; hi = -1e300;
+        for (std::size_t v = 0; v < nV; ++v) {
+            d[v] = float(cam.project(Vec3d(s.positions[v])).z());
+            lo = std::min(lo, double(d[v])); hi = std::max(hi, double(d[v]));
+        }
+        for (std::size_t v = 0; v < nV; ++v) c[v] = colorMap(hi > lo ? float((d[v] - lo) / (hi - lo)) : 0.5f);
+        break;
+    }
+    case ColorBy::Curvature: {
+        lit = false;
+        std::vector<float> k(nV);
+        for (std::size_t i = 0; i < s.numStrands(); ++i) curvatureProfile(s.data(i), s.size(i), k.data() + s.begin(i));
+        std::vector<float> sorted = k;
+        std::sort(sorted.begin(), sorted.end());
+        lo = sorted[std::size_t(0.05 * double(nV - 1))];
+        hi = sorted[std::size_t(0.95 * double(nV - 1))];
+        for (std::size_t v = 0; v < nV; ++v) c[v] = colorMap(hi > lo ? float((k[v] - lo) / (hi - lo)) : 0.5f);
+        break;
+    }
+    }
+    return c;
+}
+
+/// Kajiya–Kay fibre shading for tangent @a t (view space), light @a l, eye direction @a e.
+Vec3f shade(const Vec3f& base, const Vec3d& t, const Vec3d& l, const Vec3d& e)
+{
+    const double tl = t.dot(l), te = t.dot(e);
+    const double sl = std::sqrt(std::max(0.0, 1.0 - tl * tl)), se = std::sqrt(std::max(0.0, 1.0 - te * te));
+    const double diffuse = sl;
+    const double spec = std::pow(std::max(0.0, tl * te + sl * se), 40.0);
+    const float k = float(0.35 + 0.75 * diffuse);
+    return Vec3f(base.x() * k, base.y() * k, base.z() * k) + Vec3f(float(0.25 * spec));
+}
+
+/// Draw every segment of @a s into the supersampled raster (bands in parallel).
+void rasterize(Raster& r, const StrandSet& s, const std::vector<Vec3d>& proj, const std::vector<Vec3f>& vcolor,
+               const std::vector<Vec3f>& shadeDir, bool lit, const Camera& cam, bool onTop, int thickness)
+{
+    const int bands = 32, bandRows = (r.h + bands - 1) / bands;
+    const Vec3d light = (cam.up * 0.8 + cam.right * 0.3 - cam.forward * 0.5).unit();
+    const Vec3d eye = -cam.forward;
+    // Bin segments by band (in segment order, so each band draws in a fixed order).
+    std::vector<std::vector<std::uint32_t>> bins;
+    bins.resize(std::size_t(bands));
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        for (std::size_t v = s.begin(i); v + 1 < s.end(i); ++v) {
+            const double y0 = std::min(proj[v].y(), proj[v + 1].y()) - thickness, y1 = std::max(proj[v].y(), proj[v + 1].y()) + thickness;
+            if (y1 < 0 || y0 >= r.h || (cam.perspective && proj[v].z() <= 0)) continue;
+            const int b0 = std::max(0, int(y0) / bandRows), b1 = std::min(bands - 1, int(y1) / bandRows);
+            for (int b = b0; b <= b1; ++b) bins[std::size_t(b)].push_back(std::uint32_t(v));
+        }
+    }
+    tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& br) {
+        for (int b = br.begin(); b != br.end(); ++b) {
+            const int rowLo = b * bandRows, rowHi = std::min(r.h, rowLo + bandRows);
+            for (std::uint32_t v : bins[std::size_t(b)]) {
+                const Vec3d a = proj[v], c = proj[v + 1];
+                Vec3f col0 = vcolor[v], col1 = vcolor[v + 1];
+                if (lit) {
+                    const Vec3d t(shadeDir[v]);
+                    col0 = shade(col0, t, light, eye);
+                    col1 = shade(col1, t, light, eye);
+                }
+                const double dx = c.x() - a.x(), dy = c.y() - a.y();
+                const int n = std::max(1, int(std::ceil(std::max(std::abs(dx), std::abs(dy)))));
+                for (int k = 0; k <= n; ++k) {
+                    const double f = double(k) / n;
+                    const int px = int(std::floor(a.x() + f * dx)), py0 = int(std::floor(a.y() + f * dy));
+                    const float z = float(a.z() + f * (c.z() - a.z()));
+                    for (int o = 0; o < thickness; ++o) {
+                        const int py = py0 + o - thickness / 2;
+                        if (px < 0 || px >= r.w || py < rowLo || py >= rowHi) continue;
+                        const std::size_t idx = std::size_t(py) * std::size_t(r.w) + std::size_t(px);
+                        if (onTop || z < r.depth[idx]) {
+                            r.depth[idx] = onTop ? -std::numeric_limits<float>::max() : z;
+                            r.color[idx] = col0 + (col1 - col0) * float(f);
+                        }
+                    }
+                }
+            }
+        }
+    });
+}
+
+void checkSize(const RenderParams& p)
+{
+    if (p.width < 1 || p.height < 1 || p.width > 16384 || p.height > 16384) {
+        throw ValueError("image size " + std::to_string(p.width) + "x" + std::to_string(p.height) +
+                         " must be between 1x1 and 16384x16384 pixels");
+    }
+    if (p.supersample < 1 || p.supersample > 8) throw ValueError("supersampling " + std::to_string(p.supersample) + " must be 1 to 8");
+}
+
+} // namespace
+
+Image renderStrands(const StrandSet& strands, const RenderParams& params)
+{
+    checkSize(params);
+    const int S = params.supersample;
+    BBox box = params.frame ? *params.frame : computeBBox(strands);
+    if (params.guides && !params.frame) {
+        const BBox g = computeBBox(*params.guides);
+        if (!g.empty()) { box.expand(g.min); box.expand(g.max); }
+    }
+    Image out(params.width, params.height, params.background);
+    if (box.empty()) return out;
+    const Camera cam = makeCamera(params.view, box, params.width * S, params.height * S);
+
+    Raster r{params.width * S, params.height * S, {}, {}};
+    r.depth.assign(std::size_t(r.w) * std::size_t(r.h), std::numeric_limits<float>::max());
+    r.color.assign(r.depth.size(), params.background);
+
+    auto drawSet = [&](const StrandSet& s, const std::optional<Vec3f>& fixed, bool onTop, int thickness, double& lo, double& hi) {
+        std::vector<Vec3d> proj(s.numVertices());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, proj.size(), 4096), [&](const tbb::blocked_range<std::size_t>& br) {
+            for (std::size_t v = br.begin(); v != br.end(); ++v) proj[v] = cam.project(Vec3d(s.positions[v]));
+        });
+        bool lit = true;
+        std::vector<Vec3f> colors;
+        if (fixed) colors.assign(s.numVertices(), *fixed);
+        else colors = baseColors(s, params, cam, lo, hi, lit);
+        // Segment directions in view space for the fibre shading.
+        std::vector<Vec3f> dirs(s.numVertices(), Vec3f(0.f));
+        for (std::size_t i = 0; i < s.numStrands(); ++i) {
+            for (std::size_t v = s.begin(i); v + 1 < s.end(i); ++v) {
+                const Vec3d d = Vec3d(s.positions[v + 1]) - Vec3d(s.positions[v]);
+                const double len = d.length();
+                if (len > 0) dirs[v] = Vec3f(float(d.dot(cam.right) / len), float(d.dot(cam.up) / len), float(d.dot(cam.forward) / len));
+            }
+        }
+        // Shading works in view space: express light and eye there too.
+        Camera viewCam = cam;
+        viewCam.right = Vec3d(1, 0, 0); viewCam.up = Vec3d(0, 1, 0); viewCam.forward = Vec3d(0, 0, 1);
+        rasterize(r, s, proj, colors, dirs, lit, viewCam, onTop, thickness);
+    };
+    double lo = 0, hi = 0, glo = 0, ghi = 0;
+    drawSet(strands, std::nullopt, false, 1, lo, hi);
+    if (params.guides) drawSet(*params.guides, params.guideColor, true, std::max(2, S), glo, ghi);
+
+    // Downsample: the mean of each S x S block.
+    tbb::parallel_for(tbb::blocked_range<int>(0, params.height, 8), [&](const tbb::blocked_range<int>& br) {
+        for (int y = br.begin(); y != br.end(); ++y) {
+            for (int x = 0; x < params.width; ++x) {
+                Vec3f sum(0.f);
+                for (int j = 0; j < S; ++j) {
+                    for (int i = 0; i < S; ++i) sum += r.color[std::size_t(y * S + j) * std::size_t(r.w) + std::size_t(x * S + i)];
+                }
+                out.set(x, y, sum / float(S * S));
+            }
+        }
+    });
+    const int text = std::max(10, std::min(24, params.height / 40));
+    if (!params.title.empty()) drawText(out, text / 2, text + text / 2, params.title, text, Vec3f(0.f));
+    if (params.colorBy == ColorBy::Depth || params.colorBy == ColorBy::Curvature) {
+        const int bh = params.height / 3, bw = std::max(8, params.width / 50);
+        drawColorBar(out, params.width - bw - 8 * text / 2 - 8, params.height - bh - text, bw, bh, lo, hi,
+                     params.colorBy == ColorBy::Depth ? "depth" : "curvature");
+    }
+    return out;
+}
+
+Image renderSheet(const StrandSet& strands, const RenderParams& params)
+{
+    checkSize(params);
+    RenderParams p = params;
+    p.width = std::max(1, params.width / 2);
+    p.height = std::max(1, params.height / 2);
+    if (!p.frame) {
+        BBox box = computeBBox(strands);
+        if (params.guides) { const BBox g = computeBBox(*params.guides); if (!g.empty()) { box.expand(g.min); box.expand(g.max); } }
+        p.frame = box;
+    }
+    Image sheet(params.width, params.height, params.background);
+    const View views[4] = {View::Front, View::Side, View::Top, View::ThreeQuarter};
+    for (int i = 0; i < 4; ++i) {
+        p.view = views[i];
+        p.title = (params.title.empty() ? std::string() : params.title + ": ") + viewName(views[i]);
+        sheet.paste(renderStrands(strands, p), (i % 2) * p.width, (i / 2) * p.height);
+    }
+    return sheet;
+}
+
+} // namespace vdbhair

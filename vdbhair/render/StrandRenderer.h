@@ -1,0 +1,58 @@
+/// @file StrandRenderer.h
+/// @brief Preview images of strands: orthographic front, side, top and back views and a
+/// three-quarter perspective, hair shaded as lit fibres (Kajiya & Kay 1989: diffuse sin(T, L),
+/// specular along the tangent), depth-correct (a z-buffer) and anti-aliased (3x3 supersampling
+/// of one-subpixel lines, so dense hair shows its density).
+///
+/// Conventions: +y is up; the front view looks along -z (the viewer stands on +z), the side view
+/// along -x, the back view along +z, the top view down -y with -z at the top of the image, and
+/// the three-quarter view looks at the centre from (+1, +0.6, +1). Images depend only on their
+/// input: rasterization runs in horizontal bands, each drawing its segments in strand order.
+#pragma once
+
+#include <vdbhair/render/Image.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <optional>
+#include <string>
+
+namespace vdbhair {
+
+enum class View { Front, Side, Top, Back, ThreeQuarter };
+/// @throw ValueError listing the views.
+View viewFromName(const std::string& name);
+const char* viewName(View view);
+
+enum class ColorBy
+{
+    Shaded,     ///< one hair colour (or the strands' own colours), lit
+    Root,       ///< the root's position on the scalp, lit
+    Tangent,    ///< |T| as RGB (world axes), unlit
+    Depth,      ///< distance from the viewer, colour map with a legend
+    Curvature,  ///< 1 / world units, colour map with a legend (5th to 95th percentile)
+    Strand      ///< a colour per strand, lit
+};
+ColorBy colorByFromName(const std::string& name);
+
+struct RenderParams
+{
+    View view = View::ThreeQuarter;
+    int width = 1024, height = 1024;
+    ColorBy colorBy = ColorBy::Shaded;
+    Vec3f hairColor{0.30f, 0.17f, 0.08f};
+    Vec3f background{1.f, 1.f, 1.f};
+    int supersample = 3;
+    const StrandSet* guides = nullptr;     ///< drawn on top, in guideColor, twice as wide
+    Vec3f guideColor{0.85f, 0.05f, 0.05f};
+    std::optional<BBox> frame;             ///< the box to fit (default: the strands' own)
+    std::string title;                     ///< written in the top-left corner
+};
+
+/// @brief Render one view. @throw ValueError for a zero or huge size.
+Image renderStrands(const StrandSet& strands, const RenderParams& params);
+
+/// @brief The four views front, side, top and three-quarter in a 2x2 sheet of params.width ×
+/// params.height, all fitted to the same box.
+Image renderSheet(const StrandSet& strands, const RenderParams& params);
+
+} // namespace vdbhair
