@@ -4,6 +4,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrandGrid.h>
@@ -23,6 +24,7 @@ struct FieldCmdParams
     int levels = 1;
     std::uint64_t maxVoxels = std::uint64_t(1) << 26;
     bool withStrands = false;
+    bool helicoid = false;
     bool strict = false;
     ScalpOptions scalp;
 };
@@ -37,6 +39,8 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     }
     if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
     if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");
+    if (p.helicoid && p.levels != 1) throw ValueError("--helicoid with --levels " + std::to_string(p.levels) + ": a helicoid field has one level; use --levels 1");
+    if (p.helicoid && p.scalp.space != "world") throw ValueError("--helicoid with --space " + p.scalp.space + ": helicoid fields are world-space");
 
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
     FieldParams fp;
@@ -54,6 +58,14 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     for (const TangentField& f : fields) {
         for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density)}) {
             g->insertMeta("vdbhair:source", openvdb::StringMetadata(p.input));
+            grids.push_back(g);
+            gridsJson.push_back({{"name", g->getName()}, {"voxel_size", g->voxelSize().x()}, {"active_voxels", g->activeVoxelCount()}});
+        }
+    }
+    if (p.helicoid) {
+        const HelicoidFieldGrids h = estimateHelicoidField(*fields[0].tangent);
+        for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(h.k), openvdb::GridBase::Ptr(h.alpha),
+                                                openvdb::GridBase::Ptr(h.frameT), openvdb::GridBase::Ptr(h.frameN)}) {
             grids.push_back(g);
             gridsJson.push_back({{"name", g->getName()}, {"voxel_size", g->voxelSize().x()}, {"active_voxels", g->activeVoxelCount()}});
         }
@@ -93,6 +105,7 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--iterations", params->iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
     sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
     sub->add_option("--max-voxels", params->maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
+    sub->add_flag("--helicoid", params->helicoid, "Also fit a helicoid per voxel: grids helicoid_k, helicoid_alpha, frame_T, frame_N");
     sub->add_flag("--with-strands", params->withStrands, "Also write the strands as the points grid 'strands'");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addScalpOptions(sub, params->scalp);

@@ -3,11 +3,13 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/StreamlineTracer.h>
+#include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace vdbhair::app {
@@ -42,6 +44,7 @@ struct RetraceParams
     double vanish = 1e-3;
     std::size_t maxSteps = 0;
     int margin = 3;
+    bool helicoid = false;
     bool strict = false;
 };
 
@@ -64,6 +67,33 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
     else throw ValueError("--vertices '" + p.vertices + "' is not one of input, steps");
     strandFormatFromPath(p.output, /*forWriting=*/true);
 
+    if (p.helicoid) {
+        if (tp.vertices != RetraceVertices::Input) throw ValueError("--helicoid keeps the input's vertices; --vertices steps is not available with it");
+        const HelicoidFieldGrids field = readHelicoidField(p.field);
+        const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
+        TraceStats stats;
+        const StrandSet out = retraceHelicoidField(strands, field, tp, &stats);
+        // Coherence is measured against the tangent field when the file has one.
+        double before = 0.0, after = 0.0;
+        const std::vector<std::string> names = vdbGridNames(p.field, "retrace(" + p.field + ")");
+        if (std::find(names.begin(), names.end(), p.grid) != names.end()) {
+            const openvdb::GridBase::Ptr tangent = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
+            before = meanTangentAngleDeg(strands, *tangent);
+            after = meanTangentAngleDeg(out, *tangent);
+        }
+        const double disp = meanVertexDisplacement(strands, out);
+        writeStrands(p.output, out);
+        if (common.json) {
+            nlohmann::json j = traceReportJson(stats, before, after, disp);
+            j["output"] = p.output;
+            j["field"] = "helicoid";
+            printJson(j);
+        } else if (!common.quiet) {
+            printTraceReport(stats, before, after, disp);
+            std::cout << "wrote " << p.output << " (traced through the helicoid field)\n";
+        }
+        return 0;
+    }
     const openvdb::GridBase::Ptr grid = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
     if (!grid->isType<openvdb::Vec3SGrid>() && !grid->isType<openvdb::Vec3DGrid>()) {
         throw TypeError(p.field + ": grid '" + p.grid + "' holds " + grid->valueType() +
@@ -106,6 +136,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--max-steps", params->maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
     sub->add_option("--margin", params->margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
     sub->add_option("--vertices", params->vertices, "input: the input's vertex count and arc lengths; steps: every step")->capture_default_str();
+    sub->add_flag("--helicoid", params->helicoid, "Trace through the file's helicoid field (vdbhair field --helicoid) instead of the tangent grid");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --json");

@@ -24,3 +24,7 @@ printf 'some text\n' > unknown.abc
 /usr/bin/python3 -c "import pyopenvdb as vdb; g = vdb.FloatGrid(); g.name = 'density'; g.fill((0, 0, 0), (3, 3, 3), 1.0); vdb.write('density.vdb', grids=[g])"
 # Strands of one vertex only: all dropped, leaving an empty hairstyle.
 printf 'v 0 0 0\nv 1 1 1\nl 1\nl 2\n' > only_short.obj
+# Scenes with one mistake each.
+printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0], "length": 1}]}]}\n' > bad_scene.json
+printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0, 0], "length": 1}], "wisp": {"count": 2, "radiuss": 1}}]}\n' > unknown_key.json
+printf '{"vdbhair": "scene/1", "guides": [' > not_json.json

@@ -1,0 +1,102 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/HelicoidField.h>
+#include <vdbhair/io/VdbFile.h>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+/// The exact tangent field of concentric circles about the z axis, in an annulus about radius 7.5.
+openvdb::Vec3SGrid::Ptr circleField(double h)
+{
+    auto g = openvdb::Vec3SGrid::create(openvdb::Vec3f(0.f));
+    g->setTransform(openvdb::math::Transform::createLinearTransform(h));
+    auto acc = g->getAccessor();
+    const int n = int(12.0 / h) + 1;
+    for (int i = -n; i <= n; ++i) {
+        for (int j = -n; j <= n; ++j) {
+            for (int k = -2; k <= 2; ++k) {
+                const double x = i * h, y = j * h, r = std::hypot(x, y);
+                if (r < 7.5 - 2.0 * h || r > 7.5 + 2.0 * h) continue;
+                acc.setValue(openvdb::Coord(i, j, k), openvdb::Vec3f(float(-y / r), float(x / r), 0.f));
+            }
+        }
+    }
+    g->setName("tangent");
+    return g;
+}
+} // namespace
+
+TEST_CASE("estimateHelicoidField: concentric circles give kT = 1/r, N towards the centre", "[helicoid]")
+{
+    initializeOpenVdb();
+    const double h = 0.5;
+    const auto g = circleField(h);
+    const HelicoidFieldGrids f = estimateHelicoidField(*g);
+    REQUIRE(f.k->activeVoxelCount() == g->activeVoxelCount());
+    REQUIRE(f.k->getName() == "helicoid_k");
+    REQUIRE(f.alpha->getName() == "helicoid_alpha");
+    REQUIRE(f.frameT->getVectorType() == openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    REQUIRE(f.k->getVectorType() == openvdb::VEC_INVARIANT);
+    auto ka = f.k->getConstAccessor();
+    auto na = f.frameN->getConstAccessor();
+    for (const openvdb::Coord c : {openvdb::Coord(15, 0, 0), openvdb::Coord(0, -15, 1), openvdb::Coord(11, 11, -1)}) {
+        const double r = c.asVec3d().length() > 0 ? std::hypot(c.x() * h, c.y() * h) : 0.0;
+        const openvdb::Vec3f k = ka.getValue(c), n = na.getValue(c);
+        CAPTURE(c, r, k, n);
+        REQUIRE(k.x() == Approx(1.0 / r).epsilon(0.03));
+        REQUIRE(std::abs(k.y()) < 0.01);
+        REQUIRE(std::abs(k.z()) < 0.01);
+        REQUIRE(n.x() * c.x() + n.y() * c.y() < 0.f);  // towards the centre
+    }
+}
+
+TEST_CASE("retraceHelicoidField: a circle through the helicoid field of concentric circles", "[helicoid]")
+{
+    initializeOpenVdb();
+    StrandSet s;
+    std::vector<Vec3f> pts;
+    for (int a = 0; a <= 100; ++a) pts.emplace_back(float(7.5 * std::cos(a * 0.05)), float(7.5 * std::sin(a * 0.05)), 0.1f);
+    s.addStrand(pts);
+    for (double h : {0.5, 2.0}) {
+        const auto g = circleField(h);
+        const HelicoidFieldGrids f = estimateHelicoidField(*g);
+        TraceParams tp;
+        tp.integrator = Integrator::RK4;
+        tp.step = 0.1;
+        TraceStats stats;
+        const StrandSet r = retraceHelicoidField(s, f, tp, &stats);
+        REQUIRE(stats.fullLength == 1);
+        REQUIRE(r.offsets == s.offsets);
+        double worst = 0.0;
+        for (const Vec3f& p : r.positions) worst = std::max(worst, std::abs(std::hypot(double(p.x()), double(p.y())) - 7.5));
+        CAPTURE(h, worst);
+        REQUIRE(worst < (h < 1.0 ? 1e-3 : 1e-2));
+    }
+}
+
+TEST_CASE("estimateHelicoidField / readHelicoidField: from strands, through a file", "[helicoid]")
+{
+    initializeOpenVdb();
+    StrandSet s;
+    for (int k = 0; k < 6; ++k) {
+        std::vector<Vec3f> pts;
+        for (int a = 0; a <= 60; ++a) pts.emplace_back(float((5.0 + 0.3 * k) * std::cos(a * 0.05)), float((5.0 + 0.3 * k) * std::sin(a * 0.05)), 0.f);
+        s.addStrand(pts);
+    }
+    FieldParams p;
+    p.voxelSize = 0.5;
+    const TangentField t = estimateTangentField(s, p);
+    const HelicoidFieldGrids f = estimateHelicoidField(*t.tangent);
+    const std::string path = test::tempPath("helicoid.vdb");
+    writeVdbGrids(path, {t.tangent, f.k, f.alpha, f.frameT, f.frameN}, "test");
+    const HelicoidFieldGrids r = readHelicoidField(path);
+    REQUIRE(r.k->activeVoxelCount() == f.k->activeVoxelCount());
+    REQUIRE(r.k->metaValue<double>("vdbhair:voxel_size") == 0.5);
+    const std::string plain = test::tempPath("plain.vdb");
+    writeVdbGrids(plain, {t.tangent}, "test");
+    REQUIRE_THROWS_WITH(readHelicoidField(plain), Contains("no grid named 'helicoid_k'") && Contains("vdbhair field --helicoid"));
+}
