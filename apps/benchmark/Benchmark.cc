@@ -10,6 +10,7 @@
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/strands/Measures.h>
@@ -151,6 +152,31 @@ void benchmark(const std::string& name, const StrandSet& strands, double voxelSi
     std::printf("peak memory            %.0f MiB after vdbhair's estimation, %.0f MiB at the end (process peak)\n", memAfterOurs, peakMiB());
 }
 
+/// Helicoid tracing speed: strands per second for a four-piece p-helicoid of 64 steps (one guide
+/// and its wisps), and for the bundled default head scene.
+void benchmarkHelicoids(const std::string& source, int reps)
+{
+    std::printf("\n== generalized helicoids (Piuze et al. 2011, Eq. 3; the paper: 0.7 ms a strand) ==\n");
+    Scene scene;
+    scene.seed = 1;
+    scene.step = 4.0 / 64.0;
+    SceneGuide g;
+    g.frame = FrameD::fromTangentNormal(Vec3d(0, -1, 0), Vec3d(1, 0, 0));
+    g.pieces = {{{6.0, 0.2, 0.6, 0.10}, 1.0, 0.0}, {{5.6, -0.2, 0.8, 0.12}, 1.0, 0.4},
+                {{6.4, 0.1, 0.5, 0.09}, 1.0, 0.3}, {{6.0, 0.0, 0.7, 0.11}, 1.0, 0.5}};
+    g.wisp = WispParams{99999, 0.05, 0.02};
+    scene.guides.push_back(g);
+    StrandSet s;
+    const double t = timeBest(reps, [&] { s = growScene(scene); });
+    std::printf("four-piece p-helicoid, 64 steps: %zu strands in %.3f s: %.2f us a strand (%.1f M strands/s, %.1f M steps/s)\n",
+                s.numStrands(), t, t / double(s.numStrands()) * 1e6, double(s.numStrands()) / t / 1e6,
+                double(s.numVertices() - s.numStrands()) / t / 1e6);
+    const Scene head = readScene(source + "/scenes/default/head.json");
+    const double th = timeBest(reps, [&] { s = growScene(head); });
+    std::printf("default head scene: %zu strands, %zu vertices in %.3f s: %.2f us a strand\n", s.numStrands(), s.numVertices(), th,
+                th / double(s.numStrands()) * 1e6);
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -184,5 +210,6 @@ int main(int argc, char** argv)
     const StrandSet base = readStrands(source + "/scenes/default/ponytail.hair");
     const StrandSet big = jitteredCopies(base, strands, vertices, 0.3f);
     benchmark("synthetic: jittered copies of the bundled ponytail", big, voxelSize > 0.0 ? voxelSize : suggestVoxelSize(big), reps);
+    benchmarkHelicoids(source, reps);
     return 0;
 }

@@ -1,6 +1,7 @@
 #include "Helicoid.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/FastMath.h>
 
 #include <cmath>
 
@@ -35,17 +36,19 @@ double Helicoid::theta(const Vec3d& world, double thetaRef) const
 {
     const Vec3d d = world - p0;
     const double y1 = d.dot(q.t), y2 = d.dot(q.n), y3 = d.dot(q.b);
-    double th = std::atan2(k.kT * y1 + k.kN * y2, 1.0 + k.kN * y1 - k.kT * y2) + k.kB * y3;
+    double th = fastmath::atan2(k.kT * y1 + k.kN * y2, 1.0 + k.kN * y1 - k.kT * y2) + k.kB * y3;
     // Unwrap: the multiple of 2π that brings theta closest to its previous value.
     constexpr double twoPi = 2.0 * M_PI;
-    th += twoPi * std::nearbyint((thetaRef - th) / twoPi);
+    th += twoPi * double(fastmath::roundToInt((thetaRef - th) * (1.0 / twoPi)));
     return th;
 }
 
 FrameD Helicoid::frameFromTheta(double th) const
 {
     const double phi = k.alpha * th;
-    const double ct = std::cos(th), st = std::sin(th), cp = std::cos(phi), sp = std::sin(phi);
+    double ct, st, cp = 1.0, sp = 0.0;
+    fastmath::sinCos(th, st, ct);
+    if (phi != 0.0) fastmath::sinCos(phi, sp, cp);
     FrameD f;
     f.t = (cp * ct) * q.t + (cp * st) * q.n + sp * q.b;
     f.n = (-st) * q.t + ct * q.n;
@@ -57,7 +60,9 @@ Vec3d Helicoid::tangent(const Vec3d& world, double& thetaRef) const
 {
     thetaRef = theta(world, thetaRef);
     const double phi = k.alpha * thetaRef;
-    const double ct = std::cos(thetaRef), st = std::sin(thetaRef), cp = std::cos(phi), sp = std::sin(phi);
+    double ct, st, cp = 1.0, sp = 0.0;
+    fastmath::sinCos(thetaRef, st, ct);
+    if (phi != 0.0) fastmath::sinCos(phi, sp, cp);
     return (cp * ct) * q.t + (cp * st) * q.n + sp * q.b;
 }
 
@@ -67,68 +72,94 @@ std::size_t stepCount(double length, double step)
     return std::max<std::size_t>(1, std::size_t(std::ceil(length / step - 1e-9)));
 }
 
+void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame, const std::vector<HelicoidPiece>& pieces,
+                     double step, HelicoidIntegrator integrator, HelicoidTrace* outs, const std::vector<Helicoid>* field)
+{
+    std::size_t total = 1;
+    for (const HelicoidPiece& pc : pieces) total += stepCount(pc.length, step);
+    for (std::size_t l = 0; l < count; ++l) {
+        HelicoidTrace& out = outs[l];
+        out.points.clear();
+        out.frames.clear();
+        out.arc.clear();
+        out.pieces.clear();
+        out.joints.clear();
+        out.points.reserve(total);
+        out.frames.reserve(total);
+        out.arc.reserve(total);
+    }
+    constexpr std::size_t kMaxLanes = 8;
+    double s = 0.0;
+    // The strands advance in lockstep, kMaxLanes at a time: a step is a chain of dependent
+    // operations (atan2, sin/cos, move), and independent strands let the processor overlap them.
+    for (std::size_t first = 0; first < count; first += kMaxLanes) {
+        const std::size_t lanes = std::min(kMaxLanes, count - first);
+        Vec3d p[kMaxLanes];
+        FrameD f[kMaxLanes], fr[kMaxLanes];
+        double th[kMaxLanes];
+        Helicoid h[kMaxLanes];
+        for (std::size_t l = 0; l < lanes; ++l) {
+            p[l] = roots[first + l];
+            f[l] = frame;
+        }
+        s = 0.0;
+        for (std::size_t i = 0; i < pieces.size(); ++i) {
+            const HelicoidPiece& pc = pieces[i];
+            for (std::size_t l = 0; l < lanes; ++l) {
+                HelicoidTrace& out = outs[first + l];
+                if (field) {
+                    h[l] = (*field)[i];
+                } else {
+                    h[l].k = pc.k;
+                    h[l].q = f[l].rolled(pc.roll);
+                    h[l].p0 = p[l];
+                }
+                out.pieces.push_back(h[l]);
+                out.joints.push_back(i == 0 ? 0 : out.points.size() - 1);
+                // theta along this piece, unwrapped from its value at the piece's first point.
+                th[l] = h[l].theta(p[l], 0.0);
+                fr[l] = h[l].frameFromTheta(th[l]);
+                if (i == 0) {
+                    out.points.push_back(p[l]);
+                    out.frames.push_back(fr[l]);
+                    out.arc.push_back(0.0);
+                } else {
+                    out.frames.back() = fr[l];  // the joint takes the new piece's frame
+                }
+            }
+            const std::size_t n = stepCount(pc.length, step);
+            for (std::size_t j = 0; j < n; ++j) {
+                const double hstep = (j + 1 == n) ? pc.length - double(n - 1) * step : step;
+                s += hstep;
+                for (std::size_t l = 0; l < lanes; ++l) {
+                    if (integrator == HelicoidIntegrator::Euler) {
+                        p[l] += hstep * fr[l].t;  // Eq. 3: p_{i+1} = p_i + h E_T(p_i)
+                    } else {
+                        double t2 = th[l], t3 = th[l], t4 = th[l];
+                        const Vec3d k1 = fr[l].t;
+                        const Vec3d k2 = h[l].tangent(p[l] + 0.5 * hstep * k1, t2);
+                        const Vec3d k3 = h[l].tangent(p[l] + 0.5 * hstep * k2, t3);
+                        const Vec3d k4 = h[l].tangent(p[l] + hstep * k3, t4);
+                        p[l] += (hstep / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+                    }
+                    th[l] = h[l].theta(p[l], th[l]);
+                    fr[l] = h[l].frameFromTheta(th[l]);
+                    HelicoidTrace& out = outs[first + l];
+                    out.points.push_back(p[l]);
+                    out.frames.push_back(fr[l]);
+                    out.arc.push_back(s);
+                }
+            }
+            for (std::size_t l = 0; l < lanes; ++l) f[l] = fr[l];
+        }
+    }
+}
+
 void tracePHelicoid(const Vec3d& root, const FrameD& frame, const std::vector<HelicoidPiece>& pieces,
                     double step, HelicoidIntegrator integrator, HelicoidTrace& out,
                     const std::vector<Helicoid>* field)
 {
-    out.points.clear();
-    out.frames.clear();
-    out.arc.clear();
-    out.pieces.clear();
-    out.joints.clear();
-    std::size_t total = 1;
-    for (const HelicoidPiece& pc : pieces) total += stepCount(pc.length, step);
-    out.points.reserve(total);
-    out.frames.reserve(total);
-    out.arc.reserve(total);
-
-    Vec3d p = root;
-    FrameD f = frame;
-    double s = 0.0;
-    for (std::size_t i = 0; i < pieces.size(); ++i) {
-        const HelicoidPiece& pc = pieces[i];
-        Helicoid h;
-        if (field) {
-            h = (*field)[i];
-        } else {
-            h.k = pc.k;
-            h.q = f.rolled(pc.roll);
-            h.p0 = p;
-        }
-        out.pieces.push_back(h);
-        out.joints.push_back(i == 0 ? 0 : out.points.size() - 1);
-        // theta along this piece, unwrapped from its value at the piece's first point.
-        double th = h.theta(p, 0.0);
-        FrameD fr = h.frameFromTheta(th);
-        if (i == 0) {
-            out.points.push_back(p);
-            out.frames.push_back(fr);
-            out.arc.push_back(0.0);
-        } else {
-            out.frames.back() = fr;  // the joint takes the new piece's frame
-        }
-        const std::size_t n = stepCount(pc.length, step);
-        for (std::size_t j = 0; j < n; ++j) {
-            const double hstep = (j + 1 == n) ? pc.length - double(n - 1) * step : step;
-            if (integrator == HelicoidIntegrator::Euler) {
-                p += hstep * fr.t;  // Eq. 3: p_{i+1} = p_i + h E_T(p_i)
-            } else {
-                double t2 = th, t3 = th, t4 = th;
-                const Vec3d k1 = fr.t;
-                const Vec3d k2 = h.tangent(p + 0.5 * hstep * k1, t2);
-                const Vec3d k3 = h.tangent(p + 0.5 * hstep * k2, t3);
-                const Vec3d k4 = h.tangent(p + hstep * k3, t4);
-                p += (hstep / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            }
-            th = h.theta(p, th);
-            fr = h.frameFromTheta(th);
-            s += hstep;
-            out.points.push_back(p);
-            out.frames.push_back(fr);
-            out.arc.push_back(s);
-        }
-        f = out.frames.back();
-    }
+    tracePHelicoids(&root, 1, frame, pieces, step, integrator, &out, field);
 }
 
 } // namespace vdbhair

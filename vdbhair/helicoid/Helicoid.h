@@ -99,4 +99,9 @@ void tracePHelicoid(const Vec3d& root, const FrameD& frame, const std::vector<He
                     double step, HelicoidIntegrator integrator, HelicoidTrace& out,
                     const std::vector<Helicoid>* field = nullptr);
 
+/// @brief tracePHelicoid() for @a count strands from @a roots at once, all with the same pieces
+/// (and the same @a field when given), traced in lockstep a few at a time for speed.
+void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame, const std::vector<HelicoidPiece>& pieces,
+                     double step, HelicoidIntegrator integrator, HelicoidTrace* outs, const std::vector<Helicoid>* field = nullptr);
+
 } // namespace vdbhair

@@ -246,24 +246,37 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
         }
     };
     auto growItems = [&](const tbb::blocked_range<std::size_t>& r) {
-        HelicoidTrace wispTrace;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        // Wisp strands of one guide are traced a batch at a time (see tracePHelicoids).
+        constexpr std::size_t kBatch = 8;
+        HelicoidTrace traces[kBatch];
+        std::vector<Rng> rngs;
+        for (std::size_t i = r.begin(); i != r.end();) {
             const Item& it = items[i];
             const SceneGuide& guide = scene.guides[it.guide];
-            Rng rng(scene.seed, it.guide, it.wisp);
-            const HelicoidTrace* trace = &guideTraces[it.guide];
+            std::size_t count = 1;
+            rngs.assign(1, Rng(scene.seed, it.guide, it.wisp));
+            const HelicoidTrace* batch[kBatch] = {&guideTraces[it.guide]};
             if (it.wisp > 0) {
-                traceWisp(guideTraces[it.guide], guide.pieces, *guide.wisp, scene.step, options.integrator, rng, wispTrace);
-                trace = &wispTrace;
+                while (count < kBatch && i + count != r.end() && items[i + count].guide == it.guide) {
+                    rngs.emplace_back(scene.seed, it.guide, items[i + count].wisp);
+                    ++count;
+                }
+                traceWisps(guideTraces[it.guide], guide.pieces, *guide.wisp, scene.step, options.integrator, rngs.data(),
+                           count, traces);
+                for (std::size_t b = 0; b < count; ++b) batch[b] = &traces[b];
             }
-            Vec3f* dst = out.positions.data() + out.offsets[i];
-            if (guide.waviness) {
-                applyWaviness(*trace, *guide.waviness, rng, dst);
-            } else {
-                for (std::size_t k = 0; k < trace->points.size(); ++k) {
-                    dst[k] = Vec3f(float(trace->points[k].x()), float(trace->points[k].y()), float(trace->points[k].z()));
+            for (std::size_t b = 0; b < count; ++b) {
+                const HelicoidTrace& trace = *batch[b];
+                Vec3f* dst = out.positions.data() + out.offsets[i + b];
+                if (guide.waviness) {
+                    applyWaviness(trace, *guide.waviness, rngs[b], dst);
+                } else {
+                    for (std::size_t k = 0; k < trace.points.size(); ++k) {
+                        dst[k] = Vec3f(float(trace.points[k].x()), float(trace.points[k].y()), float(trace.points[k].z()));
+                    }
                 }
             }
+            i += count;
         }
     };
     if (threaded) {

@@ -27,4 +27,9 @@ struct WispParams
 void traceWisp(const HelicoidTrace& guide, const std::vector<HelicoidPiece>& pieces, const WispParams& params,
                double step, HelicoidIntegrator integrator, Rng& rng, HelicoidTrace& out);
 
+/// @brief traceWisp() for @a count wisp strands at once, strand i drawing from @a rngs[i]
+/// (the same strands as one call each, traced in lockstep for speed).
+void traceWisps(const HelicoidTrace& guide, const std::vector<HelicoidPiece>& pieces, const WispParams& params,
+                double step, HelicoidIntegrator integrator, Rng* rngs, std::size_t count, HelicoidTrace* outs);
+
 } // namespace vdbhair

@@ -1,0 +1,78 @@
+/// @file FastMath.h
+/// @brief Inline sin/cos and atan2 for helicoid tracing, which evaluates them at every step.
+/// The polynomials are fdlibm's kernels (k_sin.c, k_cos.c) and Cephes' atan (atan.c); with
+/// Cody–Waite reduction by π/2 they agree with the C library to about 1e-15 for the angles a
+/// trace meets (|x| < 1e5; tested). Inlined and branch-light, they are several times cheaper than
+/// the library calls, which dominated tracing.
+#pragma once
+
+#include <cmath>
+
+namespace vdbhair {
+namespace fastmath {
+
+/// Round to the nearest integer (halves away from zero) for |x| < 2^62, without a library call
+/// (std::nearbyint is one unless the target has SSE4.1).
+inline long long roundToInt(double x) { return static_cast<long long>(x + (x >= 0.0 ? 0.5 : -0.5)); }
+
+/// sin and cos of @a x (|x| < 1e5; larger arguments fall back to the library).
+inline void sinCos(double x, double& s, double& c)
+{
+    if (!(std::abs(x) < 1e5)) {
+        s = std::sin(x);
+        c = std::cos(x);
+        return;
+    }
+    constexpr double invPio2 = 6.36619772367581382433e-01;
+    constexpr double pio2a = 1.57079632673412561417e+00, pio2b = 6.07710050650619224932e-11;
+    const long long q = roundToInt(x * invPio2);
+    const double n = double(q);
+    const double r = (x - n * pio2a) - n * pio2b;
+    const double z = r * r;
+    const double sr = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
+                      z * (2.75573137070700676789e-06 + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
+    const double cr = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05 +
+                      z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11)))));
+    switch (int(q & 3)) {
+    case 0: s = sr; c = cr; break;
+    case 1: s = cr; c = -sr; break;
+    case 2: s = -sr; c = -cr; break;
+    default: s = -cr; c = sr; break;
+    }
+}
+
+/// atan of @a x (Cephes: reduction to |x| <= 0.66 and a 4/5 rational approximation).
+inline double atan(double x)
+{
+    const double sign = x < 0.0 ? -1.0 : 1.0;
+    double a = std::abs(x), y = 0.0, extra = 0.0;
+    constexpr double moreBits = 6.123233995736765886130e-17;
+    if (a > 2.41421356237309504880) {
+        y = M_PI_2;
+        extra = moreBits;
+        a = -1.0 / a;
+    } else if (a > 0.66) {
+        y = M_PI_4;
+        extra = 0.5 * moreBits;
+        a = (a - 1.0) / (a + 1.0);
+    }
+    const double z = a * a;
+    const double p = (((-8.750608600031904122785e-01 * z - 1.615753718733365076637e+01) * z - 7.500855792314704667340e+01) * z -
+                      1.228866684490136173410e+02) * z - 6.485021904942025371773e+01;
+    const double q = ((((z + 2.485846490142306297962e+01) * z + 1.650270098316988542046e+02) * z + 4.328810604912902668951e+02) * z +
+                      4.853903996359136964868e+02) * z + 1.945506571482613964425e+02;
+    return sign * (y + (a + a * z * p / q) + extra);
+}
+
+/// atan2(y, x), the library's quadrant conventions for finite arguments.
+inline double atan2(double y, double x)
+{
+    if (x > 0.0) return fastmath::atan(y / x);
+    if (x < 0.0) return (y >= 0.0 ? M_PI : -M_PI) + fastmath::atan(y / x);
+    if (y > 0.0) return M_PI_2;
+    if (y < 0.0) return -M_PI_2;
+    return 0.0;
+}
+
+} // namespace fastmath
+} // namespace vdbhair
