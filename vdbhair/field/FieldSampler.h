@@ -11,15 +11,22 @@
 /// Inactive corners contribute nothing; sample() also returns the summed weight of the active
 /// corners, so that callers can tell "outside the field" (no active corner) from "the field
 /// vanishes here" (active corners whose vectors cancel).
+///
+/// Bricks are found by leaf coordinates in a dense table over the leaves' bounding box (a hash
+/// map only for scattered leaves), and where no leaf is BrickedField::brickAt() returns an
+/// all-zero brick rather than nullptr: the streamline tracer's SIMD kernel then blends first and
+/// tests the weight afterwards, with no branch per lane (StreamlineTracer.cc).
 #pragma once
 
 #include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/field/Simd.h>
 
 #include <openvdb/math/Coord.h>
 #include <openvdb/math/Vec3.h>
 #include <openvdb/tree/LeafManager.h>
 #include <openvdb/tree/ValueAccessor.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -28,10 +35,6 @@
 #include <vector>
 
 namespace vdbhair {
-
-/// Four floats: a vector (x, y, z) and an activity weight (w), blended as one SIMD value
-/// (GCC/Clang vector extensions; compiled to scalar code where the target has no SIMD).
-typedef float Float4 __attribute__((vector_size(16)));
 
 /// @brief The leaves of a vector tree as 9³ bricks (see the file comment). Read-only after
 /// construction, and safe to share between threads.
@@ -46,14 +49,20 @@ public:
 
     struct Brick
     {
-        Float4 cell[N * N * N];  ///< x, y, z and w = 1 (active) or 0, indexed (x * N + y) * N + z
+        /// x, y, z and w = 1 (active) or 0, indexed (x * N + y) * N + z: a vector and an activity
+        /// weight, blended as one SIMD value
+        Float4 cell[N * N * N];
     };
 
     explicit BrickedField(const TreeT& tree) : mTree(tree)
     {
         openvdb::tree::LeafManager<const TreeT> leaves(tree);
-        mBricks.reset(new Brick[leaves.leafCount()]);
-        for (std::size_t i = 0; i < leaves.leafCount(); ++i) mIndex.emplace(key(leaves.leaf(i).origin()), std::uint32_t(i));
+        const std::size_t count = leaves.leafCount();
+        // One more brick than leaves: the last stays all zero (see brickAt()).
+        mBricks.reset(new Brick[count + 1]);
+        mZero = &mBricks[count];
+        std::fill(std::begin(mBricks[count].cell), std::end(mBricks[count].cell), Float4{0.f, 0.f, 0.f, 0.f});
+        buildIndex(leaves);
         leaves.foreach([&](const LeafT& leaf, std::size_t i) {
             openvdb::tree::ValueAccessor<const TreeT> acc(mTree);
             Brick& b = mBricks[i];
@@ -85,25 +94,29 @@ public:
     /// The brick of the leaf with origin @a origin (multiples of 8), or nullptr.
     const Brick* find(const openvdb::Coord& origin) const
     {
-        const auto it = mIndex.find(key(origin));
-        return it == mIndex.end() ? nullptr : &mBricks[it->second];
+        const Brick* b = brickAt(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
+        return b == mZero ? nullptr : b;
+    }
+
+    /// @brief The brick of the leaf at leaf coordinates (lx, ly, lz) (index coordinates >> 3), or
+    /// the all-zero brick where there is no leaf. Never nullptr, so a sampler can blend first and
+    /// test afterwards: a blend in the zero brick has weight 0, as outside the field.
+    const Brick* brickAt(int lx, int ly, int lz) const
+    {
+        if (!mTable.empty()) {
+            // Unsigned compares fold the lower and upper bounds into one test per axis.
+            const std::uint32_t x = std::uint32_t(lx - mLo[0]), y = std::uint32_t(ly - mLo[1]), z = std::uint32_t(lz - mLo[2]);
+            if (x >= mDim[0] || y >= mDim[1] || z >= mDim[2]) return mZero;
+            return &mBricks[mTable[(std::size_t(x) * mDim[1] + y) * mDim[2] + z]];
+        }
+        const auto it = mIndex.find(openvdb::Coord(lx, ly, lz));
+        return it == mIndex.end() ? mZero : &mBricks[it->second];
     }
 
     const TreeT& tree() const { return mTree; }
 
-    /// @brief The lower corner's cell of the sampling cell whose lower corner is (bx, by, bz), or
-    /// nullptr where no leaf holds that corner; @a origin / @a brick cache the last brick.
-    const Float4* cell(int bx, int by, int bz, openvdb::Coord& origin, const Brick*& brick) const
-    {
-        const openvdb::Coord o(bx & ~7, by & ~7, bz & ~7);
-        if (o != origin) {
-            origin = o;
-            brick = find(o);
-        }
-        return brick ? brick->cell + ((bx & 7) * N + (by & 7)) * N + (bz & 7) : nullptr;
-    }
-
-    /// @brief Trilinear blend of the cell at @a c with fractions (fx, fy, fz) (see FieldSampler).
+    /// @brief Trilinear blend of the cell at @a c with fractions (fx, fy, fz) (see FieldSampler):
+    /// corners at +0, +1 (z), +N (y), +N*N (x), three nested lerps, four lanes at a time.
     static Float4 blend(const Float4* c, float fx, float fy, float fz)
     {
         const Float4 z00 = c[0] + (c[1] - c[0]) * fz;
@@ -116,15 +129,45 @@ public:
     }
 
 private:
-    static std::uint64_t key(const openvdb::Coord& o)
+    /// @brief Leaf coordinates to brick indices. A dense table over the leaves' bounding box
+    /// (one load, no hashing) when it costs at most 64 entries per leaf, i.e. under 3% of the
+    /// bricks' own memory; a hash map for scattered leaves.
+    void buildIndex(const openvdb::tree::LeafManager<const TreeT>& leaves)
     {
-        return (std::uint64_t(std::uint32_t(o.x()) >> 3) << 42) ^ (std::uint64_t(std::uint32_t(o.y()) >> 3) << 21) ^
-               std::uint64_t(std::uint32_t(o.z()) >> 3);
+        const std::size_t count = leaves.leafCount();
+        if (count == 0) return;
+        int lo[3], hi[3];
+        for (int k = 0; k < 3; ++k) { lo[k] = std::numeric_limits<int>::max(); hi[k] = std::numeric_limits<int>::min(); }
+        for (std::size_t i = 0; i < count; ++i) {
+            const openvdb::Coord o = leaves.leaf(i).origin();
+            for (int k = 0; k < 3; ++k) { lo[k] = std::min(lo[k], o[k] >> 3); hi[k] = std::max(hi[k], o[k] >> 3); }
+        }
+        double cells = 1.0;
+        for (int k = 0; k < 3; ++k) cells *= double(hi[k]) - double(lo[k]) + 1.0;
+        if (cells <= 64.0 * double(count) + 4096.0) {
+            for (int k = 0; k < 3; ++k) { mLo[k] = lo[k]; mDim[k] = std::uint32_t(hi[k] - lo[k] + 1); }
+            mTable.assign(std::size_t(cells), std::uint32_t(count));  // count: the zero brick
+            for (std::size_t i = 0; i < count; ++i) {
+                const openvdb::Coord o = leaves.leaf(i).origin();
+                const std::size_t x = std::size_t((o.x() >> 3) - lo[0]), y = std::size_t((o.y() >> 3) - lo[1]), z = std::size_t((o.z() >> 3) - lo[2]);
+                mTable[(x * mDim[1] + y) * mDim[2] + z] = std::uint32_t(i);
+            }
+        } else {
+            mIndex.reserve(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const openvdb::Coord o = leaves.leaf(i).origin();
+                mIndex.emplace(openvdb::Coord(o.x() >> 3, o.y() >> 3, o.z() >> 3), std::uint32_t(i));
+            }
+        }
     }
 
     const TreeT& mTree;
     std::unique_ptr<Brick[]> mBricks;
-    std::unordered_map<std::uint64_t, std::uint32_t> mIndex;
+    const Brick* mZero = nullptr;
+    std::vector<std::uint32_t> mTable;  ///< dense index (empty: use mIndex)
+    int mLo[3] = {0, 0, 0};
+    std::uint32_t mDim[3] = {0, 0, 0};
+    std::unordered_map<openvdb::Coord, std::uint32_t> mIndex;  ///< leaf coordinates -> brick
 };
 
 /// @brief Trilinear sampling over a BrickedField, with the current brick and cell cached.
@@ -144,7 +187,7 @@ public:
     /// Inactive corners hold zero vectors, so they contribute nothing to x, y, z.
     Float4 sample(const openvdb::Vec3d& p)
     {
-        const int bx = floorToInt(p.x()), by = floorToInt(p.y()), bz = floorToInt(p.z());
+        const int bx = floorIndex(p.x()), by = floorIndex(p.y()), bz = floorIndex(p.z());
         if (!mValid || bx != mBase[0] || by != mBase[1] || bz != mBase[2]) load(bx, by, bz);
         // Corners at +0, +1 (z), +N (y), +N*N (x): three nested lerps, four lanes at a time.
         return Bricks::blend(mCell, float(p.x() - bx), float(p.y() - by), float(p.z() - bz));
@@ -159,6 +202,14 @@ public:
     }
 
 private:
+    /// floor(x), for any x: positions far outside the grid (or NaN) clamp to ±2^30, where no
+    /// leaf is, instead of overflowing the int.
+    static int floorIndex(double x)
+    {
+        constexpr double kLimit = double(1 << 30);
+        return floorToInt(std::min(kLimit, std::max(-kLimit, x)));  // this order maps NaN to -kLimit
+    }
+
     void load(int bx, int by, int bz)
     {
         mBase[0] = bx; mBase[1] = by; mBase[2] = bz;

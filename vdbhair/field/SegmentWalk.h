@@ -80,7 +80,9 @@ inline std::uint64_t walkSegment(const openvdb::Vec3d& a, const openvdb::Vec3d& 
 inline std::uint64_t segmentVoxelBound(const openvdb::Vec3d& a, const openvdb::Vec3d& b)
 {
     const double n = 4.0 + std::abs(b.x() - a.x()) + std::abs(b.y() - a.y()) + std::abs(b.z() - a.z());
-    return n < 1e18 ? std::uint64_t(n) : std::uint64_t(1e18);  // saturate: callers compare to a cap
+    // Saturate (callers compare to a cap); below 1e18 the signed conversion, a single instruction
+    // on x86-64 where the unsigned one is a branchy sequence, gives the same value.
+    return n < 1e18 ? std::uint64_t(std::int64_t(n)) : std::uint64_t(1e18);
 }
 
 } // namespace vdbhair

@@ -69,7 +69,8 @@ struct TraceStats
 /// length. A strand that stops early keeps the part it traced (at least its root twice).
 /// Per-strand attributes are kept; per-vertex attributes are kept in RetraceVertices::Input mode.
 /// @param[out] reasons optional #S stop reasons
-/// @throw TypeError (not a Vec3 grid), ValueError (bad step, threshold), InterruptedError.
+/// @throw TypeError (not a Vec3 grid), ValueError (bad step, threshold), LimitError (a strand that
+/// would take more than 2^31 steps: step far too small for its length), InterruptedError.
 StrandSet retraceStrands(const StrandSet& strands, const openvdb::GridBase& field, const TraceParams& params,
                          TraceStats* stats = nullptr, std::vector<StopReason>* reasons = nullptr,
                          bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr);

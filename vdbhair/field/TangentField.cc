@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/field/Simd.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <openvdb/tree/LeafManager.h>
@@ -10,6 +11,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <array>
@@ -24,37 +26,56 @@ namespace {
 using openvdb::Coord;
 using openvdb::Vec3d;
 
-/// First and second moments of the contributions to one voxel: s = Σ ℓ T, M = Σ ℓ T Tᵀ
-/// (xx, yy, zz, xy, xz, yz). trace(M) = Σ ℓ is the density.
+/// @brief First and second moments of the contributions to one voxel: s = Σ ℓ T and
+/// M = Σ ℓ T Tᵀ, as three SIMD quadruples a = (s_x, s_y, s_z, M_xx), b = (M_yy, M_zz, M_xy,
+/// M_xz), c = (M_yz, 0, 0, 0), so that adding a contribution is three multiply-adds.
+/// trace(M) = Σ ℓ is the density.
 struct Moments
 {
-    float s[3] = {0.f, 0.f, 0.f};
-    float m[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+    Float4 a = {0.f, 0.f, 0.f, 0.f}, b = {0.f, 0.f, 0.f, 0.f}, c = {0.f, 0.f, 0.f, 0.f};
 
-    /// Add a piece of length @a l of a segment whose tangent T gives @a t = T and
-    /// @a tt = (xx, yy, zz, xy, xz, yz) of T Tᵀ (computed once per segment).
-    void add(const float* t, const float* tt, float l)
+    /// @brief The moments of a whole segment d (world, length len > 0): ℓ T = d and
+    /// ℓ T Tᵀ = d dᵀ / len. A piece of it, fraction f of its length, contributes f times these.
+    static Moments ofSegment(const Float4& d, float len)
     {
-        for (int k = 0; k < 3; ++k) s[k] += l * t[k];
-        for (int k = 0; k < 6; ++k) m[k] += l * tt[k];
+        const Float4 e = d * (1.f / len);
+        Moments m;
+        m.a = Float4{d[0], d[1], d[2], d[0] * e[0]};
+        m.b = Float4{d[1] * e[1], d[2] * e[2], d[0] * e[1], d[0] * e[2]};
+        m.c = Float4{d[1] * e[2], 0.f, 0.f, 0.f};
+        return m;
     }
     void add(const Moments& o)
     {
-        for (int k = 0; k < 3; ++k) s[k] += o.s[k];
-        for (int k = 0; k < 6; ++k) m[k] += o.m[k];
+        a += o.a;
+        b += o.b;
+        c += o.c;
     }
-    bool empty() const { return m[0] == 0.f && m[1] == 0.f && m[2] == 0.f; }
+    void addScaled(const Moments& o, float f)
+    {
+        a += o.a * f;
+        b += o.b * f;
+        c += o.c * f;
+    }
+    float xx() const { return a[3]; }
+    float yy() const { return b[0]; }
+    float zz() const { return b[1]; }
+    float xy() const { return b[2]; }
+    float xz() const { return b[3]; }
+    float yz() const { return c[0]; }
+    float density() const { return xx() + yy() + zz(); }
+    bool empty() const { return xx() == 0.f && yy() == 0.f && zz() == 0.f; }
 };
 
 /// Eq. 9 from the moments: v_t = normalize(s + M v_{t-1}), v_0 = 0.
 openvdb::Vec3f robustDirection(const Moments& mo, int iterations)
 {
-    const Vec3d s(mo.s[0], mo.s[1], mo.s[2]);
+    const Vec3d s(mo.a[0], mo.a[1], mo.a[2]);
     Vec3d v(0.0);
     for (int t = 0; t < iterations; ++t) {
-        const Vec3d w = s + Vec3d(mo.m[0] * v.x() + mo.m[3] * v.y() + mo.m[4] * v.z(),
-                                  mo.m[3] * v.x() + mo.m[1] * v.y() + mo.m[5] * v.z(),
-                                  mo.m[4] * v.x() + mo.m[5] * v.y() + mo.m[2] * v.z());
+        const Vec3d w = s + Vec3d(mo.xx() * v.x() + mo.xy() * v.y() + mo.xz() * v.z(),
+                                  mo.xy() * v.x() + mo.yy() * v.y() + mo.yz() * v.z(),
+                                  mo.xz() * v.x() + mo.yz() * v.y() + mo.zz() * v.z());
         const double len = w.length();
         if (!(len > 1e-30)) return openvdb::Vec3f(0.f);
         v = w / len;
@@ -64,7 +85,7 @@ openvdb::Vec3f robustDirection(const Moments& mo, int iterations)
 
 /// The accumulation of one chunk of strands. Moments live in one array; each touched leaf-sized
 /// block (8³ voxels) maps its voxels to slots in it. Consecutive flushes of a strand mostly hit
-/// the same block, which is cached, so a flush costs a compare, an index and nine adds.
+/// the same block, which is cached, so a flush costs a compare, an index and three SIMD adds.
 struct Chunk
 {
     static constexpr std::uint32_t kEmpty = 0xffffffffu;
@@ -72,20 +93,15 @@ struct Chunk
     {
         std::uint32_t slot[512];
     };
-    std::unordered_map<std::uint64_t, std::uint32_t> blockOf;  // packed block coordinate -> block index
+    std::unordered_map<Coord, std::uint32_t> blockOf;  // block origin -> block index
     std::vector<Block> blocks;
     std::vector<Coord> origins;
     std::vector<Moments> moments;
 
-    static std::uint64_t key(const Coord& origin)
-    {
-        return (std::uint64_t(std::uint32_t(origin.x()) >> 3) << 42) ^ (std::uint64_t(std::uint32_t(origin.y()) >> 3) << 21) ^
-               std::uint64_t(std::uint32_t(origin.z()) >> 3);
-    }
     /// The block of @a origin, or nullptr.
     const Block* find(const Coord& origin) const
     {
-        const auto it = blockOf.find(key(origin));
+        const auto it = blockOf.find(origin);
         return it == blockOf.end() ? nullptr : &blocks[it->second];
     }
 };
@@ -96,32 +112,161 @@ class ChunkWriter
 public:
     explicit ChunkWriter(Chunk& c) : mChunk(c) {}
 
+    /// Add @a m to voxel @a ijk (inlined: called for every voxel a strand enters).
     void add(const Coord& ijk, const Moments& m)
     {
         const Coord origin(ijk.x() & ~7, ijk.y() & ~7, ijk.z() & ~7);
-        if (mBlock == Chunk::kEmpty || origin != mOrigin) {
-            mOrigin = origin;
-            const auto [it, inserted] = mChunk.blockOf.try_emplace(Chunk::key(origin), std::uint32_t(mChunk.blocks.size()));
-            if (inserted) {
-                mChunk.blocks.emplace_back();
-                std::fill(std::begin(mChunk.blocks.back().slot), std::end(mChunk.blocks.back().slot), Chunk::kEmpty);
-                mChunk.origins.push_back(origin);
-            }
-            mBlock = it->second;
-        }
-        std::uint32_t& slot = mChunk.blocks[mBlock].slot[((ijk.x() & 7) << 6) | ((ijk.y() & 7) << 3) | (ijk.z() & 7)];
+        if (mSlots == nullptr || !sameCoord(origin, mOrigin)) selectBlock(origin);
+        std::uint32_t& slot = mSlots[((ijk.x() & 7) << 6) | ((ijk.y() & 7) << 3) | (ijk.z() & 7)];
         if (slot == Chunk::kEmpty) {
-            slot = std::uint32_t(mChunk.moments.size());
-            mChunk.moments.push_back(m);
+            newSlot(slot, m);
         } else {
             mChunk.moments[slot].add(m);
         }
     }
 
+    /// Whether a == b, without the branches of Coord::operator== (voxels change unpredictably).
+    static bool sameCoord(const Coord& a, const Coord& b)
+    {
+        return ((a.x() ^ b.x()) | (a.y() ^ b.y()) | (a.z() ^ b.z())) == 0;
+    }
+
 private:
+    __attribute__((noinline)) void selectBlock(const Coord& origin)
+    {
+        mOrigin = origin;
+        const auto [it, inserted] = mChunk.blockOf.try_emplace(origin, std::uint32_t(mChunk.blocks.size()));
+        if (inserted) {
+            mChunk.blocks.emplace_back();
+            std::fill(std::begin(mChunk.blocks.back().slot), std::end(mChunk.blocks.back().slot), Chunk::kEmpty);
+            mChunk.origins.push_back(origin);
+        }
+        mSlots = mChunk.blocks[it->second].slot;
+    }
+
+    __attribute__((noinline)) void newSlot(std::uint32_t& slot, const Moments& m)
+    {
+        slot = std::uint32_t(mChunk.moments.size());
+        mChunk.moments.push_back(m);
+    }
+
     Chunk& mChunk;
     Coord mOrigin;
-    std::uint32_t mBlock = Chunk::kEmpty;
+    /// The cached block's slots. Adding a block may move the blocks, and add() then re-points
+    /// this at once; a chunk has one writer.
+    std::uint32_t* mSlots = nullptr;
+};
+
+/// @brief Walks one chunk's strands through the voxels and adds their moments to the chunk.
+///
+/// Consecutive pieces in the same voxel (strands often take several segments per voxel) are summed
+/// in registers and written to the chunk when the walk moves on. Per segment: the world segment
+/// gives the moments of the whole segment once (Moments::ofSegment); the index-space segment
+/// gives the voxels and the fraction of its length in each, by a 3D DDA restricted to the axes
+/// whose voxel coordinate changes — each such axis crosses exactly |Δ| voxel boundaries, so the
+/// walk takes exactly that many steps and ends in the end vertex's voxel.
+template<typename ToIndex>
+class SegmentAccumulator
+{
+public:
+    SegmentAccumulator(Chunk& chunk, const ToIndex& toIndex) : mWriter(chunk), mToIndex(toIndex) {}
+
+    /// Add the n vertices at @a v (one strand, root first).
+    void addStrand(const Vec3f* v, std::size_t n)
+    {
+        Vec3d ia = mToIndex(v[0]);
+        Coord va = voxelOf(ia);
+        Float4 pa = loadFloat3(v[0].asPointer());
+        for (std::size_t j = 1; j < n; ++j) {
+            const Vec3d ib = mToIndex(v[j]);
+            const Coord vb = voxelOf(ib);
+            const Float4 pb = loadFloat3(v[j].asPointer());
+            const Float4 d = pb - pa;
+            const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if (len2 > 0.f) {
+                const Moments u = Moments::ofSegment(d, std::sqrt(len2));
+                if (ChunkWriter::sameCoord(va, vb)) {
+                    add(va, u);  // the common case: the whole segment in one voxel
+                } else {
+                    walk(ia, ib, va, vb, u);
+                }
+            }
+            ia = ib;
+            va = vb;
+            pa = pb;
+        }
+    }
+
+    /// Write the pending moments out (at the end of the chunk).
+    void flush()
+    {
+        if (!mPending.empty()) mWriter.add(mCurrent, mPending);
+        mPending = Moments();
+    }
+
+private:
+    /// The voxel holding index position @a p (voxel ijk spans [ijk - 0.5, ijk + 0.5)).
+    static Coord voxelOf(const Vec3d& p)
+    {
+        return Coord(floorToInt(p.x() + 0.5), floorToInt(p.y() + 0.5), floorToInt(p.z() + 0.5));
+    }
+
+    void add(const Coord& ijk, const Moments& u)
+    {
+        if (!ChunkWriter::sameCoord(ijk, mCurrent)) {
+            flush();
+            mCurrent = ijk;
+        }
+        mPending.add(u);
+    }
+
+    void add(const Coord& ijk, const Moments& u, float f)
+    {
+        if (!ChunkWriter::sameCoord(ijk, mCurrent)) {
+            flush();
+            mCurrent = ijk;
+        }
+        mPending.addScaled(u, f);
+    }
+
+    /// The DDA of a segment from @a a (voxel @a va) to @a b (voxel @a vb != va), index space.
+    void walk(const Vec3d& a, const Vec3d& b, Coord c, const Coord& vb, const Moments& u)
+    {
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        int step[3], left[3];
+        double tMax[3], tDelta[3];
+        int total = 0;
+        for (int k = 0; k < 3; ++k) {
+            const int n = vb[k] - c[k];
+            left[k] = std::abs(n);
+            total += left[k];
+            if (n == 0) {
+                step[k] = 0;
+                tMax[k] = tDelta[k] = inf;
+            } else {
+                // The boundary on the way out of the first voxel, and the next ones 1 / |d| apart.
+                const double inv = 1.0 / (b[k] - a[k]);
+                step[k] = n > 0 ? 1 : -1;
+                tDelta[k] = std::abs(inv);
+                tMax[k] = (double(c[k]) + 0.5 * double(step[k]) - a[k]) * inv;
+            }
+        }
+        double t = 0.0;
+        for (int s = 0; s < total; ++s) {
+            const int axis = (tMax[0] < tMax[1]) ? (tMax[0] < tMax[2] ? 0 : 2) : (tMax[1] < tMax[2] ? 1 : 2);
+            const double tNext = std::min(std::max(tMax[axis], t), 1.0);  // monotone despite rounding
+            if (tNext > t) add(c, u, float(tNext - t));  // pieces of zero length are skipped
+            t = tNext;
+            c[axis] += step[axis];
+            tMax[axis] = --left[axis] > 0 ? tMax[axis] + tDelta[axis] : inf;
+        }
+        if (1.0 > t) add(c, u, float(1.0 - t));
+    }
+
+    ChunkWriter mWriter;
+    const ToIndex& mToIndex;
+    Coord mCurrent{std::numeric_limits<int>::max()};
+    Moments mPending;
 };
 
 /// Strands are split into this many chunks whatever the thread count (determinism).
@@ -157,34 +302,96 @@ FieldMapping mappingFor(const FieldParams& p, double voxelSize)
     return FieldMapping(openvdb::math::Transform::createLinearTransform(voxelSize));
 }
 
+/// World to index space for one vertex: the axis-aligned linear map inline, else the mapping.
+struct AxisAlignedToIndex
+{
+    Vec3d offset, invScale;
+    Vec3d operator()(const Vec3f& p) const { return (Vec3d(p) - offset) * invScale; }
+};
+struct MappedToIndex
+{
+    const FieldMapping& map;
+    Vec3d operator()(const Vec3f& p) const { return map.worldToIndex(Vec3d(p)); }
+};
+
+/// Call @a fn with the cheapest world-to-index functor for @a map (same results either way).
+template<typename Fn>
+void withToIndex(const FieldMapping& map, Fn&& fn)
+{
+    if (map.isAxisAlignedWorld()) fn(AxisAlignedToIndex{map.offset(), map.invScale()});
+    else fn(MappedToIndex{map});
+}
+
+/// The bounding box of the vertices and the voxel visit bound, in one parallel pass.
+struct Extent
+{
+    BBox box;
+    bool nan = false;  ///< some coordinate is not a number (the box leaves it out)
+    std::uint64_t visits = 0;
+};
+
+/// Voxel visit bounds saturate here (beyond any cap).
+constexpr std::uint64_t kSaturated = std::uint64_t(1) << 62;
+
+Extent measure(const StrandSet& strands, const FieldMapping& map)
+{
+    Extent result;
+    withToIndex(map, [&](const auto& toIndex) {
+        result = tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(0, strands.numStrands(), 256), Extent(),
+            [&](const tbb::blocked_range<std::size_t>& r, Extent e) {
+                Float4 lo = loadFloat3(e.box.min.asPointer()), hi = loadFloat3(e.box.max.asPointer());
+                Int4 nan = {0, 0, 0, 0};
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    const Vec3f* v = strands.data(i);
+                    const std::size_t n = strands.size(i);
+                    Vec3d a = toIndex(v[0]);
+                    for (std::size_t j = 0; j < n; ++j) {
+                        const Float4 p = loadFloat3(v[j].asPointer());
+                        lo = p < lo ? p : lo;
+                        hi = p > hi ? p : hi;
+                        nan |= p != p;
+                        if (j == 0 || e.visits > kSaturated) continue;
+                        const Vec3d b = toIndex(v[j]);
+                        e.visits += segmentVoxelBound(a, b);
+                        a = b;
+                    }
+                }
+                e.box.min = Vec3f(lo[0], lo[1], lo[2]);
+                e.box.max = Vec3f(hi[0], hi[1], hi[2]);
+                e.nan = e.nan || any(nan);
+                return e;
+            },
+            [](Extent a, const Extent& b) {
+                a.box.expand(b.box.min);
+                a.box.expand(b.box.max);
+                a.nan = a.nan || b.nan;
+                a.visits = std::min(a.visits + b.visits, kSaturated);
+                return a;
+            });
+    });
+    return result;
+}
+
 std::uint64_t visitBound(const StrandSet& strands, const FieldMapping& map)
 {
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, strands.numStrands(), 256), std::uint64_t(0),
-        [&](const tbb::blocked_range<std::size_t>& r, std::uint64_t acc) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                Vec3d a = map.worldToIndex(Vec3d(strands.root(i)));
-                for (std::size_t v = strands.begin(i) + 1; v < strands.end(i); ++v) {
-                    const Vec3d b = map.worldToIndex(Vec3d(strands.positions[v]));
-                    acc += segmentVoxelBound(a, b);
-                    a = b;
-                }
-                if (acc > (std::uint64_t(1) << 62)) return acc;
-            }
-            return acc;
-        },
-        [](std::uint64_t a, std::uint64_t b) { return std::min(a + b, std::uint64_t(1) << 62); });
+    return std::min(measure(strands, map).visits, kSaturated);
 }
 
 TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, double voxelSize, int level, int levels,
                            bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
     const FieldMapping map = mappingFor(p, voxelSize);
+    const std::size_t nS = strands.numStrands(), nChunks = chunkCount(nS);
 
     // Bounds before any allocation: index coordinates must fit OpenVDB's int32 Coord, and the
-    // voxel visits the cap.
-    const BBox box = computeBBox(strands);
-    for (const Vec3f& corner : {box.min, box.max}) {
+    // voxel visits the cap. Meanwhile, the strands in spatial order: chunks of neighbouring
+    // strands share voxels, so a chunk's moments stay small and in cache.
+    Extent extent;
+    std::vector<std::uint32_t> order;
+    tbb::parallel_invoke([&] { extent = measure(strands, map); }, [&] { order = spatialOrder(strands); });
+    if (extent.nan) extent.box.min = Vec3f(std::numeric_limits<float>::quiet_NaN());  // fails below
+    for (const Vec3f& corner : {extent.box.min, extent.box.max}) {
         const Vec3d ip = map.worldToIndex(Vec3d(corner));
         for (int k = 0; k < 3; ++k) {
             if (!(std::abs(ip[k]) < double(1 << 30))) {
@@ -194,7 +401,7 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
             }
         }
     }
-    const std::uint64_t bound = visitBound(strands, map);
+    const std::uint64_t bound = std::min(extent.visits, kSaturated);
     if (bound > p.maxVoxels) {
         throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) + " needs up to " +
                          std::to_string(bound) + " voxel visits, more than the cap of " +
@@ -202,55 +409,28 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     }
 
     // Accumulate the moments, chunk by chunk (each chunk in strand order).
-    const std::size_t nS = strands.numStrands(), nChunks = chunkCount(nS);
-    // Chunks of spatially sorted strands: neighbouring strands share voxels, so a chunk's
-    // moments stay small and in cache.
-    const std::vector<std::uint32_t> order = spatialOrder(strands);
     std::vector<Chunk> chunks(nChunks);
-    auto accumulateChunk = [&](std::size_t c) {
-        ChunkWriter writer(chunks[c]);
-        Coord current(std::numeric_limits<int>::max());
-        Moments pending;
-        auto flush = [&]() {
-            if (pending.empty()) return;
-            writer.add(current, pending);
-            pending = Moments();
-        };
-        const std::size_t first = nS * c / nChunks, last = nS * (c + 1) / nChunks;
-        for (std::size_t o = first; o < last; ++o) {
-            if (interrupter && (o & 255) == 0 && interrupter->wasInterrupted()) return;
-            const std::size_t i = order[o];
-            Vec3d pa(strands.root(i));
-            Vec3d ia = map.worldToIndex(pa);
-            for (std::size_t v = strands.begin(i) + 1; v < strands.end(i); ++v) {
-                const Vec3d pb(strands.positions[v]);
-                const Vec3d ib = map.worldToIndex(pb);
-                const Vec3d seg = pb - pa;
-                const double len = seg.length();
-                if (len > 0.0) {
-                    const float t[3] = {float(seg.x() / len), float(seg.y() / len), float(seg.z() / len)};
-                    const float tt[6] = {t[0] * t[0], t[1] * t[1], t[2] * t[2], t[0] * t[1], t[0] * t[2], t[1] * t[2]};
-                    walkSegment(ia, ib, [&](const Coord& ijk, double t0, double t1) {
-                        if (ijk != current) {
-                            flush();
-                            current = ijk;
-                        }
-                        pending.add(t, tt, float((t1 - t0) * len));
-                    });
-                }
-                pa = pb;
-                ia = ib;
+    withToIndex(map, [&](const auto& toIndex) {
+        auto accumulateChunk = [&](std::size_t c) {
+            SegmentAccumulator<std::decay_t<decltype(toIndex)>> acc(chunks[c], toIndex);
+            const std::size_t first = nS * c / nChunks, last = nS * (c + 1) / nChunks;
+            for (std::size_t o = first; o < last; ++o) {
+                if (interrupter && (o & 255) == 0 && interrupter->wasInterrupted()) return;
+                // The spatial order scatters strands over memory: fetch a later one meanwhile.
+                if (o + 2 < last) prefetchBytes(strands.data(order[o + 2]), strands.size(order[o + 2]) * sizeof(Vec3f));
+                const std::size_t i = order[o];
+                acc.addStrand(strands.data(i), strands.size(i));
             }
+            acc.flush();
+        };
+        if (threaded) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nChunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+                for (std::size_t c = r.begin(); c != r.end(); ++c) accumulateChunk(c);
+            });
+        } else {
+            for (std::size_t c = 0; c < nChunks; ++c) accumulateChunk(c);
         }
-        flush();
-    };
-    if (threaded) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nChunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t c = r.begin(); c != r.end(); ++c) accumulateChunk(c);
-        });
-    } else {
-        for (std::size_t c = 0; c < nChunks; ++c) accumulateChunk(c);
-    }
+    });
     if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("estimateTangentField: interrupted");
 
     // Topology: every block any chunk touched, as leaves of the output trees.
@@ -266,15 +446,19 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     // Per leaf: merge the chunks in order, then Eq. 9 and the density.
     openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(*tangentTree);
     leaves.foreach([&](openvdb::Vec3STree::LeafNodeType& leaf, std::size_t) {
-        std::array<Moments, 512> sum{};
+        std::array<Moments, 512> sum;
         std::array<bool, 512> hit{};
         for (const Chunk& c : chunks) {
             const Chunk::Block* block = c.find(leaf.origin());
             if (!block) continue;
             for (int k = 0; k < 512; ++k) {
                 if (block->slot[k] == Chunk::kEmpty) continue;
-                sum[std::size_t(k)].add(c.moments[block->slot[k]]);
-                hit[std::size_t(k)] = true;
+                if (hit[std::size_t(k)]) {
+                    sum[std::size_t(k)].add(c.moments[block->slot[k]]);
+                } else {
+                    sum[std::size_t(k)] = c.moments[block->slot[k]];
+                    hit[std::size_t(k)] = true;
+                }
             }
         }
         auto* dl = densityTree->probeLeaf(leaf.origin());
@@ -282,7 +466,7 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
             if (!hit[k]) continue;
             const Moments& mo = sum[k];
             leaf.setValueOn(k, robustDirection(mo, p.iterations));
-            dl->setValueOn(k, mo.m[0] + mo.m[1] + mo.m[2]);
+            dl->setValueOn(k, mo.density());
         }
     }, threaded);
 
