@@ -11,6 +11,9 @@
 #include <tbb/global_control.h>
 
 #include <memory>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace vdbhair::app {
 
@@ -26,6 +29,16 @@ void printWarnings(const std::string& verb, const ReadReport& report, const Comm
 {
     if (common.quiet) return;
     for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << w << "\n";
+}
+
+std::string formatValue(double v)
+{
+    char buf[32];
+    for (int precision = 1; precision <= 17; ++precision) {
+        std::snprintf(buf, sizeof buf, "%.*g", precision, v);
+        if (std::strtod(buf, nullptr) == v || !std::isfinite(v)) break;
+    }
+    return buf;
 }
 
 void printJson(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
@@ -101,6 +114,7 @@ int run(int argc, char** argv)
     commands.push_back(addRetraceCommand(app, common));
     commands.push_back(addRefineCommand(app, common));
     commands.push_back(addGrowCommand(app, common));
+    commands.push_back(addFitCommand(app, common));
     commands.push_back(addRenderCommand(app, common));
     commands.push_back(addDemoCommand(app, common));
 

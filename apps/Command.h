@@ -43,6 +43,9 @@ void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson = true
 /// @brief Print a reader's warnings on stderr as `vdbhair <verb>: warning: ...` (unless quiet).
 void printWarnings(const std::string& verb, const ReadReport& report, const CommonOptions& common);
 
+/// @brief @a v as the user would type it (shortest form that reads back the same: 0.02, not 0.020000).
+std::string formatValue(double v);
+
 /// @brief Print @a j on stdout as one line.
 void printJson(const nlohmann::json& j);
 
@@ -75,6 +78,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common);
 Command addRefineCommand(CLI::App& app, CommonOptions& common);
 Command addGrowCommand(CLI::App& app, CommonOptions& common);
 Command addRenderCommand(CLI::App& app, CommonOptions& common);
+Command addFitCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line.

@@ -38,11 +38,11 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     strandFormatFromPath(p.output, /*forWriting=*/true);
     for (const std::string& in : inputs) strandFormatFromPath(in);
     if (p.resample == 1) throw ValueError("--resample 1: a strand needs at least 2 vertices");
-    if (!std::isfinite(p.scale) || p.scale == 0.0) throw ValueError("--scale " + std::to_string(p.scale) + ": must be finite and non-zero");
+    if (!std::isfinite(p.scale) || p.scale == 0.0) throw ValueError("--scale " + formatValue(p.scale) + ": must be finite and non-zero");
     if (p.plyEncoding == "ascii") wopts.plyEncoding = PlyEncoding::Ascii;
     else if (p.plyEncoding != "binary") throw ValueError("--ply-encoding '" + p.plyEncoding + "': must be ascii or binary");
     wopts.vdb.codec = positionCodecFromName(p.codec);
-    if (p.voxelSize < 0.0 || !std::isfinite(p.voxelSize)) throw ValueError("--voxel-size " + std::to_string(p.voxelSize) + ": must be a positive length (0 chooses it)");
+    if (p.voxelSize < 0.0 || !std::isfinite(p.voxelSize)) throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive length (0 chooses it)");
     wopts.vdb.voxelSize = p.voxelSize;
 
     ReadOptions ropts;

@@ -35,7 +35,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     if (fileExtension(p.output) != ".vdb") throw ValueError(p.output + ": the field is written as OpenVDB; the output must end in .vdb");
     const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0;
     if (voxelGiven && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
-        throw ValueError("--voxel-size " + std::to_string(p.voxelSize) + ": must be a positive finite length");
+        throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive finite length");
     }
     if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
     if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");

@@ -14,7 +14,7 @@ namespace {
 
 struct GrowParams
 {
-    std::string scene, output, integrator = "euler";
+    std::string scene, output, integrator;
     std::size_t maxVertices = std::size_t(1) << 30;
 };
 
@@ -24,7 +24,7 @@ int runGrow(const GrowParams& p, const CommonOptions& common)
     GrowOptions opts;
     if (p.integrator == "euler") opts.integrator = HelicoidIntegrator::Euler;
     else if (p.integrator == "rk4") opts.integrator = HelicoidIntegrator::RK4;
-    else throw ValueError("--integrator '" + p.integrator + "' is not one of euler, rk4");
+    else if (!p.integrator.empty()) throw ValueError("--integrator '" + p.integrator + "' is not one of euler, rk4");
     opts.maxVertices = p.maxVertices;
     const Scene scene = readScene(p.scene);
     const auto t0 = std::chrono::steady_clock::now();
@@ -50,7 +50,7 @@ Command addGrowCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = app.add_subcommand("grow", "Grow the strands of a helicoid scene (guides, p-helicoid pieces, waviness, wisps)");
     sub->add_option("scene", params->scene, "Scene file (JSON, \"vdbhair\": \"scene/1\")")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
-    sub->add_option("--integrator", params->integrator, "euler (Eq. 3, the paper's) or rk4")->capture_default_str();
+    sub->add_option("--integrator", params->integrator, "euler (Eq. 3, the paper's) or rk4 (default: the scene's, else euler)");
     sub->add_option("--max-vertices", params->maxVertices, "Refuse scenes that would grow more vertices")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair grow scenes/figures/fig3_wisp.json -o wisp.hair");

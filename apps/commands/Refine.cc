@@ -16,10 +16,10 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     RefineParams rp;
     const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0, stepGiven = p.stepOpt && p.stepOpt->count() > 0;
     if (voxelGiven && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
-        throw ValueError("--voxel-size " + std::to_string(p.voxelSize) + ": must be a positive finite length");
+        throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive finite length");
     }
     if (stepGiven && (!(p.step > 0.0) || !std::isfinite(p.step))) {
-        throw ValueError("--step " + std::to_string(p.step) + ": must be a positive finite length");
+        throw ValueError("--step " + formatValue(p.step) + ": must be a positive finite length");
     }
     if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
     if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");

@@ -54,10 +54,10 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
     tp.integrator = integratorFromName(p.integrator);
     const bool stepGiven = p.stepOpt && p.stepOpt->count() > 0;
     if (stepGiven && (!(p.step > 0.0) || !std::isfinite(p.step))) {
-        throw ValueError("--step " + std::to_string(p.step) + ": must be a positive finite length");
+        throw ValueError("--step " + formatValue(p.step) + ": must be a positive finite length");
     }
     tp.step = stepGiven ? p.step : 0.0;
-    if (!(p.vanish >= 0.0 && p.vanish < 1.0)) throw ValueError("--vanish " + std::to_string(p.vanish) + ": must be in [0, 1)");
+    if (!(p.vanish >= 0.0 && p.vanish < 1.0)) throw ValueError("--vanish " + formatValue(p.vanish) + ": must be in [0, 1)");
     tp.vanishThreshold = p.vanish;
     tp.maxSteps = p.maxSteps;
     if (p.margin < 0 || p.margin > 16) throw ValueError("--margin " + std::to_string(p.margin) + ": must be between 0 and 16 voxels");

@@ -9,6 +9,10 @@ rm -rf "$dir"; mkdir -p "$dir"; cd "$dir"
 "$bin" convert good.hair good.data --quiet
 "$bin" convert good.hair good.obj --quiet
 cp good.hair existing.hair
+cp "$src/scenes/figures/fig2_waviness.json" existing.json
+# Strands with a known helicoid shape, sampled like the paper's data (30 vertices).
+"$bin" grow "$src/scenes/figures/fig1_k_vectors.json" -o k_vectors.hair --quiet
+"$bin" convert k_vectors.hair k_vectors30.hair --resample 30 --quiet
 # Bad inputs, one rule each.
 { printf 'HAIX'; head -c 124 /dev/zero; } > bad_magic.hair
 head -c 200 good.hair > truncated.hair
@@ -24,6 +28,8 @@ printf 'some text\n' > unknown.abc
 /usr/bin/python3 -c "import pyopenvdb as vdb; g = vdb.FloatGrid(); g.name = 'density'; g.fill((0, 0, 0), (3, 3, 3), 1.0); vdb.write('density.vdb', grids=[g])"
 # Strands of one vertex only: all dropped, leaving an empty hairstyle.
 printf 'v 0 0 0\nv 1 1 1\nl 1\nl 2\n' > only_short.obj
+# A strand of zero length (one point repeated) after a good one.
+printf 'v 0 0 0\nv 1 0 0\nv 2 1 0\nv 3 3 3\nv 3 3 3\nl 1 2 3\nl 4 5\n' > zero_length.obj
 # Scenes with one mistake each.
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0], "length": 1}]}]}\n' > bad_scene.json
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0, 0], "length": 1}], "wisp": {"count": 2, "radiuss": 1}}]}\n' > unknown_key.json

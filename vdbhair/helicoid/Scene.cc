@@ -67,7 +67,7 @@ std::string idx(const std::string& base, std::size_t i) { return base + "[" + st
 Scene sceneFromJson(const json& j, const std::string& where)
 {
     Parser P{where};
-    P.allowOnly(j, "", {"vdbhair", "seed", "step", "guides"});
+    P.allowOnly(j, "", {"vdbhair", "seed", "step", "integrator", "guides"});
     const json& tag = P.require(j, "", "vdbhair");
     if (!tag.is_string() || tag.get<std::string>() != "scene/1") P.fail("vdbhair", "expected \"scene/1\"");
     Scene s;
@@ -76,12 +76,18 @@ Scene sceneFromJson(const json& j, const std::string& where)
         s.step = P.number(j["step"], "step");
         if (!(s.step > 0.0)) P.fail("step", "must be positive");
     }
+    if (j.contains("integrator")) {
+        const json& ij = j["integrator"];
+        if (ij == "euler") s.integrator = HelicoidIntegrator::Euler;
+        else if (ij == "rk4") s.integrator = HelicoidIntegrator::RK4;
+        else P.fail("integrator", "expected \"euler\" or \"rk4\"");
+    }
     const json& guides = P.require(j, "", "guides");
     if (!guides.is_array()) P.fail("guides", "expected an array");
     for (std::size_t g = 0; g < guides.size(); ++g) {
         const std::string gp = idx("guides", g);
         const json& gj = guides[g];
-        P.allowOnly(gj, gp, {"root", "frame", "pieces", "waviness", "wisp", "fit"});
+        P.allowOnly(gj, gp, {"root", "frame", "pieces", "waviness", "wisp", "fit", "step"});
         SceneGuide guide;
         guide.root = P.vec3(P.require(gj, gp, "root"), gp + ".root");
         const json& fj = P.require(gj, gp, "frame");
@@ -137,6 +143,10 @@ Scene sceneFromJson(const json& j, const std::string& where)
             guide.wisp = w;
         }
         if (gj.contains("fit")) guide.fit = gj["fit"];
+        if (gj.contains("step")) {
+            guide.step = P.number(gj["step"], gp + ".step");
+            if (!(guide.step > 0.0)) P.fail(gp + ".step", "must be positive");
+        }
         s.guides.push_back(std::move(guide));
     }
     return s;
@@ -163,9 +173,12 @@ json sceneToJson(const Scene& s)
         }
         if (g.wisp) gj["wisp"] = {{"count", g.wisp->count}, {"radius", g.wisp->radius}, {"fanning", g.wisp->fanning}};
         if (!g.fit.is_null()) gj["fit"] = g.fit;
+        if (g.step > 0.0) gj["step"] = g.step;
         guides.push_back(gj);
     }
-    return {{"vdbhair", "scene/1"}, {"seed", s.seed}, {"step", s.step}, {"guides", guides}};
+    json out = {{"vdbhair", "scene/1"}, {"seed", s.seed}, {"step", s.step}, {"guides", guides}};
+    if (s.integrator == HelicoidIntegrator::RK4) out["integrator"] = "rk4";
+    return out;
 }
 
 Scene readScene(const std::string& path)
@@ -185,7 +198,8 @@ void writeScene(const std::string& path, const Scene& scene)
     const json j = sceneToJson(scene);
     // One guide per line: readable, diffable, and still one JSON document.
     std::string out = "{\"vdbhair\": \"scene/1\", \"seed\": " + std::to_string(scene.seed) + ", \"step\": " +
-                      j["step"].dump() + ",\n \"guides\": [\n";
+                      j["step"].dump() + (j.contains("integrator") ? ", \"integrator\": " + j["integrator"].dump() : std::string()) +
+                      ",\n \"guides\": [\n";
     for (std::size_t i = 0; i < j["guides"].size(); ++i) {
         out += "  " + j["guides"][i].dump() + (i + 1 < j["guides"].size() ? ",\n" : "\n");
     }
@@ -199,7 +213,8 @@ std::size_t sceneVertexCount(const Scene& scene)
     constexpr std::size_t kMax = std::numeric_limits<std::size_t>::max() / 4;
     for (const SceneGuide& g : scene.guides) {
         double perStrand = 1.0;
-        for (const HelicoidPiece& p : g.pieces) perStrand += std::ceil(p.length / scene.step);
+        const double step = g.step > 0.0 ? g.step : scene.step;
+        for (const HelicoidPiece& p : g.pieces) perStrand += std::ceil(p.length / step);
         const double strands = 1.0 + (g.wisp ? double(g.wisp->count) : 0.0);
         const double v = perStrand * strands;
         if (v > double(kMax) || double(total) + v > double(kMax)) return kMax;
@@ -219,6 +234,8 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
                          " vertices, more than the cap of " + std::to_string(options.maxVertices) +
                          " (fewer wisps, shorter pieces or a larger step)");
     }
+    auto stepOf = [&](const SceneGuide& g) { return g.step > 0.0 ? g.step : scene.step; };
+    const HelicoidIntegrator integrator = options.integrator ? *options.integrator : scene.integrator;
     // Layout: guide g, then its wisps; every strand of a guide has the guide's vertex count.
     struct Item { std::size_t guide, wisp; };  // wisp 0: the guide itself
     std::vector<Item> items;
@@ -226,7 +243,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
     for (std::size_t g = 0; g < scene.guides.size(); ++g) {
         const SceneGuide& guide = scene.guides[g];
         std::size_t n = 1;
-        for (const HelicoidPiece& p : guide.pieces) n += stepCount(p.length, scene.step);
+        for (const HelicoidPiece& p : guide.pieces) n += stepCount(p.length, stepOf(guide));
         const std::size_t strands = 1 + (guide.wisp ? guide.wisp->count : 0);
         for (std::size_t w = 0; w < strands; ++w) {
             items.push_back({g, w});
@@ -241,8 +258,8 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
     std::vector<HelicoidTrace> guideTraces(scene.guides.size());
     auto traceGuides = [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t g = r.begin(); g != r.end(); ++g) {
-            tracePHelicoid(scene.guides[g].root, scene.guides[g].frame, scene.guides[g].pieces, scene.step,
-                           options.integrator, guideTraces[g]);
+            tracePHelicoid(scene.guides[g].root, scene.guides[g].frame, scene.guides[g].pieces, stepOf(scene.guides[g]),
+                           integrator, guideTraces[g]);
         }
     };
     auto growItems = [&](const tbb::blocked_range<std::size_t>& r) {
@@ -261,7 +278,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
                     rngs.emplace_back(scene.seed, it.guide, items[i + count].wisp);
                     ++count;
                 }
-                traceWisps(guideTraces[it.guide], guide.pieces, *guide.wisp, scene.step, options.integrator, rngs.data(),
+                traceWisps(guideTraces[it.guide], guide.pieces, *guide.wisp, stepOf(guide), integrator, rngs.data(),
                            count, traces);
                 for (std::size_t b = 0; b < count; ++b) batch[b] = &traces[b];
             }

@@ -10,8 +10,10 @@
 ///    "wisp": {"count": 256, "radius": 0.05, "fanning": 0.0},
 ///    "fit": {...}}]}
 /// ```
-/// `step` is the tracing step in world units (Eq. 3). `roll`, `waviness` (and its `phase` and
-/// `noise`), `wisp` and `fit` are optional; `fit` (written by `vdbhair fit`) is kept but ignored
+/// `step` is the tracing step in world units and `integrator` (optional) "euler" (Eq. 3, the
+/// default) or "rk4" (which `vdbhair fit` writes: fits are exact streamlines); a guide may override it with its own
+/// `step` (`vdbhair fit` writes one per guide, fitted at its strand's scale). `roll`, `waviness`
+/// (and its `phase` and `noise`), `wisp`, `fit` and a guide's `step` are optional; `fit` (written by `vdbhair fit`) is kept but ignored
 /// by growing. Unknown keys and malformed values are errors that name the key path:
 /// `scene.json: guides[3].pieces[0].k: expected 4 numbers`.
 #pragma once
@@ -38,12 +40,14 @@ struct SceneGuide
     std::optional<WavinessParams> waviness;
     std::optional<WispParams> wisp;
     nlohmann::json fit;  ///< null when absent; kept as written
+    double step = 0.0;   ///< this guide's tracing step; 0: the scene's (optional key "step", written by fit)
 };
 
 struct Scene
 {
     std::uint64_t seed = 0;
     double step = 0.01;
+    HelicoidIntegrator integrator = HelicoidIntegrator::Euler;  ///< optional key "integrator": "euler" (Eq. 3) or "rk4"
     std::vector<SceneGuide> guides;
 };
 
@@ -59,7 +63,7 @@ void writeScene(const std::string& path, const Scene& scene);
 
 struct GrowOptions
 {
-    HelicoidIntegrator integrator = HelicoidIntegrator::Euler;
+    std::optional<HelicoidIntegrator> integrator;  ///< overrides the scene's
     std::size_t maxVertices = std::size_t(1) << 30;  ///< refuse scenes that would grow more
 };
 

@@ -1,0 +1,172 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/Frechet.h>
+#include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/Scene.h>
+
+#include <tbb/global_control.h>
+
+#include <functional>
+#include <random>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+/// Brute force over every monotone coupling (small p, q): the smallest max and the smallest sum.
+void bruteForce(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, double& bestMax, double& bestSum)
+{
+    bestMax = bestSum = 1e300;
+    std::function<void(std::size_t, std::size_t, double, double)> walk = [&](std::size_t i, std::size_t j, double mx, double sum) {
+        const double d = (a[i] - b[j]).length();
+        mx = std::max(mx, d);
+        sum += d;
+        if (i + 1 == a.size() && j + 1 == b.size()) {
+            bestMax = std::min(bestMax, mx);
+            bestSum = std::min(bestSum, sum);
+            return;
+        }
+        if (i + 1 < a.size()) walk(i + 1, j, mx, sum);
+        if (j + 1 < b.size()) walk(i, j + 1, mx, sum);
+        if (i + 1 < a.size() && j + 1 < b.size()) walk(i + 1, j + 1, mx, sum);
+    };
+    walk(0, 0, 0.0, 0.0);
+}
+
+/// @a pts with points inserted so no gap exceeds @a spacing (as fitStrand measures its targets).
+std::vector<Vec3d> densified(const std::vector<Vec3d>& pts, double spacing)
+{
+    std::vector<Vec3d> out{pts[0]};
+    for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+        const Vec3d d = pts[i + 1] - pts[i];
+        const int n = std::max(1, int(std::ceil(d.length() / spacing - 1e-9)));
+        for (int k = 1; k <= n; ++k) out.push_back(pts[i] + d * (double(k) / n));
+    }
+    return out;
+}
+
+std::vector<Vec3f> toF(const std::vector<Vec3d>& v)
+{
+    std::vector<Vec3f> out;
+    for (const Vec3d& p : v) out.emplace_back(float(p.x()), float(p.y()), float(p.z()));
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("discreteFrechet / frechetCoupling: equal brute force over all monotone couplings", "[helicoid]")
+{
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::uniform_int_distribution<int> len(1, 6);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<Vec3d> a(std::size_t(len(rng))), b(std::size_t(len(rng)));
+        for (Vec3d& p : a) p = Vec3d(u(rng), u(rng), u(rng));
+        for (Vec3d& p : b) p = Vec3d(u(rng), u(rng), u(rng));
+        double mx, sum;
+        bruteForce(a, b, mx, sum);
+        CAPTURE(trial, a.size(), b.size());
+        REQUIRE(discreteFrechet(a.data(), a.size(), b.data(), b.size()) == Approx(mx).epsilon(1e-12));
+        REQUIRE(frechetCoupling(a.data(), a.size(), b.data(), b.size()) == Approx(sum).epsilon(1e-12));
+    }
+    // Order matters: a polyline against its reverse is far, though the point sets are equal.
+    const std::vector<Vec3d> line{Vec3d(0, 0, 0), Vec3d(1, 0, 0), Vec3d(2, 0, 0)}, back{Vec3d(2, 0, 0), Vec3d(1, 0, 0), Vec3d(0, 0, 0)};
+    REQUIRE(discreteFrechet(line.data(), 3, back.data(), 3) == 2.0);
+    REQUIRE(discreteFrechet(line.data(), 3, line.data(), 3) == 0.0);
+}
+
+TEST_CASE("fitStrand: a strand traced from known parameters is fitted back", "[helicoid]")
+{
+    const FrameD frame = FrameD::fromTangentNormal(Vec3d(0, -1, 0.2), Vec3d(1, 0, 0));
+    const HelicoidParams truths[] = {{0.8, 0.0, 0.0, 0.0}, {0.6, 0.1, 0.3, 0.2}, {-0.7, 0.05, 0.2, 0.1}};
+    for (const HelicoidParams& k : truths) {
+        HelicoidTrace t;
+        tracePHelicoid(Vec3d(1, 2, 3), frame, {HelicoidPiece{k, 4.0, 0.0}}, 0.01, HelicoidIntegrator::RK4, t);
+        std::vector<Vec3d> target;
+        for (std::size_t i = 0; i < t.points.size(); i += 13) target.push_back(t.points[i]);  // 31 points, as the paper's data
+        const std::vector<Vec3f> pts = toF(target);
+        const StrandFit fit = fitStrand(pts.data(), pts.size(), FitParams{});
+        CAPTURE(k.kT, k.kN, k.kB, k.alpha, fit.frechet, fit.pieces.size());
+        // Stated tolerance: within 1 % of the length, in one piece, kT recovered up to its sign.
+        REQUIRE(fit.frechet < 0.01 * 4.0);
+        REQUIRE(fit.pieces.size() == 1);
+        REQUIRE(fit.pieces[0].k.kT >= 0.0);
+        REQUIRE(fit.pieces[0].k.kT == Approx(std::abs(k.kT)).margin(0.08));
+        // Regrowing the fit reproduces the strand it reported.
+        HelicoidTrace regrown;
+        traceFit(fit, regrown);
+        std::vector<Vec3d> asFitted;  // the float points the fit saw, not the double-precision originals
+        for (const Vec3f& p : pts) asFitted.emplace_back(p);
+        std::vector<Vec3d> tgt = densified(asFitted, fit.step);
+        REQUIRE(discreteFrechet(tgt.data(), tgt.size(), regrown.points.data(), regrown.points.size()) == Approx(fit.frechet).epsilon(1e-9));
+    }
+}
+
+TEST_CASE("fitStrand: degenerate strands fit or fail clearly, never NaN", "[helicoid]")
+{
+    auto finite = [](const StrandFit& f) {
+        for (const HelicoidPiece& p : f.pieces) {
+            for (double v : {p.k.kT, p.k.kN, p.k.kB, p.k.alpha, p.length, p.roll}) REQUIRE(std::isfinite(v));
+        }
+        REQUIRE(std::isfinite(f.frechet));
+    };
+    const std::vector<Vec3f> two{Vec3f(0.f), Vec3f(1.f, 2.f, 3.f)};
+    StrandFit f = fitStrand(two.data(), two.size(), FitParams{});
+    finite(f);
+    REQUIRE(f.frechet < 1e-6);
+    const std::vector<Vec3f> straight{Vec3f(0.f), Vec3f(1.f, 0.f, 0.f), Vec3f(2.f, 0.f, 0.f), Vec3f(3.f, 0.f, 0.f)};
+    f = fitStrand(straight.data(), straight.size(), FitParams{});
+    finite(f);
+    REQUIRE(f.frechet < 1e-6);
+    const std::vector<Vec3f> repeated{Vec3f(0.f), Vec3f(0.f), Vec3f(1.f, 0.f, 0.f), Vec3f(1.f, 0.f, 0.f), Vec3f(1.f, 1.f, 0.f)};
+    f = fitStrand(repeated.data(), repeated.size(), FitParams{});
+    finite(f);
+    const std::vector<Vec3f> zero(5, Vec3f(1.f, 1.f, 1.f));
+    REQUIRE_THROWS_WITH(fitStrand(zero.data(), zero.size(), FitParams{}), Contains("the strand has zero length"));
+}
+
+TEST_CASE("fitStrands: identical with 1 and 2 threads, and regrown through a scene", "[helicoid]")
+{
+    StrandSet s;
+    for (int i = 0; i < 6; ++i) {
+        HelicoidTrace t;
+        tracePHelicoid(Vec3d(i, 0, 0), FrameD::fromTangentNormal(Vec3d(0, -1, 0), Vec3d(1, 0, 0)),
+                       {{{0.5 + 0.1 * i, 0.1, 0.2, 0.1}, 3.0, 0.0}, {{-0.8, 0.0, 0.5, 0.0}, 3.0, 0.5}}, 0.01, HelicoidIntegrator::RK4, t);
+        std::vector<Vec3d> pts;
+        for (std::size_t k = 0; k < t.points.size(); k += 20) pts.push_back(t.points[k]);
+        s.addStrand(toF(pts));
+    }
+    std::vector<StrandFit> one, two;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        one = fitStrands(s, FitParams{});
+    }
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        two = fitStrands(s, FitParams{});
+    }
+    Scene scene;
+    scene.integrator = HelicoidIntegrator::RK4;  // as vdbhair fit writes
+    for (std::size_t i = 0; i < one.size(); ++i) {
+        REQUIRE(one[i].pieces.size() == two[i].pieces.size());
+        for (std::size_t p = 0; p < one[i].pieces.size(); ++p) REQUIRE(one[i].pieces[p].k.kT == two[i].pieces[p].k.kT);
+        REQUIRE(one[i].frechet == two[i].frechet);
+        REQUIRE(one[i].frechet < 0.05 * one[i].length);
+        SceneGuide g;
+        g.root = one[i].root;
+        g.frame = one[i].frame;
+        g.pieces = one[i].pieces;
+        g.step = one[i].step;
+        scene.guides.push_back(g);
+    }
+    const StrandSet regrown = growScene(scene);
+    for (std::size_t i = 0; i < one.size(); ++i) {
+        std::vector<Vec3d> a, b;
+        for (std::size_t v = s.begin(i); v < s.end(i); ++v) a.push_back(Vec3d(s.positions[v]));
+        a = densified(a, one[i].step);
+        for (std::size_t v = regrown.begin(i); v < regrown.end(i); ++v) b.push_back(Vec3d(regrown.positions[v]));
+        REQUIRE(discreteFrechet(a.data(), a.size(), b.data(), b.size()) == Approx(one[i].frechet).epsilon(1e-4));
+    }
+}

@@ -1,0 +1,26 @@
+/// @file Frechet.h
+/// @brief Similarity of polylines for fitting (Piuze et al. 2011, §5.1).
+///
+/// - The discrete Fréchet distance (Eiter & Mannila 1994): the shortest leash that lets a man and
+///   his dog walk their polylines vertex by vertex, neither going back: over monotone couplings,
+///   the smallest maximum of the coupled distances.
+/// - The Fréchet coupling, the paper's fitting measure: over the same monotone couplings, the
+///   smallest *total* leash length (the sum of the coupled distances), which weighs the whole
+///   curve and still respects the order of the points.
+/// Both by dynamic programming in O(pq) time and O(q) memory.
+#pragma once
+
+#include <vdbhair/Types.h>
+
+#include <cstddef>
+
+namespace vdbhair {
+
+/// @brief Discrete Fréchet distance between polylines of @a p and @a q points (world units).
+double discreteFrechet(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q);
+
+/// @brief Fréchet coupling: the smallest sum of coupled distances over monotone couplings.
+/// @param[out] steps optional: the number of pairs in that coupling (its mean leash is sum / steps)
+double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, std::size_t* steps = nullptr);
+
+} // namespace vdbhair
