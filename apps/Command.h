@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <vdbhair/io/ReadOptions.h>
+#include <vdbhair/io/VdbInfo.h>
 #include <vdbhair/strands/StrandSet.h>
 
 #include <functional>
@@ -46,6 +47,9 @@ void printWarnings(const std::string& verb, const ReadReport& report, const Comm
 /// @brief @a v as the user would type it (shortest form that reads back the same: 0.02, not 0.020000).
 std::string formatValue(double v);
 
+/// @brief A grid's description as JSON (info --json and inspect --json share it).
+nlohmann::json gridInfoJson(const GridInfo& g);
+
 /// @brief Print @a j on stdout as one line.
 void printJson(const nlohmann::json& j);
 
@@ -79,6 +83,7 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common);
 Command addGrowCommand(CLI::App& app, CommonOptions& common);
 Command addRenderCommand(CLI::App& app, CommonOptions& common);
 Command addFitCommand(CLI::App& app, CommonOptions& common);
+Command addInspectCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line.

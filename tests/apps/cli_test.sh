@@ -44,8 +44,10 @@ for f in ${exists[@]+"${exists[@]}"}; do [ -e "$f" ] || fail "$f was not written
 for f in ${keep[@]+"${keep[@]}"}; do
   sha256sum -c --quiet "$tmp/keep.$(echo "$f" | md5sum | cut -c1-8)" >/dev/null 2>&1 || fail "$f was modified"
 done
-# No temporary output may be left behind next to any file named in the checks.
+# No temporary output may be left behind for any file named in the checks.
 for f in ${absent[@]+"${absent[@]}"} ${exists[@]+"${exists[@]}"} ${keep[@]+"${keep[@]}"}; do
-  d=$(dirname "$f"); if ls -a "$d" 2>/dev/null | grep -q '\.vdbhair-tmp-'; then fail "a temporary file was left in $d"; fi
+  # Only this file's own temporaries (".STEM.vdbhair-tmp-*"): other tests write next to it in parallel.
+  d=$(dirname "$f"); b=$(basename "$f"); stem=${b%.*}
+  if ls -a "$d" 2>/dev/null | grep -qF ".$stem.vdbhair-tmp-"; then fail "a temporary file of $f was left in $d"; fi
 done
 exit 0

@@ -8,6 +8,7 @@ rm -rf "$dir"; mkdir -p "$dir"; cd "$dir"
 "$bin" convert good.hair good.vdb --quiet
 "$bin" convert good.hair good.data --quiet
 "$bin" convert good.hair good.obj --quiet
+"$bin" field good.hair -o field.vdb --voxel-size 2 --quiet
 cp good.hair existing.hair
 cp "$src/scenes/figures/fig2_waviness.json" existing.json
 # Strands with a known helicoid shape, sampled like the paper's data (30 vertices).

@@ -30,6 +30,15 @@ void Image::paste(const Image& o, int x0, int y0)
     }
 }
 
+Vec3f fromSrgb(const Vec3f& c)
+{
+    auto f = [](float v) {
+        v = std::min(1.f, std::max(0.f, v));
+        return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+    };
+    return Vec3f(f(c.x()), f(c.y()), f(c.z()));
+}
+
 Vec3f colorMap(float t)
 {
     // Viridis, sampled at 9 points and interpolated linearly.
@@ -39,14 +48,13 @@ Vec3f colorMap(float t)
     t = std::min(1.f, std::max(0.f, std::isfinite(t) ? t : 0.f)) * 8.f;
     const int i = std::min(7, int(t));
     const float f = t - float(i);
-    return Vec3f(k[i][0] + (k[i + 1][0] - k[i][0]) * f, k[i][1] + (k[i + 1][1] - k[i][1]) * f, k[i][2] + (k[i + 1][2] - k[i][2]) * f);
+    return fromSrgb(Vec3f(k[i][0] + (k[i + 1][0] - k[i][0]) * f, k[i][1] + (k[i + 1][1] - k[i][1]) * f, k[i][2] + (k[i + 1][2] - k[i][2]) * f));
 }
 
-Vec3f idColor(std::uint64_t id)
+Vec3f hsvColor(double h, double s, double v)
 {
-    // Golden-ratio hue steps, fixed saturation and value.
-    const double h = std::fmod(0.13 + double(id) * 0.6180339887498949, 1.0) * 6.0;
-    const double s = 0.65, v = 0.9, c = v * s, x = c * (1.0 - std::abs(std::fmod(h, 2.0) - 1.0)), m = v - c;
+    h = (h - std::floor(h)) * 6.0;
+    const double c = v * s, x = c * (1.0 - std::abs(std::fmod(h, 2.0) - 1.0)), m = v - c;
     double r = 0, g = 0, b = 0;
     switch (int(h)) {
     case 0: r = c; g = x; break;
@@ -56,7 +64,13 @@ Vec3f idColor(std::uint64_t id)
     case 4: r = x; b = c; break;
     default: r = c; b = x; break;
     }
-    return Vec3f(float(r + m), float(g + m), float(b + m));
+    return fromSrgb(Vec3f(float(r + m), float(g + m), float(b + m)));
+}
+
+Vec3f idColor(std::uint64_t id)
+{
+    // Golden-ratio hue steps, fixed saturation and value.
+    return hsvColor(0.13 + double(id) * 0.6180339887498949, 0.65, 0.9);
 }
 
 namespace {

@@ -23,10 +23,17 @@ struct Image
     void paste(const Image& other, int x, int y);
 };
 
-/// @brief A perceptually ordered colour map (viridis-like) at t in [0, 1].
+/// @brief A display (sRGB-encoded) colour as the linear colour the image stores, so that it is
+/// written back as itself.
+Vec3f fromSrgb(const Vec3f& c);
+
+/// @brief A perceptually ordered colour map (viridis-like) at t in [0, 1], linear.
 Vec3f colorMap(float t);
 
-/// @brief A colour for an integer id (strands, clusters), well spread in hue.
+/// @brief Hue (turns, any real), saturation and value in [0, 1] as a linear colour.
+Vec3f hsvColor(double h, double s, double v);
+
+/// @brief A colour for an integer id (strands, clusters), well spread in hue, linear.
 Vec3f idColor(std::uint64_t id);
 
 /// @brief Draw @a text with its left baseline at (x, y) in pixels, @a size pixels high.

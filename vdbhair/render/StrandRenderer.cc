@@ -137,7 +137,7 @@ std::vector<Vec3f> baseColors(const StrandSet& s, const RenderParams& p, const C
     case ColorBy::Tangent: {
         lit = false;
         const std::vector<Vec3f> t = computeTangents(s);
-        for (std::size_t v = 0; v < nV; ++v) c[v] = Vec3f(std::abs(t[v].x()), std::abs(t[v].y()), std::abs(t[v].z()));
+        for (std::size_t v = 0; v < nV; ++v) c[v] = fromSrgb(Vec3f(std::abs(t[v].x()), std::abs(t[v].y()), std::abs(t[v].z())));
         break;
     }
     case ColorBy::Depth: {

@@ -1,0 +1,203 @@
+// vdbhair inspect F.vdb [--json] [--grid NAME] [--slice x|y|z=WORLD -o S.png [--hsv] [--streamlines N]]:
+// value statistics, tiles, memory, bounds, leaf fill and metadata in words; slices as images.
+#include "../Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/VdbInspect.h>
+#include <vdbhair/render/SliceRenderer.h>
+
+#include <cstdio>
+
+namespace vdbhair::app {
+
+namespace {
+
+struct InspectParams
+{
+    std::string input, grid, slice, output;
+    bool hsv = false;
+    int streamlines = 0;
+    int width = 1024;
+};
+
+std::string g6(double v)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+std::string pct(double share)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g%%", 100.0 * share);
+    return buf;
+}
+
+std::string vec3(const Vec3d& v) { return "(" + g6(v.x()) + ", " + g6(v.y()) + ", " + g6(v.z()) + ")"; }
+
+nlohmann::json statsJson(const ValueStats& s)
+{
+    return {{"count", s.count}, {"min", s.min}, {"max", s.max}, {"mean", s.mean}, {"stddev", s.stddev},
+            {"p01", s.p01}, {"median", s.p50}, {"p99", s.p99}};
+}
+
+nlohmann::json reportJson(const GridReport& r)
+{
+    nlohmann::json j = gridInfoJson(r.info);
+    j["index_bbox"] = r.emptyIndexBBox ? nlohmann::json(nullptr) : nlohmann::json({r.indexMin, r.indexMax});
+    j["tiles_by_level"] = {{"root", r.tilesByLevel[0]}, {"upper", r.tilesByLevel[1]}, {"lower", r.tilesByLevel[2]}};
+    j["internal_nodes"] = r.internalNodes;
+    j["leaf_fill"] = {{"mean", r.leafFillMean}, {"min", r.leafFillMin}, {"max", r.leafFillMax}, {"full_share", r.leafFullShare}};
+    if (r.isVector) {
+        j["length"] = statsJson(r.values);
+        j["unit_share"] = r.unitShare;
+        j["zero_share"] = r.zeroShare;
+        j["mean_vector"] = {r.meanVector.x(), r.meanVector.y(), r.meanVector.z()};
+        j["coherence"] = r.coherence;
+    } else if (r.isScalar) {
+        j["values"] = statsJson(r.values);
+        j["zero_share"] = r.zeroShare;
+    } else if (r.info.isPoints) {
+        j["points_per_voxel"] = statsJson(r.values);
+    }
+    j["explanation"] = r.explanation;
+    return j;
+}
+
+void printReport(const GridReport& r)
+{
+    const GridInfo& g = r.info;
+    std::cout << "grid '" << g.name << "': " << g.valueType << " (" << g.type << "), class " << g.gridClass;
+    if (!g.vectorType.empty()) std::cout << ", vector type " << g.vectorType;
+    std::cout << "\n";
+    if (!r.explanation.empty()) std::cout << "  " << r.explanation << "\n";
+    const bool uniform = g.voxelSize.x() == g.voxelSize.y() && g.voxelSize.x() == g.voxelSize.z();
+    std::cout << "  voxels    " << g.activeVoxels << " active in " << g.leafNodes << " leaves";
+    if (g.leafNodes) {
+        std::cout << " (fill: mean " << pct(r.leafFillMean) << ", min " << pct(r.leafFillMin) << ", max " << pct(r.leafFillMax)
+                  << "; " << pct(r.leafFullShare) << " of leaves full)";
+    }
+    std::cout << "\n  tiles     " << g.activeTiles << " active (" << r.tilesByLevel[0] << " of 4096^3 voxels, " << r.tilesByLevel[1]
+              << " of 128^3, " << r.tilesByLevel[2] << " of 8^3); " << r.internalNodes << " internal nodes\n";
+    std::cout << "  memory    " << g6(double(g.memoryBytes) / (1 << 20)) << " MiB";
+    if (g.activeVoxels) std::cout << " (" << g6(double(g.memoryBytes) / double(g.activeVoxels)) << " bytes per active voxel)";
+    std::cout << "\n  voxel     size " << (uniform ? g6(g.voxelSize.x()) : vec3(g.voxelSize)) << (g.linear ? "" : " (non-linear transform)") << "\n";
+    if (r.emptyIndexBBox) {
+        std::cout << "  bounds    (no active voxels)\n";
+    } else {
+        std::cout << "  bounds    index (" << r.indexMin[0] << ", " << r.indexMin[1] << ", " << r.indexMin[2] << ") .. (" << r.indexMax[0]
+                  << ", " << r.indexMax[1] << ", " << r.indexMax[2] << "); world " << vec3(g.bboxMin) << " .. " << vec3(g.bboxMax) << "\n";
+    }
+    const ValueStats& s = r.values;
+    auto line = [&](const char* label) {
+        std::cout << "  " << label << "min " << g6(s.min) << ", max " << g6(s.max) << ", mean " << g6(s.mean) << ", std " << g6(s.stddev)
+                  << "; 1st percentile " << g6(s.p01) << ", median " << g6(s.p50) << ", 99th " << g6(s.p99) << "\n";
+    };
+    if (r.isVector && s.count) {
+        line("lengths   ");
+        std::cout << "  vectors   " << pct(r.unitShare) << " unit length (within 1e-3), " << pct(r.zeroShare) << " zero; mean "
+                  << vec3(r.meanVector) << ", coherence " << g6(r.coherence) << " (1: all parallel, 0: no common direction)\n";
+    } else if (r.isScalar && s.count) {
+        line("values    ");
+        std::cout << "  zeros     " << pct(r.zeroShare) << " of active values\n";
+    } else if (g.isPoints) {
+        std::cout << "  points    " << g.pointCount << "; per active voxel min " << g6(s.min) << ", mean " << g6(s.mean) << ", max " << g6(s.max)
+                  << "; attributes";
+        for (const PointAttributeInfo& a : g.attributes) std::cout << " " << a.name << " (" << a.valueType << ", " << a.codec << ")";
+        std::cout << "; groups";
+        if (g.groups.empty()) std::cout << " (none)";
+        for (const std::string& name : g.groups) std::cout << " " << name;
+        std::cout << "\n";
+    }
+    if (!g.metadata.empty()) {
+        std::cout << "  metadata ";
+        for (std::size_t i = 0; i < g.metadata.size(); ++i) {
+            std::cout << (i ? "\n            " : " ") << g.metadata[i].name << " = " << metaValueString(g.metadata[i]);
+        }
+        std::cout << "\n";
+    }
+}
+
+int runInspect(const InspectParams& p, const CommonOptions& common)
+{
+    if (fileExtension(p.input) != ".vdb") throw ValueError(p.input + ": inspect reads .vdb files (use 'vdbhair info' for strand files)");
+    if (!p.slice.empty() && p.output.empty()) throw ValueError("--slice " + p.slice + ": needs -o OUT.png for the image");
+    if (p.slice.empty() && !p.output.empty()) throw ValueError("-o " + p.output + ": inspect writes an image only with --slice AXIS=WORLD");
+    if (p.slice.empty() && (p.hsv || p.streamlines)) throw ValueError("--hsv and --streamlines draw on a slice: add --slice AXIS=WORLD -o OUT.png");
+    SliceParams sp;
+    if (!p.slice.empty()) {
+        parseSlice(p.slice, sp.axis, sp.world);
+        if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
+        sp.width = p.width;
+        sp.color = p.hsv ? SliceColor::Hsv : SliceColor::Rgb;
+        sp.streamlines = p.streamlines;
+    }
+    std::vector<GridReport> reports = inspectVdbFile(p.input);
+    if (!p.grid.empty()) {
+        std::vector<GridReport> kept;
+        std::string names;
+        for (GridReport& r : reports) {
+            names += (names.empty() ? "" : ", ") + r.info.name;
+            if (r.info.name == p.grid) kept.push_back(std::move(r));
+        }
+        if (kept.empty()) throw LookupError(p.input + ": no grid named '" + p.grid + "' (the file has: " + (names.empty() ? "no grids" : names) + ")");
+        reports = std::move(kept);
+    }
+    nlohmann::json sliceJson;
+    if (!p.slice.empty()) {
+        // The grid to slice: --grid, else 'tangent', else the first voxel grid.
+        std::string name = p.grid;
+        if (name.empty()) {
+            for (const GridReport& r : reports) if (r.info.name == "tangent") name = r.info.name;
+            for (const GridReport& r : reports) if (name.empty() && !r.info.isPoints) name = r.info.name;
+            if (name.empty()) throw ValueError(p.input + ": has no voxel grid to slice (only points)");
+        }
+        const SliceResult res = renderSlice(p.input, name, sp);
+        writeImage(p.output, res.image);
+        sliceJson = {{"output", p.output}, {"grid", name}, {"axis", std::string(1, char('x' + sp.axis))}, {"world", sp.world},
+                     {"index_plane", res.indexPlane}, {"active_voxels", res.activeVoxels}, {"range", {res.lo, res.hi}},
+                     {"streamlines", res.streamlinesDrawn}, {"width", res.image.width}, {"height", res.image.height}};
+        if (!common.json && !common.quiet) {
+            std::cout << "wrote " << p.output << ": grid '" << name << "' at " << char('x' + sp.axis) << " = " << g6(sp.world) << " (voxel layer "
+                      << res.indexPlane << ", " << res.activeVoxels << " active voxels, range " << g6(res.lo) << " .. " << g6(res.hi);
+            if (res.streamlinesDrawn) std::cout << ", " << res.streamlinesDrawn << " streamlines";
+            std::cout << ")\n";
+        }
+    }
+    if (common.json) {
+        nlohmann::json arr = nlohmann::json::array();
+        for (const GridReport& r : reports) arr.push_back(reportJson(r));
+        nlohmann::json out = {{"kind", "vdb"}, {"file", p.input}, {"grids", arr}};
+        if (!sliceJson.is_null()) out["slice"] = sliceJson;
+        printJson(out);
+        return 0;
+    }
+    if (p.slice.empty()) {
+        std::cout << p.input << ": OpenVDB file with " << reports.size() << (p.grid.empty() ? " grid" : " grid shown") << (reports.size() == 1 ? "" : "s") << "\n";
+        for (const GridReport& r : reports) printReport(r);
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addInspectCommand(CLI::App& app, CommonOptions& common)
+{
+    auto params = std::make_shared<InspectParams>();
+    CLI::App* sub = app.add_subcommand("inspect", "Look into a .vdb file: value statistics, tiles, memory, bounds, leaf fill, metadata in words; slices as images");
+    sub->add_option("file", params->input, "A .vdb file")->required();
+    sub->add_option("--grid", params->grid, "Only this grid (and the one to slice; default: 'tangent', else the first voxel grid)");
+    sub->add_option("--slice", params->slice, "Render the slice AXIS=WORLD (e.g. z=1.5: the plane z = 1.5 in world units)");
+    sub->add_option("-o,--output", params->output, "The slice image (.png, .exr, .jpg)");
+    sub->add_flag("--hsv", params->hsv, "Colour vectors by in-plane angle (hue) instead of |x|,|y|,|z| (RGB)");
+    sub->add_option("--streamlines", params->streamlines, "Overlay this many streamlines of the in-plane field")->capture_default_str();
+    sub->add_option("--width", params->width, "Width of the slice's plot in pixels")->capture_default_str();
+    addCommonOptions(sub, common);
+    sub->footer("Examples: vdbhair inspect field.vdb\n"
+                "          vdbhair inspect field.vdb --slice z=0 -o slice.png --hsv --streamlines 300");
+    return {sub, [params, &common] { return runInspect(*params, common); }};
+}
+
+} // namespace vdbhair::app
