@@ -4,12 +4,16 @@
 //                                                           per-vertex tangents (one pass)
 //   streamline tracing (forward Euler)                  vs  tools::VelocityIntegrator, RK1,
 //                                                           same step, same roots, one per thread
+//   helicoid tracing and p-helicoid fitting (Piuze et al. 2011, §3-5): no OpenVDB peer; fitting
+//   reports error, pieces, compression and strands/s on real strands (straight, wavy, curly,
+//   short) at 30 vertices and at full resolution
 //
 // Inputs: a real hairstyle from ../shared/data and a 100,000-strand, 64-vertex hairstyle made
 // deterministically from the bundled one (jittered copies). Speed is measured here, never in tests.
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
@@ -177,6 +181,78 @@ void benchmarkHelicoids(const std::string& source, int reps)
                 th / double(s.numStrands()) * 1e6);
 }
 
+/// Every k-th strand of @a s so that at most @a limit remain (all for 0).
+StrandSet strideSubset(const StrandSet& s, std::size_t limit, std::size_t& stride)
+{
+    stride = (limit == 0 || s.numStrands() <= limit) ? 1 : (s.numStrands() + limit - 1) / limit;
+    if (stride == 1) return s;
+    StrandSet out;
+    for (std::size_t i = 0; i < s.numStrands(); i += stride) out.addStrand(s.data(i), s.size(i));
+    return out;
+}
+
+/// One row of the fitting table: fit @a strands (best of up to @a reps runs, fewer when a run is
+/// slow), print errors, pieces, compression and speed.
+void fitRow(const std::string& name, const std::string& vertices, const StrandSet& strands, std::size_t total, std::size_t stride,
+            const FitParams& params, int reps)
+{
+    std::vector<StrandFit> fits;
+    std::vector<std::string> errors;
+    double best = 1e30, spent = 0.0;
+    int runs = 0;
+    for (; runs < std::max(1, reps) && (runs == 0 || spent + best < 20.0); ++runs) {
+        const double t0 = now();
+        fits = fitStrands(strands, params, true, &errors);
+        const double t = now() - t0;
+        best = std::min(best, t);
+        spent += t;
+    }
+    const FitSummary s = summarizeFits(strands, fits, errors, params.maxError);
+    char subset[64] = "all";
+    if (stride > 1) std::snprintf(subset, sizeof subset, "every %zuth", stride);
+    std::printf("%-9s %-10s %6zu of %6zu (%-10s) %6zu  %6.2f %% %6.2f %% %6zu  %6.2f  %6.1fx  %7.0f  %8.1f  (best of %d)\n", name.c_str(),
+                vertices.c_str(), s.fitted, total, subset, s.skipped, 100.0 * s.meanRelative, 100.0 * s.p95Relative, s.overMaxError,
+                s.piecesPerStrand, s.fitBytes > 0.0 ? s.pointBytes / s.fitBytes : 0.0, s.evaluationsPerStrand, double(s.fitted) / best, runs);
+    std::fflush(stdout);
+}
+
+/// Fitting p-helicoids to real strands (issue 5's targets: >= 1000 strands/s with a mean error of
+/// at most 2 % of the length on straight and wavy hair at 30 vertices).
+void benchmarkFitting(const std::string& data, std::size_t limit, int reps)
+{
+    std::printf("\n== fitting p-helicoids (Piuze et al. 2011, §5; the paper: about 5 strands/s), %d thread(s) ==\n"
+                "errors: discrete Frechet distance of the regrown fit relative to strand length; compression: bytes of points / bytes of fit;\n"
+                "strands/s: wall clock of fitStrands; at most %zu strands per row (an evenly strided subset when there are more)\n",
+                int(tbb::this_task_arena::max_concurrency()), limit);
+    std::printf("%-9s %-10s %-26s %6s  %8s %8s %6s  %6s  %7s  %7s  %8s\n", "data", "vertices", "strands fitted", "skip", "mean", "p95",
+                ">max", "pieces", "compr.", "evals", "strands/s");
+    struct Set { const char* name; const char* file; };
+    const Set sets[] = {{"straight", "hair/cyhair/straight.hair"}, {"wavy", "hair/usc_data/harolongo.data"},
+                        {"curly", "hair/ply/Curly_100.ply"}, {"short", "hair/tressfx/binary_v4/Ratboy_mohawk.tfx"}};
+    const FitParams params;
+    for (const Set& set : sets) {
+        const std::string path = data + "/" + set.file;
+        if (!std::filesystem::exists(path)) {
+            std::printf("%-9s (skipped: %s not found)\n", set.name, path.c_str());
+            continue;
+        }
+        const StrandSet all = readStrands(path);
+        std::size_t stride = 1;
+        const StrandSet r30 = resampleStrands(all, 30);
+        const StrandSet s30 = strideSubset(r30, limit, stride);
+        fitRow(set.name, "30", s30, all.numStrands(), stride, params, reps);
+        if (std::string(set.name) == "straight") {
+            FitParams noRoll = params;
+            noRoll.optimizeRoll = false;
+            fitRow("straight", "30, roll off", s30, all.numStrands(), stride, noRoll, reps);
+        }
+        std::size_t lo = all.size(0), hi = all.size(0);
+        for (std::size_t i = 0; i < all.numStrands(); ++i) { lo = std::min(lo, all.size(i)); hi = std::max(hi, all.size(i)); }
+        const StrandSet full = strideSubset(all, limit, stride);
+        fitRow(set.name, lo == hi ? std::to_string(lo) : std::to_string(lo) + "-" + std::to_string(hi), full, all.numStrands(), stride, params, reps);
+    }
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -187,6 +263,8 @@ int main(int argc, char** argv)
     std::size_t strands = 100000, vertices = 64;
     int reps = 3, threads = 0;
     double voxelSize = 0.0;
+    std::string sections = "field,helicoids,fit";
+    std::size_t fitStrands = 2000;
     app.add_option("--data", data, "The shared data folder (real hairstyles)")->capture_default_str();
     app.add_option("--scene", source, "The vdbhair checkout (for scenes/default)")->capture_default_str();
     app.add_option("--strands", strands, "Strands of the synthetic hairstyle")->capture_default_str();
@@ -194,22 +272,28 @@ int main(int argc, char** argv)
     app.add_option("--reps", reps, "Repetitions (the best time is reported)")->capture_default_str();
     app.add_option("--threads", threads, "Threads (0: all cores)")->capture_default_str();
     app.add_option("--voxel-size", voxelSize, "Voxel size (0: vdbhair's suggestion for each input)");
+    app.add_option("--sections", sections, "Sections to run: field, helicoids, fit (comma-separated)")->capture_default_str();
+    app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
     CLI11_PARSE(app, argc, argv);
+    auto wants = [&](const char* s) { return ("," + sections + ",").find("," + std::string(s) + ",") != std::string::npos; };
     std::unique_ptr<tbb::global_control> control;
     if (threads > 0) control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
     initializeOpenVdb();
     std::printf("vdbhair_benchmark: %d thread(s), best of %d\n", threads > 0 ? threads : int(tbb::this_task_arena::max_concurrency()), reps);
 
-    const std::string real = data + "/hair/cyhair/straight.hair";
-    if (std::filesystem::exists(real)) {
-        const StrandSet s = readStrands(real);
-        benchmark("real: straight.hair (Cem Yuksel)", s, voxelSize > 0.0 ? voxelSize : suggestVoxelSize(s), reps);
-    } else {
-        std::printf("\n(skipped the real hairstyle: %s not found)\n", real.c_str());
+    if (wants("field")) {
+        const std::string real = data + "/hair/cyhair/straight.hair";
+        if (std::filesystem::exists(real)) {
+            const StrandSet s = readStrands(real);
+            benchmark("real: straight.hair (Cem Yuksel)", s, voxelSize > 0.0 ? voxelSize : suggestVoxelSize(s), reps);
+        } else {
+            std::printf("\n(skipped the real hairstyle: %s not found)\n", real.c_str());
+        }
+        const StrandSet base = readStrands(source + "/scenes/default/ponytail.hair");
+        const StrandSet big = jitteredCopies(base, strands, vertices, 0.3f);
+        benchmark("synthetic: jittered copies of the bundled ponytail", big, voxelSize > 0.0 ? voxelSize : suggestVoxelSize(big), reps);
     }
-    const StrandSet base = readStrands(source + "/scenes/default/ponytail.hair");
-    const StrandSet big = jitteredCopies(base, strands, vertices, 0.3f);
-    benchmark("synthetic: jittered copies of the bundled ponytail", big, voxelSize > 0.0 ? voxelSize : suggestVoxelSize(big), reps);
-    benchmarkHelicoids(source, reps);
+    if (wants("helicoids")) benchmarkHelicoids(source, reps);
+    if (wants("fit")) benchmarkFitting(data, fitStrands, reps);
     return 0;
 }

@@ -39,12 +39,9 @@ int runFit(FitCmdParams p, const CommonOptions& common)
 
     Scene scene;
     scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines, regrown exactly
-    std::vector<double> relative;
-    std::size_t pieces = 0, skipped = 0;
     for (std::size_t i = 0; i < fits.size(); ++i) {
         if (!errors[i].empty()) {
             if (!p.skipDegenerate) throw ValueError(p.input + ": " + errors[i] + " (--skip-degenerate leaves such strands out)");
-            ++skipped;
             if (!common.quiet) std::cerr << "vdbhair fit: warning: skipped " << errors[i] << "\n";
             continue;
         }
@@ -56,38 +53,27 @@ int runFit(FitCmdParams p, const CommonOptions& common)
         g.pieces = f.pieces;
         g.fit = {{"frechet", f.frechet}, {"coupling", f.coupling}, {"pieces", f.pieces.size()}, {"strand", i}};
         scene.guides.push_back(g);
-        relative.push_back(f.frechet / f.length);
-        pieces += f.pieces.size();
     }
     if (scene.guides.empty()) throw ValueError(p.input + ": no strand could be fitted");
     writeScene(p.output, scene);
 
     // Summary: errors relative to strand length, pieces, and how much smaller the fit is.
-    std::vector<double> sorted = relative;
-    std::sort(sorted.begin(), sorted.end());
-    double mean = 0.0;
-    for (double r : relative) mean += r;
-    mean /= double(relative.size());
-    const double p95 = sorted[std::size_t(std::ceil(0.95 * double(sorted.size()))) - 1];
-    const std::size_t over = std::size_t(sorted.end() - std::upper_bound(sorted.begin(), sorted.end(), p.fit.maxError));
-    if (over && !common.quiet) {
-        std::cerr << "vdbhair fit: warning: " << over << " of " << relative.size() << " fits end above --max-error "
+    const FitSummary s = summarizeFits(strands, fits, errors, p.fit.maxError);
+    if (s.overMaxError && !common.quiet) {
+        std::cerr << "vdbhair fit: warning: " << s.overMaxError << " of " << s.fitted << " fits end above --max-error "
                   << formatValue(p.fit.maxError) << " (a last piece takes what remains at --max-pieces or under twice the shortest fragment)\n";
     }
-    const double fitBytes = double(scene.guides.size()) * (3 + 6) * 4 + double(pieces) * 6 * 4;  // floats: root, frame, per piece k, length, roll
-    const double pointBytes = double(strands.numVertices()) * 12;
     if (common.json) {
-        printJson({{"output", p.output}, {"strands", strands.numStrands()}, {"fitted", scene.guides.size()}, {"skipped", skipped}, {"over_max_error", over},
-                   {"frechet_relative", {{"mean", mean}, {"p95", p95}}}, {"pieces_per_strand", double(pieces) / double(scene.guides.size())},
-                   {"bytes", {{"fit", fitBytes}, {"points", pointBytes}}}, {"compression", pointBytes / fitBytes},
-                   {"strands_per_second", double(scene.guides.size()) / seconds}});
+        printJson({{"output", p.output}, {"strands", s.strands}, {"fitted", s.fitted}, {"skipped", s.skipped}, {"over_max_error", s.overMaxError},
+                   {"frechet_relative", {{"mean", s.meanRelative}, {"p95", s.p95Relative}}}, {"pieces_per_strand", s.piecesPerStrand},
+                   {"bytes", {{"fit", s.fitBytes}, {"points", s.pointBytes}}}, {"compression", s.pointBytes / s.fitBytes},
+                   {"strands_per_second", double(s.fitted) / seconds}});
     } else if (!common.quiet) {
-        std::cout << "fitted " << scene.guides.size() << " of " << strands.numStrands() << " strands with "
-                  << double(pieces) / double(scene.guides.size()) << " pieces each on average in " << seconds << " s ("
-                  << double(scene.guides.size()) / seconds << " strands/s)\n"
-                  << "discrete Frechet distance relative to strand length: mean " << mean << ", 95th percentile " << p95 << "\n"
-                  << "size: " << fitBytes << " bytes of helicoid parameters for " << pointBytes << " bytes of points ("
-                  << pointBytes / fitBytes << "x smaller)\nwrote " << p.output << " (regrow it with 'vdbhair grow')\n";
+        std::cout << "fitted " << s.fitted << " of " << s.strands << " strands with " << s.piecesPerStrand << " pieces each on average in "
+                  << seconds << " s (" << double(s.fitted) / seconds << " strands/s)\n"
+                  << "discrete Frechet distance relative to strand length: mean " << s.meanRelative << ", 95th percentile " << s.p95Relative << "\n"
+                  << "size: " << s.fitBytes << " bytes of helicoid parameters for " << s.pointBytes << " bytes of points ("
+                  << s.pointBytes / s.fitBytes << "x smaller)\nwrote " << p.output << " (regrow it with 'vdbhair grow')\n";
     }
     return 0;
 }

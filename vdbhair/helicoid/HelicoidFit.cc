@@ -378,4 +378,36 @@ std::vector<StrandFit> fitStrands(const StrandSet& strands, const FitParams& par
     return fits;
 }
 
+FitSummary summarizeFits(const StrandSet& strands, const std::vector<StrandFit>& fits,
+                         const std::vector<std::string>& errors, double maxError)
+{
+    FitSummary s;
+    s.strands = strands.numStrands();
+    std::vector<double> relative;
+    std::size_t pieces = 0, evaluations = 0;
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+        if (i < errors.size() && !errors[i].empty()) {
+            ++s.skipped;
+            continue;
+        }
+        const StrandFit& f = fits[i];
+        relative.push_back(f.frechet / f.length);
+        pieces += f.pieces.size();
+        evaluations += f.evaluations;
+    }
+    s.fitted = relative.size();
+    s.pointBytes = double(strands.numVertices()) * 12;
+    if (relative.empty()) return s;
+    std::vector<double> sorted = relative;
+    std::sort(sorted.begin(), sorted.end());
+    for (double r : relative) s.meanRelative += r;
+    s.meanRelative /= double(relative.size());
+    s.p95Relative = sorted[std::size_t(std::ceil(0.95 * double(sorted.size()))) - 1];
+    s.overMaxError = std::size_t(sorted.end() - std::upper_bound(sorted.begin(), sorted.end(), maxError));
+    s.piecesPerStrand = double(pieces) / double(s.fitted);
+    s.fitBytes = double(s.fitted) * (3 + 6) * 4 + double(pieces) * 6 * 4;
+    s.evaluationsPerStrand = double(evaluations) / double(s.fitted);
+    return s;
+}
+
 } // namespace vdbhair

@@ -38,6 +38,7 @@
 #include <vdbhair/strands/StrandSet.h>
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace vdbhair {
@@ -79,5 +80,23 @@ std::vector<StrandFit> fitStrands(const StrandSet& strands, const FitParams& par
 
 /// @brief The trace of a fit (as grown from a scene with the fit's step).
 void traceFit(const StrandFit& fit, HelicoidTrace& out);
+
+/// @brief What `vdbhair fit` and the benchmark report about a set of fits.
+struct FitSummary
+{
+    std::size_t strands = 0, fitted = 0, skipped = 0;
+    std::size_t overMaxError = 0;   ///< fits whose discrete Fréchet distance exceeds maxError · length
+    double meanRelative = 0.0;      ///< mean discrete Fréchet distance relative to strand length
+    double p95Relative = 0.0;       ///< its 95th percentile
+    double piecesPerStrand = 0.0;
+    double fitBytes = 0.0;          ///< floats: root, frame (t, n) per strand; k, length, roll per piece
+    double pointBytes = 0.0;        ///< 3 floats per input vertex
+    double evaluationsPerStrand = 0.0;
+};
+
+/// @brief Summarize @a fits of @a strands (@a errors as from fitStrands: non-empty where a strand
+/// was not fitted, and left out).
+FitSummary summarizeFits(const StrandSet& strands, const std::vector<StrandFit>& fits,
+                         const std::vector<std::string>& errors, double maxError);
 
 } // namespace vdbhair
