@@ -1,4 +1,5 @@
 #include "Command.h"
+#include "Progress.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
@@ -45,6 +46,7 @@ void printJson(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 
 StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict)
 {
+    const Stage stage(common, "reading " + path);
     ReadOptions opts;
     if (strict) opts.shortStrands = ShortStrandPolicy::Reject;
     ReadReport report;
@@ -57,7 +59,7 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
 StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common)
 {
     if (fileExtension(path) == ".json") {
-        StrandSet s = growScene(readScene(path));
+        StrandSet s = growScene(readScene(path), {}, true, common.interrupter);
         if (s.empty()) throw FormatError(path + ": the scene has no guides");
         return s;
     }
@@ -143,21 +145,33 @@ int run(int argc, char** argv)
             threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                             std::size_t(common.threads));
         }
+        installInterruptHandlers();
+        TerminalProgress progress(verb, common.quiet);
+        common.interrupter = &progress;
         try {
             return c.run();
+        } catch (const InterruptedError&) {
+            progress.end();
+            std::cerr << "vdbhair " << verb << ": interrupted; no partial output was written\n";
+            return 130;
         } catch (const ValueError& e) {
+            progress.end();  // erase the progress line first
             std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
             return 2;
         } catch (const Error& e) {
+            progress.end();  // erase the progress line first
             std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
             return 1;
         } catch (const openvdb::Exception& e) {
+            progress.end();  // erase the progress line first
             std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
             return 1;
         } catch (const std::bad_alloc&) {
+            progress.end();  // erase the progress line first
             std::cerr << "vdbhair " << verb << ": out of memory\n";
             return 1;
         } catch (const std::exception& e) {
+            progress.end();  // erase the progress line first
             std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
             return 1;
         }

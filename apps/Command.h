@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <vdbhair/Progress.h>
 #include <vdbhair/io/ReadOptions.h>
 #include <vdbhair/io/VdbInfo.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -29,6 +30,29 @@ struct CommonOptions
     int threads = 0;      ///< 0: all cores
     bool json = false;    ///< one JSON object on stdout instead of prose
     bool quiet = false;   ///< no progress, no warnings
+    /// The progress bar and Ctrl-C (Progress.h), set by run() before the verb runs: hand it to
+    /// every library call that takes an interrupter.
+    WorkInterrupter* interrupter = nullptr;
+};
+
+/// @brief A named step of a command that the library does not report on itself (reading or
+/// writing a file): the progress line shows its name and the time spent. Null-safe.
+class Stage
+{
+public:
+    Stage(const CommonOptions& common, const std::string& name) : mI(common.interrupter)
+    {
+        if (mI) mI->start(name.c_str());
+    }
+    ~Stage()
+    {
+        if (mI) mI->end();
+    }
+    Stage(const Stage&) = delete;
+    Stage& operator=(const Stage&) = delete;
+
+private:
+    WorkInterrupter* mI;
 };
 
 /// A registered subcommand: its CLI11 node and the function that runs it (returns the exit code).
@@ -86,7 +110,8 @@ Command addFitCommand(CLI::App& app, CommonOptions& common);
 Command addInspectCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
-/// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line.
+/// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line, 130 interrupted
+/// (Ctrl-C: nothing written).
 int run(int argc, char** argv);
 
 } // namespace vdbhair::app

@@ -49,12 +49,21 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
     StrandSet strands;
     ReadReport report;
-    for (const std::string& in : inputs) strands.append(readStrands(in, ropts, &report));
+    for (const std::string& in : inputs) {
+        const Stage stage(common, "reading " + in);
+        strands.append(readStrands(in, ropts, &report));
+    }
     printWarnings("convert", report, common);
     if (strands.empty()) throw FormatError("the input has no strands; nothing to write to " + p.output);
     if (p.scale != 1.0) scaleStrands(strands, float(p.scale));
-    if (p.resample >= 2) strands = resampleStrands(strands, p.resample);
-    writeStrands(p.output, strands, wopts);
+    if (p.resample >= 2) {
+        const Stage stage(common, "resampling");
+        strands = resampleStrands(strands, p.resample);
+    }
+    {
+        const Stage stage(common, "writing " + p.output);
+        writeStrands(p.output, strands, wopts);
+    }
 
     if (common.json) {
         printJson({{"inputs", inputs}, {"output", p.output}, {"strands", strands.numStrands()},

@@ -33,7 +33,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     fs::create_directories(p.outDir, ec);
     if (ec) throw IoError(p.outDir + ": cannot create the output folder: " + ec.message());
 
-    const RefineResult r = refineStrands(strands, rp);
+    const RefineResult r = refineStrands(strands, rp, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     const std::string dir = p.outDir;
@@ -42,33 +42,37 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     const std::string strandsPath = (fs::path(dir) / "strands.vdb").string();
     const std::string reportPath = (fs::path(dir) / "report.json").string();
     const std::string previewPath = (fs::path(dir) / "preview.png").string();
-    writeStrands(refinedPath, r.strands);
-    writeVdbGrids(fieldPath, fieldGrids(r), "demo(" + fieldPath + ")");
-    {
-        // The input and refined strands as points grids, for side-by-side viewing in Houdini/Blender.
-        auto before = createStrandGrid(strands);
-        before->setName("strands_input");
-        auto after = createStrandGrid(r.strands);
-        writeVdbGrids(strandsPath, {after, before}, "demo(" + strandsPath + ")");
+    // Before (top row) and after (bottom row): front, side and three-quarter views, one framing.
+    RenderParams view;
+    view.width = 480;
+    view.height = 480;
+    view.interrupter = common.interrupter;
+    BBox box = computeBBox(strands);
+    const BBox refinedBox = computeBBox(r.strands);
+    box.expand(refinedBox.min);
+    box.expand(refinedBox.max);
+    view.frame = box;
+    Image sheet(3 * view.width, 2 * view.height, view.background);
+    const View views[3] = {View::Front, View::Side, View::ThreeQuarter};
+    for (int row = 0; row < 2; ++row) {
+        for (int i = 0; i < 3; ++i) {
+            view.view = views[i];
+            view.title = std::string(row == 0 ? "input" : "refined") + ": " + viewName(views[i]);
+            sheet.paste(renderStrands(row == 0 ? strands : r.strands, view), i * view.width, row * view.height);
+        }
     }
+    // Everything is computed before the first file is written, so that Ctrl-C during the work
+    // leaves the folder as it was.
     {
-        // Before (top row) and after (bottom row): front, side and three-quarter views, one framing.
-        RenderParams rp;
-        rp.width = 480;
-        rp.height = 480;
-        BBox box = computeBBox(strands);
-        const BBox after = computeBBox(r.strands);
-        box.expand(after.min);
-        box.expand(after.max);
-        rp.frame = box;
-        Image sheet(3 * rp.width, 2 * rp.height, rp.background);
-        const View views[3] = {View::Front, View::Side, View::ThreeQuarter};
-        for (int row = 0; row < 2; ++row) {
-            for (int i = 0; i < 3; ++i) {
-                rp.view = views[i];
-                rp.title = std::string(row == 0 ? "input" : "refined") + ": " + viewName(views[i]);
-                sheet.paste(renderStrands(row == 0 ? strands : r.strands, rp), i * rp.width, row * rp.height);
-            }
+        const Stage writing(common, "writing " + dir);
+        writeStrands(refinedPath, r.strands);
+        writeVdbGrids(fieldPath, fieldGrids(r), "demo(" + fieldPath + ")");
+        {
+            // The input and refined strands as points grids, for side-by-side viewing in Houdini/Blender.
+            auto before = createStrandGrid(strands);
+            before->setName("strands_input");
+            auto after = createStrandGrid(r.strands);
+            writeVdbGrids(strandsPath, {after, before}, "demo(" + strandsPath + ")");
         }
         writeImage(previewPath, sheet);
     }

@@ -50,7 +50,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     applyScalpOptions(p.scalp, strands, fp);
 
     const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<TangentField> fields = estimateTangentFieldLevels(strands, fp, p.levels);
+    const std::vector<TangentField> fields = estimateTangentFieldLevels(strands, fp, p.levels, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     openvdb::GridCPtrVec grids;
@@ -63,7 +63,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         }
     }
     if (p.helicoid) {
-        const HelicoidFieldGrids h = estimateHelicoidField(*fields[0].tangent);
+        const HelicoidFieldGrids h = estimateHelicoidField(*fields[0].tangent, true, common.interrupter);
         for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(h.k), openvdb::GridBase::Ptr(h.alpha),
                                                 openvdb::GridBase::Ptr(h.frameT), openvdb::GridBase::Ptr(h.frameN)}) {
             grids.push_back(g);
@@ -71,7 +71,10 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         }
     }
     if (p.withStrands) grids.push_back(createStrandGrid(strands));
-    writeVdbGrids(p.output, grids, "field(" + p.output + ")");
+    {
+        const Stage stage(common, "writing " + p.output);
+        writeVdbGrids(p.output, grids, "field(" + p.output + ")");
+    }
 
     if (common.json) {
         nlohmann::json j = {{"output", p.output}, {"strands", strands.numStrands()}, {"voxel_size", fp.voxelSize},

@@ -34,7 +34,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
 
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<std::string> errors;
-    const std::vector<StrandFit> fits = fitStrands(strands, p.fit, true, &errors);
+    const std::vector<StrandFit> fits = fitStrands(strands, p.fit, true, &errors, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     Scene scene;

@@ -28,10 +28,13 @@ int runGrow(const GrowParams& p, const CommonOptions& common)
     opts.maxVertices = p.maxVertices;
     const Scene scene = readScene(p.scene);
     const auto t0 = std::chrono::steady_clock::now();
-    const StrandSet strands = growScene(scene, opts);
+    const StrandSet strands = growScene(scene, opts, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (strands.empty()) throw FormatError(p.scene + ": the scene has no guides; nothing to write");
-    writeStrands(p.output, strands);
+    {
+        const Stage stage(common, "writing " + p.output);
+        writeStrands(p.output, strands);
+    }
     if (common.json) {
         printJson({{"scene", p.scene}, {"output", p.output}, {"guides", scene.guides.size()},
                    {"strands", strands.numStrands()}, {"vertices", strands.numVertices()}, {"seconds", seconds}});

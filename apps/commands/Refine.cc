@@ -65,10 +65,13 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     }
     const StrandSet strands = loadStrands("refine", p.input, common, p.strict);
     const RefineParams rp = refineParamsFrom(p, strands);
-    const RefineResult r = refineStrands(strands, rp);
+    const RefineResult r = refineStrands(strands, rp, true, common.interrupter);
     // Write the field first: if the strands' write fails, nothing half-done is claimed.
-    if (!p.saveField.empty()) writeVdbGrids(p.saveField, fieldGrids(r), "refine(" + p.saveField + ")");
-    writeStrands(p.output, r.strands);
+    {
+        const Stage stage(common, "writing " + p.output);
+        if (!p.saveField.empty()) writeVdbGrids(p.saveField, fieldGrids(r), "refine(" + p.saveField + ")");
+        writeStrands(p.output, r.strands);
+    }
     if (common.json) {
         nlohmann::json j = refineReportJson(r, rp);
         j["output"] = p.output;

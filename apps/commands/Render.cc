@@ -25,6 +25,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
     rp.width = p.width;
     rp.height = p.height;
     rp.title = p.title;
+    rp.interrupter = common.interrupter;
     if (p.width < 1 || p.height < 1 || p.width > 16384 || p.height > 16384) {
         throw ValueError("--width/--height " + std::to_string(p.width) + "x" + std::to_string(p.height) +
                          ": must be between 1 and 16384 pixels");

@@ -72,7 +72,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         const HelicoidFieldGrids field = readHelicoidField(p.field);
         const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
         TraceStats stats;
-        const StrandSet out = retraceHelicoidField(strands, field, tp, &stats);
+        const StrandSet out = retraceHelicoidField(strands, field, tp, &stats, true, common.interrupter);
         // Coherence is measured against the tangent field when the file has one.
         double before = 0.0, after = 0.0;
         const std::vector<std::string> names = vdbGridNames(p.field, "retrace(" + p.field + ")");
@@ -102,7 +102,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
     const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
 
     TraceStats stats;
-    const StrandSet out = retraceStrands(strands, *grid, tp, &stats);
+    const StrandSet out = retraceStrands(strands, *grid, tp, &stats, nullptr, true, common.interrupter);
     const double before = meanTangentAngleDeg(strands, *grid);
     const double after = meanTangentAngleDeg(out, *grid);
     const double disp = meanVertexDisplacement(strands, out);

@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # Runs one command-line test: a command, its expected exit status and output, and what it must
 # (not) leave on disk.
-#   cli_test.sh [--exit N|nonzero] [--stdout RE]... [--stderr RE]... [--stderr-lines N]
+#   cli_test.sh [--exit N|nonzero] [--stdout RE]... [--no-stdout RE]... [--stderr RE]... [--stderr-lines N]
 #               [--absent PATH] [--exists PATH] [--keep PATH] -- COMMAND [ARGS...]
 # --keep PATH: the file must exist before and be byte-identical after the command.
 set -u
-want_exit=0; out_re=(); err_re=(); err_lines=""; absent=(); exists=(); keep=()
+want_exit=0; out_re=(); no_out_re=(); err_re=(); err_lines=""; absent=(); exists=(); keep=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --exit) want_exit="$2"; shift 2 ;;
     --stdout) out_re+=("$2"); shift 2 ;;
+    --no-stdout) no_out_re+=("$2"); shift 2 ;;
     --stderr) err_re+=("$2"); shift 2 ;;
     --stderr-lines) err_lines="$2"; shift 2 ;;
     --absent) absent+=("$2"); shift 2 ;;
@@ -35,6 +36,7 @@ else
   [ $status -eq "$want_exit" ] || fail "expected exit status $want_exit, got $status"
 fi
 for re in ${out_re[@]+"${out_re[@]}"}; do grep -E -q -- "$re" "$tmp/out" || fail "stdout does not match /$re/"; done
+for re in ${no_out_re[@]+"${no_out_re[@]}"}; do ! grep -E -q -- "$re" "$tmp/out" || fail "stdout must not match /$re/"; done
 for re in ${err_re[@]+"${err_re[@]}"}; do grep -E -q -- "$re" "$tmp/err" || fail "stderr does not match /$re/"; done
 if [ -n "$err_lines" ]; then
   n=$(wc -l < "$tmp/err"); [ "$n" -eq "$err_lines" ] || fail "expected $err_lines line(s) on stderr, got $n"

@@ -10,6 +10,9 @@ rm -rf "$dir"; mkdir -p "$dir"; cd "$dir"
 "$bin" convert good.hair good.obj --quiet
 "$bin" field good.hair -o field.vdb --voxel-size 2 --quiet
 cp good.hair existing.hair
+cp "$src/scenes/figures/fig2_waviness.json" existing_fit.json
+# Many strands: fitting them takes long enough to interrupt (the Ctrl-C tests).
+"$bin" grow "$src/scenes/default/head.json" -o head.hair --quiet
 cp "$src/scenes/figures/fig2_waviness.json" existing.json
 # Strands with a known helicoid shape, sampled like the paper's data (30 vertices).
 "$bin" grow "$src/scenes/figures/fig1_k_vectors.json" -o k_vectors.hair --quiet

@@ -1,6 +1,7 @@
 #include "StreamlineTracer.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
 #include <vdbhair/field/Simd.h>
@@ -132,7 +133,7 @@ struct RetraceJob
     std::vector<std::vector<Vec3f>>& stepPoints;  ///< step mode: each strand's points
     std::vector<StopReason>& reasons;
     std::vector<std::size_t>& steps;
-    openvdb::util::NullInterrupter* interrupter;
+    ProgressCounter& progress;                ///< counts strands as they are handed out
     std::atomic<bool> stop{false};
     std::atomic<std::size_t> nextBlock{0};
     std::atomic<std::size_t> ready{0};  ///< elements of *output constructed so far
@@ -147,6 +148,10 @@ struct RetraceJob
         if (first >= nS) return false;
         begin = first;
         end = std::min(nS, first + kBlock);
+        if (progress.add(end - begin)) {
+            stop = true;
+            return false;
+        }
         return true;
     }
 
@@ -533,11 +538,7 @@ private:
         RetraceJob<TreeT>& job = mJob;
         Lane& L = mLanes[l];
         const bool was = L.busy;
-        bool next = mNext < mEnd || job.nextRange(mNext, mEnd);
-        if (next && job.interrupter && (mNext & 255) == 0 && job.interrupter->wasInterrupted()) {
-            job.stop = true;
-            next = false;
-        }
+        const bool next = mNext < mEnd || job.nextRange(mNext, mEnd);
         if (!next) {
             idle(l);
             mBusy -= was;
@@ -697,7 +698,8 @@ StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams
     std::vector<std::vector<Vec3f>> stepPoints(inputMode ? 0 : nS);
     std::vector<StopReason> reasons(nS, StopReason::FullLength);
     std::vector<std::size_t> steps(nS, 0);
-    RetraceJob<TreeT> job{in, params, step, map, inputMode ? &out.positions : nullptr, used, stepPoints, reasons, steps, interrupter};
+    ProgressCounter progress(interrupter, "tracing streamlines", nS, "strands");
+    RetraceJob<TreeT> job{in, params, step, map, inputMode ? &out.positions : nullptr, used, stepPoints, reasons, steps, progress};
 
     // One task grows the output (see RetraceJob) while the bricks are built and the strands
     // traced, one LaneTracer per thread, each taking blocks of strands until none is left.

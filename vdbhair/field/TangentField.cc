@@ -1,6 +1,7 @@
 #include "TangentField.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/field/Simd.h>
@@ -409,19 +410,23 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     }
 
     // Accumulate the moments, chunk by chunk (each chunk in strand order).
+    const std::string stage = levels > 1 ? "estimating level " + std::to_string(level) + " of " + std::to_string(levels)
+                                         : std::string("estimating the tangent field");
     std::vector<Chunk> chunks(nChunks);
+    ProgressCounter progress(interrupter, stage.c_str(), nS, "strands");
     withToIndex(map, [&](const auto& toIndex) {
         auto accumulateChunk = [&](std::size_t c) {
             SegmentAccumulator<std::decay_t<decltype(toIndex)>> acc(chunks[c], toIndex);
             const std::size_t first = nS * c / nChunks, last = nS * (c + 1) / nChunks;
             for (std::size_t o = first; o < last; ++o) {
-                if (interrupter && (o & 255) == 0 && interrupter->wasInterrupted()) return;
+                if (progress.active() && o > first && ((o - first) & 255) == 0 && progress.add(256)) return;  // strands first..o-1
                 // The spatial order scatters strands over memory: fetch a later one meanwhile.
                 if (o + 2 < last) prefetchBytes(strands.data(order[o + 2]), strands.size(order[o + 2]) * sizeof(Vec3f));
                 const std::size_t i = order[o];
                 acc.addStrand(strands.data(i), strands.size(i));
             }
             acc.flush();
+            if (last > first) progress.add((last - first) - ((last - first - 1) & ~std::size_t(255)));
         };
         if (threaded) {
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nChunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -431,7 +436,8 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
             for (std::size_t c = 0; c < nChunks; ++c) accumulateChunk(c);
         }
     });
-    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("estimateTangentField: interrupted");
+    progress.finish();
+    if (progress.stopped()) throw InterruptedError("estimateTangentField: interrupted");
 
     // Topology: every block any chunk touched, as leaves of the output trees.
     openvdb::Vec3STree::Ptr tangentTree(new openvdb::Vec3STree(openvdb::Vec3f(0.f)));
@@ -445,7 +451,9 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
 
     // Per leaf: merge the chunks in order, then Eq. 9 and the density.
     openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(*tangentTree);
+    ProgressCounter directions(interrupter, (stage + ": robust directions (Eq. 9)").c_str(), leaves.leafCount(), "blocks");
     leaves.foreach([&](openvdb::Vec3STree::LeafNodeType& leaf, std::size_t) {
+        if (directions.active() && (directions.stopped() || directions.add(1))) return;
         std::array<Moments, 512> sum;
         std::array<bool, 512> hit{};
         for (const Chunk& c : chunks) {
@@ -469,6 +477,7 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
             dl->setValueOn(k, mo.density());
         }
     }, threaded);
+    if (directions.stopped()) throw InterruptedError("estimateTangentField: interrupted");
 
     TangentField out;
     out.tangent = openvdb::Vec3SGrid::create(tangentTree);

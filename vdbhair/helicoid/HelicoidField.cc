@@ -1,6 +1,7 @@
 #include "HelicoidField.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
@@ -41,7 +42,7 @@ void copyMeta(const openvdb::GridBase& from, openvdb::GridBase& to, const std::s
 
 } // namespace
 
-HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool threaded)
+HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
     if (FieldMapping::fromGrid(tangent).space() != FieldSpace::World || !FieldMapping(tangent.constTransformPtr()).isAxisAlignedWorld()) {
         throw ValueError("estimateHelicoidField: grid '" + tangent.getName() + "' is not an axis-aligned world-space field");
@@ -58,7 +59,9 @@ HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool
     out.frameN->setTree(openvdb::Vec3STree::Ptr(new openvdb::Vec3STree(tangent.tree(), openvdb::Vec3f(0.f), openvdb::TopologyCopy())));
 
     openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(out.k->tree());
+    ProgressCounter progress(interrupter, "estimating the helicoid field", leaves.leafCount(), "blocks");
     leaves.foreach([&](openvdb::Vec3STree::LeafNodeType& kLeaf, std::size_t) {
+        if (progress.active() && (progress.stopped() || progress.add(1))) return;
         openvdb::tree::ValueAccessor<const openvdb::Vec3STree> acc(tangent.tree());
         auto* aLeaf = out.alpha->tree().probeLeaf(kLeaf.origin());
         auto* tLeaf = out.frameT->tree().probeLeaf(kLeaf.origin());
@@ -124,6 +127,7 @@ HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool
             nLeaf->setValueOnly(it.pos(), toF(n));
         }
     }, threaded);
+    if (progress.stopped()) throw InterruptedError("estimateHelicoidField: interrupted");
 
     copyMeta(tangent, *out.k, "helicoid_k");
     copyMeta(tangent, *out.alpha, "helicoid_alpha");
@@ -217,7 +221,7 @@ private:
 } // namespace
 
 StrandSet retraceHelicoidField(const StrandSet& in, const HelicoidFieldGrids& field, const TraceParams& params,
-                               TraceStats* stats, bool threaded)
+                               TraceStats* stats, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
     const double step = params.step > 0.0 ? params.step : 0.5 * field.k->voxelSize().x();
     const double marginLength = double(params.margin) * field.k->voxelSize().x();
@@ -225,7 +229,9 @@ StrandSet retraceHelicoidField(const StrandSet& in, const HelicoidFieldGrids& fi
     std::vector<std::vector<Vec3f>> traced(nS);
     std::vector<StopReason> reasons(nS, StopReason::FullLength);
     std::vector<std::size_t> steps(nS, 0);
+    ProgressCounter progress(interrupter, "tracing through the helicoid field", nS, "strands");
     auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+        if (progress.stopped()) return;
         HelicoidSampler sampler(field);
         std::vector<double> target;
         std::vector<Vec3d> pts;
@@ -292,8 +298,17 @@ StrandSet retraceHelicoidField(const StrandSet& in, const HelicoidFieldGrids& fi
             reasons[i] = reason;
         }
     };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 64), body);
-    else body(tbb::blocked_range<std::size_t>(0, nS));
+    // Blocks of 64 strands, each counted when done (the whole range at once would never report).
+    auto counted = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t b = r.begin(); b < r.end(); b += 64) {
+            const std::size_t e = std::min(r.end(), b + 64);
+            body(tbb::blocked_range<std::size_t>(b, e));
+            if (progress.add(e - b)) return;
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 64), counted);
+    else counted(tbb::blocked_range<std::size_t>(0, nS));
+    if (progress.stopped()) throw InterruptedError("retraceHelicoidField: interrupted");
 
     StrandSet out;
     out.defaults = in.defaults;

@@ -9,6 +9,8 @@
 /// the tangent field they come from.
 #pragma once
 
+#include <openvdb/util/NullInterrupter.h>
+
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -38,7 +40,9 @@ struct HelicoidFieldGrids
 /// tiny ridge for conditioning, and alpha minimizes Σ (phi_j - alpha theta_j)². Neighbours
 /// pointing backwards (d·T <= 0) are ignored; with fewer than 3 neighbours k = alpha = 0.
 /// @throw TypeError / ValueError for a grid that is not a world-space vec3s tangent field.
-HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool threaded = true);
+/// @param interrupter optional progress and Ctrl-C (Progress.h); InterruptedError when it stops the work.
+HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool threaded = true,
+                                         openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// @brief Read `helicoid_k`, `helicoid_alpha`, `frame_T`, `frame_N` from a .vdb file.
 /// @throw LookupError naming the missing grid (and suggesting `vdbhair field --helicoid`).
@@ -48,7 +52,10 @@ HelicoidFieldGrids readHelicoidField(const std::string& path);
 /// sampling cell predicts a direction by evaluating its own helicoid (the exact Eq. 1, origin at
 /// the voxel centre) at that point, and the predictions are blended with trilinear weights and
 /// normalized. Same parameters, stop reasons and outputs as retraceStrands().
+/// @param interrupter optional progress and Ctrl-C (Progress.h).
+/// @throw InterruptedError when the interrupter stops the work.
 StrandSet retraceHelicoidField(const StrandSet& strands, const HelicoidFieldGrids& field, const TraceParams& params,
-                               TraceStats* stats = nullptr, bool threaded = true);
+                               TraceStats* stats = nullptr, bool threaded = true,
+                               openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace vdbhair

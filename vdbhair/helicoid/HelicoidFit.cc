@@ -1,6 +1,7 @@
 #include "HelicoidFit.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
 #include <vdbhair/helicoid/Frechet.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/strands/Measures.h>
@@ -354,23 +355,27 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
 }
 
 std::vector<StrandFit> fitStrands(const StrandSet& strands, const FitParams& params, bool threaded,
-                                  std::vector<std::string>* errors)
+                                  std::vector<std::string>* errors, openvdb::util::NullInterrupter* interrupter)
 {
     const FitParams& p = params;
     const std::size_t nS = strands.numStrands();
     std::vector<StrandFit> fits(nS);
     std::vector<std::string> messages(nS);
+    ProgressCounter progress(interrupter, "fitting p-helicoids", nS, "strands");
     auto body = [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (progress.stopped()) return;
             try {
                 fits[i] = fitStrand(strands.data(i), strands.size(i), p);
             } catch (const Error& e) {
                 messages[i] = "strand " + std::to_string(i) + ": " + e.what();
             }
+            progress.add(1);
         }
     };
     if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 4), body);
     else body(tbb::blocked_range<std::size_t>(0, nS));
+    if (progress.stopped()) throw InterruptedError("fitStrands: interrupted");
     for (std::size_t i = 0; i < nS; ++i) {
         if (!messages[i].empty() && !errors) throw ValueError("fitStrands: " + messages[i]);
     }

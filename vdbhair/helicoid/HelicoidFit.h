@@ -37,6 +37,8 @@
 #include <vdbhair/helicoid/Helicoid.h>
 #include <vdbhair/strands/StrandSet.h>
 
+#include <openvdb/util/NullInterrupter.h>
+
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -75,8 +77,11 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
 /// (its own step) unless params.step is given.
 /// @param[out] errors optional: #S messages, empty where the strand was fitted; without it the
 /// first failure throws.
+/// @param interrupter optional progress and Ctrl-C (Progress.h).
+/// @throw InterruptedError when the interrupter stops the work.
 std::vector<StrandFit> fitStrands(const StrandSet& strands, const FitParams& params, bool threaded = true,
-                                  std::vector<std::string>* errors = nullptr);
+                                  std::vector<std::string>* errors = nullptr,
+                                  openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// @brief The trace of a fit (as grown from a scene with the fit's step).
 void traceFit(const StrandFit& fit, HelicoidTrace& out);

@@ -1,6 +1,7 @@
 #include "Scene.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
 #include <vdbhair/io/FileUtil.h>
 
 #include <tbb/blocked_range.h>
@@ -223,7 +224,7 @@ std::size_t sceneVertexCount(const Scene& scene)
     return total;
 }
 
-StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded)
+StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
     if (!(scene.step > 0.0) || !std::isfinite(scene.step)) {
         throw ValueError("growScene: step " + std::to_string(scene.step) + " must be a positive length");
@@ -256,8 +257,11 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
 
     // Guides first (wisps need their traces), then all strands in parallel.
     std::vector<HelicoidTrace> guideTraces(scene.guides.size());
+    // Progress: guides traced, then strands grown (a guide's own strand copies its trace).
+    ProgressCounter progress(interrupter, "growing strands", scene.guides.size() + items.size(), "traces");
     auto traceGuides = [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t g = r.begin(); g != r.end(); ++g) {
+            if (progress.stopped() || progress.add(1)) return;
             tracePHelicoid(scene.guides[g].root, scene.guides[g].frame, scene.guides[g].pieces, stepOf(scene.guides[g]),
                            integrator, guideTraces[g]);
         }
@@ -268,6 +272,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
         HelicoidTrace traces[kBatch];
         std::vector<Rng> rngs;
         for (std::size_t i = r.begin(); i != r.end();) {
+            if (progress.stopped()) return;
             const Item& it = items[i];
             const SceneGuide& guide = scene.guides[it.guide];
             std::size_t count = 1;
@@ -294,6 +299,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
                 }
             }
             i += count;
+            progress.add(count);
         }
     };
     if (threaded) {
@@ -303,6 +309,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
         traceGuides(tbb::blocked_range<std::size_t>(0, scene.guides.size()));
         growItems(tbb::blocked_range<std::size_t>(0, items.size()));
     }
+    if (progress.stopped()) throw InterruptedError("growScene: interrupted");
     return out;
 }
 

@@ -24,6 +24,7 @@
 #include <vdbhair/strands/StrandSet.h>
 
 #include <nlohmann/json.hpp>
+#include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
 #include <optional>
@@ -69,8 +70,11 @@ struct GrowOptions
 
 /// @brief Strands of a scene: each guide, then its wisp strands. Bitwise identical for any
 /// thread count (each strand's randomness comes from (seed, guide, strand)).
-/// @throw LimitError if the scene would exceed options.maxVertices vertices.
-StrandSet growScene(const Scene& scene, const GrowOptions& options = {}, bool threaded = true);
+/// @param interrupter optional progress and Ctrl-C (Progress.h).
+/// @throw LimitError if the scene would exceed options.maxVertices vertices; InterruptedError
+/// when the interrupter stops the work.
+StrandSet growScene(const Scene& scene, const GrowOptions& options = {}, bool threaded = true,
+                    openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// @brief The vertex count growScene() would produce (checked against overflow).
 std::size_t sceneVertexCount(const Scene& scene);

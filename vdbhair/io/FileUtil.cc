@@ -67,8 +67,19 @@ AtomicOutput::~AtomicOutput()
     }
 }
 
+namespace {
+std::atomic<bool (*)()> sCommitInterrupt{nullptr};
+}
+
+void setCommitInterruptCheck(bool (*check)()) { sCommitInterrupt.store(check); }
+
 void AtomicOutput::commit()
 {
+    if (bool (*check)() = sCommitInterrupt.load(); check && check()) {
+        std::error_code ec;
+        fs::remove(mTemp, ec);
+        throw InterruptedError(mTarget + ": interrupted before the output was moved into place");
+    }
     if (std::rename(mTemp.c_str(), mTarget.c_str()) != 0) {
         const std::string reason = std::strerror(errno);
         std::error_code ec;

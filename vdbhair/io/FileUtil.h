@@ -34,13 +34,20 @@ public:
     /// Where to write: a path in the target's folder.
     const std::string& tempPath() const { return mTemp; }
     /// @brief Rename the temporary onto the target.
-    /// @throw IoError with the operating system's reason.
+    /// @throw IoError with the operating system's reason; InterruptedError (and the temporary
+    /// removed) when the check of setCommitInterruptCheck() says so.
     void commit();
 
 private:
     std::string mTarget, mTemp;
     bool mCommitted = false;
 };
+
+/// @brief Install a process-wide check that AtomicOutput::commit() runs before renaming: when it
+/// returns true, the temporary is removed and commit() throws InterruptedError. Commands set it to
+/// their Ctrl-C flag, so that work interrupted anywhere, even while writing, leaves no output.
+/// nullptr (the default) removes it.
+void setCommitInterruptCheck(bool (*check)());
 
 /// @brief Write @a bytes to @a path atomically (see AtomicOutput).
 void writeFileAtomic(const std::string& path, const std::string& bytes, const std::string& where);

@@ -1,6 +1,7 @@
 #include "StrandRenderer.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <tbb/blocked_range.h>
@@ -179,7 +180,8 @@ Vec3f shade(const Vec3f& base, const Vec3d& t, const Vec3d& l, const Vec3d& e)
 
 /// Draw every segment of @a s into the supersampled raster (bands in parallel).
 void rasterize(Raster& r, const StrandSet& s, const std::vector<Vec3d>& proj, const std::vector<Vec3f>& vcolor,
-               const std::vector<Vec3f>& shadeDir, bool lit, const Camera& cam, bool onTop, int thickness)
+               const std::vector<Vec3f>& shadeDir, bool lit, const Camera& cam, bool onTop, int thickness,
+               openvdb::util::NullInterrupter* interrupter, const std::string& stage)
 {
     const int bands = 32, bandRows = (r.h + bands - 1) / bands;
     const Vec3d light = (cam.up * 0.8 + cam.right * 0.3 - cam.forward * 0.5).unit();
@@ -195,8 +197,12 @@ void rasterize(Raster& r, const StrandSet& s, const std::vector<Vec3d>& proj, co
             for (int b = b0; b <= b1; ++b) bins[std::size_t(b)].push_back(std::uint32_t(v));
         }
     }
+    std::uint64_t binned = 0;
+    for (const auto& bin : bins) binned += bin.size();
+    ProgressCounter progress(interrupter, stage.c_str(), binned, "segments");
     tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& br) {
         for (int b = br.begin(); b != br.end(); ++b) {
+            if (progress.stopped() || progress.add(bins[std::size_t(b)].size())) return;
             const int rowLo = b * bandRows, rowHi = std::min(r.h, rowLo + bandRows);
             for (std::uint32_t v : bins[std::size_t(b)]) {
                 const Vec3d a = proj[v], c = proj[v + 1];
@@ -225,6 +231,7 @@ void rasterize(Raster& r, const StrandSet& s, const std::vector<Vec3d>& proj, co
             }
         }
     });
+    if (progress.stopped()) throw InterruptedError("renderStrands: interrupted");
 }
 
 void checkSize(const RenderParams& p)
@@ -276,7 +283,8 @@ Image renderStrands(const StrandSet& strands, const RenderParams& params)
         // Shading works in view space: express light and eye there too.
         Camera viewCam = cam;
         viewCam.right = Vec3d(1, 0, 0); viewCam.up = Vec3d(0, 1, 0); viewCam.forward = Vec3d(0, 0, 1);
-        rasterize(r, s, proj, colors, dirs, lit, viewCam, onTop, thickness);
+        const std::string stage = std::string("rendering the ") + viewName(params.view) + " view" + (onTop ? " (guides)" : "");
+        rasterize(r, s, proj, colors, dirs, lit, viewCam, onTop, thickness, params.interrupter, stage);
     };
     double lo = 0, hi = 0, glo = 0, ghi = 0;
     drawSet(strands, std::nullopt, false, 1, lo, hi);

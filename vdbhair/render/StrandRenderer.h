@@ -13,6 +13,8 @@
 #include <vdbhair/render/Image.h>
 #include <vdbhair/strands/StrandSet.h>
 
+#include <openvdb/util/NullInterrupter.h>
+
 #include <optional>
 #include <string>
 
@@ -46,6 +48,9 @@ struct RenderParams
     Vec3f guideColor{0.85f, 0.05f, 0.05f};
     std::optional<BBox> frame;             ///< the box to fit (default: the strands' own)
     std::string title;                     ///< written in the top-left corner
+    /// Optional progress and Ctrl-C (Progress.h): one stage per view; InterruptedError when it
+    /// stops the work.
+    openvdb::util::NullInterrupter* interrupter = nullptr;
 };
 
 /// @brief Render one view. @throw ValueError for a zero or huge size.
