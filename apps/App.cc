@@ -75,16 +75,20 @@ void addScalpOptions(CLI::App* sub, ScalpOptions& opts)
     sub->add_option("--up", opts.up, "The scalp's up axis for --space scalp: x, y, z, -x, -y or -z")->capture_default_str();
 }
 
+Vec3d axisFromName(const std::string& name, const std::string& option)
+{
+    const std::string axis = name.size() == 2 && name[0] == '-' ? name.substr(1) : name;
+    const double sign = name.size() == 2 && name[0] == '-' ? -1.0 : 1.0;
+    if (axis == "x") return Vec3d(sign, 0.0, 0.0);
+    if (axis == "y") return Vec3d(0.0, sign, 0.0);
+    if (axis == "z") return Vec3d(0.0, 0.0, sign);
+    throw ValueError(option + " '" + name + "' is not one of x, y, z, -x, -y, -z");
+}
+
 void applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params)
 {
     params.space = fieldSpaceFromName(opts.space);
-    Vec3d up(0.0);
-    const std::string axis = opts.up.size() == 2 && opts.up[0] == '-' ? opts.up.substr(1) : opts.up;
-    const double sign = opts.up.size() == 2 && opts.up[0] == '-' ? -1.0 : 1.0;
-    if (axis == "x") up = Vec3d(sign, 0.0, 0.0);
-    else if (axis == "y") up = Vec3d(0.0, sign, 0.0);
-    else if (axis == "z") up = Vec3d(0.0, 0.0, sign);
-    else throw ValueError("--up '" + opts.up + "' is not one of x, y, z, -x, -y, -z");
+    const Vec3d up = axisFromName(opts.up, "--up");
     if (params.space != FieldSpace::Scalp) return;
     if (opts.sphere.empty()) {
         std::vector<Vec3f> roots;

@@ -85,6 +85,10 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
 /// @brief As loadStrands(), and a helicoid scene (.json) is grown first.
 StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common);
 
+/// @brief The axis named by an option such as --up: x, y, z, -x, -y or -z.
+/// @throw ValueError naming the option, the value and the choices.
+Vec3d axisFromName(const std::string& name, const std::string& option);
+
 /// @brief The scalp sphere options of `field` and `refine` (`--space scalp`).
 struct ScalpOptions
 {

@@ -64,7 +64,9 @@ void installInterruptHandlers()
     struct sigaction sa{};
     sa.sa_handler = onInterrupt;
     sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND;  // a second Ctrl-C terminates at once
+    // One-shot (a second Ctrl-C terminates at once); system calls restart rather than fail
+    // with EINTR (a read in progress would otherwise report an I/O error, not the interruption).
+    sa.sa_flags = SA_RESETHAND | SA_RESTART;
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
     setCommitInterruptCheck(commitRefused);

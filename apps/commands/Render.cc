@@ -12,7 +12,7 @@ namespace {
 
 struct RenderCmdParams
 {
-    std::string input, output, view = "three-quarter", colorBy = "shaded", guides, title;
+    std::string input, output, view = "three-quarter", colorBy = "shaded", guides, title, up = "y", facing;
     int width = 1024, height = 1024;
     bool sheet = false;
 };
@@ -26,6 +26,14 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
     rp.height = p.height;
     rp.title = p.title;
     rp.interrupter = common.interrupter;
+    rp.up = axisFromName(p.up, "--up");
+    if (!p.facing.empty()) {
+        const Vec3d facing = axisFromName(p.facing, "--facing");
+        if (std::abs(facing.dot(rp.up)) > 0.5) {
+            throw ValueError("--facing " + p.facing + " with --up " + p.up + ": the face must look along an axis perpendicular to up");
+        }
+        rp.facing = facing;
+    }
     if (p.width < 1 || p.height < 1 || p.width > 16384 || p.height > 16384) {
         throw ValueError("--width/--height " + std::to_string(p.width) + "x" + std::to_string(p.height) +
                          ": must be between 1 and 16384 pixels");
@@ -65,6 +73,10 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--color-by", params->colorBy, "shaded, root, tangent, depth, curvature or strand")->capture_default_str();
     sub->add_option("--guides", params->guides, "Strands drawn on top in red (e.g. the guides of a scene)");
     sub->add_option("--title", params->title, "Text in the top-left corner");
+    sub->add_option("--up", params->up, "The hairstyle's up axis: x, y, z, -x, -y or -z (z for Yuksel's cyHair models)")
+        ->capture_default_str();
+    sub->add_option("--facing", params->facing,
+                    "The axis the face looks along (front view looks at it): default z, or -y for --up z (Blender's); cyHair models: --up z --facing y");
     sub->add_flag("--sheet", params->sheet, "One image with the front, side, top and three-quarter views");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair render scenes/default/head.json -o head.png --sheet");

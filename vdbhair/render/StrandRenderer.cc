@@ -8,10 +8,16 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
 namespace vdbhair {
+
+Vec3d defaultFacing(const Vec3d& up)
+{
+    return std::abs(up.z()) < 0.5 ? Vec3d(0.0, 0.0, 1.0) : Vec3d(0.0, -up.z(), 0.0);
+}
 
 View viewFromName(const std::string& name)
 {
@@ -68,7 +74,21 @@ struct Camera
     }
 };
 
-Camera makeCamera(View view, const BBox& box, int width, int height)
+/// @brief The rows of the rotation taking the hairstyle's up to +y and its facing direction to +z
+/// (so that its right, up × facing, goes to +x).
+/// @throw ValueError unless up and facing are perpendicular unit axes.
+std::array<Vec3d, 3> viewRotation(const Vec3d& up, const std::optional<Vec3d>& facingOpt)
+{
+    const Vec3d facing = facingOpt ? *facingOpt : defaultFacing(up);
+    if (std::abs(up.length() - 1.0) > 1e-9 || std::abs(facing.length() - 1.0) > 1e-9 || std::abs(up.dot(facing)) > 1e-9) {
+        throw ValueError("render: up (" + std::to_string(up.x()) + ", " + std::to_string(up.y()) + ", " + std::to_string(up.z()) +
+                         ") and facing (" + std::to_string(facing.x()) + ", " + std::to_string(facing.y()) + ", " +
+                         std::to_string(facing.z()) + ") must be perpendicular unit axes");
+    }
+    return {up.cross(facing), up, facing};
+}
+
+Camera makeCamera(View view, const BBox& box, int width, int height, const RenderParams& params)
 {
     const Vec3d lo(box.min), hi(box.max);
     const Vec3d centre = 0.5 * (lo + hi);
@@ -81,6 +101,11 @@ Camera makeCamera(View view, const BBox& box, int width, int height)
     case View::Top: c.forward = Vec3d(0, -1, 0); c.up = Vec3d(0, 0, -1); break;
     case View::ThreeQuarter: c.forward = -Vec3d(1.0, 0.6, 1.0).unit(); c.up = Vec3d(0, 1, 0); c.perspective = true; break;
     }
+    // The views are defined for +y up: take their directions back to the hairstyle's own axes.
+    const std::array<Vec3d, 3> R = viewRotation(params.up, params.facing);
+    auto toWorld = [&](const Vec3d& v) { return R[0] * v.x() + R[1] * v.y() + R[2] * v.z(); };  // Rᵀ v
+    c.forward = toWorld(c.forward);
+    c.up = toWorld(c.up);
     c.right = c.forward.cross(c.up).unit();
     c.up = c.right.cross(c.forward);
     c.eye = centre - c.forward * (c.perspective ? 3.5 * radius : 2.0 * radius);
@@ -245,6 +270,14 @@ void checkSize(const RenderParams& p)
 
 } // namespace
 
+Vec3d projectToImage(const Vec3d& world, const RenderParams& params, const BBox& frame)
+{
+    checkSize(params);
+    const int S = params.supersample;
+    const Vec3d q = makeCamera(params.view, frame, params.width * S, params.height * S, params).project(world);
+    return Vec3d(q.x() / S, q.y() / S, q.z());
+}
+
 Image renderStrands(const StrandSet& strands, const RenderParams& params)
 {
     checkSize(params);
@@ -256,7 +289,7 @@ Image renderStrands(const StrandSet& strands, const RenderParams& params)
     }
     Image out(params.width, params.height, params.background);
     if (box.empty()) return out;
-    const Camera cam = makeCamera(params.view, box, params.width * S, params.height * S);
+    const Camera cam = makeCamera(params.view, box, params.width * S, params.height * S, params);
 
     Raster r{params.width * S, params.height * S, {}, {}};
     r.depth.assign(std::size_t(r.w) * std::size_t(r.h), std::numeric_limits<float>::max());

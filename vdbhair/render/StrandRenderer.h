@@ -4,7 +4,8 @@
 /// specular along the tangent), depth-correct (a z-buffer) and anti-aliased (3x3 supersampling
 /// of one-subpixel lines, so dense hair shows its density).
 ///
-/// Conventions: +y is up; the front view looks along -z (the viewer stands on +z), the side view
+/// Conventions: +y is up and the face looks towards +z (RenderParams::up and facing name other
+/// axes); the front view looks along -z (the viewer stands on +z), the side view
 /// along -x, the back view along +z, the top view down -y with -z at the top of the image, and
 /// the three-quarter view looks at the centre from (+1, +0.6, +1). Images depend only on their
 /// input: rasterization runs in horizontal bands, each drawing its segments in strand order.
@@ -51,10 +52,24 @@ struct RenderParams
     /// Optional progress and Ctrl-C (Progress.h): one stage per view; InterruptedError when it
     /// stops the work.
     openvdb::util::NullInterrupter* interrupter = nullptr;
+    /// The hairstyle's up axis and the direction its face looks (perpendicular unit vectors):
+    /// views are named as if they were +y and +z. Without facing: +z, or -y for a ±z up (the
+    /// usual z-up convention, Blender's). Yuksel's cyHair models need up (0, 0, 1), facing (0, 1, 0).
+    Vec3d up{0.0, 1.0, 0.0};
+    std::optional<Vec3d> facing;
 };
+
+/// @brief The facing direction used when RenderParams::facing is not set (see there).
+Vec3d defaultFacing(const Vec3d& up);
 
 /// @brief Render one view. @throw ValueError for a zero or huge size.
 Image renderStrands(const StrandSet& strands, const RenderParams& params);
+
+/// @brief Where @a world lands in the image renderStrands(strands, params) draws: continuous pixel
+/// coordinates (x right, y down; pixel (i, j) covers [i, i+1) × [j, j+1)) and, as z, the distance
+/// along the view direction. @a frame is the box the render fits: params.frame if set, otherwise
+/// the strands' bounding box (with the guides').
+Vec3d projectToImage(const Vec3d& world, const RenderParams& params, const BBox& frame);
 
 /// @brief The four views front, side, top and three-quarter in a 2x2 sheet of params.width ×
 /// params.height, all fitted to the same box.
