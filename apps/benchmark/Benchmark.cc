@@ -13,6 +13,7 @@
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/StrandIO.h>
@@ -181,6 +182,47 @@ void benchmarkHelicoids(const std::string& source, int reps)
                 th / double(s.numStrands()) * 1e6);
 }
 
+/// What a helicoid field buys over a plain tangent field (issue 4): curly and wavy strands
+/// retraced from their roots through each, at vdbhair's suggested voxel size and coarser, and the
+/// mean vertex error against the input (same arc lengths), relative to the mean strand length.
+void benchmarkHelicoidFields(const std::string& data, const std::string& source)
+{
+    std::printf("\n== helicoid fields vs tangent fields: retrace every strand from its root (Euler, half-voxel step) ==\n"
+                "error: mean distance between input and retraced vertices at the same arc length, relative to the mean strand length\n");
+    std::printf("%-34s %8s %7s  %14s %14s  %7s\n", "hairstyle", "voxel", "voxels", "tangent field", "helicoid field", "ratio");
+    struct Set { std::string name; std::string path; };
+    const Set sets[] = {{"Fig. 5 curly four-piece (scene)", source + "/scenes/figures/fig5_curly_four_piece.json"},
+                        {"Fig. 2 waviness (scene)", source + "/scenes/figures/fig2_waviness.json"},
+                        {"Curly_100.ply (curly)", data + "/hair/ply/Curly_100.ply"},
+                        {"harolongo.data (wavy)", data + "/hair/usc_data/harolongo.data"}};
+    for (const Set& set : sets) {
+        if (!std::filesystem::exists(set.path)) {
+            std::printf("%-34s (skipped: %s not found)\n", set.name.c_str(), set.path.c_str());
+            continue;
+        }
+        const StrandSet s = set.path.size() > 5 && set.path.substr(set.path.size() - 5) == ".json" ? growScene(readScene(set.path))
+                                                                                                 : readStrands(set.path);
+        double meanLength = 0.0;
+        for (std::size_t i = 0; i < s.numStrands(); ++i) meanLength += polylineLength(s.data(i), s.size(i));
+        meanLength /= double(std::max<std::size_t>(1, s.numStrands()));
+        const double h0 = suggestVoxelSize(s);
+        for (double f : {1.0, 2.0, 4.0}) {
+            FieldParams fp;
+            fp.voxelSize = h0 * f;
+            const TangentField tf = estimateTangentField(s, fp);
+            TraceParams tp;
+            const StrandSet viaTangent = retraceStrands(s, *tf.tangent, tp);
+            const HelicoidFieldGrids hf = estimateHelicoidField(*tf.tangent);
+            const StrandSet viaHelicoid = retraceHelicoidField(s, hf, tp);
+            const double eT = meanVertexDisplacement(s, viaTangent) / meanLength;
+            const double eH = meanVertexDisplacement(s, viaHelicoid) / meanLength;
+            std::printf("%-34s %8.4g %7zu  %13.2f%% %13.2f%%  %6.2fx\n", f == 1.0 ? set.name.c_str() : "", fp.voxelSize,
+                        std::size_t(tf.tangent->activeVoxelCount()), 100.0 * eT, 100.0 * eH, eT / eH);
+            std::fflush(stdout);
+        }
+    }
+}
+
 /// Every k-th strand of @a s so that at most @a limit remain (all for 0).
 StrandSet strideSubset(const StrandSet& s, std::size_t limit, std::size_t& stride)
 {
@@ -263,7 +305,7 @@ int main(int argc, char** argv)
     std::size_t strands = 100000, vertices = 64;
     int reps = 3, threads = 0;
     double voxelSize = 0.0;
-    std::string sections = "field,helicoids,fit";
+    std::string sections = "field,helicoids,helicoid-fields,fit";
     std::size_t fitStrands = 2000;
     app.add_option("--data", data, "The shared data folder (real hairstyles)")->capture_default_str();
     app.add_option("--scene", source, "The vdbhair checkout (for scenes/default)")->capture_default_str();
@@ -272,7 +314,7 @@ int main(int argc, char** argv)
     app.add_option("--reps", reps, "Repetitions (the best time is reported)")->capture_default_str();
     app.add_option("--threads", threads, "Threads (0: all cores)")->capture_default_str();
     app.add_option("--voxel-size", voxelSize, "Voxel size (0: vdbhair's suggestion for each input)");
-    app.add_option("--sections", sections, "Sections to run: field, helicoids, fit (comma-separated)")->capture_default_str();
+    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit (comma-separated)")->capture_default_str();
     app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
     CLI11_PARSE(app, argc, argv);
     auto wants = [&](const char* s) { return ("," + sections + ",").find("," + std::string(s) + ",") != std::string::npos; };
@@ -294,6 +336,7 @@ int main(int argc, char** argv)
         benchmark("synthetic: jittered copies of the bundled ponytail", big, voxelSize > 0.0 ? voxelSize : suggestVoxelSize(big), reps);
     }
     if (wants("helicoids")) benchmarkHelicoids(source, reps);
+    if (wants("helicoid-fields")) benchmarkHelicoidFields(data, source);
     if (wants("fit")) benchmarkFitting(data, fitStrands, reps);
     return 0;
 }
