@@ -50,8 +50,17 @@ struct FitParams
     int maxPieces = 8;
     double splitFraction = 0.6;   ///< the paper's Fréchet threshold for the split's upper limit
     double minFragment = 0.08;    ///< shortest piece, as a fraction of the strand length
+    double splitResolution = 0.1; ///< the search for the upper limit stops within this fraction of the fragment's vertices (0: one vertex)
     bool optimizeRoll = true;     ///< also fit a roll angle for pieces after the first (measured: halves the mean error)
-    int maxEvaluations = 300;     ///< Nelder–Mead evaluations per piece and start
+    int maxEvaluations = 300;     ///< Nelder–Mead evaluations per piece without a pre-fit
+    int polishEvaluations = 40;   ///< Nelder–Mead evaluations of a polish after the pre-fit
+    int prefitIterations = 20;    ///< Levenberg–Marquardt iterations of the pre-fit per start (0: none, Nelder–Mead from the raw starts)
+    bool broyden = true;          ///< pre-fit Jacobians by Broyden updates (else forward differences every iteration)
+    int prefitStarts = 1;         ///< starts pre-fitted (the best by the pre-fit's cost at the start)
+    double prefitGain = 1e-2;     ///< the pre-fit stops when an iteration lowers its cost by less than this fraction
+    double polishMargin = 1.25;   ///< a pre-fit of a whole fragment within this many maxError is polished before it is judged
+    double polishStep = 0.05;     ///< Nelder–Mead's initial step after a pre-fit (scaled parameters; 0.5 without)
+    double polishTolerance = 1e-3; ///< Nelder–Mead's absolute tolerance on the scaled parameters
     double step = 0.0;            ///< the regrown strands' tracing step (world units); 0: a quarter of the mean segment length
 };
 
