@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 
 namespace vdbhair {
@@ -209,7 +210,7 @@ struct Fitter
     /// Levenberg–Marquardt on residuals() from @a x (forward-difference Jacobian), within the
     /// same bounds as the Nelder–Mead search. A few traces per iteration instead of hundreds of
     /// Nelder–Mead evaluations: it finds the basin; Nelder–Mead on Eq. 5 then polishes.
-    void prefit(std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q)
+    double prefit(std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q)
     {
         const std::size_t dims = x.size();
         const double L = target.arc[b] - target.arc[a];
@@ -240,6 +241,7 @@ struct Fitter
         };
         jacobian();
         bool fresh = true;
+        int rejected = 0;
         for (int it = 0; it < params.prefitIterations; ++it) {
             const Eigen::MatrixXd A = J.transpose() * J;
             const Eigen::VectorXd g = J.transpose() * r;
@@ -262,32 +264,41 @@ struct Fitter
                 cost = newCost;
                 mu = std::max(1e-9, mu * 0.3);
                 fresh = false;
+                rejected = 0;
                 if (!params.broyden) { jacobian(); fresh = true; }
                 if (gain < params.prefitGain * cost) break;
             } else {
                 mu *= 10.0;
                 if (fresh && mu > 1e6) break;
-                if (!fresh) { jacobian(); fresh = true; }
+                // Broyden's update has taken in the failed step; a second failure in a row
+                // refreshes the Jacobian.
+                if (!fresh && (!params.broyden || ++rejected >= 2)) { jacobian(); fresh = true; rejected = 0; }
             }
         }
+        return cost;
     }
 
     /// Fit one piece to the fragment [a, b] from (p0, q); q fixed (a roll may be fitted).
     /// @param hint optional: a fit of a neighbouring fragment [a, c], scaled by its length @a hintLength
     std::vector<double> fitPiece(std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q, const std::vector<double>* previous,
                                  bool allowRoll, bool thorough, bool polish, const std::vector<double>* hint = nullptr,
-                                 double hintLength = 0.0)
+                                 double hintLength = 0.0, int startsToRun = 0,
+                                 const std::function<bool(const std::vector<double>&)>& good = nullptr)
     {
         const double L = target.arc[b] - target.arc[a];
         double kappa, tau;
         startEstimate(a, b, kappa, tau);
         const std::size_t dims = allowRoll ? 5 : 4;
         std::vector<std::vector<double>> starts;
-        starts.push_back({kappa * L, 0.0, 0.0, kappa > 1e-9 ? std::max(-2.0, std::min(2.0, tau / kappa)) : 0.0});
-        if (allowRoll) {
-            // Roll the frame so that its normal is the strand's Frenet normal at the start.
-            const Vec3d& n = target.normal[a];
-            starts.back().push_back(std::atan2(n.dot(q.b), n.dot(q.n)));
+        // The strand's curvature and torsion near the start, with the frame rolled so that its
+        // normal is the strand's Frenet normal there. A search candidate with a neighbouring
+        // fit to start from (@a hint) pre-fits from that alone.
+        if (!(hint && !thorough && params.prefitIterations > 0)) {
+            starts.push_back({kappa * L, 0.0, 0.0, kappa > 1e-9 ? std::max(-2.0, std::min(2.0, tau / kappa)) : 0.0});
+            if (allowRoll) {
+                const Vec3d& n = target.normal[a];
+                starts.back().push_back(std::atan2(n.dot(q.b), n.dot(q.n)));
+            }
         }
         if (hint) {
             std::vector<double> h = *hint;
@@ -300,22 +311,23 @@ struct Fitter
         double bestF = std::numeric_limits<double>::max();
         if (params.prefitIterations > 0) {
             // Pre-fit from the starts that the smooth objective ranks first.
+            const std::size_t maxRuns = std::size_t(std::max(1, startsToRun > 0 ? startsToRun : params.prefitStarts));
             std::vector<std::pair<double, std::size_t>> ranked;
             Eigen::VectorXd r;
             for (std::size_t i = 0; i < starts.size(); ++i) {
                 starts[i].resize(dims, 0.0);
-                residuals(starts[i].data(), dims, a, b, p0, q, r);
-                ranked.emplace_back(r.squaredNorm(), i);
+                if (starts.size() > maxRuns) residuals(starts[i].data(), dims, a, b, p0, q, r);
+                ranked.emplace_back(starts.size() > maxRuns ? r.squaredNorm() : 0.0, i);
             }
-            std::sort(ranked.begin(), ranked.end());
-            const std::size_t runs = std::min<std::size_t>(ranked.size(), std::size_t(std::max(1, params.prefitStarts)));
+            if (ranked.size() > 1) std::sort(ranked.begin(), ranked.end());
+            const std::size_t runs = std::min(ranked.size(), maxRuns);
             for (std::size_t i = 0; i < runs; ++i) {
                 std::vector<double> x = starts[ranked[i].second];
-                prefit(x, a, b, p0, q);
-                Eigen::VectorXd rr;
-                residuals(x.data(), dims, a, b, p0, q, rr);
-                const double f = rr.squaredNorm();
+               
+                const double f = prefit(x, a, b, p0, q);
                 if (f < bestF) { bestF = f; best = x; }
+                // The first pre-fit that is good enough ends the search (in the starts' order).
+                if (good && i + 1 < runs && good(x)) { best = x; break; }
             }
         } else {
             for (std::vector<double> x : starts) {
@@ -436,10 +448,18 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         // polished by Nelder–Mead on Eq. 5 only when @a polish (the search for the split
         // compares pre-fits; the piece kept is polished).
         auto fitTo = [&](std::size_t b, std::vector<double>& x, bool thorough, bool polish, const std::vector<double>* hint = nullptr,
-                         std::size_t hb = 0) {
+                         std::size_t hb = 0, int startsToRun = 0) {
+            int verdict = -1;  // the last pre-fit's acceptance, when known
+            std::function<bool(const std::vector<double>&)> good;
+            if (!polish && params.firstGoodStart) {
+                good = [&](const std::vector<double>& y) {
+                    verdict = within(b, y, tolerance) ? 1 : 0;
+                    return verdict == 1;
+                };
+            }
             x = fitter.fitPiece(a, b, p0, q, previous.empty() ? nullptr : &previous, allowRoll, thorough, polish, hint,
-                                hint ? target.arc[hb] - target.arc[a] : 0.0);
-            return within(b, x, tolerance);
+                                hint ? target.arc[hb] - target.arc[a] : 0.0, startsToRun, good);
+            return verdict == 1 ? true : within(b, x, tolerance);
         };
         // Polish a pre-fit (@a ok: it is acceptable); a polish that makes an acceptable fit
         // unacceptable is undone (Eq. 5 weighs the mean leash, the acceptance its maximum).
@@ -452,9 +472,10 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         };
         const bool searchWithoutPolish = params.prefitIterations > 0;
         std::vector<double> x;
-        bool ok = fitTo(last, x, true, !searchWithoutPolish);
         std::size_t b = last;
         const bool lastPiece = int(fit.pieces.size()) + 1 >= params.maxPieces || remaining < 2.0 * minLength || last - a < 3;
+        // The last piece allowed is kept whatever its error: it gets every start.
+        bool ok = fitTo(last, x, true, !searchWithoutPolish, nullptr, 0, lastPiece ? params.lastPieceStarts : 0);
         if (searchWithoutPolish && (lastPiece || ok || within(last, x, params.polishMargin * tolerance))) ok = polishFit(last, x, ok);
         if (!ok && !lastPiece) {
             // Upper limit: the longest prefix whose fit is acceptable (the paper's Fréchet

@@ -53,10 +53,12 @@ struct FitParams
     double splitResolution = 0.1; ///< the search for the upper limit stops within this fraction of the fragment's vertices (0: one vertex)
     bool optimizeRoll = true;     ///< also fit a roll angle for pieces after the first (measured: halves the mean error)
     int maxEvaluations = 300;     ///< Nelder–Mead evaluations per piece without a pre-fit
-    int polishEvaluations = 40;   ///< Nelder–Mead evaluations of a polish after the pre-fit
-    int prefitIterations = 20;    ///< Levenberg–Marquardt iterations of the pre-fit per start (0: none, Nelder–Mead from the raw starts)
+    int polishEvaluations = 30;   ///< Nelder–Mead evaluations of a polish after the pre-fit
+    int prefitIterations = 10;    ///< Levenberg–Marquardt iterations of the pre-fit per start (0: none, Nelder–Mead from the raw starts)
     bool broyden = true;          ///< pre-fit Jacobians by Broyden updates (else forward differences every iteration)
-    int prefitStarts = 1;         ///< starts pre-fitted (the best by the pre-fit's cost at the start)
+    int prefitStarts = 3;         ///< starts pre-fitted for a whole fragment (the best by the pre-fit's cost at the start; 3: all)
+    bool firstGoodStart = true;   ///< stop at the first pre-fit within maxError (else pre-fit every start and keep the best)
+    int lastPieceStarts = 4;      ///< starts pre-fitted for the last piece allowed (kept whatever its error)
     double prefitGain = 1e-2;     ///< the pre-fit stops when an iteration lowers its cost by less than this fraction
     double polishMargin = 1.25;   ///< a pre-fit of a whole fragment within this many maxError is polished before it is judged
     double polishStep = 0.05;     ///< Nelder–Mead's initial step after a pre-fit (scaled parameters; 0.5 without)
