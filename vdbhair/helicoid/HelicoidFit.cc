@@ -28,6 +28,7 @@ struct Target
     std::vector<double> arc;
     std::vector<float> curvature;
     std::vector<Vec3d> normal;  ///< discrete Frenet normals (Frames.h)
+    std::vector<double> turning;  ///< turning angle at each vertex (radians; 0 at the ends)
     double length = 0.0;
 };
 
@@ -169,19 +170,37 @@ struct Fitter
         double th = h.theta(p, 0.0);
         Vec3d k1 = h.frameFromTheta(th).t;
         out[0] = p;
-        for (std::size_t i = a; i < b; ++i) {
-            const double seg = target.arc[i + 1] - target.arc[i];
-            const int n = std::max(1, int(std::ceil(seg / evalStep - 0.5)));
-            const double hs = seg / n;
-            for (int j = 0; j < n; ++j) {
-                double t2 = th, t3 = th, t4 = th;
-                const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
-                const Vec3d k3 = h.tangent(p + 0.5 * hs * k2, t3);
-                const Vec3d k4 = h.tangent(p + hs * k3, t4);
-                p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-                k1 = h.tangent(p, th);
+        auto rk4 = [&](double hs) {
+            double t2 = th, t3 = th, t4 = th;
+            const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
+            const Vec3d k3 = h.tangent(p + 0.5 * hs * k2, t3);
+            const Vec3d k4 = h.tangent(p + hs * k3, t4);
+            p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+            k1 = h.tangent(p, th);
+        };
+        // Where the strand turns slowly, one RK4 step spans several segments (the strand turning
+        // at most prefitMaxTurn over them: the steps depend on the fragment only, so the traced
+        // positions stay smooth in x for the Jacobian), and the vertices inside it are cubic
+        // Hermite interpolants of the step's ends (positions and unit tangents), O(h^4) as RK4.
+        for (std::size_t i = a; i < b;) {
+            std::size_t j = i + 1;
+            double len = target.arc[j] - target.arc[i];
+            double turn = target.turning[i] + target.turning[j];
+            while (j < b && j - i < 4 && (turn += target.turning[j + 1]) <= params.prefitMaxTurn) len = target.arc[++j] - target.arc[i];
+            if (j == i + 1) {
+                const int n = std::max(1, int(std::ceil(len / evalStep - 0.5)));
+                for (int m = 0; m < n; ++m) rk4(len / n);
+            } else {
+                const Vec3d pa = p, ta = k1;
+                rk4(len);
+                for (std::size_t m = i + 1; m < j; ++m) {
+                    const double u = (target.arc[m] - target.arc[i]) / len, u2 = u * u, u3 = u2 * u;
+                    out[m - a] = (2 * u3 - 3 * u2 + 1) * pa + ((u3 - 2 * u2 + u) * len) * ta + (-2 * u3 + 3 * u2) * p +
+                                 ((u3 - u2) * len) * k1;
+                }
             }
-            out[i + 1 - a] = p;
+            out[j - a] = p;
+            i = j;
         }
     }
 
@@ -369,6 +388,11 @@ Target makeTarget(const Vec3f* points, std::size_t n)
     curvatureProfile(f.data(), f.size(), t.curvature.data());
     std::vector<Frame> frames(f.size());
     if (!f.empty()) frenetFrames(f.data(), f.size(), frames.data());
+    t.turning.assign(t.pts.size(), 0.0);
+    for (std::size_t i = 1; i + 1 < t.pts.size(); ++i) {
+        const Vec3d u = (t.pts[i] - t.pts[i - 1]).unitSafe(), v = (t.pts[i + 1] - t.pts[i]).unitSafe();
+        t.turning[i] = std::atan2(u.cross(v).length(), u.dot(v));
+    }
     t.normal.resize(f.size());
     for (std::size_t i = 0; i < f.size(); ++i) t.normal[i] = Vec3d(frames[i].n);
     return t;

@@ -55,6 +55,7 @@ struct FitParams
     int maxEvaluations = 300;     ///< Nelder–Mead evaluations per piece without a pre-fit
     int polishEvaluations = 30;   ///< Nelder–Mead evaluations of a polish after the pre-fit
     int prefitIterations = 10;    ///< Levenberg–Marquardt iterations of the pre-fit per start (0: none, Nelder–Mead from the raw starts)
+    double prefitMaxTurn = 0.3;   ///< radians an RK4 step of the pre-fit may turn when it spans several segments (0: one step per segment)
     bool broyden = true;          ///< pre-fit Jacobians by Broyden updates (else forward differences every iteration)
     int prefitStarts = 3;         ///< starts pre-fitted for a whole fragment (the best by the pre-fit's cost at the start; 3: all)
     bool firstGoodStart = true;   ///< stop at the first pre-fit within maxError (else pre-fit every start and keep the best)
