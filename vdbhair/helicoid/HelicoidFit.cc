@@ -124,8 +124,10 @@ struct Fitter
         std::vector<double> stepSizes(x.size(), initialStep);
         if (x.size() > 4) stepSizes[4] = 0.8 * initialStep;
         opt.set_initial_step(stepSizes);
-        opt.set_xtol_abs(params.polishTolerance);
-        opt.set_ftol_rel(params.polishTolerance * 1e-3);
+        // Without a pre-fit, the search from the raw starts keeps its tight tolerances.
+        const double tol = params.prefitIterations > 0 ? params.polishTolerance : 1e-4;
+        opt.set_xtol_abs(tol);
+        opt.set_ftol_rel(tol * 1e-3);
         opt.set_maxeval(params.prefitIterations > 0 ? params.polishEvaluations : params.maxEvaluations);
         double f = 0.0;
         try {

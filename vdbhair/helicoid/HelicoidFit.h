@@ -16,20 +16,50 @@
 /// scale-free so one λ serves every hairstyle: C is the Fréchet coupling's mean leash divided by
 /// L, and |k| = ‖(kT, kN, kB)‖·L/2π + |alpha| (turns per piece); λ = 1e-3 by default, enough to
 /// pick the gentlest of equally good fits without biasing real ones (measured in the benchmark).
-/// The search starts from the strand's own curvature and torsion near the root — kT = mean
-/// curvature, alpha = mean torsion / curvature — and, for whole fragments, also from k = 0 and
-/// from the previous piece's k, keeping the best result.
+///
+/// Deviation for speed (`prefitIterations` > 0, the default): Nelder–Mead from raw starts spent
+/// ~300 evaluations of Eq. 5 per candidate piece (2,600 per straight strand, ~120 strands/s on
+/// 2 cores). Instead each start is first pre-fitted by Levenberg–Marquardt on a smooth stand-in:
+/// both curves are parameterized by arc length, so the residuals are trace(s_i) - h_i at the
+/// target's own vertices (plus the end point again, and a small Tikhonov term), an O(n) least-
+/// squares problem; the Jacobian is by forward differences once, then Broyden updates (one trace
+/// per iteration). Its traces take one RK4 step per segment, or one step over up to four segments
+/// where the strand turns less than `prefitMaxTurn`, with Hermite-interpolated vertices (23 % less
+/// CPU on straight hair; such steps can stray from the streamline where the field turns fast off
+/// the curve, so acceptance is always judged on the trace grow produces). The piece kept is then polished by a short Nelder–Mead on Eq. 5 itself (`polishEvaluations`, from
+/// a small simplex), so the result is still the paper's objective, locally; a polish that would
+/// push an acceptable piece over `maxError` is undone (Eq. 5 weighs the mean leash, acceptance
+/// the maximum). `prefitIterations` = 0 restores Nelder–Mead alone.
+/// Starts: the strand's curvature and torsion near the fragment's start — kT = mean curvature,
+/// alpha = mean torsion / curvature, the frame rolled so its normal is the strand's Frenet normal
+/// there — and, for whole fragments, k = 0 and the previous piece's k; they are pre-fitted in the
+/// order of their cost, stopping at the first within `maxError` (the last piece allowed tries
+/// `lastPieceStarts`). A candidate of the split search starts from the nearest fit already found.
 ///
 /// Pieces (§5.3): a fragment whose fit's discrete Fréchet distance is within `maxError` of the
 /// strand's length is accepted; otherwise the fragment is split. The upper limit of the split is
-/// the `splitFraction` of the fragment (the paper's 60 % Fréchet threshold: the piece fitted there
-/// must itself be acceptable, or the limit halves towards the minimum); from that limit the split
-/// backtracks along the curvature profile to the vertex where fragment and fit differ least in
-/// curvature, never leaving a fragment shorter than `minFragment` of the strand. Each piece
-/// starts at the end of the previous fitted piece with its frame (C¹, as the paper's pieces), so
-/// only k — and, with `optimizeRoll`, a roll about the tangent — is fitted after the first. The
-/// first piece fits a roll too: the strand's Frenet normal at the root is rarely the normal of
-/// the helicoid that generated it (measured: 1.84 % -> 1.57 % mean error on straight.hair).
+/// the longest prefix whose fit is acceptable (the paper's Fréchet threshold), searched by
+/// bisection from the `splitFraction` of the fragment (60 %, the paper's value) upwards if that is
+/// acceptable, towards the minimum fragment if not, to within `splitResolution` of its vertices;
+/// candidates are judged by their pre-fits with discreteFrechetWithin (the decision version, which
+/// stops early), and only the chosen one is polished. From that limit the split backtracks along
+/// the curvature profile to the vertex where fragment and fit differ least in curvature (and
+/// direction), within the last 40 % of the piece, never leaving a fragment shorter than
+/// `minFragment` of the strand. Each piece starts at the end of the previous fitted piece with
+/// its frame (C¹, as the paper's pieces), so only k — and, with `optimizeRoll`, a roll about the
+/// tangent — is fitted after the first. The first piece fits a roll too: the strand's Frenet
+/// normal at the root is rarely the normal of the helicoid that generated it (measured before the
+/// pre-fit: 1.84 % -> 1.57 % mean error on straight.hair).
+///
+/// Measured (vdbhair_benchmark --sections fit --fit-strands 500, 2 threads, strands resampled to
+/// 30 vertices; mean / p95 discrete Fréchet error relative to length, pieces, strands/s; before
+/// the pre-fit: straight 1.58 %, 2.16 pieces, 118/s; wavy 3.84 %, 7.93, 51/s):
+///   straight 1.63 % / 1.98 %, 2.36 pieces, 1390/s;  wavy 3.00 % / 6.03 %, 7.78 pieces, 422/s;
+///   curly 2.00 % / 2.42 %, 4.20 pieces, 739/s;       short 1.72 % / 1.99 %, 2.20 pieces, 1542/s.
+/// Wavy (harolongo: noisy coils, about 33° of turning per segment and ~600° per strand) runs into
+/// the 8 pieces allowed short of 2 %; our reading: with phi = alpha·theta a helicoid cannot hold
+/// a helix's constant tilt, so a piece follows a coil for less than a turn. More pre-fit starts
+/// help it (every start for split candidates too: about 2.7 % at twice the evaluations).
 /// Kept fits have kT >= 0: a negative kT is flipped with a half-turn roll of the frame, the same
 /// curve (§3's sign symmetry; with Eq. 1 as printed it is a half turn about E_T).
 #pragma once
