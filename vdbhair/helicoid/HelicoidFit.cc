@@ -160,7 +160,7 @@ struct Fitter
     /// lengths: out[i] is where target vertex a + i should be (RK4, one step per target segment,
     /// subdivided to at most the objective's step).
     void traceAtVertices(const double* x, std::size_t dims, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q,
-                         std::vector<Vec3d>& out) const
+                         std::vector<Vec3d>& out, Vec3d* endTangent = nullptr) const
     {
         const double L = target.arc[b] - target.arc[a];
         Helicoid h;
@@ -204,6 +204,7 @@ struct Fitter
             out[j - a] = p;
             i = j;
         }
+        if (endTangent) *endTangent = k1;
     }
 
     /// Residuals of the arc-length correspondence (the pre-fit's smooth least-squares stand-in
@@ -213,11 +214,12 @@ struct Fitter
                    Eigen::VectorXd& r)
     {
         ++evaluations;
-        traceAtVertices(x, dims, a, b, p0, q, lmTrace);
+        Vec3d endT;
+        traceAtVertices(x, dims, a, b, p0, q, lmTrace, &endT);
         const std::size_t n = b - a;
         const double L = target.arc[b] - target.arc[a];
         const double w = 1.0 / (L * std::sqrt(double(n)));
-        r.resize(Eigen::Index(3 * n + 3 + 4));
+        r.resize(Eigen::Index(3 * n + 3 + 4 + 3));
         for (std::size_t i = 1; i <= n; ++i) {
             const Vec3d d = (lmTrace[i] - target.pts[a + i]) * w;
             for (int c = 0; c < 3; ++c) r[Eigen::Index(3 * (i - 1) + std::size_t(c))] = d[c];
@@ -226,6 +228,12 @@ struct Fitter
         for (int c = 0; c < 3; ++c) r[Eigen::Index(3 * n + std::size_t(c))] = e[c];
         const double reg = std::sqrt(params.lambda) * 0.1;
         for (int c = 0; c < 4; ++c) r[Eigen::Index(3 * n + 3 + std::size_t(c))] = reg * x[c];
+        // The end direction: the next piece starts with this piece's end frame (C¹), so a
+        // piece leaving the strand at an angle hands its successor a detour.
+        const std::size_t last = target.pts.size() - 1;
+        const Vec3d dir = (target.pts[std::min(b + 1, last)] - target.pts[b - 1]).unitSafe();
+        const Vec3d et = (endT - dir) * params.endTangentWeight;
+        for (int c = 0; c < 3; ++c) r[Eigen::Index(3 * n + 7 + std::size_t(c))] = et[c];
     }
 
     /// Levenberg–Marquardt on residuals() from @a x (forward-difference Jacobian), within the

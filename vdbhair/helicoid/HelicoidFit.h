@@ -21,8 +21,10 @@
 /// ~300 evaluations of Eq. 5 per candidate piece (2,600 per straight strand, ~120 strands/s on
 /// 2 cores). Instead each start is first pre-fitted by Levenberg–Marquardt on a smooth stand-in:
 /// both curves are parameterized by arc length, so the residuals are trace(s_i) - h_i at the
-/// target's own vertices (plus the end point again, and a small Tikhonov term), an O(n) least-
-/// squares problem; the Jacobian is by forward differences once, then Broyden updates (one trace
+/// target's own vertices (plus the end point again, the end direction against the strand's —
+/// the next piece starts with this one's end frame, C¹ — weighted by `endTangentWeight`, and a
+/// small Tikhonov term), an O(n) least-squares problem (the end direction, measured at 0.3:
+/// straight 1.66 % -> 1.49 %, curly 2.00 % -> 1.74 %, with fewer pieces); the Jacobian is by forward differences once, then Broyden updates (one trace
 /// per iteration). Its traces take one RK4 step per segment, or one step over up to four segments
 /// where the strand turns less than `prefitMaxTurn`, with Hermite-interpolated vertices (23 % less
 /// CPU on straight hair; such steps can stray from the streamline where the field turns fast off
@@ -59,7 +61,8 @@
 /// Wavy (harolongo: noisy coils, about 33° of turning per segment and ~600° per strand) runs into
 /// the 8 pieces allowed short of 2 %; our reading: with phi = alpha·theta a helicoid cannot hold
 /// a helix's constant tilt, so a piece follows a coil for less than a turn. More pre-fit starts
-/// help it (every start for split candidates too: about 2.7 % at twice the evaluations).
+/// did not help it (every start for split candidates: 3.0-3.2 %); nor do pieces: 2.6 % with no
+/// limit, since C¹ joints on noisy coils leave even minimum-length pieces over maxError.
 /// Kept fits have kT >= 0: a negative kT is flipped with a half-turn roll of the frame, the same
 /// curve (§3's sign symmetry; with Eq. 1 as printed it is a half turn about E_T).
 #pragma once
@@ -85,6 +88,7 @@ struct FitParams
     int maxEvaluations = 300;     ///< Nelder–Mead evaluations per piece without a pre-fit
     int polishEvaluations = 30;   ///< Nelder–Mead evaluations of a polish after the pre-fit
     int prefitIterations = 10;    ///< Levenberg–Marquardt iterations of the pre-fit per start (0: none, Nelder–Mead from the raw starts)
+    double endTangentWeight = 0.3; ///< pre-fit weight of the end direction's residual (unit vectors; positions count as fractions of L)
     double prefitMaxTurn = 0.3;   ///< radians an RK4 step of the pre-fit may turn when it spans several segments (0: one step per segment)
     bool broyden = true;          ///< pre-fit Jacobians by Broyden updates (else forward differences every iteration)
     int prefitStarts = 3;         ///< starts pre-fitted for a whole fragment (the best by the pre-fit's cost at the start; 3: all)
