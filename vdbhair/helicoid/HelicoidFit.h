@@ -53,16 +53,19 @@
 /// normal at the root is rarely the normal of the helicoid that generated it (measured before the
 /// pre-fit: 1.84 % -> 1.57 % mean error on straight.hair).
 ///
-/// Measured (vdbhair_benchmark --sections fit --fit-strands 500, 2 threads, strands resampled to
-/// 30 vertices; mean / p95 discrete Fréchet error relative to length, pieces, strands/s; before
-/// the pre-fit: straight 1.58 %, 2.16 pieces, 118/s; wavy 3.84 %, 7.93, 51/s):
-///   straight 1.63 % / 1.98 %, 2.36 pieces, 1390/s;  wavy 3.00 % / 6.03 %, 7.78 pieces, 422/s;
-///   curly 2.00 % / 2.42 %, 4.20 pieces, 739/s;       short 1.72 % / 1.99 %, 2.20 pieces, 1542/s.
-/// Wavy (harolongo: noisy coils, about 33° of turning per segment and ~600° per strand) runs into
-/// the 8 pieces allowed short of 2 %; our reading: with phi = alpha·theta a helicoid cannot hold
-/// a helix's constant tilt, so a piece follows a coil for less than a turn. More pre-fit starts
-/// did not help it (every start for split candidates: 3.0-3.2 %); nor do pieces: 2.6 % with no
-/// limit, since C¹ joints on noisy coils leave even minimum-length pieces over maxError.
+/// Measured (vdbhair_benchmark --sections fit --fit-strands 500 --reps 1, 2 threads, strands
+/// resampled to 30 vertices; mean / p95 discrete Fréchet error relative to length, pieces,
+/// evaluations per strand, strands/s; wall-clock rates vary ±40 % with other load on the machine):
+///   straight 1.52 % / 1.97 %, 2.26 pieces, 234, 1489/s   (before the pre-fit: 1.58 %, 2.16, 2645, 118/s)
+///   wavy     2.99 % / 5.46 %, 7.82 pieces, 1076, 490/s   (before: 3.84 %, 7.93, 10260, 51/s)
+///   curly    1.74 % / 2.00 %, 4.06 pieces, 516, 848/s    (before: 1.95 %, 4.36, 5886, 72/s)
+///   short    1.50 % / 1.96 %, 2.28 pieces, 226, 1575/s   (before: 1.71 %, 2.13, 2389, 118/s)
+/// Wavy (harolongo: noisy coils, about 33° of turning per segment and ~600° per strand) stays
+/// short of 2 %. Our reading: with phi = alpha·theta a helicoid cannot hold a helix's constant
+/// tilt, so a piece follows a coil for less than a turn, and C¹ joints pass each piece's
+/// direction error on to the next. More pre-fit starts for split candidates did not help
+/// (3.0-3.2 %), nor more pieces (maxPieces 10 or 12: 2.6 %, 8.2 pieces; the 8 % minimum
+/// fragment binds).
 /// Kept fits have kT >= 0: a negative kT is flipped with a half-turn roll of the frame, the same
 /// curve (§3's sign symmetry; with Eq. 1 as printed it is a half turn about E_T).
 #pragma once
