@@ -63,9 +63,10 @@
 /// Wavy (harolongo: noisy coils, about 33° of turning per segment and ~600° per strand) stays
 /// short of 2 %. Our reading: with phi = alpha·theta a helicoid cannot hold a helix's constant
 /// tilt, so a piece follows a coil for less than a turn, and C¹ joints pass each piece's
-/// direction error on to the next. More pre-fit starts for split candidates did not help
-/// (3.0-3.2 %), nor more pieces (maxPieces 10 or 12: 2.6 %, 8.2 pieces; the 8 % minimum
-/// fragment binds).
+/// direction error on to the next. More pieces help little (maxPieces 12 or 16: 2.53 %, 8.3
+/// pieces: the split search then ends at the 8 % minimum fragment, whose fit can still fail),
+/// nor did pre-fitting every start for split candidates (3.0-3.2 %, measured before the end
+/// direction residual).
 /// Kept fits have kT >= 0: a negative kT is flipped with a half-turn roll of the frame, the same
 /// curve (§3's sign symmetry; with Eq. 1 as printed it is a half turn about E_T).
 #pragma once
