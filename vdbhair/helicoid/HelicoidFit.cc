@@ -352,7 +352,6 @@ struct Fitter
             const std::size_t runs = std::min(ranked.size(), maxRuns);
             for (std::size_t i = 0; i < runs; ++i) {
                 std::vector<double> x = starts[ranked[i].second];
-               
                 const double f = prefit(x, a, b, p0, q);
                 if (f < bestF) { bestF = f; best = x; }
                 // The first pre-fit that is good enough ends the search (in the starts' order).
@@ -473,7 +472,6 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         // Is the fit x of [a, b], as grown, within @a eps of the fragment (discrete Fréchet)?
         auto within = [&](std::size_t b, const std::vector<double>& x, double eps) {
             const double L = target.arc[b] - target.arc[a];
-           
             fitter.tracePiece(x, L, p0, q, trace, /*exact=*/true);
             densify(target.pts, a, b, step, denseTarget);
             return discreteFrechetWithin(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size(), eps);
