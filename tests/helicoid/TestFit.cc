@@ -77,18 +77,45 @@ TEST_CASE("discreteFrechet / frechetCoupling: equal brute force over all monoton
     REQUIRE(discreteFrechet(line.data(), 3, line.data(), 3) == 0.0);
 }
 
+TEST_CASE("discreteFrechetWithin: agrees with discreteFrechet at, below and above the distance", "[helicoid]")
+{
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), f(0.0, 2.0);
+    std::uniform_int_distribution<int> len(1, 40);
+    for (int trial = 0; trial < 500; ++trial) {
+        // Noisy copies of one random walk (the close curves fitting compares) and unrelated ones.
+        std::vector<Vec3d> a(std::size_t(len(rng))), b(std::size_t(len(rng)));
+        Vec3d w(0.0);
+        for (Vec3d& p : a) p = (w += Vec3d(1.0, u(rng), u(rng)));
+        for (std::size_t i = 0; i < b.size(); ++i) {
+            const Vec3d& base = a[std::min(a.size() - 1, i * a.size() / b.size())];
+            b[i] = trial % 2 ? base + 0.3 * Vec3d(u(rng), u(rng), u(rng)) : Vec3d(3 * u(rng), 3 * u(rng), 3 * u(rng));
+        }
+        const double d = discreteFrechet(a.data(), a.size(), b.data(), b.size());
+        CAPTURE(trial, a.size(), b.size(), d);
+        REQUIRE(discreteFrechetWithin(a.data(), a.size(), b.data(), b.size(), d));
+        REQUIRE(discreteFrechetWithin(a.data(), a.size(), b.data(), b.size(), d * (1.0 + 1e-12)));
+        REQUIRE_FALSE(discreteFrechetWithin(a.data(), a.size(), b.data(), b.size(), d * (1.0 - 1e-9) - 1e-300));
+        const double eps = f(rng) * d;
+        REQUIRE(discreteFrechetWithin(a.data(), a.size(), b.data(), b.size(), eps) == (d <= eps));
+    }
+}
+
 TEST_CASE("fitStrand: a strand traced from known parameters is fitted back", "[helicoid]")
 {
     const FrameD frame = FrameD::fromTangentNormal(Vec3d(0, -1, 0.2), Vec3d(1, 0, 0));
     const HelicoidParams truths[] = {{0.8, 0.0, 0.0, 0.0}, {0.6, 0.1, 0.3, 0.2}, {-0.7, 0.05, 0.2, 0.1}};
+    const int prefit = GENERATE(0, 20);  // Nelder–Mead alone (the paper's), and after the Levenberg–Marquardt pre-fit
     for (const HelicoidParams& k : truths) {
         HelicoidTrace t;
         tracePHelicoid(Vec3d(1, 2, 3), frame, {HelicoidPiece{k, 4.0, 0.0}}, 0.01, HelicoidIntegrator::RK4, t);
         std::vector<Vec3d> target;
         for (std::size_t i = 0; i < t.points.size(); i += 13) target.push_back(t.points[i]);  // 31 points, as the paper's data
         const std::vector<Vec3f> pts = toF(target);
-        const StrandFit fit = fitStrand(pts.data(), pts.size(), FitParams{});
-        CAPTURE(k.kT, k.kN, k.kB, k.alpha, fit.frechet, fit.pieces.size());
+        FitParams params;
+        params.prefitIterations = prefit;
+        const StrandFit fit = fitStrand(pts.data(), pts.size(), params);
+        CAPTURE(prefit, k.kT, k.kN, k.kB, k.alpha, fit.frechet, fit.pieces.size());
         // Stated tolerance: within 1 % of the length, in one piece, kT recovered up to its sign.
         REQUIRE(fit.frechet < 0.01 * 4.0);
         REQUIRE(fit.pieces.size() == 1);

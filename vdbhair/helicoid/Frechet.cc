@@ -26,6 +26,44 @@ double discreteFrechet(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_
     return prev[q - 1];
 }
 
+bool discreteFrechetWithin(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, double eps)
+{
+    if (p == 0 || q == 0) return true;
+    // The same distances as discreteFrechet (not squared: the answer must agree at eps = d).
+    auto free = [&](std::size_t i, std::size_t j) { return (a[i] - b[j]).length() <= eps; };
+    // Reachable cells of the previous row lie in [first, last] (flags inside); a cell is reachable
+    // if free and its left, lower or lower-left neighbour is.
+    std::vector<char> prev(q, 0), cur(q, 0);
+    std::size_t first = 0, last = 0;
+    if (!free(0, 0)) return false;
+    prev[0] = 1;
+    while (last + 1 < q && free(0, last + 1)) prev[++last] = 1;
+    for (std::size_t i = 1; i < p; ++i) {
+        std::size_t newFirst = q, newLast = 0;
+        bool left = false;
+        for (std::size_t j = first; j < q; ++j) {
+            const bool below = j <= last && prev[j];
+            const bool diag = j > first && j - 1 <= last && prev[j - 1];
+            if (!below && !diag && !left) {
+                cur[j] = 0;
+                if (j > last) break;  // nothing further right can be reached
+                continue;
+            }
+            left = free(i, j);
+            cur[j] = left;
+            if (left) {
+                newFirst = std::min(newFirst, j);
+                newLast = j;
+            }
+        }
+        if (newFirst == q) return false;
+        std::swap(prev, cur);
+        first = newFirst;
+        last = newLast;
+    }
+    return last == q - 1 && prev[q - 1];
+}
+
 double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, std::size_t* steps)
 {
     if (p == 0 || q == 0) {

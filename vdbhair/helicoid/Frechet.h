@@ -19,6 +19,12 @@ namespace vdbhair {
 /// @brief Discrete Fréchet distance between polylines of @a p and @a q points (world units).
 double discreteFrechet(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q);
 
+/// @brief Whether discreteFrechet(a, p, b, q) <= @a eps, without computing it: the decision
+/// version (Eiter & Mannila's free-space reachability), which visits only the cells reachable
+/// within @a eps, a narrow band along the diagonal when the polylines are close; false as soon as
+/// a row has no reachable cell. Fitting asks this of every candidate piece.
+bool discreteFrechetWithin(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, double eps);
+
 /// @brief Fréchet coupling: the smallest sum of coupled distances over monotone couplings.
 /// @param[out] steps optional: the number of pairs in that coupling (its mean leash is sum / steps)
 double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, std::size_t* steps = nullptr);

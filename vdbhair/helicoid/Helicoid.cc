@@ -33,17 +33,6 @@ FrameD FrameD::rolled(double angle) const
     return f;
 }
 
-double Helicoid::theta(const Vec3d& world, double thetaRef) const
-{
-    const Vec3d d = world - p0;
-    const double y1 = d.dot(q.t), y2 = d.dot(q.n), y3 = d.dot(q.b);
-    double th = fastmath::atan2(k.kT * y1 + k.kN * y2, 1.0 + k.kN * y1 - k.kT * y2) + k.kB * y3;
-    // Unwrap: the multiple of 2π that brings theta closest to its previous value.
-    constexpr double twoPi = 2.0 * M_PI;
-    th += twoPi * double(fastmath::roundToInt((thetaRef - th) * (1.0 / twoPi)));
-    return th;
-}
-
 FrameD Helicoid::frameFromTheta(double th) const
 {
     const double phi = k.alpha * th;
@@ -55,16 +44,6 @@ FrameD Helicoid::frameFromTheta(double th) const
     f.n = (-st) * q.t + ct * q.n;
     f.b = (-sp * ct) * q.t + (-sp * st) * q.n + cp * q.b;
     return f;
-}
-
-Vec3d Helicoid::tangent(const Vec3d& world, double& thetaRef) const
-{
-    thetaRef = theta(world, thetaRef);
-    const double phi = k.alpha * thetaRef;
-    double ct, st, cp = 1.0, sp = 0.0;
-    fastmath::sinCos(thetaRef, st, ct);
-    if (phi != 0.0) fastmath::sinCos(phi, sp, cp);
-    return (cp * ct) * q.t + (cp * st) * q.n + sp * q.b;
 }
 
 std::size_t stepCount(double length, double step)

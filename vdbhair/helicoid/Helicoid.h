@@ -19,6 +19,7 @@
 #pragma once
 
 #include <vdbhair/Types.h>
+#include <vdbhair/helicoid/FastMath.h>
 
 #include <cstddef>
 #include <vector>
@@ -61,6 +62,29 @@ struct Helicoid
     /// @brief Unit tangent E_T at @a world; updates @a thetaRef to the unwrapped theta there.
     Vec3d tangent(const Vec3d& world, double& thetaRef) const;
 };
+
+// theta() and tangent() are inline: tracing calls them four times per RK4 step, and fitting
+// traces thousands of times per strand.
+inline double Helicoid::theta(const Vec3d& world, double thetaRef) const
+{
+    const Vec3d d = world - p0;
+    const double y1 = d.dot(q.t), y2 = d.dot(q.n), y3 = d.dot(q.b);
+    double th = fastmath::atan2(k.kT * y1 + k.kN * y2, 1.0 + k.kN * y1 - k.kT * y2) + k.kB * y3;
+    // Unwrap: the multiple of 2π that brings theta closest to its previous value.
+    constexpr double twoPi = 2.0 * M_PI;
+    th += twoPi * double(fastmath::roundToInt((thetaRef - th) * (1.0 / twoPi)));
+    return th;
+}
+
+inline Vec3d Helicoid::tangent(const Vec3d& world, double& thetaRef) const
+{
+    thetaRef = theta(world, thetaRef);
+    const double phi = k.alpha * thetaRef;
+    double ct, st, cp = 1.0, sp = 0.0;
+    fastmath::sinCos(thetaRef, st, ct);
+    if (phi != 0.0) fastmath::sinCos(phi, sp, cp);
+    return (cp * ct) * q.t + (cp * st) * q.n + sp * q.b;
+}
 
 /// @brief Integrators for helicoid streamlines: forward Euler is Eq. 3, the paper's choice;
 /// RK4 (with theta unwrapped at every stage) is for when the streamline must be exact.

@@ -6,12 +6,14 @@
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/strands/Measures.h>
 
+#include <Eigen/Dense>
 #include <nlopt.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 
 namespace vdbhair {
@@ -26,6 +28,8 @@ struct Target
     std::vector<Vec3d> pts;
     std::vector<double> arc;
     std::vector<float> curvature;
+    std::vector<Vec3d> normal;  ///< discrete Frenet normals (Frames.h)
+    std::vector<double> turning;  ///< turning angle at each vertex (radians; 0 at the ends)
     double length = 0.0;
 };
 
@@ -97,7 +101,7 @@ struct Fitter
     }
 
     /// Nelder–Mead from @a start; returns the best x and its objective.
-    double minimize(std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q)
+    double minimize(std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q, double initialStep)
     {
         nlopt::opt opt(nlopt::LN_NELDERMEAD, unsigned(x.size()));
         struct Data { Fitter* self; std::size_t a, b; const Vec3d* p0; const FrameD* q; } data{this, a, b, &p0, &q};
@@ -118,12 +122,14 @@ struct Fitter
         opt.set_lower_bounds(lower);
         opt.set_upper_bounds(upper);
         for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::max(lower[i], std::min(upper[i], x[i]));
-        std::vector<double> stepSizes(x.size(), 0.5);
-        if (x.size() > 4) stepSizes[4] = 0.4;
+        std::vector<double> stepSizes(x.size(), initialStep);
+        if (x.size() > 4) stepSizes[4] = 0.8 * initialStep;
         opt.set_initial_step(stepSizes);
-        opt.set_xtol_abs(1e-4);
-        opt.set_ftol_rel(1e-7);
-        opt.set_maxeval(params.maxEvaluations);
+        // Without a pre-fit, the search from the raw starts keeps its tight tolerances.
+        const double tol = params.prefitIterations > 0 ? params.polishTolerance : 1e-4;
+        opt.set_xtol_abs(tol);
+        opt.set_ftol_rel(tol * 1e-3);
+        opt.set_maxeval(params.prefitIterations > 0 ? params.polishEvaluations : params.maxEvaluations);
         double f = 0.0;
         try {
             opt.optimize(x, f);
@@ -151,29 +157,226 @@ struct Fitter
         tau /= double(m);
     }
 
+    /// The piece with scaled parameters @a x traced from (p0, q) at the fragment's own arc
+    /// lengths: out[i] is where target vertex a + i should be (RK4, one step per target segment,
+    /// subdivided to at most the objective's step).
+    void traceAtVertices(const double* x, std::size_t dims, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q,
+                         std::vector<Vec3d>& out, Vec3d* endTangent = nullptr) const
+    {
+        const double L = target.arc[b] - target.arc[a];
+        Helicoid h;
+        h.k = {x[0] / L, x[1] / L, x[2] / L, x[3]};
+        h.q = dims > 4 ? q.rolled(x[4]) : q;
+        h.p0 = p0;
+        out.resize(b - a + 1);
+        Vec3d p = p0;
+        double th = h.theta(p, 0.0);
+        Vec3d k1 = h.frameFromTheta(th).t;
+        out[0] = p;
+        auto rk4 = [&](double hs) {
+            double t2 = th, t3 = th, t4 = th;
+            const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
+            const Vec3d k3 = h.tangent(p + 0.5 * hs * k2, t3);
+            const Vec3d k4 = h.tangent(p + hs * k3, t4);
+            p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+            k1 = h.tangent(p, th);
+        };
+        // Where the strand turns slowly, one RK4 step spans several segments (the strand turning
+        // at most prefitMaxTurn over them: the steps depend on the fragment only, so the traced
+        // positions stay smooth in x for the Jacobian), and the vertices inside it are cubic
+        // Hermite interpolants of the step's ends (positions and unit tangents), O(h^4) as RK4.
+        for (std::size_t i = a; i < b;) {
+            std::size_t j = i + 1;
+            double len = target.arc[j] - target.arc[i];
+            double turn = target.turning[i] + target.turning[j];
+            while (j < b && j - i < 4 && (turn += target.turning[j + 1]) <= params.prefitMaxTurn) len = target.arc[++j] - target.arc[i];
+            if (j == i + 1) {
+                const int n = std::max(1, int(std::ceil(len / evalStep - 0.5)));
+                for (int m = 0; m < n; ++m) rk4(len / n);
+            } else {
+                const Vec3d pa = p, ta = k1;
+                rk4(len);
+                for (std::size_t m = i + 1; m < j; ++m) {
+                    const double u = (target.arc[m] - target.arc[i]) / len, u2 = u * u, u3 = u2 * u;
+                    out[m - a] = (2 * u3 - 3 * u2 + 1) * pa + ((u3 - 2 * u2 + u) * len) * ta + (-2 * u3 + 3 * u2) * p +
+                                 ((u3 - u2) * len) * k1;
+                }
+            }
+            out[j - a] = p;
+            i = j;
+        }
+        if (endTangent) *endTangent = k1;
+    }
+
+    /// Residuals of the arc-length correspondence (the pre-fit's smooth least-squares stand-in
+    /// for Eq. 5): (trace(s_i) - h_i) / (L sqrt(n)) for each vertex after the first, the end
+    /// point again with weight 1 (the objective counts it twice), and a small Tikhonov term on k.
+    void residuals(const double* x, std::size_t dims, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q,
+                   Eigen::VectorXd& r)
+    {
+        ++evaluations;
+        Vec3d endT;
+        traceAtVertices(x, dims, a, b, p0, q, lmTrace, &endT);
+        const std::size_t n = b - a;
+        const double L = target.arc[b] - target.arc[a];
+        const double w = 1.0 / (L * std::sqrt(double(n)));
+        r.resize(Eigen::Index(3 * n + 3 + 4 + 3));
+        for (std::size_t i = 1; i <= n; ++i) {
+            const Vec3d d = (lmTrace[i] - target.pts[a + i]) * w;
+            for (int c = 0; c < 3; ++c) r[Eigen::Index(3 * (i - 1) + std::size_t(c))] = d[c];
+        }
+        const Vec3d e = (lmTrace[n] - target.pts[b]) / L;
+        for (int c = 0; c < 3; ++c) r[Eigen::Index(3 * n + std::size_t(c))] = e[c];
+        const double reg = std::sqrt(params.lambda) * 0.1;
+        for (int c = 0; c < 4; ++c) r[Eigen::Index(3 * n + 3 + std::size_t(c))] = reg * x[c];
+        // The end direction: the next piece starts with this piece's end frame (C¹), so a
+        // piece leaving the strand at an angle hands its successor a detour.
+        const std::size_t last = target.pts.size() - 1;
+        const Vec3d dir = (target.pts[std::min(b + 1, last)] - target.pts[b - 1]).unitSafe();
+        const Vec3d et = (endT - dir) * params.endTangentWeight;
+        for (int c = 0; c < 3; ++c) r[Eigen::Index(3 * n + 7 + std::size_t(c))] = et[c];
+    }
+
+    /// Levenberg–Marquardt on residuals() from @a x (forward-difference Jacobian), within the
+    /// same bounds as the Nelder–Mead search. A few traces per iteration instead of hundreds of
+    /// Nelder–Mead evaluations: it finds the basin; Nelder–Mead on Eq. 5 then polishes.
+    double prefit(std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q)
+    {
+        const std::size_t dims = x.size();
+        const double L = target.arc[b] - target.arc[a];
+        const double kmax = 1.0 * L / evalStep;
+        auto clamp = [&](std::vector<double>& v) {
+            for (std::size_t i = 0; i < 3; ++i) v[i] = std::max(-kmax, std::min(kmax, v[i]));
+            v[3] = std::max(-3.0, std::min(3.0, v[3]));
+            if (dims > 4) v[4] = std::max(-4.0 * M_PI, std::min(4.0 * M_PI, v[4]));
+        };
+        clamp(x);
+        Eigen::VectorXd r, rj, rn;
+        residuals(x.data(), dims, a, b, p0, q, r);
+        double cost = r.squaredNorm();
+        double mu = 1e-3;
+        const Eigen::Index d = Eigen::Index(dims);
+        Eigen::MatrixXd J(r.size(), d);
+        std::vector<double> xh(x), xn(x);
+        // The Jacobian by forward differences, then Broyden's rank-one updates from every trial
+        // step (one trace per iteration instead of dims + 1); recomputed when a step fails.
+        auto jacobian = [&]() {
+            for (std::size_t j = 0; j < dims; ++j) {
+                xh = x;
+                const double h = 1e-6 * std::max(1.0, std::abs(x[j]));
+                xh[j] += h;
+                residuals(xh.data(), dims, a, b, p0, q, rj);
+                J.col(Eigen::Index(j)) = (rj - r) / h;
+            }
+        };
+        jacobian();
+        bool fresh = true;
+        int rejected = 0;
+        for (int it = 0; it < params.prefitIterations; ++it) {
+            const Eigen::MatrixXd A = J.transpose() * J;
+            const Eigen::VectorXd g = J.transpose() * r;
+            Eigen::MatrixXd M = A;
+            for (Eigen::Index i = 0; i < d; ++i) M(i, i) += mu * (A(i, i) + 1e-9);
+            const Eigen::VectorXd dx = M.ldlt().solve(-g);
+            for (std::size_t i = 0; i < dims; ++i) xn[i] = x[i] + dx[Eigen::Index(i)];
+            clamp(xn);
+            Eigen::VectorXd step(d);
+            for (std::size_t i = 0; i < dims; ++i) step[Eigen::Index(i)] = xn[i] - x[i];
+            const double step2 = step.squaredNorm();
+            if (!(step2 > 1e-20)) break;
+            residuals(xn.data(), dims, a, b, p0, q, rn);
+            const double newCost = rn.squaredNorm();
+            if (params.broyden && std::isfinite(newCost)) J += ((rn - r - J * step) / step2) * step.transpose();
+            if (std::isfinite(newCost) && newCost < cost) {
+                const double gain = cost - newCost;
+                x = xn;
+                r = rn;
+                cost = newCost;
+                mu = std::max(1e-9, mu * 0.3);
+                fresh = false;
+                rejected = 0;
+                if (!params.broyden) { jacobian(); fresh = true; }
+                if (gain < params.prefitGain * cost) break;
+            } else {
+                mu *= 10.0;
+                if (fresh && mu > 1e6) break;
+                // Broyden's update has taken in the failed step; a second failure in a row
+                // refreshes the Jacobian.
+                if (!fresh && (!params.broyden || ++rejected >= 2)) { jacobian(); fresh = true; rejected = 0; }
+            }
+        }
+        return cost;
+    }
+
     /// Fit one piece to the fragment [a, b] from (p0, q); q fixed (a roll may be fitted).
+    /// @param hint optional: a fit of a neighbouring fragment [a, c], scaled by its length @a hintLength
     std::vector<double> fitPiece(std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q, const std::vector<double>* previous,
-                                 bool allowRoll, bool thorough)
+                                 bool allowRoll, bool thorough, bool polish, const std::vector<double>* hint = nullptr,
+                                 double hintLength = 0.0, int startsToRun = 0,
+                                 const std::function<bool(const std::vector<double>&)>& good = nullptr)
     {
         const double L = target.arc[b] - target.arc[a];
         double kappa, tau;
         startEstimate(a, b, kappa, tau);
         const std::size_t dims = allowRoll ? 5 : 4;
         std::vector<std::vector<double>> starts;
-        starts.push_back({kappa * L, 0.0, 0.0, kappa > 1e-9 ? std::max(-2.0, std::min(2.0, tau / kappa)) : 0.0});
+        // The strand's curvature and torsion near the start, with the frame rolled so that its
+        // normal is the strand's Frenet normal there. A search candidate with a neighbouring
+        // fit to start from (@a hint) pre-fits from that alone.
+        if (!(hint && !thorough && params.prefitIterations > 0)) {
+            starts.push_back({kappa * L, 0.0, 0.0, kappa > 1e-9 ? std::max(-2.0, std::min(2.0, tau / kappa)) : 0.0});
+            if (allowRoll) {
+                const Vec3d& n = target.normal[a];
+                starts.back().push_back(std::atan2(n.dot(q.b), n.dot(q.n)));
+            }
+        }
+        if (hint) {
+            std::vector<double> h = *hint;
+            for (int k = 0; k < 3; ++k) h[std::size_t(k)] *= L / hintLength;
+            starts.push_back(h);
+        }
         if (thorough) starts.push_back({0.0, 0.0, 0.0, 0.0});
         if (previous && thorough) starts.push_back({(*previous)[0] * L, (*previous)[1] * L, (*previous)[2] * L, (*previous)[3]});
-        // Nelder–Mead from the most promising start only (one evaluation each to choose).
         std::vector<double> best;
         double bestF = std::numeric_limits<double>::max();
-        for (std::vector<double> x : starts) {
-            x.resize(dims, 0.0);
-            const double f = objective(x, a, b, p0, q);
-            if (f < bestF) { bestF = f; best = x; }
+        if (params.prefitIterations > 0) {
+            // Pre-fit from the starts that the smooth objective ranks first.
+            const std::size_t maxRuns = std::size_t(std::max(1, startsToRun > 0 ? startsToRun : params.prefitStarts));
+            std::vector<std::pair<double, std::size_t>> ranked;
+            Eigen::VectorXd r;
+            for (std::size_t i = 0; i < starts.size(); ++i) {
+                starts[i].resize(dims, 0.0);
+                if (starts.size() > maxRuns) residuals(starts[i].data(), dims, a, b, p0, q, r);
+                ranked.emplace_back(starts.size() > maxRuns ? r.squaredNorm() : 0.0, i);
+            }
+            if (ranked.size() > 1) std::sort(ranked.begin(), ranked.end());
+            const std::size_t runs = std::min(ranked.size(), maxRuns);
+            for (std::size_t i = 0; i < runs; ++i) {
+                std::vector<double> x = starts[ranked[i].second];
+                const double f = prefit(x, a, b, p0, q);
+                if (f < bestF) { bestF = f; best = x; }
+                // The first pre-fit that is good enough ends the search (in the starts' order).
+                if (good && i + 1 < runs && good(x)) { best = x; break; }
+            }
+        } else {
+            for (std::vector<double> x : starts) {
+                x.resize(dims, 0.0);
+                const double f = objective(x, a, b, p0, q);
+                if (f < bestF) { bestF = f; best = x; }
+            }
         }
-        minimize(best, a, b, p0, q);
+        // Nelder–Mead from the most promising start only.
+        if (polish) minimize(best, a, b, p0, q, params.prefitIterations > 0 ? params.polishStep : 0.5);
         return best;  // scaled by this fragment's L
     }
+
+    /// Nelder–Mead on Eq. 5 from a pre-fit @a x of [a, b].
+    void polish(std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q)
+    {
+        minimize(x, a, b, p0, q, params.polishStep);
+    }
+
+    std::vector<Vec3d> lmTrace;  // scratch
 };
 
 /// Distinct points of the strand (repeated points removed), their arc lengths and curvature.
@@ -193,6 +396,15 @@ Target makeTarget(const Vec3f* points, std::size_t n)
     for (std::size_t i = 0; i < f.size(); ++i) f[i] = toF(t.pts[i]);
     t.curvature.resize(f.size());
     curvatureProfile(f.data(), f.size(), t.curvature.data());
+    std::vector<Frame> frames(f.size());
+    if (!f.empty()) frenetFrames(f.data(), f.size(), frames.data());
+    t.turning.assign(t.pts.size(), 0.0);
+    for (std::size_t i = 1; i + 1 < t.pts.size(); ++i) {
+        const Vec3d u = (t.pts[i] - t.pts[i - 1]).unitSafe(), v = (t.pts[i + 1] - t.pts[i]).unitSafe();
+        t.turning[i] = std::atan2(u.cross(v).length(), u.dot(v));
+    }
+    t.normal.resize(f.size());
+    for (std::size_t i = 0; i < f.size(); ++i) t.normal[i] = Vec3d(frames[i].n);
     return t;
 }
 
@@ -258,42 +470,77 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
     while (a < last) {
         const bool allowRoll = params.optimizeRoll;
         const double remaining = target.length - target.arc[a];
-        auto fitTo = [&](std::size_t b, std::vector<double>& x, bool thorough) {
-            x = fitter.fitPiece(a, b, p0, q, previous.empty() ? nullptr : &previous, allowRoll, thorough);
+        // Is the fit x of [a, b], as grown, within @a eps of the fragment (discrete Fréchet)?
+        auto within = [&](std::size_t b, const std::vector<double>& x, double eps) {
             const double L = target.arc[b] - target.arc[a];
             fitter.tracePiece(x, L, p0, q, trace, /*exact=*/true);
             densify(target.pts, a, b, step, denseTarget);
-            return discreteFrechet(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size());
+            return discreteFrechetWithin(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size(), eps);
         };
+        // A candidate fit of [a, b]: pre-fitted from the starts (and @a hint, a fit of [a, hb]);
+        // polished by Nelder–Mead on Eq. 5 only when @a polish (the search for the split
+        // compares pre-fits; the piece kept is polished).
+        auto fitTo = [&](std::size_t b, std::vector<double>& x, bool thorough, bool polish, const std::vector<double>* hint = nullptr,
+                         std::size_t hb = 0, int startsToRun = 0) {
+            int verdict = -1;  // the last pre-fit's acceptance, when known
+            std::function<bool(const std::vector<double>&)> good;
+            if (!polish && params.firstGoodStart) {
+                good = [&](const std::vector<double>& y) {
+                    verdict = within(b, y, tolerance) ? 1 : 0;
+                    return verdict == 1;
+                };
+            }
+            x = fitter.fitPiece(a, b, p0, q, previous.empty() ? nullptr : &previous, allowRoll, thorough, polish, hint,
+                                hint ? target.arc[hb] - target.arc[a] : 0.0, startsToRun, good);
+            return verdict == 1 ? true : within(b, x, tolerance);
+        };
+        // Polish a pre-fit (@a ok: it is acceptable); a polish that makes an acceptable fit
+        // unacceptable is undone (Eq. 5 weighs the mean leash, the acceptance its maximum).
+        auto polishFit = [&](std::size_t b, std::vector<double>& x, bool ok) {
+            std::vector<double> y = x;
+            fitter.polish(y, a, b, p0, q);
+            const bool okAfter = within(b, y, tolerance);
+            if (okAfter || !ok) { x = y; return okAfter; }
+            return ok;
+        };
+        const bool searchWithoutPolish = params.prefitIterations > 0;
         std::vector<double> x;
-        const double err = fitTo(last, x, true);
         std::size_t b = last;
         const bool lastPiece = int(fit.pieces.size()) + 1 >= params.maxPieces || remaining < 2.0 * minLength || last - a < 3;
-        if (!(err <= tolerance) && !lastPiece) {
+        // The last piece allowed is kept whatever its error: it gets every start.
+        bool ok = fitTo(last, x, true, !searchWithoutPolish, nullptr, 0, lastPiece ? params.lastPieceStarts : 0);
+        if (searchWithoutPolish && (lastPiece || ok || within(last, x, params.polishMargin * tolerance))) ok = polishFit(last, x, ok);
+        if (!ok && !lastPiece) {
             // Upper limit: the longest prefix whose fit is acceptable (the paper's Fréchet
             // threshold), by bisection over the vertices between the minimum fragment and the
-            // splitFraction of the remainder (then the remainder itself, which failed above).
+            // remainder (which failed above), starting at the splitFraction of the remainder.
+            // Each candidate starts from the nearest fit found so far.
             const std::size_t lo = std::min(last - 1, std::max(a + 2, indexAtArc(target, target.arc[a] + minLength)));
             std::size_t hi = std::min(last - 1, std::max(lo, indexAtArc(target, target.arc[a] + params.splitFraction * remaining)));
-            std::vector<double> xu, xt;
-            std::size_t u = lo;
-            double eu = fitTo(lo, xu, true);
-            if (eu <= tolerance) {
-                // Is the splitFraction itself acceptable? Then search above it, else below.
-                const double eh = hi > lo ? fitTo(hi, xt, true) : eu;
-                std::size_t good = lo, bad = last;
-                if (hi > lo) {
-                    if (eh <= tolerance) { good = hi; xu = xt; eu = eh; }
-                    else bad = hi;
-                }
-                while (bad - good > 1) {
+            const bool thorough = !searchWithoutPolish;
+            const bool polish = !searchWithoutPolish;
+            std::vector<double> xu, xt, xb = x;
+            std::size_t u = lo, good = lo, bad = last;
+            bool okU = false;
+            if (hi > lo && fitTo(hi, xt, thorough, polish, &xb, last)) {
+                good = hi;
+                xu = xt;
+                okU = true;
+            } else {
+                if (hi > lo) { bad = hi; xb = xt; }
+                okU = fitTo(lo, xu, true, polish, hi > lo ? &xb : nullptr, bad);
+            }
+            if (okU) {
+                const std::size_t resolution = std::size_t(std::max(1.0, params.splitResolution * double(last - a)));
+                while (bad - good > resolution) {
                     const std::size_t mid = (good + bad) / 2;
-                    const double em = fitTo(mid, xt, true);
-                    if (em <= tolerance) { good = mid; xu = xt; eu = em; }
-                    else bad = mid;
+                    const bool nearGood = mid - good <= bad - mid;
+                    if (fitTo(mid, xt, thorough, polish, nearGood ? &xu : &xb, nearGood ? good : bad)) { good = mid; xu = xt; }
+                    else { bad = mid; xb = xt; }
                 }
                 u = good;
             }
+            if (searchWithoutPolish) polishFit(u, xu, okU);
             // Backtrack from u along the curvature profile to where fragment and fit agree best:
             // in curvature (the paper's criterion) and, since the next piece starts there, in
             // position and direction.
