@@ -32,6 +32,14 @@ public:
         const double u1 = 1.0 - uniform(), u2 = uniform();
         return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
     }
+    /// Two independent standard normals from one Box–Muller draw (half the cost of two normal()).
+    void normalPair(double& a, double& b)
+    {
+        const double u1 = 1.0 - uniform(), u2 = uniform();
+        const double r = std::sqrt(-2.0 * std::log(u1)), angle = 2.0 * M_PI * u2;
+        a = r * std::cos(angle);
+        b = r * std::sin(angle);
+    }
 
 private:
     static std::uint64_t mix(std::uint64_t z)

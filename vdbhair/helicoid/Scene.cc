@@ -284,7 +284,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
                     ++count;
                 }
                 traceWisps(guideTraces[it.guide], guide.pieces, *guide.wisp, stepOf(guide), integrator, rngs.data(),
-                           count, traces);
+                           count, traces, guide.waviness.has_value());
                 for (std::size_t b = 0; b < count; ++b) batch[b] = &traces[b];
             }
             for (std::size_t b = 0; b < count; ++b) {

@@ -17,7 +17,7 @@ Vec3d rotate(const Vec3d& v, const Vec3d& axis, double c, double s)
 } // namespace
 
 void traceWisps(const HelicoidTrace& guide, const std::vector<HelicoidPiece>& pieces, const WispParams& params,
-                double step, HelicoidIntegrator integrator, Rng* rngs, std::size_t count, HelicoidTrace* outs)
+                double step, HelicoidIntegrator integrator, Rng* rngs, std::size_t count, HelicoidTrace* outs, bool frames)
 {
     // Roots: uniform in the disk (r = R sqrt(u)) in the guide root's E_N–E_B plane.
     const FrameD& f0 = guide.pieces.front().q;
@@ -41,6 +41,7 @@ void traceWisps(const HelicoidTrace& guide, const std::vector<HelicoidPiece>& pi
         const Vec3d root = roots[w];
         for (std::size_t i = 0; i < out.points.size(); ++i) {
             out.points[i] = root + rotate(out.points[i] - root, axis, c, s);
+            if (!frames) continue;
             FrameD& fr = out.frames[i];
             fr.t = rotate(fr.t, axis, c, s);
             fr.n = rotate(fr.n, axis, c, s);

@@ -29,7 +29,9 @@ void traceWisp(const HelicoidTrace& guide, const std::vector<HelicoidPiece>& pie
 
 /// @brief traceWisp() for @a count wisp strands at once, strand i drawing from @a rngs[i]
 /// (the same strands as one call each, traced in lockstep for speed).
+/// @param frames whether @a outs' frames must follow the fanning rotation too (waviness needs them);
+/// without, only points and arc lengths are meaningful after fanning.
 void traceWisps(const HelicoidTrace& guide, const std::vector<HelicoidPiece>& pieces, const WispParams& params,
-                double step, HelicoidIntegrator integrator, Rng* rngs, std::size_t count, HelicoidTrace* outs);
+                double step, HelicoidIntegrator integrator, Rng* rngs, std::size_t count, HelicoidTrace* outs, bool frames = true);
 
 } // namespace vdbhair
