@@ -48,6 +48,7 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
 {
     const Stage stage(common, "reading " + path);
     ReadOptions opts;
+    opts.interrupter = common.interrupter;
     if (strict) opts.shortStrands = ShortStrandPolicy::Reject;
     ReadReport report;
     StrandSet strands = readStrands(path, opts, &report);

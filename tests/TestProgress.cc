@@ -7,6 +7,8 @@
 #include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/StrandIO.h>
 #include <vdbhair/render/StrandRenderer.h>
 
 #include <tbb/blocked_range.h>
@@ -249,4 +251,28 @@ TEST_CASE("Progress: every long operation stops with InterruptedError when told 
         rp.interrupter = &rec;
         CHECK_THROWS_AS(renderStrands(s, rp), InterruptedError);
     }
+}
+
+TEST_CASE("Progress: reading a file reports its bytes and stops when told to", "[progress]")
+{
+    // 20 MiB: three pieces of the reader's 8 MiB.
+    const std::string path = test::writeBytes("progress.bin", std::string(20u << 20, 'x'));
+    Recorder rec;
+    const std::vector<char> bytes = readFileBytes(path, "test", &rec);
+    CHECK(bytes.size() == (20u << 20));
+    const Recorder::Stage& s = rec.stages.at("reading progress.bin");
+    CHECK(s.total == bytes.size());
+    CHECK(s.done == bytes.size());
+    CHECK(s.unit == "bytes");
+    Recorder stop(1);
+    CHECK_THROWS_AS(readFileBytes(path, "test", &stop), InterruptedError);
+
+    // Through a strand reader's options.
+    const StrandSet strands = manyStrands(8);
+    const std::string hair = test::tempPath("progress.hair");
+    writeStrands(hair, strands);
+    ReadOptions opts;
+    Recorder stopRead(1);
+    opts.interrupter = &stopRead;
+    CHECK_THROWS_AS(readStrands(hair, opts), InterruptedError);
 }

@@ -47,6 +47,7 @@ int runConvert(ConvertParams p, const CommonOptions& common)
 
     ReadOptions ropts;
     if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
+    ropts.interrupter = common.interrupter;
     StrandSet strands;
     ReadReport report;
     for (const std::string& in : inputs) {

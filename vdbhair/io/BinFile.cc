@@ -10,7 +10,7 @@ namespace vdbhair {
 StrandSet readBin(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readBin(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
     ByteReader in(bytes, where);
     constexpr std::size_t kVertexBytes = 7 * 4;
     const std::int32_t nS = in.read<std::int32_t>("strand count");

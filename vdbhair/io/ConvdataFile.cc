@@ -12,7 +12,7 @@ namespace vdbhair {
 StrandSet readConvdata(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readConvdata(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
     ByteReader in(bytes, where);
     if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY", 6) != 0) {
         in.fail("not a NumPy .npy file: the first 6 bytes must be \\x93NUMPY");

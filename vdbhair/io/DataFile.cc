@@ -10,7 +10,7 @@ namespace vdbhair {
 StrandSet readData(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readData(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
     ByteReader in(bytes, where);
     const std::int32_t nS = in.read<std::int32_t>("strand count");
     if (nS < 0) in.failAt(0, "strand count " + std::to_string(nS) + " is negative");

@@ -1,6 +1,7 @@
 #include "FileUtil.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
 
 #include <algorithm>
 #include <atomic>
@@ -17,7 +18,7 @@ namespace vdbhair {
 
 namespace fs = std::filesystem;
 
-std::vector<char> readFileBytes(const std::string& path, const std::string& where)
+std::vector<char> readFileBytes(const std::string& path, const std::string& where, openvdb::util::NullInterrupter* interrupter)
 {
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw IoError(where + ": is a directory, not a file");
@@ -28,9 +29,18 @@ std::vector<char> readFileBytes(const std::string& path, const std::string& wher
     if (size < 0) throw IoError(where + ": cannot determine the file size");
     in.seekg(0, std::ios::beg);
     std::vector<char> bytes(static_cast<std::size_t>(size));
-    if (size > 0 && !in.read(bytes.data(), size)) {
-        throw IoError(where + ": read failed after " + std::to_string(in.gcount()) + " of " +
-                      std::to_string(size) + " bytes");
+    // In pieces, so that a big file's progress shows and Ctrl-C is heard.
+    constexpr std::streamoff kPiece = std::streamoff(8) << 20;
+    const std::string stage = "reading " + fs::path(path).filename().string();
+    ProgressCounter progress(interrupter, stage.c_str(), std::uint64_t(size), "bytes");
+    for (std::streamoff done = 0; done < size;) {
+        const std::streamoff n = std::min(kPiece, size - done);
+        if (!in.read(bytes.data() + done, n)) {
+            throw IoError(where + ": read failed after " + std::to_string(done + in.gcount()) + " of " +
+                          std::to_string(size) + " bytes");
+        }
+        done += n;
+        if (progress.add(std::uint64_t(n))) throw InterruptedError(where + ": interrupted while reading");
     }
     return bytes;
 }

@@ -2,6 +2,8 @@
 /// @brief Reading whole files and writing outputs safely (temporary file, then rename).
 #pragma once
 
+#include <openvdb/util/NullInterrupter.h>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -10,8 +12,11 @@ namespace vdbhair {
 
 /// @brief The whole content of @a path.
 /// @param where prefix of error messages, e.g. "readHair(a.hair)"
-/// @throw IoError if the file cannot be opened or read.
-std::vector<char> readFileBytes(const std::string& path, const std::string& where);
+/// @param interrupter optional progress (bytes read) and Ctrl-C (Progress.h)
+/// @throw IoError if the file cannot be opened or read; InterruptedError when the interrupter
+/// stops the reading.
+std::vector<char> readFileBytes(const std::string& path, const std::string& where,
+                                openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// @brief Lower-case extension of @a path including the dot (".hair"), or "" if none.
 std::string fileExtension(const std::string& path);

@@ -16,7 +16,7 @@ enum : std::uint32_t { kSegments = 1, kPoints = 2, kThickness = 4, kTransparency
 StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readHair(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
     ByteReader in(bytes, where);
 
     // Header

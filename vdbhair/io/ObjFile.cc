@@ -12,7 +12,7 @@ namespace vdbhair {
 StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readObj(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
     TextScanner text(bytes, where);
 
     std::vector<Vec3f> vertices;

@@ -107,7 +107,7 @@ private:
 StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readPly(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
 
     // Header
     TextScanner header(bytes, where);

@@ -6,6 +6,8 @@
 #include <vdbhair/Types.h>
 #include <vdbhair/strands/StrandSet.h>
 
+#include <openvdb/util/NullInterrupter.h>
+
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -23,6 +25,9 @@ enum class ShortStrandPolicy { Drop, Reject };
 struct ReadOptions
 {
     ShortStrandPolicy shortStrands = ShortStrandPolicy::Drop;
+    /// Optional progress and Ctrl-C while the file's bytes are read (Progress.h); readers then
+    /// throw InterruptedError when it says stop.
+    openvdb::util::NullInterrupter* interrupter = nullptr;
 };
 
 /// @brief What a reader noticed but did not fail on.

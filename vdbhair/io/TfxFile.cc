@@ -141,7 +141,7 @@ StrandSet readAscii(const std::vector<char>& bytes, const std::string& where,
 StrandSet readTfx(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readTfx(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
     ByteReader in(bytes, where);
     if (bytes.size() >= 4 && std::isalpha(static_cast<unsigned char>(bytes[0]))) {
         return readAscii(bytes, where, opts, report);
