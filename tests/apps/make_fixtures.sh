@@ -17,6 +17,8 @@ cp "$src/scenes/figures/fig2_waviness.json" existing.json
 # Strands with a known helicoid shape, sampled like the paper's data (30 vertices).
 "$bin" grow "$src/scenes/figures/fig1_k_vectors.json" -o k_vectors.hair --quiet
 "$bin" convert k_vectors.hair k_vectors30.hair --resample 30 --quiet
+# A head for render --head: a tetrahedron around the fixture hairstyle's roots.
+printf 'v -40 0 -40\nv 40 0 -40\nv 0 0 40\nv 0 80 0\nf 1 2 3\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' > head.obj
 # Bad inputs, one rule each.
 { printf 'HAIX'; head -c 124 /dev/zero; } > bad_magic.hair
 head -c 200 good.hair > truncated.hair

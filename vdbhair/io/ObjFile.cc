@@ -1,5 +1,7 @@
 #include "ObjFile.h"
 
+#include <vdbhair/io/MeshFile.h>
+
 #include <vdbhair/Version.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/TextScanner.h>
@@ -124,6 +126,47 @@ void writeObj(const std::string& path, const StrandSet& strands)
         out += '\n';
     }
     writeFileAtomic(path, out, where);
+}
+
+} // namespace vdbhair
+
+namespace vdbhair {
+
+TriangleMesh readObjMesh(const std::string& path)
+{
+    const std::string where = "readObjMesh(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where);
+    TextScanner text(bytes, where);
+    TriangleMesh mesh;
+    std::vector<std::string_view> tok;
+    std::vector<std::uint32_t> face;
+    while (text.nextLine(tok)) {
+        if (tok.empty()) continue;
+        if (tok[0] == "v") {
+            if (tok.size() < 4) text.fail("a 'v' line needs 3 coordinates, got " + std::to_string(tok.size() - 1));
+            const Vec3f p(text.toFloat(tok[1], "x"), text.toFloat(tok[2], "y"), text.toFloat(tok[3], "z"));
+            checkFinite(p, mesh.vertices.size(), where, "line " + std::to_string(text.line()));
+            mesh.vertices.push_back(p);
+        } else if (tok[0] == "f") {
+            if (tok.size() < 4) text.fail("an 'f' line needs at least 3 vertices, got " + std::to_string(tok.size() - 1));
+            face.clear();
+            for (std::size_t j = 1; j < tok.size(); ++j) {
+                std::string_view t = tok[j];
+                if (const std::size_t slash = t.find('/'); slash != std::string_view::npos) t = t.substr(0, slash);
+                const std::int64_t idx = text.toInt(t, "vertex index");
+                const std::int64_t n = std::int64_t(mesh.vertices.size());
+                const std::int64_t resolved = idx > 0 ? idx - 1 : n + idx;
+                if (idx == 0 || resolved < 0 || resolved >= n) {
+                    text.fail("vertex index " + std::to_string(idx) + " is out of range: " + std::to_string(n) +
+                              " vertices are defined before this line");
+                }
+                face.push_back(std::uint32_t(resolved));
+            }
+            for (std::size_t j = 1; j + 1 < face.size(); ++j) mesh.triangles.push_back({face[0], face[j], face[j + 1]});
+        }
+    }
+    if (mesh.triangles.empty()) throw FormatError(where + ": the file has no faces ('f' lines)");
+    return mesh;
 }
 
 } // namespace vdbhair

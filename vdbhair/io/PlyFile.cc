@@ -1,5 +1,7 @@
 #include "PlyFile.h"
 
+#include <vdbhair/io/MeshFile.h>
+
 #include <vdbhair/Version.h>
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
@@ -102,14 +104,16 @@ private:
     std::size_t mTok = 0;
 };
 
-} // namespace
-
-StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
+/// The header of a PLY file: encoding, elements, and where the body starts.
+struct PlyHeader
 {
-    const std::string where = "readPly(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
+    bool binary = false;
+    std::vector<Element> elements;
+    std::size_t bodyOffset = 0, bodyLine = 0;
+};
 
-    // Header
+PlyHeader parsePlyHeader(const std::vector<char>& bytes, const std::string& where)
+{
     TextScanner header(bytes, where);
     std::vector<std::string_view> tok;
     if (!header.nextLine(tok) || tok.size() != 1 || tok[0] != "ply") header.fail("not a PLY file: the first line must be 'ply'");
@@ -161,6 +165,20 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     if (!ended) header.fail("the header has no 'end_header'");
     if (!sawFormat) header.fail("the header has no 'format' line");
 
+    return PlyHeader{binary, std::move(elements), header.offset(), header.line()};
+}
+
+} // namespace
+
+StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    const std::string where = "readPly(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
+
+    const PlyHeader hdr = parsePlyHeader(bytes, where);
+    const bool binary = hdr.binary;
+    const std::vector<Element>& elements = hdr.elements;
+
     const Element* vertexEl = nullptr;
     const Element* strandEl = nullptr;
     for (const Element& e : elements) {
@@ -186,9 +204,9 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
 
     // Body
     ByteReader bin(bytes, where);
-    TextScanner text(bytes, where, header.offset());
-    text.setLine(header.line());  // body line numbers continue the header's
-    bin.seek(header.offset(), "end_header");
+    TextScanner text(bytes, where, hdr.bodyOffset);
+    text.setLine(hdr.bodyLine);  // body line numbers continue the header's
+    bin.seek(hdr.bodyOffset, "end_header");
     ValueSource src(binary ? &bin : nullptr, binary ? nullptr : &text);
 
     std::vector<Vec3f> positions, colors;
@@ -213,7 +231,10 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
                     const double c = src.read(p.countType, "list count");
                     if (c < 0) src.fail("list '" + p.name + "' has a negative count");
                     const std::uint64_t cnt = std::uint64_t(c);
-                    if (cnt > src.remainingBytes()) src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
+                    // Nothing is allocated from cnt; ascii items fail one by one at the end of the file.
+                    if (binary && cnt > src.remainingBytes() / plySize(p.type)) {
+                        src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
+                    }
                     for (std::uint64_t j = 0; j < cnt; ++j) src.read(p.type, "list item");
                 } else {
                     values[k] = src.read(p.type, p.name.c_str());
@@ -313,6 +334,99 @@ void writePly(const std::string& path, const StrandSet& strands, PlyEncoding enc
         }
     }
     writeFileAtomic(path, out, where);
+}
+
+} // namespace vdbhair
+
+namespace vdbhair {
+
+TriangleMesh readPlyMesh(const std::string& path)
+{
+    const std::string where = "readPlyMesh(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where);
+    const PlyHeader hdr = parsePlyHeader(bytes, where);
+    const Element* vertexEl = nullptr;
+    const Element* faceEl = nullptr;
+    for (const Element& e : hdr.elements) {
+        if (e.name == "vertex") vertexEl = &e;
+        if (e.name == "face") faceEl = &e;
+    }
+    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    if (!faceEl) throw FormatError(where + ": the header has no 'face' element");
+    int ix = -1, iy = -1, iz = -1, iface = -1;
+    for (std::size_t i = 0; i < vertexEl->props.size(); ++i) {
+        const Property& p = vertexEl->props[i];
+        if (p.isList) continue;
+        if (p.name == "x") ix = int(i);
+        if (p.name == "y") iy = int(i);
+        if (p.name == "z") iz = int(i);
+    }
+    for (std::size_t i = 0; i < faceEl->props.size(); ++i) {
+        const Property& p = faceEl->props[i];
+        if (p.isList && (p.name == "vertex_indices" || p.name == "vertex_index")) iface = int(i);
+    }
+    if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
+    if (iface < 0) throw FormatError(where + ": line " + std::to_string(faceEl->line) + ": the 'face' element needs a list 'vertex_indices'");
+
+    ByteReader bin(bytes, where);
+    TextScanner text(bytes, where, hdr.bodyOffset);
+    text.setLine(hdr.bodyLine);
+    bin.seek(hdr.bodyOffset, "end_header");
+    ValueSource src(hdr.binary ? &bin : nullptr, hdr.binary ? nullptr : &text);
+
+    TriangleMesh mesh;
+    std::vector<double> values;
+    std::vector<std::uint32_t> face;
+    for (const Element& e : hdr.elements) {
+        std::size_t minBytes = 0;
+        for (const Property& p : e.props) minBytes += hdr.binary ? (p.isList ? plySize(p.countType) : plySize(p.type)) : 2;
+        if (minBytes && e.count > src.remainingBytes() / minBytes) {
+            src.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
+                     std::to_string(minBytes) + " bytes but only " + std::to_string(src.remainingBytes()) + " bytes remain");
+        }
+        const bool isVertex = &e == vertexEl, isFace = &e == faceEl;
+        if (isVertex) mesh.vertices.reserve(e.count);
+        if (isFace) mesh.triangles.reserve(e.count);
+        values.assign(e.props.size(), 0.0);
+        for (std::uint64_t n = 0; n < e.count; ++n) {
+            for (std::size_t k = 0; k < e.props.size(); ++k) {
+                const Property& p = e.props[k];
+                if (!p.isList) {
+                    values[k] = src.read(p.type, p.name.c_str());
+                    continue;
+                }
+                const double c = src.read(p.countType, "list count");
+                if (c < 0) src.fail("list '" + p.name + "' has a negative count");
+                const std::uint64_t cnt = std::uint64_t(c);
+                // Nothing is allocated from cnt (ascii items fail one by one at the end of the file).
+                if (hdr.binary && cnt > src.remainingBytes() / plySize(p.type)) {
+                    src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
+                }
+                const bool wanted = isFace && int(k) == iface;
+                if (wanted) face.clear();
+                for (std::uint64_t j = 0; j < cnt; ++j) {
+                    const double idx = src.read(p.type, "vertex index");
+                    if (!wanted) continue;
+                    if (!(idx >= 0.0) || idx >= double(mesh.vertices.size()) || idx != std::floor(idx)) {
+                        src.fail("face " + std::to_string(n) + " names vertex " + std::to_string(idx) + " of " +
+                                 std::to_string(mesh.vertices.size()));
+                    }
+                    face.push_back(std::uint32_t(idx));
+                }
+                if (wanted) {
+                    if (face.size() < 3) src.fail("face " + std::to_string(n) + " has " + std::to_string(face.size()) + " vertices; a face needs 3");
+                    for (std::size_t j = 1; j + 1 < face.size(); ++j) mesh.triangles.push_back({face[0], face[j], face[j + 1]});
+                }
+            }
+            if (isVertex) {
+                const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
+                checkFinite(pos, mesh.vertices.size(), where, src.location());
+                mesh.vertices.push_back(pos);
+            }
+        }
+    }
+    if (mesh.triangles.empty()) throw FormatError(where + ": the file has no faces");
+    return mesh;
 }
 
 } // namespace vdbhair

@@ -259,6 +259,67 @@ void rasterize(Raster& r, const StrandSet& s, const std::vector<Vec3d>& proj, co
     if (progress.stopped()) throw InterruptedError("renderStrands: interrupted");
 }
 
+/// Draw the triangles of @a mesh into the raster's depth and colour (bands in parallel), lit
+/// two-sided by the strands' light.
+void rasterizeMesh(Raster& r, const TriangleMesh& mesh, const Camera& cam, const Vec3f& color,
+                   openvdb::util::NullInterrupter* interrupter)
+{
+    std::vector<Vec3d> proj(mesh.vertices.size());
+    for (std::size_t v = 0; v < proj.size(); ++v) proj[v] = cam.project(Vec3d(mesh.vertices[v]));
+    const Vec3d light = (cam.up * 0.8 + cam.right * 0.3 - cam.forward * 0.5).unit();
+    const int bands = 32, bandRows = (r.h + bands - 1) / bands;
+    ProgressCounter progress(interrupter, "rendering the head", std::uint64_t(bands), "bands");
+    tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& br) {
+        for (int band = br.begin(); band != br.end(); ++band) {
+            if (progress.stopped() || progress.add(1)) return;
+            const int rowLo = band * bandRows, rowHi = std::min(r.h, rowLo + bandRows);
+            for (const auto& tri : mesh.triangles) {
+                const Vec3d &a = proj[tri[0]], &b = proj[tri[1]], &c = proj[tri[2]];
+                if (cam.perspective && (a.z() <= 0 || b.z() <= 0 || c.z() <= 0)) continue;
+                const double y0 = std::min({a.y(), b.y(), c.y()}), y1 = std::max({a.y(), b.y(), c.y()});
+                if (y1 < rowLo || y0 >= rowHi) continue;
+                const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+                if (area == 0.0) continue;
+                const Vec3d n = (Vec3d(mesh.vertices[tri[1]]) - Vec3d(mesh.vertices[tri[0]]))
+                                    .cross(Vec3d(mesh.vertices[tri[2]]) - Vec3d(mesh.vertices[tri[0]]));
+                const double len = n.length();
+                const float lit = len > 0.0 ? float(0.35 + 0.65 * std::abs(n.dot(light)) / len) : 0.35f;
+                const Vec3f shaded = color * lit;
+                const int px0 = std::max(0, int(std::floor(std::min({a.x(), b.x(), c.x()}))));
+                const int px1 = std::min(r.w - 1, int(std::ceil(std::max({a.x(), b.x(), c.x()}))));
+                const int py0 = std::max(rowLo, int(std::floor(y0))), py1 = std::min(rowHi - 1, int(std::ceil(y1)));
+                for (int y = py0; y <= py1; ++y) {
+                    for (int x = px0; x <= px1; ++x) {
+                        // Barycentric weights of the pixel centre; inside when all share area's sign.
+                        const double sx = x + 0.5, sy = y + 0.5;
+                        const double w0 = ((b.x() - sx) * (c.y() - sy) - (b.y() - sy) * (c.x() - sx)) / area;
+                        const double w1 = ((c.x() - sx) * (a.y() - sy) - (c.y() - sy) * (a.x() - sx)) / area;
+                        const double w2 = 1.0 - w0 - w1;
+                        if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
+                        const float z = float(w0 * a.z() + w1 * b.z() + w2 * c.z());
+                        const std::size_t idx = std::size_t(y) * std::size_t(r.w) + std::size_t(x);
+                        if (z < r.depth[idx]) {
+                            r.depth[idx] = z;
+                            r.color[idx] = shaded;
+                        }
+                    }
+                }
+            }
+        }
+    });
+    if (progress.stopped()) throw InterruptedError("renderStrands: interrupted");
+}
+
+/// The box a render fits by default: the strands, the guides and the head.
+BBox renderFrame(const StrandSet& strands, const RenderParams& params)
+{
+    BBox box = computeBBox(strands);
+    for (const BBox& b : {params.guides ? computeBBox(*params.guides) : BBox(), params.head ? meshBBox(*params.head) : BBox()}) {
+        if (!b.empty()) { box.expand(b.min); box.expand(b.max); }
+    }
+    return box;
+}
+
 void checkSize(const RenderParams& p)
 {
     if (p.width < 1 || p.height < 1 || p.width > 16384 || p.height > 16384) {
@@ -282,11 +343,7 @@ Image renderStrands(const StrandSet& strands, const RenderParams& params)
 {
     checkSize(params);
     const int S = params.supersample;
-    BBox box = params.frame ? *params.frame : computeBBox(strands);
-    if (params.guides && !params.frame) {
-        const BBox g = computeBBox(*params.guides);
-        if (!g.empty()) { box.expand(g.min); box.expand(g.max); }
-    }
+    const BBox box = params.frame ? *params.frame : renderFrame(strands, params);
     Image out(params.width, params.height, params.background);
     if (box.empty()) return out;
     const Camera cam = makeCamera(params.view, box, params.width * S, params.height * S, params);
@@ -320,6 +377,7 @@ Image renderStrands(const StrandSet& strands, const RenderParams& params)
         rasterize(r, s, proj, colors, dirs, lit, viewCam, onTop, thickness, params.interrupter, stage);
     };
     double lo = 0, hi = 0, glo = 0, ghi = 0;
+    if (params.head) rasterizeMesh(r, *params.head, cam, params.headColor, params.interrupter);
     drawSet(strands, std::nullopt, false, 1, lo, hi);
     if (params.guides) drawSet(*params.guides, params.guideColor, true, std::max(2, S), glo, ghi);
 
@@ -352,9 +410,7 @@ Image renderSheet(const StrandSet& strands, const RenderParams& params)
     p.width = std::max(1, params.width / 2);
     p.height = std::max(1, params.height / 2);
     if (!p.frame) {
-        BBox box = computeBBox(strands);
-        if (params.guides) { const BBox g = computeBBox(*params.guides); if (!g.empty()) { box.expand(g.min); box.expand(g.max); } }
-        p.frame = box;
+        p.frame = renderFrame(strands, params);
     }
     Image sheet(params.width, params.height, params.background);
     const View views[4] = {View::Front, View::Side, View::Top, View::ThreeQuarter};

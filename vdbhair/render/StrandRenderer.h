@@ -11,6 +11,7 @@
 /// input: rasterization runs in horizontal bands, each drawing its segments in strand order.
 #pragma once
 
+#include <vdbhair/io/MeshFile.h>
 #include <vdbhair/render/Image.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -57,6 +58,10 @@ struct RenderParams
     /// usual z-up convention, Blender's). Yuksel's cyHair models need up (0, 0, 1), facing (0, 1, 0).
     Vec3d up{0.0, 1.0, 0.0};
     std::optional<Vec3d> facing;
+    /// A head (or any occluder) drawn first, as lit grey surfaces the hair is depth-tested
+    /// against, so that front views show the face framed by hair. Included in the default frame.
+    const TriangleMesh* head = nullptr;
+    Vec3f headColor{0.78f, 0.76f, 0.74f};
 };
 
 /// @brief The facing direction used when RenderParams::facing is not set (see there).
