@@ -15,6 +15,30 @@ namespace fastmath {
 /// (std::nearbyint is one unless the target has SSE4.1).
 inline long long roundToInt(double x) { return static_cast<long long>(x + (x >= 0.0 ? 0.5 : -0.5)); }
 
+/// @name The polynomial kernels (fdlibm k_sin.c / k_cos.c on |r| <= π/4, z = r²; Cephes atan.c on
+/// |a| <= 0.66), shared by the branchy and the branchless forms below.
+/// @{
+inline double sinKernel(double r, double z)
+{
+    return r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
+                        z * (2.75573137070700676789e-06 + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
+}
+inline double cosKernel(double z)
+{
+    return 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05 +
+                                   z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11)))));
+}
+inline double atanKernel(double a)
+{
+    const double z = a * a;
+    const double p = (((-8.750608600031904122785e-01 * z - 1.615753718733365076637e+01) * z - 7.500855792314704667340e+01) * z -
+                      1.228866684490136173410e+02) * z - 6.485021904942025371773e+01;
+    const double q = ((((z + 2.485846490142306297962e+01) * z + 1.650270098316988542046e+02) * z + 4.328810604912902668951e+02) * z +
+                      4.853903996359136964868e+02) * z + 1.945506571482613964425e+02;
+    return a + a * z * p / q;
+}
+/// @}
+
 /// sin and cos of @a x (|x| < 1e5; larger arguments fall back to the library).
 inline void sinCos(double x, double& s, double& c)
 {
@@ -29,10 +53,7 @@ inline void sinCos(double x, double& s, double& c)
     const double n = double(q);
     const double r = (x - n * pio2a) - n * pio2b;
     const double z = r * r;
-    const double sr = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
-                      z * (2.75573137070700676789e-06 + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
-    const double cr = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05 +
-                      z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11)))));
+    const double sr = sinKernel(r, z), cr = cosKernel(z);
     switch (int(q & 3)) {
     case 0: s = sr; c = cr; break;
     case 1: s = cr; c = -sr; break;
@@ -56,12 +77,7 @@ inline double atan(double x)
         extra = 0.5 * moreBits;
         a = (a - 1.0) / (a + 1.0);
     }
-    const double z = a * a;
-    const double p = (((-8.750608600031904122785e-01 * z - 1.615753718733365076637e+01) * z - 7.500855792314704667340e+01) * z -
-                      1.228866684490136173410e+02) * z - 6.485021904942025371773e+01;
-    const double q = ((((z + 2.485846490142306297962e+01) * z + 1.650270098316988542046e+02) * z + 4.328810604912902668951e+02) * z +
-                      4.853903996359136964868e+02) * z + 1.945506571482613964425e+02;
-    return sign * (y + (a + a * z * p / q) + extra);
+    return sign * (y + atanKernel(a) + extra);
 }
 
 /// atan2(y, x), the library's quadrant conventions for finite arguments.
@@ -93,10 +109,7 @@ inline void sinCosLane(double x, double& s, double& c)
     const double n = roundLane(x * invPio2);
     const double r = (x - n * pio2a) - n * pio2b;
     const double z = r * r;
-    const double sr = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
-                      z * (2.75573137070700676789e-06 + z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
-    const double cr = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05 +
-                      z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11)))));
+    const double sr = sinKernel(r, z), cr = cosKernel(z);
     // The quadrant n mod 4 as m = n - 4 round(n / 4) in {-2, -1, 0, 1, 2} (±2 both mean 2:
     // round(n / 4) takes either way at the halves), i.e. quadrants 2, 3, 0, 1, 2.
     const double m = n - 4.0 * roundLane(0.25 * n);
@@ -121,12 +134,7 @@ inline double atan2Lane(double y, double x)
     const double reduced = (t - 1.0) / (t + 1.0);
     const double a = red ? reduced : t;
     const double base = red ? M_PI_4 : 0.0, extra = red ? 0.5 * moreBits : 0.0;
-    const double z = a * a;
-    const double p = (((-8.750608600031904122785e-01 * z - 1.615753718733365076637e+01) * z - 7.500855792314704667340e+01) * z -
-                      1.228866684490136173410e+02) * z - 6.485021904942025371773e+01;
-    const double q = ((((z + 2.485846490142306297962e+01) * z + 1.650270098316988542046e+02) * z + 4.328810604912902668951e+02) * z +
-                      4.853903996359136964868e+02) * z + 1.945506571482613964425e+02;
-    const double r0 = base + (a + a * z * p / q) + extra;  // atan t, in [0, π/4]
+    const double r0 = base + atanKernel(a) + extra;  // atan t, in [0, π/4]
     const double r0c = (M_PI_2 - r0) + moreBits;
     const double r1 = swap ? r0c : r0;                     // atan(ay / ax) in [0, π/2]
     const double r1c = (M_PI - r1) + 2.0 * moreBits;
