@@ -153,32 +153,26 @@ int run(int argc, char** argv)
         installInterruptHandlers();
         TerminalProgress progress(verb, common.quiet);
         common.interrupter = &progress;
+        // Errors: one line, after the progress line is erased.
+        auto fail = [&](int code, const std::string& message) {
+            progress.clear();
+            std::cerr << "vdbhair " << verb << ": " << message << "\n";
+            return code;
+        };
         try {
             return c.run();
         } catch (const InterruptedError&) {
-            progress.end();
-            std::cerr << "vdbhair " << verb << ": interrupted; no partial output was written\n";
-            return 130;
+            return fail(130, "interrupted; no partial output was written");
         } catch (const ValueError& e) {
-            progress.end();  // erase the progress line first
-            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
-            return 2;
+            return fail(2, e.what());
         } catch (const Error& e) {
-            progress.end();  // erase the progress line first
-            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
-            return 1;
+            return fail(1, e.what());
         } catch (const openvdb::Exception& e) {
-            progress.end();  // erase the progress line first
-            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
-            return 1;
+            return fail(1, e.what());
         } catch (const std::bad_alloc&) {
-            progress.end();  // erase the progress line first
-            std::cerr << "vdbhair " << verb << ": out of memory\n";
-            return 1;
+            return fail(1, "out of memory");
         } catch (const std::exception& e) {
-            progress.end();  // erase the progress line first
-            std::cerr << "vdbhair " << verb << ": " << e.what() << "\n";
-            return 1;
+            return fail(1, e.what());
         }
     }
     return 2;

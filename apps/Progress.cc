@@ -105,6 +105,7 @@ void TerminalProgress::startWork(const char* name, std::uint64_t total, const ch
 {
     std::lock_guard<std::mutex> lock(mMutex);
     erase();
+    if (mActive) mOuter.push_back({mStage, mUnit, mTotal, mStart, mDone.load()});  // a stage within a stage
     mStage = name ? name : "";
     mUnit = unit ? unit : "";
     mTotal = total;
@@ -116,8 +117,25 @@ void TerminalProgress::startWork(const char* name, std::uint64_t total, const ch
 void TerminalProgress::end()
 {
     std::lock_guard<std::mutex> lock(mMutex);
-    mActive = false;
     erase();
+    mActive = !mOuter.empty();
+    if (!mActive) return;
+    // Back to the enclosing stage, its clock still running.
+    const Saved& o = mOuter.back();
+    mStage = o.stage;
+    mUnit = o.unit;
+    mTotal = o.total;
+    mStart = o.start;
+    mDone = o.done;
+    mOuter.pop_back();
+}
+
+void TerminalProgress::clear()
+{
+    std::lock_guard<std::mutex> lock(mMutex);
+    erase();
+    mOuter.clear();
+    mActive = false;
 }
 
 bool TerminalProgress::wasInterrupted(int percent)

@@ -23,6 +23,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace vdbhair::app {
 
@@ -43,7 +44,10 @@ public:
 
     void start(const char* name = nullptr) override;
     void startWork(const char* name, std::uint64_t total, const char* unit) override;
+    /// Ends the current stage; a stage started within another returns to that one.
     void end() override;
+    /// Ends every stage and erases the line (before an error message).
+    void clear();
     /// Thread-safe and cheap: records the percentage, reports Ctrl-C.
     bool wasInterrupted(int percent = -1) override;
     bool wasInterruptedAt(std::uint64_t done, int percent) override;
@@ -70,6 +74,14 @@ private:
     bool mShown = false;               ///< a line is on the terminal
     bool mQuit = false;
     std::atomic<std::uint64_t> mDone{0};
+    struct Saved
+    {
+        std::string stage, unit;
+        std::uint64_t total;
+        Clock::time_point start;
+        std::uint64_t done;
+    };
+    std::vector<Saved> mOuter;         ///< the stages this one runs within, innermost last
     std::atomic<bool> mActive{false};
     std::condition_variable mWake;
     std::thread mTicker;               ///< redraws every 0.1 s while drawing()

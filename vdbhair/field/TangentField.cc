@@ -418,15 +418,19 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
         auto accumulateChunk = [&](std::size_t c) {
             SegmentAccumulator<std::decay_t<decltype(toIndex)>> acc(chunks[c], toIndex);
             const std::size_t first = nS * c / nChunks, last = nS * (c + 1) / nChunks;
+            std::size_t counted = first;  // strands reported so far end here
             for (std::size_t o = first; o < last; ++o) {
-                if (progress.active() && o > first && ((o - first) & 255) == 0 && progress.add(256)) return;  // strands first..o-1
+                if (progress.active() && o - counted == 256) {  // report every 256 strands
+                    counted = o;
+                    if (progress.add(256)) return;
+                }
                 // The spatial order scatters strands over memory: fetch a later one meanwhile.
                 if (o + 2 < last) prefetchBytes(strands.data(order[o + 2]), strands.size(order[o + 2]) * sizeof(Vec3f));
                 const std::size_t i = order[o];
                 acc.addStrand(strands.data(i), strands.size(i));
             }
             acc.flush();
-            if (last > first) progress.add((last - first) - ((last - first - 1) & ~std::size_t(255)));
+            progress.add(last - counted);
         };
         if (threaded) {
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nChunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {

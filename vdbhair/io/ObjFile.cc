@@ -11,6 +11,34 @@
 
 namespace vdbhair {
 
+namespace {
+
+/// The position on a 'v' line (vertex number @a index, for the error message).
+Vec3f objPosition(TextScanner& text, const std::vector<std::string_view>& tok, std::size_t index, const std::string& where)
+{
+    if (tok.size() < 4) text.fail("a 'v' line needs 3 coordinates, got " + std::to_string(tok.size() - 1));
+    const Vec3f p(text.toFloat(tok[1], "x"), text.toFloat(tok[2], "y"), text.toFloat(tok[3], "z"));
+    checkFinite(p, index, where, "line " + std::to_string(text.line()));
+    return p;
+}
+
+/// The 0-based vertex an index token names ("i", "i/t", "i//n", "i/t/n"; 1-based, negative
+/// counting back from the @a defined vertices so far).
+std::uint32_t objVertexIndex(TextScanner& text, std::string_view t, std::size_t defined)
+{
+    if (const std::size_t slash = t.find('/'); slash != std::string_view::npos) t = t.substr(0, slash);
+    const std::int64_t idx = text.toInt(t, "vertex index");
+    const std::int64_t n = std::int64_t(defined);
+    const std::int64_t resolved = idx > 0 ? idx - 1 : n + idx;
+    if (idx == 0 || resolved < 0 || resolved >= n) {
+        text.fail("vertex index " + std::to_string(idx) + " is out of range: " + std::to_string(n) +
+                  " vertices are defined so far (1-based, negative counts back)");
+    }
+    return std::uint32_t(resolved);
+}
+
+} // namespace
+
 StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readObj(" + path + ")";
@@ -31,10 +59,7 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
         if (tok.empty()) continue;
         const std::string_view key = tok[0];
         if (key == "v") {
-            if (tok.size() < 4) text.fail("a 'v' line needs 3 coordinates, got " + std::to_string(tok.size() - 1));
-            const Vec3f p(text.toFloat(tok[1], "x"), text.toFloat(tok[2], "y"), text.toFloat(tok[3], "z"));
-            checkFinite(p, vertices.size(), where, "line " + std::to_string(text.line()));
-            vertices.push_back(p);
+            vertices.push_back(objPosition(text, tok, vertices.size(), where));
             Vec3f c(0.5f);
             if (tok.size() >= 7) {
                 c = Vec3f(text.toFloat(tok[4], "red"), text.toFloat(tok[5], "green"), text.toFloat(tok[6], "blue"));
@@ -44,18 +69,7 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
         } else if (key == "l") {
             if (tok.size() < 2) text.fail("an 'l' element needs at least one vertex index");
             const std::size_t first = indices.size();
-            for (std::size_t j = 1; j < tok.size(); ++j) {
-                std::string_view t = tok[j];
-                if (const std::size_t slash = t.find('/'); slash != std::string_view::npos) t = t.substr(0, slash);
-                const std::int64_t idx = text.toInt(t, "vertex index");
-                const std::int64_t n = std::int64_t(vertices.size());
-                std::int64_t resolved = idx > 0 ? idx - 1 : n + idx;
-                if (idx == 0 || resolved < 0 || resolved >= n) {
-                    text.fail("vertex index " + std::to_string(idx) + " is out of range: " +
-                              std::to_string(n) + " vertices are defined so far (1-based, negative counts back)");
-                }
-                indices.push_back(std::uint32_t(resolved));
-            }
+            for (std::size_t j = 1; j < tok.size(); ++j) indices.push_back(objVertexIndex(text, tok[j], vertices.size()));
             // A chain of edges: this element starts where the previous one ended.
             const bool continues = strandStart.size() > 1 && indices[first] == indices[first - 1];
             if (continues) {
@@ -128,10 +142,6 @@ void writeObj(const std::string& path, const StrandSet& strands)
     writeFileAtomic(path, out, where);
 }
 
-} // namespace vdbhair
-
-namespace vdbhair {
-
 TriangleMesh readObjMesh(const std::string& path)
 {
     const std::string where = "readObjMesh(" + path + ")";
@@ -143,25 +153,11 @@ TriangleMesh readObjMesh(const std::string& path)
     while (text.nextLine(tok)) {
         if (tok.empty()) continue;
         if (tok[0] == "v") {
-            if (tok.size() < 4) text.fail("a 'v' line needs 3 coordinates, got " + std::to_string(tok.size() - 1));
-            const Vec3f p(text.toFloat(tok[1], "x"), text.toFloat(tok[2], "y"), text.toFloat(tok[3], "z"));
-            checkFinite(p, mesh.vertices.size(), where, "line " + std::to_string(text.line()));
-            mesh.vertices.push_back(p);
+            mesh.vertices.push_back(objPosition(text, tok, mesh.vertices.size(), where));
         } else if (tok[0] == "f") {
             if (tok.size() < 4) text.fail("an 'f' line needs at least 3 vertices, got " + std::to_string(tok.size() - 1));
             face.clear();
-            for (std::size_t j = 1; j < tok.size(); ++j) {
-                std::string_view t = tok[j];
-                if (const std::size_t slash = t.find('/'); slash != std::string_view::npos) t = t.substr(0, slash);
-                const std::int64_t idx = text.toInt(t, "vertex index");
-                const std::int64_t n = std::int64_t(mesh.vertices.size());
-                const std::int64_t resolved = idx > 0 ? idx - 1 : n + idx;
-                if (idx == 0 || resolved < 0 || resolved >= n) {
-                    text.fail("vertex index " + std::to_string(idx) + " is out of range: " + std::to_string(n) +
-                              " vertices are defined before this line");
-                }
-                face.push_back(std::uint32_t(resolved));
-            }
+            for (std::size_t j = 1; j < tok.size(); ++j) face.push_back(objVertexIndex(text, tok[j], mesh.vertices.size()));
             for (std::size_t j = 1; j + 1 < face.size(); ++j) mesh.triangles.push_back({face[0], face[j], face[j + 1]});
         }
     }

@@ -168,6 +168,67 @@ PlyHeader parsePlyHeader(const std::vector<char>& bytes, const std::string& wher
     return PlyHeader{binary, std::move(elements), header.offset(), header.line()};
 }
 
+/// Index of @a e's property @a name (a scalar, or a list with @a list), or -1.
+int findProperty(const Element* e, const char* name, bool list = false)
+{
+    if (!e) return -1;
+    for (std::size_t i = 0; i < e->props.size(); ++i) {
+        if (e->props[i].name == name && e->props[i].isList == list) return int(i);
+    }
+    return -1;
+}
+
+/// @brief Read the body after @a hdr, element by element and item by item, bounds-checked before
+/// anything is allocated. @a onElement(e) runs before an element's items; @a onItem(e, n, values,
+/// list, src) after each item, with its scalar property values (by property index) and, for the
+/// list property @a listProp of @a listElement, the list's items (other lists are skipped).
+template<typename ElementFn, typename ItemFn>
+void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std::string& where, const Element* listElement,
+                 int listProp, ElementFn&& onElement, ItemFn&& onItem)
+{
+    ByteReader bin(bytes, where);
+    TextScanner text(bytes, where, hdr.bodyOffset);
+    text.setLine(hdr.bodyLine);  // body line numbers continue the header's
+    bin.seek(hdr.bodyOffset, "end_header");
+    ValueSource src(hdr.binary ? &bin : nullptr, hdr.binary ? nullptr : &text);
+    std::vector<double> values, list;
+    for (const Element& e : hdr.elements) {
+        // Each instance needs at least one byte per property (binary) or two (ascii "0 ").
+        std::size_t minBytes = 0;
+        for (const Property& p : e.props) minBytes += hdr.binary ? (p.isList ? plySize(p.countType) : plySize(p.type)) : 2;
+        if (minBytes && e.count > src.remainingBytes() / minBytes) {
+            src.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
+                     std::to_string(minBytes) + " bytes but only " + std::to_string(src.remainingBytes()) + " bytes remain");
+        }
+        onElement(e);
+        values.assign(e.props.size(), 0.0);
+        for (std::uint64_t n = 0; n < e.count; ++n) {
+            for (std::size_t k = 0; k < e.props.size(); ++k) {
+                const Property& p = e.props[k];
+                if (!p.isList) {
+                    values[k] = src.read(p.type, p.name.c_str());
+                    continue;
+                }
+                const double c = src.read(p.countType, "list count");
+                if (c < 0) src.fail("list '" + p.name + "' has a negative count");
+                const std::uint64_t cnt = std::uint64_t(c);
+                // Binary lists are checked against the bytes left; ascii items fail one by one at
+                // the end of the file (and only the kept list grows, item by item).
+                if (hdr.binary && cnt > src.remainingBytes() / plySize(p.type)) {
+                    src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
+                }
+                const bool keep = &e == listElement && int(k) == listProp;
+                if (keep) list.clear();
+                for (std::uint64_t j = 0; j < cnt; ++j) {
+                    const double v = src.read(p.type, "list item");
+                    if (keep) list.push_back(v);
+                }
+            }
+            onItem(e, n, values, list, src);
+        }
+    }
+}
+
 } // namespace
 
 StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
@@ -176,82 +237,40 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
 
     const PlyHeader hdr = parsePlyHeader(bytes, where);
-    const bool binary = hdr.binary;
-    const std::vector<Element>& elements = hdr.elements;
-
     const Element* vertexEl = nullptr;
     const Element* strandEl = nullptr;
-    for (const Element& e : elements) {
+    for (const Element& e : hdr.elements) {
         if (e.name == "vertex") vertexEl = &e;
         if (e.name == "strand") strandEl = &e;
     }
-    auto findProp = [](const Element* e, const char* name) -> int {
-        if (!e) return -1;
-        for (std::size_t i = 0; i < e->props.size(); ++i) {
-            if (e->props[i].name == name && !e->props[i].isList) return int(i);
-        }
-        return -1;
-    };
     if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
-    const int ix = findProp(vertexEl, "x"), iy = findProp(vertexEl, "y"), iz = findProp(vertexEl, "z");
+    const int ix = findProperty(vertexEl, "x"), iy = findProperty(vertexEl, "y"), iz = findProperty(vertexEl, "z");
     if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
     if (!strandEl) throw FormatError(where + ": the header has no 'strand' element (hairutil layout: element strand with property nsegs)");
-    const int iseg = findProp(strandEl, "nsegs");
+    const int iseg = findProperty(strandEl, "nsegs");
     if (iseg < 0) throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the 'strand' element needs an integer property 'nsegs'");
-    const int ir = findProp(vertexEl, "red"), ig = findProp(vertexEl, "green"), ib = findProp(vertexEl, "blue");
+    const int ir = findProperty(vertexEl, "red"), ig = findProperty(vertexEl, "green"), ib = findProperty(vertexEl, "blue");
     const bool hasColor = ir >= 0 && ig >= 0 && ib >= 0;
     const float colorScale = hasColor && vertexEl->props[std::size_t(ir)].type == PlyType::UInt8 ? 1.f / 255.f : 1.f;
 
     // Body
-    ByteReader bin(bytes, where);
-    TextScanner text(bytes, where, hdr.bodyOffset);
-    text.setLine(hdr.bodyLine);  // body line numbers continue the header's
-    bin.seek(hdr.bodyOffset, "end_header");
-    ValueSource src(binary ? &bin : nullptr, binary ? nullptr : &text);
-
     std::vector<Vec3f> positions, colors;
     std::vector<std::uint64_t> counts;
-    std::vector<double> values;
-    for (const Element& e : elements) {
-        // Each instance needs at least one byte per property (binary) or two (ascii "0 ").
-        std::size_t minBytes = 0;
-        for (const Property& p : e.props) minBytes += binary ? (p.isList ? plySize(p.countType) : plySize(p.type)) : 2;
-        if (minBytes && e.count > src.remainingBytes() / minBytes) {
-            src.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
-                     std::to_string(minBytes) + " bytes but only " + std::to_string(src.remainingBytes()) + " bytes remain");
+    readPlyBody(bytes, hdr, where, nullptr, -1, [&](const Element& e) {
+        if (&e == vertexEl) { positions.reserve(e.count); if (hasColor) colors.reserve(e.count); }
+        if (&e == strandEl) counts.reserve(e.count);
+    }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
+        if (&e == vertexEl) {
+            const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
+            checkFinite(pos, positions.size(), where, src.location());
+            positions.push_back(pos);
+            if (hasColor) colors.emplace_back(float(values[std::size_t(ir)]) * colorScale, float(values[std::size_t(ig)]) * colorScale, float(values[std::size_t(ib)]) * colorScale);
+        } else if (&e == strandEl) {
+            const double s = values[std::size_t(iseg)];
+            if (s < 0 || s != std::floor(s)) src.fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
+            counts.push_back(std::uint64_t(s) + 1);
         }
-        const bool isVertex = (&e == vertexEl), isStrand = (&e == strandEl);
-        if (isVertex) { positions.reserve(e.count); if (hasColor) colors.reserve(e.count); }
-        if (isStrand) counts.reserve(e.count);
-        values.assign(e.props.size(), 0.0);
-        for (std::uint64_t n = 0; n < e.count; ++n) {
-            for (std::size_t k = 0; k < e.props.size(); ++k) {
-                const Property& p = e.props[k];
-                if (p.isList) {
-                    const double c = src.read(p.countType, "list count");
-                    if (c < 0) src.fail("list '" + p.name + "' has a negative count");
-                    const std::uint64_t cnt = std::uint64_t(c);
-                    // Nothing is allocated from cnt; ascii items fail one by one at the end of the file.
-                    if (binary && cnt > src.remainingBytes() / plySize(p.type)) {
-                        src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
-                    }
-                    for (std::uint64_t j = 0; j < cnt; ++j) src.read(p.type, "list item");
-                } else {
-                    values[k] = src.read(p.type, p.name.c_str());
-                }
-            }
-            if (isVertex) {
-                const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
-                checkFinite(pos, positions.size(), where, src.location());
-                positions.push_back(pos);
-                if (hasColor) colors.emplace_back(float(values[std::size_t(ir)]) * colorScale, float(values[std::size_t(ig)]) * colorScale, float(values[std::size_t(ib)]) * colorScale);
-            } else if (isStrand) {
-                const double s = values[std::size_t(iseg)];
-                if (s < 0 || s != std::floor(s)) src.fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
-                counts.push_back(std::uint64_t(s) + 1);
-            }
-        }
-    }
+    });
     std::uint64_t sum = 0;
     for (std::uint64_t c : counts) sum += c;
     if (sum != positions.size()) {
@@ -336,10 +355,6 @@ void writePly(const std::string& path, const StrandSet& strands, PlyEncoding enc
     writeFileAtomic(path, out, where);
 }
 
-} // namespace vdbhair
-
-namespace vdbhair {
-
 TriangleMesh readPlyMesh(const std::string& path)
 {
     const std::string where = "readPlyMesh(" + path + ")";
@@ -353,78 +368,32 @@ TriangleMesh readPlyMesh(const std::string& path)
     }
     if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
     if (!faceEl) throw FormatError(where + ": the header has no 'face' element");
-    int ix = -1, iy = -1, iz = -1, iface = -1;
-    for (std::size_t i = 0; i < vertexEl->props.size(); ++i) {
-        const Property& p = vertexEl->props[i];
-        if (p.isList) continue;
-        if (p.name == "x") ix = int(i);
-        if (p.name == "y") iy = int(i);
-        if (p.name == "z") iz = int(i);
-    }
-    for (std::size_t i = 0; i < faceEl->props.size(); ++i) {
-        const Property& p = faceEl->props[i];
-        if (p.isList && (p.name == "vertex_indices" || p.name == "vertex_index")) iface = int(i);
-    }
+    const int ix = findProperty(vertexEl, "x"), iy = findProperty(vertexEl, "y"), iz = findProperty(vertexEl, "z");
+    const int iface = std::max(findProperty(faceEl, "vertex_indices", true), findProperty(faceEl, "vertex_index", true));
     if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
     if (iface < 0) throw FormatError(where + ": line " + std::to_string(faceEl->line) + ": the 'face' element needs a list 'vertex_indices'");
 
-    ByteReader bin(bytes, where);
-    TextScanner text(bytes, where, hdr.bodyOffset);
-    text.setLine(hdr.bodyLine);
-    bin.seek(hdr.bodyOffset, "end_header");
-    ValueSource src(hdr.binary ? &bin : nullptr, hdr.binary ? nullptr : &text);
-
     TriangleMesh mesh;
-    std::vector<double> values;
-    std::vector<std::uint32_t> face;
-    for (const Element& e : hdr.elements) {
-        std::size_t minBytes = 0;
-        for (const Property& p : e.props) minBytes += hdr.binary ? (p.isList ? plySize(p.countType) : plySize(p.type)) : 2;
-        if (minBytes && e.count > src.remainingBytes() / minBytes) {
-            src.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
-                     std::to_string(minBytes) + " bytes but only " + std::to_string(src.remainingBytes()) + " bytes remain");
-        }
-        const bool isVertex = &e == vertexEl, isFace = &e == faceEl;
-        if (isVertex) mesh.vertices.reserve(e.count);
-        if (isFace) mesh.triangles.reserve(e.count);
-        values.assign(e.props.size(), 0.0);
-        for (std::uint64_t n = 0; n < e.count; ++n) {
-            for (std::size_t k = 0; k < e.props.size(); ++k) {
-                const Property& p = e.props[k];
-                if (!p.isList) {
-                    values[k] = src.read(p.type, p.name.c_str());
-                    continue;
-                }
-                const double c = src.read(p.countType, "list count");
-                if (c < 0) src.fail("list '" + p.name + "' has a negative count");
-                const std::uint64_t cnt = std::uint64_t(c);
-                // Nothing is allocated from cnt (ascii items fail one by one at the end of the file).
-                if (hdr.binary && cnt > src.remainingBytes() / plySize(p.type)) {
-                    src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
-                }
-                const bool wanted = isFace && int(k) == iface;
-                if (wanted) face.clear();
-                for (std::uint64_t j = 0; j < cnt; ++j) {
-                    const double idx = src.read(p.type, "vertex index");
-                    if (!wanted) continue;
-                    if (!(idx >= 0.0) || idx >= double(mesh.vertices.size()) || idx != std::floor(idx)) {
-                        src.fail("face " + std::to_string(n) + " names vertex " + std::to_string(idx) + " of " +
-                                 std::to_string(mesh.vertices.size()));
-                    }
-                    face.push_back(std::uint32_t(idx));
-                }
-                if (wanted) {
-                    if (face.size() < 3) src.fail("face " + std::to_string(n) + " has " + std::to_string(face.size()) + " vertices; a face needs 3");
-                    for (std::size_t j = 1; j + 1 < face.size(); ++j) mesh.triangles.push_back({face[0], face[j], face[j + 1]});
+    readPlyBody(bytes, hdr, where, faceEl, iface, [&](const Element& e) {
+        if (&e == vertexEl) mesh.vertices.reserve(e.count);
+        if (&e == faceEl) mesh.triangles.reserve(e.count);
+    }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>& face, ValueSource& src) {
+        if (&e == vertexEl) {
+            const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
+            checkFinite(pos, mesh.vertices.size(), where, src.location());
+            mesh.vertices.push_back(pos);
+        } else if (&e == faceEl) {
+            for (double idx : face) {
+                if (!(idx >= 0.0) || idx >= double(mesh.vertices.size()) || idx != std::floor(idx)) {
+                    src.fail("face " + std::to_string(n) + " names vertex " + std::to_string(idx) + " of " + std::to_string(mesh.vertices.size()));
                 }
             }
-            if (isVertex) {
-                const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
-                checkFinite(pos, mesh.vertices.size(), where, src.location());
-                mesh.vertices.push_back(pos);
+            if (face.size() < 3) src.fail("face " + std::to_string(n) + " has " + std::to_string(face.size()) + " vertices; a face needs 3");
+            for (std::size_t j = 1; j + 1 < face.size(); ++j) {
+                mesh.triangles.push_back({std::uint32_t(face[0]), std::uint32_t(face[j]), std::uint32_t(face[j + 1])});
             }
         }
-    }
+    });
     if (mesh.triangles.empty()) throw FormatError(where + ": the file has no faces");
     return mesh;
 }
