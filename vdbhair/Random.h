@@ -26,13 +26,7 @@ public:
     }
     /// Uniform in [0, 1).
     double uniform() { return double(next() >> 11) * 0x1.0p-53; }
-    /// Standard normal (Box–Muller).
-    double normal()
-    {
-        const double u1 = 1.0 - uniform(), u2 = uniform();
-        return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-    }
-    /// Two independent standard normals from one Box–Muller draw (half the cost of two normal()).
+    /// Two independent standard normals from one Box–Muller draw.
     void normalPair(double& a, double& b)
     {
         const double u1 = 1.0 - uniform(), u2 = uniform();

@@ -60,6 +60,9 @@ struct Camera
     bool perspective = false;
     double scale = 1.0, cx = 0.0, cy = 0.0;  // image = centre + scale * projected
 
+    /// The key light: above, a little to the right of and towards the viewer.
+    Vec3d light() const { return (up * 0.8 + right * 0.3 - forward * 0.5).unit(); }
+
     Vec3d project(const Vec3d& p) const
     {
         const Vec3d d = p - eye;
@@ -209,7 +212,7 @@ void rasterize(Raster& r, const StrandSet& s, const std::vector<Vec3d>& proj, co
                openvdb::util::NullInterrupter* interrupter, const std::string& stage)
 {
     const int bands = 32, bandRows = (r.h + bands - 1) / bands;
-    const Vec3d light = (cam.up * 0.8 + cam.right * 0.3 - cam.forward * 0.5).unit();
+    const Vec3d light = cam.light();
     const Vec3d eye = -cam.forward;
     // Bin segments by band (in segment order, so each band draws in a fixed order).
     std::vector<std::vector<std::uint32_t>> bins;
@@ -266,7 +269,7 @@ void rasterizeMesh(Raster& r, const TriangleMesh& mesh, const Camera& cam, const
 {
     std::vector<Vec3d> proj(mesh.vertices.size());
     for (std::size_t v = 0; v < proj.size(); ++v) proj[v] = cam.project(Vec3d(mesh.vertices[v]));
-    const Vec3d light = (cam.up * 0.8 + cam.right * 0.3 - cam.forward * 0.5).unit();
+    const Vec3d light = cam.light();
     const int bands = 32, bandRows = (r.h + bands - 1) / bands;
     ProgressCounter progress(interrupter, "rendering the head", std::uint64_t(bands), "bands");
     tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& br) {
