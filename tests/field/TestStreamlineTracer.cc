@@ -9,6 +9,9 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <cstring>
+
 using namespace vdbhair;
 using Catch::Matchers::Contains;
 
@@ -188,6 +191,89 @@ TEST_CASE("retraceStrands: bitwise identical with 1 and 2 threads", "[field]")
     }
     REQUIRE(one.offsets == two.offsets);
     REQUIRE(std::memcmp(one.positions.data(), two.positions.data(), one.positions.size() * sizeof(Vec3f)) == 0);
+}
+
+TEST_CASE("retraceStrands: strands stopping early all through the set keep their own prefixes", "[field]")
+{
+    // A field of straight strands along +x over x in [0, 10], on a 30 x 20 lattice in (y, z).
+    StrandSet fieldStrands;
+    for (int a = 0; a < 30; ++a) {
+        for (int b = 0; b < 20; ++b) {
+            fieldStrands.addStrand(std::vector<Vec3f>{Vec3f(0.f, 0.3f * a, 0.3f * b), Vec3f(10.f, 0.3f * a, 0.3f * b)});
+        }
+    }
+    FieldParams p;
+    p.voxelSize = 0.5;
+    const TangentField f = estimateTangentField(fieldStrands, p);
+    // Probes from x = 0: every third one is longer than the field and stops where it leaves it,
+    // so the kept prefixes shift every later strand, in both halves of the set (which a retrace
+    // on two threads compacts separately). Vertex counts vary so that the shifts do too.
+    StrandSet probes;
+    for (int k = 0; k < 3000; ++k) {
+        const int lattice = k % 600;
+        const float y = 0.3f * float(lattice / 20), z = 0.3f * float(lattice % 20);
+        const float length = k % 3 == 0 ? 14.f : 8.f;
+        const int n = 5 + (k * 7) % 31;
+        std::vector<Vec3f> pts;
+        for (int i = 0; i < n; ++i) pts.emplace_back(length * float(i) / float(n - 1), y, z);
+        probes.addStrand(pts);
+    }
+    TraceParams tp;
+    tp.margin = 0;
+    StrandSet one, two;
+    TraceStats stats;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        one = retraceStrands(probes, *f.tangent, tp, &stats);
+    }
+    REQUIRE(stats.leftField == 1000);
+    REQUIRE(stats.fullLength == 2000);
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        two = retraceStrands(probes, *f.tangent, tp);
+    }
+    REQUIRE(one.offsets == two.offsets);
+    REQUIRE(one.positions == two.positions);
+    // Each strand is what a retrace of it alone gives (no compaction there).
+    for (std::size_t k = 0; k < probes.numStrands(); k += 7) {
+        CAPTURE(k);
+        StrandSet alone;
+        alone.addStrand(probes.data(k), probes.size(k));
+        const StrandSet r = retraceStrands(alone, *f.tangent, tp);
+        REQUIRE(two.size(k) == r.size(0));
+        REQUIRE(std::equal(r.positions.begin(), r.positions.end(), two.positions.begin() + std::ptrdiff_t(two.begin(k))));
+        if (k % 3 == 0) {
+            REQUIRE(r.size(0) < probes.size(k));
+            REQUIRE(r.tip(0).x() == Approx(10.25).margin(0.3));  // where the field ends
+        } else {
+            REQUIRE(r.size(0) == probes.size(k));
+            REQUIRE(r.tip(0).x() == Approx(8.0).margin(1e-4));
+        }
+    }
+}
+
+TEST_CASE("retraceStrandsInto: the same strands as retraceStrands, in the output's own storage", "[field]")
+{
+    const StrandSet circles = concentricCircles(2.0, 0.3, 10, 4, 4.0);
+    FieldParams p;
+    p.voxelSize = 0.3;
+    const TangentField f = estimateTangentField(circles, p);
+    const StrandSet expected = retraceStrands(circles, *f.tangent, TraceParams{});
+    StrandSet out;
+    out.addStrand(std::vector<Vec3f>{Vec3f(1.f), Vec3f(2.f)});  // replaced, whatever it held
+    out.thickness = {0.5f, 0.5f};
+    retraceStrandsInto(circles, *f.tangent, TraceParams{}, out);
+    REQUIRE(out.offsets == expected.offsets);
+    REQUIRE(out.positions == expected.positions);
+    REQUIRE(out.thickness.empty());
+    // Again into the same set: its storage is reused, not reallocated.
+    const Vec3f* storage = out.positions.data();
+    retraceStrandsInto(circles, *f.tangent, TraceParams{}, out);
+    REQUIRE(out.positions.data() == storage);
+    REQUIRE(out.positions == expected.positions);
+    // Never into the input itself.
+    StrandSet same = circles;
+    REQUIRE_THROWS_WITH(retraceStrandsInto(same, *f.tangent, TraceParams{}, same), Contains("must be another StrandSet"));
 }
 
 TEST_CASE("retraceStrands: bad parameters and grids", "[field]")

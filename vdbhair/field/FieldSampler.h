@@ -116,17 +116,23 @@ public:
     const TreeT& tree() const { return mTree; }
 
     /// @brief Trilinear blend of the cell at @a c with fractions (fx, fy, fz) (see FieldSampler):
-    /// corners at +0, +1 (z), +N (y), +N*N (x), three nested lerps, four lanes at a time.
-    static Float4 blend(const Float4* c, float fx, float fy, float fz)
+    /// corners at +0, +1 (z), +N (y), +N*N (x). The two corners of a z pair are adjacent, so
+    /// each pair is one eight-float value: lerp the pairs in x, then y (eight lanes at a time,
+    /// one AVX operation each where the caller is compiled for it), then the pair's halves in z.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // Float8 values stay inside this inlined function (Simd.h)
+    __attribute__((always_inline)) static Float4 blend(const Float4* c, float fx, float fy, float fz)
     {
-        const Float4 z00 = c[0] + (c[1] - c[0]) * fz;
-        const Float4 z01 = c[N] + (c[N + 1] - c[N]) * fz;
-        const Float4 z10 = c[N * N] + (c[N * N + 1] - c[N * N]) * fz;
-        const Float4 z11 = c[N * N + N] + (c[N * N + N + 1] - c[N * N + N]) * fz;
-        const Float4 y0 = z00 + (z01 - z00) * fy;
-        const Float4 y1 = z10 + (z11 - z10) * fy;
-        return y0 + (y1 - y0) * fx;
+        const Float8 c00 = loadPair(c), c01 = loadPair(c + N), c10 = loadPair(c + N * N), c11 = loadPair(c + N * N + N);
+        // (Scalar operands, not splat8(): GCC lowers a vector built in a default-target inline
+        // function for SSE before inlining it into the AVX2 clone, but broadcasts a scalar operand.)
+        const Float8 y0 = c00 + (c10 - c00) * fx;  // corners (y0, z0|z1), lerped in x
+        const Float8 y1 = c01 + (c11 - c01) * fx;
+        const Float8 z = y0 + (y1 - y0) * fy;      // (z0 | z1)
+        const Float4 z0 = lowHalf(z), z1 = highHalf(z);
+        return z0 + (z1 - z0) * fz;
     }
+#pragma GCC diagnostic pop
 
 private:
     /// @brief Leaf coordinates to brick indices. A dense table over the leaves' bounding box

@@ -34,11 +34,11 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
     RefineResult result;
     result.voxelSize = fp.voxelSize;
     result.fields.resize(std::size_t(params.levels));
-    StrandSet current = strands;
+    StrandSet current;  // the last level's strands (the input's before the first level)
     for (int level = params.levels - 1; level >= 0; --level) {
         FieldParams lp = fp;
         lp.voxelSize = fp.voxelSize * double(1 << level);
-        TangentField f = estimateTangentField(current, lp, threaded, interrupter);
+        TangentField f = estimateTangentField(level == params.levels - 1 ? strands : current, lp, threaded, interrupter);
         f.tangent->setName(tangentGridName(level, params.levels));
         f.density->setName(densityGridName(level, params.levels));
         for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(f.tangent.get()), static_cast<openvdb::GridBase*>(f.density.get())}) {
@@ -46,8 +46,10 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
             g->insertMeta("vdbhair:levels", openvdb::Int32Metadata(params.levels));
         }
         // Every level retraces the input strands' roots for the input's lengths and vertex
-        // arc lengths, so that early stops at one level do not shorten the next.
-        current = retraceStrands(strands, *f.tangent, params.trace, &result.stats, nullptr, threaded, interrupter);
+        // arc lengths, so that early stops at one level do not shorten the next. The last
+        // level's strands are not needed once its field is estimated: their storage takes the
+        // new ones (retraceStrandsInto).
+        retraceStrandsInto(strands, *f.tangent, params.trace, current, &result.stats, nullptr, threaded, interrupter);
         result.fields[std::size_t(level)] = std::move(f);
     }
     result.strands = std::move(current);

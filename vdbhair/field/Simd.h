@@ -14,6 +14,40 @@ namespace vdbhair {
 typedef float Float4 __attribute__((vector_size(16)));
 /// Four ints; also the lane masks that comparisons of Float4 values give (-1 true, 0 false).
 typedef int Int4 __attribute__((vector_size(16)));
+/// Four unsigned ints (unsigned comparisons).
+typedef unsigned UInt4 __attribute__((vector_size(16)));
+/// Eight floats: two Float4 side by side. One AVX register in code compiled for AVX (the
+/// tracer's AVX2 clone), two SSE registers elsewhere, with the same results either way.
+typedef float Float8 __attribute__((vector_size(32)));
+
+// Float8 helpers are always inlined, so passing one by value never crosses a call: GCC's note
+// that the SSE and AVX calling conventions differ for 32-byte vectors does not apply.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+/// @brief The two Float4 at @a p (p[0] in the low half): one unaligned load.
+__attribute__((always_inline)) inline Float8 loadPair(const Float4* p)
+{
+    Float8 v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+}
+
+/// @brief The low (p[0] of loadPair) and high halves of @a v.
+__attribute__((always_inline)) inline Float4 lowHalf(const Float8& v)
+{
+    Float4 r;
+    __builtin_memcpy(&r, &v, sizeof r);
+    return r;
+}
+__attribute__((always_inline)) inline Float4 highHalf(const Float8& v)
+{
+    Float4 r;
+    __builtin_memcpy(&r, reinterpret_cast<const char*>(&v) + sizeof r, sizeof r);
+    return r;
+}
+
+#pragma GCC diagnostic pop
 
 /// @brief Lanes (A, B, C, D) of the eight lanes of @a a (0-3) and @a b (4-7).
 template<int A, int B, int C, int D>
@@ -52,6 +86,13 @@ inline Float4 select(const Int4& mask, const Float4& a, const Float4& b)
 {
     return (Float4)((mask & (Int4)a) | (~mask & (Int4)b));
 }
+
+/// @brief The larger of @a a and @a b, lane by lane, as unsigned ints.
+inline UInt4 maxU(const UInt4& a, const UInt4& b) { return a > b ? a : b; }
+
+/// @brief Store @a v at @a p (16 bytes, aligned).
+inline void storeFloat4(float* p, const Float4& v) { __builtin_memcpy(p, &v, sizeof v); }
+inline void storeInt4(int* p, const Int4& v) { __builtin_memcpy(p, &v, sizeof v); }
 
 /// @brief Whether any lane of the mask is set.
 inline bool any(const Int4& mask)

@@ -219,6 +219,11 @@ struct RetraceJob
 /// lanes in three Float4): only the brick lookups and blends are per lane; normalizing, testing,
 /// stepping and storing the step points are done for four lanes at once. Step points are kept
 /// relative to the strand's first brick and become world positions in finish().
+///
+/// The whole loop — steps, strand starts (arc lengths) and write-outs — is compiled twice, for
+/// the x86-64 baseline and for AVX2, and run() picks by the processor: in the AVX2 clone a blend
+/// is nine 8-float operations on pairs of corners instead of eighteen 4-float ones (FieldSampler.h).
+/// Neither clone contracts to FMA (ISO C++ mode), so both give the same floats.
 template<typename TreeT>
 class LaneTracer
 {
@@ -245,8 +250,23 @@ public:
         for (int l = 0; l < kLanes; ++l) idle(l);
     }
 
-    /// Trace strands until the job has none left.
+    /// Trace strands until the job has none left: with the AVX2 clone of the loop where the
+    /// processor has AVX2 (the blends then take half the operations; no FMA, so the results are
+    /// the same as the SSE loop's).
     void run()
+    {
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+        if (__builtin_cpu_supports("avx2")) return runAvx2();
+#endif
+        runLoop();
+    }
+
+private:
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+    __attribute__((target("avx2"))) void runAvx2() { runLoop(); }
+#endif
+
+    __attribute__((always_inline)) void runLoop()
     {
         for (int l = 0; l < kLanes; ++l) start(l);
         while (mBusy > 0) {
@@ -259,7 +279,6 @@ public:
         }
     }
 
-private:
     /// Four lanes' fast-path state, one SIMD lane each.
     struct Group
     {
@@ -300,18 +319,24 @@ private:
 
     /// @brief One forward Euler step of each lane of @a G that can take it without help.
     /// @return the lanes that did not step (bits 0-3): done, idle, or needing handle().
-    unsigned fastRound(Group& G)
+    __attribute__((always_inline)) unsigned fastRound(Group& G)
     {
         // The sampling cells and the fractions within them: offsets are >= 0, so truncation floors.
         const Float4 cx = __builtin_convertvector(__builtin_convertvector(G.lx, Int4), Float4);
         const Float4 cy = __builtin_convertvector(__builtin_convertvector(G.ly, Int4), Float4);
         const Float4 cz = __builtin_convertvector(__builtin_convertvector(G.lz, Int4), Float4);
-        const Float4 fx = G.lx - cx, fy = G.ly - cy, fz = G.lz - cz;
-        const Int4 cell = __builtin_convertvector(cx * float(N * N) + cy * float(N) + cz, Int4);  // exact: small integers
-        Float4 vx = Bricks::blend(G.brick[0]->cell + cell[0], fx[0], fy[0], fz[0]);
-        Float4 vy = Bricks::blend(G.brick[1]->cell + cell[1], fx[1], fy[1], fz[1]);
-        Float4 vz = Bricks::blend(G.brick[2]->cell + cell[2], fx[2], fy[2], fz[2]);
-        Float4 vw = Bricks::blend(G.brick[3]->cell + cell[3], fx[3], fy[3], fz[3]);
+        // Each lane's blend takes its fractions from memory: the compiler broadcasts them with
+        // one load each rather than shuffling lanes out of a register.
+        alignas(16) float f[3][4];
+        alignas(16) int cell[4];
+        storeFloat4(f[0], G.lx - cx);
+        storeFloat4(f[1], G.ly - cy);
+        storeFloat4(f[2], G.lz - cz);
+        storeInt4(cell, __builtin_convertvector(cx * float(N * N) + cy * float(N) + cz, Int4));  // exact: small integers
+        Float4 vx = Bricks::blend(G.brick[0]->cell + cell[0], f[0][0], f[1][0], f[2][0]);
+        Float4 vy = Bricks::blend(G.brick[1]->cell + cell[1], f[0][1], f[1][1], f[2][1]);
+        Float4 vz = Bricks::blend(G.brick[2]->cell + cell[2], f[0][2], f[1][2], f[2][2]);
+        Float4 vw = Bricks::blend(G.brick[3]->cell + cell[3], f[0][3], f[1][3], f[2][3]);
         transpose(vx, vy, vz, vw);  // now x, y, z, w of the four lanes
         // Vanishing (|v| <= threshold · w) or outside (w = 0: no active corner, and then v = 0
         // too, as inactive corners hold zero vectors) fail the one test len2 > threshold² w².
@@ -333,8 +358,11 @@ private:
         }
         // Out of the brick (or not a number, from a field holding infinities): move the base
         // (rare, and well predicted).
-        const Float4 zero = {0.f, 0.f, 0.f, 0.f}, eight = {8.f, 8.f, 8.f, 8.f};
-        const Int4 out = ~((G.lx >= zero) & (G.lx < eight) & (G.ly >= zero) & (G.ly < eight) & (G.lz >= zero) & (G.lz < eight));
+        // A float is in [0, 8) exactly when its bits, read as unsigned, are below those of 8.0f
+        // (negative floats have the sign bit, NaNs the all-ones exponent): one test for all three.
+        const UInt4 bx = (UInt4)G.lx, by = (UInt4)G.ly, bz = (UInt4)G.lz;
+        const UInt4 bmax = maxU(maxU(bx, by), bz);
+        const Int4 out = (Int4)(bmax >= UInt4{kBitsOf8, kBitsOf8, kBitsOf8, kBitsOf8});
         if (__builtin_expect(any(out), 0)) {
             for (int e = 0; e < 4; ++e) if (out[e]) rebase(4 * int(&G - mGroups) + e);
         }
@@ -354,7 +382,7 @@ private:
     }
 
     /// A flagged lane: finish its strand, let it take its shortened last step fast, or step slowly.
-    void handle(int l)
+    __attribute__((always_inline)) void handle(int l)
     {
         Lane& L = mLanes[l];
         if (!L.busy) return;
@@ -374,23 +402,32 @@ private:
     }
 
     /// Move lane l's base to the brick its offset has entered.
-    void rebase(int l)
+    __attribute__((always_inline)) void rebase(int l)
     {
         Lane& L = mLanes[l];
         Group& G = group(l);
         const int e = l & 3;
         const float local[3] = {G.lx[e], G.ly[e], G.lz[e]};
         int b[3];
-        bool far = false;
-        for (int a = 0; a < 3; ++a) {
-            if (!(std::abs(double(local[a])) < kFar)) {  // a huge step, or NaN
-                far = true;
-                break;
+        // The common case: the step left the brick by less than a brick (local in (-8, 16)):
+        // the base moves by -8, 0 or +8 on each axis, and the offsets by exact small integers.
+        if (std::abs(local[0] - 4.f) < 12.f && std::abs(local[1] - 4.f) < 12.f && std::abs(local[2] - 4.f) < 12.f) {
+            for (int a = 0; a < 3; ++a) b[a] = L.base[a] + (local[a] < 0.f ? -8 : local[a] >= 8.f ? 8 : 0);
+        } else {
+            bool far = false;
+            for (int a = 0; a < 3; ++a) {
+                if (!(std::abs(double(local[a])) < kFar)) {  // a huge step, or NaN
+                    far = true;
+                    break;
+                }
+                b[a] = L.base[a] + 8 * floorToInt(double(local[a]) * 0.125);
             }
-            b[a] = L.base[a] + 8 * floorToInt(double(local[a]) * 0.125);
-            far = far || !(std::abs(double(b[a])) < kFar);
+            if (far) {
+                goFar(l, worldOf(l));
+                return;
+            }
         }
-        if (far) {
+        if (!(std::abs(double(b[0])) < kFar && std::abs(double(b[1])) < kFar && std::abs(double(b[2])) < kFar)) {
             goFar(l, worldOf(l));
             return;
         }
@@ -401,7 +438,7 @@ private:
     }
 
     /// Set lane l's base (and its brick and offset from the origin).
-    void setBase(int l, const int* b)
+    __attribute__((always_inline)) void setBase(int l, const int* b)
     {
         Lane& L = mLanes[l];
         Group& G = group(l);
@@ -441,7 +478,7 @@ private:
 
     /// @brief Put lane l at world position @a q after step k (a new strand's root when k == 0):
     /// its base, offset and brick, and step point k.
-    void place(int l, const Vec3d& q)
+    __attribute__((always_inline)) void place(int l, const Vec3d& q)
     {
         Lane& L = mLanes[l];
         Group& G = group(l);
@@ -533,7 +570,7 @@ private:
 
     /// @brief Start the next strand in lane l, or leave it idle if there is none (or the
     /// retrace was interrupted).
-    void start(int l)
+    __attribute__((always_inline)) void start(int l)
     {
         RetraceJob<TreeT>& job = mJob;
         Lane& L = mLanes[l];
@@ -576,12 +613,41 @@ private:
     }
 
     /// @brief Arc lengths of a strand's vertices (segment lengths in float, summed in double).
+    /// Four segments at a time: the twelve floats of points j..j+3 minus those of j-1..j+2 are
+    /// the four segments' components, regrouped by shuffles into x, y and z; each length is the
+    /// same float operations as one segment at a time ((dx² + dy²) + dz², then its square root),
+    /// and the sum runs in the same order, so the result is the scalar loop's, bit for bit.
     /// @return the strand's length.
-    static double arcLengthsF(const Vec3f* v, std::size_t n, double* out)
+    __attribute__((always_inline)) static double arcLengthsF(const Vec3f* v, std::size_t n, double* out)
     {
         double s = 0.0;
         out[0] = 0.0;
-        for (std::size_t j = 1; j < n; ++j) {
+        std::size_t j = 1;
+        const float* f = v[0].asPointer();
+        for (; j + 3 < n; j += 4) {
+            Float4 a0, a1, a2, b0, b1, b2;
+            __builtin_memcpy(&a0, f + 3 * j, 16);
+            __builtin_memcpy(&a1, f + 3 * j + 4, 16);
+            __builtin_memcpy(&a2, f + 3 * j + 8, 16);
+            __builtin_memcpy(&b0, f + 3 * j - 3, 16);
+            __builtin_memcpy(&b1, f + 3 * j + 1, 16);
+            __builtin_memcpy(&b2, f + 3 * j + 5, 16);
+            const Float4 d0 = a0 - b0, d1 = a1 - b1, d2 = a2 - b2;  // x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3
+            const Float4 q0 = d0 * d0, q1 = d1 * d1, q2 = d2 * d2;
+            const Float4 x = Float4{q0[0], q0[3], q1[2], q2[1]};
+            const Float4 y = Float4{q0[1], q1[0], q1[3], q2[2]};
+            const Float4 z = Float4{q0[2], q1[1], q2[0], q2[3]};
+            const Float4 len = sqrt4(x + y + z);
+            s += double(len[0]);
+            out[j] = s;
+            s += double(len[1]);
+            out[j + 1] = s;
+            s += double(len[2]);
+            out[j + 2] = s;
+            s += double(len[3]);
+            out[j + 3] = s;
+        }
+        for (; j < n; ++j) {
             const float dx = v[j].x() - v[j - 1].x(), dy = v[j].y() - v[j - 1].y(), dz = v[j].z() - v[j - 1].z();
             s += double(std::sqrt(dx * dx + dy * dy + dz * dz));
             out[j] = s;
@@ -590,7 +656,7 @@ private:
     }
 
     /// Write lane @a l's strand out and start the next strand in the lane (or idle it).
-    void finish(int l, StopReason reason)
+    __attribute__((always_inline)) void finish(int l, StopReason reason)
     {
         Lane& L = mLanes[l];
         RetraceJob<TreeT>& job = mJob;
@@ -606,6 +672,13 @@ private:
         auto world = [&](const Float4& p) {
             const Float4 w = o4 + p * s4;
             return Vec3f(w[0], w[1], w[2]);
+        };
+        // Output vertex u of @a count from step point p: all four floats of the world position
+        // in one store where the next vertex (of this strand, written later) takes the fourth.
+        auto emit = [&](Vec3f* out, std::size_t u, std::size_t count, const Float4& p) {
+            const Float4 w = o4 + p * s4;
+            if (u + 1 < count) __builtin_memcpy(out[u].asPointer(), &w, sizeof w);
+            else out[u] = Vec3f(w[0], w[1], w[2]);
         };
         const Vec3f root = job.in.root(i);
         if (!mInputMode) {
@@ -634,11 +707,11 @@ private:
                     const double x = target[j] * invStep;
                     const std::size_t m = std::min(std::size_t(std::int64_t(x)), mMax);
                     const float t = float(x - double(m));
-                    out[u++] = world(pts[m] + (pts[m + 1] - pts[m]) * t);
+                    emit(out, u++, n, pts[m] + (pts[m + 1] - pts[m]) * t);
                 }
                 for (; j < n && target[j] <= reached; ++j) {  // on the last, shorter step
                     const float t = float(std::min(1.0, (target[j] - wholeEnd) / L.lastStep));
-                    out[u++] = world(pts[whole] + (pts[whole + 1] - pts[whole]) * t);
+                    emit(out, u++, n, pts[whole] + (pts[whole + 1] - pts[whole]) * t);
                 }
             }
             const Vec3f last = taken == 0 ? root : world(pts[taken]);
@@ -657,6 +730,8 @@ private:
         start(l);
     }
 
+    /// The bits of 8.0f (see fastRound()).
+    static constexpr unsigned kBitsOf8 = 0x41000000u;
     /// Index coordinates beyond this are "far" (int32 and float offsets stay exact below it).
     static constexpr double kFar = double(1 << 29);
     /// Strands ahead of the next one whose vertices start() prefetches.
@@ -679,11 +754,65 @@ private:
     std::size_t mNext = 0, mEnd = 0;
 };
 
+/// @brief Move each strand's kept prefix down to its final place, in place: strand i's first
+/// used[i] vertices go from in.begin(i) to offsets[i] (<= in.begin(i)).
+///
+/// One pass in strand order (runs of strands that shift alike move in one memmove) is safe,
+/// since every destination lies at or below its source and above every earlier destination, but
+/// it moves tens of megabytes on one thread. So the strands are cut into @a chunks pieces of
+/// about equal size, moved in two phases: first each piece moves, on its own, everything whose
+/// destination lies within its own source range (no other piece reads or writes there), and
+/// copies aside the head that lands below it — in the sources of earlier pieces, which may not
+/// have been read yet; then, once every piece is through, the heads go to their places (the gaps
+/// the earlier pieces' moves left). The heads add up to the vertices dropped before each piece.
+void compactPrefixes(const StrandSet& in, const std::vector<std::uint32_t>& used, const std::vector<std::uint32_t>& offsets,
+                     Vec3f* pos, std::size_t chunks)
+{
+    const std::size_t nS = in.numStrands();
+    chunks = std::max<std::size_t>(1, std::min(chunks, nS));
+    std::vector<std::size_t> first(chunks + 1, nS);  // first strand of each piece
+    for (std::size_t c = 0, i = 0; c < chunks; ++c) {
+        const std::size_t goal = in.numVertices() / chunks * c;
+        while (i < nS && in.begin(i) < goal) ++i;
+        first[c] = i;
+    }
+    std::vector<std::vector<Vec3f>> heads(chunks);
+    auto movePiece = [&](std::size_t c) {
+        const std::size_t a = first[c], b = first[c + 1];
+        if (a >= b) return;
+        const std::size_t dst0 = offsets[a];
+        const std::size_t mine = std::min<std::size_t>(offsets[b], in.begin(a));  // destinations below this go to the head
+        heads[c].resize(mine - dst0);
+        for (std::size_t i = a; i < b;) {
+            const std::size_t from = in.begin(i), to = offsets[i];
+            std::size_t j = i + 1;
+            while (j < b && used[j - 1] == in.size(j - 1)) ++j;  // strands i+1 .. j-1 shift as strand i
+            const std::size_t len = offsets[j] - to;
+            const std::size_t toHead = to < mine ? std::min(len, mine - to) : 0;
+            if (toHead) std::memcpy(heads[c].data() + (to - dst0), pos + from, toHead * sizeof(Vec3f));
+            if (len > toHead && to != from) {
+                std::memmove(pos + to + toHead, pos + from + toHead, (len - toHead) * sizeof(Vec3f));
+            }
+            i = j;
+        }
+    };
+    auto placeHead = [&](std::size_t c) {
+        if (!heads[c].empty()) std::memcpy(pos + offsets[first[c]], heads[c].data(), heads[c].size() * sizeof(Vec3f));
+    };
+    if (chunks == 1) {
+        movePiece(0);
+        placeHead(0);
+        return;
+    }
+    tbb::parallel_for(std::size_t(0), chunks, movePiece);
+    tbb::parallel_for(std::size_t(0), chunks, placeHead);
+}
+
 /// Retrace all strands through the tree of a Vec3 grid.
 template<typename GridT>
-StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams& params, double step,
-                       TraceStats* stats, std::vector<StopReason>* reasonsOut, bool threaded,
-                       openvdb::util::NullInterrupter* interrupter)
+void retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams& params, double step, StrandSet& out,
+                  TraceStats* stats, std::vector<StopReason>* reasonsOut, bool threaded,
+                  openvdb::util::NullInterrupter* interrupter)
 {
     using TreeT = typename GridT::TreeType;
     const FieldMapping map = FieldMapping::fromGrid(grid);
@@ -691,8 +820,8 @@ StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams
     const bool inputMode = params.vertices == RetraceVertices::Input;
 
     // Input mode writes into the input's layout (compacted afterwards if a strand stops early);
-    // step mode collects each strand's points.
-    StrandSet out;
+    // step mode collects each strand's points. The output's storage is kept (retraceStrandsInto).
+    out.clear();
     if (inputMode) out.positions.reserve(in.numVertices());
     std::vector<std::uint32_t> used(inputMode ? nS : 0, 0);
     std::vector<std::vector<Vec3f>> stepPoints(inputMode ? 0 : nS);
@@ -744,15 +873,7 @@ StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams
             out.offsets.assign(nS + 1, 0);
             for (std::size_t i = 0; i < nS; ++i) out.offsets[i + 1] = out.offsets[i] + used[i];
             const std::size_t total = out.offsets[nS];
-            // Runs of strands that move by the same amount move together.
-            Vec3f* pos = out.positions.data();
-            for (std::size_t i = 0; i < nS;) {
-                const std::size_t from = in.begin(i), to = out.offsets[i];
-                std::size_t j = i + 1;
-                while (j < nS && used[j - 1] == in.size(j - 1)) ++j;  // strands i+1 .. j-1 shift as strand i
-                if (to != from) std::memmove(pos + to, pos + from, (out.offsets[j] - to) * sizeof(Vec3f));
-                i = j;
-            }
+            compactPrefixes(in, used, out.offsets, out.positions.data(), workers);
             out.positions.resize(total);
             if (!in.thickness.empty()) out.thickness.resize(total);
             if (!in.transparency.empty()) out.transparency.resize(total);
@@ -784,7 +905,6 @@ StrandSet retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams
         }
     }
     if (reasonsOut) *reasonsOut = std::move(reasons);
-    return out;
 }
 
 template<typename Fn>
@@ -811,6 +931,18 @@ StrandSet retraceStrands(const StrandSet& strands, const openvdb::GridBase& fiel
                          TraceStats* stats, std::vector<StopReason>* reasons, bool threaded,
                          openvdb::util::NullInterrupter* interrupter)
 {
+    StrandSet out;
+    retraceStrandsInto(strands, field, params, out, stats, reasons, threaded, interrupter);
+    return out;
+}
+
+void retraceStrandsInto(const StrandSet& strands, const openvdb::GridBase& field, const TraceParams& params, StrandSet& out,
+                        TraceStats* stats, std::vector<StopReason>* reasons, bool threaded,
+                        openvdb::util::NullInterrupter* interrupter)
+{
+    if (&out == &strands) {
+        throw ValueError("retraceStrandsInto: the output must be another StrandSet than the input (strands are read while others are written)");
+    }
     if (params.margin < 0 || params.margin > 16) {
         throw ValueError("margin " + std::to_string(params.margin) + " voxels must be between 0 and 16");
     }
@@ -818,11 +950,9 @@ StrandSet retraceStrands(const StrandSet& strands, const openvdb::GridBase& fiel
         throw ValueError("vanish threshold " + std::to_string(params.vanishThreshold) + " must be in [0, 1)");
     }
     const double step = resolveStep(field, params);
-    StrandSet out;
     applyVec3(field, "retraceStrands", [&](const auto& grid) {
-        out = retraceTyped(strands, grid, params, step, stats, reasons, threaded, interrupter);
+        retraceTyped(strands, grid, params, step, out, stats, reasons, threaded, interrupter);
     });
-    return out;
 }
 
 double meanTangentAngleDeg(const StrandSet& strands, const openvdb::GridBase& field, std::size_t* counted, bool threaded)
