@@ -163,7 +163,8 @@ struct RetraceJob
         if (!output || growing.exchange(true)) return;
         try {
             const std::size_t n = in.numVertices();
-            for (std::size_t size = 0; size < n;) {
+            ready.store(output->size(), std::memory_order_release);  // a reused output's elements
+            for (std::size_t size = output->size(); size < n;) {
                 const std::size_t from = size;
                 size = std::min(n, size + kPiece);
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
@@ -412,7 +413,7 @@ private:
         // The common case: the step left the brick by less than a brick (local in (-8, 16)):
         // the base moves by -8, 0 or +8 on each axis, and the offsets by exact small integers.
         if (std::abs(local[0] - 4.f) < 12.f && std::abs(local[1] - 4.f) < 12.f && std::abs(local[2] - 4.f) < 12.f) {
-            for (int a = 0; a < 3; ++a) b[a] = L.base[a] + (local[a] < 0.f ? -8 : local[a] >= 8.f ? 8 : 0);
+            for (int a = 0; a < 3; ++a) b[a] = L.base[a] + 8 * (int(local[a] >= 8.f) - int(local[a] < 0.f));
         } else {
             bool far = false;
             for (int a = 0; a < 3; ++a) {
@@ -427,7 +428,8 @@ private:
                 return;
             }
         }
-        if (!(std::abs(double(b[0])) < kFar && std::abs(double(b[1])) < kFar && std::abs(double(b[2])) < kFar)) {
+        constexpr std::uint32_t kFarI = std::uint32_t(kFar);  // |b| < kFar, as one unsigned test per axis
+        if (!(std::uint32_t(b[0]) + kFarI < 2 * kFarI && std::uint32_t(b[1]) + kFarI < 2 * kFarI && std::uint32_t(b[2]) + kFarI < 2 * kFarI)) {
             goFar(l, worldOf(l));
             return;
         }
@@ -700,12 +702,12 @@ private:
                 // a full-length trace is shorter; vertices on it are placed separately.
                 const bool shortLast = taken == needed;
                 const std::size_t whole = shortLast ? taken - 1 : taken;
-                const std::size_t mMax = whole - (whole > 0);
+                const int mMax = int(whole - (whole > 0));  // steps are below 2^31 (kMaxSteps)
                 const double wholeEnd = double(whole) * mStep, invStep = 1.0 / mStep;
                 std::size_t j = 1;
                 for (; j < n && target[j] <= wholeEnd; ++j) {
-                    const double x = target[j] * invStep;
-                    const std::size_t m = std::min(std::size_t(std::int64_t(x)), mMax);
+                    const double x = target[j] * invStep;  // >= 0: truncation floors
+                    const int m = std::min(int(x), mMax);
                     const float t = float(x - double(m));
                     emit(out, u++, n, pts[m] + (pts[m + 1] - pts[m]) * t);
                 }
@@ -821,8 +823,15 @@ void retraceTyped(const StrandSet& in, const GridT& grid, const TraceParams& par
 
     // Input mode writes into the input's layout (compacted afterwards if a strand stops early);
     // step mode collects each strand's points. The output's storage is kept (retraceStrandsInto).
+    // Elements a reused output already holds are overwritten, not zeroed again: every vertex a
+    // strand keeps is written, and only new elements need mapping (growOutput()).
+    std::vector<Vec3f> held = std::move(out.positions);
     out.clear();
-    if (inputMode) out.positions.reserve(in.numVertices());
+    if (inputMode) {
+        out.positions = std::move(held);
+        if (out.positions.size() > in.numVertices()) out.positions.resize(in.numVertices());
+        out.positions.reserve(in.numVertices());
+    }
     std::vector<std::uint32_t> used(inputMode ? nS : 0, 0);
     std::vector<std::vector<Vec3f>> stepPoints(inputMode ? 0 : nS);
     std::vector<StopReason> reasons(nS, StopReason::FullLength);
