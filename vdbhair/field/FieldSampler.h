@@ -124,8 +124,9 @@ public:
     __attribute__((always_inline)) static Float4 blend(const Float4* c, float fx, float fy, float fz)
     {
         const Float8 c00 = loadPair(c), c01 = loadPair(c + N), c10 = loadPair(c + N * N), c11 = loadPair(c + N * N + N);
-        // (Scalar operands, not splat8(): GCC lowers a vector built in a default-target inline
-        // function for SSE before inlining it into the AVX2 clone, but broadcasts a scalar operand.)
+        // Scalar operands on purpose: a vector of copies built here would be lowered for SSE
+        // (this function has the default target) before it is inlined into the AVX2 clone, while
+        // a scalar operand becomes one broadcast there.
         const Float8 y0 = c00 + (c10 - c00) * fx;  // corners (y0, z0|z1), lerped in x
         const Float8 y1 = c01 + (c11 - c01) * fx;
         const Float8 z = y0 + (y1 - y0) * fy;      // (z0 | z1)
