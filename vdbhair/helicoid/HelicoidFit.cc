@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <functional>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace vdbhair {
 
@@ -55,6 +57,7 @@ struct Fitter
     double step;      ///< the scene's step: pieces are chained (and regrown) with RK4 at this step
     double evalStep;  ///< the objective's step: RK4 follows the same streamline with 4x fewer points
     std::size_t evaluations = 0;
+    std::size_t dbgObj = 0, dbgRes = 0, dbgWithin = 0, dbgCand = 0, dbgPrefit = 0;
 
     Fitter(const Target& t, const FitParams& p, double s) : target(t), params(p), step(s), evalStep(4.0 * s) {}
 
@@ -88,7 +91,7 @@ struct Fitter
     /// Eq. 5, scale-free: the coupling's mean leash over L, plus λ times the turns of the piece.
     double objective(const std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q)
     {
-        ++evaluations;
+        ++evaluations; ++dbgObj;
         const double L = target.arc[b] - target.arc[a];
         tracePiece(x, L, p0, q, trace);
         const std::vector<Vec3d>& frag = fragment(a, b);
@@ -214,7 +217,7 @@ struct Fitter
     void residuals(const double* x, std::size_t dims, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q,
                    Eigen::VectorXd& r)
     {
-        ++evaluations;
+        ++evaluations; ++dbgRes;
         Vec3d endT;
         traceAtVertices(x, dims, a, b, p0, q, lmTrace, &endT);
         const std::size_t n = b - a;
@@ -353,7 +356,7 @@ struct Fitter
             const std::size_t runs = std::min(ranked.size(), maxRuns);
             for (std::size_t i = 0; i < runs; ++i) {
                 std::vector<double> x = starts[ranked[i].second];
-                const double f = prefit(x, a, b, p0, q);
+                const double f = prefit(x, a, b, p0, q); ++dbgPrefit;
                 if (f < bestF) { bestF = f; best = x; }
                 // The first pre-fit that is good enough ends the search (in the starts' order).
                 if (good && i + 1 < runs && good(x)) { best = x; break; }
@@ -465,6 +468,8 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
     Vec3d p0 = fit.root;
     FrameD q = fit.frame;
     std::vector<double> previous;
+    double previousTurn = 0.0;  // turning of the previous piece's upper limit (the forward search's first guess)
+    const bool forward = params.forwardSearch && params.prefitIterations > 0;
     HelicoidTrace trace;
     std::vector<Vec3d> denseTarget;
     while (a < last) {
@@ -473,8 +478,10 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         // Is the fit x of [a, b], as grown, within @a eps of the fragment (discrete Fréchet)?
         auto within = [&](std::size_t b, const std::vector<double>& x, double eps) {
             const double L = target.arc[b] - target.arc[a];
+            ++fitter.dbgWithin;
             fitter.tracePiece(x, L, p0, q, trace, /*exact=*/true);
             densify(target.pts, a, b, step, denseTarget);
+            if (b < last && (trace.points.back() - target.pts[b]).length() > params.acceptEndOffset * eps) return false;
             return discreteFrechetWithin(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size(), eps);
         };
         // A candidate fit of [a, b]: pre-fitted from the starts (and @a hint, a fit of [a, hb]);
@@ -483,6 +490,7 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         auto fitTo = [&](std::size_t b, std::vector<double>& x, bool thorough, bool polish, const std::vector<double>* hint = nullptr,
                          std::size_t hb = 0, int startsToRun = 0) {
             int verdict = -1;  // the last pre-fit's acceptance, when known
+            ++fitter.dbgCand;
             std::function<bool(const std::vector<double>&)> good;
             if (!polish && params.firstGoodStart) {
                 good = [&](const std::vector<double>& y) {
@@ -497,6 +505,7 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         // Polish a pre-fit (@a ok: it is acceptable); a polish that makes an acceptable fit
         // unacceptable is undone (Eq. 5 weighs the mean leash, the acceptance its maximum).
         auto polishFit = [&](std::size_t b, std::vector<double>& x, bool ok) {
+            if (params.polishEvaluations <= 0) return ok;
             std::vector<double> y = x;
             fitter.polish(y, a, b, p0, q);
             const bool okAfter = within(b, y, tolerance);
@@ -507,10 +516,71 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         std::vector<double> x;
         std::size_t b = last;
         const bool lastPiece = int(fit.pieces.size()) + 1 >= params.maxPieces || remaining < 2.0 * minLength || last - a < 3;
-        // The last piece allowed is kept whatever its error: it gets every start.
-        bool ok = fitTo(last, x, true, !searchWithoutPolish, nullptr, 0, lastPiece ? params.lastPieceStarts : 0);
-        if (searchWithoutPolish && (lastPiece || ok || within(last, x, params.polishMargin * tolerance))) ok = polishFit(last, x, ok);
-        if (!ok && !lastPiece) {
+        // The search for the split's upper limit u (the longest acceptable prefix) and its fit.
+        std::size_t u = last;
+        std::vector<double> xu;
+        bool okU = false, split = false;
+        if (forward && !lastPiece) {
+            // Forward search: candidates [a, b] with b in [lo, hiMax] (leaving at least the
+            // minimum fragment) or the whole remainder. The first candidate ends where the strand
+            // has turned as much as the previous piece's limit did (searchTurn for the first
+            // piece): gallop up from an acceptable candidate by growth, down by halves from an
+            // unacceptable one, then bisect. Each candidate starts from the nearest fit found.
+            const std::size_t lo = std::min(last, std::max(a + 2, indexAtArc(target, target.arc[a] + minLength)));
+            std::size_t hiMax = last;
+            while (hiMax > a && (last - hiMax < 2 || target.arc[last] - target.arc[hiMax] < minLength)) --hiMax;
+            auto snap = [&](std::size_t c) { return c > hiMax ? last : std::max(c, lo); };
+            const double budget = previousTurn > 0.0 ? previousTurn : params.searchTurn;
+            std::size_t g = a + 1;
+            for (double turned = 0.0; g < last && turned + target.turning[g] <= budget; ++g) turned += target.turning[g];
+            const bool polish = !searchWithoutPolish;
+            std::size_t good = a, bad = last + 1, c = snap(g);
+            std::vector<double> xg, xb, xt;
+            bool okC = fitTo(c, xt, true, polish, nullptr, 0, c == last ? params.lastPieceStarts : 0);
+            (okC ? good : bad) = c;
+            (okC ? xg : xb) = xt;
+            if (okC) {
+                while (good < last) {
+                    c = snap(a + std::size_t(std::ceil(double(good - a) * params.searchGrowth)));
+                    if (fitTo(c, xt, false, polish, &xg, good)) { good = c; xg = xt; }
+                    else { bad = c; xb = xt; break; }
+                }
+            } else {
+                while (bad > lo) {
+                    c = std::max(lo, a + (bad - a) / 2);
+                    if (fitTo(c, xt, c == lo, polish, &xb, bad)) { good = c; xg = xt; break; }
+                    bad = c;
+                    xb = xt;
+                }
+            }
+            if (good > a) {
+                // Bisect between the longest acceptable and the shortest unacceptable candidate
+                // (below the minimum remainder when the whole remainder failed).
+                std::size_t top = bad == last ? hiMax + 1 : bad;
+                const std::size_t resolution = std::size_t(std::max(1.0, params.splitResolution * double(last - a)));
+                while (top > good + resolution) {
+                    const std::size_t mid = (good + top) / 2;
+                    const bool nearGood = mid - good <= top - mid || xb.empty();
+                    if (fitTo(mid, xt, false, polish, nearGood ? &xg : &xb, nearGood ? good : bad)) { good = mid; xg = xt; }
+                    else { top = bad = mid; xb = xt; }
+                }
+                u = good;
+                xu = xg;
+                okU = true;
+            } else {
+                u = lo;
+                xu = xb;
+            }
+            if (searchWithoutPolish) okU = polishFit(u, xu, okU);
+            split = u < last;
+            if (!split) x = xu;
+        } else {
+            // The last piece allowed is kept whatever its error: it gets every start.
+            bool ok = fitTo(last, x, true, !searchWithoutPolish, nullptr, 0, lastPiece ? params.lastPieceStarts : 0);
+            if (searchWithoutPolish && (lastPiece || ok || within(last, x, params.polishMargin * tolerance))) ok = polishFit(last, x, ok);
+            split = !ok && !lastPiece;
+        }
+        if (split && !forward) {
             // Upper limit: the longest prefix whose fit is acceptable (the paper's Fréchet
             // threshold), by bisection over the vertices between the minimum fragment and the
             // remainder (which failed above), starting at the splitFraction of the remainder.
@@ -519,9 +589,9 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
             std::size_t hi = std::min(last - 1, std::max(lo, indexAtArc(target, target.arc[a] + params.splitFraction * remaining)));
             const bool thorough = !searchWithoutPolish;
             const bool polish = !searchWithoutPolish;
-            std::vector<double> xu, xt, xb = x;
-            std::size_t u = lo, good = lo, bad = last;
-            bool okU = false;
+            std::vector<double> xt, xb = x;
+            std::size_t good = lo, bad = last;
+            u = lo;
             if (hi > lo && fitTo(hi, xt, thorough, polish, &xb, last)) {
                 good = hi;
                 xu = xt;
@@ -541,6 +611,10 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
                 u = good;
             }
             if (searchWithoutPolish) polishFit(u, xu, okU);
+        }
+        if (split) {
+            previousTurn = 0.0;
+            for (std::size_t v = a + 1; v < u; ++v) previousTurn += target.turning[v];
             // Backtrack from u along the curvature profile to where fragment and fit agree best:
             // in curvature (the paper's criterion) and, since the next piece starts there, in
             // position and direction.
@@ -550,25 +624,25 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
             for (std::size_t i = 0; i < tf.size(); ++i) tf[i] = toF(trace.points[i]);
             std::vector<float> fitCurv(tf.size());
             curvatureProfile(tf.data(), tf.size(), fitCurv.data());
-            std::size_t split = u;
+            std::size_t cut = u;
             double bestScore = std::numeric_limits<double>::max();
             // A fit that ends on the strand, in its direction, keeps its whole length: backtracking
             // exists for the fits that drift near their end.
             const double endOffset = (trace.points.back() - target.pts[u]).length();
             const double endAngle = std::acos(std::max(-1.0, std::min(1.0, trace.frames.back().t.dot((target.pts[u] - target.pts[u - 1]).unitSafe()))));
-            const bool keepU = endOffset < 0.5 * tolerance && endAngle < 0.1;
+            const bool keepU = endOffset < params.keepOffset * tolerance && endAngle < params.keepAngle;
             // The window: the last 40 % of the piece (backtracking adjusts the split; it must not
             // throw away the length the bisection found acceptable).
-            const double windowStart = std::max(target.arc[a] + minLength, target.arc[u] - 0.4 * (target.arc[u] - target.arc[a]));
+            const double windowStart = std::max(target.arc[a] + minLength, target.arc[u] - params.backtrackWindow * (target.arc[u] - target.arc[a]));
             for (std::size_t v = u; !keepU && v > a + 1 && target.arc[v] >= windowStart; --v) {
                 const double s = target.arc[v] - target.arc[a];
                 const std::size_t m = std::min(tf.size() - 1, std::size_t(std::lround(s / fitter.evalStep)));
                 const Vec3d targetDir = (target.pts[std::min(v + 1, last)] - target.pts[v - 1]).unitSafe();
                 const double angle = std::acos(std::max(-1.0, std::min(1.0, trace.frames[m].t.dot(targetDir))));
                 const double score = std::abs(double(target.curvature[v]) - double(fitCurv[m])) * target.length + angle / 0.05;
-                if (score < bestScore) { bestScore = score; split = v; }
+                if (score < bestScore) { bestScore = score; cut = v; }
             }
-            b = split;
+            b = cut;
             x = xu;
             // The piece fitted to [a, u], kept up to the split (the scaled x refer to Lu).
             const double Lb = target.arc[b] - target.arc[a];
@@ -586,6 +660,7 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         previous = x;
         for (int k = 0; k < 3; ++k) previous[std::size_t(k)] = previous[std::size_t(k)] / L;  // unscaled for the next start
         fit.pieces.push_back(pc);
+        if (std::getenv("FITDEBUG")) std::fprintf(stderr, "  piece a %zu u %zu b %zu last %zu okU %d split %d lastPiece %d turn %.2f\n", a, u, b, last, int(okU), int(split), int(lastPiece), previousTurn);
         a = b;
     }
     bool carried = false;
@@ -598,6 +673,7 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
     const double c = frechetCoupling(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size(), &pairs);
     fit.coupling = c / double(std::max<std::size_t>(1, pairs));
     fit.evaluations = fitter.evaluations;
+    if (std::getenv("FITSTATS")) std::fprintf(stderr, "stats obj %zu res %zu within %zu cand %zu prefit %zu pieces %zu\n", fitter.dbgObj, fitter.dbgRes, fitter.dbgWithin, fitter.dbgCand, fitter.dbgPrefit, fit.pieces.size());
     return fit;
 }
 

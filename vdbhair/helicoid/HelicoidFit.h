@@ -87,6 +87,12 @@ struct FitParams
     double maxError = 0.02;       ///< accepted discrete Fréchet distance, as a fraction of the strand length
     double lambda = 1e-3;         ///< regularization weight (dimensionless, see above)
     int maxPieces = 8;
+    bool forwardSearch = true;    ///< search the split's upper limit forwards from a guess (else top-down from splitFraction, the paper's)
+    double searchTurn = 2.0;      ///< the forward search's first guess for the first piece: where the strand has turned this much (radians)
+    double searchGrowth = 2.0;    ///< the forward search's gallop: each acceptable candidate is followed by one this many times as long
+    double backtrackWindow = 0.4; ///< the split backtracks from the upper limit within this fraction of the piece
+    double keepOffset = 0.5, keepAngle = 0.1;
+    double acceptEndOffset = 1.0;
     double splitFraction = 0.6;   ///< the paper's Fréchet threshold for the split's upper limit
     double minFragment = 0.08;    ///< shortest piece, as a fraction of the strand length
     double splitResolution = 0.1; ///< the search for the upper limit stops within this fraction of the fragment's vertices (0: one vertex)
