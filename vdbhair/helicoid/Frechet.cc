@@ -1,6 +1,7 @@
 #include "Frechet.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -9,21 +10,21 @@ namespace vdbhair {
 double discreteFrechet(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q)
 {
     if (p == 0 || q == 0) return 0.0;
-    // Row by row: F(i, j) = max(d(i, j), min(F(i-1, j), F(i, j-1), F(i-1, j-1))).
+    // Row by row: F(i, j) = max(d(i, j), min(F(i-1, j), F(i, j-1), F(i-1, j-1))), on squared
+    // distances (max and min commute with the square root, so the result is the same length).
     std::vector<double> prev(q), cur(q);
-    for (std::size_t i = 0; i < p; ++i) {
-        for (std::size_t j = 0; j < q; ++j) {
-            const double d = (a[i] - b[j]).length();
-            double best;
-            if (i == 0 && j == 0) best = 0.0;
-            else if (i == 0) best = cur[j - 1];
-            else if (j == 0) best = prev[j];
-            else best = std::min({prev[j], cur[j - 1], prev[j - 1]});
-            cur[j] = std::max(d, best);
+    prev[0] = (a[0] - b[0]).lengthSqr();
+    for (std::size_t j = 1; j < q; ++j) prev[j] = std::max((a[0] - b[j]).lengthSqr(), prev[j - 1]);
+    for (std::size_t i = 1; i < p; ++i) {
+        const Vec3d ai = a[i];
+        cur[0] = std::max((ai - b[0]).lengthSqr(), prev[0]);
+        for (std::size_t j = 1; j < q; ++j) {
+            const double best = std::min(std::min(prev[j], cur[j - 1]), prev[j - 1]);
+            cur[j] = std::max((ai - b[j]).lengthSqr(), best);
         }
         std::swap(prev, cur);
     }
-    return prev[q - 1];
+    return std::sqrt(prev[q - 1]);
 }
 
 bool discreteFrechetWithin(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, double eps)
@@ -70,26 +71,26 @@ double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_
         if (steps) *steps = 0;
         return 0.0;
     }
-    // C(i, j) = d(i, j) + min(C(i-1, j), C(i, j-1), C(i-1, j-1)); ties keep the shorter coupling.
+    // C(i, j) = d(i, j) + min(C(i-1, j-1), C(i-1, j), C(i, j-1)); ties keep the shorter
+    // coupling (in that order of preference when the lengths tie too).
     std::vector<double> prev(q), cur(q);
     std::vector<std::size_t> prevN(q), curN(q);
-    for (std::size_t i = 0; i < p; ++i) {
-        for (std::size_t j = 0; j < q; ++j) {
-            const double d = (a[i] - b[j]).length();
-            if (i == 0 && j == 0) {
-                cur[j] = d;
-                curN[j] = 1;
-                continue;
-            }
-            double best = std::numeric_limits<double>::max();
-            std::size_t n = 0;
-            auto consider = [&](double c, std::size_t k) {
-                if (c < best || (c == best && k < n)) { best = c; n = k; }
-            };
-            if (i > 0 && j > 0) consider(prev[j - 1], prevN[j - 1]);
-            if (i > 0) consider(prev[j], prevN[j]);
-            if (j > 0) consider(cur[j - 1], curN[j - 1]);
-            cur[j] = d + best;
+    prev[0] = (a[0] - b[0]).length();
+    prevN[0] = 1;
+    for (std::size_t j = 1; j < q; ++j) {
+        prev[j] = prev[j - 1] + (a[0] - b[j]).length();
+        prevN[j] = j + 1;
+    }
+    for (std::size_t i = 1; i < p; ++i) {
+        const Vec3d ai = a[i];
+        cur[0] = prev[0] + (ai - b[0]).length();
+        curN[0] = i + 1;
+        for (std::size_t j = 1; j < q; ++j) {
+            double best = prev[j - 1];
+            std::size_t n = prevN[j - 1];
+            if (prev[j] < best || (prev[j] == best && prevN[j] < n)) { best = prev[j]; n = prevN[j]; }
+            if (cur[j - 1] < best || (cur[j - 1] == best && curN[j - 1] < n)) { best = cur[j - 1]; n = curN[j - 1]; }
+            cur[j] = (ai - b[j]).length() + best;
             curN[j] = n + 1;
         }
         std::swap(prev, cur);

@@ -86,21 +86,26 @@ struct FitParams
 {
     double maxError = 0.02;       ///< accepted discrete Fréchet distance, as a fraction of the strand length
     double lambda = 1e-3;         ///< regularization weight (dimensionless, see above)
-    int maxPieces = 8;
-    bool forwardSearch = true;    ///< search the split's upper limit forwards from a guess (else top-down from splitFraction, the paper's)
-    double searchTurn = 2.0;      ///< the forward search's first guess for the first piece: where the strand has turned this much (radians)
-    double searchGrowth = 2.0;    ///< the forward search's gallop: each acceptable candidate is followed by one this many times as long
-    double backtrackWindow = 0.4; ///< the split backtracks from the upper limit within this fraction of the piece
-    double keepOffset = 0.5, keepAngle = 0.1;
-    double acceptEndOffset = 1.0;
-    double splitFraction = 0.6;   ///< the paper's Fréchet threshold for the split's upper limit
-    double minFragment = 0.08;    ///< shortest piece, as a fraction of the strand length
+    int maxPieces = 16;           ///< most pieces per strand (see capByPoints)
+    bool capByPoints = true;      ///< also at most (3 n - 10) / 6 pieces for n vertices: a fit never has more floats than its points
+    bool forwardSearch = true;    ///< search the split's upper limit forwards from a guess (else top-down from splitFraction, the paper's reading)
+    double searchTurn = 2.0;      ///< the forward search's first candidate for the first piece: where the strand has turned this much (radians)
+    double searchGrowth = 2.0;    ///< the forward search's gallop: an acceptable candidate is followed by one this many times as long
+    double splitFraction = 0.6;   ///< the paper's Fréchet threshold for the split's upper limit (top-down search)
+    double minFragment = 0.03;    ///< shortest piece, as a fraction of the strand length (and at least two segments)
     double splitResolution = 0.1; ///< the search for the upper limit stops within this fraction of the fragment's vertices (0: one vertex)
+    double acceptEndOffset = 0.7; ///< a piece before the last is accepted only if it also ends within this fraction of the tolerance of its target vertex (the next piece starts there)
+    double backtrackWindow = 0.4; ///< the split backtracks from the upper limit within this fraction of the piece
+    double keepOffset = 0.7;      ///< no backtracking for a fit ending within this fraction of the tolerance of its target vertex ...
+    double keepAngle = 0.3;       ///< ... and within this angle (radians) of the strand's direction there
+    int relaxRetries = 2;         ///< refits of a strand that used every piece allowed and still misses maxError, each with relaxFactor times the tolerance
+    double relaxFactor = 1.4;
     bool optimizeRoll = true;     ///< also fit a roll angle for pieces after the first (measured: halves the mean error)
     int maxEvaluations = 300;     ///< Nelder–Mead evaluations per piece without a pre-fit
-    int polishEvaluations = 30;   ///< Nelder–Mead evaluations of a polish after the pre-fit
+    int polishEvaluations = 20;   ///< Nelder–Mead evaluations of a polish after the pre-fit (0: no polish)
     int prefitIterations = 10;    ///< Levenberg–Marquardt iterations of the pre-fit per start (0: none, Nelder–Mead from the raw starts)
-    double endTangentWeight = 0.3; ///< pre-fit weight of the end direction's residual (unit vectors; positions count as fractions of L)
+    double prefitStopFraction = 0.7; ///< a search candidate's pre-fit stops once every vertex is within this fraction of the tolerance of its arc-length counterpart (0: never)
+    double endTangentWeight = 0.45; ///< pre-fit weight of the end direction's residual (unit vectors; positions count as fractions of L)
     double prefitMaxTurn = 0.3;   ///< radians an RK4 step of the pre-fit may turn when it spans several segments (0: one step per segment)
     bool broyden = true;          ///< pre-fit Jacobians by Broyden updates (else forward differences every iteration)
     int prefitStarts = 2;         ///< starts pre-fitted for a whole fragment, the best by the pre-fit's cost at the start (3: all; measured on wavy: 2.99 % with 2, 3.05 % with 3 at 11 % more evaluations, 3.95 % with 1)
