@@ -566,7 +566,7 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
     // A fit with more floats than the points it replaces is pointless: 9 floats per strand and
     // 6 per piece against 3 per vertex.
     int maxPieces = params.maxPieces;
-    if (params.capByPoints) maxPieces = std::max(1, std::min(maxPieces, int((3 * std::min<std::size_t>(n, 1 << 20) - 10) / 6)));
+    if (params.capByPoints) maxPieces = std::max(1, std::min(maxPieces, (3 * int(std::min<std::size_t>(n, 1 << 20)) - 10) / 6));
     const double minLength = std::max(params.minFragment * target.length, 1e-12);
     const bool forward = params.forwardSearch && params.prefitIterations > 0;
     HelicoidTrace trace;
