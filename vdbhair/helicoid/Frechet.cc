@@ -12,16 +12,21 @@ double discreteFrechet(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_
     if (p == 0 || q == 0) return 0.0;
     // Row by row: F(i, j) = max(d(i, j), min(F(i-1, j), F(i, j-1), F(i-1, j-1))), on squared
     // distances (max and min commute with the square root, so the result is the same length).
-    std::vector<double> prev(q), cur(q);
-    prev[0] = (a[0] - b[0]).lengthSqr();
-    for (std::size_t j = 1; j < q; ++j) prev[j] = std::max((a[0] - b[j]).lengthSqr(), prev[j - 1]);
-    for (std::size_t i = 1; i < p; ++i) {
-        const Vec3d ai = a[i];
-        cur[0] = std::max((ai - b[0]).lengthSqr(), prev[0]);
-        for (std::size_t j = 1; j < q; ++j) {
-            const double best = std::min(std::min(prev[j], cur[j - 1]), prev[j - 1]);
-            cur[j] = std::max((ai - b[j]).lengthSqr(), best);
+    // Each row's distances are computed first, in a loop the compiler vectorizes.
+    std::vector<double> prev(q), cur(q), d(q);
+    auto row = [&](const Vec3d& ai) {
+        for (std::size_t j = 0; j < q; ++j) {
+            const double x = ai.x() - b[j].x(), y = ai.y() - b[j].y(), z = ai.z() - b[j].z();
+            d[j] = x * x + y * y + z * z;
         }
+    };
+    row(a[0]);
+    prev[0] = d[0];
+    for (std::size_t j = 1; j < q; ++j) prev[j] = std::max(d[j], prev[j - 1]);
+    for (std::size_t i = 1; i < p; ++i) {
+        row(a[i]);
+        cur[0] = std::max(d[0], prev[0]);
+        for (std::size_t j = 1; j < q; ++j) cur[j] = std::max(d[j], std::min(std::min(prev[j], cur[j - 1]), prev[j - 1]));
         std::swap(prev, cur);
     }
     return std::sqrt(prev[q - 1]);
@@ -72,25 +77,33 @@ double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_
         return 0.0;
     }
     // C(i, j) = d(i, j) + min(C(i-1, j-1), C(i-1, j), C(i, j-1)); ties keep the shorter
-    // coupling (in that order of preference when the lengths tie too).
-    std::vector<double> prev(q), cur(q);
+    // coupling (in that order of preference when the lengths tie too). Each row's distances are
+    // computed first, in a loop the compiler vectorizes.
+    std::vector<double> prev(q), cur(q), d(q);
     std::vector<std::size_t> prevN(q), curN(q);
-    prev[0] = (a[0] - b[0]).length();
+    auto row = [&](const Vec3d& ai) {
+        for (std::size_t j = 0; j < q; ++j) {
+            const double x = ai.x() - b[j].x(), y = ai.y() - b[j].y(), z = ai.z() - b[j].z();
+            d[j] = std::sqrt(x * x + y * y + z * z);
+        }
+    };
+    row(a[0]);
+    prev[0] = d[0];
     prevN[0] = 1;
     for (std::size_t j = 1; j < q; ++j) {
-        prev[j] = prev[j - 1] + (a[0] - b[j]).length();
+        prev[j] = prev[j - 1] + d[j];
         prevN[j] = j + 1;
     }
     for (std::size_t i = 1; i < p; ++i) {
-        const Vec3d ai = a[i];
-        cur[0] = prev[0] + (ai - b[0]).length();
+        row(a[i]);
+        cur[0] = prev[0] + d[0];
         curN[0] = i + 1;
         for (std::size_t j = 1; j < q; ++j) {
             double best = prev[j - 1];
             std::size_t n = prevN[j - 1];
             if (prev[j] < best || (prev[j] == best && prevN[j] < n)) { best = prev[j]; n = prevN[j]; }
             if (cur[j - 1] < best || (cur[j - 1] == best && curN[j - 1] < n)) { best = cur[j - 1]; n = curN[j - 1]; }
-            cur[j] = (ai - b[j]).length() + best;
+            cur[j] = d[j] + best;
             curN[j] = n + 1;
         }
         std::swap(prev, cur);
