@@ -308,9 +308,9 @@ struct Fitter
             return true;
         };
         if (closeEnough(r)) return cost;
-        // At most 5 parameters: the normal equations are formed and solved (Cholesky) by hand,
-        // on the stack, rather than with Eigen's general (large-matrix) kernels, which cost as
-        // much as a trace at these sizes.
+        // At most 5 parameters: the normal equations are formed by hand and solved on the stack,
+        // rather than with Eigen's general (large-matrix) kernels, which cost as much as a trace
+        // at these sizes.
         const std::size_t rows = std::size_t(r.size());
         std::vector<double> J(rows * dims);  // column-major: column j at J[j * rows]
         std::vector<double> xh(x), xn(x);
@@ -329,7 +329,9 @@ struct Fitter
         jacobian();
         bool fresh = true;
         int rejected = 0;
-        double A[5][5], M[5][5], g[5], dx[5], step[5];
+        using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 5, 5>;
+        using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 5, 1>;
+        double A[5][5], g[5], dx[5], step[5];
         for (int it = 0; it < params.prefitIterations; ++it) {
             for (std::size_t i = 0; i < dims; ++i) {
                 const double* ci = &J[i * rows];
@@ -343,35 +345,19 @@ struct Fitter
                 for (std::size_t k = 0; k < rows; ++k) sum += ci[k] * r[Eigen::Index(k)];
                 g[i] = sum;
             }
-            // Cholesky of M = A + mu diag(A) (+ a tiny ridge), then dx = -M^-1 g.
-            bool spd = true;
-            for (std::size_t i = 0; i < dims && spd; ++i) {
-                for (std::size_t j = 0; j <= i; ++j) {
-                    double sum = A[i][j] + (i == j ? mu * (A[i][i] + 1e-9) : 0.0);
-                    for (std::size_t k = 0; k < j; ++k) sum -= M[i][k] * M[j][k];
-                    if (i == j) {
-                        if (!(sum > 0.0)) { spd = false; break; }
-                        M[i][i] = std::sqrt(sum);
-                    } else {
-                        M[i][j] = sum / M[j][j];
-                    }
-                }
-            }
-            if (!spd) {
-                mu *= 10.0;
-                if (mu > 1e6) break;
-                continue;
-            }
+            // dx = -M⁻¹ g with M = A + mu diag(A) (+ a tiny ridge), by LDLᵀ with pivoting: J's
+            // columns can be nearly dependent (a roll that barely moves a nearly straight piece),
+            // and a Cholesky factorization that gives up there was measured worse (wavy at the
+            // former defaults: 3.30 % instead of 3.01 %).
+            Small M(dims, dims);
+            SmallVec rhs(dims);
             for (std::size_t i = 0; i < dims; ++i) {
-                double sum = -g[i];
-                for (std::size_t k = 0; k < i; ++k) sum -= M[i][k] * dx[k];
-                dx[i] = sum / M[i][i];
+                rhs[Eigen::Index(i)] = -g[i];
+                for (std::size_t j = 0; j < dims; ++j) M(Eigen::Index(i), Eigen::Index(j)) = A[i][j];
+                M(Eigen::Index(i), Eigen::Index(i)) += mu * (A[i][i] + 1e-9);
             }
-            for (std::size_t i = dims; i-- > 0;) {
-                double sum = dx[i];
-                for (std::size_t k = i + 1; k < dims; ++k) sum -= M[k][i] * dx[k];
-                dx[i] = sum / M[i][i];
-            }
+            const SmallVec sol = M.ldlt().solve(rhs);
+            for (std::size_t i = 0; i < dims; ++i) dx[i] = sol[Eigen::Index(i)];
             for (std::size_t i = 0; i < dims; ++i) xn[i] = x[i] + dx[i];
             clamp(xn);
             double step2 = 0.0;
