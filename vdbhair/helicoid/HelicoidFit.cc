@@ -198,8 +198,8 @@ struct Fitter
     }
 
     /// The piece with scaled parameters @a x traced from (p0, q) at the fragment's own arc
-    /// lengths: out[i] is where target vertex a + i should be (RK4, one step per target segment,
-    /// subdivided to at most the objective's step).
+    /// lengths: out[i] is where target vertex a + i should be (one step of Kutta's third-order rule
+    /// or of RK4, `prefitOrder`, per target segment, subdivided to at most the objective's step).
     void traceAtVertices(const double* x, std::size_t dims, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q,
                          std::vector<Vec3d>& out, Vec3d* endTangent = nullptr) const
     {
@@ -213,7 +213,17 @@ struct Fitter
         double th = h.theta(p, 0.0);
         Vec3d k1 = h.frameFromTheta(th).t;
         out[0] = p;
-        auto rk4 = [&](double hs) {
+        auto advance = [&](double hs) {
+            if (params.prefitOrder == 3) {
+                // Kutta's third-order rule: one tangent fewer per step (the last one is the next
+                // step's first).
+                double t2 = th, t3 = th;
+                const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
+                const Vec3d k3 = h.tangent(p + hs * (2.0 * k2 - k1), t3);
+                p += (hs / 6.0) * (k1 + 4.0 * k2 + k3);
+                k1 = h.tangent(p, th);
+                return;
+            }
             double t2 = th, t3 = th, t4 = th;
             const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
             const Vec3d k3 = h.tangent(p + 0.5 * hs * k2, t3);
@@ -221,10 +231,10 @@ struct Fitter
             p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
             k1 = h.tangent(p, th);
         };
-        // Where the strand turns slowly, one RK4 step spans several segments (the strand turning
+        // Where the strand turns slowly, one step spans several segments (the strand turning
         // at most prefitMaxTurn over them: the steps depend on the fragment only, so the traced
         // positions stay smooth in x for the Jacobian), and the vertices inside it are cubic
-        // Hermite interpolants of the step's ends (positions and unit tangents), O(h^4) as RK4.
+        // Hermite interpolants of the step's ends (positions and unit tangents), O(h^4).
         for (std::size_t i = a; i < b;) {
             std::size_t j = i + 1;
             double len = target.arc[j] - target.arc[i];
@@ -232,10 +242,10 @@ struct Fitter
             while (j < b && j - i < 4 && (turn += target.turning[j + 1]) <= params.prefitMaxTurn) len = target.arc[++j] - target.arc[i];
             if (j == i + 1) {
                 const int n = std::max(1, int(std::ceil(len / evalStep - 0.5)));
-                for (int m = 0; m < n; ++m) rk4(len / n);
+                for (int m = 0; m < n; ++m) advance(len / n);
             } else {
                 const Vec3d pa = p, ta = k1;
-                rk4(len);
+                advance(len);
                 for (std::size_t m = i + 1; m < j; ++m) {
                     const double u = (target.arc[m] - target.arc[i]) / len, u2 = u * u, u3 = u2 * u;
                     out[m - a] = (2 * u3 - 3 * u2 + 1) * pa + ((u3 - 2 * u2 + u) * len) * ta + (-2 * u3 + 3 * u2) * p +
