@@ -77,6 +77,42 @@ TEST_CASE("discreteFrechet / frechetCoupling: equal brute force over all monoton
     REQUIRE(discreteFrechet(line.data(), 3, line.data(), 3) == 0.0);
 }
 
+TEST_CASE("discreteFrechet: the banded recurrence equals the full one on close and far curves", "[helicoid]")
+{
+    // discreteFrechet visits only the cells within an upper bound; the full O(pq) recurrence
+    // (Eiter & Mannila) is the reference, on long polylines the brute force cannot enumerate.
+    auto full = [](const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
+        std::vector<std::vector<double>> F(a.size(), std::vector<double>(b.size()));
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            for (std::size_t j = 0; j < b.size(); ++j) {
+                const double d = (a[i] - b[j]).length();
+                double best = 0.0;
+                if (i > 0 && j > 0) best = std::min({F[i - 1][j], F[i][j - 1], F[i - 1][j - 1]});
+                else if (i > 0) best = F[i - 1][j];
+                else if (j > 0) best = F[i][j - 1];
+                F[i][j] = std::max(d, best);
+            }
+        }
+        return F.back().back();
+    };
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::uniform_int_distribution<int> len(1, 60);
+    for (int trial = 0; trial < 300; ++trial) {
+        std::vector<Vec3d> a(std::size_t(len(rng))), b(std::size_t(len(rng)));
+        Vec3d w(0.0);
+        for (Vec3d& p : a) p = (w += Vec3d(0.2, 0.2 * u(rng), 0.2 * u(rng)));
+        const double noise = trial % 3 == 0 ? 2.0 : 0.05;  // far apart, or a noisy copy
+        for (std::size_t i = 0; i < b.size(); ++i) {
+            const Vec3d& base = a[std::min(a.size() - 1, i * a.size() / b.size())];
+            b[i] = base + noise * Vec3d(u(rng), u(rng), u(rng));
+        }
+        CAPTURE(trial, a.size(), b.size());
+        REQUIRE(discreteFrechet(a.data(), a.size(), b.data(), b.size()) == full(a, b));
+        REQUIRE(discreteFrechet(b.data(), b.size(), a.data(), a.size()) == full(b, a));
+    }
+}
+
 TEST_CASE("discreteFrechetWithin: agrees with discreteFrechet at, below and above the distance", "[helicoid]")
 {
     std::mt19937 rng(7);

@@ -10,26 +10,65 @@ namespace vdbhair {
 double discreteFrechet(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q)
 {
     if (p == 0 || q == 0) return 0.0;
-    // Row by row: F(i, j) = max(d(i, j), min(F(i-1, j), F(i, j-1), F(i-1, j-1))), on squared
-    // distances (max and min commute with the square root, so the result is the same length).
-    // Each row's distances are computed first, in a loop the compiler vectorizes.
-    std::vector<double> prev(q), cur(q), d(q);
-    auto row = [&](const Vec3d& ai) {
-        for (std::size_t j = 0; j < q; ++j) {
-            const double x = ai.x() - b[j].x(), y = ai.y() - b[j].y(), z = ai.z() - b[j].z();
-            d[j] = x * x + y * y + z * z;
-        }
+    auto dist2 = [&](std::size_t i, std::size_t j) {
+        const double x = a[i].x() - b[j].x(), y = a[i].y() - b[j].y(), z = a[i].z() - b[j].z();
+        return x * x + y * y + z * z;
     };
-    row(a[0]);
-    prev[0] = d[0];
-    for (std::size_t j = 1; j < q; ++j) prev[j] = std::max(d[j], prev[j - 1]);
-    for (std::size_t i = 1; i < p; ++i) {
-        row(a[i]);
-        cur[0] = std::max(d[0], prev[0]);
-        for (std::size_t j = 1; j < q; ++j) cur[j] = std::max(d[j], std::min(std::min(prev[j], cur[j - 1]), prev[j - 1]));
-        std::swap(prev, cur);
+    // An upper bound: the largest distance along one monotone coupling, the staircase closest to
+    // the diagonal. No cell farther apart than that can be on an optimal coupling, so the
+    // recurrence below visits only the band of cells within it (a few per row for close curves)
+    // and still gives the exact distance.
+    double bound = 0.0;
+    for (std::size_t i = 0, j = 0;;) {
+        bound = std::max(bound, dist2(i, j));
+        if (i + 1 == p && j + 1 == q) break;
+        // Step to the neighbour that stays closest to the diagonal i / (p - 1) = j / (q - 1).
+        if (i + 1 == p) ++j;
+        else if (j + 1 == q) ++i;
+        else {
+            const double di = double(i + 1) * double(q - 1), dj = double(j + 1) * double(p - 1);
+            if (di < dj) ++i;
+            else if (dj < di) ++j;
+            else { ++i; ++j; }
+        }
     }
-    return std::sqrt(prev[q - 1]);
+    // Row by row: F(i, j) = max(d(i, j), min(F(i-1, j), F(i, j-1), F(i-1, j-1))), on squared
+    // distances (max and min commute with the square root, so the result is the same length),
+    // over the cells within the bound: those of the previous row lie in [first, last].
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> prev(q, inf), cur(q, inf);
+    std::size_t first = 0, last = 0;
+    prev[0] = dist2(0, 0);
+    for (std::size_t j = 1; j < q; ++j) {
+        const double d = dist2(0, j);
+        if (d > bound) break;
+        prev[j] = std::max(d, prev[j - 1]);
+        last = j;
+    }
+    for (std::size_t i = 1; i < p; ++i) {
+        std::size_t newFirst = q, newLast = 0;
+        double left = inf;
+        for (std::size_t j = first; j < q; ++j) {
+            const double below = j <= last ? prev[j] : inf;
+            const double diag = j > first && j - 1 <= last ? prev[j - 1] : inf;
+            const double best = std::min(std::min(below, diag), left);
+            if (best == inf && j > last) break;  // nothing further right is within the bound
+            const double d = dist2(i, j);
+            left = (best == inf || d > bound) ? inf : std::max(d, best);
+            cur[j] = left;
+            if (left != inf) {
+                newFirst = std::min(newFirst, j);
+                newLast = j;
+            }
+        }
+        // Clear the previous row's band before it becomes the next row's output.
+        for (std::size_t j = first; j <= last; ++j) prev[j] = inf;
+        std::swap(prev, cur);
+        first = newFirst;
+        last = newLast;
+        if (first == q) return std::sqrt(bound);  // unreachable: rounding; the bound is a coupling's value
+    }
+    return std::sqrt(prev[q - 1] == inf ? bound : prev[q - 1]);
 }
 
 bool discreteFrechetWithin(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, double eps)
