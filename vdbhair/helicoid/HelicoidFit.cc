@@ -22,6 +22,23 @@ namespace {
 
 Vec3f toF(const Vec3d& v) { return Vec3f(float(v.x()), float(v.y()), float(v.z())); }
 
+/// Helicoid::tangent() with the branchless forms of fastmath's functions (the same polynomials):
+/// the pre-fit's traces call it millions of times, and the branches of the scalar forms (the
+/// quadrant of sin/cos, the reduction of atan) follow the data.
+inline Vec3d prefitTangent(const Helicoid& h, const Vec3d& world, double& thetaRef)
+{
+    const Vec3d d = world - h.p0;
+    const double y1 = d.dot(h.q.t), y2 = d.dot(h.q.n), y3 = d.dot(h.q.b);
+    double th = fastmath::atan2Lane(h.k.kT * y1 + h.k.kN * y2, 1.0 + h.k.kN * y1 - h.k.kT * y2) + h.k.kB * y3;
+    constexpr double twoPi = 2.0 * M_PI;
+    th += twoPi * fastmath::roundLane((thetaRef - th) * (1.0 / twoPi));
+    thetaRef = th;
+    double ct, st, cp, sp;
+    fastmath::sinCosLane(th, st, ct);
+    fastmath::sinCosLane(h.k.alpha * th, sp, cp);
+    return (cp * ct) * h.q.t + (cp * st) * h.q.n + sp * h.q.b;
+}
+
 /// The target strand: distinct points, their arc lengths, and its curvature profile.
 struct Target
 {
@@ -218,18 +235,18 @@ struct Fitter
                 // Kutta's third-order rule: one tangent fewer per step (the last one is the next
                 // step's first).
                 double t2 = th, t3 = th;
-                const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
-                const Vec3d k3 = h.tangent(p + hs * (2.0 * k2 - k1), t3);
+                const Vec3d k2 = prefitTangent(h, p + 0.5 * hs * k1, t2);
+                const Vec3d k3 = prefitTangent(h, p + hs * (2.0 * k2 - k1), t3);
                 p += (hs / 6.0) * (k1 + 4.0 * k2 + k3);
-                k1 = h.tangent(p, th);
+                k1 = prefitTangent(h, p, th);
                 return;
             }
             double t2 = th, t3 = th, t4 = th;
-            const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
-            const Vec3d k3 = h.tangent(p + 0.5 * hs * k2, t3);
-            const Vec3d k4 = h.tangent(p + hs * k3, t4);
+            const Vec3d k2 = prefitTangent(h, p + 0.5 * hs * k1, t2);
+            const Vec3d k3 = prefitTangent(h, p + 0.5 * hs * k2, t3);
+            const Vec3d k4 = prefitTangent(h, p + hs * k3, t4);
             p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            k1 = h.tangent(p, th);
+            k1 = prefitTangent(h, p, th);
         };
         // Where the strand turns slowly, one step spans several segments (the strand turning
         // at most prefitMaxTurn over them: the steps depend on the fragment only, so the traced
