@@ -73,7 +73,8 @@
 /// From an acceptable candidate it gallops up (`searchGrowth`, 1.5, times as long, or the whole
 /// remainder), from an unacceptable one down by halves to the minimum fragment, then bisects to
 /// `splitResolution`, each candidate warm-started from the nearest fit found. Measured at the same
-/// settings otherwise (500 strands, one thread): wavy top-down 1.81 %, 9.01 pieces, 1052
+/// settings otherwise (500 strands, one thread; these comparisons were run before the branchless
+/// pre-fit math, which moves wavy by a few hundredths of a percent either way): wavy top-down 1.81 %, 9.01 pieces, 1052
 /// evaluations per strand, 228 strands per CPU second; forward 1.76 %, 9.12 pieces, 645
 /// evaluations, 627 per CPU second (a gallop of 2: 670 evaluations); curly 1.63 % -> 1.56 %,
 /// 374 -> 298 evaluations; straight 226 -> 194 evaluations, 2.75 -> 2.59 pieces but 1.38 % ->
@@ -104,7 +105,13 @@
 /// vertices unless noted; mean / p95 discrete Fréchet error relative to length, pieces,
 /// evaluations per strand, strands/s; wall-clock rates vary ±30 % or more with other load;
 /// "before" is the previous top-down search with at most 8 pieces, on the same rows):
-///   (final numbers below)
+///   straight 1.50 % / 1.96 %, 2.60 pieces, 196, 1671/s   (before: 1.53 %, 1239/s)
+///   straight 16 vertices (as stored) 1.64 % / 2.23 %, 3.44 pieces, 326, 2424/s
+///   wavy     1.78 % / 2.00 %, 9.20 pieces, 651, 1278/s   (before: 3.13 % / 5.88 %, 7.80, 1076, 411/s)
+///   wavy 21 vertices (as stored) 2.78 % / 3.84 %, 7.66 pieces, 1324, 803/s   (before: 3.62 %, 552/s)
+///   curly    1.54 % / 1.94 %, 4.07 pieces, 293, 1566/s   (before: 1.74 %, 712/s)
+///   short    1.38 % / 1.93 %, 2.23 pieces, 147, 1921/s   (before: 1.50 %, 1280/s)
+/// (on a quiet machine; with another build sharing the host the same binary gave wavy 660-1010/s).
 /// Wavy (harolongo: noisy coils, about 20° of turning per segment at 30 vertices and ~600° per
 /// strand) needs about 9 pieces for 2 %: with phi = alpha·theta a helicoid cannot hold a helix's
 /// constant tilt, so a piece follows a coil for about 60° of turning (3-4 segments), and C¹
