@@ -111,7 +111,7 @@
 ///   wavy 21 vertices (as stored) 2.78 % / 3.84 %, 7.66 pieces, 1324, 803/s   (before: 3.62 %, 552/s)
 ///   curly    1.54 % / 1.94 %, 4.07 pieces, 293, 1566/s   (before: 1.74 %, 712/s)
 ///   short    1.38 % / 1.93 %, 2.23 pieces, 147, 1921/s   (before: 1.50 %, 1280/s)
-/// (on a quiet machine; with another build sharing the host the same binary gave wavy 660-1010/s).
+/// (on a quiet machine; with another build sharing the host the same binary gave wavy 662/s).
 /// Wavy (harolongo: noisy coils, about 20° of turning per segment at 30 vertices and ~600° per
 /// strand) needs about 9 pieces for 2 %: with phi = alpha·theta a helicoid cannot hold a helix's
 /// constant tilt, so a piece follows a coil for about 60° of turning (3-4 segments), and C¹
