@@ -61,7 +61,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
     const FitSummary s = summarizeFits(strands, fits, errors, p.fit.maxError);
     if (s.overMaxError && !common.quiet) {
         std::cerr << "vdbhair fit: warning: " << s.overMaxError << " of " << s.fitted << " fits end above --max-error "
-                  << formatValue(p.fit.maxError) << " (a last piece takes what remains at --max-pieces or under twice the shortest fragment)\n";
+                  << formatValue(p.fit.maxError) << " (a last piece takes what remains at the most pieces a strand may have, or under twice the shortest fragment)\n";
     }
     if (common.json) {
         printJson({{"output", p.output}, {"strands", s.strands}, {"fitted", s.fitted}, {"skipped", s.skipped}, {"over_max_error", s.overMaxError},
@@ -88,7 +88,7 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "Scene file (.json): one guide per input strand, in input order")->required();
     sub->add_option("--max-error", params->fit.maxError, "Accept a piece within this discrete Frechet distance, as a fraction of the strand length")->capture_default_str();
     sub->add_option("--lambda", params->fit.lambda, "Regularization weight of Eq. 5 (dimensionless: per turn of the piece)")->capture_default_str();
-    sub->add_option("--max-pieces", params->fit.maxPieces, "Most pieces per strand")->capture_default_str();
+    sub->add_option("--max-pieces", params->fit.maxPieces, "Most pieces per strand (and at most (3 n - 10) / 6 for n vertices: a fit is never larger than its points)")->capture_default_str();
     sub->add_option("--max-evaluations", params->fit.maxEvaluations, "Nelder-Mead evaluations per piece and start")->capture_default_str();
     sub->add_option("--step", params->fit.step, "Tracing step of the fits in world units (default: a quarter of each strand's mean segment length)");
     sub->add_option("--roll", params->fit.optimizeRoll, "Also fit a roll angle of each piece's frame about its tangent (true/false)")->capture_default_str();

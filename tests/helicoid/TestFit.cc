@@ -77,6 +77,42 @@ TEST_CASE("discreteFrechet / frechetCoupling: equal brute force over all monoton
     REQUIRE(discreteFrechet(line.data(), 3, line.data(), 3) == 0.0);
 }
 
+TEST_CASE("discreteFrechet: the banded recurrence equals the full one on close and far curves", "[helicoid]")
+{
+    // discreteFrechet visits only the cells within an upper bound; the full O(pq) recurrence
+    // (Eiter & Mannila) is the reference, on long polylines the brute force cannot enumerate.
+    auto full = [](const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
+        std::vector<std::vector<double>> F(a.size(), std::vector<double>(b.size()));
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            for (std::size_t j = 0; j < b.size(); ++j) {
+                const double d = (a[i] - b[j]).length();
+                double best = 0.0;
+                if (i > 0 && j > 0) best = std::min({F[i - 1][j], F[i][j - 1], F[i - 1][j - 1]});
+                else if (i > 0) best = F[i - 1][j];
+                else if (j > 0) best = F[i][j - 1];
+                F[i][j] = std::max(d, best);
+            }
+        }
+        return F.back().back();
+    };
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::uniform_int_distribution<int> len(1, 60);
+    for (int trial = 0; trial < 300; ++trial) {
+        std::vector<Vec3d> a(std::size_t(len(rng))), b(std::size_t(len(rng)));
+        Vec3d w(0.0);
+        for (Vec3d& p : a) p = (w += Vec3d(0.2, 0.2 * u(rng), 0.2 * u(rng)));
+        const double noise = trial % 3 == 0 ? 2.0 : 0.05;  // far apart, or a noisy copy
+        for (std::size_t i = 0; i < b.size(); ++i) {
+            const Vec3d& base = a[std::min(a.size() - 1, i * a.size() / b.size())];
+            b[i] = base + noise * Vec3d(u(rng), u(rng), u(rng));
+        }
+        CAPTURE(trial, a.size(), b.size());
+        REQUIRE(discreteFrechet(a.data(), a.size(), b.data(), b.size()) == full(a, b));
+        REQUIRE(discreteFrechet(b.data(), b.size(), a.data(), a.size()) == full(b, a));
+    }
+}
+
 TEST_CASE("discreteFrechetWithin: agrees with discreteFrechet at, below and above the distance", "[helicoid]")
 {
     std::mt19937 rng(7);
@@ -196,4 +232,88 @@ TEST_CASE("fitStrands: identical with 1 and 2 threads, and regrown through a sce
         for (std::size_t v = regrown.begin(i); v < regrown.end(i); ++v) b.push_back(Vec3d(regrown.positions[v]));
         REQUIRE(discreteFrechet(a.data(), a.size(), b.data(), b.size()) == Approx(one[i].frechet).epsilon(1e-4));
     }
+}
+
+TEST_CASE("fitStrand: a p-helicoid of several pieces is fitted back by both split searches", "[helicoid]")
+{
+    // Three C¹ pieces (§3.4) of known parameters, with a roll at each joint, sampled at 40
+    // vertices: each search must fit it within maxError, in a few pieces.
+    const FrameD frame = FrameD::fromTangentNormal(Vec3d(0.2, -1, 0.1), Vec3d(1, 0, 0));
+    const std::vector<HelicoidPiece> truth{{{0.9, 0.05, 0.2, 0.1}, 3.0, 0.0}, {{-1.4, 0.0, 0.4, 0.3}, 2.5, 0.7}, {{0.6, 0.1, -0.3, 0.0}, 3.5, -0.4}};
+    HelicoidTrace t;
+    tracePHelicoid(Vec3d(0, 1, 2), frame, truth, 0.005, HelicoidIntegrator::RK4, t);
+    std::vector<Vec3d> target;
+    const std::size_t stride = (t.points.size() - 1) / 39;
+    for (std::size_t i = 0; i < t.points.size(); i += stride) target.push_back(t.points[i]);
+    const std::vector<Vec3f> pts = toF(target);
+    const bool forward = GENERATE(true, false);
+    FitParams params;
+    params.forwardSearch = forward;
+    const StrandFit fit = fitStrand(pts.data(), pts.size(), params);
+    CAPTURE(forward, fit.frechet / fit.length, fit.pieces.size(), fit.evaluations);
+    REQUIRE(fit.frechet <= params.maxError * fit.length);
+    REQUIRE(fit.pieces.size() >= 2);  // one helicoid cannot hold three
+    REQUIRE(fit.pieces.size() <= 6);
+    double length = 0.0;
+    for (const HelicoidPiece& p : fit.pieces) {
+        REQUIRE(p.k.kT >= 0.0);
+        length += p.length;
+    }
+    REQUIRE(length == Approx(fit.length).epsilon(1e-9));  // the pieces cover the strand
+}
+
+TEST_CASE("fitStrand: a fit never has more floats than the points it replaces", "[helicoid]")
+{
+    // Noisy coils (the hard case), where an uncapped fit can take more pieces than the points
+    // are worth: 9 floats per strand and 6 per piece must stay below 3 per vertex.
+    std::mt19937 rng(11);
+    std::normal_distribution<double> noise(0.0, 0.08);
+    int binding = 0;
+    for (const std::size_t n : {12, 16, 22}) {
+        std::vector<Vec3d> coil;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double s = double(i) * 1.2;
+            coil.emplace_back(std::cos(s) + noise(rng), std::sin(s) + noise(rng), 0.25 * s + noise(rng));
+        }
+        const std::vector<Vec3f> pts = toF(coil);
+        const std::size_t cap = (3 * n - 10) / 6;
+        const StrandFit fit = fitStrand(pts.data(), pts.size(), FitParams{});
+        FitParams uncapped;
+        uncapped.capByPoints = false;
+        const StrandFit more = fitStrand(pts.data(), pts.size(), uncapped);
+        CAPTURE(n, cap, fit.pieces.size(), fit.frechet / fit.length, more.pieces.size(), more.frechet / more.length);
+        REQUIRE(9 + 6 * fit.pieces.size() < 3 * n);
+        REQUIRE(fit.pieces.size() <= cap);
+        REQUIRE(std::isfinite(fit.frechet));
+        if (more.pieces.size() < cap) {
+            // The cap does not bind: the same fit.
+            REQUIRE(fit.pieces.size() == more.pieces.size());
+            REQUIRE(fit.frechet == more.frechet);
+        }
+        binding += more.pieces.size() > cap;
+    }
+    REQUIRE(binding > 0);  // and for at least one of them it does
+}
+
+TEST_CASE("fitStrand: a strand that needs more pieces than allowed is refitted with longer pieces", "[helicoid]")
+{
+    // A coil of about four turns in at most three pieces: the plain fit ends in a long last piece;
+    // the refits with a larger tolerance are kept only when closer, and stay within the cap.
+    std::vector<Vec3d> coil;
+    for (int i = 0; i < 40; ++i) {
+        const double s = 0.6 * i;
+        coil.emplace_back(std::cos(s), std::sin(s), 0.3 * s);
+    }
+    const std::vector<Vec3f> pts = toF(coil);
+    FitParams plain;
+    plain.maxPieces = 3;
+    plain.relaxRetries = 0;
+    FitParams relaxed = plain;
+    relaxed.relaxRetries = 2;
+    const StrandFit a = fitStrand(pts.data(), pts.size(), plain), b = fitStrand(pts.data(), pts.size(), relaxed);
+    CAPTURE(a.frechet / a.length, b.frechet / b.length, a.pieces.size(), b.pieces.size());
+    REQUIRE(a.frechet > plain.maxError * a.length);  // the case the refits are for
+    REQUIRE(b.frechet <= a.frechet);
+    REQUIRE(b.pieces.size() <= 3);
+    REQUIRE(b.evaluations > a.evaluations);
 }

@@ -1,6 +1,7 @@
 #include "Frechet.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -9,21 +10,65 @@ namespace vdbhair {
 double discreteFrechet(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q)
 {
     if (p == 0 || q == 0) return 0.0;
-    // Row by row: F(i, j) = max(d(i, j), min(F(i-1, j), F(i, j-1), F(i-1, j-1))).
-    std::vector<double> prev(q), cur(q);
-    for (std::size_t i = 0; i < p; ++i) {
-        for (std::size_t j = 0; j < q; ++j) {
-            const double d = (a[i] - b[j]).length();
-            double best;
-            if (i == 0 && j == 0) best = 0.0;
-            else if (i == 0) best = cur[j - 1];
-            else if (j == 0) best = prev[j];
-            else best = std::min({prev[j], cur[j - 1], prev[j - 1]});
-            cur[j] = std::max(d, best);
+    auto dist2 = [&](std::size_t i, std::size_t j) {
+        const double x = a[i].x() - b[j].x(), y = a[i].y() - b[j].y(), z = a[i].z() - b[j].z();
+        return x * x + y * y + z * z;
+    };
+    // An upper bound: the largest distance along one monotone coupling, the staircase closest to
+    // the diagonal. No cell farther apart than that can be on an optimal coupling, so the
+    // recurrence below visits only the band of cells within it (a few per row for close curves)
+    // and still gives the exact distance.
+    double bound = 0.0;
+    for (std::size_t i = 0, j = 0;;) {
+        bound = std::max(bound, dist2(i, j));
+        if (i + 1 == p && j + 1 == q) break;
+        // Step to the neighbour that stays closest to the diagonal i / (p - 1) = j / (q - 1).
+        if (i + 1 == p) ++j;
+        else if (j + 1 == q) ++i;
+        else {
+            const double di = double(i + 1) * double(q - 1), dj = double(j + 1) * double(p - 1);
+            if (di < dj) ++i;
+            else if (dj < di) ++j;
+            else { ++i; ++j; }
         }
-        std::swap(prev, cur);
     }
-    return prev[q - 1];
+    // Row by row: F(i, j) = max(d(i, j), min(F(i-1, j), F(i, j-1), F(i-1, j-1))), on squared
+    // distances (max and min commute with the square root, so the result is the same length),
+    // over the cells within the bound: those of the previous row lie in [first, last].
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> prev(q, inf), cur(q, inf);
+    std::size_t first = 0, last = 0;
+    prev[0] = dist2(0, 0);
+    for (std::size_t j = 1; j < q; ++j) {
+        const double d = dist2(0, j);
+        if (d > bound) break;
+        prev[j] = std::max(d, prev[j - 1]);
+        last = j;
+    }
+    for (std::size_t i = 1; i < p; ++i) {
+        std::size_t newFirst = q, newLast = 0;
+        double left = inf;
+        for (std::size_t j = first; j < q; ++j) {
+            const double below = j <= last ? prev[j] : inf;
+            const double diag = j > first && j - 1 <= last ? prev[j - 1] : inf;
+            const double best = std::min(std::min(below, diag), left);
+            if (best == inf && j > last) break;  // nothing further right is within the bound
+            const double d = dist2(i, j);
+            left = (best == inf || d > bound) ? inf : std::max(d, best);
+            cur[j] = left;
+            if (left != inf) {
+                newFirst = std::min(newFirst, j);
+                newLast = j;
+            }
+        }
+        // Clear the previous row's band before it becomes the next row's output.
+        for (std::size_t j = first; j <= last; ++j) prev[j] = inf;
+        std::swap(prev, cur);
+        first = newFirst;
+        last = newLast;
+        if (first == q) return std::sqrt(bound);  // unreachable: rounding; the bound is a coupling's value
+    }
+    return std::sqrt(prev[q - 1] == inf ? bound : prev[q - 1]);
 }
 
 bool discreteFrechetWithin(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, double eps)
@@ -70,26 +115,34 @@ double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_
         if (steps) *steps = 0;
         return 0.0;
     }
-    // C(i, j) = d(i, j) + min(C(i-1, j), C(i, j-1), C(i-1, j-1)); ties keep the shorter coupling.
-    std::vector<double> prev(q), cur(q);
+    // C(i, j) = d(i, j) + min(C(i-1, j-1), C(i-1, j), C(i, j-1)); ties keep the shorter
+    // coupling (in that order of preference when the lengths tie too). Each row's distances are
+    // computed first, in a loop the compiler vectorizes.
+    std::vector<double> prev(q), cur(q), d(q);
     std::vector<std::size_t> prevN(q), curN(q);
-    for (std::size_t i = 0; i < p; ++i) {
+    auto row = [&](const Vec3d& ai) {
         for (std::size_t j = 0; j < q; ++j) {
-            const double d = (a[i] - b[j]).length();
-            if (i == 0 && j == 0) {
-                cur[j] = d;
-                curN[j] = 1;
-                continue;
-            }
-            double best = std::numeric_limits<double>::max();
-            std::size_t n = 0;
-            auto consider = [&](double c, std::size_t k) {
-                if (c < best || (c == best && k < n)) { best = c; n = k; }
-            };
-            if (i > 0 && j > 0) consider(prev[j - 1], prevN[j - 1]);
-            if (i > 0) consider(prev[j], prevN[j]);
-            if (j > 0) consider(cur[j - 1], curN[j - 1]);
-            cur[j] = d + best;
+            const double x = ai.x() - b[j].x(), y = ai.y() - b[j].y(), z = ai.z() - b[j].z();
+            d[j] = std::sqrt(x * x + y * y + z * z);
+        }
+    };
+    row(a[0]);
+    prev[0] = d[0];
+    prevN[0] = 1;
+    for (std::size_t j = 1; j < q; ++j) {
+        prev[j] = prev[j - 1] + d[j];
+        prevN[j] = j + 1;
+    }
+    for (std::size_t i = 1; i < p; ++i) {
+        row(a[i]);
+        cur[0] = prev[0] + d[0];
+        curN[0] = i + 1;
+        for (std::size_t j = 1; j < q; ++j) {
+            double best = prev[j - 1];
+            std::size_t n = prevN[j - 1];
+            if (prev[j] < best || (prev[j] == best && prevN[j] < n)) { best = prev[j]; n = prevN[j]; }
+            if (cur[j - 1] < best || (cur[j - 1] == best && curN[j - 1] < n)) { best = cur[j - 1]; n = curN[j - 1]; }
+            cur[j] = d[j] + best;
             curN[j] = n + 1;
         }
         std::swap(prev, cur);

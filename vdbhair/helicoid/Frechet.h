@@ -7,7 +7,9 @@
 /// - The Fréchet coupling, the paper's fitting measure: over the same monotone couplings, the
 ///   smallest *total* leash length (the sum of the coupled distances), which weighs the whole
 ///   curve and still respects the order of the points.
-/// Both by dynamic programming in O(pq) time and O(q) memory.
+/// Both by dynamic programming in O(pq) time and O(q) memory; the discrete Fréchet distance visits
+/// only the cells within an upper bound (the largest distance along the staircase coupling closest
+/// to the diagonal), a narrow band for close curves, and is still exact.
 #pragma once
 
 #include <vdbhair/Types.h>

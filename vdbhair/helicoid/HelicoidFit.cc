@@ -22,6 +22,23 @@ namespace {
 
 Vec3f toF(const Vec3d& v) { return Vec3f(float(v.x()), float(v.y()), float(v.z())); }
 
+/// Helicoid::tangent() with the branchless forms of fastmath's functions (the same polynomials):
+/// the pre-fit's traces call it millions of times, and the branches of the scalar forms (the
+/// quadrant of sin/cos, the reduction of atan) follow the data.
+inline Vec3d prefitTangent(const Helicoid& h, const Vec3d& world, double& thetaRef)
+{
+    const Vec3d d = world - h.p0;
+    const double y1 = d.dot(h.q.t), y2 = d.dot(h.q.n), y3 = d.dot(h.q.b);
+    double th = fastmath::atan2Lane(h.k.kT * y1 + h.k.kN * y2, 1.0 + h.k.kN * y1 - h.k.kT * y2) + h.k.kB * y3;
+    constexpr double twoPi = 2.0 * M_PI;
+    th += twoPi * fastmath::roundLane((thetaRef - th) * (1.0 / twoPi));
+    thetaRef = th;
+    double ct, st, cp, sp;
+    fastmath::sinCosLane(th, st, ct);
+    fastmath::sinCosLane(h.k.alpha * th, sp, cp);
+    return (cp * ct) * h.q.t + (cp * st) * h.q.n + sp * h.q.b;
+}
+
 /// The target strand: distinct points, their arc lengths, and its curvature profile.
 struct Target
 {
@@ -59,6 +76,20 @@ struct Fitter
     Fitter(const Target& t, const FitParams& p, double s) : target(t), params(p), step(s), evalStep(4.0 * s) {}
 
     HelicoidTrace trace;  // scratch
+    std::vector<Vec3d> points;          // scratch: traced points
+    double prefitStop = 0.0;
+    std::vector<Vec3d> denseExact;      // the fragment [exactA, exactB] densified to the scene's step
+    std::size_t exactA = ~std::size_t(0), exactB = 0;
+
+    const std::vector<Vec3d>& exactFragment(std::size_t a, std::size_t b)
+    {
+        if (a != exactA || b != exactB) {
+            densify(target.pts, a, b, step, denseExact);
+            exactA = a;
+            exactB = b;
+        }
+        return denseExact;
+    }
     std::vector<Vec3d> dense;           // the current fragment, densified to evalStep
     std::size_t denseA = ~std::size_t(0), denseB = 0;
 
@@ -85,18 +116,44 @@ struct Fitter
         else tracePHelicoid(p0, q, {pc}, evalStep, HelicoidIntegrator::RK4, out);
     }
 
+    /// The points of tracePiece() at step @a h, without its frames (the same RK4 steps and
+    /// arithmetic as tracePHelicoids): what the objective and the acceptance test compare.
+    void tracePoints(const std::vector<double>& x, double L, const Vec3d& p0, const FrameD& q, double h, std::vector<Vec3d>& out) const
+    {
+        Helicoid hel;
+        hel.k = {x[0] / L, x[1] / L, x[2] / L, x[3]};
+        hel.q = x.size() > 4 ? q.rolled(x[4]) : q;
+        hel.p0 = p0;
+        const std::size_t n = stepCount(L, h);
+        out.resize(n + 1);
+        Vec3d p = p0;
+        double th = hel.theta(p, 0.0);
+        Vec3d k1 = hel.frameFromTheta(th).t;
+        out[0] = p;
+        for (std::size_t j = 0; j < n; ++j) {
+            const double hs = (j + 1 == n) ? L - double(n - 1) * h : h;
+            double t2 = th, t3 = th, t4 = th;
+            const Vec3d k2 = hel.tangent(p + 0.5 * hs * k1, t2);
+            const Vec3d k3 = hel.tangent(p + 0.5 * hs * k2, t3);
+            const Vec3d k4 = hel.tangent(p + hs * k3, t4);
+            p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+            k1 = hel.tangent(p, th);
+            out[j + 1] = p;
+        }
+    }
+
     /// Eq. 5, scale-free: the coupling's mean leash over L, plus λ times the turns of the piece.
     double objective(const std::vector<double>& x, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q)
     {
         ++evaluations;
         const double L = target.arc[b] - target.arc[a];
-        tracePiece(x, L, p0, q, trace);
+        tracePoints(x, L, p0, q, evalStep, points);
         const std::vector<Vec3d>& frag = fragment(a, b);
         std::size_t pairs = 0;
-        const double c = frechetCoupling(frag.data(), frag.size(), trace.points.data(), trace.points.size(), &pairs);
+        const double c = frechetCoupling(frag.data(), frag.size(), points.data(), points.size(), &pairs);
         const double turns = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) / (2.0 * M_PI) + std::abs(x[3]);
         // The end point matters twice: the next piece starts there, and can only bend, not jump.
-        const double end = (trace.points.back() - target.pts[b]).length();
+        const double end = (points.back() - target.pts[b]).length();
         return (c / double(std::max<std::size_t>(1, pairs)) + end) / L + params.lambda * turns;
     }
 
@@ -158,8 +215,8 @@ struct Fitter
     }
 
     /// The piece with scaled parameters @a x traced from (p0, q) at the fragment's own arc
-    /// lengths: out[i] is where target vertex a + i should be (RK4, one step per target segment,
-    /// subdivided to at most the objective's step).
+    /// lengths: out[i] is where target vertex a + i should be (one step of Kutta's third-order rule
+    /// or of RK4, `prefitOrder`, per target segment, subdivided to at most the objective's step).
     void traceAtVertices(const double* x, std::size_t dims, std::size_t a, std::size_t b, const Vec3d& p0, const FrameD& q,
                          std::vector<Vec3d>& out, Vec3d* endTangent = nullptr) const
     {
@@ -173,18 +230,28 @@ struct Fitter
         double th = h.theta(p, 0.0);
         Vec3d k1 = h.frameFromTheta(th).t;
         out[0] = p;
-        auto rk4 = [&](double hs) {
+        auto advance = [&](double hs) {
+            if (params.prefitOrder == 3) {
+                // Kutta's third-order rule: one tangent fewer per step (the last one is the next
+                // step's first).
+                double t2 = th, t3 = th;
+                const Vec3d k2 = prefitTangent(h, p + 0.5 * hs * k1, t2);
+                const Vec3d k3 = prefitTangent(h, p + hs * (2.0 * k2 - k1), t3);
+                p += (hs / 6.0) * (k1 + 4.0 * k2 + k3);
+                k1 = prefitTangent(h, p, th);
+                return;
+            }
             double t2 = th, t3 = th, t4 = th;
-            const Vec3d k2 = h.tangent(p + 0.5 * hs * k1, t2);
-            const Vec3d k3 = h.tangent(p + 0.5 * hs * k2, t3);
-            const Vec3d k4 = h.tangent(p + hs * k3, t4);
+            const Vec3d k2 = prefitTangent(h, p + 0.5 * hs * k1, t2);
+            const Vec3d k3 = prefitTangent(h, p + 0.5 * hs * k2, t3);
+            const Vec3d k4 = prefitTangent(h, p + hs * k3, t4);
             p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            k1 = h.tangent(p, th);
+            k1 = prefitTangent(h, p, th);
         };
-        // Where the strand turns slowly, one RK4 step spans several segments (the strand turning
+        // Where the strand turns slowly, one step spans several segments (the strand turning
         // at most prefitMaxTurn over them: the steps depend on the fragment only, so the traced
         // positions stay smooth in x for the Jacobian), and the vertices inside it are cubic
-        // Hermite interpolants of the step's ends (positions and unit tangents), O(h^4) as RK4.
+        // Hermite interpolants of the step's ends (positions and unit tangents), O(h^4).
         for (std::size_t i = a; i < b;) {
             std::size_t j = i + 1;
             double len = target.arc[j] - target.arc[i];
@@ -192,10 +259,10 @@ struct Fitter
             while (j < b && j - i < 4 && (turn += target.turning[j + 1]) <= params.prefitMaxTurn) len = target.arc[++j] - target.arc[i];
             if (j == i + 1) {
                 const int n = std::max(1, int(std::ceil(len / evalStep - 0.5)));
-                for (int m = 0; m < n; ++m) rk4(len / n);
+                for (int m = 0; m < n; ++m) advance(len / n);
             } else {
                 const Vec3d pa = p, ta = k1;
-                rk4(len);
+                advance(len);
                 for (std::size_t m = i + 1; m < j; ++m) {
                     const double u = (target.arc[m] - target.arc[i]) / len, u2 = u * u, u3 = u2 * u;
                     out[m - a] = (2 * u3 - 3 * u2 + 1) * pa + ((u3 - 2 * u2 + u) * len) * ta + (-2 * u3 + 3 * u2) * p +
@@ -255,8 +322,24 @@ struct Fitter
         residuals(x.data(), dims, a, b, p0, q, r);
         double cost = r.squaredNorm();
         double mu = 1e-3;
-        const Eigen::Index d = Eigen::Index(dims);
-        Eigen::MatrixXd J(r.size(), d);
+        // Good enough: every vertex within prefitStop of its arc-length counterpart.
+        const double wv = 1.0 / (L * std::sqrt(double(b - a)));
+        auto closeEnough = [&](const Eigen::VectorXd& v) {
+            if (!(prefitStop > 0.0)) return false;
+            const double lim = prefitStop * prefitStop * wv * wv;
+            for (std::size_t i = 0; i < b - a; ++i) {
+                const double d2 = v[Eigen::Index(3 * i)] * v[Eigen::Index(3 * i)] + v[Eigen::Index(3 * i + 1)] * v[Eigen::Index(3 * i + 1)] +
+                                  v[Eigen::Index(3 * i + 2)] * v[Eigen::Index(3 * i + 2)];
+                if (d2 > lim) return false;
+            }
+            return true;
+        };
+        if (closeEnough(r)) return cost;
+        // At most 5 parameters: the normal equations are formed by hand and solved on the stack,
+        // rather than with Eigen's general (large-matrix) kernels, which cost as much as a trace
+        // at these sizes.
+        const std::size_t rows = std::size_t(r.size());
+        std::vector<double> J(rows * dims);  // column-major: column j at J[j * rows]
         std::vector<double> xh(x), xn(x);
         // The Jacobian by forward differences, then Broyden's rank-one updates from every trial
         // step (one trace per iteration instead of dims + 1); recomputed when a step fails.
@@ -266,27 +349,61 @@ struct Fitter
                 const double h = 1e-6 * std::max(1.0, std::abs(x[j]));
                 xh[j] += h;
                 residuals(xh.data(), dims, a, b, p0, q, rj);
-                J.col(Eigen::Index(j)) = (rj - r) / h;
+                double* col = &J[j * rows];
+                for (std::size_t k = 0; k < rows; ++k) col[k] = (rj[Eigen::Index(k)] - r[Eigen::Index(k)]) / h;
             }
         };
         jacobian();
         bool fresh = true;
         int rejected = 0;
+        using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 5, 5>;
+        using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 5, 1>;
+        double A[5][5], g[5], dx[5], step[5];
         for (int it = 0; it < params.prefitIterations; ++it) {
-            const Eigen::MatrixXd A = J.transpose() * J;
-            const Eigen::VectorXd g = J.transpose() * r;
-            Eigen::MatrixXd M = A;
-            for (Eigen::Index i = 0; i < d; ++i) M(i, i) += mu * (A(i, i) + 1e-9);
-            const Eigen::VectorXd dx = M.ldlt().solve(-g);
-            for (std::size_t i = 0; i < dims; ++i) xn[i] = x[i] + dx[Eigen::Index(i)];
+            for (std::size_t i = 0; i < dims; ++i) {
+                const double* ci = &J[i * rows];
+                for (std::size_t j = 0; j <= i; ++j) {
+                    const double* cj = &J[j * rows];
+                    double sum = 0.0;
+                    for (std::size_t k = 0; k < rows; ++k) sum += ci[k] * cj[k];
+                    A[i][j] = A[j][i] = sum;
+                }
+                double sum = 0.0;
+                for (std::size_t k = 0; k < rows; ++k) sum += ci[k] * r[Eigen::Index(k)];
+                g[i] = sum;
+            }
+            // dx = -M⁻¹ g with M = A + mu diag(A) (+ a tiny ridge), by LDLᵀ with pivoting: J's
+            // columns can be nearly dependent (a roll that barely moves a nearly straight piece),
+            // and a Cholesky factorization that gives up there was measured worse (wavy at the
+            // former defaults: 3.30 % instead of 3.01 %).
+            Small M(dims, dims);
+            SmallVec rhs(dims);
+            for (std::size_t i = 0; i < dims; ++i) {
+                rhs[Eigen::Index(i)] = -g[i];
+                for (std::size_t j = 0; j < dims; ++j) M(Eigen::Index(i), Eigen::Index(j)) = A[i][j];
+                M(Eigen::Index(i), Eigen::Index(i)) += mu * (A[i][i] + 1e-9);
+            }
+            const SmallVec sol = M.ldlt().solve(rhs);
+            for (std::size_t i = 0; i < dims; ++i) dx[i] = sol[Eigen::Index(i)];
+            for (std::size_t i = 0; i < dims; ++i) xn[i] = x[i] + dx[i];
             clamp(xn);
-            Eigen::VectorXd step(d);
-            for (std::size_t i = 0; i < dims; ++i) step[Eigen::Index(i)] = xn[i] - x[i];
-            const double step2 = step.squaredNorm();
+            double step2 = 0.0;
+            for (std::size_t i = 0; i < dims; ++i) {
+                step[i] = xn[i] - x[i];
+                step2 += step[i] * step[i];
+            }
             if (!(step2 > 1e-20)) break;
             residuals(xn.data(), dims, a, b, p0, q, rn);
             const double newCost = rn.squaredNorm();
-            if (params.broyden && std::isfinite(newCost)) J += ((rn - r - J * step) / step2) * step.transpose();
+            if (params.broyden && std::isfinite(newCost)) {
+                // J += (rn - r - J step) stepᵀ / |step|²
+                for (std::size_t k = 0; k < rows; ++k) {
+                    double u = rn[Eigen::Index(k)] - r[Eigen::Index(k)];
+                    for (std::size_t j = 0; j < dims; ++j) u -= J[j * rows + k] * step[j];
+                    u /= step2;
+                    for (std::size_t j = 0; j < dims; ++j) J[j * rows + k] += u * step[j];
+                }
+            }
             if (std::isfinite(newCost) && newCost < cost) {
                 const double gain = cost - newCost;
                 x = xn;
@@ -296,7 +413,7 @@ struct Fitter
                 fresh = false;
                 rejected = 0;
                 if (!params.broyden) { jacobian(); fresh = true; }
-                if (gain < params.prefitGain * cost) break;
+                if (gain < params.prefitGain * cost || closeEnough(r)) break;
             } else {
                 mu *= 10.0;
                 if (fresh && mu > 1e6) break;
@@ -316,14 +433,14 @@ struct Fitter
                                  const std::function<bool(const std::vector<double>&)>& good = nullptr)
     {
         const double L = target.arc[b] - target.arc[a];
-        double kappa, tau;
-        startEstimate(a, b, kappa, tau);
         const std::size_t dims = allowRoll ? 5 : 4;
         std::vector<std::vector<double>> starts;
         // The strand's curvature and torsion near the start, with the frame rolled so that its
         // normal is the strand's Frenet normal there. A search candidate with a neighbouring
         // fit to start from (@a hint) pre-fits from that alone.
         if (!(hint && !thorough && params.prefitIterations > 0)) {
+            double kappa, tau;
+            startEstimate(a, b, kappa, tau);
             starts.push_back({kappa * L, 0.0, 0.0, kappa > 1e-9 ? std::max(-2.0, std::min(2.0, tau / kappa)) : 0.0});
             if (allowRoll) {
                 const Vec3d& n = target.normal[a];
@@ -459,141 +576,243 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         fit.frame = FrameD::fromTangentNormal(Vec3d(frames[0].t), Vec3d(frames[0].n));
     }
 
-    const double tolerance = params.maxError * target.length;
+    // A fit with more floats than the points it replaces is pointless: 9 floats per strand and
+    // 6 per piece against 3 per vertex.
+    int maxPieces = params.maxPieces;
+    if (params.capByPoints) maxPieces = std::max(1, std::min(maxPieces, (3 * int(std::min<std::size_t>(n, 1 << 20)) - 10) / 6));
     const double minLength = std::max(params.minFragment * target.length, 1e-12);
-    std::size_t a = 0;
-    Vec3d p0 = fit.root;
-    FrameD q = fit.frame;
-    std::vector<double> previous;
+    const bool forward = params.forwardSearch && params.prefitIterations > 0;
     HelicoidTrace trace;
     std::vector<Vec3d> denseTarget;
-    while (a < last) {
-        const bool allowRoll = params.optimizeRoll;
-        const double remaining = target.length - target.arc[a];
-        // Is the fit x of [a, b], as grown, within @a eps of the fragment (discrete Fréchet)?
-        auto within = [&](std::size_t b, const std::vector<double>& x, double eps) {
-            const double L = target.arc[b] - target.arc[a];
-            fitter.tracePiece(x, L, p0, q, trace, /*exact=*/true);
-            densify(target.pts, a, b, step, denseTarget);
-            return discreteFrechetWithin(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size(), eps);
-        };
-        // A candidate fit of [a, b]: pre-fitted from the starts (and @a hint, a fit of [a, hb]);
-        // polished by Nelder–Mead on Eq. 5 only when @a polish (the search for the split
-        // compares pre-fits; the piece kept is polished).
-        auto fitTo = [&](std::size_t b, std::vector<double>& x, bool thorough, bool polish, const std::vector<double>* hint = nullptr,
-                         std::size_t hb = 0, int startsToRun = 0) {
-            int verdict = -1;  // the last pre-fit's acceptance, when known
-            std::function<bool(const std::vector<double>&)> good;
-            if (!polish && params.firstGoodStart) {
-                good = [&](const std::vector<double>& y) {
-                    verdict = within(b, y, tolerance) ? 1 : 0;
-                    return verdict == 1;
-                };
-            }
-            x = fitter.fitPiece(a, b, p0, q, previous.empty() ? nullptr : &previous, allowRoll, thorough, polish, hint,
-                                hint ? target.arc[hb] - target.arc[a] : 0.0, startsToRun, good);
-            return verdict == 1 ? true : within(b, x, tolerance);
-        };
-        // Polish a pre-fit (@a ok: it is acceptable); a polish that makes an acceptable fit
-        // unacceptable is undone (Eq. 5 weighs the mean leash, the acceptance its maximum).
-        auto polishFit = [&](std::size_t b, std::vector<double>& x, bool ok) {
-            std::vector<double> y = x;
-            fitter.polish(y, a, b, p0, q);
-            const bool okAfter = within(b, y, tolerance);
-            if (okAfter || !ok) { x = y; return okAfter; }
-            return ok;
-        };
-        const bool searchWithoutPolish = params.prefitIterations > 0;
-        std::vector<double> x;
-        std::size_t b = last;
-        const bool lastPiece = int(fit.pieces.size()) + 1 >= params.maxPieces || remaining < 2.0 * minLength || last - a < 3;
-        // The last piece allowed is kept whatever its error: it gets every start.
-        bool ok = fitTo(last, x, true, !searchWithoutPolish, nullptr, 0, lastPiece ? params.lastPieceStarts : 0);
-        if (searchWithoutPolish && (lastPiece || ok || within(last, x, params.polishMargin * tolerance))) ok = polishFit(last, x, ok);
-        if (!ok && !lastPiece) {
-            // Upper limit: the longest prefix whose fit is acceptable (the paper's Fréchet
-            // threshold), by bisection over the vertices between the minimum fragment and the
-            // remainder (which failed above), starting at the splitFraction of the remainder.
-            // Each candidate starts from the nearest fit found so far.
-            const std::size_t lo = std::min(last - 1, std::max(a + 2, indexAtArc(target, target.arc[a] + minLength)));
-            std::size_t hi = std::min(last - 1, std::max(lo, indexAtArc(target, target.arc[a] + params.splitFraction * remaining)));
-            const bool thorough = !searchWithoutPolish;
-            const bool polish = !searchWithoutPolish;
-            std::vector<double> xu, xt, xb = x;
-            std::size_t u = lo, good = lo, bad = last;
-            bool okU = false;
-            if (hi > lo && fitTo(hi, xt, thorough, polish, &xb, last)) {
-                good = hi;
-                xu = xt;
-                okU = true;
-            } else {
-                if (hi > lo) { bad = hi; xb = xt; }
-                okU = fitTo(lo, xu, true, polish, hi > lo ? &xb : nullptr, bad);
-            }
-            if (okU) {
-                const std::size_t resolution = std::size_t(std::max(1.0, params.splitResolution * double(last - a)));
-                while (bad - good > resolution) {
-                    const std::size_t mid = (good + bad) / 2;
-                    const bool nearGood = mid - good <= bad - mid;
-                    if (fitTo(mid, xt, thorough, polish, nearGood ? &xu : &xb, nearGood ? good : bad)) { good = mid; xu = xt; }
-                    else { bad = mid; xb = xt; }
+
+    // The pieces (§5.3) accepted within @a tolerance (world units), into f.pieces.
+    auto fitPieces = [&](double tolerance, StrandFit& f) {
+        f.pieces.clear();
+        std::size_t a = 0;
+        Vec3d p0 = f.root;
+        FrameD q = f.frame;
+        std::vector<double> previous;
+        double previousTurn = 0.0;  // turning of the previous piece's upper limit (the forward search's first guess)
+        while (a < last) {
+            const bool allowRoll = params.optimizeRoll;
+            const double remaining = target.length - target.arc[a];
+            // Is the fit x of [a, b], as grown, within @a eps of the fragment (discrete Fréchet)?
+            auto within = [&](std::size_t b, const std::vector<double>& x, double eps) {
+                const double L = target.arc[b] - target.arc[a];
+                std::vector<Vec3d>& pts = fitter.points;
+                fitter.tracePoints(x, L, p0, q, step, pts);
+                if (b < last && (pts.back() - target.pts[b]).length() > params.acceptEndOffset * eps) return false;
+                const std::vector<Vec3d>& frag = fitter.exactFragment(a, b);
+                return discreteFrechetWithin(frag.data(), frag.size(), pts.data(), pts.size(), eps);
+            };
+            // A candidate fit of [a, b]: pre-fitted from the starts (and @a hint, a fit of [a, hb]);
+            // polished by Nelder–Mead on Eq. 5 only when @a polish (the search for the split
+            // compares pre-fits; the piece kept is polished).
+            auto fitTo = [&](std::size_t b, std::vector<double>& x, bool thorough, bool polish, const std::vector<double>* hint = nullptr,
+                             std::size_t hb = 0, int startsToRun = 0) {
+                int verdict = -1;  // the last pre-fit's acceptance, when known
+                std::function<bool(const std::vector<double>&)> good;
+                if (!polish && params.firstGoodStart) {
+                    good = [&](const std::vector<double>& y) {
+                        verdict = within(b, y, tolerance) ? 1 : 0;
+                        return verdict == 1;
+                    };
                 }
-                u = good;
+                fitter.prefitStop = polish ? 0.0 : params.prefitStopFraction * tolerance;
+                x = fitter.fitPiece(a, b, p0, q, previous.empty() ? nullptr : &previous, allowRoll, thorough, polish, hint,
+                                    hint ? target.arc[hb] - target.arc[a] : 0.0, startsToRun, good);
+                return verdict == 1 ? true : within(b, x, tolerance);
+            };
+            // Polish a pre-fit (@a ok: it is acceptable); a polish that makes an acceptable fit
+            // unacceptable is undone (Eq. 5 weighs the mean leash, the acceptance its maximum).
+            auto polishFit = [&](std::size_t b, std::vector<double>& x, bool ok) {
+                if (params.polishEvaluations <= 0) return ok;
+                std::vector<double> y = x;
+                fitter.polish(y, a, b, p0, q);
+                const bool okAfter = within(b, y, tolerance);
+                if (okAfter || !ok) { x = y; return okAfter; }
+                return ok;
+            };
+            const bool searchWithoutPolish = params.prefitIterations > 0;
+            std::vector<double> x;
+            std::size_t b = last;
+            const bool lastPiece = int(f.pieces.size()) + 1 >= maxPieces || remaining < 2.0 * minLength || last - a < 3;
+            // The search for the split's upper limit u (the longest acceptable prefix) and its fit.
+            std::size_t u = last;
+            std::vector<double> xu;
+            bool okU = false, split = false;
+            if (forward && !lastPiece) {
+                // Forward search: candidates [a, b] with b in [lo, hiMax] (leaving at least the
+                // minimum fragment) or the whole remainder. The first candidate ends where the strand
+                // has turned as much as the previous piece's limit did (searchTurn for the first
+                // piece): gallop up from an acceptable candidate by growth, down by halves from an
+                // unacceptable one, then bisect. Each candidate starts from the nearest fit found.
+                const std::size_t lo = std::min(last, std::max(a + 2, indexAtArc(target, target.arc[a] + minLength)));
+                std::size_t hiMax = last;
+                while (hiMax > a && (last - hiMax < 2 || target.arc[last] - target.arc[hiMax] < minLength)) --hiMax;
+                auto snap = [&](std::size_t c) { return c > hiMax ? last : std::max(c, lo); };
+                const double budget = previousTurn > 0.0 ? previousTurn : params.searchTurn;
+                std::size_t g = a + 1;
+                for (double turned = 0.0; g < last && turned + target.turning[g] <= budget; ++g) turned += target.turning[g];
+                const bool polish = !searchWithoutPolish;
+                std::size_t good = a, bad = last + 1, c = snap(g);
+                std::vector<double> xg, xb, xt;
+                // The whole remainder, as the paper's first fit of a fragment: a pre-fit close to
+                // acceptable is polished on Eq. 5 before it is judged.
+                bool polishedLast = false;
+                auto judgeLast = [&](std::size_t cand, std::vector<double>& y, bool ok) {
+                    if (ok || cand != last || !searchWithoutPolish || !within(last, y, params.polishMargin * tolerance)) return ok;
+                    polishedLast = true;
+                    return polishFit(last, y, false);
+                };
+                bool okC = judgeLast(c, xt, fitTo(c, xt, true, polish, nullptr, 0, c == last ? params.lastPieceStarts : 0));
+                (okC ? good : bad) = c;
+                (okC ? xg : xb) = xt;
+                if (okC) {
+                    while (good < last) {
+                        c = snap(a + std::size_t(std::ceil(double(good - a) * params.searchGrowth)));
+                        if (judgeLast(c, xt, fitTo(c, xt, false, polish, &xg, good))) { good = c; xg = xt; }
+                        else { bad = c; xb = xt; break; }
+                    }
+                } else {
+                    while (bad > lo) {
+                        c = std::max(lo, a + (bad - a) / 2);
+                        if (fitTo(c, xt, c == lo, polish, &xb, bad)) { good = c; xg = xt; break; }
+                        bad = c;
+                        xb = xt;
+                    }
+                }
+                if (good > a) {
+                    // Bisect between the longest acceptable and the shortest unacceptable candidate
+                    // (below the minimum remainder when the whole remainder failed).
+                    std::size_t top = bad == last ? hiMax + 1 : bad;
+                    const std::size_t resolution = std::size_t(std::max(1.0, params.splitResolution * double(last - a)));
+                    while (top > good + resolution) {
+                        const std::size_t mid = (good + top) / 2;
+                        const bool nearGood = mid - good <= top - mid || xb.empty();
+                        if (fitTo(mid, xt, false, polish, nearGood ? &xg : &xb, nearGood ? good : bad)) { good = mid; xg = xt; }
+                        else { top = bad = mid; xb = xt; }
+                    }
+                    u = good;
+                    xu = xg;
+                    okU = true;
+                } else {
+                    u = lo;
+                    xu = xb;
+                }
+                if (searchWithoutPolish && !(u == last && polishedLast)) okU = polishFit(u, xu, okU);
+                split = u < last;
+                if (!split) x = xu;
+            } else {
+                // The last piece allowed is kept whatever its error: it gets every start.
+                bool ok = fitTo(last, x, true, !searchWithoutPolish, nullptr, 0, lastPiece ? params.lastPieceStarts : 0);
+                if (searchWithoutPolish && (lastPiece || ok || within(last, x, params.polishMargin * tolerance))) ok = polishFit(last, x, ok);
+                split = !ok && !lastPiece;
             }
-            if (searchWithoutPolish) polishFit(u, xu, okU);
-            // Backtrack from u along the curvature profile to where fragment and fit agree best:
-            // in curvature (the paper's criterion) and, since the next piece starts there, in
-            // position and direction.
-            const double Lu = target.arc[u] - target.arc[a];
-            fitter.tracePiece(xu, Lu, p0, q, trace);
-            std::vector<Vec3f> tf(trace.points.size());
-            for (std::size_t i = 0; i < tf.size(); ++i) tf[i] = toF(trace.points[i]);
-            std::vector<float> fitCurv(tf.size());
-            curvatureProfile(tf.data(), tf.size(), fitCurv.data());
-            std::size_t split = u;
-            double bestScore = std::numeric_limits<double>::max();
-            // A fit that ends on the strand, in its direction, keeps its whole length: backtracking
-            // exists for the fits that drift near their end.
-            const double endOffset = (trace.points.back() - target.pts[u]).length();
-            const double endAngle = std::acos(std::max(-1.0, std::min(1.0, trace.frames.back().t.dot((target.pts[u] - target.pts[u - 1]).unitSafe()))));
-            const bool keepU = endOffset < 0.5 * tolerance && endAngle < 0.1;
-            // The window: the last 40 % of the piece (backtracking adjusts the split; it must not
-            // throw away the length the bisection found acceptable).
-            const double windowStart = std::max(target.arc[a] + minLength, target.arc[u] - 0.4 * (target.arc[u] - target.arc[a]));
-            for (std::size_t v = u; !keepU && v > a + 1 && target.arc[v] >= windowStart; --v) {
-                const double s = target.arc[v] - target.arc[a];
-                const std::size_t m = std::min(tf.size() - 1, std::size_t(std::lround(s / fitter.evalStep)));
-                const Vec3d targetDir = (target.pts[std::min(v + 1, last)] - target.pts[v - 1]).unitSafe();
-                const double angle = std::acos(std::max(-1.0, std::min(1.0, trace.frames[m].t.dot(targetDir))));
-                const double score = std::abs(double(target.curvature[v]) - double(fitCurv[m])) * target.length + angle / 0.05;
-                if (score < bestScore) { bestScore = score; split = v; }
+            if (split && !forward) {
+                // Upper limit: the longest prefix whose fit is acceptable (the paper's Fréchet
+                // threshold), by bisection over the vertices between the minimum fragment and the
+                // remainder (which failed above), starting at the splitFraction of the remainder.
+                // Each candidate starts from the nearest fit found so far.
+                const std::size_t lo = std::min(last - 1, std::max(a + 2, indexAtArc(target, target.arc[a] + minLength)));
+                std::size_t hi = std::min(last - 1, std::max(lo, indexAtArc(target, target.arc[a] + params.splitFraction * remaining)));
+                const bool thorough = !searchWithoutPolish;
+                const bool polish = !searchWithoutPolish;
+                std::vector<double> xt, xb = x;
+                std::size_t good = lo, bad = last;
+                u = lo;
+                if (hi > lo && fitTo(hi, xt, thorough, polish, &xb, last)) {
+                    good = hi;
+                    xu = xt;
+                    okU = true;
+                } else {
+                    if (hi > lo) { bad = hi; xb = xt; }
+                    okU = fitTo(lo, xu, true, polish, hi > lo ? &xb : nullptr, bad);
+                }
+                if (okU) {
+                    const std::size_t resolution = std::size_t(std::max(1.0, params.splitResolution * double(last - a)));
+                    while (bad - good > resolution) {
+                        const std::size_t mid = (good + bad) / 2;
+                        const bool nearGood = mid - good <= bad - mid;
+                        if (fitTo(mid, xt, thorough, polish, nearGood ? &xu : &xb, nearGood ? good : bad)) { good = mid; xu = xt; }
+                        else { bad = mid; xb = xt; }
+                    }
+                    u = good;
+                }
+                if (searchWithoutPolish) polishFit(u, xu, okU);
             }
-            b = split;
-            x = xu;
-            // The piece fitted to [a, u], kept up to the split (the scaled x refer to Lu).
-            const double Lb = target.arc[b] - target.arc[a];
-            for (int k = 0; k < 3; ++k) x[std::size_t(k)] *= Lb / Lu;
+            if (split) {
+                previousTurn = 0.0;
+                for (std::size_t v = a + 1; v < u; ++v) previousTurn += target.turning[v];
+                // Backtrack from u along the curvature profile to where fragment and fit agree best:
+                // in curvature (the paper's criterion) and, since the next piece starts there, in
+                // position and direction.
+                const double Lu = target.arc[u] - target.arc[a];
+                fitter.tracePiece(xu, Lu, p0, q, trace);
+                std::vector<Vec3f> tf(trace.points.size());
+                for (std::size_t i = 0; i < tf.size(); ++i) tf[i] = toF(trace.points[i]);
+                std::vector<float> fitCurv(tf.size());
+                curvatureProfile(tf.data(), tf.size(), fitCurv.data());
+                std::size_t cut = u;
+                double bestScore = std::numeric_limits<double>::max();
+                // A fit that ends on the strand, in its direction, keeps its whole length: backtracking
+                // exists for the fits that drift near their end.
+                const double endOffset = (trace.points.back() - target.pts[u]).length();
+                const double endAngle = std::acos(std::max(-1.0, std::min(1.0, trace.frames.back().t.dot((target.pts[u] - target.pts[u - 1]).unitSafe()))));
+                const bool keepU = endOffset < params.keepOffset * tolerance && endAngle < params.keepAngle;
+                // The window: the last 40 % of the piece (backtracking adjusts the split; it must not
+                // throw away the length the bisection found acceptable).
+                const double windowStart = std::max(target.arc[a] + minLength, target.arc[u] - params.backtrackWindow * (target.arc[u] - target.arc[a]));
+                for (std::size_t v = u; !keepU && v > a + 1 && target.arc[v] >= windowStart; --v) {
+                    const double s = target.arc[v] - target.arc[a];
+                    const std::size_t m = std::min(tf.size() - 1, std::size_t(std::lround(s / fitter.evalStep)));
+                    const Vec3d targetDir = (target.pts[std::min(v + 1, last)] - target.pts[v - 1]).unitSafe();
+                    const double angle = std::acos(std::max(-1.0, std::min(1.0, trace.frames[m].t.dot(targetDir))));
+                    const double score = std::abs(double(target.curvature[v]) - double(fitCurv[m])) * target.length + angle / 0.05;
+                    if (score < bestScore) { bestScore = score; cut = v; }
+                }
+                b = cut;
+                x = xu;
+                // The piece fitted to [a, u], kept up to the split (the scaled x refer to Lu).
+                const double Lb = target.arc[b] - target.arc[a];
+                for (int k = 0; k < 3; ++k) x[std::size_t(k)] *= Lb / Lu;
+            }
+            // Keep the piece and continue from its end, with its frame.
+            const double L = target.arc[b] - target.arc[a];
+            HelicoidPiece pc;
+            pc.k = {x[0] / L, x[1] / L, x[2] / L, x[3]};
+            pc.length = L;
+            pc.roll = x.size() > 4 ? x[4] : 0.0;
+            fitter.tracePiece(x, L, p0, q, trace, /*exact=*/true);  // chain pieces as they will be grown
+            p0 = trace.points.back();
+            q = trace.frames.back();
+            previous = x;
+            for (int k = 0; k < 3; ++k) previous[std::size_t(k)] = previous[std::size_t(k)] / L;  // unscaled for the next start
+            f.pieces.push_back(pc);
+            a = b;
         }
-        // Keep the piece and continue from its end, with its frame.
-        const double L = target.arc[b] - target.arc[a];
-        HelicoidPiece pc;
-        pc.k = {x[0] / L, x[1] / L, x[2] / L, x[3]};
-        pc.length = L;
-        pc.roll = x.size() > 4 ? x[4] : 0.0;
-        fitter.tracePiece(x, L, p0, q, trace, /*exact=*/true);  // chain pieces as they will be grown
-        p0 = trace.points.back();
-        q = trace.frames.back();
-        previous = x;
-        for (int k = 0; k < 3; ++k) previous[std::size_t(k)] = previous[std::size_t(k)] / L;  // unscaled for the next start
-        fit.pieces.push_back(pc);
-        a = b;
+    };
+    // The whole fit, as grown, against the target densified to the same spacing.
+    densify(target.pts, 0, last, step, denseTarget);
+    auto measure = [&](StrandFit& f) {
+        traceFit(f, trace);
+        f.frechet = discreteFrechet(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size());
+    };
+    const double tolerance = params.maxError * target.length;
+    fitPieces(tolerance, fit);
+    measure(fit);
+    // A strand that needs more pieces than it may have ends in a long last piece, however far
+    // it strays: refit with a larger tolerance (longer pieces) and keep the closest fit.
+    for (int retry = 1; retry <= params.relaxRetries && fit.frechet > tolerance && int(fit.pieces.size()) >= maxPieces; ++retry) {
+        StrandFit relaxed = fit;
+        fitPieces(tolerance * std::pow(params.relaxFactor, retry), relaxed);
+        measure(relaxed);
+        if (relaxed.frechet < fit.frechet) fit = relaxed;
+        if (int(relaxed.pieces.size()) < maxPieces) break;  // within the budget: larger tolerances only lose
     }
     bool carried = false;
     for (std::size_t i = 0; i < fit.pieces.size(); ++i) normalizeSign(fit.pieces[i], i == 0, fit.frame, carried);
-    // The whole fit, as grown, against the target densified to the same spacing.
     traceFit(fit, trace);
-    densify(target.pts, 0, last, step, denseTarget);
-    fit.frechet = discreteFrechet(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size());
     std::size_t pairs = 0;
     const double c = frechetCoupling(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size(), &pairs);
     fit.coupling = c / double(std::max<std::size_t>(1, pairs));

@@ -24,49 +24,109 @@
 /// target's own vertices (plus the end point again, the end direction against the strand's —
 /// the next piece starts with this one's end frame, C¹ — weighted by `endTangentWeight`, and a
 /// small Tikhonov term), an O(n) least-squares problem (the end direction, measured at 0.3:
-/// straight 1.66 % -> 1.49 %, curly 2.00 % -> 1.74 %, with fewer pieces); the Jacobian is by forward differences once, then Broyden updates (one trace
-/// per iteration). Its traces take one RK4 step per segment, or one step over up to four segments
-/// where the strand turns less than `prefitMaxTurn`, with Hermite-interpolated vertices (23 % less
-/// CPU on straight hair; such steps can stray from the streamline where the field turns fast off
-/// the curve, so acceptance is always judged on the trace grow produces). The piece kept is then polished by a short Nelder–Mead on Eq. 5 itself (`polishEvaluations`, from
-/// a small simplex), so the result is still the paper's objective, locally; a polish that would
-/// push an acceptable piece over `maxError` is undone (Eq. 5 weighs the mean leash, acceptance
-/// the maximum). `prefitIterations` = 0 restores Nelder–Mead alone.
+/// straight 1.66 % -> 1.49 %, curly 2.00 % -> 1.74 %, with fewer pieces; raised to 0.45 with the
+/// forward search below: wavy 1.88 % -> 1.76 %; 0.6 gave 1.69 % with 4 % more pieces). The
+/// Jacobian is by forward differences once, then Broyden updates (one trace per iteration); the
+/// damped normal equations (at most 5 unknowns) are formed by hand and solved by LDLᵀ with
+/// pivoting on the stack (a Cholesky solve that gives up on nearly dependent columns was worse:
+/// wavy at the former defaults 3.30 % instead of 3.01 %). Its traces take one step per segment,
+/// or one step over up to four segments where the strand turns less than `prefitMaxTurn`, with
+/// Hermite-interpolated vertices (23 % less CPU on straight hair; such steps can stray from the
+/// streamline where the field turns fast off the curve, so acceptance is always judged on the
+/// trace grow produces). A step is Kutta's third-order rule (`prefitOrder` 3: three tangents, the
+/// last shared with the next step, against RK4's four; 7 % fewer instructions, and on wavy 1.76 %
+/// against RK4's 1.78 %; the midpoint rule saved 14 % but its bias flipped borderline
+/// candidates: 1.84 % and twice the strands over maxError), with the branchless forms of
+/// fastmath's sin/cos and atan2 (the same polynomials; the scalar forms' branches follow the data:
+/// 9 % faster on wavy, interleaved runs on one thread). A search candidate's pre-fit stops as
+/// soon as every vertex is within `prefitStopFraction` (0.7) of the tolerance of its arc-length
+/// counterpart: it only has to be judged (wavy: 768 -> 645 evaluations per strand; 1.77 %
+/// without). The piece kept is then polished by a short Nelder–Mead on Eq. 5 itself
+/// (`polishEvaluations`, 20, from a small simplex), so the result is still the paper's objective,
+/// locally; a polish that would push an acceptable piece over `maxError` is undone (Eq. 5 weighs
+/// the mean leash, acceptance the maximum). The polish matters at C¹ joints: without it wavy is at
+/// 1.95 % with 72 strands over maxError (1.76 % and 23 with it); 30 evaluations gave 1.77 %.
+/// `prefitIterations` = 0 restores Nelder–Mead alone.
 /// Starts: the strand's curvature and torsion near the fragment's start — kT = mean curvature,
 /// alpha = mean torsion / curvature, the frame rolled so its normal is the strand's Frenet normal
 /// there — and, for whole fragments, k = 0 and the previous piece's k; the `prefitStarts` with
 /// the lowest pre-fit cost are pre-fitted in that order, stopping at the first within `maxError`
-/// (the last piece allowed tries `lastPieceStarts`). A candidate of the split search starts from the nearest fit already found.
+/// (the last piece allowed tries `lastPieceStarts`). A candidate of the split search starts from
+/// the nearest fit already found.
 ///
 /// Pieces (§5.3): a fragment whose fit's discrete Fréchet distance is within `maxError` of the
 /// strand's length is accepted; otherwise the fragment is split. The upper limit of the split is
-/// the longest prefix whose fit is acceptable (the paper's Fréchet threshold), searched by
-/// bisection from the `splitFraction` of the fragment (60 %, the paper's value) upwards if that is
-/// acceptable, towards the minimum fragment if not, to within `splitResolution` of its vertices;
-/// candidates are judged by their pre-fits with discreteFrechetWithin (the decision version, which
-/// stops early), and only the chosen one is polished. From that limit the split backtracks along
-/// the curvature profile to the vertex where fragment and fit differ least in curvature (and
-/// direction), within the last 40 % of the piece, never leaving a fragment shorter than
-/// `minFragment` of the strand. Each piece starts at the end of the previous fitted piece with
-/// its frame (C¹, as the paper's pieces), so only k — and, with `optimizeRoll`, a roll about the
-/// tangent — is fitted after the first. The first piece fits a roll too: the strand's Frenet
-/// normal at the root is rarely the normal of the helicoid that generated it (measured before the
-/// pre-fit: 1.84 % -> 1.57 % mean error on straight.hair).
+/// the longest prefix whose fit is acceptable. Candidates are judged by their pre-fits with
+/// discreteFrechetWithin (the decision version, which stops early) on the trace grow produces;
+/// a candidate that is not the last piece must also end within `acceptEndOffset` (0.7) of the
+/// tolerance of its target vertex, since the next piece starts where it ends (without this, wavy
+/// 1.86 % with 47 strands over maxError: a piece ending at the edge of the tolerance hands its
+/// successor a start it often cannot recover from). Only the chosen candidate is polished.
 ///
-/// Measured (vdbhair_benchmark --sections fit --fit-strands 500 --reps 1, 2 threads, strands
-/// resampled to 30 vertices; mean / p95 discrete Fréchet error relative to length, pieces,
-/// evaluations per strand, strands/s; wall-clock rates vary ±40 % with other load on the machine):
-///   straight 1.52 % / 1.97 %, 2.26 pieces, 234, 1489/s   (before the pre-fit: 1.58 %, 2.16, 2645, 118/s)
-///   wavy     2.99 % / 5.46 %, 7.82 pieces, 1076, 490/s   (before: 3.84 %, 7.93, 10260, 51/s)
-///   curly    1.74 % / 2.00 %, 4.06 pieces, 516, 848/s    (before: 1.95 %, 4.36, 5886, 72/s)
-///   short    1.50 % / 1.96 %, 2.28 pieces, 226, 1575/s   (before: 1.71 %, 2.13, 2389, 118/s)
-/// Wavy (harolongo: noisy coils, about 33° of turning per segment and ~600° per strand) stays
-/// short of 2 %. Our reading: with phi = alpha·theta a helicoid cannot hold a helix's constant
-/// tilt, so a piece follows a coil for less than a turn, and C¹ joints pass each piece's
-/// direction error on to the next. More pieces help little (maxPieces 12 or 16: 2.53 %, 8.3
-/// pieces: the split search then ends at the 8 % minimum fragment, whose fit can still fail),
-/// nor did pre-fitting every start for split candidates (3.0-3.2 %, measured before the end
-/// direction residual).
+/// Deviation in the search for the upper limit (`forwardSearch`, the default): the paper's
+/// reading — the whole fragment, then 60 % of it (`splitFraction`), then bisection towards the
+/// minimum fragment — pre-fits long candidates that fail on wavy hair, whose pieces cover a ninth
+/// of the strand. The forward search first fits the whole remainder when the strand turns less
+/// than `searchTurn` (2 rad) over it (the paper's first fit of a fragment; a pre-fit within
+/// `polishMargin` of acceptable is polished before it is judged), else the prefix over which it
+/// turns that much; later pieces start from the turning the previous piece's upper limit covered.
+/// From an acceptable candidate it gallops up (`searchGrowth`, 1.5, times as long, or the whole
+/// remainder), from an unacceptable one down by halves to the minimum fragment, then bisects to
+/// `splitResolution`, each candidate warm-started from the nearest fit found. Measured at the same
+/// settings otherwise (500 strands, one thread; these comparisons were run before the branchless
+/// pre-fit math, which moves wavy by a few hundredths of a percent either way): wavy top-down 1.81 %, 9.01 pieces, 1052
+/// evaluations per strand, 228 strands per CPU second; forward 1.76 %, 9.12 pieces, 645
+/// evaluations, 627 per CPU second (a gallop of 2: 670 evaluations); curly 1.63 % -> 1.56 %,
+/// 374 -> 298 evaluations; straight 226 -> 194 evaluations, 2.75 -> 2.59 pieces but 1.38 % ->
+/// 1.49 % (the top-down search cuts straight strands into more, shorter pieces).
+/// From the upper limit the split backtracks along the curvature profile, the paper's rule, to
+/// the vertex where fragment and fit differ least in curvature (and direction), within the last
+/// `backtrackWindow` (40 %) of the piece, never leaving a fragment shorter than `minFragment`
+/// (3 % of the strand, and two segments); a fit that ends within `keepOffset` (0.7) of the
+/// tolerance of the strand and `keepAngle` (0.3 rad) of its direction keeps its whole length
+/// (with the former 0.5 and 0.1 rad the short pieces of wavy hair were cut back nearly always:
+/// 10.2 pieces and 32 strands over maxError; without backtracking 1.85 %, 8.56 pieces).
+/// Each piece starts at the end of the previous fitted piece with its frame (C¹, as the paper's
+/// pieces), so only k — and, with `optimizeRoll`, a roll about the tangent — is fitted after the
+/// first. The first piece fits a roll too: the strand's Frenet normal at the root is rarely the
+/// normal of the helicoid that generated it (measured before the pre-fit: 1.84 % -> 1.57 % mean
+/// error on straight.hair).
+///
+/// Piece budget: at most `maxPieces` (16) and, with `capByPoints`, (3 n - 10) / 6 for n vertices,
+/// so that a fit (9 floats and 6 per piece) is never larger than its points (3 floats a vertex):
+/// 13 pieces at 30 vertices, 8 at 21. Each strand takes only the pieces it needs. The last piece
+/// allowed takes what remains, however far it strays; a strand that used every piece and still
+/// misses maxError is refitted with `relaxFactor` (1.4) times the tolerance, up to `relaxRetries`
+/// (2) times, and the closest fit kept (longer pieces, so the budget reaches the tip): wavy at its
+/// stored 21 vertices 4.21 % -> 2.80 %, at 2.6 times the evaluations (without the cap: 2.39 % but
+/// fits larger than the points, 0.98x); at 30 vertices it rarely triggers.
+///
+/// Measured (vdbhair_benchmark --sections fit, 2 threads, best of 3, strands resampled to 30
+/// vertices unless noted; mean / p95 discrete Fréchet error relative to length, pieces,
+/// evaluations per strand, strands/s; wall-clock rates vary ±30 % or more with other load;
+/// "before" is the previous top-down search with at most 8 pieces, on the same rows):
+///   straight 1.50 % / 1.96 %, 2.60 pieces, 196, 1671/s   (before: 1.53 %, 1239/s)
+///   straight 16 vertices (as stored) 1.64 % / 2.23 %, 3.44 pieces, 326, 2424/s
+///   wavy     1.78 % / 2.00 %, 9.20 pieces, 651, 1278/s   (before: 3.13 % / 5.88 %, 7.80, 1076, 411/s)
+///   wavy 21 vertices (as stored) 2.78 % / 3.84 %, 7.66 pieces, 1324, 803/s   (before: 3.62 %, 552/s)
+///   curly    1.54 % / 1.94 %, 4.07 pieces, 293, 1566/s   (before: 1.74 %, 712/s)
+///   short    1.38 % / 1.93 %, 2.23 pieces, 147, 1921/s   (before: 1.50 %, 1280/s)
+/// (on a quiet machine; with another build sharing the host the same binary gave wavy 662/s).
+/// Wavy (harolongo: noisy coils, about 20° of turning per segment at 30 vertices and ~600° per
+/// strand) needs about 9 pieces for 2 %: with phi = alpha·theta a helicoid cannot hold a helix's
+/// constant tilt, so a piece follows a coil for about 60° of turning (3-4 segments), and C¹
+/// joints pass each piece's direction error on to the next. Error against pieces (the tolerance
+/// varied, 500 strands): maxError 1.5 % -> 1.36 % mean, 10.1 pieces; 2 % -> 1.76 %, 9.1; 2.5 % ->
+/// 2.20 %, 8.3; at most 8 pieces (the former cap) 2.41 %. The former minimum fragment of 8 % of
+/// the strand was what held it back before (2.45 % with it, everything else as now).
+/// Measured and not kept: pieces of one segment (more pieces, no lower error), one-vertex
+/// resolution of the search (1.78 %, 662 evaluations), a first candidate from 1 rad of turning
+/// (1.76 % but p95 2.11 %), a midpoint pre-fit trace (see above), pre-fitting later pieces' first
+/// candidate from a single start (more strands over maxError), a Jacobian by forward-mode
+/// automatic differentiation (one trace in dual numbers instead of five: the same errors, but a
+/// dual trace costs about four plain ones, so only 4 % fewer instructions for 150 lines), and
+/// refreshing the Broyden Jacobian after three rejected steps instead of two (more strands over
+/// maxError).
 /// Kept fits have kT >= 0: a negative kT is flipped with a half-turn roll of the frame, the same
 /// curve (§3's sign symmetry; with Eq. 1 as printed it is a half turn about E_T).
 #pragma once
@@ -86,16 +146,28 @@ struct FitParams
 {
     double maxError = 0.02;       ///< accepted discrete Fréchet distance, as a fraction of the strand length
     double lambda = 1e-3;         ///< regularization weight (dimensionless, see above)
-    int maxPieces = 8;
-    double splitFraction = 0.6;   ///< the paper's Fréchet threshold for the split's upper limit
-    double minFragment = 0.08;    ///< shortest piece, as a fraction of the strand length
+    int maxPieces = 16;           ///< most pieces per strand (see capByPoints)
+    bool capByPoints = true;      ///< also at most (3 n - 10) / 6 pieces for n vertices: a fit never has more floats than its points
+    bool forwardSearch = true;    ///< search the split's upper limit forwards from a guess (else top-down from splitFraction, the paper's reading)
+    double searchTurn = 2.0;      ///< the forward search's first candidate for the first piece: where the strand has turned this much (radians)
+    double searchGrowth = 1.5;    ///< the forward search's gallop: an acceptable candidate is followed by one this many times as long
+    double splitFraction = 0.6;   ///< the paper's Fréchet threshold for the split's upper limit (top-down search)
+    double minFragment = 0.03;    ///< shortest piece, as a fraction of the strand length (and at least two segments)
     double splitResolution = 0.1; ///< the search for the upper limit stops within this fraction of the fragment's vertices (0: one vertex)
+    double acceptEndOffset = 0.7; ///< a piece before the last is accepted only if it also ends within this fraction of the tolerance of its target vertex (the next piece starts there)
+    double backtrackWindow = 0.4; ///< the split backtracks from the upper limit within this fraction of the piece
+    double keepOffset = 0.7;      ///< no backtracking for a fit ending within this fraction of the tolerance of its target vertex ...
+    double keepAngle = 0.3;       ///< ... and within this angle (radians) of the strand's direction there
+    int relaxRetries = 2;         ///< refits of a strand that used every piece allowed and still misses maxError, each with relaxFactor times the tolerance
+    double relaxFactor = 1.4;
     bool optimizeRoll = true;     ///< also fit a roll angle for pieces after the first (measured: halves the mean error)
     int maxEvaluations = 300;     ///< Nelder–Mead evaluations per piece without a pre-fit
-    int polishEvaluations = 30;   ///< Nelder–Mead evaluations of a polish after the pre-fit
+    int polishEvaluations = 20;   ///< Nelder–Mead evaluations of a polish after the pre-fit (0: no polish)
     int prefitIterations = 10;    ///< Levenberg–Marquardt iterations of the pre-fit per start (0: none, Nelder–Mead from the raw starts)
-    double endTangentWeight = 0.3; ///< pre-fit weight of the end direction's residual (unit vectors; positions count as fractions of L)
+    double prefitStopFraction = 0.7; ///< a search candidate's pre-fit stops once every vertex is within this fraction of the tolerance of its arc-length counterpart (0: never)
+    double endTangentWeight = 0.45; ///< pre-fit weight of the end direction's residual (unit vectors; positions count as fractions of L)
     double prefitMaxTurn = 0.3;   ///< radians an RK4 step of the pre-fit may turn when it spans several segments (0: one step per segment)
+    int prefitOrder = 3;          ///< the pre-fit traces with Kutta's third-order rule (3) or RK4 (4): 7 % less CPU, the same errors
     bool broyden = true;          ///< pre-fit Jacobians by Broyden updates (else forward differences every iteration)
     int prefitStarts = 2;         ///< starts pre-fitted for a whole fragment, the best by the pre-fit's cost at the start (3: all; measured on wavy: 2.99 % with 2, 3.05 % with 3 at 11 % more evaluations, 3.95 % with 1)
     bool firstGoodStart = true;   ///< stop at the first pre-fit within maxError (else pre-fit every start and keep the best)
