@@ -78,30 +78,27 @@ struct Fitter
     HelicoidTrace trace;  // scratch
     std::vector<Vec3d> points;          // scratch: traced points
     double prefitStop = 0.0;
-    std::vector<Vec3d> denseExact;      // the fragment [exactA, exactB] densified to the scene's step
-    std::size_t exactA = ~std::size_t(0), exactB = 0;
-
-    const std::vector<Vec3d>& exactFragment(std::size_t a, std::size_t b)
+    /// The target's vertices a..b densified to one spacing, kept while the same fragment is asked for.
+    struct DenseFragment
     {
-        if (a != exactA || b != exactB) {
-            densify(target.pts, a, b, step, denseExact);
-            exactA = a;
-            exactB = b;
-        }
-        return denseExact;
-    }
-    std::vector<Vec3d> dense;           // the current fragment, densified to evalStep
-    std::size_t denseA = ~std::size_t(0), denseB = 0;
+        std::vector<Vec3d> pts;
+        std::size_t a = ~std::size_t(0), b = 0;
 
-    const std::vector<Vec3d>& fragment(std::size_t a, std::size_t b)
-    {
-        if (a != denseA || b != denseB) {
-            densify(target.pts, a, b, evalStep, dense);
-            denseA = a;
-            denseB = b;
+        const std::vector<Vec3d>& get(const Target& target, std::size_t first, std::size_t last, double spacing)
+        {
+            if (first != a || last != b) {
+                densify(target.pts, first, last, spacing, pts);
+                a = first;
+                b = last;
+            }
+            return pts;
         }
-        return dense;
-    }
+    };
+    DenseFragment denseExact;  ///< at the scene's step
+    DenseFragment dense;       ///< at the objective's step (evalStep)
+
+    const std::vector<Vec3d>& exactFragment(std::size_t a, std::size_t b) { return denseExact.get(target, a, b, step); }
+    const std::vector<Vec3d>& fragment(std::size_t a, std::size_t b) { return dense.get(target, a, b, evalStep); }
 
     /// Trace one piece with scaled parameters x = (kT L, kN L, kB L, alpha[, roll]): RK4 at the
     /// objective's step, or (@a exact) Euler at the scene's step, as the strand will be grown.
