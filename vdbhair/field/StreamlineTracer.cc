@@ -410,26 +410,21 @@ private:
         const int e = l & 3;
         const float local[3] = {G.lx[e], G.ly[e], G.lz[e]};
         int b[3];
-        // The common case: the step left the brick by less than a brick (local in (-8, 16)):
-        // the base moves by -8, 0 or +8 on each axis, and the offsets by exact small integers.
+        bool far = false;
         if (std::abs(local[0] - 4.f) < 12.f && std::abs(local[1] - 4.f) < 12.f && std::abs(local[2] - 4.f) < 12.f) {
+            // The common case: the step left the brick by less than a brick (local in (-8, 16)):
+            // the base moves by -8, 0 or +8 on each axis, and the offsets by exact small integers.
             for (int a = 0; a < 3; ++a) b[a] = L.base[a] + 8 * (int(local[a] >= 8.f) - int(local[a] < 0.f));
         } else {
-            bool far = false;
-            for (int a = 0; a < 3; ++a) {
-                if (!(std::abs(double(local[a])) < kFar)) {  // a huge step, or NaN
-                    far = true;
-                    break;
-                }
-                b[a] = L.base[a] + 8 * floorToInt(double(local[a]) * 0.125);
-            }
-            if (far) {
-                goFar(l, worldOf(l));
-                return;
+            for (int a = 0; a < 3 && !far; ++a) {
+                far = !(std::abs(double(local[a])) < kFar);  // a huge step, or NaN
+                if (!far) b[a] = L.base[a] + 8 * floorToInt(double(local[a]) * 0.125);
             }
         }
-        constexpr std::uint32_t kFarI = std::uint32_t(kFar);  // |b| < kFar, as one unsigned test per axis
-        if (!(std::uint32_t(b[0]) + kFarI < 2 * kFarI && std::uint32_t(b[1]) + kFarI < 2 * kFarI && std::uint32_t(b[2]) + kFarI < 2 * kFarI)) {
+        // |b| < kFar on every axis, as one unsigned test each.
+        constexpr std::uint32_t kFarI = std::uint32_t(kFar);
+        for (int a = 0; a < 3 && !far; ++a) far = !(std::uint32_t(b[a]) + (kFarI - 1) < 2 * kFarI - 1);
+        if (far) {
             goFar(l, worldOf(l));
             return;
         }
@@ -678,9 +673,12 @@ private:
         // Output vertex u of @a count from step point p: all four floats of the world position
         // in one store where the next vertex (of this strand, written later) takes the fourth.
         auto emit = [&](Vec3f* out, std::size_t u, std::size_t count, const Float4& p) {
+            if (u + 1 == count) {
+                out[u] = world(p);
+                return;
+            }
             const Float4 w = o4 + p * s4;
-            if (u + 1 < count) __builtin_memcpy(out[u].asPointer(), &w, sizeof w);
-            else out[u] = Vec3f(w[0], w[1], w[2]);
+            __builtin_memcpy(out[u].asPointer(), &w, sizeof w);
         };
         const Vec3f root = job.in.root(i);
         if (!mInputMode) {
