@@ -91,9 +91,10 @@ StrandSet jitteredCopies(const StrandSet& base, std::size_t count, std::size_t v
 }
 
 /// @brief A reference hairstyle whose field fits in the processor's cache: @a count gently wavy
-/// strands of @a vertices vertices, half a unit apart, running along x through a 7 × 7 unit
-/// cross-section (seeded, deterministic). At voxel size 1 its field is a handful of leaves, so
-/// tracing it measures the tracers' own work, without the cache misses of a large field.
+/// strands of @a vertices vertices half a unit apart, running along x with roots in a 6 × 6 × 6
+/// unit cube (seeded, deterministic). At voxel size 1 (used whatever --voxel-size says) its field
+/// is one leaf across and a few long (5 leaves at 64 vertices), so tracing it measures the
+/// tracers' own work, without the cache misses of a large field.
 StrandSet bundleInCache(std::size_t count, std::size_t vertices)
 {
     StrandSet out;
