@@ -1,6 +1,6 @@
 /// @file RefineOptions.h
 /// @brief What `refine` and `demo` share: the refinement options and their reports
-/// (defined in commands/Refine.cc and commands/Retrace.cc).
+/// (defined in commands/Refine.cc; the trace report in commands/Retrace.cc).
 #pragma once
 
 #include "Command.h"
@@ -11,28 +11,31 @@
 
 namespace vdbhair::app {
 
+/// The command line of refine: options bind to the library's RefineParams fields, so `--help`
+/// shows the library's defaults.
 struct RefineCmdParams
 {
     std::string input, output, saveField;
-    double voxelSize = 0.0;
+    RefineParams refine;
     CLI::Option* voxelOpt = nullptr;  ///< whether --voxel-size was given
-    int levels = 1, iterations = 2;
-    double step = 0.0;
     CLI::Option* stepOpt = nullptr;   ///< whether --step was given
+    std::string mode = "consistent";
     std::string integrator = "euler";
-    int margin = 3;
-    std::uint64_t maxVoxels = std::uint64_t(1) << 26;
+    std::string head;                 ///< --head: a .vdb level set, or "none"
     bool strict = false;
     ScalpOptions scalp;
 };
 
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p);
-/// @throw ValueError for out-of-range options.
+/// @throw ValueError for out-of-range options, IoError/FormatError for an unreadable --head.
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands);
 openvdb::GridCPtrVec fieldGrids(const RefineResult& r);
+/// The refine report: settings, then what an artist sees (RefineMeasures), for the finest level
+/// and for every level.
 nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp);
+void printRefineReport(const RefineResult& r, const RefineParams& rp);
 
-/// The report of retrace and refine: {"strands","full_length","stopped":{...},"tangent_angle_deg":{...},"mean_displacement"}.
+/// The report of retrace: {"strands","full_length","stopped":{...},"tangent_angle_deg":{...},"mean_displacement"}.
 nlohmann::json traceReportJson(const TraceStats& s, double before, double after, double displacement);
 void printTraceReport(const TraceStats& s, double before, double after, double displacement);
 

@@ -91,9 +91,9 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
                   << s.length.min << " .. " << s.length.max << " (mean " << s.length.mean << ")\n"
                   << "refined through its own tangent field (" << rp.levels << " level(s), finest voxel size " << r.voxelSize
                   << ", " << rp.field.iterations << " iterations of Wang et al. Eq. 9) in " << seconds << " s\n";
-        printTraceReport(r.stats, r.angleBefore, r.angleAfter, r.meanDisplacement);
+        printRefineReport(r, rp);
         std::cout << "wrote " << refinedPath << " (refined strands)\n"
-                  << "wrote " << fieldPath << " (grids 'tangent' and 'density')\n"
+                  << "wrote " << fieldPath << " (grids 'tangent', 'density', 'coherence' and 'spread')\n"
                   << "wrote " << strandsPath << " (points grids 'strands' and 'strands_input', for Houdini or Blender)\n"
                   << "wrote " << previewPath << " (before and after)\n"
                   << "wrote " << reportPath << "\n";

@@ -13,25 +13,42 @@ namespace vdbhair::app {
 
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands)
 {
-    RefineParams rp;
+    RefineParams rp = p.refine;
     const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0, stepGiven = p.stepOpt && p.stepOpt->count() > 0;
-    if (voxelGiven && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
-        throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive finite length");
+    const double voxel = rp.field.voxelSize;
+    if (voxelGiven && (!(voxel > 0.0) || !std::isfinite(voxel))) {
+        throw ValueError("--voxel-size " + formatValue(voxel) + ": must be a positive finite length");
     }
-    if (stepGiven && (!(p.step > 0.0) || !std::isfinite(p.step))) {
-        throw ValueError("--step " + formatValue(p.step) + ": must be a positive finite length");
+    if (!voxelGiven) rp.field.voxelSize = 0.0;
+    if (stepGiven && (!(rp.trace.step > 0.0) || !std::isfinite(rp.trace.step))) {
+        throw ValueError("--step " + formatValue(rp.trace.step) + ": must be a positive finite length");
     }
-    if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
-    if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");
-    rp.field.voxelSize = voxelGiven ? p.voxelSize : 0.0;
-    rp.field.iterations = p.iterations;
-    rp.field.maxVoxels = p.maxVoxels;
-    rp.levels = p.levels;
-    rp.trace.step = stepGiven ? p.step : 0.0;
+    rp.consistency.step = rp.trace.step;  // one --step for both modes
+    if (rp.field.iterations < 1) throw ValueError("--iterations " + std::to_string(rp.field.iterations) + ": must be at least 1");
+    if (rp.levels < 1 || rp.levels > RefineParams::kMaxLevels) {
+        throw ValueError("--levels " + std::to_string(rp.levels) + ": must be between 1 and " + std::to_string(RefineParams::kMaxLevels));
+    }
+    if (rp.trace.margin < 0 || rp.trace.margin > 16) throw ValueError("--margin " + std::to_string(rp.trace.margin) + ": must be between 0 and 16 voxels");
+    if (!(rp.consistency.zStart >= 0.0) || !std::isfinite(rp.consistency.zStart)) {
+        throw ValueError("--outlier-start " + formatValue(rp.consistency.zStart) + ": must be finite and at least 0");
+    }
+    if (!(rp.consistency.zFull > rp.consistency.zStart) || !std::isfinite(rp.consistency.zFull)) {
+        throw ValueError("--outlier-full " + formatValue(rp.consistency.zFull) + ": must be finite and above --outlier-start " +
+                         formatValue(rp.consistency.zStart));
+    }
+    if (!(rp.consistency.minSpreadDeg >= 0.0 && rp.consistency.minSpreadDeg < 90.0)) {
+        throw ValueError("--min-spread " + formatValue(rp.consistency.minSpreadDeg) + ": must be in [0, 90) degrees");
+    }
+    rp.mode = refineModeFromName(p.mode);
     rp.trace.integrator = integratorFromName(p.integrator);
-    if (p.margin < 0 || p.margin > 16) throw ValueError("--margin " + std::to_string(p.margin) + ": must be between 0 and 16 voxels");
-    rp.trace.margin = p.margin;
     applyScalpOptions(p.scalp, strands, rp.field);
+    if (p.head == "none") {
+        rp.head = HeadObstacle::none();
+    } else if (!p.head.empty()) {
+        rp.head = readHeadObstacle(p.head, "--head " + p.head);
+    } else if (!p.scalp.sphere.empty()) {
+        rp.head = HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius);
+    }
     return rp;
 }
 
@@ -39,20 +56,85 @@ openvdb::GridCPtrVec fieldGrids(const RefineResult& r)
 {
     openvdb::GridCPtrVec grids;
     for (const TangentField& f : r.fields) {
-        grids.push_back(f.tangent);
-        grids.push_back(f.density);
+        for (const openvdb::GridBase::ConstPtr& g : f.grids()) grids.push_back(g);
     }
     return grids;
 }
 
+namespace {
+
+nlohmann::json measuresJson(const RefineMeasures& m)
+{
+    return {{"strands", m.strands},
+            {"full_length", m.fullLength},
+            {"left_hair_volume", m.leftVolume},
+            {"left_hair_volume_examples", m.leftExamples},
+            {"inside_head", {{"before", m.insideHeadBefore}, {"after", m.insideHeadAfter}}},
+            {"curvature_kept", {{"vertex", m.curvatureKeptVertex}, {"segments8", m.curvatureKept8}}},
+            {"tip_occupancy", m.tipOccupancy},
+            {"displacement_voxels", {{"mean", m.displacementMean}, {"p95", m.displacementP95}}},
+            {"coherence", {{"before", m.coherenceBefore}, {"after", m.coherenceAfter}}}};
+}
+
+} // namespace
+
 nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp)
 {
-    nlohmann::json j = traceReportJson(r.stats, r.angleBefore, r.angleAfter, r.meanDisplacement);
+    nlohmann::json j = rp.measure ? measuresJson(r.levels.front().measures) : nlohmann::json::object();
+    j["mode"] = refineModeName(rp.mode);
     j["voxel_size"] = r.voxelSize;
     j["levels"] = rp.levels;
     j["iterations"] = rp.field.iterations;
     j["space"] = fieldSpaceName(rp.field.space);
+    j["head"] = r.head.describe();
+    nlohmann::json per = nlohmann::json::array();
+    for (std::size_t l = 0; l < r.levels.size(); ++l) {
+        const RefineLevel& lv = r.levels[l];
+        nlohmann::json e = rp.measure ? measuresJson(lv.measures) : nlohmann::json::object();
+        e["level"] = l;
+        e["voxel_size"] = lv.voxelSize;
+        if (rp.mode == RefineMode::Consistent) {
+            e["corrected_strands"] = lv.consistency.corrected;
+            e["field_steps"] = lv.consistency.fieldSteps;
+            e["no_field_steps"] = lv.consistency.noFieldSteps;
+            e["steps"] = lv.consistency.steps;
+            e["pushed_out_of_head"] = lv.consistency.pushedOut;
+            e["held_in_hair_steps"] = lv.consistency.heldIn;
+        } else {
+            e["stopped"] = {{"vanished", lv.trace.vanished}, {"left_field", lv.trace.leftField}, {"max_steps", lv.trace.maxSteps}};
+        }
+        per.push_back(e);
+    }
+    j["per_level"] = per;
+    if (rp.mode == RefineMode::Consistent) j["corrected_strands"] = r.levels.front().consistency.corrected;
     return j;
+}
+
+void printRefineReport(const RefineResult& r, const RefineParams& rp)
+{
+    std::cout << "refined " << r.strands.numStrands() << " strands (" << refineModeName(rp.mode) << " mode) with " << rp.levels
+              << " level(s), finest voxel size " << r.voxelSize << " (" << fieldSpaceName(rp.field.space) << " space); head: "
+              << r.head.describe() << "\n";
+    for (std::size_t l = r.levels.size(); l-- > 0;) {
+        const RefineLevel& lv = r.levels[l];
+        std::cout << "level " << l << " (voxel " << lv.voxelSize << "): ";
+        if (rp.mode == RefineMode::Consistent) {
+            std::cout << lv.consistency.corrected << " strands corrected where they strayed from the flow, "
+                      << lv.consistency.pushedOut << " segments kept out of the head\n";
+        } else {
+            std::cout << lv.trace.fullLength << " full length, " << lv.trace.vanished << " stopped where the field vanished, "
+                      << lv.trace.leftField << " left the field\n";
+        }
+    }
+    if (!rp.measure) return;
+    const RefineMeasures& m = r.levels.front().measures;
+    std::cout << "against the input: " << m.fullLength << " of " << m.strands << " strands at full length, " << m.leftVolume
+              << " leave the hair volume, vertices inside the head " << m.insideHeadBefore << " before and " << m.insideHeadAfter
+              << " after\n"
+              << "curvature kept " << 100.0 * m.curvatureKept8 << " % at 8 segments (" << 100.0 * m.curvatureKeptVertex
+              << " % at the vertices), tips in place " << 100.0 * m.tipOccupancy << " %\n"
+              << "displacement " << m.displacementMean << " voxels mean, " << m.displacementP95 << " at the 95th percentile; "
+              << "coherence " << m.coherenceBefore << " before, " << m.coherenceAfter << " after\n";
 }
 
 namespace {
@@ -77,9 +159,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
         j["output"] = p.output;
         printJson(j);
     } else if (!common.quiet) {
-        std::cout << "refined with " << rp.levels << " level(s), finest voxel size " << r.voxelSize << " ("
-                  << fieldSpaceName(rp.field.space) << " space)\n";
-        printTraceReport(r.stats, r.angleBefore, r.angleAfter, r.meanDisplacement);
+        printRefineReport(r, rp);
         if (!p.saveField.empty()) std::cout << "wrote " << p.saveField << "\n";
         std::cout << "wrote " << p.output << "\n";
     }
@@ -90,13 +170,25 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
 
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
 {
-    p.voxelOpt = sub->add_option("--voxel-size", p.voxelSize, "Finest voxel size in world units (default: twice the mean segment length)");
-    sub->add_option("--levels", p.levels, "Levels, coarse (h*2^(n-1)) to fine (h)")->capture_default_str();
-    sub->add_option("--iterations", p.iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
-    p.stepOpt = sub->add_option("--step", p.step, "Integration step in world units (default: half of each level's voxel)");
-    sub->add_option("--integrator", p.integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
-    sub->add_option("--margin", p.margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
-    sub->add_option("--max-voxels", p.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
+    RefineParams& rp = p.refine;
+    p.voxelOpt = sub->add_option("--voxel-size", rp.field.voxelSize,
+                                 "Finest voxel size in world units (default: 3 x the median root spacing, within 1/64..1/4 of the head radius)");
+    sub->add_option("--levels", rp.levels, "Levels, coarse (h*2^(n-1)) to fine (h)")->capture_default_str();
+    sub->add_option("--mode", p.mode, "consistent: fix only strands that stray from the flow, keep every strand's detail; "
+                                      "field: replace every strand by the field's streamline (Wang et al.)")->capture_default_str();
+    sub->add_option("--iterations", rp.field.iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
+    p.stepOpt = sub->add_option("--step", rp.trace.step, "Integration step in world units (default: half of each level's voxel)");
+    sub->add_option("--outlier-start", rp.consistency.zStart,
+                    "consistent mode: outlier score (deviation over the voxel's spread) where the field starts to take over")->capture_default_str();
+    sub->add_option("--outlier-full", rp.consistency.zFull,
+                    "consistent mode: outlier score from which the field's direction is followed")->capture_default_str();
+    sub->add_option("--min-spread", rp.consistency.minSpreadDeg,
+                    "consistent mode: deviations below this many degrees are never outliers")->capture_default_str();
+    sub->add_option("--head", p.head, "The head strands may not enter: a .vdb with a level set grid ('surface' or the first one), "
+                                      "or 'none' (default: --scalp's sphere if given, else a sphere fitted to the roots)");
+    sub->add_option("--integrator", p.integrator, "field mode: euler (the papers' choice), rk2 or rk4")->capture_default_str();
+    sub->add_option("--margin", rp.trace.margin, "field mode: voxels a strand may continue straight past the field's active region")->capture_default_str();
+    sub->add_option("--max-voxels", rp.field.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
     sub->add_flag("--strict", p.strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addScalpOptions(sub, p.scalp);
 }

@@ -291,17 +291,3 @@ TEST_CASE("retraceStrands: bad parameters and grids", "[field]")
     REQUIRE_THROWS_WITH(retraceStrands(circles, *f.density, TraceParams{}), Contains("holds float values; tracing needs a vector grid"));
 }
 
-TEST_CASE("refineStrands: draped long hair retraces to full length in world space", "[field][data]")
-{
-    VDBHAIR_REQUIRE_SHARED_DATA();
-    const std::string dir = test::sharedData() + "/hair/";
-    for (const char* file : {"usc_data/harolongo.data", "tressfx/ascii_v2/hair_tail_16_guide.tfx"}) {
-        CAPTURE(file);
-        const StrandSet s = readStrands(dir + file);
-        const RefineResult r = refineStrands(s, RefineParams{});
-        CAPTURE(r.voxelSize, r.stats.fullLength, r.stats.leftField, r.stats.vanished);
-        REQUIRE(double(r.stats.fullLength) >= 0.99 * double(s.numStrands()));
-        REQUIRE(r.angleAfter < r.angleBefore);
-        REQUIRE(r.strands.offsets == s.offsets);
-    }
-}

@@ -28,6 +28,16 @@ std::string densityGridName(int level, int levels)
     return levels <= 1 ? "density" : "density_level_" + std::to_string(level);
 }
 
+std::string coherenceGridName(int level, int levels)
+{
+    return levels <= 1 ? "coherence" : "coherence_level_" + std::to_string(level);
+}
+
+std::string spreadGridName(int level, int levels)
+{
+    return levels <= 1 ? "spread" : "spread_level_" + std::to_string(level);
+}
+
 FieldMapping::FieldMapping(openvdb::math::Transform::ConstPtr xform) : mXform(std::move(xform))
 {
     // Axis-aligned linear transforms (scale and translation only) take the fast path.

@@ -22,5 +22,8 @@ FieldSpace fieldSpaceFromName(const std::string& name);
 /// `density_level_<l>` for multi-level fields (level 0 the finest).
 std::string tangentGridName(int level, int levels);
 std::string densityGridName(int level, int levels);
+/// `coherence` / `coherence_level_<l>` and `spread` / `spread_level_<l>` (TangentField.h).
+std::string coherenceGridName(int level, int levels);
+std::string spreadGridName(int level, int levels);
 
 } // namespace vdbhair

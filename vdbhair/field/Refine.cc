@@ -3,60 +3,176 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/strands/Measures.h>
 
+#include <nanoflann.hpp>
+
 #include <algorithm>
 #include <cmath>
 
 namespace vdbhair {
 
+RefineMode refineModeFromName(const std::string& name)
+{
+    if (name == "consistent") return RefineMode::Consistent;
+    if (name == "field") return RefineMode::Field;
+    throw ValueError("mode '" + name + "' is not one of consistent, field");
+}
+
+const char* refineModeName(RefineMode mode)
+{
+    return mode == RefineMode::Consistent ? "consistent" : "field";
+}
+
+void RefineParams::validate(const char* where) const
+{
+    if (levels < 1 || levels > kMaxLevels) {
+        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + " must be between 1 and " +
+                         std::to_string(kMaxLevels));
+    }
+    consistency.validate(where);
+}
+
+namespace {
+
+/// The roots as a nanoflann point cloud.
+struct RootCloud
+{
+    const StrandSet& s;
+    std::size_t kdtree_get_point_count() const { return s.numStrands(); }
+    float kdtree_get_pt(std::size_t i, std::size_t d) const { return s.root(i)[int(d)]; }
+    template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
+};
+
+/// Median distance from a root to its nearest other root (0 for fewer than two distinct roots).
+double medianRootSpacing(const StrandSet& strands)
+{
+    const std::size_t n = strands.numStrands();
+    if (n < 2) return 0.0;
+    using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, RootCloud>, RootCloud, 3>;
+    const RootCloud cloud{strands};
+    Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree.buildIndex();
+    // At most 4096 roots, evenly spaced in index order: the median is stable long before that.
+    const std::size_t stride = std::max<std::size_t>(1, n / 4096);
+    std::vector<double> d;
+    for (std::size_t i = 0; i < n; i += stride) {
+        // The nearest root at a positive distance (duplicated roots are skipped).
+        std::uint32_t idx[8];
+        float dist2[8];
+        const Vec3f& q = strands.root(i);
+        const float query[3] = {q.x(), q.y(), q.z()};
+        const std::size_t found = tree.knnSearch(query, 8, idx, dist2);
+        for (std::size_t k = 0; k < found; ++k) {
+            if (dist2[k] > 0.f) {
+                d.push_back(std::sqrt(double(dist2[k])));
+                break;
+            }
+        }
+    }
+    if (d.empty()) return 0.0;
+    std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
+    return d[d.size() / 2];
+}
+
+std::vector<Vec3f> rootsOf(const StrandSet& strands)
+{
+    std::vector<Vec3f> roots(strands.numStrands());
+    for (std::size_t i = 0; i < roots.size(); ++i) roots[i] = strands.root(i);
+    return roots;
+}
+
+/// Half the largest extent of the hair: the head radius when the roots do not fit a sphere.
+double halfExtent(const StrandSet& strands)
+{
+    const Vec3f e = computeBBox(strands).extent();
+    return 0.5 * double(std::max({e.x(), e.y(), e.z()}));
+}
+
+/// The fitted sphere of the roots if it is plausible: a radius no larger than the hair's extent
+/// (roots on a nearly flat patch fit a huge sphere).
+bool plausibleRootSphere(const StrandSet& strands, ScalpSphere& sphere)
+{
+    if (strands.numStrands() < 4) return false;
+    try {
+        sphere = fitScalpSphere(rootsOf(strands));
+    } catch (const ValueError&) {
+        return false;
+    }
+    return std::isfinite(sphere.radius) && sphere.radius <= 2.0 * halfExtent(strands);
+}
+
+} // namespace
+
 double suggestVoxelSize(const StrandSet& strands)
 {
     if (strands.empty()) throw ValueError("suggestVoxelSize: the hairstyle has no strands");
-    double total = 0.0;
-    for (float len : strandLengths(strands)) total += len;
-    const std::size_t segments = strands.numVertices() - strands.numStrands();
-    const double meanSegment = segments ? total / double(segments) : 0.0;
-    const BBox box = computeBBox(strands);
-    const Vec3f e = box.extent();
-    const double floorSize = double(std::max({e.x(), e.y(), e.z()})) / 2048.0;
-    const double h = std::max(2.0 * meanSegment, floorSize);
-    return h > 0.0 ? h : 1.0;
+    ScalpSphere sphere;
+    const double radius = plausibleRootSphere(strands, sphere) ? sphere.radius : halfExtent(strands);
+    const double spacing = medianRootSpacing(strands);
+    double h = 3.0 * spacing;
+    h = std::min(std::max(h, radius / 64.0), radius / 4.0);
+    if (!(h > 0.0) || !std::isfinite(h)) h = 1.0;
+    return h;
+}
+
+HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up)
+{
+    (void)up;
+    ScalpSphere sphere;
+    if (!plausibleRootSphere(strands, sphere)) return HeadObstacle::none();
+    return HeadObstacle::sphere(sphere.center, sphere.radius, HeadPolicy::NoDeeper);
 }
 
 RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded,
                            openvdb::util::NullInterrupter* interrupter)
 {
-    if (params.levels < 1 || params.levels > 16) {
-        throw ValueError("refineStrands: levels " + std::to_string(params.levels) + " must be between 1 and 16");
-    }
+    params.validate("refineStrands");
+    if (strands.empty()) throw ValueError("refineStrands: the hairstyle has no strands");
     FieldParams fp = params.field;
     if (fp.voxelSize == 0.0) fp.voxelSize = suggestVoxelSize(strands);
 
     RefineResult result;
     result.voxelSize = fp.voxelSize;
+    result.head = params.head.unset() ? headFromRoots(strands, fp.scalp.up) : params.head;
     result.fields.resize(std::size_t(params.levels));
+    result.levels.resize(std::size_t(params.levels));
+
+    // The input's own field at the finest voxel size: its active voxels are the hair volume that
+    // every level keeps strands in, and the reference every level is measured against.
+    const TangentField inputField = estimateTangentField(strands, fp, threaded, interrupter);
+
     StrandSet current;  // the last level's strands (the input's before the first level)
     for (int level = params.levels - 1; level >= 0; --level) {
         FieldParams lp = fp;
         lp.voxelSize = fp.voxelSize * double(1 << level);
-        TangentField f = estimateTangentField(level == params.levels - 1 ? strands : current, lp, threaded, interrupter);
+        const StrandSet& from = level == params.levels - 1 ? strands : current;
+        TangentField f = estimateTangentField(from, lp, threaded, interrupter);
         f.tangent->setName(tangentGridName(level, params.levels));
         f.density->setName(densityGridName(level, params.levels));
-        for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(f.tangent.get()), static_cast<openvdb::GridBase*>(f.density.get())}) {
+        f.coherence->setName(coherenceGridName(level, params.levels));
+        f.spread->setName(spreadGridName(level, params.levels));
+        for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(f.tangent.get()), static_cast<openvdb::GridBase*>(f.density.get()),
+                                     static_cast<openvdb::GridBase*>(f.coherence.get()), static_cast<openvdb::GridBase*>(f.spread.get())}) {
             g->insertMeta("vdbhair:level", openvdb::Int32Metadata(level));
             g->insertMeta("vdbhair:levels", openvdb::Int32Metadata(params.levels));
+            g->insertMeta("vdbhair:refine_mode", openvdb::StringMetadata(refineModeName(params.mode)));
         }
-        // Every level retraces the input strands' roots for the input's lengths and vertex
-        // arc lengths, so that early stops at one level do not shorten the next. The last
-        // level's strands are not needed once its field is estimated: their storage takes the
-        // new ones (retraceStrandsInto).
-        retraceStrandsInto(strands, *f.tangent, params.trace, current, &result.stats, nullptr, threaded, interrupter);
+        RefineLevel& info = result.levels[std::size_t(level)];
+        info.voxelSize = lp.voxelSize;
+        if (params.mode == RefineMode::Consistent) {
+            // Each level starts from the last one's strands: detail that a level keeps is there for the next.
+            current = retraceConsistent(from, f, params.consistency, result.head, &info.consistency, threaded, interrupter,
+                                        inputField.tangent.get());
+        } else {
+            // The paper: every level retraces the input's roots for the input's lengths and
+            // vertex arc lengths, so that early stops at one level do not shorten the next. The
+            // last level's strands are not needed once its field is estimated: their storage
+            // takes the new ones (retraceStrandsInto).
+            retraceStrandsInto(strands, *f.tangent, params.trace, current, &info.trace, nullptr, threaded, interrupter);
+        }
+        if (params.measure) info.measures = measureRefinement(strands, current, inputField, fp, result.head, threaded);
         result.fields[std::size_t(level)] = std::move(f);
     }
     result.strands = std::move(current);
-    const openvdb::GridBase& finest = *result.fields[0].tangent;
-    result.angleBefore = meanTangentAngleDeg(strands, finest, nullptr, threaded);
-    result.angleAfter = meanTangentAngleDeg(result.strands, finest, nullptr, threaded);
-    result.meanDisplacement = meanVertexDisplacement(strands, result.strands, threaded);
     return result;
 }
 

@@ -1,40 +1,95 @@
 /// @file Refine.h
-/// @brief The vector-field refinement of Wang et al. 2009, §5.3: estimate the robust tangent
-/// field of a hairstyle, retrace every strand from its root for its own length, and repeat from
-/// the coarsest level to the finest (voxel size h·2^(levels-1) down to h).
+/// @brief Vector-field refinement (Wang et al. 2009, §5.3): estimate the robust tangent field of
+/// a hairstyle, retrace every strand from its root through it, and repeat from the coarsest level
+/// to the finest (voxel size h·2^(levels-1) down to h).
+///
+/// Two modes (RefineMode):
+/// - **consistent** (the default) keeps the hairstyle and fixes only its inconsistencies: each
+///   level retraces the previous level's strands with ConsistentRetrace.h, which follows the
+///   field only where a strand is an outlier among the hair around it, and otherwise the strand's
+///   own direction. Strands keep their detail (waves, curls, crossing wisps) through any number
+///   of levels, their length and vertex count, and never enter the head deeper than they were.
+///   This goes beyond the paper; README, "Refinement", shows both modes on the shared hair.
+/// - **field** is the paper's rule: every strand is replaced by the streamline of the field from
+///   its root, for its own length (StreamlineTracer.h). It smooths everything at the voxel's
+///   scale: waves are combed straight and crossing wisps are merged. Strands stop where the
+///   field ends (margin 0: no straight spikes past the hair).
+///
+/// The default voxel size follows the hair's own scale (suggestVoxelSize()).
 #pragma once
 
+#include <vdbhair/field/ConsistentRetrace.h>
+#include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/field/RefineReport.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
 
+#include <string>
 #include <vector>
 
 namespace vdbhair {
 
+enum class RefineMode { Consistent, Field };
+
+/// @throw ValueError unless "consistent" or "field".
+RefineMode refineModeFromName(const std::string& name);
+const char* refineModeName(RefineMode mode);
+
 struct RefineParams
 {
+    static constexpr int kMaxLevels = 8;
+
     FieldParams field;  ///< field.voxelSize is the finest level's; 0 picks suggestVoxelSize()
-    int levels = 1;
-    TraceParams trace;  ///< trace.step = 0: half of each level's voxel size
+    int levels = 1;     ///< 1 to kMaxLevels
+    RefineMode mode = RefineMode::Consistent;
+    ConsistencyParams consistency;  ///< the consistent mode's retrace
+    /// The field mode's retrace: step 0 is half of each level's voxel; margin 0, so strands stop
+    /// where the field ends instead of continuing straight past the hair.
+    TraceParams trace = [] {
+        TraceParams t;
+        t.margin = 0;
+        return t;
+    }();
+    /// The head retraced strands may not enter. Unset: a sphere fitted to the roots (headFromRoots());
+    /// HeadObstacle::none(): no head.
+    HeadObstacle head;
+    bool measure = true;  ///< fill RefineLevel::measures (costs a field estimate per level)
+
+    /// @throw ValueError naming the parameter for values out of range.
+    void validate(const char* where) const;
+};
+
+/// @brief What happened at one level.
+struct RefineLevel
+{
+    double voxelSize = 0.0;
+    ConsistencyStats consistency;  ///< consistent mode
+    TraceStats trace;              ///< field mode
+    RefineMeasures measures;       ///< this level's output against the *input*, at the finest voxel size
 };
 
 struct RefineResult
 {
     StrandSet strands;                 ///< the refined hairstyle (input vertex counts)
     std::vector<TangentField> fields;  ///< element l: level l (0 the finest), the field the strands were traced through
-    TraceStats stats;                  ///< of the last (finest) retrace
-    double angleBefore = 0.0;          ///< meanTangentAngleDeg(input, finest field)
-    double angleAfter = 0.0;           ///< meanTangentAngleDeg(output, finest field)
-    double meanDisplacement = 0.0;     ///< meanVertexDisplacement(input, output)
+    std::vector<RefineLevel> levels;   ///< element l: level l
     double voxelSize = 0.0;            ///< the finest voxel size used
+    HeadObstacle head;                 ///< the obstacle used
 };
 
-/// @brief A voxel size for a hairstyle with no better information: twice the mean segment length
-/// (so a voxel holds a couple of vertices of every strand through it), and never so small that
-/// the bounding box would exceed 2048 voxels on a side.
+/// @brief The default finest voxel size of a hairstyle, from its own scale: three times the
+/// median distance between neighbouring roots (so that a voxel near the scalp holds about nine
+/// strands, enough for a robust direction and its spread), kept between 1/64 and 1/4 of the head
+/// radius (the radius of the sphere fitted to the roots, or half the hair's largest extent when
+/// that fit is implausible) so that the finest level resolves wisps whatever the strand count.
+/// Coarser levels double it, as Wang et al. halve their spacing from coarse to fine.
 double suggestVoxelSize(const StrandSet& strands);
 
-/// @throw as estimateTangentField() and retraceStrands(); ValueError for levels outside [1, 16].
+/// @brief The fallback head: the sphere fitted to the roots (fitScalpSphere()) with the up axis @a up.
+HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up = Vec3d(0.0, 1.0, 0.0));
+
+/// @throw as estimateTangentField(), retraceStrands() and retraceConsistent(); ValueError for
+/// parameters out of range.
 RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded = true,
                            openvdb::util::NullInterrupter* interrupter = nullptr);
 

@@ -84,6 +84,26 @@ openvdb::Vec3f robustDirection(const Moments& mo, int iterations)
     return openvdb::Vec3f(float(v.x()), float(v.y()), float(v.z()));
 }
 
+/// |s| / Σ ℓ: 1 for parallel contributions, 0 where they cancel.
+float coherenceOf(const Moments& mo)
+{
+    const double d = mo.density();
+    if (!(d > 0.0)) return 0.f;
+    const double s = std::sqrt(double(mo.a[0]) * mo.a[0] + double(mo.a[1]) * mo.a[1] + double(mo.a[2]) * mo.a[2]);
+    return float(std::min(1.0, s / d));
+}
+
+/// 1 − vᵀ M v / Σ ℓ: the contributions' mean squared sine of their angle to v (1 if v is zero).
+float spreadOf(const Moments& mo, const openvdb::Vec3f& v)
+{
+    const double d = mo.density();
+    if (!(d > 0.0) || v.lengthSqr() == 0.f) return 1.f;
+    const double x = v.x(), y = v.y(), z = v.z();
+    const double vmv = mo.xx() * x * x + mo.yy() * y * y + mo.zz() * z * z +
+                       2.0 * (mo.xy() * x * y + mo.xz() * x * z + mo.yz() * y * z);
+    return float(std::min(1.0, std::max(0.0, 1.0 - vmv / d)));
+}
+
 /// The accumulation of one chunk of strands. Moments live in one array; each touched leaf-sized
 /// block (8³ voxels) maps its voxels to slots in it. Consecutive flushes of a strand mostly hit
 /// the same block, which is cached, so a flush costs a compare, an index and three SIMD adds.
@@ -446,10 +466,14 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     // Topology: every block any chunk touched, as leaves of the output trees.
     openvdb::Vec3STree::Ptr tangentTree(new openvdb::Vec3STree(openvdb::Vec3f(0.f)));
     openvdb::FloatTree::Ptr densityTree(new openvdb::FloatTree(0.f));
+    openvdb::FloatTree::Ptr coherenceTree(new openvdb::FloatTree(0.f));
+    openvdb::FloatTree::Ptr spreadTree(new openvdb::FloatTree(0.f));
     for (const Chunk& c : chunks) {
         for (const Coord& origin : c.origins) {
             tangentTree->touchLeaf(origin);
             densityTree->touchLeaf(origin);
+            coherenceTree->touchLeaf(origin);
+            spreadTree->touchLeaf(origin);
         }
     }
 
@@ -474,11 +498,16 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
             }
         }
         auto* dl = densityTree->probeLeaf(leaf.origin());
+        auto* cl = coherenceTree->probeLeaf(leaf.origin());
+        auto* sl = spreadTree->probeLeaf(leaf.origin());
         for (openvdb::Index k = 0; k < 512; ++k) {
             if (!hit[k]) continue;
             const Moments& mo = sum[k];
-            leaf.setValueOn(k, robustDirection(mo, p.iterations));
+            const openvdb::Vec3f v = robustDirection(mo, p.iterations);
+            leaf.setValueOn(k, v);
             dl->setValueOn(k, mo.density());
+            cl->setValueOn(k, coherenceOf(mo));
+            sl->setValueOn(k, spreadOf(mo, v));
         }
     }, threaded);
     if (directions.stopped()) throw InterruptedError("estimateTangentField: interrupted");
@@ -486,23 +515,37 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     TangentField out;
     out.tangent = openvdb::Vec3SGrid::create(tangentTree);
     out.density = openvdb::FloatGrid::create(densityTree);
-    out.tangent->setTransform(map.transform().copy());
-    out.density->setTransform(map.transform().copy());
+    out.coherence = openvdb::FloatGrid::create(coherenceTree);
+    out.spread = openvdb::FloatGrid::create(spreadTree);
     out.tangent->setName(tangentGridName(level, levels));
     out.density->setName(densityGridName(level, levels));
+    out.coherence->setName(coherenceGridName(level, levels));
+    out.spread->setName(spreadGridName(level, levels));
     out.tangent->setGridClass(openvdb::GRID_UNKNOWN);
     // World-space grids hold world directions that move with the transform's Jacobian
     // (contravariant relative, like velocity); scalp-space grids hold world directions on a
     // (u, v, w) lattice, which the lattice's transform does not act on (invariant).
     out.tangent->setVectorType(p.space == FieldSpace::Scalp ? openvdb::VEC_INVARIANT : openvdb::VEC_CONTRAVARIANT_RELATIVE);
     out.density->setGridClass(openvdb::GRID_FOG_VOLUME);
-    for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(out.tangent.get()), static_cast<openvdb::GridBase*>(out.density.get())}) {
+    for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(out.tangent.get()), static_cast<openvdb::GridBase*>(out.density.get()),
+                                 static_cast<openvdb::GridBase*>(out.coherence.get()), static_cast<openvdb::GridBase*>(out.spread.get())}) {
+        g->setTransform(map.transform().copy());
         setFieldMetadata(*g, voxelSize, p.iterations, p.space, p.scalp, level, levels, strands.numStrands());
     }
     return out;
 }
 
 } // namespace
+
+openvdb::GridCPtrVec TangentField::grids() const
+{
+    openvdb::GridCPtrVec out;
+    for (const openvdb::GridBase::ConstPtr& g : {openvdb::GridBase::ConstPtr(tangent), openvdb::GridBase::ConstPtr(density),
+                                                 openvdb::GridBase::ConstPtr(coherence), openvdb::GridBase::ConstPtr(spread)}) {
+        if (g) out.push_back(g);
+    }
+    return out;
+}
 
 std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params)
 {

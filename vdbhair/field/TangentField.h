@@ -48,6 +48,16 @@ struct TangentField
 {
     openvdb::Vec3SGrid::Ptr tangent;  ///< unit directions, root to tip; class unknown, contravariant relative
     openvdb::FloatGrid::Ptr density;  ///< summed segment length per voxel (world units); fog volume
+    /// |Σ ℓ T| / Σ ℓ per voxel, in [0, 1]: 1 where every contribution points the same way, near 0
+    /// where they cancel (crossing or opposing strands); class unknown, same topology as tangent.
+    openvdb::FloatGrid::Ptr coherence;
+    /// The contributions' mean squared sine of their angle to the robust direction v̄:
+    /// 1 − v̄ᵀ M v̄ / Σ ℓ, in [0, 1] (0: all parallel to v̄); how far a strand's own direction may
+    /// stray from v̄ before it is an outlier (Refine.h). Class unknown, same topology as tangent.
+    openvdb::FloatGrid::Ptr spread;
+
+    /// @brief The four grids, for writing.
+    openvdb::GridCPtrVec grids() const;
 };
 
 /// @brief Estimate the field of @a strands at one voxel size.

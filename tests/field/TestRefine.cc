@@ -1,0 +1,248 @@
+// Tests of vdbhair/field/Refine.h, ConsistentRetrace.h, HeadObstacle.h and RefineReport.h.
+#include "TestUtil.h"
+
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <cmath>
+#include <random>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+/// A straight strand from @a root along @a dir, @a n vertices over @a length.
+std::vector<Vec3f> line(const Vec3f& root, Vec3f dir, float length, std::size_t n)
+{
+    dir.normalize();
+    std::vector<Vec3f> p(n);
+    for (std::size_t i = 0; i < n; ++i) p[i] = root + dir * (length * float(i) / float(n - 1));
+    return p;
+}
+
+/// A bundle of parallel straight strands along +x, roots on a square grid of side @a side in the
+/// x = 0 plane, @a perSide strands to a side.
+StrandSet bundle(int perSide, float side, float length, std::size_t n)
+{
+    StrandSet s;
+    for (int j = 0; j < perSide; ++j) {
+        for (int k = 0; k < perSide; ++k) {
+            const Vec3f root(0.f, side * (float(j) + 0.5f) / float(perSide), side * (float(k) + 0.5f) / float(perSide));
+            s.addStrand(line(root, Vec3f(1.f, 0.f, 0.f), length, n));
+        }
+    }
+    return s;
+}
+
+double maxDisplacement(const StrandSet& a, const StrandSet& b, std::size_t strand)
+{
+    double m = 0.0;
+    for (std::size_t j = 0; j < a.size(strand); ++j) m = std::max(m, double((a.data(strand)[j] - b.data(strand)[j]).length()));
+    return m;
+}
+
+Vec3f unitDir(const StrandSet& s, std::size_t i, std::size_t j)
+{
+    Vec3f d = s.data(i)[j + 1] - s.data(i)[j];
+    d.normalize();
+    return d;
+}
+
+} // namespace
+
+TEST_CASE("refineStrands: outliers crossing a coherent bundle are pulled into its flow, inliers stay", "[field]")
+{
+    StrandSet s = bundle(20, 2.f, 10.f, 41);
+    const std::size_t inliers = s.numStrands();
+    // Three strands that start inside the bundle and head off at 25-35 degrees from it.
+    const float angles[3] = {25.f, 30.f, 35.f};
+    for (int k = 0; k < 3; ++k) {
+        const float a = angles[k] * float(M_PI) / 180.f;
+        s.addStrand(line(Vec3f(0.f, 0.35f + 0.5f * float(k), 1.05f), Vec3f(std::cos(a), k == 1 ? -std::sin(a) : std::sin(a), 0.f), 10.f, 41));
+    }
+    RefineParams rp;
+    rp.field.voxelSize = 0.5;
+    rp.head = HeadObstacle::none();
+    const RefineResult r = refineStrands(s, rp);
+    const double voxel = 0.5;
+    double worstInlier = 0.0;
+    for (std::size_t i = 0; i < inliers; ++i) worstInlier = std::max(worstInlier, maxDisplacement(s, r.strands, i));
+    CAPTURE(worstInlier);
+    REQUIRE(worstInlier < 0.1 * voxel);
+    for (std::size_t i = inliers; i < s.numStrands(); ++i) {
+        CAPTURE(i);
+        // Pulled toward the flow: the tip is closer to the bundle's axis line than it was, and
+        // the strand runs along +x where it is inside the bundle.
+        const Vec3f tipIn = s.tip(i), tipOut = r.strands.tip(i);
+        const float offIn = std::abs(tipIn.y() - 1.f), offOut = std::abs(tipOut.y() - 1.f);
+        CAPTURE(offIn, offOut);
+        REQUIRE(offOut < 0.5f * offIn);
+        REQUIRE(unitDir(r.strands, i, 20).x() > std::cos(10.0 * M_PI / 180.0));
+        REQUIRE(polylineLength(r.strands.data(i), r.strands.size(i)) == Approx(10.0).epsilon(1e-5));
+    }
+    const RefineMeasures& m = r.levels.front().measures;
+    REQUIRE(m.fullLength == s.numStrands());
+    REQUIRE(m.leftVolume == 0);
+    REQUIRE(r.levels.front().consistency.corrected == 3);
+    REQUIRE(m.coherenceAfter > m.coherenceBefore);
+}
+
+TEST_CASE("refineStrands: two wisps crossing in an X stay an X", "[field]")
+{
+    // Two wisps of 49 strands each, crossing at 60 degrees at the origin.
+    StrandSet s;
+    const float a = 30.f * float(M_PI) / 180.f;
+    for (int w = 0; w < 2; ++w) {
+        const Vec3f dir(std::cos(a), w == 0 ? std::sin(a) : -std::sin(a), 0.f);
+        const Vec3f side(-dir.y(), dir.x(), 0.f);
+        for (int j = 0; j < 7; ++j) {
+            for (int k = 0; k < 7; ++k) {
+                const Vec3f root = dir * -5.f + side * (0.15f * float(j - 3)) + Vec3f(0.f, 0.f, 0.15f * float(k - 3));
+                s.addStrand(line(root, dir, 10.f, 41));
+            }
+        }
+    }
+    RefineParams rp;
+    rp.field.voxelSize = 0.4;
+    rp.levels = 2;
+    rp.head = HeadObstacle::none();
+    const RefineResult r = refineStrands(s, rp);
+    std::size_t swapped = 0;
+    double worst = 0.0;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        if ((s.tip(i).y() > 0.f) != (r.strands.tip(i).y() > 0.f)) ++swapped;
+        worst = std::max(worst, maxDisplacement(s, r.strands, i));
+    }
+    CAPTURE(worst);
+    REQUIRE(swapped == 0);
+    REQUIRE(worst < 0.1 * 0.4);
+
+    // The paper's rule merges the wisps where they cross: a single-valued field holds one direction.
+    rp.mode = RefineMode::Field;
+    const RefineResult paper = refineStrands(s, rp);
+    double paperWorst = 0.0;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) paperWorst = std::max(paperWorst, maxDisplacement(s, paper.strands, i));
+    CAPTURE(paperWorst);
+    REQUIRE(paperWorst > 10.0 * worst);
+}
+
+TEST_CASE("refineStrands: a strand pointed into a sphere head is kept outside it", "[field]")
+{
+    // Strands rooted on top of a unit sphere and heading down through it, in a bundle that
+    // flows over the sphere (so the field itself would carry them in).
+    StrandSet s;
+    for (int j = 0; j < 5; ++j) {
+        const float x = 0.05f * float(j - 2);
+        s.addStrand(line(Vec3f(x, 1.02f, 0.f), Vec3f(0.3f, -1.f, 0.f), 2.f, 21));
+    }
+    RefineParams rp;
+    rp.field.voxelSize = 0.1;
+    rp.head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    const RefineResult r = refineStrands(s, rp);
+    for (std::size_t i = 0; i < r.strands.numStrands(); ++i) {
+        for (std::size_t j = 0; j < r.strands.size(i); ++j) {
+            CAPTURE(i, j);
+            REQUIRE(r.strands.data(i)[j].length() >= 1.f);
+        }
+    }
+    const RefineMeasures& m = r.levels.front().measures;
+    REQUIRE(m.insideHeadBefore > 0);
+    REQUIRE(m.insideHeadAfter == 0);
+    REQUIRE(r.levels.front().consistency.pushedOut > 0);
+
+    // A head that was only guessed (NoDeeper) never pushes a vertex deeper than the input had it.
+    rp.head = HeadObstacle::sphere(Vec3d(0.0), 1.0, HeadPolicy::NoDeeper);
+    const RefineResult guessed = refineStrands(s, rp);
+    REQUIRE(guessed.levels.front().measures.insideHeadAfter <= m.insideHeadBefore);
+}
+
+TEST_CASE("refineStrands: a helix bundle keeps its helix through 3 levels", "[field]")
+{
+    StrandSet s;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> jitter(-0.3f, 0.3f);
+    for (int j = 0; j < 36; ++j) {
+        std::vector<Vec3f> h = test::helix(1.0, 0.3, 6.0 * M_PI, 121);
+        const Vec3f offset(jitter(rng), jitter(rng), 0.f);
+        for (Vec3f& p : h) p += offset;
+        s.addStrand(h);
+    }
+    const double kappa = 1.0 / (1.0 + 0.09);  // r / (r² + c²)
+    RefineParams rp;
+    rp.levels = 3;
+    rp.head = HeadObstacle::none();
+    rp.field.voxelSize = 0.15;
+    const RefineResult r = refineStrands(s, rp);
+    std::vector<float> curv;
+    double mean = 0.0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < r.strands.numStrands(); ++i) {
+        curv.resize(r.strands.size(i));
+        curvatureProfile(r.strands.data(i), curv.size(), curv.data());
+        for (std::size_t j = 1; j + 1 < curv.size(); ++j, ++n) mean += curv[j];
+    }
+    mean /= double(n);
+    CAPTURE(mean, kappa);
+    REQUIRE(mean == Approx(kappa).epsilon(0.1));
+    REQUIRE(r.levels.front().measures.curvatureKept8 > 0.9);
+}
+
+TEST_CASE("refineStrands: identical for 1 and 2 threads", "[field]")
+{
+    StrandSet s = bundle(12, 1.2f, 6.f, 25);
+    std::mt19937 rng(3);
+    std::normal_distribution<float> noise(0.f, 0.05f);
+    for (Vec3f& p : s.positions) p += Vec3f(0.f, noise(rng), noise(rng));
+    for (RefineMode mode : {RefineMode::Consistent, RefineMode::Field}) {
+        RefineParams rp;
+        rp.mode = mode;
+        rp.levels = 2;
+        rp.field.voxelSize = 0.3;
+        const RefineResult one = refineStrands(s, rp, /*threaded=*/false);
+        const RefineResult two = refineStrands(s, rp, /*threaded=*/true);
+        REQUIRE(one.strands.positions == two.strands.positions);
+        REQUIRE(one.levels.front().measures.displacementMean == two.levels.front().measures.displacementMean);
+    }
+}
+
+TEST_CASE("refineStrands: bad parameters are refused, naming them", "[field]")
+{
+    const StrandSet s = bundle(3, 1.f, 2.f, 5);
+    RefineParams rp;
+    rp.levels = 0;
+    REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("levels 0 must be between 1 and 8"));
+    rp.levels = 1;
+    rp.consistency.zFull = 1.0;
+    REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("zFull"));
+    REQUIRE_THROWS_WITH(refineStrands(StrandSet(), RefineParams{}), Contains("no strands"));
+    REQUIRE_THROWS_AS(HeadObstacle::sphere(Vec3d(0.0), -1.0), ValueError);
+}
+
+TEST_CASE("suggestVoxelSize: three root spacings, within the head's scale", "[field]")
+{
+    // Roots 0.1 apart on a plane: three spacings.
+    const StrandSet s = bundle(20, 2.f, 10.f, 11);
+    REQUIRE(suggestVoxelSize(s) == Approx(0.3).epsilon(1e-5));
+}
+
+TEST_CASE("refineStrands: the shared hairstyles keep their shape at the defaults", "[field][data]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string dir = test::sharedData() + "/hair/";
+    for (const char* file : {"usc_data/harolongo.data", "tressfx/ascii_v2/hair_tail_16_guide.tfx", "ply/Curly_100.ply"}) {
+        CAPTURE(file);
+        const StrandSet s = readStrands(dir + file);
+        const RefineResult r = refineStrands(s, RefineParams{});
+        const RefineMeasures& m = r.levels.front().measures;
+        CAPTURE(r.voxelSize, m.leftVolume, m.curvatureKept8, m.displacementMean, m.coherenceBefore, m.coherenceAfter);
+        REQUIRE(m.fullLength == s.numStrands());
+        REQUIRE(m.leftVolume == 0);
+        REQUIRE(m.insideHeadAfter <= m.insideHeadBefore);
+        REQUIRE(m.curvatureKept8 >= 0.8);
+        REQUIRE(m.displacementMean < 1.0);
+        REQUIRE(m.coherenceAfter >= m.coherenceBefore);
+        REQUIRE(r.strands.offsets == s.offsets);
+    }
+}

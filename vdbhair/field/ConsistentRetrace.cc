@@ -1,0 +1,286 @@
+#include "ConsistentRetrace.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Progress.h>
+#include <vdbhair/field/FieldMapping.h>
+#include <vdbhair/field/FieldSampler.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace vdbhair {
+
+void ConsistencyParams::validate(const char* where) const
+{
+    auto fail = [&](const std::string& what) { throw ValueError(std::string(where) + ": " + what); };
+    if (!(step >= 0.0) || !std::isfinite(step)) fail("step " + std::to_string(step) + " must be 0 (half a voxel) or a positive finite length");
+    if (!(zStart >= 0.0) || !std::isfinite(zStart)) fail("outlier score zStart " + std::to_string(zStart) + " must be finite and at least 0");
+    if (!(zFull > zStart) || !std::isfinite(zFull)) fail("outlier score zFull " + std::to_string(zFull) + " must be finite and above zStart " + std::to_string(zStart));
+    if (!(minSpreadDeg >= 0.0 && minSpreadDeg < 90.0)) fail("minimum spread " + std::to_string(minSpreadDeg) + " degrees must be in [0, 90)");
+    if (!(returnVoxels > 0.0) || !std::isfinite(returnVoxels)) fail("return length " + std::to_string(returnVoxels) + " voxels must be positive and finite");
+    if (!(vanishThreshold >= 0.0 && vanishThreshold < 1.0)) fail("vanish threshold " + std::to_string(vanishThreshold) + " must be in [0, 1)");
+}
+
+namespace {
+
+using openvdb::Vec3d;
+using TreeT = openvdb::Vec3STree;
+
+/// The spread grid as a vector tree (spread, 0, 0) with the tangent's topology, so that both are
+/// sampled by the bricked trilinear sampler with the same active-corner weights.
+TreeT::Ptr spreadAsVectors(const TangentField& field)
+{
+    TreeT::Ptr tree(new TreeT(openvdb::Vec3f(0.f)));
+    tree->topologyUnion(field.tangent->tree());
+    openvdb::FloatGrid::ConstAccessor acc = field.spread->getConstAccessor();
+    for (auto leaf = tree->beginLeaf(); leaf; ++leaf) {
+        for (auto it = leaf->beginValueOn(); it; ++it) it.setValue(openvdb::Vec3f(acc.getValue(it.getCoord()), 0.f, 0.f));
+    }
+    return tree;
+}
+
+double smoothstep(double a, double b, double x)
+{
+    const double t = std::min(1.0, std::max(0.0, (x - a) / (b - a)));
+    return t * t * (3.0 - 2.0 * t);
+}
+
+struct Shared
+{
+    const StrandSet& in;
+    const FieldMapping map;
+    const FieldMapping volumeMap;
+    const BrickedField<TreeT>& tangents;
+    const BrickedField<TreeT>& spreads;
+    const BrickedField<TreeT>& volume;
+    const HeadObstacle& head;
+    const ConsistencyParams& params;
+    double step;
+    double minSigma;
+    double invReturn;  ///< 1 / the return length (world units)
+    StrandSet& out;
+};
+
+struct Counts
+{
+    std::size_t corrected = 0, steps = 0, fieldSteps = 0, noFieldSteps = 0, pushedOut = 0, heldIn = 0;
+    void add(const Counts& o)
+    {
+        corrected += o.corrected;
+        steps += o.steps;
+        fieldSteps += o.fieldSteps;
+        noFieldSteps += o.noFieldSteps;
+        pushedOut += o.pushedOut;
+        heldIn += o.heldIn;
+    }
+};
+
+/// One thread's samplers, and the retrace of one strand at a time.
+class StrandTracer
+{
+public:
+    explicit StrandTracer(const Shared& s) : mS(s), mTan(s.tangents), mSpread(s.spreads), mVolume(s.volume), mHead(s.head) {}
+
+    void trace(std::size_t i, Counts& counts)
+    {
+        const std::size_t n = mS.in.size(i);
+        const Vec3f* c = mS.in.data(i);
+        Vec3f* o = mS.out.data(i);
+        const bool haveHead = !mS.head.empty();
+        const bool relative = haveHead && mS.head.policy() == HeadPolicy::NoDeeper;
+        Vec3d p(c[0]);
+        o[0] = c[0];
+        bool corrected = false;
+        for (std::size_t j = 0; j + 1 < n; ++j) {
+            const Vec3d a(c[j]), b(c[j + 1]);
+            const Vec3d seg = b - a;
+            const double len = seg.length();
+            if (len > 0.0) {
+                const Vec3d t = seg / len;
+                const std::size_t m = std::max<std::size_t>(1, std::size_t(std::ceil(len / mS.step)));
+                const double h = len / double(m);
+                bool pushed = false;
+                const Vec3d start = p;
+                for (std::size_t k = 0; k < m; ++k) {
+                    // The strand's own direction, steered back toward the input strand at this
+                    // arc length when an earlier correction moved it away: a corrected kink
+                    // stays local, the rest of the strand stays where it was.
+                    const Vec3d off = a + seg * (double(k) / double(m)) - p;
+                    Vec3d own = t + off * mS.invReturn;
+                    const double ol = own.length();
+                    own = ol > 1e-12 ? own / ol : t;
+                    double w = 0.0;
+                    Vec3d d = direction(p, own, w, counts);
+                    if (w >= 0.5) corrected = true;
+                    Vec3d q = p + h * d;
+                    if (!insideField(q)) {
+                        // The step would leave the hair: head for the input strand's own point
+                        // at the step's end instead (the input lies inside the hair by definition).
+                        const Vec3d back = a + seg * (double(k + 1) / double(m)) - p;
+                        const double bl = back.length();
+                        if (bl > 1e-12) {
+                            d = back / bl;
+                            q = p + h * d;
+                            ++counts.heldIn;
+                        }
+                    }
+                    if (haveHead) {
+                        // Outside the head, or for a guessed head no deeper inside than the
+                        // input strand at this arc length (HeadPolicy).
+                        const double floor = relative ? std::min(0.0, mHead.distance(a + seg * (double(k + 1) / double(m)))) : 0.0;
+                        if (mHead.distance(q) < floor) {
+                            // Slide along the head: drop the step's inward component (the step
+                            // keeps its length), then move out what the surface's curvature left in.
+                            const Vec3d nrm = mHead.normal(p);
+                            const double dn = d.dot(nrm);
+                            if (dn < 0.0) {
+                                const Vec3d slide = d - dn * nrm;
+                                const double sl = slide.length();
+                                if (sl > 1e-12) d = slide / sl;
+                                q = p + h * d;
+                            }
+                            // Out of the head at the step's own length: push out and pull the
+                            // step back to length h, a few times (a fixed point on the surface
+                            // for steps much shorter than the head's radius), then make sure.
+                            for (int it = 0; it < 3 && mHead.pushOut(q, floor); ++it) {
+                                pushed = true;
+                                const Vec3d e = q - p;
+                                const double el = e.length();
+                                if (el > 1e-12) q = p + e * (h / el);
+                            }
+                            pushed |= mHead.pushOut(q, floor);
+                        }
+                    }
+                    p = q;
+                }
+                counts.steps += m;
+                // The output segment is the chord of the sub-steps at the input segment's own
+                // length: a path that bends inside a segment would otherwise shorten the
+                // polyline (its chord is shorter than its arc), and the strand with it.
+                const Vec3d chord = p - start;
+                const double cl = chord.length();
+                if (cl > 1e-12) {
+                    const Vec3d scaled = start + chord * (len / cl);
+                    if (insideField(scaled) || !insideField(p)) {
+                        p = scaled;
+                    } else {
+                        // The chord at full length would leave the hair: aim at the input vertex.
+                        const Vec3d toB = b - start;
+                        const double tl = toB.length();
+                        p = tl > 1e-12 ? start + toB * (len / tl) : scaled;
+                    }
+                }
+                if (haveHead) {
+                    const double floor = relative ? std::min(0.0, mHead.distance(b)) : 0.0;
+                    pushed |= mHead.pushOut(p, floor);
+                }
+                if (pushed) ++counts.pushedOut;
+            }
+            o[j + 1] = Vec3f(float(p.x()), float(p.y()), float(p.z()));
+        }
+        if (corrected) ++counts.corrected;
+    }
+
+private:
+    /// Whether any corner of the hair volume's cell around world point @a q is active.
+    bool insideField(const Vec3d& q) { return mVolume.sample(mS.volumeMap.worldToIndex(q))[3] > 0.f; }
+
+    /// The blended direction at @a p for a strand heading @a t; @a w receives the field's weight.
+    Vec3d direction(const Vec3d& p, const Vec3d& t, double& w, Counts& counts)
+    {
+        const Vec3d ip = mS.map.worldToIndex(p);
+        const Float4 r = mTan.sample(ip);
+        const double weight = r[3];
+        if (!(weight > 0.0)) {
+            ++counts.noFieldSteps;
+            return t;
+        }
+        Vec3d v(r[0], r[1], r[2]);
+        const double len = v.length();
+        if (!(len > mS.params.vanishThreshold * weight)) {
+            ++counts.noFieldSteps;
+            return t;
+        }
+        v /= len;
+        const Float4 sp = mSpread.sample(ip);
+        const double spread = std::max(0.0, double(sp[0]) / weight);  // the active corners' mean
+        const double sigma = std::max(mS.minSigma, std::sqrt(spread));
+        const double cosA = t.dot(v);
+        const double delta = cosA > 0.0 ? std::sqrt(std::max(0.0, 1.0 - cosA * cosA)) : 1.0;
+        w = smoothstep(mS.params.zStart, mS.params.zFull, delta / sigma);
+        if (w >= 0.5) ++counts.fieldSteps;
+        if (w <= 0.0) return t;
+        Vec3d d = (1.0 - w) * t + w * v;
+        const double dl = d.length();
+        return dl > 1e-12 ? d / dl : v;
+    }
+
+    const Shared& mS;
+    FieldSampler<TreeT> mTan, mSpread, mVolume;
+    HeadObstacle::Probe mHead;
+};
+
+} // namespace
+
+StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field, const ConsistencyParams& params,
+                            const HeadObstacle& head, ConsistencyStats* stats, bool threaded,
+                            openvdb::util::NullInterrupter* interrupter, const openvdb::Vec3SGrid* hairVolume)
+{
+    params.validate("retraceConsistent");
+    if (!field.tangent || !field.spread) throw ValueError("retraceConsistent: the field needs its tangent and spread grids");
+    const FieldMapping map = FieldMapping::fromGrid(*field.tangent);
+    const double step = params.step > 0.0 ? params.step : 0.5 * map.worldVoxelSize();
+    // A strand needs about length / step sub-steps: refuse a step that would take forever.
+    double total = 0.0;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
+        const Vec3f* s = strands.data(i);
+        for (std::size_t j = 0; j + 1 < strands.size(i); ++j) total += double((s[j + 1] - s[j]).length());
+    }
+    if (total / step > 4e9) {
+        throw LimitError("retraceConsistent: step " + std::to_string(step) + " needs about " + std::to_string(total / step) +
+                         " sub-steps for a hairstyle of total length " + std::to_string(total) + " (at most 4e9)");
+    }
+
+    StrandSet out = strands;  // topology and attributes; positions are overwritten
+    const BrickedField<TreeT> tangents(field.tangent->tree());
+    const TreeT::Ptr spreadTree = spreadAsVectors(field);
+    const BrickedField<TreeT> spreads(*spreadTree);
+    const openvdb::Vec3SGrid& volumeGrid = hairVolume ? *hairVolume : *field.tangent;
+    const BrickedField<TreeT> volume(volumeGrid.tree());
+    const Shared shared{strands, map, FieldMapping::fromGrid(volumeGrid), tangents, spreads, volume, head, params, step,
+                        std::sin(params.minSpreadDeg * M_PI / 180.0), 1.0 / (params.returnVoxels * map.worldVoxelSize()), out};
+
+    const std::size_t nS = strands.numStrands();
+    constexpr std::size_t kChunk = 256;
+    const std::size_t nChunks = (nS + kChunk - 1) / kChunk;
+    std::vector<Counts> counts(nChunks);
+    ProgressCounter progress(interrupter, "retracing (consistent)", nS, "strands");
+    auto run = [&](std::size_t c) {
+        if (progress.stopped()) return;
+        StrandTracer tracer(shared);
+        const std::size_t first = c * kChunk, last = std::min(nS, first + kChunk);
+        for (std::size_t i = first; i < last; ++i) tracer.trace(i, counts[c]);
+        progress.add(last - first);
+    };
+    if (threaded) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nChunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c) run(c);
+        });
+    } else {
+        for (std::size_t c = 0; c < nChunks; ++c) run(c);
+    }
+    progress.finish();
+    if (progress.stopped()) throw InterruptedError("retraceConsistent: interrupted");
+    if (stats) {
+        Counts all;
+        for (const Counts& c : counts) all.add(c);  // in chunk order
+        *stats = ConsistencyStats{nS, all.corrected, all.steps, all.fieldSteps, all.noFieldSteps, all.pushedOut, all.heldIn};
+    }
+    return out;
+}
+
+} // namespace vdbhair

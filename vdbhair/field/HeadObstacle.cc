@@ -1,0 +1,158 @@
+#include "HeadObstacle.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/VdbFile.h>
+
+#include <openvdb/tools/Interpolation.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace vdbhair {
+
+HeadObstacle HeadObstacle::none()
+{
+    HeadObstacle h;
+    h.mKind = Kind::Disabled;
+    return h;
+}
+
+HeadObstacle HeadObstacle::sphere(const Vec3d& center, double radius, HeadPolicy policy)
+{
+    if (!(radius > 0.0) || !std::isfinite(radius)) {
+        throw ValueError("head sphere: radius " + std::to_string(radius) + " must be positive and finite");
+    }
+    for (int k = 0; k < 3; ++k) {
+        if (!std::isfinite(center[k])) throw ValueError("head sphere: the centre must be finite");
+    }
+    HeadObstacle h;
+    h.mKind = Kind::Sphere;
+    h.mPolicy = policy;
+    h.mCenter = center;
+    h.mRadius = radius;
+    return h;
+}
+
+HeadObstacle HeadObstacle::levelSet(openvdb::FloatGrid::ConstPtr grid, HeadPolicy policy)
+{
+    if (!grid) throw ValueError("head level set: no grid");
+    if (grid->getGridClass() != openvdb::GRID_LEVEL_SET) {
+        throw TypeError("head level set '" + grid->getName() + "': grid class is '" +
+                        openvdb::GridBase::gridClassToString(grid->getGridClass()) + "', not a level set");
+    }
+    if (grid->activeVoxelCount() == 0) throw ValueError("head level set '" + grid->getName() + "': no active voxels");
+    HeadObstacle h;
+    h.mKind = Kind::LevelSet;
+    h.mPolicy = policy;
+    h.mGrid = grid;
+    // The band's centre: where the normal points away from when a point is outside the band.
+    Vec3d sum(0.0);
+    double n = 0.0;
+    for (auto it = grid->cbeginValueOn(); it; ++it) {
+        if (!it.isVoxelValue()) continue;
+        sum += grid->indexToWorld(it.getCoord());
+        n += 1.0;
+    }
+    h.mCenter = n > 0.0 ? sum / n : Vec3d(0.0);
+    return h;
+}
+
+std::string HeadObstacle::describe() const
+{
+    std::ostringstream s;
+    switch (mKind) {
+    case Kind::None:
+    case Kind::Disabled: s << "none"; break;
+    case Kind::Sphere:
+        s << "sphere (" << mCenter.x() << ", " << mCenter.y() << ", " << mCenter.z() << ") radius " << mRadius
+          << (mPolicy == HeadPolicy::NoDeeper ? ", fitted to the roots" : "");
+        break;
+    case Kind::LevelSet: s << "level set '" << mGrid->getName() << "' (voxel " << mGrid->voxelSize()[0] << ")"; break;
+    }
+    return s.str();
+}
+
+HeadObstacle::Probe::Probe(const HeadObstacle& head) : mHead(head)
+{
+    if (head.mKind == Kind::LevelSet) mAcc.reset(new openvdb::FloatGrid::ConstAccessor(head.mGrid->getConstAccessor()));
+}
+
+double HeadObstacle::Probe::distance(const Vec3d& p)
+{
+    switch (mHead.mKind) {
+    case Kind::None:
+    case Kind::Disabled: return std::numeric_limits<double>::infinity();
+    case Kind::Sphere: return (p - mHead.mCenter).length() - mHead.mRadius;
+    case Kind::LevelSet:
+        return double(openvdb::tools::BoxSampler::sample(*mAcc, mHead.mGrid->worldToIndex(p)));
+    }
+    return std::numeric_limits<double>::infinity();
+}
+
+Vec3d HeadObstacle::Probe::normal(const Vec3d& p)
+{
+    Vec3d g(0.0);
+    switch (mHead.mKind) {
+    case Kind::None:
+    case Kind::Disabled: return g;
+    case Kind::Sphere: g = p - mHead.mCenter; break;
+    case Kind::LevelSet: {
+        // Central differences of the trilinear distance, half a voxel apart.
+        const double h = 0.5 * mHead.mGrid->voxelSize()[0];
+        for (int k = 0; k < 3; ++k) {
+            Vec3d a = p, b = p;
+            a[k] -= h;
+            b[k] += h;
+            g[k] = distance(b) - distance(a);
+        }
+        if (!(g.lengthSqr() > 0.0)) g = p - mHead.mCenter;  // outside the band, or a flat spot
+        break;
+    }
+    }
+    const double len = g.length();
+    return len > 0.0 ? g / len : Vec3d(0.0);
+}
+
+bool HeadObstacle::Probe::pushOut(Vec3d& p, double minDistance)
+{
+    if (mHead.empty()) return false;
+    // A little beyond the floor, so that the float output vertex is not rounded back inside.
+    const double scale = mHead.mKind == Kind::Sphere ? mHead.mRadius : mHead.mGrid->voxelSize()[0];
+    const double target = minDistance + 1e-4 * scale;
+    bool moved = false;
+    // Exact for a sphere in one step; a few Newton steps on a level set, whose distance is only
+    // approximately a distance.
+    for (int iter = 0; iter < 4; ++iter) {
+        const double d = distance(p);
+        if (!(d < minDistance) && (iter == 0 || !(d < target))) break;
+        const Vec3d n = normal(p);
+        if (n.lengthSqr() == 0.0) break;
+        p += (target - d) * n;
+        moved = true;
+    }
+    return moved;
+}
+
+HeadObstacle readHeadObstacle(const std::string& path, const std::string& where)
+{
+    if (fileExtension(path) != ".vdb") {
+        throw UnsupportedError(where + ": the head must be a .vdb holding a level set (such as the 'surface' grid of a scalp)");
+    }
+    const openvdb::GridPtrVec grids = readVdbGrids(path, where);
+    openvdb::FloatGrid::Ptr found;
+    for (const openvdb::GridBase::Ptr& g : grids) {
+        auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+        if (!f || f->getGridClass() != openvdb::GRID_LEVEL_SET) continue;
+        if (f->getName() == "surface") {
+            found = f;
+            break;
+        }
+        if (!found) found = f;
+    }
+    if (!found) throw LookupError(where + ": no float level set grid in the file (a head needs one, e.g. 'surface')");
+    return HeadObstacle::levelSet(found);
+}
+
+} // namespace vdbhair

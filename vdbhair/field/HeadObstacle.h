@@ -1,0 +1,91 @@
+/// @file HeadObstacle.h
+/// @brief The head as an obstacle for retraced strands: a signed distance (world units,
+/// negative inside) and its gradient, from a sphere or a narrow-band level set (an OpenVDB
+/// FloatGrid of class level set, such as the `surface` grid of a scalp .vdb).
+///
+/// What a retrace may do near it is the obstacle's HeadPolicy: a head the user gave (a scalp level
+/// set, a sphere) is trusted, and no retraced vertex may be inside it (KeepOutside); a head that
+/// was only guessed (the sphere fitted to the roots) must not undo the input, so a retraced
+/// vertex may be inside it only as deep as the input vertex at the same arc length was
+/// (NoDeeper): strands are never pushed into the head, and hair that already crossed a rough
+/// head model is not pushed out either.
+#pragma once
+
+#include <vdbhair/Types.h>
+
+#include <openvdb/openvdb.h>
+
+#include <memory>
+#include <string>
+
+namespace vdbhair {
+
+enum class HeadPolicy
+{
+    KeepOutside,  ///< no retraced vertex inside the head
+    NoDeeper      ///< no retraced vertex deeper inside than the input was
+};
+
+class HeadObstacle
+{
+public:
+    /// @brief Unset: refineStrands() then fits a sphere to the roots.
+    HeadObstacle() = default;
+    /// @brief Explicitly no obstacle: distance() is +infinity everywhere.
+    static HeadObstacle none();
+
+    /// @throw ValueError unless @a radius is positive and finite and @a center finite.
+    static HeadObstacle sphere(const Vec3d& center, double radius, HeadPolicy policy = HeadPolicy::KeepOutside);
+
+    /// @brief A narrow-band level set (negative inside). Outside its band the distance is the
+    /// grid's background with its sign, and the gradient falls back to the direction from the
+    /// band's centre of mass.
+    /// @throw TypeError unless @a grid is a level set, ValueError if it has no active voxels.
+    static HeadObstacle levelSet(openvdb::FloatGrid::ConstPtr grid, HeadPolicy policy = HeadPolicy::KeepOutside);
+
+    /// @brief Whether there is no obstacle (unset or none()).
+    bool empty() const { return mKind == Kind::None || mKind == Kind::Disabled; }
+    /// @brief Whether it was never set (refineStrands() fits a sphere to the roots then).
+    bool unset() const { return mKind == Kind::None; }
+    bool isSphere() const { return mKind == Kind::Sphere; }
+    HeadPolicy policy() const { return mPolicy; }
+    const Vec3d& center() const { return mCenter; }
+    double radius() const { return mRadius; }
+    /// @brief A short description for reports ("sphere (0, 1.6, 0) r 0.11", "level set 'surface'").
+    std::string describe() const;
+
+    /// @brief Signed distance and outward unit normal at world points; one per thread.
+    class Probe
+    {
+    public:
+        explicit Probe(const HeadObstacle& head);
+        /// Signed distance at @a p (world units; +inf without an obstacle).
+        double distance(const Vec3d& p);
+        /// Outward unit normal at @a p (zero without an obstacle).
+        Vec3d normal(const Vec3d& p);
+        /// @brief Move @a p along the normal until its distance is at least @a minDistance (a few
+        /// Newton steps on a level set); @return whether it moved.
+        bool pushOut(Vec3d& p, double minDistance);
+
+    private:
+        const HeadObstacle& mHead;
+        std::unique_ptr<openvdb::FloatGrid::ConstAccessor> mAcc;
+    };
+
+private:
+    enum class Kind { None, Disabled, Sphere, LevelSet };
+    Kind mKind = Kind::None;
+    HeadPolicy mPolicy = HeadPolicy::KeepOutside;
+    Vec3d mCenter{0.0};
+    double mRadius = 0.0;
+    openvdb::FloatGrid::ConstPtr mGrid;
+};
+
+/// @brief The head in a file: a .vdb's level set grid (the one named `surface`, else the first
+/// level set in the file).
+/// @param where prefix for messages, e.g. "--head scalp.vdb"
+/// @throw IoError, FormatError (unreadable file), LookupError (no level set in it),
+/// UnsupportedError (not a .vdb).
+HeadObstacle readHeadObstacle(const std::string& path, const std::string& where);
+
+} // namespace vdbhair
