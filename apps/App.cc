@@ -7,6 +7,7 @@
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/render/SphereMesh.h>
 
 #include <openvdb/Exceptions.h>
 #include <tbb/global_control.h>
@@ -57,10 +58,12 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
     return strands;
 }
 
-StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common)
+StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common, TriangleMesh* head)
 {
     if (fileExtension(path) == ".json") {
-        StrandSet s = growScene(readScene(path), {}, true, common.interrupter);
+        const Scene scene = readScene(path);
+        if (head && scene.head) *head = makeSphereMesh(scene.head->center, scene.head->radius);
+        StrandSet s = growScene(scene, {}, true, common.interrupter);
         if (s.empty()) throw FormatError(path + ": the scene has no guides");
         return s;
     }

@@ -9,6 +9,7 @@
 
 #include <vdbhair/Progress.h>
 #include <vdbhair/io/ReadOptions.h>
+#include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbInfo.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -83,7 +84,10 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
                       bool strict = false);
 
 /// @brief As loadStrands(), and a helicoid scene (.json) is grown first.
-StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common);
+/// @param head when given and @a path is a scene with a "head" record, set to a mesh of that head
+/// (makeSphereMesh()); left as it is otherwise.
+StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
+                             TriangleMesh* head = nullptr);
 
 /// @brief The axis named by an option such as --up: x, y, z, -x, -y or -z.
 /// @throw ValueError naming the option, the value and the choices.

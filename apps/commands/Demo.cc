@@ -27,7 +27,8 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
 {
     namespace fs = std::filesystem;
     const auto t0 = std::chrono::steady_clock::now();
-    const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common);
+    TriangleMesh head;  // a scene's own head, drawn in the preview
+    const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common, &head);
     const RefineParams rp = refineParamsFrom(p.refine, strands);
     std::error_code ec;
     fs::create_directories(p.outDir, ec);
@@ -51,6 +52,11 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     const BBox refinedBox = computeBBox(r.strands);
     box.expand(refinedBox.min);
     box.expand(refinedBox.max);
+    if (!head.triangles.empty()) {
+        view.head = &head;
+        box.expand(meshBBox(head).min);
+        box.expand(meshBBox(head).max);
+    }
     view.frame = box;
     Image sheet(3 * view.width, 2 * view.height, view.background);
     const View views[3] = {View::Front, View::Side, View::ThreeQuarter};

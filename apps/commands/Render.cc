@@ -40,18 +40,18 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
                          ": must be between 1 and 16384 pixels");
     }
     if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
-    const StrandSet strands = loadStrandsOrScene("render", p.input, common);
+    TriangleMesh head;  // --head, or the scene's own head
+    const StrandSet strands = loadStrandsOrScene("render", p.input, common, p.head.empty() ? &head : nullptr);
     StrandSet guides;
     if (!p.guides.empty()) {
         guides = loadStrandsOrScene("render", p.guides, common);
         rp.guides = &guides;
     }
-    TriangleMesh head;
     if (!p.head.empty()) {
         const Stage stage(common, "reading " + p.head);
         head = readTriangleMesh(p.head);
-        rp.head = &head;
     }
+    if (!head.triangles.empty()) rp.head = &head;
     const auto t0 = std::chrono::steady_clock::now();
     const Image image = p.sheet ? renderSheet(strands, rp) : renderStrands(strands, rp);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -78,7 +78,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--width", params->width, "Width in pixels")->capture_default_str();
     sub->add_option("--height", params->height, "Height in pixels")->capture_default_str();
     sub->add_option("--color-by", params->colorBy, "shaded, root, tangent, depth, curvature or strand")->capture_default_str();
-    sub->add_option("--head", params->head, "A head mesh (.ply, .obj) drawn behind the hair, e.g. from ../shared/data/scalp");
+    sub->add_option("--head", params->head, "A head mesh (.ply, .obj) drawn behind the hair, e.g. from ../shared/data/scalp (default: a scene's own \"head\")");
     sub->add_option("--guides", params->guides, "Strands drawn on top in red (e.g. the guides of a scene)");
     sub->add_option("--title", params->title, "Text in the top-left corner");
     sub->add_option("--up", params->up, "The hairstyle's up axis: x, y, z, -x, -y or -z (z for Yuksel's cyHair models)")

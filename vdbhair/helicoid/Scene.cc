@@ -68,7 +68,7 @@ std::string idx(const std::string& base, std::size_t i) { return base + "[" + st
 Scene sceneFromJson(const json& j, const std::string& where)
 {
     Parser P{where};
-    P.allowOnly(j, "", {"vdbhair", "seed", "step", "integrator", "guides"});
+    P.allowOnly(j, "", {"vdbhair", "seed", "step", "integrator", "guides", "head"});
     const json& tag = P.require(j, "", "vdbhair");
     if (!tag.is_string() || tag.get<std::string>() != "scene/1") P.fail("vdbhair", "expected \"scene/1\"");
     Scene s;
@@ -82,6 +82,17 @@ Scene sceneFromJson(const json& j, const std::string& where)
         if (ij == "euler") s.integrator = HelicoidIntegrator::Euler;
         else if (ij == "rk4") s.integrator = HelicoidIntegrator::RK4;
         else P.fail("integrator", "expected \"euler\" or \"rk4\"");
+    }
+    if (j.contains("head")) {
+        const json& hj = j["head"];
+        P.allowOnly(hj, "head", {"sphere"});
+        const json& sj = P.require(hj, "head", "sphere");
+        if (!sj.is_array() || sj.size() != 4) P.fail("head.sphere", "expected 4 numbers (cx, cy, cz, r)");
+        SceneHead head;
+        head.center = Vec3d(P.number(sj[0], "head.sphere[0]"), P.number(sj[1], "head.sphere[1]"), P.number(sj[2], "head.sphere[2]"));
+        head.radius = P.number(sj[3], "head.sphere[3]");
+        if (!(head.radius > 0.0)) P.fail("head.sphere[3]", "the radius must be positive, got " + sj[3].dump());
+        s.head = head;
     }
     const json& guides = P.require(j, "", "guides");
     if (!guides.is_array()) P.fail("guides", "expected an array");
@@ -134,13 +145,23 @@ Scene sceneFromJson(const json& j, const std::string& where)
         if (gj.contains("wisp")) {
             const json& wj = gj["wisp"];
             const std::string wp = gp + ".wisp";
-            P.allowOnly(wj, wp, {"count", "radius", "fanning"});
+            P.allowOnly(wj, wp, {"count", "radius", "fanning", "normal", "strays"});
             WispParams w;
             w.count = std::size_t(P.count(P.require(wj, wp, "count"), wp + ".count"));
             w.radius = P.number(P.require(wj, wp, "radius"), wp + ".radius");
             if (wj.contains("fanning")) w.fanning = P.number(wj["fanning"], wp + ".fanning");
             if (w.radius < 0.0) P.fail(wp + ".radius", "must not be negative");
             if (w.fanning < 0.0) P.fail(wp + ".fanning", "must not be negative");
+            if (wj.contains("normal")) {
+                const Vec3d n = P.vec3(wj["normal"], wp + ".normal");
+                const double len = n.length();
+                if (!(len > 1e-12) || !std::isfinite(len)) P.fail(wp + ".normal", "must be a non-zero vector (the scalp's normal at the root)");
+                w.normal = n / len;
+            }
+            if (wj.contains("strays")) {
+                w.strays = P.number(wj["strays"], wp + ".strays");
+                if (w.strays < 0.0 || w.strays > 1.0) P.fail(wp + ".strays", "must be a fraction in [0, 1], got " + wj["strays"].dump());
+            }
             guide.wisp = w;
         }
         if (gj.contains("fit")) guide.fit = gj["fit"];
@@ -172,13 +193,18 @@ json sceneToJson(const Scene& s)
             if (g.waviness->phase != 0.0) gj["waviness"]["phase"] = g.waviness->phase;
             if (g.waviness->noise != 0.0) gj["waviness"]["noise"] = g.waviness->noise;
         }
-        if (g.wisp) gj["wisp"] = {{"count", g.wisp->count}, {"radius", g.wisp->radius}, {"fanning", g.wisp->fanning}};
+        if (g.wisp) {
+            gj["wisp"] = {{"count", g.wisp->count}, {"radius", g.wisp->radius}, {"fanning", g.wisp->fanning}};
+            if (g.wisp->normal.length() > 0.0) gj["wisp"]["normal"] = {g.wisp->normal.x(), g.wisp->normal.y(), g.wisp->normal.z()};
+            if (g.wisp->strays > 0.0) gj["wisp"]["strays"] = g.wisp->strays;
+        }
         if (!g.fit.is_null()) gj["fit"] = g.fit;
         if (g.step > 0.0) gj["step"] = g.step;
         guides.push_back(gj);
     }
     json out = {{"vdbhair", "scene/1"}, {"seed", s.seed}, {"step", s.step}, {"guides", guides}};
     if (s.integrator == HelicoidIntegrator::RK4) out["integrator"] = "rk4";
+    if (s.head) out["head"] = {{"sphere", {s.head->center.x(), s.head->center.y(), s.head->center.z(), s.head->radius}}};
     return out;
 }
 
@@ -200,6 +226,7 @@ void writeScene(const std::string& path, const Scene& scene)
     // One guide per line: readable, diffable, and still one JSON document.
     std::string out = "{\"vdbhair\": \"scene/1\", \"seed\": " + std::to_string(scene.seed) + ", \"step\": " +
                       j["step"].dump() + (j.contains("integrator") ? ", \"integrator\": " + j["integrator"].dump() : std::string()) +
+                      (j.contains("head") ? ", \"head\": " + j["head"].dump() : std::string()) +
                       ",\n \"guides\": [\n";
     for (std::size_t i = 0; i < j["guides"].size(); ++i) {
         out += "  " + j["guides"][i].dump() + (i + 1 < j["guides"].size() ? ",\n" : "\n");

@@ -2,19 +2,24 @@
 /// @brief Helicoid scene files (`scene/1` JSON) and growing them into strands.
 ///
 /// ```json
-/// {"vdbhair": "scene/1", "seed": 7, "step": 0.01,
+/// {"vdbhair": "scene/1", "seed": 7, "step": 0.01, "head": {"sphere": [0, 0, 0, 10]},
 ///  "guides": [
 ///   {"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]},
 ///    "pieces": [{"k": [1.0, -0.1, 0.3, 1.0], "length": 2.0, "roll": 0.0}],
 ///    "waviness": {"amplitude": 0.02, "frequency": 40.0, "phase": 0.0, "noise": 0.0},
-///    "wisp": {"count": 256, "radius": 0.05, "fanning": 0.0},
+///    "wisp": {"count": 256, "radius": 0.05, "fanning": 0.0, "normal": [0,1,0], "strays": 0.05},
 ///    "fit": {...}}]}
 /// ```
 /// `step` is the tracing step in world units and `integrator` (optional) "euler" (Eq. 3, the
 /// default) or "rk4" (which `vdbhair fit` writes: fits are exact streamlines); a guide may override it with its own
 /// `step` (`vdbhair fit` writes one per guide, fitted at its strand's scale). `roll`, `waviness`
 /// (and its `phase` and `noise`), `wisp`, `fit` and a guide's `step` are optional; `fit` (written by `vdbhair fit`) is kept but ignored
-/// by growing. Unknown keys and malformed values are errors that name the key path:
+/// by growing. A wisp's `normal` (optional) is the scalp's normal at the guide's root: its roots are
+/// then sampled in the scalp's tangent plane instead of perpendicular to the guide (WispParams); its
+/// `strays` (optional, a fraction in [0, 1], default 0) makes that share of its strands strays,
+/// rotated by 0.3-0.6 rad out of the wisp's flow. The scene-level `head` (optional) names the head
+/// the hair grows on, `{"sphere": [cx, cy, cz, r]}`: growing ignores it; `render` draws it (see
+/// makeSphereMesh()). Unknown keys and malformed values are errors that name the key path:
 /// `scene.json: guides[3].pieces[0].k: expected 4 numbers`.
 #pragma once
 
@@ -44,12 +49,20 @@ struct SceneGuide
     double step = 0.0;   ///< this guide's tracing step; 0: the scene's (optional key "step", written by fit)
 };
 
+/// @brief The head a scene's hair grows on (optional key "head"): today a sphere.
+struct SceneHead
+{
+    Vec3d center{0.0};  ///< world units
+    double radius = 0.0;  ///< world units, positive
+};
+
 struct Scene
 {
     std::uint64_t seed = 0;
     double step = 0.01;
     HelicoidIntegrator integrator = HelicoidIntegrator::Euler;  ///< optional key "integrator": "euler" (Eq. 3) or "rk4"
     std::vector<SceneGuide> guides;
+    std::optional<SceneHead> head;  ///< optional key "head": {"sphere": [cx, cy, cz, r]}
 };
 
 /// @brief Parse a scene from JSON. @param where message prefix (the file name).
