@@ -3,6 +3,7 @@
 #include "../RefineOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
@@ -29,7 +30,12 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     const auto t0 = std::chrono::steady_clock::now();
     TriangleMesh head;  // a scene's own head, drawn in the preview
     const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common, &head);
-    const RefineParams rp = refineParamsFrom(p.refine, strands);
+    RefineParams rp = refineParamsFrom(p.refine, strands);
+    // A scene's own head is the obstacle refinement keeps strands out of, unless --head says otherwise.
+    if (p.refine.head.empty() && fileExtension(p.refine.input) == ".json") {
+        const Scene scene = readScene(p.refine.input);
+        if (scene.head) rp.head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
+    }
     std::error_code ec;
     fs::create_directories(p.outDir, ec);
     if (ec) throw IoError(p.outDir + ": cannot create the output folder: " + ec.message());
