@@ -44,10 +44,12 @@ std::string formatValue(double v)
 
 void printJson(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 
-StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict)
+StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict,
+                      const std::string& vdbGrid)
 {
     const Stage stage(common, "reading " + path);
     ReadOptions opts;
+    opts.vdbGrid = vdbGrid;
     opts.interrupter = common.interrupter;
     if (strict) opts.shortStrands = ShortStrandPolicy::Reject;
     ReadReport report;
@@ -57,14 +59,15 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
     return strands;
 }
 
-StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common)
+StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
+                             const std::string& vdbGrid)
 {
     if (fileExtension(path) == ".json") {
         StrandSet s = growScene(readScene(path), {}, true, common.interrupter);
         if (s.empty()) throw FormatError(path + ": the scene has no guides");
         return s;
     }
-    return loadStrands(verb, path, common);
+    return loadStrands(verb, path, common, false, vdbGrid);
 }
 
 void addScalpOptions(CLI::App* sub, ScalpOptions& opts)

@@ -79,11 +79,13 @@ void printJson(const nlohmann::json& j);
 
 /// @brief Read strands from any supported file, printing the reader's warnings for @a verb.
 /// @param strict reject strands of fewer than two vertices instead of dropping them
+/// @param vdbGrid for a .vdb file, the points grid holding the strands (`--grid`)
 StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common,
-                      bool strict = false);
+                      bool strict = false, const std::string& vdbGrid = "strands");
 
 /// @brief As loadStrands(), and a helicoid scene (.json) is grown first.
-StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common);
+StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
+                             const std::string& vdbGrid = "strands");
 
 /// @brief The axis named by an option such as --up: x, y, z, -x, -y or -z.
 /// @throw ValueError naming the option, the value and the choices.

@@ -29,7 +29,8 @@ struct RefineCmdParams
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p);
 /// @throw ValueError for out-of-range options.
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands);
-openvdb::GridCPtrVec fieldGrids(const RefineResult& r);
+/// The field grids of @a r, each tagged `vdbhair_source` = @a source (the input file).
+openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source);
 nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp);
 
 /// The report of retrace and refine: {"strands","full_length","stopped":{...},"tangent_angle_deg":{...},"mean_displacement"}.

@@ -22,6 +22,9 @@ struct ConvertParams
     std::string codec = "float";
     double voxelSize = 0.0;
     bool strict = false;
+    std::string objLines = "edges";
+    std::vector<double> rootNear;  ///< x, y, z; empty: OBJ roots at the lower-index end
+    std::string grid = "strands";
 };
 
 int runConvert(ConvertParams p, const CommonOptions& common)
@@ -44,8 +47,14 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     wopts.vdb.codec = positionCodecFromName(p.codec);
     if (p.voxelSize < 0.0 || !std::isfinite(p.voxelSize)) throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive length (0 chooses it)");
     wopts.vdb.voxelSize = p.voxelSize;
+    wopts.objLines = objLineStyleFromName(p.objLines);
 
     ReadOptions ropts;
+    ropts.vdbGrid = p.grid;
+    if (!p.rootNear.empty()) {
+        if (p.rootNear.size() != 3) throw ValueError("--root-near needs X,Y,Z");
+        ropts.objRootNear = Vec3f(float(p.rootNear[0]), float(p.rootNear[1]), float(p.rootNear[2]));
+    }
     if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
     ropts.interrupter = common.interrupter;
     StrandSet strands;
@@ -90,6 +99,13 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--codec", params->codec, "VDB position codec: float (exact), fixed16, fixed8")->capture_default_str();
     sub->add_option("--voxel-size", params->voxelSize, "VDB points voxel size in world units (default: about 8 points per voxel)");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    sub->add_option("--obj-lines", params->objLines,
+                    "OBJ output: edges (a two-vertex 'l' per segment, what Blender's importer reads whole) or polylines (one 'l' per strand, Houdini)")
+        ->capture_default_str();
+    sub->add_option("--root-near", params->rootNear,
+                    "OBJ input: root each strand at its end nearest X,Y,Z (e.g. the head's centre) instead of its lower-index end")
+        ->delimiter(',')->expected(3);
+    sub->add_option("--grid", params->grid, "VDB input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");
     return {sub, [params, &common] { return runConvert(*params, common); }};

@@ -66,7 +66,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     {
         const Stage writing(common, "writing " + dir);
         writeStrands(refinedPath, r.strands);
-        writeVdbGrids(fieldPath, fieldGrids(r), "demo(" + fieldPath + ")");
+        writeVdbGrids(fieldPath, fieldGrids(r, p.refine.input), "demo(" + fieldPath + ")");
         {
             // The input and refined strands as points grids, for side-by-side viewing in Houdini/Blender.
             auto before = createStrandGrid(strands);

@@ -57,7 +57,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     nlohmann::json gridsJson = nlohmann::json::array();
     for (const TangentField& f : fields) {
         for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density)}) {
-            g->insertMeta("vdbhair:source", openvdb::StringMetadata(p.input));
+            g->insertMeta("vdbhair_source", openvdb::StringMetadata(p.input));
             grids.push_back(g);
             gridsJson.push_back({{"name", g->getName()}, {"voxel_size", g->voxelSize().x()}, {"active_voxels", g->activeVoxelCount()}});
         }

@@ -35,12 +35,14 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     return rp;
 }
 
-openvdb::GridCPtrVec fieldGrids(const RefineResult& r)
+openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source)
 {
     openvdb::GridCPtrVec grids;
     for (const TangentField& f : r.fields) {
-        grids.push_back(f.tangent);
-        grids.push_back(f.density);
+        for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density)}) {
+            g->insertMeta("vdbhair_source", openvdb::StringMetadata(source));
+            grids.push_back(g);
+        }
     }
     return grids;
 }
@@ -69,7 +71,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     // Write the field first: if the strands' write fails, nothing half-done is claimed.
     {
         const Stage stage(common, "writing " + p.output);
-        if (!p.saveField.empty()) writeVdbGrids(p.saveField, fieldGrids(r), "refine(" + p.saveField + ")");
+        if (!p.saveField.empty()) writeVdbGrids(p.saveField, fieldGrids(r, p.input), "refine(" + p.saveField + ")");
         writeStrands(p.output, r.strands);
     }
     if (common.json) {

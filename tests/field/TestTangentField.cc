@@ -50,9 +50,9 @@ TEST_CASE("estimateTangentField: a straight parallel hairstyle gives a uniform f
     REQUIRE(f.density->getName() == "density");
     REQUIRE(f.tangent->getVectorType() == openvdb::VEC_CONTRAVARIANT_RELATIVE);
     REQUIRE(f.density->getGridClass() == openvdb::GRID_FOG_VOLUME);
-    REQUIRE(f.tangent->metaValue<double>("vdbhair:voxel_size") == 0.5);
-    REQUIRE(f.tangent->metaValue<int>("vdbhair:iterations") == 2);
-    REQUIRE(f.tangent->metaValue<std::string>("vdbhair:space") == "world");
+    REQUIRE(f.tangent->metaValue<double>("vdbhair_voxel_size") == 0.5);
+    REQUIRE(f.tangent->metaValue<int>("vdbhair_iterations") == 2);
+    REQUIRE(f.tangent->metaValue<std::string>("vdbhair_space") == "world");
 }
 
 TEST_CASE("estimateTangentField: a segment marks every voxel it passes, and no other", "[field]")
@@ -156,7 +156,7 @@ TEST_CASE("estimateTangentFieldLevels: level l has voxel size h*2^l and its own 
         REQUIRE(levels[std::size_t(l)].tangent->getName() == "tangent_level_" + std::to_string(l));
         REQUIRE(levels[std::size_t(l)].density->getName() == "density_level_" + std::to_string(l));
         REQUIRE(levels[std::size_t(l)].tangent->voxelSize().x() == Approx(0.25 * (1 << l)));
-        REQUIRE(levels[std::size_t(l)].tangent->metaValue<int>("vdbhair:level") == l);
+        REQUIRE(levels[std::size_t(l)].tangent->metaValue<int>("vdbhair_level") == l);
     }
     REQUIRE(levels[2].tangent->activeVoxelCount() < levels[0].tangent->activeVoxelCount());
 }

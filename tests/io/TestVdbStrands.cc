@@ -47,7 +47,7 @@ TEST_CASE("createStrandGrid: attributes, root group and metadata", "[io][vdb]")
     const StrandSet s = test::sampleStrands(false);
     const auto grid = createStrandGrid(s);
     REQUIRE(grid->getName() == "strands");
-    REQUIRE(grid->metaValue<std::int64_t>("vdbhair:strand_count") == 3);
+    REQUIRE(grid->metaValue<std::int64_t>("vdbhair_strand_count") == 3);
     REQUIRE(grid->metaValue<std::string>("creator").rfind("vdbhair ", 0) == 0);
     const auto& desc = grid->tree().cbeginLeaf()->attributeSet().descriptor();
     REQUIRE(desc.find("strand") != openvdb::points::AttributeSet::INVALID_POS);
@@ -117,10 +117,10 @@ TEST_CASE("readVdbStrands: each kind of bad input has its own error", "[io][vdb]
     {
         StrandSet s = test::sampleStrands(false);
         auto g = createStrandGrid(s);
-        g->insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(1000000));
+        g->insertMeta("vdbhair_strand_count", openvdb::Int64Metadata(1000000));
         std::string path = test::tempPath("count.vdb");
         writeVdbGrids(path, {g}, "test");
-        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("vdbhair:strand_count 1000000 is impossible for 52 points"));
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("vdbhair_strand_count 1000000 is impossible for 52 points"));
 
         g = createStrandGrid(s);
         for (auto leaf = g->tree().beginLeaf(); leaf; ++leaf) {

@@ -42,8 +42,8 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
         f.tangent->setName(tangentGridName(level, params.levels));
         f.density->setName(densityGridName(level, params.levels));
         for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(f.tangent.get()), static_cast<openvdb::GridBase*>(f.density.get())}) {
-            g->insertMeta("vdbhair:level", openvdb::Int32Metadata(level));
-            g->insertMeta("vdbhair:levels", openvdb::Int32Metadata(params.levels));
+            g->insertMeta("vdbhair_level", openvdb::Int32Metadata(level));
+            g->insertMeta("vdbhair_levels", openvdb::Int32Metadata(params.levels));
         }
         // Every level retraces the input strands' roots for the input's lengths and vertex
         // arc lengths, so that early stops at one level do not shorten the next. The last

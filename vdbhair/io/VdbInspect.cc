@@ -157,11 +157,13 @@ std::string plural(std::int64_t n, const char* one, const char* many)
     return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
+/// The metadata @a name; a `vdbhair_` key is also found under its older `vdbhair:` spelling.
 const MetaValue* findMeta(const GridInfo& info, const std::string& name)
 {
     for (const MetaValue& m : info.metadata) {
         if (m.name == name) return &m;
     }
+    if (name.rfind("vdbhair_", 0) == 0) return findMeta(info, "vdbhair:" + name.substr(8));
     return nullptr;
 }
 
@@ -189,23 +191,23 @@ std::string explainGrid(const GridInfo& info)
         {"strands", "hair strands as points: one point per vertex, with strand and vertex indices"},
     };
     std::string base = info.name;
-    const std::int64_t level = integer("vdbhair:level");
+    const std::int64_t level = integer("vdbhair_level");
     // Multi-level fields are named tangent_level_0, density_level_1, ...
     const std::size_t lv = base.rfind("_level_");
     if (lv != std::string::npos && lv > 0) base.resize(lv);
     const auto it = meaning.find(base);
     const std::string creator = text("creator");
-    const bool ours = creator.rfind("vdbhair", 0) == 0 || findMeta(info, "vdbhair:strand_count") != nullptr;
+    const bool ours = creator.rfind("vdbhair", 0) == 0 || findMeta(info, "vdbhair_strand_count") != nullptr;
     if (it != meaning.end() && ours) os << "Holds " << it->second << ".";
-    const std::int64_t strands = integer("vdbhair:strand_count");
-    const std::string source = text("vdbhair:source");
-    const std::int64_t iterations = integer("vdbhair:iterations");
-    const std::string space = text("vdbhair:space");
-    const std::string voxel = text("vdbhair:voxel_size");
+    const std::int64_t strands = integer("vdbhair_strand_count");
+    const std::string source = text("vdbhair_source");
+    const std::int64_t iterations = integer("vdbhair_iterations");
+    const std::string space = text("vdbhair_space");
+    const std::string voxel = text("vdbhair_voxel_size");
     if (info.isPoints && strands >= 0) {
         os << (os.tellp() > 0 ? " " : "") << "Written by " << (creator.empty() ? "vdbhair" : creator) << " from "
            << plural(strands, "strand", "strands");
-        const std::string codec = text("vdbhair:position_codec");
+        const std::string codec = text("vdbhair_position_codec");
         if (!codec.empty()) os << ", positions stored with the " << codec << " codec";
         os << ".";
     } else if (iterations >= 0 || !space.empty()) {
@@ -228,19 +230,19 @@ std::string explainGrid(const GridInfo& info)
         if (space == "world") os << ", in world space";
         else if (space == "scalp") {
             os << ", in scalp space (Wang et al.'s (u, v, height) over a sphere";
-            const std::string c = text("vdbhair:scalp_center"), rad = text("vdbhair:scalp_radius");
+            const std::string c = text("vdbhair_scalp_center"), rad = text("vdbhair_scalp_radius");
             if (!c.empty()) os << " centred at " << c;
             if (!rad.empty()) os << " of radius " << rad;
             os << ")";
         }
         os << ".";
-        const std::int64_t levels = integer("vdbhair:levels");
+        const std::int64_t levels = integer("vdbhair_levels");
         if (levels > 1) {
             os << " Level " << level << " of 0.." << levels - 1 << (level == 0 ? " (the finest" : " (level 0 is the finest")
                << "; each level doubles the voxel size).";
         }
     }
-    const std::string fit = text("vdbhair:helicoid_fit");
+    const std::string fit = text("vdbhair_helicoid_fit");
     if (!fit.empty()) os << " Helicoid parameters fitted per voxel: " << fit << ".";
     if (!ours && !creator.empty()) os << (os.tellp() > 0 ? " " : "") << "Written by " << creator << ".";
     return os.str();
