@@ -30,6 +30,7 @@ struct CommonOptions
     int threads = 0;      ///< 0: all cores
     bool json = false;    ///< one JSON object on stdout instead of prose
     bool quiet = false;   ///< no progress, no warnings
+    bool noClobber = false;  ///< refuse to replace existing outputs (--no-clobber)
     /// The progress bar and Ctrl-C (Progress.h), set by run() before the verb runs: hand it to
     /// every library call that takes an interrupter.
     WorkInterrupter* interrupter = nullptr;
@@ -114,6 +115,10 @@ Command addGrowCommand(CLI::App& app, CommonOptions& common);
 Command addRenderCommand(CLI::App& app, CommonOptions& common);
 Command addFitCommand(CLI::App& app, CommonOptions& common);
 Command addInspectCommand(CLI::App& app, CommonOptions& common);
+
+/// @brief The verbs of @a verbs nearest to @a word (edit distance, a prefix counting as 1), for
+/// "did you mean"; empty when none is close.
+std::vector<std::string> nearestVerbs(const std::string& word, const std::vector<std::string>& verbs);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line, 130 interrupted

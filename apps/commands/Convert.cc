@@ -25,6 +25,8 @@ struct ConvertParams
     std::string objLines = "edges";
     std::vector<double> rootNear;  ///< x, y, z; empty: OBJ roots at the lower-index end
     std::string grid = "strands";
+    std::string usdUp = "y";
+    double metersPerUnit = 0.01;
 };
 
 int runConvert(ConvertParams p, const CommonOptions& common)
@@ -48,6 +50,10 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     if (p.voxelSize < 0.0 || !std::isfinite(p.voxelSize)) throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive length (0 chooses it)");
     wopts.vdb.voxelSize = p.voxelSize;
     wopts.objLines = objLineStyleFromName(p.objLines);
+    if (p.usdUp != "y" && p.usdUp != "z" && p.usdUp != "Y" && p.usdUp != "Z") throw ValueError("--usd-up '" + p.usdUp + "': must be y or z (USD's choices)");
+    wopts.usd.upAxis = p.usdUp == "z" || p.usdUp == "Z" ? "Z" : "Y";
+    if (!(p.metersPerUnit > 0.0) || !std::isfinite(p.metersPerUnit)) throw ValueError("--meters-per-unit " + formatValue(p.metersPerUnit) + ": must be a positive length");
+    wopts.usd.metersPerUnit = p.metersPerUnit;
 
     ReadOptions ropts;
     ropts.vdbGrid = p.grid;
@@ -92,7 +98,7 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     auto params = std::make_shared<ConvertParams>();
     CLI::App* sub = app.add_subcommand("convert", "Convert strands between formats (several inputs are concatenated)");
     sub->add_option("files", params->files, "IN [IN...] OUT, or IN [IN...] with -o OUT")->required();
-    sub->add_option("-o,--output", params->output, "Output file; its extension picks the format (.hair .data .obj .ply .vdb)");
+    sub->add_option("-o,--output", params->output, "Output file; its extension picks the format (.hair .data .obj .ply .vdb .usda)");
     sub->add_option("--resample", params->resample, "Resample every strand to N vertices, equally spaced in arc length")->check(CLI::NonNegativeNumber);
     sub->add_option("--scale", params->scale, "Multiply every position (and thickness) by S");
     sub->add_option("--ply-encoding", params->plyEncoding, "PLY output encoding: binary (little-endian) or ascii")->capture_default_str();
@@ -105,6 +111,8 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--root-near", params->rootNear,
                     "OBJ input: root each strand at its end nearest X,Y,Z (e.g. the head's centre) instead of its lower-index end")
         ->delimiter(',')->expected(3);
+    sub->add_option("--usd-up", params->usdUp, "USD output: the stage's upAxis, y or z (coordinates are not rotated)")->capture_default_str();
+    sub->add_option("--meters-per-unit", params->metersPerUnit, "USD output: the stage's metersPerUnit (0.01: centimetres)")->capture_default_str();
     sub->add_option("--grid", params->grid, "VDB input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");

@@ -39,7 +39,13 @@ openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source
 {
     openvdb::GridCPtrVec grids;
     for (const TangentField& f : r.fields) {
-        for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density)}) {
+        // hair_length follows density's name (density_level_l -> hair_length_level_l) and metadata.
+        const std::string densityName = f.density->getName();
+        f.hairLength->setName("hair_length" + densityName.substr(std::string("density").size()));
+        for (const char* key : {"vdbhair_level", "vdbhair_levels"}) {
+            if (const auto m = f.density->getMetadata<openvdb::Int32Metadata>(key)) f.hairLength->insertMeta(key, *m);
+        }
+        for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density), openvdb::GridBase::Ptr(f.hairLength)}) {
             g->insertMeta("vdbhair_source", openvdb::StringMetadata(source));
             grids.push_back(g);
         }

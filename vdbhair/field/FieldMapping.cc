@@ -24,6 +24,11 @@ std::string tangentGridName(int level, int levels)
     return levels <= 1 ? "tangent" : "tangent_level_" + std::to_string(level);
 }
 
+std::string hairLengthGridName(int level, int levels)
+{
+    return levels <= 1 ? "hair_length" : "hair_length_level_" + std::to_string(level);
+}
+
 std::string densityGridName(int level, int levels)
 {
     return levels <= 1 ? "density" : "density_level_" + std::to_string(level);

@@ -17,7 +17,7 @@ struct FormatEntry { const char* ext; StrandFormat format; const char* name; boo
 constexpr FormatEntry kFormats[] = {
     {".hair", StrandFormat::Hair, "cyHair", true},
     {".data", StrandFormat::Data, "USC-HairSalon", true},
-    {".obj", StrandFormat::Obj, "OBJ polylines", true},
+    {".obj", StrandFormat::Obj, "OBJ lines", true},
     {".ply", StrandFormat::Ply, "PLY (hairutil layout)", true},
     {".vdb", StrandFormat::Vdb, "OpenVDB points", true},
     {".usda", StrandFormat::Usda, "USD BasisCurves (text)", true},

@@ -443,6 +443,12 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         perVertex("widths", 1, widths, &defaults.thickness);
         perVertex("primvars:displayColor", 3, colors, &defaults.color[0]);
         if (perVertex("primvars:displayOpacity", 1, opacity, &opacityConstant) && opacity.empty()) defaults.transparency = 1.f - opacityConstant;
+        // vdbhair's own record of the defaults (exact, and kept when the arrays are per vertex).
+        if (const Property* d = find("vdbhair_default_thickness"); d && d->value.numbers.size() == 1) defaults.thickness = float(d->value.numbers[0]);
+        if (const Property* d = find("vdbhair_default_transparency"); d && d->value.numbers.size() == 1) defaults.transparency = float(d->value.numbers[0]);
+        if (const Property* d = find("vdbhair_default_color"); d && d->value.numbers.size() == 3) {
+            defaults.color = Vec3f(float(d->value.numbers[0]), float(d->value.numbers[1]), float(d->value.numbers[2]));
+        }
         if (first) out.defaults = defaults;
         first = false;
 
@@ -530,6 +536,14 @@ void writeUsda(const std::string& path, const StrandSet& strands, const UsdWrite
     if (strands.transparency.empty()) num(1.f - strands.defaults.transparency);
     else for (std::size_t v = 0; v < nV; ++v) { if (v) out += ", "; num(1.f - strands.transparency[v]); }
     out += std::string("] (\n        interpolation = \"") + (strands.transparency.empty() ? "constant" : "vertex") + "\"\n    )\n";
+    // The defaults themselves (cyHair's header), exactly, whether or not the arrays are per vertex.
+    out += "    custom float vdbhair_default_thickness = ";
+    num(strands.defaults.thickness);
+    out += "\n    custom float vdbhair_default_transparency = ";
+    num(strands.defaults.transparency);
+    out += "\n    custom color3f vdbhair_default_color = ";
+    vec3(strands.defaults.color);
+    out += "\n";
     const BBox box = computeBBox(strands);
     out += "    float3[] extent = [";
     vec3(box.min);

@@ -22,13 +22,17 @@
 ///     float[] widths = [...] (interpolation = "vertex")      // or one value, "constant"
 ///     color3f[] primvars:displayColor = [...] (interpolation = "vertex")  // or "constant"
 ///     float[] primvars:displayOpacity = [...] (interpolation = "vertex")  // 1 - transparency
+///     custom float vdbhair_default_thickness = 1         // the defaults, exactly
+///     custom float vdbhair_default_transparency = 0
+///     custom color3f vdbhair_default_color = (0.5, 0.5, 0.5)
 ///     float3[] extent = [(min), (max)]
 /// }
 /// ```
 ///
 /// Widths are vdbhair's thickness (a diameter in world units, as USD's `widths`); per-vertex
 /// arrays are written with "vertex" interpolation, and where the set has none its defaults (the
-/// cyHair header's) are written as one "constant" value, so `.hair -> .usda -> .hair` keeps both.
+/// cyHair header's) are written as one "constant" value; the defaults are also written exactly as
+/// custom attributes `vdbhair_default_*`, so `.hair -> .usda -> .hair` keeps both.
 /// Floats are written in the shortest form that reads back exactly.
 ///
 /// Reading accepts every `def BasisCurves` prim of the file (concatenated in file order), nested

@@ -183,7 +183,9 @@ std::string explainGrid(const GridInfo& info)
     // What the grid holds, by its name (DESIGN.md's grid conventions).
     static const std::map<std::string, std::string> meaning = {
         {"tangent", "the hair's unit direction, root to tip, per voxel (inactive where no hair passed)"},
-        {"density", "the hair length that passed through each voxel (summed segment length)"},
+        {"density", "the hair density as a fog volume in [0, 1]: hair length per unit volume over vdbhair_density_reference, clamped"},
+        {"hair_length", "the hair length that passed through each voxel (summed segment length)"},
+        {"hair_direction", "the hair's unit direction, root to tip, per voxel (the tangent grid under a name Blender's Cycles does not reserve)"},
         {"helicoid_k", "the local helicoid curvatures (kT, kN, kB) fitted per voxel"},
         {"helicoid_alpha", "the local helicoid elevation factor alpha fitted per voxel"},
         {"frame_T", "the local helicoid frame's tangent T per voxel"},
@@ -211,7 +213,7 @@ std::string explainGrid(const GridInfo& info)
         if (!codec.empty()) os << ", positions stored with the " << codec << " codec";
         os << ".";
     } else if (iterations >= 0 || !space.empty()) {
-        const bool tangent = base == "tangent", density = base == "density";
+        const bool tangent = base == "tangent" || base == "hair_direction", density = base == "density" || base == "hair_length";
         const bool helicoid = base.rfind("helicoid_", 0) == 0 || base.rfind("frame_", 0) == 0;
         os << (os.tellp() > 0 ? " " : "") << (tangent ? "Estimated" : density ? "Accumulated" : helicoid ? "Fitted" : "Made") << " by "
            << (creator.empty() ? "vdbhair" : creator);
@@ -251,7 +253,7 @@ std::string explainGrid(const GridInfo& info)
 std::vector<GridReport> inspectVdbFile(const std::string& path)
 {
     const std::string where = "inspect(" + path + ")";
-    std::vector<GridInfo> infos = describeVdbFile(path);
+    std::vector<GridInfo> infos = describeVdbFile(path, where);
     const openvdb::GridPtrVec grids = readVdbGrids(path, where);
     std::vector<GridReport> out;
     for (std::size_t g = 0; g < grids.size() && g < infos.size(); ++g) {
