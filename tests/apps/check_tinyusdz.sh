@@ -10,7 +10,9 @@ command -v npm >/dev/null 2>&1 || { echo "SKIPPED: npm is not installed (apt-get
 pkg="$scratch/node_modules/tinyusdz"
 if [ ! -f "$pkg/tinyusdz.wasm" ]; then
   mkdir -p "$scratch"
-  if ! timeout 180 npm install --prefix "$scratch" --no-audit --no-fund --no-save tinyusdz > "$scratch/npm.log" 2>&1; then
+  # A package of its own, so npm installs here whatever folder ctest runs in.
+  [ -f "$scratch/package.json" ] || echo '{"name": "vdbhair-tinyusdz-check", "private": true}' > "$scratch/package.json"
+  if ! (cd "$scratch" && timeout 180 npm install --no-audit --no-fund tinyusdz > npm.log 2>&1); then
     echo "SKIPPED: could not install tinyusdz from the npm registry (offline?): $(tail -n 2 "$scratch/npm.log" | tr '\n' ' ')"
     exit 0
   fi
