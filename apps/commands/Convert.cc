@@ -6,7 +6,13 @@
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
 
 namespace vdbhair::app {
 
@@ -27,6 +33,26 @@ struct ConvertParams
     std::string grid = "strands";
     std::string usdUp = "y";
     double metersPerUnit = 0.01;
+    std::string format;  ///< the format of `-` (standard input or output), e.g. "obj"
+};
+
+/// Files standing in for `-`: standard input copied into one, standard output written from one.
+/// Removed when the command ends.
+struct StdioFiles
+{
+    std::vector<std::string> paths;
+    ~StdioFiles()
+    {
+        std::error_code ec;
+        for (const std::string& f : paths) std::filesystem::remove(f, ec);
+    }
+    std::string make(const std::string& role, const std::string& ext)
+    {
+        static int counter = 0;
+        const std::string name = "vdbhair-" + role + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ext;
+        paths.push_back((std::filesystem::temp_directory_path() / name).string());
+        return paths.back();
+    }
 };
 
 int runConvert(ConvertParams p, const CommonOptions& common)
@@ -38,10 +64,28 @@ int runConvert(ConvertParams p, const CommonOptions& common)
         p.output = inputs.back();
         inputs.pop_back();
     }
+    // `-`: standard input or output, in the format --format names.
+    StdioFiles stdio;
+    std::string ext = p.format.empty() ? std::string() : (p.format[0] == '.' ? p.format : "." + p.format);
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const bool toStdout = p.output == "-";
+    const std::size_t fromStdin = std::size_t(std::count(inputs.begin(), inputs.end(), std::string("-")));
+    if ((toStdout || fromStdin) && ext.empty()) throw ValueError("'-' (standard input or output) needs --format, e.g. --format obj");
+    if (fromStdin > 1) throw ValueError("'-' (standard input) can be read once");
+    if (toStdout && common.json) throw ValueError("--json with output '-': standard output carries the strands");
+    if (toStdout) p.output = stdio.make("stdout", ext);
+    if (fromStdin) strandFormatFromPath("stdin" + ext);
     // Check everything about the command line before reading anything.
     WriteOptions wopts;
     strandFormatFromPath(p.output, /*forWriting=*/true);
-    for (const std::string& in : inputs) strandFormatFromPath(in);
+    for (const std::string& in : inputs) if (in != "-") strandFormatFromPath(in);
+    for (std::string& in : inputs) {
+        if (in != "-") continue;
+        in = stdio.make("stdin", ext);
+        std::ofstream f(in, std::ios::binary);
+        f << std::cin.rdbuf();
+        if (!f) throw IoError("cannot copy standard input to " + in);
+    }
     if (p.resample == 1) throw ValueError("--resample 1: a strand needs at least 2 vertices");
     if (!std::isfinite(p.scale) || p.scale == 0.0) throw ValueError("--scale " + formatValue(p.scale) + ": must be finite and non-zero");
     if (p.plyEncoding == "ascii") wopts.plyEncoding = PlyEncoding::Ascii;
@@ -77,8 +121,16 @@ int runConvert(ConvertParams p, const CommonOptions& common)
         strands = resampleStrands(strands, p.resample);
     }
     {
-        const Stage stage(common, "writing " + p.output);
+        const Stage stage(common, "writing " + (toStdout ? std::string("standard output") : p.output));
         writeStrands(p.output, strands, wopts);
+    }
+    if (toStdout) {
+        std::ifstream f(p.output, std::ios::binary);
+        std::cout << f.rdbuf();
+        std::cout.flush();
+        if (!std::cout) throw IoError("cannot write the strands to standard output");
+        if (!common.quiet) std::cerr << "vdbhair convert: wrote " << strands.numStrands() << " strands, " << strands.numVertices() << " vertices to standard output\n";
+        return 0;
     }
 
     if (common.json) {
@@ -113,6 +165,7 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
         ->delimiter(',')->expected(3);
     sub->add_option("--usd-up", params->usdUp, "USD output: the stage's upAxis, y or z (coordinates are not rotated)")->capture_default_str();
     sub->add_option("--meters-per-unit", params->metersPerUnit, "USD output: the stage's metersPerUnit (0.01: centimetres)")->capture_default_str();
+    sub->add_option("--format", params->format, "The format of '-' (standard input or output): hair, data, obj, ply, vdb or usda");
     sub->add_option("--grid", params->grid, "VDB input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");
