@@ -34,7 +34,23 @@ struct ConvertParams
     std::string usdUp = "y";
     double metersPerUnit = 0.01;
     std::string format;  ///< the format of `-` (standard input or output), e.g. "obj"
+    std::string up = "y";  ///< the input's up axis; rotated onto +Y
 };
+
+/// @brief Rotate @a strands so that the axis @a up (a unit axis, possibly negative) becomes +Y,
+/// by a quarter or half turn that keeps the frame right-handed.
+void rotateUpToY(StrandSet& strands, const Vec3d& up)
+{
+    auto map = [&](const Vec3f& p) -> Vec3f {
+        if (up.z() > 0.5) return Vec3f(p.x(), p.z(), -p.y());   // -90 deg about X
+        if (up.z() < -0.5) return Vec3f(p.x(), -p.z(), p.y());  // +90 deg about X
+        if (up.x() > 0.5) return Vec3f(-p.y(), p.x(), p.z());   // +90 deg about Z
+        if (up.x() < -0.5) return Vec3f(p.y(), -p.x(), p.z());  // -90 deg about Z
+        if (up.y() < -0.5) return Vec3f(p.x(), -p.y(), -p.z()); // 180 deg about X
+        return p;
+    };
+    for (Vec3f& p : strands.positions) p = map(p);
+}
 
 /// Files standing in for `-`: standard input copied into one, standard output written from one.
 /// Removed when the command ends.
@@ -94,6 +110,7 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     if (p.voxelSize < 0.0 || !std::isfinite(p.voxelSize)) throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive length (0 chooses it)");
     wopts.vdb.voxelSize = p.voxelSize;
     wopts.objLines = objLineStyleFromName(p.objLines);
+    axisFromName(p.up, "--up");
     if (p.usdUp != "y" && p.usdUp != "z" && p.usdUp != "Y" && p.usdUp != "Z") throw ValueError("--usd-up '" + p.usdUp + "': must be y or z (USD's choices)");
     wopts.usd.upAxis = p.usdUp == "z" || p.usdUp == "Z" ? "Z" : "Y";
     if (!(p.metersPerUnit > 0.0) || !std::isfinite(p.metersPerUnit)) throw ValueError("--meters-per-unit " + formatValue(p.metersPerUnit) + ": must be a positive length");
@@ -116,6 +133,7 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     printWarnings("convert", report, common);
     if (strands.empty()) throw FormatError("the input has no strands; nothing to write to " + p.output);
     if (p.scale != 1.0) scaleStrands(strands, float(p.scale));
+    rotateUpToY(strands, axisFromName(p.up, "--up"));
     if (p.resample >= 2) {
         const Stage stage(common, "resampling");
         strands = resampleStrands(strands, p.resample);
@@ -165,6 +183,9 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
         ->delimiter(',')->expected(3);
     sub->add_option("--usd-up", params->usdUp, "USD output: the stage's upAxis, y or z (coordinates are not rotated)")->capture_default_str();
     sub->add_option("--meters-per-unit", params->metersPerUnit, "USD output: the stage's metersPerUnit (0.01: centimetres)")->capture_default_str();
+    sub->add_option("--up", params->up,
+                    "The input's up axis (x, y, z, -x, -y, -z), turned onto +Y, vdbhair's and OBJ's convention (cyHair models: z)")
+        ->capture_default_str();
     sub->add_option("--format", params->format, "The format of '-' (standard input or output): hair, data, obj, ply, vdb or usda");
     sub->add_option("--grid", params->grid, "VDB input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     addCommonOptions(sub, common);
