@@ -1,5 +1,5 @@
 /// @file ObjFile.h
-/// @brief Wavefront OBJ polylines (`.obj`): `v x y z` vertices and `l` line elements, as Houdini
+/// @brief Wavefront OBJ lines (`.obj`): `v x y z` vertices and `l` line elements, as Houdini
 /// and Blender export curves and loose edges.
 ///
 /// **Writing.** One `v` line per vertex (shortest round-trip decimal floats, `x y z r g b` when

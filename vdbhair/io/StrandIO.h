@@ -6,7 +6,7 @@
 /// |---|---|---|---|
 /// | .hair | cyHair (HairFile.h) | yes | yes |
 /// | .data | USC-HairSalon (DataFile.h) | yes | yes |
-/// | .obj | OBJ polylines (ObjFile.h) | yes | yes |
+/// | .obj | OBJ lines: two-vertex edges written, edges in any order read (ObjFile.h) | yes | yes |
 /// | .ply | hairutil PLY, ascii / binary LE (PlyFile.h) | yes | yes |
 /// | .vdb | OpenVDB points grid `strands` (VdbStrands.h) | yes | yes |
 /// | .usda | USD BasisCurves, text (UsdFile.h) | yes | yes |
