@@ -12,6 +12,8 @@
 #include <openvdb/Exceptions.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <limits>
 #include <memory>
 #include <cmath>
 #include <cstdio>
@@ -21,8 +23,9 @@ namespace vdbhair::app {
 
 void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson)
 {
-    sub->add_option("--threads", common.threads, "Worker threads (0: all cores); results do not depend on it")
-        ->check(CLI::NonNegativeNumber);
+    // Checked in run() (one clear message instead of CLI11's range with a 309-digit bound).
+    sub->add_option("--threads", common.threads, "Worker threads (0: all cores); results do not depend on it");
+    sub->add_flag("--no-clobber", common.noClobber, "Refuse to replace an existing output file (the default replaces it atomically)");
     if (withJson) sub->add_flag("--json", common.json, "Print one JSON object on stdout instead of prose");
     sub->add_flag("--quiet,-q", common.quiet, "No progress and no warnings on stderr");
 }
@@ -45,10 +48,12 @@ std::string formatValue(double v)
 
 void printJson(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 
-StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict)
+StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict,
+                      const std::string& vdbGrid)
 {
     const Stage stage(common, "reading " + path);
     ReadOptions opts;
+    opts.vdbGrid = vdbGrid;
     opts.interrupter = common.interrupter;
     if (strict) opts.shortStrands = ShortStrandPolicy::Reject;
     ReadReport report;
@@ -58,7 +63,8 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
     return strands;
 }
 
-StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common, TriangleMesh* head)
+StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
+                             const std::string& vdbGrid, TriangleMesh* head)
 {
     if (fileExtension(path) == ".json") {
         const Scene scene = readScene(path);
@@ -67,7 +73,7 @@ StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, c
         if (s.empty()) throw FormatError(path + ": the scene has no guides");
         return s;
     }
-    return loadStrands(verb, path, common);
+    return loadStrands(verb, path, common, false, vdbGrid);
 }
 
 void addScalpOptions(CLI::App* sub, ScalpOptions& opts)
@@ -106,11 +112,50 @@ void applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, Field
     }
 }
 
+namespace {
+
+/// Levenshtein distance between @a a and @a b (short words: the plain dynamic programme).
+std::size_t editDistance(const std::string& a, const std::string& b)
+{
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diag = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            diag = up;
+        }
+    }
+    return row[b.size()];
+}
+
+} // namespace
+
+std::vector<std::string> nearestVerbs(const std::string& word, const std::vector<std::string>& verbs)
+{
+    // A verb the word starts or a verb that starts with the word counts as distance 1.
+    std::size_t best = std::numeric_limits<std::size_t>::max();
+    std::vector<std::pair<std::size_t, std::string>> scored;
+    for (const std::string& v : verbs) {
+        std::size_t d = editDistance(word, v);
+        if (!word.empty() && (v.rfind(word, 0) == 0 || word.rfind(v, 0) == 0)) d = std::min<std::size_t>(d, 1);
+        scored.push_back({d, v});
+        best = std::min(best, d);
+    }
+    std::vector<std::string> out;
+    const std::size_t limit = std::max<std::size_t>(2, word.size() / 3);
+    if (best > limit) return out;
+    for (const auto& [d, v] : scored) if (d == best) out.push_back(v);
+    return out;
+}
+
 int run(int argc, char** argv)
 {
     CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
                  ": hair geometry on OpenVDB - strands, tangent fields and generalized helicoids.\n"
-                 "Formats: .hair .data .obj .ply .vdb (read and write), .tfx .bin .convdata (read).",
+                 "Formats: .hair .data .obj .ply .vdb .usda (read and write), .tfx .bin .convdata (read).",
                  "vdbhair"};
     app.set_version_flag("--version", "vdbhair " VDBHAIR_VERSION_STRING);
     app.require_subcommand(1, 1);
@@ -129,9 +174,34 @@ int run(int argc, char** argv)
     commands.push_back(addRenderCommand(app, common));
     commands.push_back(addDemoCommand(app, common));
 
+    std::vector<std::string> verbs;
+    for (const Command& c : commands) verbs.push_back(c.sub->get_name());
+
+    // `vdbhair help [VERB]` is `vdbhair [VERB] --help`.
+    std::vector<std::string> args(argv, argv + argc);
+    if (args.size() >= 2 && args[1] == "help") {
+        args.erase(args.begin() + 1);
+        args.push_back("--help");
+    }
+    // An unknown verb: say so and suggest the nearest (`vdbhair inf` -> did you mean info?).
+    if (args.size() >= 2 && !args[1].empty() && args[1][0] != '-' &&
+        std::find(verbs.begin(), verbs.end(), args[1]) == verbs.end()) {
+        const std::vector<std::string> near = nearestVerbs(args[1], verbs);
+        std::cerr << "vdbhair: unknown verb '" << args[1] << "'";
+        for (std::size_t i = 0; i < near.size(); ++i) {
+            std::cerr << (i == 0 ? "; did you mean " : i + 1 == near.size() ? " or " : ", ") << near[i];
+        }
+        std::cerr << (near.empty() ? "" : "?") << " (the verbs are";
+        for (std::size_t i = 0; i < verbs.size(); ++i) std::cerr << (i ? ", " : " ") << verbs[i];
+        std::cerr << "; 'vdbhair help VERB' explains one)\n";
+        return 2;
+    }
+    std::vector<char*> argvNew;
+    for (std::string& a : args) argvNew.push_back(a.data());
+
     std::string verb = "";
     try {
-        app.parse(argc, argv);
+        app.parse(int(argvNew.size()), argvNew.data());
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {
@@ -148,6 +218,11 @@ int run(int argc, char** argv)
     for (const Command& c : commands) {
         if (!c.sub->parsed()) continue;
         verb = c.sub->get_name();
+        if (common.threads < 0) {
+            std::cerr << "vdbhair " << verb << ": --threads " << common.threads << ": must be 0 (all cores) or more\n";
+            return 2;
+        }
+        setOverwritePolicy(common.noClobber ? OverwritePolicy::NoClobber : OverwritePolicy::Replace);
         std::unique_ptr<tbb::global_control> threads;
         if (common.threads > 0) {
             threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,

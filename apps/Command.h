@@ -31,6 +31,7 @@ struct CommonOptions
     int threads = 0;      ///< 0: all cores
     bool json = false;    ///< one JSON object on stdout instead of prose
     bool quiet = false;   ///< no progress, no warnings
+    bool noClobber = false;  ///< refuse to replace existing outputs (--no-clobber)
     /// The progress bar and Ctrl-C (Progress.h), set by run() before the verb runs: hand it to
     /// every library call that takes an interrupter.
     WorkInterrupter* interrupter = nullptr;
@@ -80,14 +81,15 @@ void printJson(const nlohmann::json& j);
 
 /// @brief Read strands from any supported file, printing the reader's warnings for @a verb.
 /// @param strict reject strands of fewer than two vertices instead of dropping them
+/// @param vdbGrid for a .vdb file, the points grid holding the strands (`--grid`)
 StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common,
-                      bool strict = false);
+                      bool strict = false, const std::string& vdbGrid = "strands");
 
 /// @brief As loadStrands(), and a helicoid scene (.json) is grown first.
 /// @param head when given and @a path is a scene with a "head" record, set to a mesh of that head
 /// (makeSphereMesh()); left as it is otherwise.
 StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
-                             TriangleMesh* head = nullptr);
+                             const std::string& vdbGrid = "strands", TriangleMesh* head = nullptr);
 
 /// @brief The axis named by an option such as --up: x, y, z, -x, -y or -z.
 /// @throw ValueError naming the option, the value and the choices.
@@ -116,6 +118,10 @@ Command addGrowCommand(CLI::App& app, CommonOptions& common);
 Command addRenderCommand(CLI::App& app, CommonOptions& common);
 Command addFitCommand(CLI::App& app, CommonOptions& common);
 Command addInspectCommand(CLI::App& app, CommonOptions& common);
+
+/// @brief The verbs of @a verbs nearest to @a word (edit distance, a prefix counting as 1), for
+/// "did you mean"; empty when none is close.
+std::vector<std::string> nearestVerbs(const std::string& word, const std::vector<std::string>& verbs);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line, 130 interrupted

@@ -6,7 +6,13 @@
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
 
 namespace vdbhair::app {
 
@@ -22,6 +28,47 @@ struct ConvertParams
     std::string codec = "float";
     double voxelSize = 0.0;
     bool strict = false;
+    std::string objLines = "edges";
+    std::vector<double> rootNear;  ///< x, y, z; empty: OBJ roots at the lower-index end
+    std::string grid = "strands";
+    std::string usdUp = "y";
+    double metersPerUnit = 0.01;
+    std::string format;  ///< the format of `-` (standard input or output), e.g. "obj"
+    std::string up = "y";  ///< the input's up axis; rotated onto +Y
+};
+
+/// @brief Rotate @a strands so that the axis @a up (a unit axis, possibly negative) becomes +Y,
+/// by a quarter or half turn that keeps the frame right-handed.
+void rotateUpToY(StrandSet& strands, const Vec3d& up)
+{
+    auto map = [&](const Vec3f& p) -> Vec3f {
+        if (up.z() > 0.5) return Vec3f(p.x(), p.z(), -p.y());   // -90 deg about X
+        if (up.z() < -0.5) return Vec3f(p.x(), -p.z(), p.y());  // +90 deg about X
+        if (up.x() > 0.5) return Vec3f(-p.y(), p.x(), p.z());   // +90 deg about Z
+        if (up.x() < -0.5) return Vec3f(p.y(), -p.x(), p.z());  // -90 deg about Z
+        if (up.y() < -0.5) return Vec3f(p.x(), -p.y(), -p.z()); // 180 deg about X
+        return p;
+    };
+    for (Vec3f& p : strands.positions) p = map(p);
+}
+
+/// Files standing in for `-`: standard input copied into one, standard output written from one.
+/// Removed when the command ends.
+struct StdioFiles
+{
+    std::vector<std::string> paths;
+    ~StdioFiles()
+    {
+        std::error_code ec;
+        for (const std::string& f : paths) std::filesystem::remove(f, ec);
+    }
+    std::string make(const std::string& role, const std::string& ext)
+    {
+        static int counter = 0;
+        const std::string name = "vdbhair-" + role + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ext;
+        paths.push_back((std::filesystem::temp_directory_path() / name).string());
+        return paths.back();
+    }
 };
 
 int runConvert(ConvertParams p, const CommonOptions& common)
@@ -33,10 +80,28 @@ int runConvert(ConvertParams p, const CommonOptions& common)
         p.output = inputs.back();
         inputs.pop_back();
     }
+    // `-`: standard input or output, in the format --format names.
+    StdioFiles stdio;
+    std::string ext = p.format.empty() ? std::string() : (p.format[0] == '.' ? p.format : "." + p.format);
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const bool toStdout = p.output == "-";
+    const std::size_t fromStdin = std::size_t(std::count(inputs.begin(), inputs.end(), std::string("-")));
+    if ((toStdout || fromStdin) && ext.empty()) throw ValueError("'-' (standard input or output) needs --format, e.g. --format obj");
+    if (fromStdin > 1) throw ValueError("'-' (standard input) can be read once");
+    if (toStdout && common.json) throw ValueError("--json with output '-': standard output carries the strands");
+    if (toStdout) p.output = stdio.make("stdout", ext);
+    if (fromStdin) strandFormatFromPath("stdin" + ext);
     // Check everything about the command line before reading anything.
     WriteOptions wopts;
     strandFormatFromPath(p.output, /*forWriting=*/true);
-    for (const std::string& in : inputs) strandFormatFromPath(in);
+    for (const std::string& in : inputs) if (in != "-") strandFormatFromPath(in);
+    for (std::string& in : inputs) {
+        if (in != "-") continue;
+        in = stdio.make("stdin", ext);
+        std::ofstream f(in, std::ios::binary);
+        f << std::cin.rdbuf();
+        if (!f) throw IoError("cannot copy standard input to " + in);
+    }
     if (p.resample == 1) throw ValueError("--resample 1: a strand needs at least 2 vertices");
     if (!std::isfinite(p.scale) || p.scale == 0.0) throw ValueError("--scale " + formatValue(p.scale) + ": must be finite and non-zero");
     if (p.plyEncoding == "ascii") wopts.plyEncoding = PlyEncoding::Ascii;
@@ -44,8 +109,19 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     wopts.vdb.codec = positionCodecFromName(p.codec);
     if (p.voxelSize < 0.0 || !std::isfinite(p.voxelSize)) throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive length (0 chooses it)");
     wopts.vdb.voxelSize = p.voxelSize;
+    wopts.objLines = objLineStyleFromName(p.objLines);
+    axisFromName(p.up, "--up");
+    if (p.usdUp != "y" && p.usdUp != "z" && p.usdUp != "Y" && p.usdUp != "Z") throw ValueError("--usd-up '" + p.usdUp + "': must be y or z (USD's choices)");
+    wopts.usd.upAxis = p.usdUp == "z" || p.usdUp == "Z" ? "Z" : "Y";
+    if (!(p.metersPerUnit > 0.0) || !std::isfinite(p.metersPerUnit)) throw ValueError("--meters-per-unit " + formatValue(p.metersPerUnit) + ": must be a positive length");
+    wopts.usd.metersPerUnit = p.metersPerUnit;
 
     ReadOptions ropts;
+    ropts.vdbGrid = p.grid;
+    if (!p.rootNear.empty()) {
+        if (p.rootNear.size() != 3) throw ValueError("--root-near needs X,Y,Z");
+        ropts.objRootNear = Vec3f(float(p.rootNear[0]), float(p.rootNear[1]), float(p.rootNear[2]));
+    }
     if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
     ropts.interrupter = common.interrupter;
     StrandSet strands;
@@ -57,13 +133,22 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     printWarnings("convert", report, common);
     if (strands.empty()) throw FormatError("the input has no strands; nothing to write to " + p.output);
     if (p.scale != 1.0) scaleStrands(strands, float(p.scale));
+    rotateUpToY(strands, axisFromName(p.up, "--up"));
     if (p.resample >= 2) {
         const Stage stage(common, "resampling");
         strands = resampleStrands(strands, p.resample);
     }
     {
-        const Stage stage(common, "writing " + p.output);
+        const Stage stage(common, "writing " + (toStdout ? std::string("standard output") : p.output));
         writeStrands(p.output, strands, wopts);
+    }
+    if (toStdout) {
+        std::ifstream f(p.output, std::ios::binary);
+        std::cout << f.rdbuf();
+        std::cout.flush();
+        if (!std::cout) throw IoError("cannot write the strands to standard output");
+        if (!common.quiet) std::cerr << "vdbhair convert: wrote " << strands.numStrands() << " strands, " << strands.numVertices() << " vertices to standard output\n";
+        return 0;
     }
 
     if (common.json) {
@@ -83,13 +168,26 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     auto params = std::make_shared<ConvertParams>();
     CLI::App* sub = app.add_subcommand("convert", "Convert strands between formats (several inputs are concatenated)");
     sub->add_option("files", params->files, "IN [IN...] OUT, or IN [IN...] with -o OUT")->required();
-    sub->add_option("-o,--output", params->output, "Output file; its extension picks the format (.hair .data .obj .ply .vdb)");
+    sub->add_option("-o,--output", params->output, "Output file; its extension picks the format (.hair .data .obj .ply .vdb .usda)");
     sub->add_option("--resample", params->resample, "Resample every strand to N vertices, equally spaced in arc length")->check(CLI::NonNegativeNumber);
     sub->add_option("--scale", params->scale, "Multiply every position (and thickness) by S");
     sub->add_option("--ply-encoding", params->plyEncoding, "PLY output encoding: binary (little-endian) or ascii")->capture_default_str();
     sub->add_option("--codec", params->codec, "VDB position codec: float (exact), fixed16, fixed8")->capture_default_str();
     sub->add_option("--voxel-size", params->voxelSize, "VDB points voxel size in world units (default: about 8 points per voxel)");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    sub->add_option("--obj-lines", params->objLines,
+                    "OBJ output: edges (a two-vertex 'l' per segment, what Blender's importer reads whole) or polylines (one 'l' per strand, Houdini)")
+        ->capture_default_str();
+    sub->add_option("--root-near", params->rootNear,
+                    "OBJ input: root each strand at its end nearest X,Y,Z (e.g. the head's centre) instead of its lower-index end")
+        ->delimiter(',')->expected(3);
+    sub->add_option("--usd-up", params->usdUp, "USD output: the stage's upAxis, y or z (coordinates are not rotated)")->capture_default_str();
+    sub->add_option("--meters-per-unit", params->metersPerUnit, "USD output: the stage's metersPerUnit (0.01: centimetres)")->capture_default_str();
+    sub->add_option("--up", params->up,
+                    "The input's up axis (x, y, z, -x, -y, -z), turned onto +Y, vdbhair's and OBJ's convention (cyHair models: z)")
+        ->capture_default_str();
+    sub->add_option("--format", params->format, "The format of '-' (standard input or output): hair, data, obj, ply, vdb or usda");
+    sub->add_option("--grid", params->grid, "VDB input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");
     return {sub, [params, &common] { return runConvert(*params, common); }};

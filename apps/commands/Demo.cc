@@ -29,7 +29,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     namespace fs = std::filesystem;
     const auto t0 = std::chrono::steady_clock::now();
     TriangleMesh head;  // a scene's own head, drawn in the preview
-    const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common, &head);
+    const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common, "strands", &head);
     RefineParams rp = refineParamsFrom(p.refine, strands);
     // A scene's own head is the obstacle refinement keeps strands out of, unless --head says otherwise.
     if (p.refine.head.empty() && fileExtension(p.refine.input) == ".json") {
@@ -78,7 +78,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     {
         const Stage writing(common, "writing " + dir);
         writeStrands(refinedPath, r.strands);
-        writeVdbGrids(fieldPath, fieldGrids(r), "demo(" + fieldPath + ")");
+        writeVdbGrids(fieldPath, fieldGrids(r, p.refine.input), "demo(" + fieldPath + ")");
         {
             // The input and refined strands as points grids, for side-by-side viewing in Houdini/Blender.
             auto before = createStrandGrid(strands);

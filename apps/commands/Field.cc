@@ -9,7 +9,9 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrandGrid.h>
 
+#include <cctype>
 #include <chrono>
+#include <cmath>
 
 namespace vdbhair::app {
 
@@ -27,6 +29,8 @@ struct FieldCmdParams
     bool helicoid = false;
     bool strict = false;
     ScalpOptions scalp;
+    double densityReference = 0.0;
+    std::string vectorName = "tangent";
 };
 
 int runField(const FieldCmdParams& p, const CommonOptions& common)
@@ -41,12 +45,21 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");
     if (p.helicoid && p.levels != 1) throw ValueError("--helicoid with --levels " + std::to_string(p.levels) + ": a helicoid field has one level; use --levels 1");
     if (p.helicoid && p.scalp.space != "world") throw ValueError("--helicoid with --space " + p.scalp.space + ": helicoid fields are world-space");
+    if (p.densityReference < 0.0 || !std::isfinite(p.densityReference)) {
+        throw ValueError("--density-reference " + formatValue(p.densityReference) + ": must be a positive length per unit volume (0 chooses it)");
+    }
+    if (p.vectorName.empty() || p.vectorName.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos ||
+        std::isdigit(static_cast<unsigned char>(p.vectorName[0]))) {
+        throw ValueError("--vector-name '" + p.vectorName + "': must be a valid attribute name (letters, digits, _; not starting with a digit)");
+    }
+    if (p.helicoid && p.vectorName != "tangent") throw ValueError("--helicoid with --vector-name " + p.vectorName + ": retrace --helicoid reads the vector grid 'tangent'");
 
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
     FieldParams fp;
     fp.voxelSize = voxelGiven ? p.voxelSize : suggestVoxelSize(strands);
     fp.iterations = p.iterations;
     fp.maxVoxels = p.maxVoxels;
+    fp.densityReference = p.densityReference;
     applyScalpOptions(p.scalp, strands, fp);
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -56,8 +69,12 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     openvdb::GridCPtrVec grids;
     nlohmann::json gridsJson = nlohmann::json::array();
     for (const TangentField& f : fields) {
-        for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density)}) {
-            g->insertMeta("vdbhair:source", openvdb::StringMetadata(p.input));
+        if (p.vectorName != "tangent") {  // e.g. hair_direction: Blender's Cycles reserves 'tangent'
+            const std::string name = f.tangent->getName();
+            f.tangent->setName(p.vectorName + name.substr(std::string("tangent").size()));
+        }
+        for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density), openvdb::GridBase::Ptr(f.hairLength)}) {
+            g->insertMeta("vdbhair_source", openvdb::StringMetadata(p.input));
             grids.push_back(g);
             gridsJson.push_back({{"name", g->getName()}, {"voxel_size", g->voxelSize().x()}, {"active_voxels", g->activeVoxelCount()}});
         }
@@ -103,11 +120,16 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     auto params = std::make_shared<FieldCmdParams>();
     CLI::App* sub = app.add_subcommand("field", "Estimate the robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9) as VDB grids");
     sub->add_option("input", params->input, "Strand file")->required();
-    sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent' and 'density' (or *_level_<l>)")->required();
+    sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent', 'density' (fog volume in [0,1]) and 'hair_length' (or *_level_<l>)")->required();
     params->voxelOpt = sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: twice the mean segment length)");
     sub->add_option("--iterations", params->iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
     sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
     sub->add_option("--max-voxels", params->maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
+    sub->add_option("--density-reference", params->densityReference,
+                    "Hair length per unit volume (world units^-2) that 'density' maps to 1 (default: the 95th percentile of the hairstyle's)");
+    sub->add_option("--vector-name", params->vectorName,
+                    "Name of the direction grid; Blender's Cycles reserves 'tangent' for UV tangents, so use e.g. hair_direction for Cycles")
+        ->capture_default_str();
     sub->add_flag("--helicoid", params->helicoid, "Also fit a helicoid per voxel: grids helicoid_k, helicoid_alpha, frame_T, frame_N");
     sub->add_flag("--with-strands", params->withStrands, "Also write the strands as the points grid 'strands'");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");

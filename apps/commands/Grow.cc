@@ -52,7 +52,7 @@ Command addGrowCommand(CLI::App& app, CommonOptions& common)
     auto params = std::make_shared<GrowParams>();
     CLI::App* sub = app.add_subcommand("grow", "Grow the strands of a helicoid scene (guides, p-helicoid pieces, waviness, wisps)");
     sub->add_option("scene", params->scene, "Scene file (JSON, \"vdbhair\": \"scene/1\")")->required();
-    sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
+    sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--integrator", params->integrator, "euler (Eq. 3, the paper's) or rk4 (default: the scene's, else euler)");
     sub->add_option("--max-vertices", params->maxVertices, "Refuse scenes that would grow more vertices")->capture_default_str();
     addCommonOptions(sub, common);

@@ -17,6 +17,7 @@ struct InfoParams
 {
     std::string input;
     bool strict = false;
+    std::string grid;  ///< a .vdb's points grid to summarize as strands; empty: list every grid
 };
 
 nlohmann::json vec3Json(const Vec3d& v) { return {v.x(), v.y(), v.z()}; }
@@ -39,6 +40,7 @@ int infoStrands(const InfoParams& p, const CommonOptions& common)
 {
     ReadOptions ropts;
     if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
+    if (!p.grid.empty()) ropts.vdbGrid = p.grid;
     ReadReport report;
     const StrandSet strands = readStrands(p.input, ropts, &report);
     printWarnings("info", report, common);
@@ -48,6 +50,7 @@ int infoStrands(const InfoParams& p, const CommonOptions& common)
     if (common.json) {
         printJson({{"kind", "strands"},
                    {"file", p.input},
+                   {"grid", p.grid.empty() ? nlohmann::json(nullptr) : nlohmann::json(p.grid)},
                    {"format", formatName(strandFormatFromPath(p.input))},
                    {"strands", s.strands},
                    {"vertices", s.vertices},
@@ -58,7 +61,8 @@ int infoStrands(const InfoParams& p, const CommonOptions& common)
                    {"dropped_strands", report.droppedStrands}});
         return 0;
     }
-    std::cout << p.input << ": " << formatName(strandFormatFromPath(p.input)) << " strands\n"
+    std::cout << p.input << (p.grid.empty() ? std::string() : " (grid '" + p.grid + "')") << ": "
+              << formatName(strandFormatFromPath(p.input)) << " strands\n"
               << "  strands:             " << s.strands << "\n"
               << "  vertices:            " << s.vertices << "\n"
               << "  vertices per strand: min " << fmt(s.verticesPerStrand.min) << ", mean "
@@ -138,12 +142,13 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<InfoParams>();
     CLI::App* sub = app.add_subcommand("info", "Summarize a strand file or list the grids of a .vdb file");
-    sub->add_option("file", params->input, "A strand file (.hair .data .obj .ply .tfx .bin .convdata) or a .vdb file")->required();
+    sub->add_option("file", params->input, "A strand file (.hair .data .obj .ply .usda .tfx .bin .convdata) or a .vdb file")->required();
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
     addCommonOptions(sub, common);
-    sub->footer("Example: vdbhair info scenes/ponytail.hair --json");
+    sub->footer("Example: vdbhair info scenes/default/ponytail.hair --json");
     return {sub, [params, &common] {
-                if (fileExtension(params->input) == ".vdb") {
+                if (fileExtension(params->input) == ".vdb" && params->grid.empty()) {
                     return infoVdb(*params, common);
                 }
                 return infoStrands(*params, common);

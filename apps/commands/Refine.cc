@@ -52,11 +52,15 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     return rp;
 }
 
-openvdb::GridCPtrVec fieldGrids(const RefineResult& r)
+openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source)
 {
     openvdb::GridCPtrVec grids;
     for (const TangentField& f : r.fields) {
-        for (const openvdb::GridBase::ConstPtr& g : f.grids()) grids.push_back(g);
+        for (const openvdb::GridBase::ConstPtr& cg : f.grids()) {
+            // The grids are this result's own; the source is stamped as they are handed out for writing.
+            std::const_pointer_cast<openvdb::GridBase>(cg)->insertMeta("vdbhair_source", openvdb::StringMetadata(source));
+            grids.push_back(cg);
+        }
     }
     return grids;
 }
@@ -151,7 +155,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     // Write the field first: if the strands' write fails, nothing half-done is claimed.
     {
         const Stage stage(common, "writing " + p.output);
-        if (!p.saveField.empty()) writeVdbGrids(p.saveField, fieldGrids(r), "refine(" + p.saveField + ")");
+        if (!p.saveField.empty()) writeVdbGrids(p.saveField, fieldGrids(r, p.input), "refine(" + p.saveField + ")");
         writeStrands(p.output, r.strands);
     }
     if (common.json) {

@@ -14,6 +14,7 @@ namespace {
 struct RenderCmdParams
 {
     std::string input, output, view = "three-quarter", colorBy = "shaded", guides, title, up = "y", facing, head;
+    std::string grid = "strands";
     int width = 1024, height = 1024;
     bool sheet = false;
 };
@@ -41,7 +42,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
     }
     if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
     TriangleMesh head;  // --head, or the scene's own head
-    const StrandSet strands = loadStrandsOrScene("render", p.input, common, p.head.empty() ? &head : nullptr);
+    const StrandSet strands = loadStrandsOrScene("render", p.input, common, p.grid, p.head.empty() ? &head : nullptr);
     StrandSet guides;
     if (!p.guides.empty()) {
         guides = loadStrandsOrScene("render", p.guides, common);
@@ -85,6 +86,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
         ->capture_default_str();
     sub->add_option("--facing", params->facing,
                     "The axis the face looks along (front view looks at it): default z, or -y for --up z (Blender's); cyHair models: --up z --facing y");
+    sub->add_option("--grid", params->grid, "For a .vdb input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     sub->add_flag("--sheet", params->sheet, "One image with the front, side, top and three-quarter views");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair render scenes/default/head.json -o head.png --sheet");

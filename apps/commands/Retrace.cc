@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace vdbhair::app {
 
@@ -20,20 +21,41 @@ nlohmann::json traceReportJson(const TraceStats& s, double before, double after,
     return {{"strands", s.strands},
             {"full_length", s.fullLength},
             {"stopped", {{"vanished", s.vanished}, {"left_field", s.leftField}, {"max_steps", s.maxSteps}}},
-            {"tangent_angle_deg", {{"before", before}, {"after", after}}},
+            // NaN: no vertex lay inside the field (every strand left it), so there is no angle.
+            {"tangent_angle_deg", {{"before", std::isnan(before) ? nlohmann::json(nullptr) : nlohmann::json(before)},
+                                   {"after", std::isnan(after) ? nlohmann::json(nullptr) : nlohmann::json(after)}}},
             {"mean_displacement", displacement}};
 }
+
+namespace {
+std::string angleText(double deg)
+{
+    if (std::isnan(deg)) return "none (no vertex inside the field)";
+    std::ostringstream os;
+    os << deg << " deg";
+    return os.str();
+}
+} // namespace
 
 void printTraceReport(const TraceStats& s, double before, double after, double displacement)
 {
     std::cout << "retraced " << s.strands << " strands: " << s.fullLength << " full length, " << s.vanished
               << " stopped where the field vanished, " << s.leftField << " left the field, " << s.maxSteps
               << " hit the step limit (" << s.steps << " steps)\n"
-              << "mean angle between strand tangents and the field: " << before << " deg before, " << after << " deg after\n"
+              << "mean angle between strand tangents and the field: "
+              << angleText(before) << " before, " << angleText(after) << " after\n"
               << "mean vertex displacement: " << displacement << "\n";
 }
 
 namespace {
+
+/// The mean angle between @a strands and @a field, NaN when no vertex lies inside the field.
+double angleOrNan(const StrandSet& strands, const openvdb::GridBase& field)
+{
+    std::size_t counted = 0;
+    const double a = meanTangentAngleDeg(strands, field, &counted);
+    return counted ? a : std::nan("");
+}
 
 struct RetraceParams
 {
@@ -74,12 +96,12 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         TraceStats stats;
         const StrandSet out = retraceHelicoidField(strands, field, tp, &stats, true, common.interrupter);
         // Coherence is measured against the tangent field when the file has one.
-        double before = 0.0, after = 0.0;
+        double before = std::nan(""), after = std::nan("");
         const std::vector<std::string> names = vdbGridNames(p.field, "retrace(" + p.field + ")");
         if (std::find(names.begin(), names.end(), p.grid) != names.end()) {
             const openvdb::GridBase::Ptr tangent = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
-            before = meanTangentAngleDeg(strands, *tangent);
-            after = meanTangentAngleDeg(out, *tangent);
+            before = angleOrNan(strands, *tangent);
+            after = angleOrNan(out, *tangent);
         }
         const double disp = meanVertexDisplacement(strands, out);
         writeStrands(p.output, out);
@@ -103,8 +125,8 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 
     TraceStats stats;
     const StrandSet out = retraceStrands(strands, *grid, tp, &stats, nullptr, true, common.interrupter);
-    const double before = meanTangentAngleDeg(strands, *grid);
-    const double after = meanTangentAngleDeg(out, *grid);
+    const double before = angleOrNan(strands, *grid);
+    const double after = angleOrNan(out, *grid);
     const double disp = meanVertexDisplacement(strands, out);
     writeStrands(p.output, out);
     if (common.json) {
@@ -128,7 +150,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = app.add_subcommand("retrace", "Retrace every strand through a vector field from its root, for its own length");
     sub->add_option("input", params->input, "Strand file (roots, lengths and vertex spacing to follow)")->required();
     sub->add_option("--field", params->field, "A .vdb file holding the field")->required();
-    sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
+    sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
     params->stepOpt = sub->add_option("--step", params->step, "Integration step in world units (default: half a voxel)");
     sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();

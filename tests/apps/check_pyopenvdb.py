@@ -31,10 +31,10 @@ check(density.gridClass == "fog volume", "density class fog volume, got %s" % de
 for g in (tangent, density):
     m = g.metadata
     check(m.get("creator", "").startswith("vdbhair "), "%s creator" % g.name)
-    check(abs(m["vdbhair:voxel_size"] - voxel) < 1e-9 * voxel, "%s vdbhair:voxel_size" % g.name)
-    check(m["vdbhair:iterations"] == 2, "%s vdbhair:iterations" % g.name)
-    check(m["vdbhair:space"] == "world", "%s vdbhair:space" % g.name)
-    check(m["vdbhair:strand_count"] > 0, "%s vdbhair:strand_count" % g.name)
+    check(abs(m["vdbhair_voxel_size"] - voxel) < 1e-9 * voxel, "%s vdbhair_voxel_size" % g.name)
+    check(m["vdbhair_iterations"] == 2, "%s vdbhair_iterations" % g.name)
+    check(m["vdbhair_space"] == "world", "%s vdbhair_space" % g.name)
+    check(m["vdbhair_strand_count"] > 0, "%s vdbhair_strand_count" % g.name)
     check(abs(g.transform.voxelSize()[0] - voxel) < 1e-9 * voxel, "%s transform voxel size" % g.name)
 check(tangent.activeVoxelCount() == density.activeVoxelCount(), "same active voxels")
 dacc = density.getConstAccessor()

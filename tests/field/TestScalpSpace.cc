@@ -1,6 +1,7 @@
 #include "../TestUtil.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/ScalpSpace.h>
 
 #include <random>
@@ -52,4 +53,21 @@ TEST_CASE("fitScalpSphere: recovers a sphere from points on a cap", "[field]")
     std::vector<Vec3f> plane;
     for (int i = 0; i < 10; ++i) plane.emplace_back(float(i), float(i * i % 7), 0.f);
     REQUIRE_THROWS_AS(fitScalpSphere(plane), ValueError);
+}
+
+TEST_CASE("FieldMapping::fromGrid: scalp metadata under vdbhair_ keys and the older vdbhair: keys", "[field]")
+{
+    for (const char* prefix : {"vdbhair_", "vdbhair:"}) {
+        CAPTURE(prefix);
+        openvdb::FloatGrid grid;
+        const std::string p(prefix);
+        grid.insertMeta(p + "space", openvdb::StringMetadata("scalp"));
+        grid.insertMeta(p + "scalp_center", openvdb::Vec3DMetadata(openvdb::Vec3d(1, 2, 3)));
+        grid.insertMeta(p + "scalp_radius", openvdb::DoubleMetadata(4.0));
+        grid.insertMeta(p + "scalp_up", openvdb::Vec3DMetadata(openvdb::Vec3d(0, 1, 0)));
+        const FieldMapping m = FieldMapping::fromGrid(grid);
+        REQUIRE(m.space() == FieldSpace::Scalp);
+        REQUIRE(m.scalp().radius == 4.0);
+        REQUIRE(m.scalp().center == Vec3d(1, 2, 3));
+    }
 }

@@ -41,18 +41,20 @@ TEST_CASE("estimateTangentField: a straight parallel hairstyle gives a uniform f
     const TangentField f = estimateTangentField(s, p);
     REQUIRE(f.tangent->activeVoxelCount() > 0);
     for (auto it = f.tangent->cbeginValueOn(); it; ++it) REQUIRE(((*it) - dir).length() < 1e-6f);
-    // Density: the total length, distributed over the voxels the strands pass.
+    // hair_length: the total length, distributed over the voxels the strands pass.
     double total = 0.0;
-    for (auto it = f.density->cbeginValueOn(); it; ++it) total += *it;
+    for (auto it = f.hairLength->cbeginValueOn(); it; ++it) total += *it;
     REQUIRE(total == Approx(25 * 10.0).epsilon(1e-5));
     REQUIRE(f.tangent->activeVoxelCount() == f.density->activeVoxelCount());
     REQUIRE(f.tangent->getName() == "tangent");
     REQUIRE(f.density->getName() == "density");
     REQUIRE(f.tangent->getVectorType() == openvdb::VEC_CONTRAVARIANT_RELATIVE);
     REQUIRE(f.density->getGridClass() == openvdb::GRID_FOG_VOLUME);
-    REQUIRE(f.tangent->metaValue<double>("vdbhair:voxel_size") == 0.5);
-    REQUIRE(f.tangent->metaValue<int>("vdbhair:iterations") == 2);
-    REQUIRE(f.tangent->metaValue<std::string>("vdbhair:space") == "world");
+    REQUIRE(f.hairLength->getName() == "hair_length");
+    REQUIRE(f.hairLength->getGridClass() == openvdb::GRID_UNKNOWN);
+    REQUIRE(f.tangent->metaValue<double>("vdbhair_voxel_size") == 0.5);
+    REQUIRE(f.tangent->metaValue<int>("vdbhair_iterations") == 2);
+    REQUIRE(f.tangent->metaValue<std::string>("vdbhair_space") == "world");
 }
 
 TEST_CASE("estimateTangentField: a segment marks every voxel it passes, and no other", "[field]")
@@ -64,8 +66,8 @@ TEST_CASE("estimateTangentField: a segment marks every voxel it passes, and no o
     const TangentField f = estimateTangentField(s, p);
     REQUIRE(f.tangent->activeVoxelCount() == 11);
     for (int i = 0; i <= 10; ++i) REQUIRE(f.tangent->tree().isValueOn(openvdb::Coord(i, 0, 0)));
-    REQUIRE(f.density->tree().getValue(openvdb::Coord(5, 0, 0)) == Approx(1.0));
-    REQUIRE(f.density->tree().getValue(openvdb::Coord(0, 0, 0)) == Approx(0.4));
+    REQUIRE(f.hairLength->tree().getValue(openvdb::Coord(5, 0, 0)) == Approx(1.0));
+    REQUIRE(f.hairLength->tree().getValue(openvdb::Coord(0, 0, 0)) == Approx(0.4));
     REQUIRE_FALSE(f.tangent->tree().isValueOn(openvdb::Coord(0, 1, 0)));
 }
 
@@ -110,7 +112,7 @@ TEST_CASE("estimateTangentField: opposing strands cancel to a zero vector in an 
     const TangentField f = estimateTangentField(s, p);
     REQUIRE(f.tangent->tree().isValueOn(openvdb::Coord(0)));
     REQUIRE(f.tangent->tree().getValue(openvdb::Coord(0)) == openvdb::Vec3f(0.f));
-    REQUIRE(f.density->tree().getValue(openvdb::Coord(0)) == Approx(1.6));
+    REQUIRE(f.hairLength->tree().getValue(openvdb::Coord(0)) == Approx(1.6));
 }
 
 TEST_CASE("estimateTangentField: bitwise identical with 1 and 2 threads", "[field]")
@@ -155,8 +157,10 @@ TEST_CASE("estimateTangentFieldLevels: level l has voxel size h*2^l and its own 
     for (int l = 0; l < 3; ++l) {
         REQUIRE(levels[std::size_t(l)].tangent->getName() == "tangent_level_" + std::to_string(l));
         REQUIRE(levels[std::size_t(l)].density->getName() == "density_level_" + std::to_string(l));
+        REQUIRE(levels[std::size_t(l)].hairLength->getName() == "hair_length_level_" + std::to_string(l));
+        REQUIRE(levels[std::size_t(l)].densityReference == levels[0].densityReference);  // one meaning for every level
         REQUIRE(levels[std::size_t(l)].tangent->voxelSize().x() == Approx(0.25 * (1 << l)));
-        REQUIRE(levels[std::size_t(l)].tangent->metaValue<int>("vdbhair:level") == l);
+        REQUIRE(levels[std::size_t(l)].tangent->metaValue<int>("vdbhair_level") == l);
     }
     REQUIRE(levels[2].tangent->activeVoxelCount() < levels[0].tangent->activeVoxelCount());
 }
@@ -186,4 +190,38 @@ TEST_CASE("estimateTangentField: bad parameters are clear errors before any work
     p.voxelSize = 1e-4;
     p.maxVoxels = std::uint64_t(1) << 62;
     REQUIRE_THROWS_WITH(estimateTangentField(far, p), Contains("beyond the grid's index range"));
+}
+
+TEST_CASE("estimateTangentField: density is a fog volume in [0, 1], the same at any voxel size for a given reference", "[field]")
+{
+    // A block of parallel strands 0.1 apart: hair length per unit volume 1 / 0.1^2 = 100 inside.
+    StrandSet s;
+    for (int i = 0; i < 40; ++i)
+        for (int j = 0; j < 40; ++j) {
+            const Vec3f root(0.025f + 0.1f * float(i), 0.025f + 0.1f * float(j), 0.f);
+            s.addStrand(std::vector<Vec3f>{root, root + Vec3f(0.f, 0.f, 4.f)});
+        }
+    for (const double h : {0.5, 1.0}) {
+        CAPTURE(h);
+        FieldParams p;
+        p.voxelSize = h;
+        p.densityReference = 200.0;  // length per unit volume that counts as 1
+        const TangentField f = estimateTangentField(s, p);
+        REQUIRE(f.density->metaValue<double>("vdbhair_density_reference") == 200.0);
+        // A voxel well inside the block holds 100 / 200 = 0.5 whatever its size.
+        const openvdb::Coord inside = f.density->transform().worldToIndexCellCentered(openvdb::Vec3d(2.0, 2.0, 2.0));
+        REQUIRE(f.density->tree().getValue(inside) == Approx(0.5).epsilon(1e-3));
+        REQUIRE(f.hairLength->tree().getValue(inside) == Approx(100.0 * h * h * h).epsilon(1e-3));
+        for (auto it = f.density->cbeginValueOn(); it; ++it) REQUIRE((*it >= 0.f && *it <= 1.f));
+    }
+    // Chosen reference: the 95th percentile of length per volume, so the densest voxels are 1.
+    FieldParams p;
+    p.voxelSize = 0.5;
+    const TangentField f = estimateTangentField(s, p);
+    REQUIRE(f.densityReference == Approx(100.0).epsilon(1e-3));
+    float maxDensity = 0.f;
+    for (auto it = f.density->cbeginValueOn(); it; ++it) maxDensity = std::max(maxDensity, *it);
+    REQUIRE(maxDensity == Approx(1.f).epsilon(1e-3));
+    p.densityReference = -1.0;
+    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("density reference"));
 }

@@ -95,7 +95,7 @@ TEST_CASE("estimateHelicoidField / readHelicoidField: from strands, through a fi
     writeVdbGrids(path, {t.tangent, f.k, f.alpha, f.frameT, f.frameN}, "test");
     const HelicoidFieldGrids r = readHelicoidField(path);
     REQUIRE(r.k->activeVoxelCount() == f.k->activeVoxelCount());
-    REQUIRE(r.k->metaValue<double>("vdbhair:voxel_size") == 0.5);
+    REQUIRE(r.k->metaValue<double>("vdbhair_voxel_size") == 0.5);
     const std::string plain = test::tempPath("plain.vdb");
     writeVdbGrids(plain, {t.tangent}, "test");
     REQUIRE_THROWS_WITH(readHelicoidField(plain), Contains("no grid named 'helicoid_k'") && Contains("vdbhair field --helicoid"));

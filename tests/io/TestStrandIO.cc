@@ -10,7 +10,7 @@ using Catch::Matchers::Contains;
 TEST_CASE("readStrands/writeStrands: every writable format round-trips", "[io]")
 {
     const StrandSet s = test::sampleStrands(false);
-    for (const char* ext : {".hair", ".data", ".obj", ".ply", ".vdb"}) {
+    for (const char* ext : {".hair", ".data", ".obj", ".ply", ".vdb", ".usda"}) {
         CAPTURE(ext);
         const std::string path = test::tempPath(std::string("any") + ext);
         writeStrands(path, s);
@@ -55,4 +55,60 @@ TEST_CASE("readStrands: the same hairstyle in five formats reads to the same str
         test::requireSameStrands(ref, readStrands(dir + f));
     }
     test::requireSameStrands(ref, readStrands(dir + "ply/Bangs_100_ascii.ply"), 1e-3f);
+}
+
+namespace {
+
+/// Attributes and defaults of @a b equal @a a's (transparency within float rounding of 1 - (1 - t),
+/// as .vdb and .usda store opacity).
+void requireSameAttributes(const StrandSet& a, const StrandSet& b)
+{
+    REQUIRE(b.defaults.thickness == a.defaults.thickness);
+    REQUIRE(b.defaults.transparency == Approx(a.defaults.transparency).margin(1e-7));
+    REQUIRE(b.defaults.color == a.defaults.color);
+    REQUIRE(b.thickness == a.thickness);
+    REQUIRE(b.color == a.color);
+    REQUIRE(b.transparency.size() == a.transparency.size());
+    for (std::size_t v = 0; v < a.transparency.size(); ++v) REQUIRE(b.transparency[v] == Approx(a.transparency[v]).margin(1e-7));
+}
+
+} // namespace
+
+TEST_CASE("writeStrands: .hair -> .vdb / .usda -> .hair loses neither header defaults nor per-vertex arrays", "[io]")
+{
+    for (const bool perVertex : {false, true}) {
+        StrandSet s = test::sampleStrands(perVertex);
+        s.defaults.thickness = 0.1f;
+        s.defaults.transparency = 0.356f;
+        s.defaults.color = Vec3f(0.9f, 0.6f, 0.3f);
+        writeStrands(test::tempPath("orig.hair"), s);
+        const StrandSet hair = readStrands(test::tempPath("orig.hair"));
+        for (const char* ext : {".vdb", ".usda"}) {
+            CAPTURE(perVertex, ext);
+            writeStrands(test::tempPath(std::string("mid") + ext), hair);
+            writeStrands(test::tempPath("back.hair"), readStrands(test::tempPath(std::string("mid") + ext)));
+            const StrandSet back = readStrands(test::tempPath("back.hair"));
+            test::requireSameStrands(hair, back, std::string(ext) == ".vdb" ? 1e-6f * computeBBox(s).extent().length() : 0.f);
+            requireSameAttributes(hair, back);
+        }
+    }
+}
+
+TEST_CASE("writeStrands: straight.hair's header defaults survive .vdb and .usda", "[io][data]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string path = test::sharedData() + "/hair/cyhair/straight.hair";
+    if (!std::filesystem::exists(path)) {
+        std::cout << "SKIPPED: " << path << " is not in the shared data\n";
+        WARN("SKIPPED: straight.hair is not in the shared data");
+        return;
+    }
+    const StrandSet hair = readStrands(path);
+    for (const char* ext : {".vdb", ".usda"}) {
+        CAPTURE(ext);
+        writeStrands(test::tempPath(std::string("straight") + ext), hair);
+        const StrandSet back = readStrands(test::tempPath(std::string("straight") + ext));
+        test::requireSameStrands(hair, back, std::string(ext) == ".vdb" ? 1e-6f * computeBBox(hair).extent().length() : 0.f);
+        requireSameAttributes(hair, back);
+    }
 }

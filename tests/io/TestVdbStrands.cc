@@ -8,6 +8,9 @@
 
 #include <openvdb/points/PointAttribute.h>
 #include <openvdb/points/PointConversion.h>
+#include <openvdb/tools/PointIndexGrid.h>
+
+#include <vdbhair/io/StrandIO.h>
 
 using namespace vdbhair;
 using Catch::Matchers::Contains;
@@ -47,7 +50,7 @@ TEST_CASE("createStrandGrid: attributes, root group and metadata", "[io][vdb]")
     const StrandSet s = test::sampleStrands(false);
     const auto grid = createStrandGrid(s);
     REQUIRE(grid->getName() == "strands");
-    REQUIRE(grid->metaValue<std::int64_t>("vdbhair:strand_count") == 3);
+    REQUIRE(grid->metaValue<std::int64_t>("vdbhair_strand_count") == 3);
     REQUIRE(grid->metaValue<std::string>("creator").rfind("vdbhair ", 0) == 0);
     const auto& desc = grid->tree().cbeginLeaf()->attributeSet().descriptor();
     REQUIRE(desc.find("strand") != openvdb::points::AttributeSet::INVALID_POS);
@@ -117,10 +120,10 @@ TEST_CASE("readVdbStrands: each kind of bad input has its own error", "[io][vdb]
     {
         StrandSet s = test::sampleStrands(false);
         auto g = createStrandGrid(s);
-        g->insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(1000000));
+        g->insertMeta("vdbhair_strand_count", openvdb::Int64Metadata(1000000));
         std::string path = test::tempPath("count.vdb");
         writeVdbGrids(path, {g}, "test");
-        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("vdbhair:strand_count 1000000 is impossible for 52 points"));
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("vdbhair_strand_count 1000000 is impossible for 52 points"));
 
         g = createStrandGrid(s);
         for (auto leaf = g->tree().beginLeaf(); leaf; ++leaf) {
@@ -136,4 +139,70 @@ TEST_CASE("readVdbStrands: each kind of bad input has its own error", "[io][vdb]
         REQUIRE_THROWS_WITH(writeVdbStrands(test::tempPath("empty.vdb"), StrandSet{}), Contains("no strands"));
         REQUIRE_FALSE(std::filesystem::exists(test::tempPath("empty.vdb")));
     }
+}
+
+namespace {
+
+/// A points grid as Houdini writes one: P, and strand/vertex attributes of type @a T.
+template<typename T>
+openvdb::points::PointDataGrid::Ptr houdiniPoints(const StrandSet& s, const std::string& name, T badValue = T(0), bool bad = false)
+{
+    namespace pts = openvdb::points;
+    const pts::PointAttributeVector<openvdb::Vec3f> positions(s.positions);
+    const auto xform = openvdb::math::Transform::createLinearTransform(0.5);
+    const auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *xform);
+    auto grid = pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, positions, *xform);
+    std::vector<T> strand(s.numVertices()), vertex(s.numVertices());
+    for (std::size_t i = 0; i < s.numStrands(); ++i)
+        for (std::size_t v = s.begin(i); v < s.end(i); ++v) { strand[v] = T(i); vertex[v] = T(v - s.begin(i)); }
+    if (bad) vertex[5] = badValue;
+    pts::appendAttribute<T>(grid->tree(), "strand");
+    pts::populateAttribute(grid->tree(), index->tree(), "strand", pts::PointAttributeVector<T>(strand));
+    pts::appendAttribute<T>(grid->tree(), "vertex");
+    pts::populateAttribute(grid->tree(), index->tree(), "vertex", pts::PointAttributeVector<T>(vertex));
+    grid->setName(name);
+    return grid;
+}
+
+} // namespace
+
+TEST_CASE("readVdbStrands: Houdini's int64 and float strand/vertex attributes holding whole numbers", "[io][vdb]")
+{
+    initializeOpenVdb();
+    const StrandSet s = test::sampleStrands(false);
+    const float tol = 1e-6f * computeBBox(s).extent().length();
+    const std::string path = test::tempPath("houdini.vdb");
+    writeVdbGrids(path, {houdiniPoints<std::int64_t>(s, "strands")}, "test");
+    test::requireSameStrands(s, readVdbStrands(path), tol);
+    writeVdbGrids(path, {houdiniPoints<float>(s, "strands")}, "test");
+    test::requireSameStrands(s, readVdbStrands(path), tol);
+    writeVdbGrids(path, {houdiniPoints<double>(s, "points")}, "test");
+    test::requireSameStrands(s, readVdbStrands(path, {}, nullptr, "points"), tol);
+    ReadOptions byName;
+    byName.vdbGrid = "points";  // what --grid sets
+    test::requireSameStrands(s, readStrands(path, byName), tol);
+
+    writeVdbGrids(path, {houdiniPoints<float>(s, "strands", 2.5f, true)}, "test");
+    REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("has vertex 2.5; strand and vertex must hold whole numbers"));
+    writeVdbGrids(path, {houdiniPoints<std::int64_t>(s, "strands", std::int64_t(1) << 40, true)}, "test");
+    REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("vertex 1099511627776; strand must be in [0, 52) and vertex in [0, 52)"));
+}
+
+TEST_CASE("createStrandGrid: Houdini-valid metadata keys, class, and the older vdbhair: keys still read", "[io][vdb]")
+{
+    const StrandSet s = test::sampleStrands(false);
+    auto grid = createStrandGrid(s);
+    REQUIRE(grid->getGridClass() == openvdb::GRID_UNKNOWN);
+    REQUIRE(grid->metaValue<std::string>("class") == "unknown");
+    for (auto it = grid->beginMeta(); it != grid->endMeta(); ++it) {
+        CAPTURE(it->first);
+        // Houdini attribute names: letters, digits and underscores.
+        REQUIRE(it->first.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") == std::string::npos);
+    }
+    // A file of vdbhair 0.1: the strand count under "vdbhair:strand_count".
+    grid->removeMeta("vdbhair_strand_count");
+    grid->insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(1000000));
+    const std::string path = test::tempPath("legacy.vdb");
+    writeVdbGrids(path, {grid}, "test");
+    REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("vdbhair_strand_count 1000000 is impossible"));
 }

@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/io/MetaKeys.h>
 
 #include <openvdb/Metadata.h>
 
@@ -21,6 +22,11 @@ FieldSpace fieldSpaceFromName(const std::string& name)
 std::string tangentGridName(int level, int levels)
 {
     return levels <= 1 ? "tangent" : "tangent_level_" + std::to_string(level);
+}
+
+std::string hairLengthGridName(int level, int levels)
+{
+    return levels <= 1 ? "hair_length" : "hair_length_level_" + std::to_string(level);
 }
 
 std::string densityGridName(int level, int levels)
@@ -73,14 +79,14 @@ double FieldMapping::worldVoxelSize() const
 
 FieldMapping FieldMapping::fromGrid(const openvdb::GridBase& grid)
 {
-    const auto space = grid.getMetadata<openvdb::StringMetadata>("vdbhair:space");
+    const auto space = findVdbhairMeta<openvdb::StringMetadata>(grid, "space");
     if (!space || space->value() != "scalp") return FieldMapping(grid.constTransformPtr());
-    const auto center = grid.getMetadata<openvdb::Vec3DMetadata>("vdbhair:scalp_center");
-    const auto radius = grid.getMetadata<openvdb::DoubleMetadata>("vdbhair:scalp_radius");
-    const auto up = grid.getMetadata<openvdb::Vec3DMetadata>("vdbhair:scalp_up");
+    const auto center = findVdbhairMeta<openvdb::Vec3DMetadata>(grid, "scalp_center");
+    const auto radius = findVdbhairMeta<openvdb::DoubleMetadata>(grid, "scalp_radius");
+    const auto up = findVdbhairMeta<openvdb::Vec3DMetadata>(grid, "scalp_up");
     if (!center || !radius || !up || !(radius->value() > 0.0)) {
-        throw FormatError("grid '" + grid.getName() + "' is in scalp space but lacks a valid vdbhair:scalp_center, "
-                          "vdbhair:scalp_radius (> 0) and vdbhair:scalp_up");
+        throw FormatError("grid '" + grid.getName() + "' is in scalp space but lacks a valid vdbhair_scalp_center, "
+                          "vdbhair_scalp_radius (> 0) and vdbhair_scalp_up");
     }
     ScalpSphere s;
     s.center = Vec3d(center->value().x(), center->value().y(), center->value().z());
@@ -93,16 +99,16 @@ void setFieldMetadata(openvdb::GridBase& grid, double voxelSize, int iterations,
                       const ScalpSphere& scalp, int level, int levels, std::size_t strandCount)
 {
     grid.insertMeta("creator", openvdb::StringMetadata(creatorString()));
-    grid.insertMeta("vdbhair:voxel_size", openvdb::DoubleMetadata(voxelSize));
-    grid.insertMeta("vdbhair:iterations", openvdb::Int32Metadata(iterations));
-    grid.insertMeta("vdbhair:space", openvdb::StringMetadata(fieldSpaceName(space)));
-    grid.insertMeta("vdbhair:level", openvdb::Int32Metadata(level));
-    grid.insertMeta("vdbhair:levels", openvdb::Int32Metadata(levels));
-    grid.insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(std::int64_t(strandCount)));
+    grid.insertMeta("vdbhair_voxel_size", openvdb::DoubleMetadata(voxelSize));
+    grid.insertMeta("vdbhair_iterations", openvdb::Int32Metadata(iterations));
+    grid.insertMeta("vdbhair_space", openvdb::StringMetadata(fieldSpaceName(space)));
+    grid.insertMeta("vdbhair_level", openvdb::Int32Metadata(level));
+    grid.insertMeta("vdbhair_levels", openvdb::Int32Metadata(levels));
+    grid.insertMeta("vdbhair_strand_count", openvdb::Int64Metadata(std::int64_t(strandCount)));
     if (space == FieldSpace::Scalp) {
-        grid.insertMeta("vdbhair:scalp_center", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.center.x(), scalp.center.y(), scalp.center.z())));
-        grid.insertMeta("vdbhair:scalp_radius", openvdb::DoubleMetadata(scalp.radius));
-        grid.insertMeta("vdbhair:scalp_up", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.up.x(), scalp.up.y(), scalp.up.z())));
+        grid.insertMeta("vdbhair_scalp_center", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.center.x(), scalp.center.y(), scalp.center.z())));
+        grid.insertMeta("vdbhair_scalp_radius", openvdb::DoubleMetadata(scalp.radius));
+        grid.insertMeta("vdbhair_scalp_up", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.up.x(), scalp.up.y(), scalp.up.z())));
     }
 }
 

@@ -14,8 +14,9 @@ namespace vdbhair {
 class FieldMapping
 {
 public:
-    /// @brief The mapping of @a grid: scalp space when its metadata says `vdbhair:space` =
-    /// "scalp" (with `vdbhair:scalp_center`, `vdbhair:scalp_radius`, `vdbhair:scalp_up`), else world.
+    /// @brief The mapping of @a grid: scalp space when its metadata says `vdbhair_space` =
+    /// "scalp" (with `vdbhair_scalp_center`, `vdbhair_scalp_radius`, `vdbhair_scalp_up`; the older
+    /// `vdbhair:` spellings are read too), else world.
     /// @throw FormatError if scalp metadata is missing or invalid.
     static FieldMapping fromGrid(const openvdb::GridBase& grid);
 
@@ -56,8 +57,8 @@ private:
 };
 
 /// @brief Write the self-describing metadata of DESIGN.md on a field grid: `creator`,
-/// `vdbhair:voxel_size`, `vdbhair:iterations`, `vdbhair:space`, `vdbhair:level`, `vdbhair:levels`,
-/// `vdbhair:strand_count`, and the scalp sphere for scalp-space grids.
+/// `vdbhair_voxel_size`, `vdbhair_iterations`, `vdbhair_space`, `vdbhair_level`, `vdbhair_levels`,
+/// `vdbhair_strand_count`, and the scalp sphere for scalp-space grids.
 void setFieldMetadata(openvdb::GridBase& grid, double voxelSize, int iterations, FieldSpace space,
                       const ScalpSphere& scalp, int level, int levels, std::size_t strandCount);
 

@@ -18,12 +18,14 @@ const char* fieldSpaceName(FieldSpace space);
 /// @throw ValueError unless "world" or "scalp".
 FieldSpace fieldSpaceFromName(const std::string& name);
 
-/// @brief Grid names of DESIGN.md: `tangent` / `density` for one level, `tangent_level_<l>` /
-/// `density_level_<l>` for multi-level fields (level 0 the finest).
+/// @brief Grid names of DESIGN.md: `tangent` / `density` / `hair_length` for one level,
+/// `tangent_level_<l>` / `density_level_<l>` / `hair_length_level_<l>` for multi-level fields
+/// (level 0 the finest).
 std::string tangentGridName(int level, int levels);
 std::string densityGridName(int level, int levels);
 /// `coherence` / `coherence_level_<l>` and `spread` / `spread_level_<l>` (TangentField.h).
 std::string coherenceGridName(int level, int levels);
 std::string spreadGridName(int level, int levels);
+std::string hairLengthGridName(int level, int levels);
 
 } // namespace vdbhair

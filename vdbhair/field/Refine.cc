@@ -148,13 +148,15 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
         TangentField f = estimateTangentField(from, lp, threaded, interrupter);
         f.tangent->setName(tangentGridName(level, params.levels));
         f.density->setName(densityGridName(level, params.levels));
+        f.hairLength->setName(hairLengthGridName(level, params.levels));
         f.coherence->setName(coherenceGridName(level, params.levels));
         f.spread->setName(spreadGridName(level, params.levels));
         for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(f.tangent.get()), static_cast<openvdb::GridBase*>(f.density.get()),
-                                     static_cast<openvdb::GridBase*>(f.coherence.get()), static_cast<openvdb::GridBase*>(f.spread.get())}) {
-            g->insertMeta("vdbhair:level", openvdb::Int32Metadata(level));
-            g->insertMeta("vdbhair:levels", openvdb::Int32Metadata(params.levels));
-            g->insertMeta("vdbhair:refine_mode", openvdb::StringMetadata(refineModeName(params.mode)));
+                                     static_cast<openvdb::GridBase*>(f.hairLength.get()), static_cast<openvdb::GridBase*>(f.coherence.get()),
+                                     static_cast<openvdb::GridBase*>(f.spread.get())}) {
+            g->insertMeta("vdbhair_level", openvdb::Int32Metadata(level));
+            g->insertMeta("vdbhair_levels", openvdb::Int32Metadata(params.levels));
+            g->insertMeta("vdbhair_refine_mode", openvdb::StringMetadata(refineModeName(params.mode)));
         }
         RefineLevel& info = result.levels[std::size_t(level)];
         info.voxelSize = lp.voxelSize;

@@ -66,9 +66,9 @@ double median(std::vector<double>& v)
 
 double meanCoherence(const TangentField& field)
 {
-    if (!field.coherence || !field.density) return 0.0;
+    if (!field.coherence || !field.hairLength) return 0.0;
     double sum = 0.0, weight = 0.0;
-    openvdb::FloatGrid::ConstAccessor dens = field.density->getConstAccessor();
+    openvdb::FloatGrid::ConstAccessor dens = field.hairLength->getConstAccessor();
     for (auto it = field.coherence->cbeginValueOn(); it; ++it) {
         const double d = double(dens.getValue(it.getCoord()));
         sum += d * double(*it);

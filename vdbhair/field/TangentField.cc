@@ -299,6 +299,10 @@ void checkParams(const StrandSet& strands, const FieldParams& p, const char* whe
     if (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize)) {
         throw ValueError(std::string(where) + ": voxel size " + std::to_string(p.voxelSize) + " must be a positive finite length");
     }
+    if (p.densityReference < 0.0 || !std::isfinite(p.densityReference)) {
+        throw ValueError(std::string(where) + ": density reference " + std::to_string(p.densityReference) +
+                         " must be a positive hair length per unit volume (0 chooses it)");
+    }
     // OpenVDB refuses transforms whose scale determinant is within 1e-15 of zero.
     const double lattice = p.space == FieldSpace::Scalp ? p.voxelSize / p.scalp.radius : p.voxelSize;
     if (lattice < 2e-5) {
@@ -512,7 +516,30 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     }, threaded);
     if (directions.stopped()) throw InterruptedError("estimateTangentField: interrupted");
 
+    // The raw sums as hair_length; density normalized to a fog volume (TangentField.h states the rule).
     TangentField out;
+    out.hairLength = openvdb::FloatGrid::create(openvdb::FloatTree::Ptr(new openvdb::FloatTree(*densityTree)));
+    const double voxelVolume = voxelSize * voxelSize * voxelSize;
+    double reference = p.densityReference;
+    if (!(reference > 0.0)) {
+        std::vector<float> values;
+        values.reserve(std::size_t(densityTree->activeVoxelCount()));
+        for (auto it = densityTree->cbeginValueOn(); it; ++it) values.push_back(*it);
+        if (!values.empty()) {
+            const std::size_t k = std::min(values.size() - 1, std::size_t(0.95 * double(values.size())));
+            std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
+            reference = double(values[k]) / voxelVolume;
+        }
+        if (!(reference > 0.0)) reference = 1.0 / voxelVolume;
+    }
+    out.densityReference = reference;
+    {
+        const float scale = float(1.0 / (voxelVolume * reference));
+        openvdb::tree::LeafManager<openvdb::FloatTree> dleaves(*densityTree);
+        dleaves.foreach([scale](openvdb::FloatTree::LeafNodeType& leaf, std::size_t) {
+            for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(std::min(1.f, *it * scale));
+        }, threaded);
+    }
     out.tangent = openvdb::Vec3SGrid::create(tangentTree);
     out.density = openvdb::FloatGrid::create(densityTree);
     out.coherence = openvdb::FloatGrid::create(coherenceTree);
@@ -527,11 +554,17 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     // (u, v, w) lattice, which the lattice's transform does not act on (invariant).
     out.tangent->setVectorType(p.space == FieldSpace::Scalp ? openvdb::VEC_INVARIANT : openvdb::VEC_CONTRAVARIANT_RELATIVE);
     out.density->setGridClass(openvdb::GRID_FOG_VOLUME);
+    out.hairLength->setName(hairLengthGridName(level, levels));
+    out.hairLength->setGridClass(openvdb::GRID_UNKNOWN);
     for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(out.tangent.get()), static_cast<openvdb::GridBase*>(out.density.get()),
-                                 static_cast<openvdb::GridBase*>(out.coherence.get()), static_cast<openvdb::GridBase*>(out.spread.get())}) {
+                                 static_cast<openvdb::GridBase*>(out.hairLength.get()), static_cast<openvdb::GridBase*>(out.coherence.get()),
+                                 static_cast<openvdb::GridBase*>(out.spread.get())}) {
         g->setTransform(map.transform().copy());
         setFieldMetadata(*g, voxelSize, p.iterations, p.space, p.scalp, level, levels, strands.numStrands());
     }
+    out.density->insertMeta("vdbhair_density_reference", openvdb::DoubleMetadata(reference));
+    out.density->insertMeta("vdbhair_density_rule", openvdb::StringMetadata(
+        "min(1, hair_length / (voxel_size^3 * vdbhair_density_reference)): hair length per unit volume over the reference"));
     return out;
 }
 
@@ -541,7 +574,8 @@ openvdb::GridCPtrVec TangentField::grids() const
 {
     openvdb::GridCPtrVec out;
     for (const openvdb::GridBase::ConstPtr& g : {openvdb::GridBase::ConstPtr(tangent), openvdb::GridBase::ConstPtr(density),
-                                                 openvdb::GridBase::ConstPtr(coherence), openvdb::GridBase::ConstPtr(spread)}) {
+                                                 openvdb::GridBase::ConstPtr(hairLength), openvdb::GridBase::ConstPtr(coherence),
+                                                 openvdb::GridBase::ConstPtr(spread)}) {
         if (g) out.push_back(g);
     }
     return out;
@@ -566,8 +600,10 @@ std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, c
     checkParams(strands, params, "estimateTangentField");
     if (levels < 1 || levels > 16) throw ValueError("estimateTangentField: levels " + std::to_string(levels) + " must be between 1 and 16");
     std::vector<TangentField> out;
+    FieldParams lp = params;
     for (int l = 0; l < levels; ++l) {
-        out.push_back(estimateLevel(strands, params, params.voxelSize * double(1 << l), l, levels, threaded, interrupter));
+        out.push_back(estimateLevel(strands, lp, params.voxelSize * double(1 << l), l, levels, threaded, interrupter));
+        lp.densityReference = out.front().densityReference;  // one meaning for every level
     }
     return out;
 }

@@ -41,13 +41,25 @@ struct FieldParams
     /// allocation); about 40 bytes each at most. A voxel size too small for the hairstyle fails
     /// with LimitError instead of exhausting memory.
     std::uint64_t maxVoxels = std::uint64_t(1) << 26;
+    /// The hair length per unit volume (world units^-2) that `density` maps to 1; 0 chooses it
+    /// (see TangentField::density).
+    double densityReference = 0.0;
 };
 
 /// @brief The grids of one level.
 struct TangentField
 {
     openvdb::Vec3SGrid::Ptr tangent;  ///< unit directions, root to tip; class unknown, contravariant relative
-    openvdb::FloatGrid::Ptr density;  ///< summed segment length per voxel (world units); fog volume
+    /// A fog volume in [0, 1] a shader can use as it is: `min(1, hair_length / (h^3 rho))`, the
+    /// hair length per unit volume in the voxel (h: the voxel size in world units, at the scalp in
+    /// scalp space) over the reference rho (world units^-2). rho is FieldParams::densityReference
+    /// when given (the same value gives the same meaning at any voxel size and for any
+    /// hairstyle), otherwise the 95th percentile of hair_length / h^3 over the active voxels (of
+    /// level 0 for multi-level fields, used for every level): 1 then means "as dense as the
+    /// densest 5% of this hairstyle". The value used is the grid's `vdbhair_density_reference`.
+    openvdb::FloatGrid::Ptr density;
+    openvdb::FloatGrid::Ptr hairLength;  ///< summed segment length per voxel (world units); class unknown
+    double densityReference = 0.0;       ///< rho, as used for `density`
     /// |Σ ℓ T| / Σ ℓ per voxel, in [0, 1]: 1 where every contribution points the same way, near 0
     /// where they cancel (crossing or opposing strands); class unknown, same topology as tangent.
     openvdb::FloatGrid::Ptr coherence;
@@ -56,7 +68,7 @@ struct TangentField
     /// stray from v̄ before it is an outlier (Refine.h). Class unknown, same topology as tangent.
     openvdb::FloatGrid::Ptr spread;
 
-    /// @brief The four grids, for writing.
+    /// @brief The five grids (tangent, density, hair_length, coherence, spread), for writing.
     openvdb::GridCPtrVec grids() const;
 };
 

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/helicoid/Helicoid.h>
@@ -33,11 +34,11 @@ Vec3f toF(const Vec3d& v) { return Vec3f(float(v.x()), float(v.y()), float(v.z()
 void copyMeta(const openvdb::GridBase& from, openvdb::GridBase& to, const std::string& name)
 {
     for (auto it = from.beginMeta(); it != from.endMeta(); ++it) {
-        if (it->first.rfind("vdbhair:", 0) == 0 || it->first == "creator") to.insertMeta(it->first, *it->second);
+        if (isVdbhairMetaKey(it->first) || it->first == "creator") to.insertMeta(it->first, *it->second);
     }
     to.setName(name);
     to.setTransform(from.transform().copy());
-    to.insertMeta("vdbhair:helicoid_fit", openvdb::StringMetadata("Eq. 1 to first order, least squares over the 26 neighbours"));
+    to.insertMeta("vdbhair_helicoid_fit", openvdb::StringMetadata("Eq. 1 to first order, least squares over the 26 neighbours"));
 }
 
 } // namespace

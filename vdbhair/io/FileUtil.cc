@@ -83,12 +83,33 @@ std::atomic<bool (*)()> sCommitInterrupt{nullptr};
 
 void setCommitInterruptCheck(bool (*check)()) { sCommitInterrupt.store(check); }
 
+namespace {
+std::atomic<OverwritePolicy> sOverwrite{OverwritePolicy::Replace};
+}
+
+void setOverwritePolicy(OverwritePolicy policy) { sOverwrite.store(policy); }
+OverwritePolicy overwritePolicy() { return sOverwrite.load(); }
+
 void AtomicOutput::commit()
 {
     if (bool (*check)() = sCommitInterrupt.load(); check && check()) {
         std::error_code ec;
         fs::remove(mTemp, ec);
         throw InterruptedError(mTarget + ": interrupted before the output was moved into place");
+    }
+    if (sOverwrite.load() == OverwritePolicy::NoClobber) {
+        // link() never replaces: it fails with EEXIST when the target exists, atomically.
+        if (::link(mTemp.c_str(), mTarget.c_str()) != 0) {
+            const int err = errno;
+            std::error_code ec;
+            fs::remove(mTemp, ec);
+            if (err == EEXIST) throw IoError(mTarget + ": exists; --no-clobber refuses to replace it (nothing was written)");
+            throw IoError(mTarget + ": cannot move the finished output into place: " + std::strerror(err));
+        }
+        std::error_code ec;
+        fs::remove(mTemp, ec);
+        mCommitted = true;
+        return;
     }
     if (std::rename(mTemp.c_str(), mTarget.c_str()) != 0) {
         const std::string reason = std::strerror(errno);

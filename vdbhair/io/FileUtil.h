@@ -38,8 +38,10 @@ public:
     const std::string& target() const { return mTarget; }
     /// Where to write: a path in the target's folder.
     const std::string& tempPath() const { return mTemp; }
-    /// @brief Rename the temporary onto the target.
-    /// @throw IoError with the operating system's reason; InterruptedError (and the temporary
+    /// @brief Rename the temporary onto the target (under OverwritePolicy::NoClobber: link it to
+    /// the target, which fails atomically if the target exists).
+    /// @throw IoError with the operating system's reason or, with NoClobber, because the target
+    /// exists; InterruptedError (and the temporary
     /// removed) when the check of setCommitInterruptCheck() says so.
     void commit();
 
@@ -53,6 +55,17 @@ private:
 /// their Ctrl-C flag, so that work interrupted anywhere, even while writing, leaves no output.
 /// nullptr (the default) removes it.
 void setCommitInterruptCheck(bool (*check)());
+
+/// What AtomicOutput::commit() does when the target already exists.
+enum class OverwritePolicy
+{
+    Replace,   ///< rename over it atomically (the default)
+    NoClobber, ///< refuse: commit() throws IoError and the existing file is left as it was
+};
+
+/// @brief Set the process-wide OverwritePolicy (the command's `--no-clobber`). Thread-safe.
+void setOverwritePolicy(OverwritePolicy policy);
+OverwritePolicy overwritePolicy();
 
 /// @brief Write @a bytes to @a path atomically (see AtomicOutput).
 void writeFileAtomic(const std::string& path, const std::string& bytes, const std::string& where);

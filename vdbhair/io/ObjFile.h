@@ -1,14 +1,30 @@
 /// @file ObjFile.h
-/// @brief Wavefront OBJ polylines (`.obj`): `v x y z` vertices and `l i j k ...` polyline
-/// elements, as Houdini and Blender export curves.
+/// @brief Wavefront OBJ lines (`.obj`): `v x y z` vertices and `l` line elements, as Houdini
+/// and Blender export curves and loose edges.
 ///
-/// Reading: indices are 1-based, negative indices count back from the latest vertex, `i/t`
-/// forms take the vertex index. Each `l` element is a strand; an `l` element that starts at the
-/// very vertex index where the previous one ended continues that strand (Blender writes curves
-/// as chains of two-vertex `l` edges). `v` lines with 6 numbers (x y z r g b) give vertex colours.
-/// Faces and other elements are ignored (counted in a warning); a file without `l` elements
-/// is an error. Writing: one `v` line per vertex (shortest round-trip decimal floats) and one
-/// `l` element per strand.
+/// **Writing.** One `v` line per vertex (shortest round-trip decimal floats, `x y z r g b` when
+/// the set has colours), in strand order, root first. By default each segment is its own
+/// two-vertex `l i j` element, chained per strand (`l 1 2`, `l 2 3`, ...): Blender 3.4's default
+/// OBJ importer (`wm.obj_import`) keeps only the first segment of a longer `l` element, so this
+/// is the only form it reads completely (it imports loose edges; tests/apps/check_blender_obj.py
+/// counts them). ObjLineStyle::Polylines writes one `l` element per strand instead, which
+/// Houdini and most other tools read as one curve each.
+///
+/// **Reading.** Every `l` element contributes its consecutive pairs as edges; strands are
+/// rebuilt from the edges by connectivity, so edges may come in any order and any direction
+/// (Blender writes them unchained). Each connected chain is one strand, rooted at its end with
+/// the lower vertex index (or, with ReadOptions::objRootNear, at the end nearest that point);
+/// strands are ordered by the index of that lower end, which reproduces the order of every file
+/// vdbhair writes. A vertex joined to three or more others (a branch) and a closed loop are
+/// errors naming the vertex (1-based, as in the file) and the lines involved. A one-vertex `l`
+/// element on a vertex no edge uses is a one-vertex strand (dropped or rejected like any short
+/// strand). Indices are 1-based; negative ones count back from the latest vertex; `i/t` forms
+/// take the vertex index. Faces and other elements are ignored (counted in a warning); a file
+/// without `l` elements is an error.
+///
+/// **Axes.** OBJ has no up axis. Blender's OBJ importer (default "Up: Y, Forward: -Z") turns the
+/// file's +Y into Blender's +Z (x, y, z) -> (x, -z, y), and its exporter turns it back with the
+/// same defaults, so a vdbhair (+Y up) file arrives upright in Blender and round-trips unchanged.
 #pragma once
 
 #include <vdbhair/io/ReadOptions.h>
@@ -18,10 +34,21 @@
 
 namespace vdbhair {
 
-/// @throw IoError, FormatError (bad numbers, index out of range or zero, no polylines).
+/// How writeObj() writes each strand's line elements.
+enum class ObjLineStyle
+{
+    Edges,      ///< a chain of two-vertex `l` elements (Blender reads every segment; the default)
+    Polylines,  ///< one `l` element per strand (Houdini; Blender keeps only its first segment)
+};
+
+/// @brief Parse "edges" or "polylines". @throw ValueError otherwise.
+ObjLineStyle objLineStyleFromName(const std::string& name);
+
+/// @throw IoError, FormatError (bad numbers, index out of range or zero, no polylines, a
+/// branching vertex, a closed loop).
 StrandSet readObj(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 
-/// @brief Write positions (and colours when present) as polylines.
-void writeObj(const std::string& path, const StrandSet& strands);
+/// @brief Write positions (and colours when present) as line elements.
+void writeObj(const std::string& path, const StrandSet& strands, ObjLineStyle style = ObjLineStyle::Edges);
 
 } // namespace vdbhair

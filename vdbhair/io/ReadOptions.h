@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,13 @@ struct ReadOptions
     /// Optional progress and Ctrl-C while the file's bytes are read (Progress.h); readers then
     /// throw InterruptedError when it says stop.
     openvdb::util::NullInterrupter* interrupter = nullptr;
+    /// `.vdb`: the name of the points grid that holds the strands (Houdini and the demo's
+    /// `strands_input` use other names than the default).
+    std::string vdbGrid = "strands";
+    /// `.obj`: edges carry no direction, so each strand rebuilt from them is rooted at the end
+    /// nearest this point (e.g. the scalp's centre) when it is set, otherwise at its end with the
+    /// lower vertex index (which is the root of every file vdbhair and Blender write).
+    std::optional<Vec3f> objRootNear;
 };
 
 /// @brief What a reader noticed but did not fail on.

@@ -8,6 +8,7 @@
 #include <vdbhair/io/HairFile.h>
 #include <vdbhair/io/ObjFile.h>
 #include <vdbhair/io/TfxFile.h>
+#include <vdbhair/io/UsdFile.h>
 
 namespace vdbhair {
 
@@ -16,9 +17,10 @@ struct FormatEntry { const char* ext; StrandFormat format; const char* name; boo
 constexpr FormatEntry kFormats[] = {
     {".hair", StrandFormat::Hair, "cyHair", true},
     {".data", StrandFormat::Data, "USC-HairSalon", true},
-    {".obj", StrandFormat::Obj, "OBJ polylines", true},
-    {".ply", StrandFormat::Ply, "PLY strands", true},
+    {".obj", StrandFormat::Obj, "OBJ lines", true},
+    {".ply", StrandFormat::Ply, "PLY (hairutil layout)", true},
     {".vdb", StrandFormat::Vdb, "OpenVDB points", true},
+    {".usda", StrandFormat::Usda, "USD BasisCurves (text)", true},
     {".tfx", StrandFormat::Tfx, "TressFX", false},
     {".bin", StrandFormat::Bin, "CT2Hair", false},
     {".convdata", StrandFormat::Convdata, "HairNet convdata", false},
@@ -32,7 +34,7 @@ StrandFormat strandFormatFromPath(const std::string& path, bool forWriting)
         if (ext != f.ext) continue;
         if (forWriting && !f.writable) {
             throw ValueError(path + ": " + f.name + " (" + ext +
-                             ") is read-only in vdbhair; write .hair, .data, .obj, .ply or .vdb");
+                             ") is read-only in vdbhair; write .hair, .data, .obj, .ply, .vdb or .usda");
         }
         return f.format;
     }
@@ -71,7 +73,8 @@ StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadRepo
     case StrandFormat::Data: return readData(path, opts, report);
     case StrandFormat::Obj: return readObj(path, opts, report);
     case StrandFormat::Ply: return readPly(path, opts, report);
-    case StrandFormat::Vdb: return readVdbStrands(path, opts, report);
+    case StrandFormat::Vdb: return readVdbStrands(path, opts, report, opts.vdbGrid);
+    case StrandFormat::Usda: return readUsda(path, opts, report);
     case StrandFormat::Tfx: return readTfx(path, opts, report);
     case StrandFormat::Bin: return readBin(path, opts, report);
     case StrandFormat::Convdata: return readConvdata(path, opts, report);
@@ -84,9 +87,10 @@ void writeStrands(const std::string& path, const StrandSet& strands, const Write
     switch (strandFormatFromPath(path, /*forWriting=*/true)) {
     case StrandFormat::Hair: writeHair(path, strands); return;
     case StrandFormat::Data: writeData(path, strands); return;
-    case StrandFormat::Obj: writeObj(path, strands); return;
+    case StrandFormat::Obj: writeObj(path, strands, opts.objLines); return;
     case StrandFormat::Ply: writePly(path, strands, opts.plyEncoding); return;
     case StrandFormat::Vdb: writeVdbStrands(path, strands, opts.vdb); return;
+    case StrandFormat::Usda: writeUsda(path, strands, opts.usd); return;
     default: break;
     }
     throw ValueError(path + ": format is not writable");

@@ -6,15 +6,18 @@
 /// |---|---|---|---|
 /// | .hair | cyHair (HairFile.h) | yes | yes |
 /// | .data | USC-HairSalon (DataFile.h) | yes | yes |
-/// | .obj | OBJ polylines (ObjFile.h) | yes | yes |
+/// | .obj | OBJ lines: two-vertex edges written, edges in any order read (ObjFile.h) | yes | yes |
 /// | .ply | hairutil PLY, ascii / binary LE (PlyFile.h) | yes | yes |
 /// | .vdb | OpenVDB points grid `strands` (VdbStrands.h) | yes | yes |
+/// | .usda | USD BasisCurves, text (UsdFile.h) | yes | yes |
 /// | .tfx | TressFX binary 3/4, ASCII 1/2 (TfxFile.h) | yes | no |
 /// | .bin | CT2Hair (BinFile.h) | yes | no |
 /// | .convdata | HairNet (ConvdataFile.h) | yes | no |
 #pragma once
 
+#include <vdbhair/io/ObjFile.h>
 #include <vdbhair/io/PlyFile.h>
+#include <vdbhair/io/UsdFile.h>
 #include <vdbhair/io/ReadOptions.h>
 #include <vdbhair/io/VdbStrands.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -23,7 +26,7 @@
 
 namespace vdbhair {
 
-enum class StrandFormat { Hair, Data, Obj, Ply, Vdb, Tfx, Bin, Convdata };
+enum class StrandFormat { Hair, Data, Obj, Ply, Vdb, Usda, Tfx, Bin, Convdata };
 
 /// @brief The format of @a path from its extension.
 /// @param forWriting also require a writable format
@@ -42,7 +45,9 @@ StrandSet readStrands(const std::string& path, const ReadOptions& opts = {}, Rea
 struct WriteOptions
 {
     PlyEncoding plyEncoding = PlyEncoding::Binary;
+    ObjLineStyle objLines = ObjLineStyle::Edges;
     VdbPointsOptions vdb;
+    UsdWriteOptions usd;
 };
 
 /// @brief Write strands in the format of @a path's extension, atomically.

@@ -60,9 +60,9 @@ std::string metaValueString(const MetaValue& m)
     return os.str();
 }
 
-std::vector<GridInfo> describeVdbFile(const std::string& path)
+std::vector<GridInfo> describeVdbFile(const std::string& path, const std::string& whereGiven)
 {
-    const std::string where = "info(" + path + ")";
+    const std::string where = whereGiven.empty() ? "info(" + path + ")" : whereGiven;
     const openvdb::GridPtrVec grids = readVdbGrids(path, where);
     std::vector<GridInfo> out;
     for (const openvdb::GridBase::Ptr& grid : grids) {

@@ -50,7 +50,8 @@ struct GridInfo
 
 /// @brief Describe every grid of @a path, in file order.
 /// @throw IoError, FormatError.
-std::vector<GridInfo> describeVdbFile(const std::string& path);
+/// @param where message prefix; empty: "info(PATH)"
+std::vector<GridInfo> describeVdbFile(const std::string& path, const std::string& where = "");
 
 /// @brief A metadata value as text ("0.5", "[1, 2, 3]", "vdbhair 0.1.0").
 std::string metaValueString(const MetaValue& m);

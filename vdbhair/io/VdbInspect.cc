@@ -157,11 +157,13 @@ std::string plural(std::int64_t n, const char* one, const char* many)
     return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
+/// The metadata @a name; a `vdbhair_` key is also found under its older `vdbhair:` spelling.
 const MetaValue* findMeta(const GridInfo& info, const std::string& name)
 {
     for (const MetaValue& m : info.metadata) {
         if (m.name == name) return &m;
     }
+    if (name.rfind("vdbhair_", 0) == 0) return findMeta(info, "vdbhair:" + name.substr(8));
     return nullptr;
 }
 
@@ -181,7 +183,9 @@ std::string explainGrid(const GridInfo& info)
     // What the grid holds, by its name (DESIGN.md's grid conventions).
     static const std::map<std::string, std::string> meaning = {
         {"tangent", "the hair's unit direction, root to tip, per voxel (inactive where no hair passed)"},
-        {"density", "the hair length that passed through each voxel (summed segment length)"},
+        {"density", "the hair density as a fog volume in [0, 1]: hair length per unit volume over vdbhair_density_reference, clamped"},
+        {"hair_length", "the hair length that passed through each voxel (summed segment length)"},
+        {"hair_direction", "the hair's unit direction, root to tip, per voxel (the tangent grid under a name Blender's Cycles does not reserve)"},
         {"helicoid_k", "the local helicoid curvatures (kT, kN, kB) fitted per voxel"},
         {"helicoid_alpha", "the local helicoid elevation factor alpha fitted per voxel"},
         {"frame_T", "the local helicoid frame's tangent T per voxel"},
@@ -189,27 +193,27 @@ std::string explainGrid(const GridInfo& info)
         {"strands", "hair strands as points: one point per vertex, with strand and vertex indices"},
     };
     std::string base = info.name;
-    const std::int64_t level = integer("vdbhair:level");
+    const std::int64_t level = integer("vdbhair_level");
     // Multi-level fields are named tangent_level_0, density_level_1, ...
     const std::size_t lv = base.rfind("_level_");
     if (lv != std::string::npos && lv > 0) base.resize(lv);
     const auto it = meaning.find(base);
     const std::string creator = text("creator");
-    const bool ours = creator.rfind("vdbhair", 0) == 0 || findMeta(info, "vdbhair:strand_count") != nullptr;
+    const bool ours = creator.rfind("vdbhair", 0) == 0 || findMeta(info, "vdbhair_strand_count") != nullptr;
     if (it != meaning.end() && ours) os << "Holds " << it->second << ".";
-    const std::int64_t strands = integer("vdbhair:strand_count");
-    const std::string source = text("vdbhair:source");
-    const std::int64_t iterations = integer("vdbhair:iterations");
-    const std::string space = text("vdbhair:space");
-    const std::string voxel = text("vdbhair:voxel_size");
+    const std::int64_t strands = integer("vdbhair_strand_count");
+    const std::string source = text("vdbhair_source");
+    const std::int64_t iterations = integer("vdbhair_iterations");
+    const std::string space = text("vdbhair_space");
+    const std::string voxel = text("vdbhair_voxel_size");
     if (info.isPoints && strands >= 0) {
         os << (os.tellp() > 0 ? " " : "") << "Written by " << (creator.empty() ? "vdbhair" : creator) << " from "
            << plural(strands, "strand", "strands");
-        const std::string codec = text("vdbhair:position_codec");
+        const std::string codec = text("vdbhair_position_codec");
         if (!codec.empty()) os << ", positions stored with the " << codec << " codec";
         os << ".";
     } else if (iterations >= 0 || !space.empty()) {
-        const bool tangent = base == "tangent", density = base == "density";
+        const bool tangent = base == "tangent" || base == "hair_direction", density = base == "density" || base == "hair_length";
         const bool helicoid = base.rfind("helicoid_", 0) == 0 || base.rfind("frame_", 0) == 0;
         os << (os.tellp() > 0 ? " " : "") << (tangent ? "Estimated" : density ? "Accumulated" : helicoid ? "Fitted" : "Made") << " by "
            << (creator.empty() ? "vdbhair" : creator);
@@ -228,19 +232,19 @@ std::string explainGrid(const GridInfo& info)
         if (space == "world") os << ", in world space";
         else if (space == "scalp") {
             os << ", in scalp space (Wang et al.'s (u, v, height) over a sphere";
-            const std::string c = text("vdbhair:scalp_center"), rad = text("vdbhair:scalp_radius");
+            const std::string c = text("vdbhair_scalp_center"), rad = text("vdbhair_scalp_radius");
             if (!c.empty()) os << " centred at " << c;
             if (!rad.empty()) os << " of radius " << rad;
             os << ")";
         }
         os << ".";
-        const std::int64_t levels = integer("vdbhair:levels");
+        const std::int64_t levels = integer("vdbhair_levels");
         if (levels > 1) {
             os << " Level " << level << " of 0.." << levels - 1 << (level == 0 ? " (the finest" : " (level 0 is the finest")
                << "; each level doubles the voxel size).";
         }
     }
-    const std::string fit = text("vdbhair:helicoid_fit");
+    const std::string fit = text("vdbhair_helicoid_fit");
     if (!fit.empty()) os << " Helicoid parameters fitted per voxel: " << fit << ".";
     if (!ours && !creator.empty()) os << (os.tellp() > 0 ? " " : "") << "Written by " << creator << ".";
     return os.str();
@@ -249,7 +253,7 @@ std::string explainGrid(const GridInfo& info)
 std::vector<GridReport> inspectVdbFile(const std::string& path)
 {
     const std::string where = "inspect(" + path + ")";
-    std::vector<GridInfo> infos = describeVdbFile(path);
+    std::vector<GridInfo> infos = describeVdbFile(path, where);
     const openvdb::GridPtrVec grids = readVdbGrids(path, where);
     std::vector<GridReport> out;
     for (std::size_t g = 0; g < grids.size() && g < infos.size(); ++g) {

@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/io/VdbFile.h>
 
 #include <openvdb/points/PointAttribute.h>
@@ -12,6 +13,8 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <sstream>
 
 namespace vdbhair {
 
@@ -22,6 +25,41 @@ std::string toString(const openvdb::Coord& c)
 {
     return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ")";
 }
+/// A topology attribute (`strand`, `vertex`) of any integer or floating type, read as a whole
+/// number: Houdini writes int64 for `i@strand` set in VEX and float for a bare `@strand`.
+class WholeNumberAttribute
+{
+public:
+    WholeNumberAttribute(const pts::AttributeArray& array, const std::string& type)
+    {
+        if (type == "int16") m16.emplace(array);
+        else if (type == "int32") m32.emplace(array);
+        else if (type == "int64") m64.emplace(array);
+        else if (type == "float") mF.emplace(array);
+        else if (type == "double") mD.emplace(array);
+    }
+    static bool supports(const std::string& type)
+    {
+        return type == "int16" || type == "int32" || type == "int64" || type == "float" || type == "double";
+    }
+    /// The value at point @a i, as a double (exact for every integer an index can be).
+    double get(openvdb::Index i) const
+    {
+        if (m32) return double(m32->get(i));
+        if (m64) return double(m64->get(i));
+        if (mF) return double(mF->get(i));
+        if (mD) return mD->get(i);
+        return double(m16->get(i));
+    }
+
+private:
+    std::optional<pts::AttributeHandle<std::int16_t>> m16;
+    std::optional<pts::AttributeHandle<std::int32_t>> m32;
+    std::optional<pts::AttributeHandle<std::int64_t>> m64;
+    std::optional<pts::AttributeHandle<float>> mF;
+    std::optional<pts::AttributeHandle<double>> mD;
+};
+
 } // namespace
 
 PositionCodec positionCodecFromName(const std::string& name)
@@ -110,9 +148,14 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
     }
 
     grid->setName("strands");
+    grid->setGridClass(openvdb::GRID_UNKNOWN);
     grid->insertMeta("creator", openvdb::StringMetadata(creatorString()));
-    grid->insertMeta("vdbhair:strand_count", openvdb::Int64Metadata(std::int64_t(strands.numStrands())));
-    grid->insertMeta("vdbhair:position_codec", openvdb::StringMetadata(positionCodecName(opts.codec)));
+    // The per-vertex defaults (cyHair's header), so that .hair -> .vdb -> .hair loses nothing.
+    grid->insertMeta(metaKey("default_thickness"), openvdb::FloatMetadata(strands.defaults.thickness));
+    grid->insertMeta(metaKey("default_transparency"), openvdb::FloatMetadata(strands.defaults.transparency));
+    grid->insertMeta(metaKey("default_color"), openvdb::Vec3SMetadata(strands.defaults.color));
+    grid->insertMeta("vdbhair_strand_count", openvdb::Int64Metadata(std::int64_t(strands.numStrands())));
+    grid->insertMeta("vdbhair_position_codec", openvdb::StringMetadata(positionCodecName(opts.codec)));
     return grid;
 }
 
@@ -130,12 +173,16 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
                               "' attribute; a vdbhair strands grid has P, strand and vertex");
         }
     }
-    auto checkType = [&](const char* name, const char* type) {
+    auto checkType = [&](const char* name) {
         const std::string got = desc.valueType(desc.find(name));
-        if (got != type) throw FormatError(where + ": attribute '" + std::string(name) + "' has type " + got + ", expected " + type);
+        if (!WholeNumberAttribute::supports(got)) {
+            throw FormatError(where + ": attribute '" + std::string(name) + "' has type " + got +
+                              "; strand and vertex must be integers (int16, int32, int64) or floats (float, double) holding whole numbers");
+        }
     };
-    checkType("strand", "int32");
-    checkType("vertex", "int32");
+    checkType("strand");
+    checkType("vertex");
+    const std::string typeS = desc.valueType(desc.find("strand")), typeV = desc.valueType(desc.find("vertex"));
     const std::size_t iP = desc.find("P"), iS = desc.find("strand"), iV = desc.find("vertex");
     const std::size_t iCd = desc.find("Cd"), iW = desc.find("width"), iA = desc.find("Alpha");
     const bool hasCd = iCd != pts::AttributeSet::INVALID_POS && desc.valueType(iCd) == "vec3s";
@@ -144,10 +191,10 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
 
     // The declared strand count must be possible before anything is sized by it.
     std::int64_t declared = -1;
-    if (const auto meta = grid.getMetadata<openvdb::Int64Metadata>("vdbhair:strand_count")) {
+    if (const auto meta = findVdbhairMeta<openvdb::Int64Metadata>(grid, "strand_count")) {
         declared = meta->value();
         if (declared < 0 || std::uint64_t(declared) > nPoints) {
-            throw FormatError(where + ": metadata vdbhair:strand_count " + std::to_string(declared) +
+            throw FormatError(where + ": metadata vdbhair_strand_count " + std::to_string(declared) +
                               " is impossible for " + std::to_string(nPoints) + " points");
         }
     }
@@ -160,7 +207,7 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
     std::int64_t maxStrand = -1;
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
         pts::AttributeHandle<openvdb::Vec3f> hP(leaf->constAttributeArray(iP));
-        pts::AttributeHandle<std::int32_t> hS(leaf->constAttributeArray(iS)), hV(leaf->constAttributeArray(iV));
+        const WholeNumberAttribute hS(leaf->constAttributeArray(iS), typeS), hV(leaf->constAttributeArray(iV), typeV);
         std::unique_ptr<pts::AttributeHandle<openvdb::Vec3f>> hCd;
         std::unique_ptr<pts::AttributeHandle<float>> hW, hA;
         if (hasCd) hCd.reset(new pts::AttributeHandle<openvdb::Vec3f>(leaf->constAttributeArray(iCd)));
@@ -170,14 +217,26 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
             const openvdb::Vec3d ijk = it.getCoord().asVec3d();
             const openvdb::Vec3d world = grid.transform().indexToWorld(ijk + hP.get(*it));
             pos[k] = Vec3f(float(world.x()), float(world.y()), float(world.z()));
-            sid[k] = hS.get(*it);
-            vid[k] = hV.get(*it);
+            const double sv = hS.get(*it), vv = hV.get(*it);
+            const std::pair<const char*, double> checks[] = {{"strand", sv}, {"vertex", vv}};
+            for (const auto& [name, value] : checks) {
+                if (!std::isfinite(value) || value != std::floor(value)) {
+                    std::ostringstream v;
+                    v.precision(9);
+                    v << value;
+                    throw FormatError(where + ": a point in voxel " + toString(it.getCoord()) + " has " + name + " " + v.str() +
+                                      "; strand and vertex must hold whole numbers");
+                }
+            }
+            const double limit = double(declared >= 0 ? declared : std::int64_t(nPoints));
+            sid[k] = (sv >= 0.0 && sv < limit) ? std::int32_t(sv) : -1;
+            vid[k] = (vv >= 0.0 && vv < double(nPoints)) ? std::int32_t(vv) : -1;
             if (hasCd) cd[k] = hCd->get(*it);
             if (hasW) width[k] = hW->get(*it);
             if (hasA) alpha[k] = hA->get(*it);
             if (sid[k] < 0 || sid[k] >= (declared >= 0 ? declared : std::int64_t(nPoints)) || vid[k] < 0 || std::uint64_t(vid[k]) >= nPoints) {
-                throw FormatError(where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + std::to_string(sid[k]) +
-                                  " and vertex " + std::to_string(vid[k]) + "; strand must be in [0, " +
+                throw FormatError(where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + std::to_string(std::int64_t(sv)) +
+                                  " and vertex " + std::to_string(std::int64_t(vv)) + "; strand must be in [0, " +
                                   std::to_string(declared >= 0 ? declared : std::int64_t(nPoints)) +
                                   ") and vertex in [0, " + std::to_string(nPoints) + ")");
             }
@@ -208,6 +267,9 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
 
     StrandSet out;
     out.reserve(nS, nPoints);
+    if (const auto m = findVdbhairMeta<openvdb::FloatMetadata>(grid, "default_thickness")) out.defaults.thickness = m->value();
+    if (const auto m = findVdbhairMeta<openvdb::FloatMetadata>(grid, "default_transparency")) out.defaults.transparency = m->value();
+    if (const auto m = findVdbhairMeta<openvdb::Vec3SMetadata>(grid, "default_color")) out.defaults.color = m->value();
     ShortStrandFilter filter(opts, report, where);
     for (std::size_t s = 0; s < nS; ++s) {
         if (!filter.keep(s, count[s], "grid '" + grid.getName() + "'")) continue;

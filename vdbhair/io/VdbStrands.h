@@ -6,8 +6,16 @@
 /// `vertex` (the index along the strand, 0 at the root) — OpenVDB reorders points spatially, so
 /// topology is explicit — a group `root` holding each strand's first vertex, and when the set has
 /// them `Cd` (vec3f colour), `width` (float thickness) and `Alpha` (float, 1 - transparency),
-/// named as Houdini names them. Grid metadata: `vdbhair:strand_count` (int64), `creator`,
-/// `vdbhair:position_codec`.
+/// named as Houdini names them. Grid class `unknown`; metadata `creator`, `vdbhair_strand_count`
+/// (int64), `vdbhair_position_codec`, and the per-vertex defaults (cyHair's header)
+/// `vdbhair_default_thickness`, `vdbhair_default_transparency` (floats) and
+/// `vdbhair_default_color` (vec3s), so `.hair -> .vdb -> .hair` keeps them. Keys are valid
+/// Houdini attribute names (MetaKeys.h); the older `vdbhair:` keys are read too.
+///
+/// Reading accepts points made elsewhere: `strand` and `vertex` may be int16, int32, int64,
+/// float or double (Houdini writes int64 for `i@strand`, float for a bare `@strand`) as long as
+/// they hold whole numbers; the first value that is not one is an error naming it. Without
+/// `vdbhair_strand_count`, the strand count is one more than the highest `strand`.
 ///
 /// Position precision: with the default `float` codec (OpenVDB's NullCodec) P is stored as a
 /// 32-bit float offset from its voxel's centre, so a position round-trips to within about

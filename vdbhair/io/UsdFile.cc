@@ -1,0 +1,556 @@
+#include "UsdFile.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Version.h>
+#include <vdbhair/io/FileUtil.h>
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+
+namespace vdbhair {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Tokens of the USD text format: punctuation, identifiers (with ':' '.' and a trailing "[]"),
+// numbers, strings, paths <...> and asset paths @...@; '#' starts a comment.
+
+enum class Tok { End, Punct, Word, Number, String, Path };
+
+struct Token
+{
+    Tok kind = Tok::End;
+    std::string_view text;  ///< the characters (a string's without its quotes)
+    double number = 0.0;
+    std::size_t line = 0;
+};
+
+class UsdLexer
+{
+public:
+    UsdLexer(const std::vector<char>& bytes, std::string where) : mData(bytes.data()), mSize(bytes.size()), mWhere(std::move(where))
+    {
+        // The magic line.
+        static const char kMagic[] = "#usda";
+        if (mSize < 5 || std::memcmp(mData, kMagic, 5) != 0) {
+            throw FormatError(mWhere + ": line 1: not a USD text file: it must start with '#usda 1.0'"
+                              " (binary .usdc files are not read)");
+        }
+        while (mPos < mSize && mData[mPos] != '\n') ++mPos;
+        advance();
+    }
+
+    const Token& peek() const { return mTok; }
+    Token next()
+    {
+        Token t = mTok;
+        advance();
+        return t;
+    }
+    bool isPunct(char c) const { return mTok.kind == Tok::Punct && mTok.text[0] == c; }
+    bool isWord(std::string_view w) const { return mTok.kind == Tok::Word && mTok.text == w; }
+    void expect(char c, const std::string& context)
+    {
+        if (!isPunct(c)) fail(std::string("expected '") + c + "' " + context + ", found " + describe(mTok));
+        advance();
+    }
+    [[noreturn]] void fail(const std::string& msg) const
+    {
+        throw FormatError(mWhere + ": line " + std::to_string(mTok.line) + ": " + msg);
+    }
+    static std::string describe(const Token& t)
+    {
+        switch (t.kind) {
+        case Tok::End: return "the end of the file";
+        case Tok::String: return "the string \"" + std::string(t.text.substr(0, 40)) + "\"";
+        default: return "'" + std::string(t.text.substr(0, 40)) + "'";
+        }
+    }
+    const std::string& where() const { return mWhere; }
+
+private:
+    static bool isWordStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+    static bool isWordChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':' || c == '.'; }
+
+    void advance()
+    {
+        // Skip blanks and comments, counting lines.
+        for (;;) {
+            while (mPos < mSize && std::isspace(static_cast<unsigned char>(mData[mPos]))) {
+                if (mData[mPos] == '\n') ++mLine;
+                ++mPos;
+            }
+            if (mPos < mSize && mData[mPos] == '#') {
+                while (mPos < mSize && mData[mPos] != '\n') ++mPos;
+                continue;
+            }
+            break;
+        }
+        mTok = Token{};
+        mTok.line = mLine;
+        if (mPos >= mSize) return;
+        const char c = mData[mPos];
+        const std::size_t start = mPos;
+        if (c == '"' || c == '\'') {
+            const bool triple = mPos + 2 < mSize && mData[mPos + 1] == c && mData[mPos + 2] == c;
+            const std::size_t q = triple ? 3 : 1;
+            mPos += q;
+            const std::size_t body = mPos;
+            for (;;) {
+                if (mPos >= mSize) {
+                    mTok.line = mLine;
+                    fail("a string that starts on this line never ends");
+                }
+                if (mData[mPos] == '\\') { mPos += 2; continue; }
+                if (mData[mPos] == '\n') ++mLine;
+                if (mData[mPos] == c && (!triple || (mPos + 2 < mSize && mData[mPos + 1] == c && mData[mPos + 2] == c))) break;
+                ++mPos;
+            }
+            mTok.kind = Tok::String;
+            mTok.text = std::string_view(mData + body, mPos - body);
+            mPos += q;
+            return;
+        }
+        if (c == '<' || c == '@') {
+            const char close = c == '<' ? '>' : '@';
+            ++mPos;
+            while (mPos < mSize && mData[mPos] != close && mData[mPos] != '\n') ++mPos;
+            if (mPos >= mSize || mData[mPos] != close) fail(std::string("a ") + (c == '<' ? "path <...>" : "asset path @...@") + " is not closed on its line");
+            ++mPos;
+            mTok.kind = Tok::Path;
+            mTok.text = std::string_view(mData + start, mPos - start);
+            return;
+        }
+        if (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.') {
+            std::size_t p = mPos;
+            if (mData[p] == '+') ++p;
+            double v = 0.0;
+            const auto res = std::from_chars(mData + p, mData + mSize, v);
+            if (res.ec == std::errc() && res.ptr > mData + p) {
+                mPos = std::size_t(res.ptr - mData);
+                mTok.kind = Tok::Number;
+                mTok.number = v;
+                mTok.text = std::string_view(mData + start, mPos - start);
+                return;
+            }
+            if (c == '-' && mPos + 1 < mSize && isWordStart(mData[mPos + 1])) {  // -inf
+                ++mPos;
+                while (mPos < mSize && isWordChar(mData[mPos])) ++mPos;
+                mTok.kind = Tok::Number;
+                mTok.text = std::string_view(mData + start, mPos - start);
+                mTok.number = mTok.text == "-inf" ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::quiet_NaN();
+                return;
+            }
+        }
+        if (isWordStart(c)) {
+            while (mPos < mSize && isWordChar(mData[mPos])) ++mPos;
+            if (mPos + 1 < mSize && mData[mPos] == '[' && mData[mPos + 1] == ']') mPos += 2;  // int[], point3f[]
+            mTok.kind = Tok::Word;
+            mTok.text = std::string_view(mData + start, mPos - start);
+            if (mTok.text == "inf" || mTok.text == "nan") {
+                mTok.kind = Tok::Number;
+                mTok.number = mTok.text == "inf" ? std::numeric_limits<double>::infinity() : std::numeric_limits<double>::quiet_NaN();
+            }
+            return;
+        }
+        if (std::strchr("()[]{}=,:;", c)) {
+            ++mPos;
+            mTok.kind = Tok::Punct;
+            mTok.text = std::string_view(mData + start, 1);
+            return;
+        }
+        mTok.line = mLine;
+        fail(std::string("unexpected character '") + c + "'");
+    }
+
+    const char* mData;
+    std::size_t mSize, mPos = 0, mLine = 1;
+    std::string mWhere;
+    Token mTok;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Values, flattened: every number in order, every string or word, how many top-level elements.
+
+struct FlatValue
+{
+    std::vector<double> numbers;
+    std::vector<std::string> words;
+    std::size_t elements = 0;  ///< top-level array elements (1 for a scalar)
+    bool array = false;
+    std::size_t line = 0;
+};
+
+void parseValueInto(UsdLexer& lex, FlatValue& v, int depth)
+{
+    const Token& t = lex.peek();
+    if (t.kind == Tok::Number) { v.numbers.push_back(lex.next().number); return; }
+    if (t.kind == Tok::String || t.kind == Tok::Word || t.kind == Tok::Path) { v.words.emplace_back(lex.next().text); return; }
+    if (t.kind == Tok::Punct && (t.text[0] == '[' || t.text[0] == '(' || t.text[0] == '{')) {
+        const char open = t.text[0];
+        const char close = open == '[' ? ']' : open == '(' ? ')' : '}';
+        lex.next();
+        std::size_t count = 0;
+        while (!lex.isPunct(close)) {
+            if (lex.peek().kind == Tok::End) lex.fail(std::string("a value that opens with '") + open + "' is not closed");
+            parseValueInto(lex, v, depth + 1);
+            ++count;
+            if (open == '{' && lex.isPunct(':')) { lex.next(); parseValueInto(lex, v, depth + 1); }  // time samples
+            if (lex.isPunct(',')) lex.next();
+            else if (!lex.isPunct(close)) lex.fail(std::string("expected ',' or '") + close + "' in a value, found " + UsdLexer::describe(lex.peek()));
+        }
+        lex.next();
+        if (depth == 0) {
+            v.array = open == '[';
+            v.elements = open == '[' ? count : 1;
+        }
+        return;
+    }
+    lex.fail("expected a value, found " + UsdLexer::describe(t));
+}
+
+FlatValue parseValue(UsdLexer& lex)
+{
+    FlatValue v;
+    v.line = lex.peek().line;
+    parseValueInto(lex, v, 0);
+    if (!v.array) v.elements = 1;
+    return v;
+}
+
+/// `( key = value ... )` metadata: the simple entries (a string, word or number), by key.
+std::map<std::string, FlatValue> parseMetadata(UsdLexer& lex)
+{
+    std::map<std::string, FlatValue> out;
+    lex.expect('(', "to open metadata");
+    while (!lex.isPunct(')')) {
+        if (lex.peek().kind == Tok::End) lex.fail("metadata that opens with '(' is not closed");
+        if (lex.peek().kind == Tok::String) { lex.next(); continue; }  // a bare doc string
+        // [prepend|append|add|delete|reorder] key = value
+        std::string key;
+        while (lex.peek().kind == Tok::Word) key = std::string(lex.next().text);
+        if (key.empty()) lex.fail("expected a metadata key, found " + UsdLexer::describe(lex.peek()));
+        lex.expect('=', "after metadata key '" + key + "'");
+        out[key] = parseValue(lex);
+        if (lex.isPunct(';') || lex.isPunct(',')) lex.next();
+    }
+    lex.next();
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// A BasisCurves prim's properties.
+
+struct Property
+{
+    FlatValue value;
+    std::string interpolation;
+    bool hasValue = false;
+};
+
+struct CurvesPrim
+{
+    std::string name;
+    std::size_t line = 0;
+    std::map<std::string, Property> props;
+};
+
+struct UsdDocument
+{
+    std::vector<CurvesPrim> curves;
+    std::string upAxis;
+    std::size_t xformOps = 0, timeSamples = 0;
+};
+
+void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves);
+
+void parsePrim(UsdLexer& lex, UsdDocument& doc)
+{
+    const Token spec = lex.next();  // def, over, class
+    std::string type;
+    if (lex.peek().kind == Tok::Word) type = std::string(lex.next().text);
+    if (lex.peek().kind != Tok::String) lex.fail("expected the prim's name in quotes after '" + std::string(spec.text) + "', found " + UsdLexer::describe(lex.peek()));
+    const Token name = lex.next();
+    if (lex.isPunct('(')) parseMetadata(lex);
+    lex.expect('{', "to open the body of prim \"" + std::string(name.text) + "\"");
+    if (spec.text == "def" && type == "BasisCurves") {
+        CurvesPrim prim;
+        prim.name = std::string(name.text);
+        prim.line = name.line;
+        parsePrimBody(lex, doc, &prim);
+        doc.curves.push_back(std::move(prim));
+    } else {
+        parsePrimBody(lex, doc, nullptr);
+    }
+}
+
+void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves)
+{
+    while (!lex.isPunct('}')) {
+        const Token& t = lex.peek();
+        if (t.kind == Tok::End) lex.fail("a prim's body is not closed with '}'");
+        if (t.kind == Tok::Punct && t.text[0] == ';') { lex.next(); continue; }
+        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) { parsePrim(lex, doc); continue; }
+        if (lex.isWord("variantSet")) {  // variantSet "name" = { "a" { ... } }
+            lex.next();
+            lex.next();
+            lex.expect('=', "after variantSet's name");
+            lex.expect('{', "to open a variantSet");
+            while (!lex.isPunct('}')) {
+                if (lex.peek().kind != Tok::String) lex.fail("expected a variant name, found " + UsdLexer::describe(lex.peek()));
+                lex.next();
+                if (lex.isPunct('(')) parseMetadata(lex);
+                lex.expect('{', "to open a variant");
+                parsePrimBody(lex, doc, nullptr);
+            }
+            lex.next();
+            continue;
+        }
+        if (t.kind != Tok::Word) lex.fail("expected a property or a prim, found " + UsdLexer::describe(t));
+        // [custom] [uniform|varying] TYPE NAME [= VALUE] [(METADATA)], or rel NAME [= TARGET]
+        while (lex.isWord("custom") || lex.isWord("uniform") || lex.isWord("varying") || lex.isWord("config")) lex.next();
+        std::string name;
+        if (lex.isWord("rel")) {
+            lex.next();
+        } else {
+            if (lex.peek().kind != Tok::Word) lex.fail("expected a property type, found " + UsdLexer::describe(lex.peek()));
+            lex.next();
+        }
+        if (lex.peek().kind != Tok::Word) lex.fail("expected a property name, found " + UsdLexer::describe(lex.peek()));
+        name = std::string(lex.next().text);
+        Property prop;
+        if (lex.isPunct('=')) {
+            lex.next();
+            prop.value = parseValue(lex);
+            prop.hasValue = true;
+        }
+        if (lex.isPunct('(')) {
+            const auto meta = parseMetadata(lex);
+            if (const auto it = meta.find("interpolation"); it != meta.end() && !it->second.words.empty()) prop.interpolation = it->second.words[0];
+        }
+        const auto suffix = [&](const char* s) { return name.size() > std::strlen(s) && name.compare(name.size() - std::strlen(s), std::string::npos, s) == 0; };
+        if (suffix(".timeSamples")) { ++doc.timeSamples; continue; }
+        if (suffix(".connect")) continue;
+        if (name.rfind("xformOp:", 0) == 0) ++doc.xformOps;
+        if (curves) curves->props[name] = std::move(prop);
+    }
+    lex.next();
+}
+
+UsdDocument parseUsda(const std::vector<char>& bytes, const std::string& where)
+{
+    UsdLexer lex(bytes, where);
+    UsdDocument doc;
+    if (lex.isPunct('(')) {
+        const auto meta = parseMetadata(lex);
+        if (const auto it = meta.find("upAxis"); it != meta.end() && !it->second.words.empty()) doc.upAxis = it->second.words[0];
+    }
+    while (lex.peek().kind != Tok::End) {
+        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) parsePrim(lex, doc);
+        else lex.fail("expected a prim (def, over or class), found " + UsdLexer::describe(lex.peek()));
+    }
+    return doc;
+}
+
+} // namespace
+
+StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    const std::string where = "readUsda(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
+    const UsdDocument doc = parseUsda(bytes, where);
+    if (doc.curves.empty()) {
+        throw FormatError(where + ": no strands: the file has no 'def BasisCurves' prim");
+    }
+    auto warn = [&](const std::string& w) { if (report) report->warnings.push_back(where + ": " + w); };
+    if (doc.upAxis == "Z") warn("the stage's upAxis is Z; coordinates are kept as they are (render with --up z)");
+    if (doc.xformOps) warn(std::to_string(doc.xformOps) + " xformOp(s) of BasisCurves prims were not applied: points are read in the prim's own space");
+    if (doc.timeSamples) warn(std::to_string(doc.timeSamples) + " time-sampled attribute(s) were ignored; only default values are read");
+
+    StrandSet out;
+    ShortStrandFilter filter(opts, report, where);
+    std::size_t strandIndex = 0;
+    bool first = true;
+    for (const CurvesPrim& prim : doc.curves) {
+        const std::string at = "prim \"" + prim.name + "\" (line " + std::to_string(prim.line) + ")";
+        auto find = [&](const char* name) -> const Property* {
+            const auto it = prim.props.find(name);
+            return it != prim.props.end() && it->second.hasValue ? &it->second : nullptr;
+        };
+        const Property* type = find("type");
+        if (type && !type->value.words.empty() && type->value.words[0] != "linear") {
+            warn(at + ": type \"" + type->value.words[0] + "\": its control points are read as a linear polyline");
+        }
+        const Property* counts = find("curveVertexCounts");
+        const Property* points = find("points");
+        if (!counts) throw FormatError(where + ": " + at + ": BasisCurves without curveVertexCounts");
+        if (!points) throw FormatError(where + ": " + at + ": BasisCurves without points");
+        const std::vector<double>& n = counts->value.numbers;
+        const std::vector<double>& p = points->value.numbers;
+        if (p.size() % 3 != 0 || (points->value.array && points->value.elements * 3 != p.size())) {
+            throw FormatError(where + ": line " + std::to_string(points->value.line) + ": " + at + ": points must be (x, y, z) triples");
+        }
+        const std::size_t nP = p.size() / 3, nC = n.size();
+        std::uint64_t sum = 0;
+        for (std::size_t i = 0; i < nC; ++i) {
+            if (!(n[i] >= 0.0) || n[i] != std::floor(n[i]) || n[i] > 4294967295.0) {
+                throw FormatError(where + ": line " + std::to_string(counts->value.line) + ": " + at + ": curveVertexCounts[" +
+                                  std::to_string(i) + "] is " + std::to_string(n[i]) + "; counts must be whole numbers of at least 0");
+            }
+            sum += std::uint64_t(n[i]);
+        }
+        if (sum != nP) {
+            throw FormatError(where + ": line " + std::to_string(counts->value.line) + ": " + at + ": curveVertexCounts add up to " +
+                              std::to_string(sum) + " but there are " + std::to_string(nP) + " points");
+        }
+        // A primvar as per-vertex values of @a arity components (empty: constant, into @a constant).
+        auto perVertex = [&](const char* name, std::size_t arity, std::vector<float>& values, float* constant) {
+            values.clear();
+            const Property* prop = find(name);
+            if (!prop) return false;
+            const std::vector<double>& v = prop->value.numbers;
+            const std::string interp = prop->interpolation.empty() ? (std::strcmp(name, "widths") == 0 ? "vertex" : "constant") : prop->interpolation;
+            const std::string line = "line " + std::to_string(prop->value.line);
+            if (interp == "constant") {
+                if (v.size() != arity) throw FormatError(where + ": " + line + ": " + at + ": constant " + name + " needs " + std::to_string(arity) + " number(s), got " + std::to_string(v.size()));
+                for (std::size_t c = 0; c < arity; ++c) constant[c] = float(v[c]);
+                return true;
+            }
+            if (interp == "uniform") {
+                if (v.size() != arity * nC) throw FormatError(where + ": " + line + ": " + at + ": uniform " + name + " needs one value per curve (" + std::to_string(nC) + "), got " + std::to_string(v.size() / arity));
+                values.resize(arity * nP);
+                std::size_t k = 0;
+                for (std::size_t i = 0; i < nC; ++i)
+                    for (std::size_t j = 0; j < std::size_t(n[i]); ++j, ++k)
+                        for (std::size_t c = 0; c < arity; ++c) values[arity * k + c] = float(v[arity * i + c]);
+                return true;
+            }
+            if (interp == "vertex" || interp == "varying") {
+                if (v.size() != arity * nP) throw FormatError(where + ": " + line + ": " + at + ": " + interp + " " + name + " needs one value per point (" + std::to_string(nP) + "), got " + std::to_string(v.size() / arity));
+                values.resize(v.size());
+                for (std::size_t k = 0; k < v.size(); ++k) values[k] = float(v[k]);
+                return true;
+            }
+            throw FormatError(where + ": " + line + ": " + at + ": " + name + " has interpolation \"" + interp + "\"; expected constant, uniform, vertex or varying");
+        };
+        StrandDefaults defaults = out.defaults;
+        std::vector<float> widths, colors, opacity;
+        float opacityConstant = 1.f - defaults.transparency;
+        perVertex("widths", 1, widths, &defaults.thickness);
+        perVertex("primvars:displayColor", 3, colors, &defaults.color[0]);
+        if (perVertex("primvars:displayOpacity", 1, opacity, &opacityConstant) && opacity.empty()) defaults.transparency = 1.f - opacityConstant;
+        // vdbhair's own record of the defaults (exact, and kept when the arrays are per vertex).
+        if (const Property* d = find("vdbhair_default_thickness"); d && d->value.numbers.size() == 1) defaults.thickness = float(d->value.numbers[0]);
+        if (const Property* d = find("vdbhair_default_transparency"); d && d->value.numbers.size() == 1) defaults.transparency = float(d->value.numbers[0]);
+        if (const Property* d = find("vdbhair_default_color"); d && d->value.numbers.size() == 3) {
+            defaults.color = Vec3f(float(d->value.numbers[0]), float(d->value.numbers[1]), float(d->value.numbers[2]));
+        }
+        if (first) out.defaults = defaults;
+        first = false;
+
+        // Strands, with the attributes where this prim has them (defaults elsewhere).
+        StrandSet part;
+        part.defaults = out.defaults;
+        std::size_t v0 = 0;
+        for (std::size_t i = 0; i < nC; ++i) {
+            const std::size_t cnt = std::size_t(n[i]);
+            for (std::size_t k = v0; k < v0 + cnt; ++k) {
+                const Vec3f q(float(p[3 * k]), float(p[3 * k + 1]), float(p[3 * k + 2]));
+                checkFinite(q, k, where, at);
+            }
+            if (filter.keep(strandIndex++, cnt, at + ", curve " + std::to_string(i))) {
+                for (std::size_t k = v0; k < v0 + cnt; ++k) {
+                    part.positions.emplace_back(float(p[3 * k]), float(p[3 * k + 1]), float(p[3 * k + 2]));
+                    if (!widths.empty()) part.thickness.push_back(widths[k]);
+                    if (!colors.empty()) part.color.emplace_back(colors[3 * k], colors[3 * k + 1], colors[3 * k + 2]);
+                    if (!opacity.empty()) part.transparency.push_back(1.f - opacity[k]);
+                }
+                part.offsets.push_back(std::uint32_t(part.positions.size()));
+            }
+            v0 += cnt;
+        }
+        if (out.empty()) {
+            out = std::move(part);
+        } else {
+            out.append(part);
+        }
+    }
+    filter.finish();
+    return out;
+}
+
+void writeUsda(const std::string& path, const StrandSet& strands, const UsdWriteOptions& opts)
+{
+    const std::string where = "writeUsda(" + path + ")";
+    if (strands.empty()) throw ValueError(where + ": the hairstyle has no strands; there is nothing to write");
+    if (opts.upAxis != "Y" && opts.upAxis != "Z") throw ValueError(where + ": up axis '" + opts.upAxis + "' must be Y or Z (USD's choices)");
+    if (!(opts.metersPerUnit > 0.0) || !std::isfinite(opts.metersPerUnit)) {
+        throw ValueError(where + ": metersPerUnit " + std::to_string(opts.metersPerUnit) + " must be positive and finite");
+    }
+    const std::size_t nV = strands.numVertices(), nS = strands.numStrands();
+    std::string out;
+    out.reserve(64 * nV + 8 * nS + 1024);
+    char buf[64];
+    auto num = [&](double v, bool isFloat = true) {
+        const auto res = isFloat ? std::to_chars(buf, buf + sizeof buf, float(v)) : std::to_chars(buf, buf + sizeof buf, v);
+        out.append(buf, res.ptr);
+    };
+    auto vec3 = [&](const Vec3f& v) {
+        out += '(';
+        num(v.x()); out += ", "; num(v.y()); out += ", "; num(v.z());
+        out += ')';
+    };
+    out += "#usda 1.0\n(\n    defaultPrim = \"hair\"\n    doc = \"";
+    out += creatorString();
+    out += ": " + std::to_string(nS) + " strands, " + std::to_string(nV) + " vertices, root to tip\"\n    metersPerUnit = ";
+    num(opts.metersPerUnit, false);
+    out += "\n    upAxis = \"" + opts.upAxis + "\"\n)\n\n";
+    out += "def BasisCurves \"hair\"\n{\n";
+    out += "    uniform token type = \"linear\"\n";
+    out += "    uniform token wrap = \"nonperiodic\"\n";
+    out += "    int[] curveVertexCounts = [";
+    for (std::size_t i = 0; i < nS; ++i) {
+        if (i) out += ", ";
+        out += std::to_string(strands.size(i));
+    }
+    out += "]\n    point3f[] points = [";
+    for (std::size_t v = 0; v < nV; ++v) {
+        if (v) out += ", ";
+        vec3(strands.positions[v]);
+    }
+    out += "]\n";
+    // Widths, colour and opacity: per vertex where the set has them, else its defaults, constant.
+    out += "    float[] widths = [";
+    if (strands.thickness.empty()) num(strands.defaults.thickness);
+    else for (std::size_t v = 0; v < nV; ++v) { if (v) out += ", "; num(strands.thickness[v]); }
+    out += std::string("] (\n        interpolation = \"") + (strands.thickness.empty() ? "constant" : "vertex") + "\"\n    )\n";
+    out += "    color3f[] primvars:displayColor = [";
+    if (strands.color.empty()) vec3(strands.defaults.color);
+    else for (std::size_t v = 0; v < nV; ++v) { if (v) out += ", "; vec3(strands.color[v]); }
+    out += std::string("] (\n        interpolation = \"") + (strands.color.empty() ? "constant" : "vertex") + "\"\n    )\n";
+    out += "    float[] primvars:displayOpacity = [";
+    if (strands.transparency.empty()) num(1.f - strands.defaults.transparency);
+    else for (std::size_t v = 0; v < nV; ++v) { if (v) out += ", "; num(1.f - strands.transparency[v]); }
+    out += std::string("] (\n        interpolation = \"") + (strands.transparency.empty() ? "constant" : "vertex") + "\"\n    )\n";
+    // The defaults themselves (cyHair's header), exactly, whether or not the arrays are per vertex.
+    out += "    custom float vdbhair_default_thickness = ";
+    num(strands.defaults.thickness);
+    out += "\n    custom float vdbhair_default_transparency = ";
+    num(strands.defaults.transparency);
+    out += "\n    custom color3f vdbhair_default_color = ";
+    vec3(strands.defaults.color);
+    out += "\n";
+    const BBox box = computeBBox(strands);
+    out += "    float3[] extent = [";
+    vec3(box.min);
+    out += ", ";
+    vec3(box.max);
+    out += "]\n}\n";
+    writeFileAtomic(path, out, where);
+}
+
+} // namespace vdbhair
