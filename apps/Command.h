@@ -112,6 +112,8 @@ Command addGrowCommand(CLI::App& app, CommonOptions& common);
 Command addRenderCommand(CLI::App& app, CommonOptions& common);
 Command addFitCommand(CLI::App& app, CommonOptions& common);
 Command addInspectCommand(CLI::App& app, CommonOptions& common);
+Command addScalpCommand(CLI::App& app, CommonOptions& common);
+Command addRootsCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line, 130 interrupted
