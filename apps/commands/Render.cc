@@ -79,7 +79,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
         printJson({{"output", p.output}, {"width", image.width}, {"height", image.height}, {"strands", strands.numStrands()},
                    {"view", p.sheet ? "sheet" : p.view}, {"seconds", seconds}});
     } else if (!common.quiet) {
-        std::cout << "rendered " << strands.numStrands() << (rootsInput ? " roots (" : " strands (")" << (p.sheet ? std::string("sheet") : p.view) << ", "
+        std::cout << "rendered " << strands.numStrands() << (rootsInput ? " roots (" : " strands (") << (p.sheet ? std::string("sheet") : p.view) << ", "
                   << image.width << "x" << image.height << ") in " << seconds << " s\nwrote " << p.output << "\n";
     }
     return 0;

@@ -24,6 +24,7 @@ struct RootsCmdParams
     CLI::Option* spacingOpt = nullptr;
     std::uint64_t seed = 0;
     int iterations = 200;
+    double stepScale = 0.5;
     bool noRegion = false;
 };
 
@@ -42,6 +43,7 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     if (spacingGiven) fp.spacing = p.spacing;
     fp.seed = p.seed;
     fp.maxIterations = p.iterations;
+    fp.stepScale = p.stepScale;
     fp.up = axisFromName(p.up, "--up");
 
     openvdb::FloatGrid::Ptr surface;
@@ -103,6 +105,7 @@ Command addRootsCommand(CLI::App& app, CommonOptions& common)
     params->spacingOpt = sub->add_option("--spacing", params->spacing, "Target nearest-neighbour spacing in world units (instead of --count)");
     sub->add_option("--seed", params->seed, "Random seed of the initial placement")->capture_default_str();
     sub->add_option("--iterations", params->iterations, "Most relaxation iterations")->capture_default_str();
+    sub->add_option("--step-scale", params->stepScale, "Relaxation step as a multiple of sigma^2 times the energy gradient")->capture_default_str();
     sub->add_option("--up", params->up, "Reference axis of the tangent frame: x, y, z, -x, -y or -z")->capture_default_str();
     sub->add_flag("--no-region", params->noRegion, "Ignore the file's 'region' grid: roots over the whole surface");
     addCommonOptions(sub, common);

@@ -58,3 +58,4 @@ open("coplanar.ply", "w").write(hdr % 6 + "".join("%d %d 2 0 0 1\n" % (i % 3, i 
 PY
 : > empty_mesh.obj
 printf 'ply\nformat ascii 1.0\nelement vertex 0\nend_header\n' > existing_roots.ply
+"$bin" roots scalp_sphere.vdb -o roots.ply --count 500 --quiet
