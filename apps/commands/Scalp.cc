@@ -117,8 +117,11 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
             // Default: twice the roots' mean nearest-neighbour spacing, so the region has no gaps.
             radius = std::max(2.0 * measureFollicles(roots).nnMean, 2.0 * surface->voxelSize().x());
         }
+        // Roots farther from the scalp than a tenth of its size belong to another head.
+        const openvdb::CoordBBox ib = surface->evalActiveVoxelBoundingBox();
+        const double maxDistance = 0.1 * (surface->indexToWorld(ib.max()) - surface->indexToWorld(ib.min())).length();
         const Stage stage(common, "region from the roots of " + p.region);
-        region = regionFromRoots(*surface, roots, radius, p.region);
+        region = regionFromRoots(*surface, roots, radius, p.region, std::uint64_t(1) << 28, maxDistance);
         grids.push_back(region);
         detail["region"] = {{"roots", roots.size()}, {"radius", radius}, {"active_voxels", region->activeVoxelCount()}};
     }

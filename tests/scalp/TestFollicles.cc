@@ -128,7 +128,7 @@ TEST_CASE("sampleFollicles: bad counts and regions", "[scalp]")
     fp.count = 0;
     fp.spacing = 1e-6;
     CHECK_THROWS_WITH(sampleFollicles(g, nullptr, fp), Contains("more than the cap"));
-    CHECK_THROWS_AS(regionFromRoots(*g, {Vec3f(50.f, 0.f, 0.f)}, 0.3), LookupError);
+    CHECK_THROWS_AS(regionFromRoots(*g, {Vec3f(50.f, 0.f, 0.f)}, 0.3, "far", std::uint64_t(1) << 28, 5.0), LookupError);
     CHECK_THROWS_AS(regionFromRoots(*g, {}, 0.3), ValueError);
 }
 
@@ -176,7 +176,7 @@ TEST_CASE("sampleFollicles: roots on the shared heads, in the region of a hairst
             // The region covers the hairstyle's roots (projected onto the surface).
             const ScalpSampler s(g, region);
             std::size_t covered = 0;
-            for (const Vec3f& p : roots) covered += s.inRegion(s.project(Vec3d(p))) ? 1 : 0;
+            for (const Vec3f& p : projectOntoSurface(*g, roots)) covered += s.inRegion(Vec3d(p)) ? 1 : 0;
             std::cout << k.head << ": region of " << k.hair << " (radius " << radius << "): " << region->activeVoxelCount() << " voxels, covers "
                       << covered << " of " << roots.size() << " roots\n";
             CHECK(double(covered) >= 0.99 * double(roots.size()));

@@ -54,11 +54,13 @@ void checkBandEstimate(double area, double h, const ScalpParams& params, const s
     }
 }
 
-/// Whether the level set has an inside (a negative value or tile anywhere).
+/// Whether the level set has an inside with volume: a value (voxel or tile) at least 1.5 voxels
+/// deep. A flat or open sheet gets negative values only in the voxels it crosses.
 bool hasInside(const openvdb::FloatGrid& grid)
 {
+    const float deep = -1.5f * float(grid.voxelSize().x());
     for (auto it = grid.tree().cbeginValueAll(); it; ++it) {
-        if (*it < 0.f) return true;
+        if (*it <= deep) return true;
     }
     return false;
 }
