@@ -43,7 +43,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
     }
     if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
     // Roots (a PLY of points with normals, as `vdbhair roots` writes) are drawn as dots: stubs
-    // along their normals, 1/150 of the roots' extent long.
+    // along their normals, 1/60 of the roots' extent long.
     const bool rootsInput = fileExtension(p.input) == ".ply" && plyElementCount(p.input, "strand") == 0 &&
                             plyElementCount(p.input, "face") == 0;
     StrandSet strands;
@@ -53,7 +53,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
         if (roots.normals.size() != roots.size()) throw FormatError(p.input + ": the points have no normals (nx ny nz); render draws roots along them");
         BBox box;
         for (const Vec3f& q : roots.positions) box.expand(q);
-        const float len = box.extent().length() / 150.f;
+        const float len = box.extent().length() / 60.f;
         for (std::size_t i = 0; i < roots.size(); ++i) {
             strands.addStrand(std::vector<Vec3f>{roots.positions[i], roots.positions[i] + roots.normals[i] * len});
         }
