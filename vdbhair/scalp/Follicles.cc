@@ -125,6 +125,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     {
         ProgressCounter progress(interrupter, "placing roots", count, "roots");
         forRange(count, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
+            ScalpSampler::Local local(sampler);
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 Rng rng(params.seed, i, 0x5ca1b);
                 for (int attempt = 0; attempt < 32 && !placed[i]; ++attempt) {
@@ -132,8 +133,8 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                     const std::size_t c = std::min<std::size_t>(
                         std::size_t(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin()), cells.size() - 1);
                     const Vec3d jitter(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
-                    const Vec3d p = sampler.project(surface->transform().indexToWorld(cells[c].ijk.asVec3d() + jitter));
-                    if (!sampler.inRegion(p) || !(std::abs(sampler.distance(p)) < 0.01 * h)) continue;
+                    const Vec3d p = local.project(surface->transform().indexToWorld(cells[c].ijk.asVec3d() + jitter));
+                    if (!local.inRegion(p) || !(std::abs(local.distance(p)) < 0.01 * h)) continue;
                     pos[i] = p;
                     placed[i] = 1;
                 }
@@ -162,6 +163,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
         const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         forRange(count, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
             std::vector<std::pair<std::uint32_t, double>> nb;
+            ScalpSampler::Local local(sampler);
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 nb.clear();
                 tree.radiusSearch(&pos[i][0], searchR2, nb, nanoflann::SearchParams(32, 0.f, false));
@@ -172,17 +174,17 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                     f += (pos[i] - pos[j]) * std::exp(-r2 * inv2s2);  // sigma^2 * grad E
                 }
                 f *= params.stepScale;
-                const Vec3d n = sampler.normal(pos[i]);
+                const Vec3d n = local.normal(pos[i]);
                 f -= n * f.dot(n);
                 const double len = f.length();
                 if (len > maxMove) f *= maxMove / len;
                 // A move that leaves the region is halved (up to three times), else not taken.
-                Vec3d p = sampler.project(pos[i] + f);
-                for (int k = 0; k < 3 && !sampler.inRegion(p); ++k) {
+                Vec3d p = local.project(pos[i] + f);
+                for (int k = 0; k < 3 && !local.inRegion(p); ++k) {
                     f *= 0.5;
-                    p = sampler.project(pos[i] + f);
+                    p = local.project(pos[i] + f);
                 }
-                if (!sampler.inRegion(p)) p = pos[i];
+                if (!local.inRegion(p)) p = pos[i];
                 next[i] = p;
                 moved[i] = (p - pos[i]).length();
             }
@@ -203,8 +205,9 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     out.tangents.resize(count);
     const Vec3d up = params.up.length() > 0.0 ? params.up / params.up.length() : Vec3d(0, 1, 0);
     forRange(count, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
+        ScalpSampler::Local local(sampler);
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const Vec3d n = sampler.normal(pos[i]);
+            const Vec3d n = local.normal(pos[i]);
             out.positions[i] = Vec3f(pos[i]);
             out.normals[i] = Vec3f(n);
             out.tangents[i] = Vec3f(tangentFrom(n, up));

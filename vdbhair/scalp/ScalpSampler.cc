@@ -41,37 +41,59 @@ ScalpSampler::~ScalpSampler() = default;
 const openvdb::FloatGrid& ScalpSampler::surface() const { return *mImpl->surface; }
 bool ScalpSampler::hasRegion() const { return bool(mImpl->region); }
 
-double ScalpSampler::distance(const Vec3d& worldPos) const
+namespace {
+
+// The queries, over trees or accessors alike.
+template<typename SurfaceT>
+double distanceAt(const openvdb::math::Transform& xf, const SurfaceT& surface, const Vec3d& worldPos)
 {
-    const Vec3d ijk = mImpl->surface->transform().worldToIndex(worldPos);
-    return double(openvdb::tools::BoxSampler::sample(mImpl->surface->tree(), ijk));
+    return double(openvdb::tools::BoxSampler::sample(surface, xf.worldToIndex(worldPos)));
 }
 
-Vec3d ScalpSampler::normal(const Vec3d& worldPos) const
+template<typename GradientT>
+Vec3d normalAt(const openvdb::math::Transform& xf, const GradientT& gradient, const Vec3d& worldPos)
 {
-    const Vec3d ijk = mImpl->gradient->transform().worldToIndex(worldPos);
-    Vec3d g(openvdb::tools::BoxSampler::sample(mImpl->gradient->tree(), ijk));
+    Vec3d g(openvdb::tools::BoxSampler::sample(gradient, xf.worldToIndex(worldPos)));
     const double len = g.length();
     return len > 0.0 ? g / len : Vec3d(0.0);
 }
 
-Vec3d ScalpSampler::project(const Vec3d& worldPos, double tolVoxels, int maxSteps) const
+template<typename SurfaceT, typename GradientT>
+Vec3d projectFrom(const openvdb::math::Transform& xf, const SurfaceT& surface, const GradientT& gradient, const Vec3d& worldPos,
+                  double voxelSize, double maxStep, double tolVoxels, int maxSteps)
 {
     Vec3d p = worldPos;
-    const auto& xf = mImpl->surface->transform();
     for (int k = 0; k < maxSteps; ++k) {
         const Vec3d ijk = xf.worldToIndex(p);
-        const double phi = double(openvdb::tools::BoxSampler::sample(mImpl->surface->tree(), ijk));
-        if (std::abs(phi) < tolVoxels * mVoxelSize) break;
-        const Vec3d g(openvdb::tools::BoxSampler::sample(mImpl->gradient->tree(), ijk));
+        const double phi = double(openvdb::tools::BoxSampler::sample(surface, ijk));
+        if (std::abs(phi) < tolVoxels * voxelSize) break;
+        const Vec3d g(openvdb::tools::BoxSampler::sample(gradient, ijk));
         const double g2 = g.lengthSqr();
         if (!(g2 > 1e-12)) break;
         Vec3d step = g * (phi / g2);
-        const double len = step.length(), maxStep = mBackground;  // never jump past the band
-        if (len > maxStep) step *= maxStep / len;
+        const double len = step.length();
+        if (len > maxStep) step *= maxStep / len;  // never jump past the band
         p -= step;
     }
     return p;
+}
+
+} // namespace
+
+double ScalpSampler::distance(const Vec3d& worldPos) const
+{
+    return distanceAt(mImpl->surface->transform(), mImpl->surface->tree(), worldPos);
+}
+
+Vec3d ScalpSampler::normal(const Vec3d& worldPos) const
+{
+    return normalAt(mImpl->gradient->transform(), mImpl->gradient->tree(), worldPos);
+}
+
+Vec3d ScalpSampler::project(const Vec3d& worldPos, double tolVoxels, int maxSteps) const
+{
+    return projectFrom(mImpl->surface->transform(), mImpl->surface->tree(), mImpl->gradient->tree(), worldPos, mVoxelSize,
+                       mBackground, tolVoxels, maxSteps);
 }
 
 bool ScalpSampler::inRegion(const Vec3d& worldPos) const
@@ -79,6 +101,34 @@ bool ScalpSampler::inRegion(const Vec3d& worldPos) const
     if (!mImpl->region) return true;
     const openvdb::Coord c = mImpl->region->transform().worldToIndexNodeCentered(worldPos);
     return mImpl->region->tree().isValueOn(c);
+}
+
+ScalpSampler::Local::Local(const ScalpSampler& sampler)
+    : mSampler(sampler), mSurface(sampler.mImpl->surface->getConstAccessor()), mGradient(sampler.mImpl->gradient->getConstAccessor())
+{
+    if (sampler.mImpl->region) mRegion = std::make_unique<openvdb::BoolGrid::ConstAccessor>(sampler.mImpl->region->getConstAccessor());
+}
+
+double ScalpSampler::Local::distance(const Vec3d& worldPos)
+{
+    return distanceAt(mSampler.mImpl->surface->transform(), mSurface, worldPos);
+}
+
+Vec3d ScalpSampler::Local::normal(const Vec3d& worldPos)
+{
+    return normalAt(mSampler.mImpl->gradient->transform(), mGradient, worldPos);
+}
+
+Vec3d ScalpSampler::Local::project(const Vec3d& worldPos, double tolVoxels, int maxSteps)
+{
+    return projectFrom(mSampler.mImpl->surface->transform(), mSurface, mGradient, worldPos, mSampler.mVoxelSize,
+                       mSampler.mBackground, tolVoxels, maxSteps);
+}
+
+bool ScalpSampler::Local::inRegion(const Vec3d& worldPos)
+{
+    if (!mRegion) return true;
+    return mRegion->isValueOn(mSampler.mImpl->region->transform().worldToIndexNodeCentered(worldPos));
 }
 
 } // namespace vdbhair

@@ -33,6 +33,24 @@ public:
     bool inRegion(const Vec3d& worldPos) const;
     bool hasRegion() const;
 
+    /// @brief The same queries through OpenVDB value accessors (caching the last node visited):
+    /// one per thread, never shared, for loops over many nearby positions. Same results.
+    class Local
+    {
+    public:
+        explicit Local(const ScalpSampler& sampler);
+        double distance(const Vec3d& worldPos);
+        Vec3d normal(const Vec3d& worldPos);
+        Vec3d project(const Vec3d& worldPos, double tolVoxels = 1e-4, int maxSteps = 12);
+        bool inRegion(const Vec3d& worldPos);
+
+    private:
+        const ScalpSampler& mSampler;
+        openvdb::FloatGrid::ConstAccessor mSurface;
+        openvdb::Vec3SGrid::ConstAccessor mGradient;
+        std::unique_ptr<openvdb::BoolGrid::ConstAccessor> mRegion;
+    };
+
     double voxelSize() const { return mVoxelSize; }
     double halfWidthWorld() const { return mBackground; }
     const openvdb::FloatGrid& surface() const;
