@@ -80,7 +80,7 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     }
     if (common.json) {
         printJson({{"output", p.output}, {"count", f.positions.size()}, {"region", bool(region)}, {"area", f.area},
-                   {"target_spacing", f.targetSpacing}, {"iterations", f.iterations}, {"last_move", f.lastMove},
+                   {"target_spacing", f.targetSpacing}, {"iterations", f.iterations}, {"last_move", f.lastMove}, {"removed", f.removed},
                    {"spacing", {{"mean", stats.nnMean}, {"cv", stats.nnCV}, {"min", stats.nnMin}, {"max", stats.nnMax}}},
                    {"max_surface_distance_voxels", stats.maxSurfaceDistanceVoxels}, {"seconds", seconds}});
     } else if (!common.quiet) {

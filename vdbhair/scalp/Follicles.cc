@@ -178,13 +178,18 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                 f -= n * f.dot(n);
                 const double len = f.length();
                 if (len > maxMove) f *= maxMove / len;
-                // A move that leaves the region is halved (up to three times), else not taken.
+                // A move must stay in the region and land on the zero level set near where it was
+                // aimed (projection can run off where the band is thin or folded): else it is
+                // halved, up to three times, or not taken.
+                auto acceptable = [&](const Vec3d& q) {
+                    return local.inRegion(q) && std::abs(local.distance(q)) < 0.01 * h && (q - pos[i]).length() < maxMove + 2.0 * h;
+                };
                 Vec3d p = local.project(pos[i] + f);
-                for (int k = 0; k < 3 && !local.inRegion(p); ++k) {
+                for (int k = 0; k < 3 && !acceptable(p); ++k) {
                     f *= 0.5;
                     p = local.project(pos[i] + f);
                 }
-                if (!local.inRegion(p)) p = pos[i];
+                if (!acceptable(p)) p = pos[i];
                 next[i] = p;
                 moved[i] = (p - pos[i]).length();
             }
@@ -199,7 +204,29 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     progress.finish();
     out.iterations = it;
 
-    // 5. Frames.
+    // 5. Death: a particle within 0.1 d of an earlier one is removed (they have no force between
+    // them once they coincide, which projection onto thin or folded parts of a band can cause).
+    {
+        const Cloud cloud{&pos};
+        const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+        std::vector<char> alive(count, 1);
+        std::vector<std::pair<std::uint32_t, double>> nb;
+        const double r2 = (0.1 * d) * (0.1 * d);
+        for (std::size_t i = 0; i < count; ++i) {
+            nb.clear();
+            tree.radiusSearch(&pos[i][0], r2, nb, nanoflann::SearchParams(32, 0.f, false));
+            for (const auto& m : nb) {
+                if (m.first < i && alive[m.first]) { alive[i] = 0; break; }
+            }
+        }
+        std::size_t k = 0;
+        for (std::size_t i = 0; i < count; ++i) if (alive[i]) pos[k++] = pos[i];
+        out.removed = count - k;
+        pos.resize(k);
+        count = k;
+    }
+
+    // 6. Frames.
     out.positions.resize(count);
     out.normals.resize(count);
     out.tangents.resize(count);

@@ -15,11 +15,15 @@
 /// 4. Relaxation (Witkin & Heckbert's repulsion energy E_i = sum_j exp(-r_ij^2 / (2 sigma^2)),
 ///    sigma = d / 2): every particle moves by sigma^2 times its energy gradient, projected onto the
 ///    tangent plane, capped at d / 4, then reprojected onto the surface; a move that leaves the
-///    region is halved up to three times, else not taken. Neighbours within 4 sigma come from a nanoflann k-d tree rebuilt each
+///    region, or whose projection fails (|phi| above 0.01 voxel, or landing more than 2 voxels
+///    beyond the aimed step: thin or folded parts of a mesh's band), is halved up to three times,
+///    else not taken. Neighbours within 4 sigma come from a nanoflann k-d tree rebuilt each
 ///    iteration. All particles move at once from the previous positions (Jacobi), each summing its
 ///    neighbours in index order, so the result is the same bit for bit for any thread count.
 ///    Equilibrium: the largest move is below @c tolerance d, or @c maxIterations.
-/// 5. Frame: the normal is the level set's gradient; the tangent is the reference axis @c up
+/// 5. Death: a particle within 0.1 d of an earlier one is removed (coincident particles exert no
+///    force on each other; projection onto thin or folded parts of a mesh's band can make them).
+/// 6. Frame: the normal is the level set's gradient; the tangent is the reference axis @c up
 ///    projected onto the tangent plane (x, then z, where up is nearly normal).
 ///
 /// Not implemented from Witkin & Heckbert: per-particle adaptive radii and fission/death (the
@@ -60,6 +64,7 @@ struct Follicles
     double targetSpacing = 0.0;  ///< d of step 2
     int iterations = 0;          ///< relaxation iterations run
     double lastMove = 0.0;       ///< largest move of the last iteration, in units of d
+    std::size_t removed = 0;     ///< particles removed by step 6 (within 0.1 d of another)
 };
 
 /// @brief Spread follicles over @a surface (in @a region when given).
