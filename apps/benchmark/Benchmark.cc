@@ -345,7 +345,7 @@ struct PointList
 
 /// Follicles on the shared heads: vdbhair's particle system against the quick alternative a user
 /// would write, UniformPointScatter in the voxels the zero level set crosses, projected onto it.
-void benchmarkRoots(const std::string& data, const std::vector<std::size_t>& counts)
+void benchmarkRoots(const std::string& data, const std::vector<std::size_t>& counts, const std::string& only)
 {
     std::printf("\n== follicles on the shared heads (voxel size 1/100 of the head; %d thread(s)) ==\n"
                 "NN CV: coefficient of variation of each root's distance to its nearest neighbour (lower is more regular)\n",
@@ -355,6 +355,7 @@ void benchmarkRoots(const std::string& data, const std::vector<std::size_t>& cou
                            "scalp/sintel/sintel.obj", "scalp/tressfx/head_max4.obj", "scalp/tressfx/ruby_head.obj"};
     for (const char* head : heads) {
         const std::string path = data + "/" + head;
+        if (!only.empty() && std::string(head).find(only) == std::string::npos) continue;
         if (!std::filesystem::exists(path)) {
             std::printf("%-28s (skipped: not found)\n", head);
             continue;
@@ -409,6 +410,7 @@ int main(int argc, char** argv)
     std::string sections = "field,helicoids,helicoid-fields,fit,roots";
     std::size_t fitStrands = 2000;
     std::vector<std::size_t> rootCounts{10000, 100000};
+    std::string rootHeads;
     app.add_option("--data", data, "The shared data folder (real hairstyles)")->capture_default_str();
     app.add_option("--scene", source, "The vdbhair checkout (for scenes/default)")->capture_default_str();
     app.add_option("--strands", strands, "Strands of the synthetic hairstyle")->capture_default_str();
@@ -419,6 +421,7 @@ int main(int argc, char** argv)
     app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots (comma-separated)")->capture_default_str();
     app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
     app.add_option("--root-counts", rootCounts, "Root counts of the follicle rows")->delimiter(',')->capture_default_str();
+    app.add_option("--root-heads", rootHeads, "Only the shared heads whose path contains this");
     CLI11_PARSE(app, argc, argv);
     auto wants = [&](const char* s) { return ("," + sections + ",").find("," + std::string(s) + ",") != std::string::npos; };
     std::unique_ptr<tbb::global_control> control;
@@ -444,6 +447,6 @@ int main(int argc, char** argv)
     if (wants("helicoids")) benchmarkHelicoids(source, reps);
     if (wants("helicoid-fields")) benchmarkHelicoidFields(data, source);
     if (wants("fit")) benchmarkFitting(data, fitStrands, reps);
-    if (wants("roots")) benchmarkRoots(data, rootCounts);
+    if (wants("roots")) benchmarkRoots(data, rootCounts, rootHeads);
     return 0;
 }
