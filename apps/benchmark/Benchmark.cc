@@ -7,6 +7,8 @@
 //   helicoid tracing and p-helicoid fitting (Piuze et al. 2011, §3-5): no OpenVDB peer; fitting
 //   reports error, pieces, compression and strands/s on real strands (straight, wavy, curly,
 //   short) at 30 vertices and at full resolution
+//   follicles (Witkin & Heckbert repulsion on the    vs  tools::UniformPointScatter in the
+//   scalp level set, `vdbhair roots`)                    zero-crossing voxels + projection
 //
 // Inputs: a real hairstyle from ../shared/data and a 100,000-strand, 64-vertex hairstyle made
 // deterministically from the bundled one (jittered copies), and, for reference, as many strands
@@ -19,7 +21,11 @@
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/ScalpSampler.h>
+#include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
 
@@ -29,6 +35,7 @@
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointRasterizeTrilinear.h>
 #include <openvdb/tools/PointIndexGrid.h>
+#include <openvdb/tools/PointScatter.h>
 #include <openvdb/tools/VelocityFields.h>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -328,6 +335,68 @@ void benchmarkFitting(const std::string& data, std::size_t limit, int reps)
     }
 }
 
+
+/// Points for tools::UniformPointScatter.
+struct PointList
+{
+    std::vector<Vec3d> points;
+    void add(const openvdb::Vec3R& p) { points.emplace_back(p); }
+};
+
+/// Follicles on the shared heads: vdbhair's particle system against the quick alternative a user
+/// would write, UniformPointScatter in the voxels the zero level set crosses, projected onto it.
+void benchmarkRoots(const std::string& data, const std::vector<std::size_t>& counts, const std::string& only)
+{
+    std::printf("\n== follicles on the shared heads (voxel size 1/100 of the head; %d thread(s)) ==\n"
+                "NN CV: coefficient of variation of each root's distance to its nearest neighbour (lower is more regular)\n",
+                int(tbb::this_task_arena::max_concurrency()));
+    std::printf("%-28s %8s  %9s %7s %6s  %9s %7s  %7s\n", "head", "roots", "vdbhair s", "NN CV", "iters", "scatter s", "NN CV", "time x");
+    const char* heads[] = {"scalp/ct2hair/Bangs_head.ply", "scalp/usc_hairsalon/head_model.ply", "scalp/cem_yuksel/woman_head.ply",
+                           "scalp/sintel/sintel.obj", "scalp/tressfx/head_max4.obj", "scalp/tressfx/ruby_head.obj"};
+    for (const char* head : heads) {
+        const std::string path = data + "/" + head;
+        if (!only.empty() && std::string(head).find(only) == std::string::npos) continue;
+        if (!std::filesystem::exists(path)) {
+            std::printf("%-28s (skipped: not found)\n", head);
+            continue;
+        }
+        ScalpParams sp;
+        const openvdb::FloatGrid::Ptr surface = scalpFromMesh(readTriangleMesh(path), sp);
+        const ScalpSampler sampler(surface);
+        openvdb::BoolGrid::Ptr mask = openvdb::BoolGrid::create(false);
+        mask->setTransform(surface->transform().copy());
+        {
+            auto acc = mask->getAccessor();
+            for (auto it = surface->cbeginValueOn(); it; ++it) {
+                if (it.isVoxelValue() && std::abs(*it) < float(surface->voxelSize().x())) acc.setValueOn(it.getCoord(), true);
+            }
+        }
+        const std::string name = std::filesystem::path(head).filename().string();
+        for (std::size_t count : counts) {
+            FollicleParams fp;
+            fp.count = count;
+            double t0 = now();
+            const Follicles f = sampleFollicles(surface, nullptr, fp);
+            const double tv = now() - t0;
+            const FollicleStats sv = measureFollicles(f.positions);
+            t0 = now();
+            PointList list;
+            std::mt19937 rng(1);
+            openvdb::tools::UniformPointScatter<PointList, std::mt19937> scatter(list, openvdb::Index64(count), rng);
+            scatter(*mask);
+            std::vector<Vec3f> projected(list.points.size());
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, list.points.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) projected[i] = Vec3f(sampler.project(list.points[i]));
+            });
+            const double ts = now() - t0;
+            const FollicleStats ss = measureFollicles(projected);
+            std::printf("%-28s %8zu  %9.3f %7.3f %6d  %9.3f %7.3f  %7.1f\n", name.c_str(), f.positions.size(), tv, sv.nnCV, f.iterations, ts,
+                        ss.nnCV, ts > 0.0 ? tv / ts : 0.0);
+            std::fflush(stdout);
+        }
+    }
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -338,8 +407,10 @@ int main(int argc, char** argv)
     std::size_t strands = 100000, vertices = 64;
     int reps = 3, threads = 0;
     double voxelSize = 0.0;
-    std::string sections = "field,helicoids,helicoid-fields,fit";
+    std::string sections = "field,helicoids,helicoid-fields,fit,roots";
     std::size_t fitStrands = 2000;
+    std::vector<std::size_t> rootCounts{10000, 100000};
+    std::string rootHeads;
     app.add_option("--data", data, "The shared data folder (real hairstyles)")->capture_default_str();
     app.add_option("--scene", source, "The vdbhair checkout (for scenes/default)")->capture_default_str();
     app.add_option("--strands", strands, "Strands of the synthetic hairstyle")->capture_default_str();
@@ -347,8 +418,10 @@ int main(int argc, char** argv)
     app.add_option("--reps", reps, "Repetitions (the best time is reported)")->capture_default_str();
     app.add_option("--threads", threads, "Threads (0: all cores)")->capture_default_str();
     app.add_option("--voxel-size", voxelSize, "Voxel size (0: vdbhair's suggestion for each input)");
-    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit (comma-separated)")->capture_default_str();
+    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots (comma-separated)")->capture_default_str();
     app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
+    app.add_option("--root-counts", rootCounts, "Root counts of the follicle rows")->delimiter(',')->capture_default_str();
+    app.add_option("--root-heads", rootHeads, "Only the shared heads whose path contains this");
     CLI11_PARSE(app, argc, argv);
     auto wants = [&](const char* s) { return ("," + sections + ",").find("," + std::string(s) + ",") != std::string::npos; };
     std::unique_ptr<tbb::global_control> control;
@@ -374,5 +447,6 @@ int main(int argc, char** argv)
     if (wants("helicoids")) benchmarkHelicoids(source, reps);
     if (wants("helicoid-fields")) benchmarkHelicoidFields(data, source);
     if (wants("fit")) benchmarkFitting(data, fitStrands, reps);
+    if (wants("roots")) benchmarkRoots(data, rootCounts, rootHeads);
     return 0;
 }

@@ -188,8 +188,8 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
                     "consistent mode: outlier score from which the field's direction is followed")->capture_default_str();
     sub->add_option("--min-spread", rp.consistency.minSpreadDeg,
                     "consistent mode: deviations below this many degrees are never outliers")->capture_default_str();
-    sub->add_option("--head", p.head, "The head strands may not enter: a .vdb with a level set grid ('surface' or the first one), "
-                                      "or 'none' (default: --scalp's sphere if given, else a sphere fitted to the roots)");
+    sub->add_option("--head", p.head, "The head strands may not enter: a triangle mesh (.ply, .obj), a .vdb with a level set grid "
+                                      "('surface' or the first one), or 'none' (default: --scalp's sphere if given, else a sphere fitted to the roots)");
     sub->add_option("--integrator", p.integrator, "field mode: euler (the papers' choice), rk2 or rk4")->capture_default_str();
     sub->add_option("--margin", rp.trace.margin, "field mode: voxels a strand may continue straight past the field's active region")->capture_default_str();
     sub->add_option("--max-voxels", rp.field.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();

@@ -2,7 +2,9 @@
 #include "../Command.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/MeshFile.h>
+#include <vdbhair/io/PointFile.h>
 #include <vdbhair/render/StrandRenderer.h>
 
 #include <chrono>
@@ -41,8 +43,25 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
                          ": must be between 1 and 16384 pixels");
     }
     if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
+    // Roots (a PLY of points with normals, as `vdbhair roots` writes) are drawn as dots: stubs
+    // along their normals, 1/60 of the roots' extent long.
+    const bool rootsInput = fileExtension(p.input) == ".ply" && plyElementCount(p.input, "strand") == 0 &&
+                            plyElementCount(p.input, "face") == 0;
+    StrandSet strands;
     TriangleMesh head;  // --head, or the scene's own head
-    const StrandSet strands = loadStrandsOrScene("render", p.input, common, p.grid, p.head.empty() ? &head : nullptr);
+    if (rootsInput) {
+        const OrientedPoints roots = readPlyPoints(p.input);
+        if (roots.size() == 0) throw FormatError(p.input + ": the file has no points");
+        if (roots.normals.size() != roots.size()) throw FormatError(p.input + ": the points have no normals (nx ny nz); render draws roots along them");
+        BBox box;
+        for (const Vec3f& q : roots.positions) box.expand(q);
+        const float len = box.extent().length() / 60.f;
+        for (std::size_t i = 0; i < roots.size(); ++i) {
+            strands.addStrand(std::vector<Vec3f>{roots.positions[i], roots.positions[i] + roots.normals[i] * len});
+        }
+    } else {
+        strands = loadStrandsOrScene("render", p.input, common, p.grid, p.head.empty() ? &head : nullptr);
+    }
     StrandSet guides;
     if (!p.guides.empty()) {
         guides = loadStrandsOrScene("render", p.guides, common);
@@ -61,7 +80,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
         printJson({{"output", p.output}, {"width", image.width}, {"height", image.height}, {"strands", strands.numStrands()},
                    {"view", p.sheet ? "sheet" : p.view}, {"seconds", seconds}});
     } else if (!common.quiet) {
-        std::cout << "rendered " << strands.numStrands() << " strands (" << (p.sheet ? std::string("sheet") : p.view) << ", "
+        std::cout << "rendered " << strands.numStrands() << (rootsInput ? " roots (" : " strands (") << (p.sheet ? std::string("sheet") : p.view) << ", "
                   << image.width << "x" << image.height << ") in " << seconds << " s\nwrote " << p.output << "\n";
     }
     return 0;
@@ -73,7 +92,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<RenderCmdParams>();
     CLI::App* sub = app.add_subcommand("render", "Preview strands as an image: lit fibres, depth-correct, anti-aliased");
-    sub->add_option("input", params->input, "Strands (any format), .vdb points, or a scene .json")->required();
+    sub->add_option("input", params->input, "Strands (any format), .vdb points, a scene .json, or roots (.ply points with normals: drawn as dots)")->required();
     sub->add_option("-o,--output", params->output, "Image (.png, .exr, .jpg: by extension)")->required();
     sub->add_option("--view", params->view, "front, side, top, back or three-quarter (perspective)")->capture_default_str();
     sub->add_option("--width", params->width, "Width in pixels")->capture_default_str();

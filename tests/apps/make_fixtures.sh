@@ -40,3 +40,22 @@ printf 'v 0 0 0\nv 1 0 0\nv 2 1 0\nv 3 3 3\nv 3 3 3\nl 1 2 3\nl 4 5\n' > zero_le
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0], "length": 1}]}]}\n' > bad_scene.json
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0, 0], "length": 1}], "wisp": {"count": 2, "radiuss": 1}}]}\n' > unknown_key.json
 printf '{"vdbhair": "scene/1", "guides": [' > not_json.json
+# Scalps: the default head's sphere with the region of its hairstyle's roots; oriented points on
+# a sphere (ascii PLY with normals); too few points; coplanar points; an empty mesh.
+"$bin" scalp --sphere 0,0,0,10 -o scalp_sphere.vdb --voxel-size 0.25 --region head.hair --quiet
+/usr/bin/python3 - <<'PY'
+import math
+n = 300; g = math.pi * (3 - math.sqrt(5))
+rows = []
+for i in range(n):
+    y = 1 - 2 * (i + 0.5) / n; r = math.sqrt(1 - y * y); t = g * i
+    u = (r * math.cos(t), y, r * math.sin(t))
+    rows.append("%.6f %.6f %.6f %.6f %.6f %.6f" % (10 * u[0], 10 * u[1] + 5, 10 * u[2], u[0], u[1], u[2]))
+hdr = "ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n"
+open("points.ply", "w").write(hdr % n + "\n".join(rows) + "\n")
+open("few_points.ply", "w").write(hdr % 4 + "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n1 1 1 0 0 1\n")
+open("coplanar.ply", "w").write(hdr % 6 + "".join("%d %d 2 0 0 1\n" % (i % 3, i // 3) for i in range(6)))
+PY
+: > empty_mesh.obj
+printf 'ply\nformat ascii 1.0\nelement vertex 0\nend_header\n' > existing_roots.ply
+"$bin" roots scalp_sphere.vdb -o roots.ply --count 500 --quiet

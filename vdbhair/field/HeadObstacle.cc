@@ -2,7 +2,9 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/scalp/ScalpSurface.h>
 
 #include <openvdb/tools/Interpolation.h>
 
@@ -137,8 +139,15 @@ bool HeadObstacle::Probe::pushOut(Vec3d& p, double minDistance)
 
 HeadObstacle readHeadObstacle(const std::string& path, const std::string& where)
 {
-    if (fileExtension(path) != ".vdb") {
-        throw UnsupportedError(where + ": the head must be a .vdb holding a level set (such as the 'surface' grid of a scalp)");
+    const std::string ext = fileExtension(path);
+    if (ext == ".ply" || ext == ".obj") {
+        // A triangle mesh: its level set as `vdbhair scalp MESH` makes it (default voxel size).
+        const TriangleMesh mesh = readTriangleMesh(path);
+        return HeadObstacle::levelSet(scalpFromMesh(mesh, ScalpParams{}));
+    }
+    if (ext != ".vdb") {
+        throw UnsupportedError(where + ": the head must be a triangle mesh (.ply, .obj) or a .vdb holding a level set "
+                               "(such as the 'surface' grid of vdbhair scalp)");
     }
     const openvdb::GridPtrVec grids = readVdbGrids(path, where);
     openvdb::FloatGrid::Ptr found;

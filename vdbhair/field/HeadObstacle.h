@@ -81,8 +81,9 @@ private:
     openvdb::FloatGrid::ConstPtr mGrid;
 };
 
-/// @brief The head in a file: a .vdb's level set grid (the one named `surface`, else the first
-/// level set in the file).
+/// @brief The head in a file: a triangle mesh (.ply, .obj: its level set as `vdbhair scalp`
+/// makes it, open boundaries capped) or a .vdb's level set grid (the one named `surface`, else
+/// the first level set in the file).
 /// @param where prefix for messages, e.g. "--head scalp.vdb"
 /// @throw IoError, FormatError (unreadable file), LookupError (no level set in it),
 /// UnsupportedError (not a .vdb).

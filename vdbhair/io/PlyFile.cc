@@ -1,6 +1,7 @@
 #include "PlyFile.h"
 
 #include <vdbhair/io/MeshFile.h>
+#include <vdbhair/io/PointFile.h>
 
 #include <vdbhair/Version.h>
 #include <vdbhair/io/ByteReader.h>
@@ -396,6 +397,56 @@ TriangleMesh readPlyMesh(const std::string& path)
     });
     if (mesh.triangles.empty()) throw FormatError(where + ": the file has no faces");
     return mesh;
+}
+
+} // namespace vdbhair
+
+// Oriented points (PointFile.h): the vertex element only; here for the shared PLY parser.
+namespace vdbhair {
+
+OrientedPoints readPlyPoints(const std::string& path)
+{
+    const std::string where = "readPlyPoints(" + path + ")";
+    const std::vector<char> bytes = readFileBytes(path, where);
+    const PlyHeader hdr = parsePlyHeader(bytes, where);
+    const Element* vertexEl = nullptr;
+    for (const Element& e : hdr.elements) {
+        if (e.name == "vertex") vertexEl = &e;
+    }
+    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    const int ix = findProperty(vertexEl, "x"), iy = findProperty(vertexEl, "y"), iz = findProperty(vertexEl, "z");
+    if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
+    const int inx = findProperty(vertexEl, "nx"), iny = findProperty(vertexEl, "ny"), inz = findProperty(vertexEl, "nz");
+    const int itx = findProperty(vertexEl, "tx"), ity = findProperty(vertexEl, "ty"), itz = findProperty(vertexEl, "tz");
+    const bool hasN = inx >= 0 && iny >= 0 && inz >= 0, hasT = itx >= 0 && ity >= 0 && itz >= 0;
+
+    OrientedPoints pts;
+    readPlyBody(bytes, hdr, where, nullptr, -1, [&](const Element& e) {
+        if (&e == vertexEl) pts.positions.reserve(e.count);
+    }, [&](const Element& e, std::uint64_t, const std::vector<double>& v, const std::vector<double>&, ValueSource& src) {
+        if (&e != vertexEl) return;
+        auto vec = [&](int a, int b, int c) { return Vec3f(float(v[std::size_t(a)]), float(v[std::size_t(b)]), float(v[std::size_t(c)])); };
+        const Vec3f p = vec(ix, iy, iz);
+        checkFinite(p, pts.positions.size(), where, src.location());
+        pts.positions.push_back(p);
+        if (hasN) {
+            const Vec3f n = vec(inx, iny, inz);
+            checkFinite(n, pts.normals.size(), where, src.location());
+            pts.normals.push_back(n);
+        }
+        if (hasT) pts.tangents.push_back(vec(itx, ity, itz));
+    });
+    return pts;
+}
+
+std::uint64_t plyElementCount(const std::string& path, const std::string& element)
+{
+    const std::string where = "readPly(" + path + ")";
+    const PlyHeader hdr = parsePlyHeader(readFileBytes(path, where), where);
+    for (const Element& e : hdr.elements) {
+        if (e.name == element) return e.count;
+    }
+    return 0;
 }
 
 } // namespace vdbhair

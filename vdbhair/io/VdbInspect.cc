@@ -191,6 +191,9 @@ std::string explainGrid(const GridInfo& info)
         {"frame_T", "the local helicoid frame's tangent T per voxel"},
         {"frame_N", "the local helicoid frame's normal N per voxel (B = T x N)"},
         {"strands", "hair strands as points: one point per vertex, with strand and vertex indices"},
+        {"surface", "the scalp as a narrow-band signed distance field (negative inside the head)"},
+        {"region", "where on the scalp hair grows (active voxels of the surface's band)"},
+        {"roots", "hair roots (follicles) as points: P on the scalp, the surface normal N and a tangent"},
     };
     std::string base = info.name;
     const std::int64_t level = integer("vdbhair_level");
@@ -243,6 +246,23 @@ std::string explainGrid(const GridInfo& info)
             os << " Level " << level << " of 0.." << levels - 1 << (level == 0 ? " (the finest" : " (level 0 is the finest")
                << "; each level doubles the voxel size).";
         }
+    }
+    // Scalps, regions and roots (vdbhair scalp, vdbhair roots).
+    const std::string scalpKind = text("vdbhair_scalp_kind"), scalpSource = text("vdbhair_source");
+    if (!scalpKind.empty()) {
+        os << (os.tellp() > 0 ? " " : "") << "Made by " << (creator.empty() ? "vdbhair" : creator) << " from ";
+        if (scalpKind == "mesh") os << "the triangle mesh " << scalpSource << " (openvdb::tools::meshToLevelSet; open boundary loops capped)";
+        else if (scalpKind == "points") os << "the oriented points of " << scalpSource << " (Turk & O'Brien's variational implicit)";
+        else os << "a " << scalpSource;
+        const std::string vs = text("vdbhair_voxel_size"), hw = text("vdbhair_half_width");
+        if (!vs.empty()) os << ", voxel size " << vs;
+        if (!hw.empty()) os << ", band half width " << hw << " voxels";
+        os << ".";
+    }
+    const std::string regionRadius = text("vdbhair_region_radius");
+    if (!regionRadius.empty()) {
+        os << (os.tellp() > 0 ? " " : "") << "The surface's band voxels within " << regionRadius << " of the "
+           << text("vdbhair_region_roots") << " roots of " << (scalpSource.empty() ? "a hairstyle" : scalpSource) << ", projected onto it.";
     }
     const std::string fit = text("vdbhair_helicoid_fit");
     if (!fit.empty()) os << " Helicoid parameters fitted per voxel: " << fit << ".";

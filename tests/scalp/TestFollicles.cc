@@ -1,0 +1,193 @@
+#include "../TestUtil.h"
+#include "ScalpTestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/PointFile.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/io/VdbFile.h>
+#include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/RootGrid.h>
+#include <vdbhair/scalp/ScalpRegion.h>
+#include <vdbhair/scalp/ScalpSampler.h>
+#include <vdbhair/scalp/ScalpSurface.h>
+
+#include <openvdb/points/PointCount.h>
+#include <tbb/global_control.h>
+
+#include <cstring>
+#include <filesystem>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+openvdb::FloatGrid::Ptr unitSphere(const Vec3d& c, double r, double h)
+{
+    ScalpParams sp;
+    sp.voxelSize = h;
+    return scalpFromSphere(c, r, sp);
+}
+
+} // namespace
+
+TEST_CASE("sampleFollicles: a sphere gets evenly spread roots on it", "[scalp]")
+{
+    const Vec3d c(0.25, -1.0, 2.0);
+    const double r = 1.0, h = 0.05;
+    const openvdb::FloatGrid::Ptr g = unitSphere(c, r, h);
+    FollicleParams fp;
+    fp.count = 1500;
+    fp.seed = 3;
+    const Follicles f = sampleFollicles(g, nullptr, fp);
+    const FollicleStats st = measureFollicles(f.positions, g);
+    std::cout << "sphere: " << f.positions.size() << " roots, area " << f.area << " (true " << 4 * M_PI * r * r << "), target spacing "
+              << f.targetSpacing << ", NN mean " << st.nnMean << ", CV " << st.nnCV << ", iterations " << f.iterations
+              << ", last move " << f.lastMove << ", max |phi| " << st.maxSurfaceDistanceVoxels << " voxels\n";
+    CHECK(std::abs(double(f.positions.size()) - 1500.0) <= 0.02 * 1500.0);
+    CHECK(f.area == Approx(4 * M_PI * r * r).epsilon(0.03));
+    CHECK(st.nnCV < 0.1);
+    double worstDist = 0.0, worstAngle = 0.0, worstTangent = 0.0;
+    for (std::size_t i = 0; i < f.positions.size(); ++i) {
+        const Vec3d p(f.positions[i]), radial = (p - c) / (p - c).length();
+        worstDist = std::max(worstDist, std::abs((p - c).length() - r) / h);
+        const double cosA = std::min(1.0, Vec3d(f.normals[i]).dot(radial));
+        worstAngle = std::max(worstAngle, std::acos(cosA) * 180.0 / M_PI);
+        worstTangent = std::max({worstTangent, std::abs(Vec3d(f.tangents[i]).dot(Vec3d(f.normals[i]))),
+                                 std::abs(Vec3d(f.tangents[i]).length() - 1.0)});
+    }
+    CAPTURE(worstDist, worstAngle, worstTangent);
+    CHECK(worstDist < 0.05);
+    CHECK(worstAngle < 1.0);
+    CHECK(worstTangent < 1e-5);
+}
+
+TEST_CASE("sampleFollicles: a cap region holds every root", "[scalp]")
+{
+    const Vec3d c(0.0);
+    const double r = 1.0, h = 0.05, capRadius = 0.8;
+    const openvdb::FloatGrid::Ptr g = unitSphere(c, r, h);
+    const openvdb::BoolGrid::Ptr region = regionFromRoots(*g, {Vec3f(0.f, 1.1f, 0.f)}, capRadius, "pole");
+    CHECK(region->getName() == "region");
+    const Vec3d pole(0.0, 1.0, 0.0);
+    FollicleParams fp;
+    fp.spacing = 0.08;
+    const Follicles f = sampleFollicles(g, region, fp);
+    const FollicleStats st = measureFollicles(f.positions, g);
+    // Cap area 2 pi r^2 (1 - cos a), sin(a/2) = capRadius / (2 r).
+    const double a = 2.0 * std::asin(capRadius / (2.0 * r)), capArea = 2.0 * M_PI * r * r * (1.0 - std::cos(a));
+    std::cout << "cap: " << f.positions.size() << " roots, area " << f.area << " (true " << capArea << "), NN mean " << st.nnMean
+              << " (target " << fp.spacing << "), CV " << st.nnCV << ", iterations " << f.iterations << "\n";
+    CHECK(f.area == Approx(capArea).epsilon(0.05));
+    REQUIRE(f.positions.size() > 100);
+    const ScalpSampler s(g, region);
+    double farthest = 0.0;
+    for (const Vec3f& p : f.positions) {
+        CHECK(s.inRegion(Vec3d(p)));
+        farthest = std::max(farthest, (Vec3d(p) - pole).length());
+    }
+    CHECK(farthest <= capRadius + 0.5 * std::sqrt(3.0) * h);
+    CHECK(st.nnMean == Approx(fp.spacing).epsilon(0.1));
+}
+
+TEST_CASE("sampleFollicles: the same roots with 1 and 2 threads, bit for bit", "[scalp]")
+{
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.05);
+    FollicleParams fp;
+    fp.count = 800;
+    fp.seed = 11;
+    Follicles one, two;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = sampleFollicles(g, nullptr, fp);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        two = sampleFollicles(g, nullptr, fp);
+    }
+    const Follicles serial = sampleFollicles(g, nullptr, fp, /*threaded=*/false);
+    REQUIRE(one.positions.size() == two.positions.size());
+    REQUIRE(one.positions.size() == serial.positions.size());
+    const std::size_t bytes = one.positions.size() * sizeof(Vec3f);
+    CHECK(std::memcmp(one.positions.data(), two.positions.data(), bytes) == 0);
+    CHECK(std::memcmp(one.normals.data(), two.normals.data(), bytes) == 0);
+    CHECK(std::memcmp(one.tangents.data(), two.tangents.data(), bytes) == 0);
+    CHECK(std::memcmp(one.positions.data(), serial.positions.data(), bytes) == 0);
+    fp.seed = 12;
+    const Follicles other = sampleFollicles(g, nullptr, fp);
+    CHECK(std::memcmp(one.positions.data(), other.positions.data(), bytes) != 0);
+}
+
+TEST_CASE("sampleFollicles: bad counts and regions", "[scalp]")
+{
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.1);
+    FollicleParams fp;
+    CHECK_THROWS_WITH(sampleFollicles(g, nullptr, fp), Contains("give a count of at least 1 or a positive spacing"));
+    fp.count = std::size_t(1) << 40;
+    CHECK_THROWS_AS(sampleFollicles(g, nullptr, fp), LimitError);
+    fp.count = 0;
+    fp.spacing = 1e-6;
+    CHECK_THROWS_WITH(sampleFollicles(g, nullptr, fp), Contains("more than the cap"));
+    CHECK_THROWS_AS(regionFromRoots(*g, {Vec3f(50.f, 0.f, 0.f)}, 0.3, "far", std::uint64_t(1) << 28, 5.0), LookupError);
+    CHECK_THROWS_AS(regionFromRoots(*g, {}, 0.3), ValueError);
+}
+
+TEST_CASE("writePlyPoints and createRootGrid: roots round trip through PLY and VDB points", "[scalp]")
+{
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.1);
+    FollicleParams fp;
+    fp.count = 200;
+    const Follicles f = sampleFollicles(g, nullptr, fp);
+    OrientedPoints pts{f.positions, f.normals, f.tangents};
+    const std::string ply = test::tempPath("roots.ply");
+    writePlyPoints(ply, pts);
+    const OrientedPoints back = readPlyPoints(ply);
+    REQUIRE(back.size() == pts.size());
+    CHECK(std::memcmp(back.positions.data(), pts.positions.data(), pts.size() * sizeof(Vec3f)) == 0);
+    CHECK(std::memcmp(back.normals.data(), pts.normals.data(), pts.size() * sizeof(Vec3f)) == 0);
+    CHECK(std::memcmp(back.tangents.data(), pts.tangents.data(), pts.size() * sizeof(Vec3f)) == 0);
+    const openvdb::points::PointDataGrid::Ptr grid = createRootGrid(pts);
+    CHECK(grid->getName() == "roots");
+    CHECK(openvdb::points::pointCount(grid->tree()) == pts.size());
+    CHECK(openvdb::points::pointCount(grid->tree(), openvdb::points::GroupFilter("root", grid->tree().cbeginLeaf()->attributeSet())) == pts.size());
+    const auto& desc = grid->tree().cbeginLeaf()->attributeSet().descriptor();
+    CHECK(desc.find("N") != openvdb::points::AttributeSet::INVALID_POS);
+}
+
+TEST_CASE("sampleFollicles: roots on the shared heads, in the region of a hairstyle's roots", "[scalp]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string data = test::sharedData();
+    struct Case { const char* head; const char* hair; };
+    for (const Case& k : {Case{"scalp/ct2hair/Bangs_head.ply", "hair/cyhair/Bangs_100.hair"},
+                          Case{"scalp/cem_yuksel/woman_head.ply", "hair/cyhair/straight.hair"},
+                          Case{"scalp/usc_hairsalon/head_model.ply", ""}}) {
+        const std::string headPath = data + "/" + k.head;
+        if (!std::filesystem::exists(headPath)) { WARN("missing " << headPath); continue; }
+        ScalpParams sp;
+        const openvdb::FloatGrid::Ptr g = scalpFromMesh(readTriangleMesh(headPath), sp);
+        openvdb::BoolGrid::Ptr region;
+        std::vector<Vec3f> roots;
+        if (*k.hair && std::filesystem::exists(data + "/" + k.hair)) {
+            const StrandSet hair = readStrands(data + "/" + k.hair);
+            for (std::size_t i = 0; i < hair.numStrands(); ++i) roots.push_back(hair.root(i));
+            const double radius = std::max(2.0 * measureFollicles(roots).nnMean, 2.0 * g->voxelSize().x());
+            region = regionFromRoots(*g, roots, radius, k.hair);
+            // The region covers the hairstyle's roots (projected onto the surface).
+            const ScalpSampler s(g, region);
+            std::size_t covered = 0;
+            for (const Vec3f& p : projectOntoSurface(*g, roots)) covered += s.inRegion(Vec3d(p)) ? 1 : 0;
+            std::cout << k.head << ": region of " << k.hair << " (radius " << radius << "): " << region->activeVoxelCount() << " voxels, covers "
+                      << covered << " of " << roots.size() << " roots\n";
+            CHECK(double(covered) >= 0.99 * double(roots.size()));
+        }
+        FollicleParams fp;
+        fp.count = 3000;
+        const Follicles f = sampleFollicles(g, region, fp);
+        const FollicleStats st = measureFollicles(f.positions, g);
+        std::cout << k.head << ": " << f.positions.size() << " roots, area " << f.area << ", NN mean " << st.nnMean << ", CV " << st.nnCV
+                  << ", iterations " << f.iterations << ", max |phi| " << st.maxSurfaceDistanceVoxels << " voxels\n";
+        CHECK(f.positions.size() >= 2900);
+        CHECK(st.maxSurfaceDistanceVoxels < 0.1);
+    }
+}

@@ -1,0 +1,113 @@
+#include "ScalpRegion.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Version.h>
+#include <vdbhair/scalp/ScalpSampler.h>
+
+#include <nanoflann.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace vdbhair {
+
+namespace {
+struct Cloud
+{
+    const std::vector<Vec3d>* pts;
+    std::size_t kdtree_get_point_count() const { return pts->size(); }
+    double kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i][int(d)]; }
+    template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
+};
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3, std::uint32_t>;
+std::string fmtLength(double v)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+} // namespace
+
+std::vector<Vec3f> projectOntoSurface(const openvdb::FloatGrid& surface, const std::vector<Vec3f>& points, std::vector<char>* onSurface)
+{
+    const openvdb::FloatGrid::ConstPtr surf = surface.copy();
+    const ScalpSampler sampler(surf);
+    const double h = sampler.voxelSize();
+    std::vector<Vec3d> crossing;  // centres of the voxels the zero level set passes near
+    for (auto it = surface.cbeginValueOn(); it; ++it) {
+        if (it.isVoxelValue() && std::abs(double(*it)) < h) crossing.push_back(surface.transform().indexToWorld(it.getCoord()));
+    }
+    std::vector<Vec3f> out(points.size());
+    if (onSurface) onSurface->assign(points.size(), 0);
+    if (crossing.empty()) return out;
+    const Cloud cloud{&crossing};
+    const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3d q(points[i]);
+            std::uint32_t idx = 0;
+            double d2 = 0.0;
+            tree.knnSearch(q.asPointer(), 1, &idx, &d2);
+            // Start from the point itself when it is in the band, else from the nearest crossing.
+            const Vec3d start = std::abs(sampler.distance(q)) < 0.9 * sampler.halfWidthWorld() ? q : crossing[idx];
+            const Vec3d p = sampler.project(start);
+            out[i] = Vec3f(p);
+            if (onSurface) (*onSurface)[i] = std::abs(sampler.distance(p)) < 0.5 * h ? 1 : 0;
+        }
+    });
+    return out;
+}
+
+openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const std::vector<Vec3f>& roots, double radius,
+                                       const std::string& source, std::uint64_t maxVoxels, double maxDistance)
+{
+    const std::string where = "regionFromRoots(" + (source.empty() ? std::string("roots") : source) + ")";
+    if (!(radius > 0.0) || !std::isfinite(radius)) throw ValueError(where + ": radius " + std::to_string(radius) + " must be a positive length");
+    if (roots.empty()) throw ValueError(where + ": no roots; the region would be empty");
+    const openvdb::FloatGrid::ConstPtr surf = surface.copy();
+    const ScalpSampler sampler(surf);
+    const double h = sampler.voxelSize();
+    const int r = int(std::ceil(radius / h));
+    const std::uint64_t perRoot = std::uint64_t(2 * r + 1) * std::uint64_t(2 * r + 1) * std::uint64_t(2 * r + 1);
+    if (perRoot > maxVoxels / roots.size() + 1) {
+        throw LimitError(where + ": radius " + std::to_string(radius) + " over " + std::to_string(roots.size()) + " roots visits about " +
+                         std::to_string(perRoot * roots.size()) + " voxels, more than the cap of " + std::to_string(maxVoxels));
+    }
+    openvdb::BoolGrid::Ptr region = openvdb::BoolGrid::create(false);
+    region->setTransform(surface.transform().copy());
+    auto out = region->getAccessor();
+    auto in = surface.getConstAccessor();
+    const double band = double(surface.background());
+    std::size_t used = 0;
+    std::vector<char> ok;
+    const std::vector<Vec3f> projected = projectOntoSurface(surface, roots, &ok);
+    for (std::size_t k = 0; k < roots.size(); ++k) {
+        const Vec3d p(projected[k]);
+        if (!ok[k]) continue;  // no surface near this root
+        if ((p - Vec3d(roots[k])).length() > maxDistance) continue;
+        ++used;
+        const openvdb::Coord c = surface.transform().worldToIndexNodeCentered(p);
+        for (int dx = -r; dx <= r; ++dx)
+            for (int dy = -r; dy <= r; ++dy)
+                for (int dz = -r; dz <= r; ++dz) {
+                    const openvdb::Coord q = c.offsetBy(dx, dy, dz);
+                    if ((surface.transform().indexToWorld(q) - p).length() > radius) continue;
+                    if (!(std::abs(double(in.getValue(q))) < band) || !in.isValueOn(q)) continue;
+                    out.setValueOn(q, true);
+                }
+    }
+    if (used == 0 || region->activeVoxelCount() == 0) {
+        throw LookupError(where + ": none of the " + std::to_string(roots.size()) +
+                          " roots is within " + fmtLength(maxDistance) + " of the surface; the region is empty (are the roots and the scalp in the same units and place?)");
+    }
+    region->setName("region");
+    region->setCreator("vdbhair " VDBHAIR_VERSION_STRING);
+    region->insertMeta("vdbhair_region_kind", openvdb::StringMetadata("roots"));
+    region->insertMeta("vdbhair_region_radius", openvdb::DoubleMetadata(radius));
+    region->insertMeta("vdbhair_region_roots", openvdb::Int64Metadata(std::int64_t(used)));
+    if (!source.empty()) region->insertMeta("vdbhair_source", openvdb::StringMetadata(source));
+    return region;
+}
+
+} // namespace vdbhair
