@@ -21,7 +21,8 @@ struct RefineCmdParams
     CLI::Option* stepOpt = nullptr;   ///< whether --step was given
     std::string mode = "consistent";
     std::string integrator = "euler";
-    std::string head;                 ///< --head: a .vdb level set, or "none"
+    std::string head;                 ///< --head: a mesh, a .vdb level set, or "none"
+    std::string headPolicy = "no-deeper";
     bool strict = false;
     ScalpOptions scalp;
 };

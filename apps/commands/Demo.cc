@@ -34,7 +34,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     // A scene's own head is the obstacle refinement keeps strands out of, unless --head says otherwise.
     if (p.refine.head.empty() && fileExtension(p.refine.input) == ".json") {
         const Scene scene = readScene(p.refine.input);
-        if (scene.head) rp.head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
+        if (scene.head) rp.head = HeadObstacle::sphere(scene.head->center, scene.head->radius, headPolicyFromName(p.refine.headPolicy));
     }
     std::error_code ec;
     fs::create_directories(p.outDir, ec);

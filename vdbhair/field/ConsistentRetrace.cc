@@ -93,7 +93,9 @@ public:
         const bool haveHead = !mS.head.empty();
         const bool relative = haveHead && mS.head.policy() == HeadPolicy::NoDeeper;
         Vec3d p(c[0]);
-        o[0] = c[0];
+        // KeepOutside holds for the root too: a root inside the head starts on its surface.
+        if (haveHead && !relative && mHead.pushOut(p, 0.0)) ++counts.pushedOut;
+        o[0] = Vec3f(float(p.x()), float(p.y()), float(p.z()));
         bool corrected = false;
         for (std::size_t j = 0; j + 1 < n; ++j) {
             const Vec3d a(c[j]), b(c[j + 1]);

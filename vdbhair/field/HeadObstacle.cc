@@ -68,11 +68,12 @@ std::string HeadObstacle::describe() const
     case Kind::None:
     case Kind::Disabled: s << "none"; break;
     case Kind::Sphere:
-        s << "sphere (" << mCenter.x() << ", " << mCenter.y() << ", " << mCenter.z() << ") radius " << mRadius
-          << (mPolicy == HeadPolicy::NoDeeper ? ", fitted to the roots" : "");
+        s << "sphere (" << mCenter.x() << ", " << mCenter.y() << ", " << mCenter.z() << ") radius " << mRadius;
         break;
     case Kind::LevelSet: s << "level set '" << mGrid->getName() << "' (voxel " << mGrid->voxelSize()[0] << ")"; break;
     }
+    if (!mLabel.empty()) s << ", " << mLabel;
+    if (!empty()) s << (mPolicy == HeadPolicy::NoDeeper ? ", no vertex deeper inside than the input's" : ", every vertex kept outside");
     return s.str();
 }
 
@@ -124,9 +125,11 @@ bool HeadObstacle::Probe::pushOut(Vec3d& p, double minDistance)
     const double scale = mHead.mKind == Kind::Sphere ? mHead.mRadius : mHead.mGrid->voxelSize()[0];
     const double target = minDistance + 1e-4 * scale;
     bool moved = false;
-    // Exact for a sphere in one step; a few Newton steps on a level set, whose distance is only
-    // approximately a distance.
-    for (int iter = 0; iter < 4; ++iter) {
+    // Exact for a sphere in one step; Newton steps on a level set, whose distance is only
+    // approximately a distance, and beyond whose narrow band it is the band's half width: a
+    // point deep inside moves out by that much a step until it reaches the band.
+    const int iterations = mHead.mKind == Kind::Sphere ? 2 : 256;
+    for (int iter = 0; iter < iterations; ++iter) {
         const double d = distance(p);
         if (!(d < minDistance) && (iter == 0 || !(d < target))) break;
         const Vec3d n = normal(p);
@@ -137,13 +140,20 @@ bool HeadObstacle::Probe::pushOut(Vec3d& p, double minDistance)
     return moved;
 }
 
-HeadObstacle readHeadObstacle(const std::string& path, const std::string& where)
+HeadPolicy headPolicyFromName(const std::string& name)
+{
+    if (name == "no-deeper") return HeadPolicy::NoDeeper;
+    if (name == "outside") return HeadPolicy::KeepOutside;
+    throw ValueError("head policy '" + name + "' is not one of no-deeper, outside");
+}
+
+HeadObstacle readHeadObstacle(const std::string& path, const std::string& where, HeadPolicy policy)
 {
     const std::string ext = fileExtension(path);
     if (ext == ".ply" || ext == ".obj") {
         // A triangle mesh: its level set as `vdbhair scalp MESH` makes it (default voxel size).
         const TriangleMesh mesh = readTriangleMesh(path);
-        return HeadObstacle::levelSet(scalpFromMesh(mesh, ScalpParams{}));
+        return HeadObstacle::levelSet(scalpFromMesh(mesh, ScalpParams{}), policy);
     }
     if (ext != ".vdb") {
         throw UnsupportedError(where + ": the head must be a triangle mesh (.ply, .obj) or a .vdb holding a level set "
@@ -161,7 +171,7 @@ HeadObstacle readHeadObstacle(const std::string& path, const std::string& where)
         if (!found) found = f;
     }
     if (!found) throw LookupError(where + ": no float level set grid in the file (a head needs one, e.g. 'surface')");
-    return HeadObstacle::levelSet(found);
+    return HeadObstacle::levelSet(found, policy);
 }
 
 } // namespace vdbhair

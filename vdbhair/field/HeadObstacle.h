@@ -3,12 +3,12 @@
 /// negative inside) and its gradient, from a sphere or a narrow-band level set (an OpenVDB
 /// FloatGrid of class level set, such as the `surface` grid of a scalp .vdb).
 ///
-/// What a retrace may do near it is the obstacle's HeadPolicy: a head the user gave (a scalp level
-/// set, a sphere) is trusted, and no retraced vertex may be inside it (KeepOutside); a head that
-/// was only guessed (the sphere fitted to the roots) must not undo the input, so a retraced
-/// vertex may be inside it only as deep as the input vertex at the same arc length was
-/// (NoDeeper): strands are never pushed into the head, and hair that already crossed a rough
-/// head model is not pushed out either.
+/// What a retrace may do near it is the obstacle's HeadPolicy. NoDeeper (what `refine --head` and
+/// the fitted-sphere fallback use): a retraced vertex may be inside the head only as deep as the
+/// input vertex at the same arc length was, so no vertex enters the head that was outside it, and
+/// hair that already crossed the head model (roots embedded in the shared heads' scalps, a rough
+/// sphere) is left as it was instead of being pushed out, which would change its length and
+/// shape. KeepOutside (`--head-policy outside`, and the analytic tests): no retraced vertex inside.
 #pragma once
 
 #include <vdbhair/Types.h>
@@ -51,6 +51,8 @@ public:
     HeadPolicy policy() const { return mPolicy; }
     const Vec3d& center() const { return mCenter; }
     double radius() const { return mRadius; }
+    /// @brief Set the words describe() adds on where the head came from ("fitted to the roots").
+    void setLabel(const std::string& label) { mLabel = label; }
     /// @brief A short description for reports ("sphere (0, 1.6, 0) r 0.11", "level set 'surface'").
     std::string describe() const;
 
@@ -76,6 +78,8 @@ private:
     enum class Kind { None, Disabled, Sphere, LevelSet };
     Kind mKind = Kind::None;
     HeadPolicy mPolicy = HeadPolicy::KeepOutside;
+    std::string mLabel;  ///< where it came from, for describe()
+
     Vec3d mCenter{0.0};
     double mRadius = 0.0;
     openvdb::FloatGrid::ConstPtr mGrid;
@@ -87,6 +91,10 @@ private:
 /// @param where prefix for messages, e.g. "--head scalp.vdb"
 /// @throw IoError, FormatError (unreadable file), LookupError (no level set in it),
 /// UnsupportedError (not a .vdb).
-HeadObstacle readHeadObstacle(const std::string& path, const std::string& where);
+HeadObstacle readHeadObstacle(const std::string& path, const std::string& where,
+                              HeadPolicy policy = HeadPolicy::NoDeeper);
+
+/// @throw ValueError unless "no-deeper" or "outside".
+HeadPolicy headPolicyFromName(const std::string& name);
 
 } // namespace vdbhair

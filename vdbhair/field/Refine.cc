@@ -119,7 +119,9 @@ HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up)
     (void)up;
     ScalpSphere sphere;
     if (!plausibleRootSphere(strands, sphere)) return HeadObstacle::none();
-    return HeadObstacle::sphere(sphere.center, sphere.radius, HeadPolicy::NoDeeper);
+    HeadObstacle head = HeadObstacle::sphere(sphere.center, sphere.radius, HeadPolicy::NoDeeper);
+    head.setLabel("fitted to the roots");
+    return head;
 }
 
 RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded,
