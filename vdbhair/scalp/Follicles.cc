@@ -1,11 +1,12 @@
 #include "Follicles.h"
 
+#include <vdbhair/scalp/PointCloud.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/Random.h>
 #include <vdbhair/scalp/ScalpSampler.h>
 
-#include <nanoflann.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -24,15 +25,6 @@ std::string fmt(double v)
     return buf;
 }
 
-/// nanoflann's view of a vector of positions.
-struct Cloud
-{
-    const std::vector<Vec3d>* pts;
-    std::size_t kdtree_get_point_count() const { return pts->size(); }
-    double kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i][int(d)]; }
-    template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
-};
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3, std::uint32_t>;
 
 template<typename Fn>
 void forRange(std::size_t n, bool threaded, const Fn& fn)
@@ -159,8 +151,8 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     ProgressCounter progress(interrupter, "relaxing roots", std::uint64_t(params.maxIterations), "iterations");
     int it = 0;
     for (; it < params.maxIterations; ++it) {
-        const Cloud cloud{&pos};
-        const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+        const PointCloud cloud{&pos};
+        const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         forRange(count, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
             std::vector<std::pair<std::uint32_t, double>> nb;
             ScalpSampler::Local local(sampler);
@@ -207,8 +199,8 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     // 5. Death: a particle within 0.1 d of an earlier one is removed (they have no force between
     // them once they coincide, which projection onto thin or folded parts of a band can cause).
     {
-        const Cloud cloud{&pos};
-        const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+        const PointCloud cloud{&pos};
+        const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         std::vector<char> alive(count, 1);
         std::vector<std::pair<std::uint32_t, double>> nb;
         const double r2 = (0.1 * d) * (0.1 * d);
@@ -249,8 +241,8 @@ FollicleStats measureFollicles(const std::vector<Vec3f>& positions, const openvd
     s.count = positions.size();
     if (positions.size() >= 2) {
         std::vector<Vec3d> pts(positions.begin(), positions.end());
-        const Cloud cloud{&pts};
-        const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+        const PointCloud cloud{&pts};
+        const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         std::vector<double> nn(pts.size());
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pts.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {

@@ -1,10 +1,11 @@
 #include "ScalpRegion.h"
 
+#include <vdbhair/scalp/PointCloud.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/scalp/ScalpSampler.h>
 
-#include <nanoflann.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -13,14 +14,6 @@
 namespace vdbhair {
 
 namespace {
-struct Cloud
-{
-    const std::vector<Vec3d>* pts;
-    std::size_t kdtree_get_point_count() const { return pts->size(); }
-    double kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i][int(d)]; }
-    template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
-};
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3, std::uint32_t>;
 std::string fmtLength(double v)
 {
     char buf[32];
@@ -41,8 +34,8 @@ std::vector<Vec3f> projectOntoSurface(const openvdb::FloatGrid& surface, const s
     std::vector<Vec3f> out(points.size());
     if (onSurface) onSurface->assign(points.size(), 0);
     if (crossing.empty()) return out;
-    const Cloud cloud{&crossing};
-    const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    const PointCloud cloud{&crossing};
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const Vec3d q(points[i]);
