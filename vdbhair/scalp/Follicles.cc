@@ -1,5 +1,7 @@
 #include "Follicles.h"
 
+#include <vdbhair/Format.h>
+
 #include <vdbhair/scalp/PointCloud.h>
 
 #include <vdbhair/Exceptions.h>
@@ -18,12 +20,6 @@ namespace vdbhair {
 
 namespace {
 
-std::string fmt(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
 
 
 template<typename Fn>
@@ -58,7 +54,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
         throw ValueError(where + ": count 0 and no spacing: give a count of at least 1 or a positive spacing");
     }
     if (params.count > 0 && params.spacing > 0.0) throw ValueError(where + ": both a count and a spacing: give one");
-    if (params.spacing < 0.0 || !std::isfinite(params.spacing)) throw ValueError(where + ": spacing " + fmt(params.spacing) + " must be a positive length");
+    if (params.spacing < 0.0 || !std::isfinite(params.spacing)) throw ValueError(where + ": spacing " + formatNumber(params.spacing) + " must be a positive length");
     if (params.count > params.maxCount) {
         throw LimitError(where + ": count " + std::to_string(params.count) + " is more than the cap of " + std::to_string(params.maxCount) +
                          " (about " + std::to_string(params.count / 5000000 + 1) + " GB of particles and neighbour lists)");
@@ -97,7 +93,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
         d = params.spacing / kNearestPerHexSpacing;
         const double n = 2.0 * area / (std::sqrt(3.0) * d * d);
         if (!(n <= double(params.maxCount))) {
-            throw LimitError(where + ": spacing " + fmt(params.spacing) + " over an area of " + fmt(area) + " makes about " + fmt(std::round(n)) +
+            throw LimitError(where + ": spacing " + formatNumber(params.spacing) + " over an area of " + formatNumber(area) + " makes about " + formatNumber(std::round(n)) +
                              " roots, more than the cap of " + std::to_string(params.maxCount));
         }
         count = std::max<std::size_t>(1, std::size_t(std::llround(n)));

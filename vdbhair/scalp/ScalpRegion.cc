@@ -1,5 +1,7 @@
 #include "ScalpRegion.h"
 
+#include <vdbhair/Format.h>
+
 #include <vdbhair/scalp/PointCloud.h>
 
 #include <vdbhair/Exceptions.h>
@@ -13,14 +15,6 @@
 
 namespace vdbhair {
 
-namespace {
-std::string fmtLength(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
-} // namespace
 
 std::vector<Vec3f> projectOntoSurface(const openvdb::FloatGrid& surface, const std::vector<Vec3f>& points, std::vector<char>* onSurface)
 {
@@ -92,7 +86,7 @@ openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const 
     }
     if (used == 0 || region->activeVoxelCount() == 0) {
         throw LookupError(where + ": none of the " + std::to_string(roots.size()) +
-                          " roots is within " + fmtLength(maxDistance) + " of the surface; the region is empty (are the roots and the scalp in the same units and place?)");
+                          " roots is within " + formatNumber(maxDistance) + " of the surface; the region is empty (are the roots and the scalp in the same units and place?)");
     }
     region->setName("region");
     region->setCreator("vdbhair " VDBHAIR_VERSION_STRING);

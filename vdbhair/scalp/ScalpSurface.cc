@@ -1,6 +1,8 @@
 // The one translation unit that includes OpenVDB's mesh-to-volume and level-set tools for scalps.
 #include "ScalpSurface.h"
 
+#include <vdbhair/Format.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/Version.h>
@@ -24,22 +26,16 @@ namespace vdbhair {
 
 namespace {
 
-std::string fmt(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
 
 /// The voxel size to use, checked (OpenVDB's transforms refuse less than 2e-5... keep it sane).
 double resolveVoxelSize(const ScalpParams& params, const BBox& box, const std::string& where)
 {
     const double h = params.voxelSize > 0.0 ? params.voxelSize : defaultScalpVoxelSize(box);
     if (!(h >= 1e-5) || !std::isfinite(h)) {
-        throw ValueError(where + ": voxel size " + fmt(h) + " must be a finite length of at least 1e-5");
+        throw ValueError(where + ": voxel size " + formatNumber(h) + " must be a finite length of at least 1e-5");
     }
     if (!(params.halfWidth >= 1.f) || !(params.halfWidth <= 64.f)) {
-        throw ValueError(where + ": half width " + fmt(params.halfWidth) + " voxels must be between 1 and 64");
+        throw ValueError(where + ": half width " + formatNumber(params.halfWidth) + " voxels must be between 1 and 64");
     }
     return h;
 }
@@ -48,8 +44,8 @@ void checkBandEstimate(double area, double h, const ScalpParams& params, const s
 {
     const std::uint64_t estimate = estimateBandVoxels(area, h, params.halfWidth);
     if (estimate > params.maxVoxels) {
-        throw LimitError(where + ": voxel size " + fmt(h) + " would make about " + std::to_string(estimate) +
-                         " narrow-band voxels (surface area " + fmt(area) + ", half width " + fmt(params.halfWidth) +
+        throw LimitError(where + ": voxel size " + formatNumber(h) + " would make about " + std::to_string(estimate) +
+                         " narrow-band voxels (surface area " + formatNumber(area) + ", half width " + formatNumber(params.halfWidth) +
                          "), more than the cap of " + std::to_string(params.maxVoxels) + "; use a larger voxel size");
     }
 }
@@ -221,7 +217,7 @@ openvdb::FloatGrid::Ptr scalpFromSphere(const Vec3d& center, double radius, cons
 {
     initializeOpenVdb();
     const std::string where = "scalpFromSphere";
-    if (!(radius > 0.0) || !std::isfinite(radius)) throw ValueError(where + ": radius " + fmt(radius) + " must be a positive length");
+    if (!(radius > 0.0) || !std::isfinite(radius)) throw ValueError(where + ": radius " + formatNumber(radius) + " must be a positive length");
     if (!std::isfinite(center.x()) || !std::isfinite(center.y()) || !std::isfinite(center.z())) throw ValueError(where + ": the centre must be finite");
     BBox box;
     box.expand(Vec3f(center - Vec3d(radius)));
@@ -231,7 +227,7 @@ openvdb::FloatGrid::Ptr scalpFromSphere(const Vec3d& center, double radius, cons
     openvdb::FloatGrid::Ptr grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
         float(radius), openvdb::Vec3f(float(center.x()), float(center.y()), float(center.z())), float(h), params.halfWidth);
     ScalpParams p = params;
-    if (p.source.empty()) p.source = "sphere " + fmt(center.x()) + "," + fmt(center.y()) + "," + fmt(center.z()) + "," + fmt(radius);
+    if (p.source.empty()) p.source = "sphere " + formatNumber(center.x()) + "," + formatNumber(center.y()) + "," + formatNumber(center.z()) + "," + formatNumber(radius);
     stampScalpGrid(*grid, "sphere", p);
     return grid;
 }

@@ -1,5 +1,7 @@
 #include "VariationalImplicit.h"
 
+#include <vdbhair/Format.h>
+
 #include <vdbhair/Exceptions.h>
 
 #include <Eigen/Dense>
@@ -10,14 +12,6 @@
 
 namespace vdbhair {
 
-namespace {
-std::string fmt(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
-}
-} // namespace
 
 VariationalImplicit::VariationalImplicit(const std::vector<Vec3f>& points, const std::vector<Vec3f>& normals,
                                          double offsetFraction)
@@ -32,7 +26,7 @@ VariationalImplicit::VariationalImplicit(const std::vector<Vec3f>& points, const
                          " points; every constraint point needs its normal");
     }
     if (!(offsetFraction > 0.0) || !std::isfinite(offsetFraction)) {
-        throw ValueError(where + ": offset fraction " + fmt(offsetFraction) + " must be positive");
+        throw ValueError(where + ": offset fraction " + formatNumber(offsetFraction) + " must be positive");
     }
 
     // Centre and scale: the unit frame has the bounding box's centre at 0 and diagonal 1.
@@ -56,8 +50,8 @@ VariationalImplicit::VariationalImplicit(const std::vector<Vec3f>& points, const
         const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues();
         if (!(std::sqrt(std::max(ev(0), 0.0)) > 1e-6 * std::sqrt(ev(2)))) {
             throw ValueError(where + ": the " + std::to_string(points.size()) +
-                             " constraint points lie on one plane (principal extents " + fmt(std::sqrt(std::max(ev(0), 0.0))) + " and " +
-                             fmt(std::sqrt(ev(2))) + "); a surface through them is undetermined");
+                             " constraint points lie on one plane (principal extents " + formatNumber(std::sqrt(std::max(ev(0), 0.0))) + " and " +
+                             formatNumber(std::sqrt(ev(2))) + "); a surface through them is undetermined");
         }
     }
 
@@ -98,7 +92,7 @@ VariationalImplicit::VariationalImplicit(const std::vector<Vec3f>& points, const
     mResidual = (sys * x - rhs).cwiseAbs().maxCoeff() / bMax;
     if (!x.allFinite() || !(mResidual < 1e-6)) {
         throw ValueError(where + ": the system of " + std::to_string(m) + " constraints is singular (relative residual " +
-                         fmt(mResidual) + "); are some points repeated?");
+                         formatNumber(mResidual) + "); are some points repeated?");
     }
     mWeights.assign(x.data(), x.data() + m);
     for (int k = 0; k < 4; ++k) mAffine[k] = x(Eigen::Index(m) + k);
