@@ -39,12 +39,13 @@ def main():
     ap.add_argument("--mode", default="consistent")
     ap.add_argument("--vdbhair", default=os.path.join(ROOT, "build", "bin", "vdbhair"))
     ap.add_argument("--render")
+    ap.add_argument("--width", type=int, default=400, help="width of the rendered previews")
     ap.add_argument("--head-voxel", type=float, default=0.0, help="voxel size of the head level sets (0: the scalp verb's default)")
     args = ap.parse_args()
     if not os.path.isdir(DATA):
         sys.exit("refine_table: %s not found" % DATA)
     tmp = tempfile.mkdtemp(prefix="vdbhair-refine-")
-    print("| hairstyle | voxel | full length | leave hair | in head before → after | curvature kept (8 seg / vertex) | tips in place | displacement mean / p95 (voxels) | coherence before → after | corrected |")
+    print("| hairstyle | voxel | full length | leave hair | in head before → after | curvature kept (8 seg / vertex) | tips in place | displacement mean / p95 (voxels) | coherence before → after | corrected / left as they were |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name, hair, head, ropts in STYLES:
         path = os.path.join(DATA, hair)
@@ -72,15 +73,15 @@ def main():
                "%.0f %% / %.0f %%" % (100 * j["curvature_kept"]["segments8"], 100 * j["curvature_kept"]["vertex"]),
                "%.1f %%" % (100 * j["tip_occupancy"]),
                "%.2f / %.2f" % (j["displacement_voxels"]["mean"], j["displacement_voxels"]["p95"]),
-               "%.3f → %.3f" % (j["coherence"]["before"], j["coherence"]["after"]),
-               str(j.get("corrected_strands", "—"))]
+               "%.5f → %.5f" % (j["coherence"]["before"], j["coherence"]["after"]),
+               "%s / %s" % (j.get("corrected_strands", "—"), sum(l.get("reverted_strands", 0) for l in j.get("per_level", [])))]
         print("| " + " | ".join(row) + " |")
         sys.stdout.flush()
         if args.render:
             os.makedirs(args.render, exist_ok=True)
-            base = os.path.join(args.render, name.split()[0].lower())
+            base = os.path.join(args.render, "_".join(name.split()[:2]).lower().replace("(", "").replace(")", ""))
             for tag, f in (("before", path), ("after", out)):
-                rcmd = [args.vdbhair, "render", f, "-o", "%s_%s.png" % (base, tag), "--quiet", "--view", "three-quarter"] + ropts
+                rcmd = [args.vdbhair, "render", f, "-o", "%s_%s.png" % (base, tag), "--quiet", "--view", "three-quarter", "--width", str(args.width)] + ropts
                 if head:
                     rcmd += ["--head", os.path.join(DATA, head)]
                 subprocess.run(rcmd, capture_output=True, text=True)

@@ -104,6 +104,7 @@ nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp)
             e["steps"] = lv.consistency.steps;
             e["pushed_out_of_head"] = lv.consistency.pushedOut;
             e["held_in_hair_steps"] = lv.consistency.heldIn;
+            e["reverted_strands"] = lv.consistency.reverted;
         } else {
             e["stopped"] = {{"vanished", lv.trace.vanished}, {"left_field", lv.trace.leftField}, {"max_steps", lv.trace.maxSteps}};
         }
@@ -124,7 +125,8 @@ void printRefineReport(const RefineResult& r, const RefineParams& rp)
         std::cout << "level " << l << " (voxel " << lv.voxelSize << "): ";
         if (rp.mode == RefineMode::Consistent) {
             std::cout << lv.consistency.corrected << " strands corrected where they strayed from the flow, "
-                      << lv.consistency.pushedOut << " segments kept out of the head\n";
+                      << lv.consistency.pushedOut << " segments kept out of the head, " << lv.consistency.reverted
+                      << " left as they were (their correction left the hair)\n";
         } else {
             std::cout << lv.trace.fullLength << " full length, " << lv.trace.vanished << " stopped where the field vanished, "
                       << lv.trace.leftField << " left the field\n";

@@ -4,6 +4,7 @@
 #include <vdbhair/Progress.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
+#include <vdbhair/field/HairVolume.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -57,6 +58,7 @@ struct Shared
     const BrickedField<TreeT>& tangents;
     const BrickedField<TreeT>& spreads;
     const BrickedField<TreeT>& volume;
+    const HairVolume& dilated;
     const HeadObstacle& head;
     const ConsistencyParams& params;
     double step;
@@ -67,9 +69,10 @@ struct Shared
 
 struct Counts
 {
-    std::size_t corrected = 0, steps = 0, fieldSteps = 0, noFieldSteps = 0, pushedOut = 0, heldIn = 0;
+    std::size_t corrected = 0, steps = 0, fieldSteps = 0, noFieldSteps = 0, pushedOut = 0, heldIn = 0, reverted = 0;
     void add(const Counts& o)
     {
+        reverted += o.reverted;
         corrected += o.corrected;
         steps += o.steps;
         fieldSteps += o.fieldSteps;
@@ -83,7 +86,7 @@ struct Counts
 class StrandTracer
 {
 public:
-    explicit StrandTracer(const Shared& s) : mS(s), mTan(s.tangents), mSpread(s.spreads), mVolume(s.volume), mHead(s.head) {}
+    explicit StrandTracer(const Shared& s) : mS(s), mTan(s.tangents), mSpread(s.spreads), mVolume(s.volume), mDilated(s.dilated), mHead(s.head) {}
 
     void trace(std::size_t i, Counts& counts)
     {
@@ -133,7 +136,7 @@ public:
                     if (haveHead) {
                         // Outside the head, or for a guessed head no deeper inside than the
                         // input strand at this arc length (HeadPolicy).
-                        const double floor = relative ? std::min(0.0, mHead.distance(a + seg * (double(k + 1) / double(m)))) : 0.0;
+                        const double floor = relative ? depthFloor(a + seg * (double(k + 1) / double(m))) : 0.0;
                         if (mHead.distance(q) < floor) {
                             // Slide along the head: drop the step's inward component (the step
                             // keeps its length), then move out what the surface's curvature left in.
@@ -177,17 +180,38 @@ public:
                     }
                 }
                 if (haveHead) {
-                    const double floor = relative ? std::min(0.0, mHead.distance(b)) : 0.0;
+                    const double floor = relative ? depthFloor(b) : 0.0;
                     pushed |= mHead.pushOut(p, floor);
                 }
                 if (pushed) ++counts.pushedOut;
             }
             o[j + 1] = Vec3f(float(p.x()), float(p.y()), float(p.z()));
         }
+        if (!mDilated.containsPolyline(o, n) && mDilated.containsPolyline(c, n)) {
+            // The corrections took the strand out of the hair volume (chords across a gap, a
+            // slide along the head): leave the strand as it was, out of the head if it must be.
+            for (std::size_t j = 0; j < n; ++j) {
+                Vec3d q(c[j]);
+                if (haveHead && !relative) mHead.pushOut(q, 0.0);
+                o[j] = Vec3f(float(q.x()), float(q.y()), float(q.z()));
+            }
+            ++counts.reverted;
+            return;
+        }
         if (corrected) ++counts.corrected;
     }
 
 private:
+    /// How deep (a negative distance) a retraced vertex may be inside a NoDeeper head where the
+    /// input vertex at the same arc length is at @a input: on or outside the surface where the
+    /// input was outside it; where the input was inside, as deep plus half a sub-step, so that
+    /// sub-voxel differences from the input are not pushed (each push turns a step off the flow).
+    double depthFloor(const Vec3d& input)
+    {
+        const double d = mHead.distance(input);
+        return d < 0.0 ? d - 0.5 * mS.step : 0.0;
+    }
+
     /// Whether any corner of the hair volume's cell around world point @a q is active.
     bool insideField(const Vec3d& q) { return mVolume.sample(mS.volumeMap.worldToIndex(q))[3] > 0.f; }
 
@@ -223,6 +247,7 @@ private:
 
     const Shared& mS;
     FieldSampler<TreeT> mTan, mSpread, mVolume;
+    HairVolume::Probe mDilated;
     HeadObstacle::Probe mHead;
 };
 
@@ -253,7 +278,8 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
     const BrickedField<TreeT> spreads(*spreadTree);
     const openvdb::Vec3SGrid& volumeGrid = hairVolume ? *hairVolume : *field.tangent;
     const BrickedField<TreeT> volume(volumeGrid.tree());
-    const Shared shared{strands, map, FieldMapping::fromGrid(volumeGrid), tangents, spreads, volume, head, params, step,
+    const HairVolume dilated(volumeGrid);
+    const Shared shared{strands, map, FieldMapping::fromGrid(volumeGrid), tangents, spreads, volume, dilated, head, params, step,
                         std::sin(params.minSpreadDeg * M_PI / 180.0), 1.0 / (params.returnVoxels * map.worldVoxelSize()), out};
 
     const std::size_t nS = strands.numStrands();
@@ -280,7 +306,7 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
     if (stats) {
         Counts all;
         for (const Counts& c : counts) all.add(c);  // in chunk order
-        *stats = ConsistencyStats{nS, all.corrected, all.steps, all.fieldSteps, all.noFieldSteps, all.pushedOut, all.heldIn};
+        *stats = ConsistencyStats{nS, all.corrected, all.steps, all.fieldSteps, all.noFieldSteps, all.pushedOut, all.heldIn, all.reverted};
     }
     return out;
 }

@@ -29,7 +29,9 @@
 /// it, instead of carrying the correction to its tip.
 ///
 /// A step that would leave the field's active region (the hair volume) heads for the input
-/// strand's own point at the step's end instead: corrected strands stay in the hair.
+/// strand's own point at the step's end instead: corrected strands stay in the hair. A retraced
+/// strand that still leaves the hair volume dilated by a voxel (HairVolume.h: the output chords
+/// can cut across a gap, a slide along the head can carry it out) is left as it was.
 ///
 /// Output strands keep the input's vertex count and segment lengths (so every strand has its
 /// full length), and the head is an obstacle: its HeadPolicy says whether retraced vertices must
@@ -70,6 +72,9 @@ struct ConsistencyStats
     std::size_t noFieldSteps = 0;  ///< sub-steps outside the field or where it vanishes (own direction)
     std::size_t pushedOut = 0;     ///< segments whose end was moved back out of the head on the way
     std::size_t heldIn = 0;        ///< sub-steps that would have left the field, turned toward the input strand
+    /// strands left as they were (out of the head if the policy says so) because their retrace
+    /// left the hair volume (HairVolume.h) where the input did not; not counted as corrected
+    std::size_t reverted = 0;
 };
 
 /// @brief Retrace @a strands through @a field as described in the file comment.

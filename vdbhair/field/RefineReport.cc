@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/FieldMapping.h>
+#include <vdbhair/field/HairVolume.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <openvdb/tools/Morphology.h>
@@ -91,16 +92,15 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
     const FieldMapping map = FieldMapping::fromGrid(*inputField.tangent);
     const double voxel = map.worldVoxelSize();
 
-    // The hair volume and the tip voxels, each dilated by one voxel (26 neighbours).
-    openvdb::BoolTree volume(false), tips(false);
-    volume.topologyUnion(inputField.tangent->tree());
+    const HairVolume volume(*inputField.tangent);
+    // The tip voxels, dilated by one voxel (26 neighbours).
+    openvdb::BoolTree tips(false);
     {
         openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(tips);
         for (std::size_t i = 0; i < nS; ++i) {
             acc.setValueOn(openvdb::Coord::round(map.worldToIndex(Vec3d(input.tip(i)))));
         }
     }
-    openvdb::tools::dilateActiveValues(volume, 1, openvdb::tools::NN_FACE_EDGE_VERTEX, openvdb::tools::IGNORE_TILES);
     openvdb::tools::dilateActiveValues(tips, 1, openvdb::tools::NN_FACE_EDGE_VERTEX, openvdb::tools::IGNORE_TILES);
 
     const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(64, nS / 64));
@@ -114,24 +114,16 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
     std::vector<Part> parts(chunks);
     forChunks(nS, chunks, threaded, [&](std::size_t first, std::size_t last, std::size_t c) {
         Part& part = parts[c];
-        openvdb::tree::ValueAccessor<const openvdb::BoolTree> vol(volume), tip(tips);
+        HairVolume::Probe vol(volume);
+        openvdb::tree::ValueAccessor<const openvdb::BoolTree> tip(tips);
         HeadObstacle::Probe probe(head);
         std::vector<float> scratch;
         std::vector<Vec3f> coarse;
-        auto inside = [&](const Vec3d& p) {
-            return vol.isValueOn(openvdb::Coord::round(map.worldToIndex(p)));
-        };
         for (std::size_t i = first; i < last; ++i) {
             const Vec3f* a = input.data(i);
             const Vec3f* b = output.data(i);
             const std::size_t na = input.size(i), nb = output.size(i);
-            // Leaving the hair volume: vertices and points at most half a voxel apart.
-            bool left = !inside(Vec3d(b[0]));
-            for (std::size_t j = 0; j + 1 < nb && !left; ++j) {
-                const Vec3d p(b[j]), q(b[j + 1]);
-                const std::size_t k = std::max<std::size_t>(1, std::size_t(std::ceil((q - p).length() / (0.5 * voxel))));
-                for (std::size_t s = 1; s <= k && !left; ++s) left = !inside(p + (q - p) * (double(s) / double(k)));
-            }
+            const bool left = !vol.containsPolyline(b, nb);
             part.left += left;
             if (left && part.leftIds.size() < 10) part.leftIds.push_back(i);
             if (!head.empty()) {

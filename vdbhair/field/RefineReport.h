@@ -18,7 +18,7 @@ struct RefineMeasures
     std::size_t strands = 0;
     /// strands with a point (vertices, and points at most half a voxel apart between them)
     /// outside the input's hair volume: the voxels the input's segments pass, dilated by one
-    /// voxel (26 neighbours)
+    /// voxel (26 neighbours; HairVolume.h, the rule retraceConsistent() holds strands to)
     std::size_t leftVolume = 0;
     std::vector<std::size_t> leftExamples;  ///< the first (lowest) indices of such strands, at most 10
     std::size_t insideHeadBefore = 0;  ///< input vertices strictly inside the head

@@ -1,0 +1,45 @@
+/// @file HairVolume.h
+/// @brief The volume a hairstyle occupies, as refinement holds strands in it and measures them
+/// against it: the voxels of a field's active region (the voxels its strands' segments pass),
+/// dilated by one voxel (26 neighbours). A world point is inside when the voxel nearest to it is;
+/// a polyline when its vertices and points at most half a voxel apart between them are.
+#pragma once
+
+#include <vdbhair/Types.h>
+#include <vdbhair/field/FieldMapping.h>
+
+#include <openvdb/openvdb.h>
+
+#include <cstddef>
+
+namespace vdbhair {
+
+class HairVolume
+{
+public:
+    /// @brief The active region of @a grid (a tangent field's), dilated by one voxel.
+    explicit HairVolume(const openvdb::Vec3SGrid& grid);
+
+    const FieldMapping& mapping() const { return mMap; }
+
+    /// @brief Point queries; one per thread.
+    class Probe
+    {
+    public:
+        explicit Probe(const HairVolume& v) : mV(v), mAcc(v.mTree) {}
+        bool contains(const Vec3d& world) { return mAcc.isValueOn(openvdb::Coord::round(mV.mMap.worldToIndex(world))); }
+        /// @brief Whether the vertices of @a p (n of them) and points at most half a voxel apart
+        /// between them are all inside.
+        bool containsPolyline(const Vec3f* p, std::size_t n);
+
+    private:
+        const HairVolume& mV;
+        openvdb::tree::ValueAccessor<const openvdb::BoolTree> mAcc;
+    };
+
+private:
+    FieldMapping mMap;
+    openvdb::BoolTree mTree;
+};
+
+} // namespace vdbhair
