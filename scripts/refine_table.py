@@ -19,7 +19,7 @@ DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
 # (name, hair file, head mesh or None, extra render options)
 STYLES = [
-    ("straight", "hair/cyhair/straight.hair", "scalp/cem_yuksel/woman_head.ply", ["--up", "z"]),
+    ("straight", "hair/cyhair/straight.hair", "scalp/cem_yuksel/woman_head.ply", ["--up", "z", "--facing", "y"]),
     ("harolongo (wavy)", "hair/usc_data/harolongo.data", None, []),
     ("Ruby short", "hair/tressfx/ascii_v2/ruby_short_hair_16_guide.tfx", "scalp/tressfx/ruby_head.obj", []),
     ("Ruby long", "hair/tressfx/ascii_v2/ruby_long_hair_16_guide.tfx", "scalp/tressfx/ruby_head.obj", []),
@@ -81,7 +81,7 @@ def main():
             os.makedirs(args.render, exist_ok=True)
             base = os.path.join(args.render, "_".join(name.split()[:2]).lower().replace("(", "").replace(")", ""))
             for tag, f in (("before", path), ("after", out)):
-                rcmd = [args.vdbhair, "render", f, "-o", "%s_%s.png" % (base, tag), "--quiet", "--view", "three-quarter", "--width", str(args.width)] + ropts
+                rcmd = [args.vdbhair, "render", f, "-o", "%s_%s.png" % (base, tag), "--quiet", "--view", "three-quarter", "--width", str(args.width), "--height", str(args.width)] + ropts
                 if head:
                     rcmd += ["--head", os.path.join(DATA, head)]
                 subprocess.run(rcmd, capture_output=True, text=True)
