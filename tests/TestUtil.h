@@ -123,8 +123,9 @@ inline void requireSameStrands(const StrandSet& a, const StrandSet& b, float tol
 
 } // namespace vdbhair::test
 
-/// Skip the rest of a test case, saying so, when the shared real data is not available.
-/// ctest reports such a case as skipped (SKIP_REGULAR_EXPRESSION "SKIPPED:" in tests/CMakeLists.txt).
+/// Skip the rest of a test case, saying so, when the shared real data is not available. Such a
+/// case must be tagged [data]: those run as one CTest ("unit: real data"), which ctest reports as
+/// skipped when the output says SKIPPED (tests/CMakeLists.txt).
 #define VDBHAIR_REQUIRE_SHARED_DATA()                                                          \
     do {                                                                                       \
         if (vdbhair::test::sharedData().empty()) {                                             \

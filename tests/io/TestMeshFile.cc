@@ -53,7 +53,7 @@ TEST_CASE("readObjMesh: vertices, polygons split into fans, index forms and nega
     for (const Vec3f& v : sphere.vertices) CHECK(std::abs(v.length() - 1.f) < 1e-5f);
 }
 
-TEST_CASE("readPlyMesh: ascii faces of any size; the shared heads read with their counts", "[io][mesh]")
+TEST_CASE("readPlyMesh: ascii faces of any size; the shared heads read with their counts", "[io][mesh][data]")
 {
     const std::string ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
                             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";

@@ -154,7 +154,7 @@ TEST_CASE("writePlyPoints and createRootGrid: roots round trip through PLY and V
     CHECK(desc.find("N") != openvdb::points::AttributeSet::INVALID_POS);
 }
 
-TEST_CASE("sampleFollicles: roots on the shared heads, in the region of a hairstyle's roots", "[scalp]")
+TEST_CASE("sampleFollicles: roots on the shared heads, in the region of a hairstyle's roots", "[scalp][data]")
 {
     VDBHAIR_REQUIRE_SHARED_DATA();
     const std::string data = test::sharedData();

@@ -116,7 +116,7 @@ TEST_CASE("scalpFromPoints: a sphere given as points agrees with the sphere", "[
     CHECK_THROWS_WITH(scalpFromPoints(noNormals, sp), Contains("no normals"));
 }
 
-TEST_CASE("scalpFromMesh: the shared heads become closed level sets", "[scalp]")
+TEST_CASE("scalpFromMesh: the shared heads become closed level sets", "[scalp][data]")
 {
     VDBHAIR_REQUIRE_SHARED_DATA();
     const std::string dir = test::sharedData() + "/scalp";

@@ -1,5 +1,6 @@
 /// @file Image.h
-/// @brief A linear RGB float image, colour maps, text (OpenImageIO with a DejaVu font) and
+/// @brief A linear RGB float image, colour maps, text (OpenImageIO, through the image module
+/// loaded on first use: ImageModule.h, with a DejaVu font) and
 /// atomic writing by extension (PNG, EXR, JPEG, ... whatever OpenImageIO writes).
 #pragma once
 
