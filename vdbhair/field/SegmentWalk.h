@@ -3,8 +3,7 @@
 /// with the part of the segment inside each voxel.
 #pragma once
 
-#include <openvdb/math/Coord.h>
-#include <openvdb/math/Vec3.h>
+#include <openvdb/Types.h>  // openvdb::Vec3d, openvdb::Coord
 
 #include <cmath>
 #include <cstdint>
