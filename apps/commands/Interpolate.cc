@@ -89,8 +89,7 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         const double estimate = count * double(probe.maxVerticesPerHair());
         if (estimate > double(p.helicoid.maxVertices)) {
             throw LimitError(formatValue(count) + " strands would grow up to " + formatValue(estimate) + " vertices, more than the cap of " +
-                             std::to_string(p.helicoid.maxVertices) + " (about " + formatValue(double(p.helicoid.maxVertices) * 12e-9) +
-                             " GB of points): ask for fewer strands");
+                             std::to_string(p.helicoid.maxVertices) + " (--max-vertices; 12 bytes a vertex): ask for fewer strands");
         }
     };
 

@@ -248,7 +248,9 @@ TEST_CASE("interpolateHelicoids: guides of 2 and 4 pieces blend with C1 joints a
     scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(0.3),
                                      {piece(0.5, 0.0, 0.0, 0.0, 0.5), piece(2.5, 0.2, 0.3, 0.1, 0.5), piece(1.0, 0.0, 0.0, 0.0, 0.5, -0.3), piece(3.0, 0.0, 0.5, 0.0, 0.5)}));
     const InterpolationRoots roots = rootsOnLine(Vec3d(0, 0, 0), Vec3d(1, 0, 0), 41);
-    const Scene interp = interpolateHelicoids(scene, roots, {});
+    HelicoidInterpolationParams most;
+    most.pieceCount = PieceCountRule::Most;  // the rule without a jump (the default keeps the heaviest's pieces)
+    const Scene interp = interpolateHelicoids(scene, roots, most);
     for (std::size_t i = 1; i + 1 < interp.guides.size(); ++i) {
         const SceneGuide& g = interp.guides[i];
         REQUIRE(g.pieces.size() == 4u);

@@ -169,6 +169,11 @@ SceneGuide HelicoidInterpolator::interpolate(const Vec3d& root, const Vec3d* nor
         step += gw.weight * g.step;
         if (gw.weight > 0.0) P = std::max(P, g.k.size());
     }
+    if (mParams.pieceCount == PieceCountRule::Heaviest) {
+        std::size_t h = 0;
+        for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h].weight) h = i;
+        P = mGuides[ws[h].guide].k.size();
+    }
     out.step = step;
 
     // Breakpoints b_j = Σ w_i C_i(j / P) and the pieces (§4.2, the rule in the header).

@@ -122,7 +122,13 @@ double relativeFrechet(const Vec3f* a, std::size_t na, const Vec3f* b, std::size
     for (std::size_t i = 0; i < na; ++i) pa[i] = toD(a[i]);
     for (std::size_t i = 0; i < nb; ++i) pb[i] = toD(b[i]);
     densifyPolyline(pa, 0, na - 1, spacing, da);
-    densifyPolyline(pb, 0, nb - 1, spacing, db);
+    // A reconstruction already at the spacing (a trace, stored in floats: its chords are a
+    // rounding longer than its step) is taken as it is; splitting every segment would change the
+    // discrete measure. Others are densified exactly as the original.
+    double longest = 0.0;
+    for (std::size_t i = 0; i + 1 < nb; ++i) longest = std::max(longest, (pb[i + 1] - pb[i]).length());
+    if (longest <= spacing * (1.0 + 1e-4)) db = pb;
+    else densifyPolyline(pb, 0, nb - 1, spacing, db);
     return discreteFrechet(da.data(), da.size(), db.data(), db.size()) / length;
 }
 

@@ -65,8 +65,10 @@ struct ReconstructResult
 /// @throw ValueError for a fraction outside (0, 1] or no strands.
 std::vector<std::size_t> selectGuides(const StrandSet& strands, double fraction, GuideSelection selection, std::uint64_t seed);
 
-/// @brief Discrete Fréchet distance of @a b from @a a, both densified to @a spacing, relative to
-/// @a a's length (0 for a zero-length @a a).
+/// @brief Discrete Fréchet distance of @a b from @a a, both densified to @a spacing (@a b not at
+/// all when no segment of it is longer than the spacing and 1e-4 for float rounding), relative to
+/// @a a's length (0 for a zero-length @a a). The measure has a floor of about half the spacing
+/// where two different vertex sequences sample the same curve (a discrete measure).
 double relativeFrechet(const Vec3f* a, std::size_t na, const Vec3f* b, std::size_t nb, double spacing);
 
 /// @brief Reconstruct @a strands from a share of them, both ways (see above). Identical for any

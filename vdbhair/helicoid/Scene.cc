@@ -216,6 +216,9 @@ Scene readScene(const std::string& path)
         j = json::parse(bytes.begin(), bytes.end());
     } catch (const json::parse_error& e) {
         throw FormatError(path + ": not valid JSON (" + std::string(e.what()) + ")");
+    } catch (const json::out_of_range& e) {
+        // A number no double holds (1e999): the scene would carry a non-finite value.
+        throw FormatError(path + ": a number is out of range; every value must be a finite number (" + std::string(e.what()) + ")");
     }
     return sceneFromJson(j, path);
 }
