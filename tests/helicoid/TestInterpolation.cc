@@ -334,3 +334,21 @@ TEST_CASE("interpolation: bad input is refused before any work, naming the value
     flat.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(0.f)});
     REQUIRE_THROWS_WITH(interpolatePoints(flat, roots, {}), Contains("zero length"));
 }
+
+TEST_CASE("interpolateHelicoids: next to a guide's root the blend approaches that guide (the general path)", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.01;
+    scene.integrator = HelicoidIntegrator::RK4;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp.rolled(0.7),
+                                     {piece(1.0, 0.2, 0.3, 0.5, 1.0, 0.2), piece(2.0, 0.1, -0.4, 0.2, 0.6, 1.3), piece(0.5, -0.3, 0.0, 0.1, 0.9, -2.0)}));
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(-0.4), {piece(0.3, 0.0, 0.2, 0.0, 1.5), piece(1.0, 0.5, 0.0, 0.0, 1.0, 0.5)}));
+    const StrandSet guides = growScene(scene);
+    InterpolationRoots near;
+    near.positions.push_back(Vec3d(1e-4, 0, 0));  // weight of the other guide ~1e-12
+    const StrandSet s = growScene(interpolateHelicoids(scene, near, {}));
+    REQUIRE(s.size(0) == guides.size(0));
+    float worst = 0.f;
+    for (std::size_t v = 0; v < s.size(0); ++v) worst = std::max(worst, (s.positions[v] - Vec3f(1e-4f, 0.f, 0.f) - guides.positions[v]).length());
+    REQUIRE(worst < 1e-5f);
+}

@@ -135,6 +135,21 @@ SceneGuide HelicoidInterpolator::interpolate(const Vec3d& root, const Vec3d* nor
 {
     thread_local std::vector<GuideWeight> ws;
     weights(root, ws);
+    if (mParams.pieceCount == PieceCountRule::Heaviest && ws.size() > 1) {
+        // Only guides with the heaviest's piece count take part (weights renormalized over them).
+        std::size_t h = 0;
+        for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h].weight) h = i;
+        const std::size_t P = mGuides[ws[h].guide].k.size();
+        double sum = 0.0;
+        std::size_t kept = 0;
+        for (const GuideWeight& gw : ws) {
+            if (mGuides[gw.guide].k.size() != P) continue;
+            ws[kept++] = gw;
+            sum += gw.weight;
+        }
+        ws.resize(kept);
+        for (GuideWeight& gw : ws) gw.weight /= sum;
+    }
     const bool surface = mSurface && normal;
     const FrameD W = surface ? surfaceFrame(*normal, mParams.up) : FrameD();
 
@@ -168,11 +183,6 @@ SceneGuide HelicoidInterpolator::interpolate(const Vec3d& root, const Vec3d* nor
         length += gw.weight * g.length;
         step += gw.weight * g.step;
         if (gw.weight > 0.0) P = std::max(P, g.k.size());
-    }
-    if (mParams.pieceCount == PieceCountRule::Heaviest) {
-        std::size_t h = 0;
-        for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h].weight) h = i;
-        P = mGuides[ws[h].guide].k.size();
     }
     out.step = step;
 
