@@ -19,6 +19,8 @@
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/HelicoidInterpolation.h>
+#include <vdbhair/helicoid/PointInterpolation.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/MeshFile.h>
@@ -222,6 +224,43 @@ void benchmarkHelicoids(const std::string& source, int reps)
                 th / double(s.numStrands()) * 1e6);
 }
 
+/// Interpolation (Piuze et al. 2011, §4.2): the paper's setup, 9 p-helicoid guides of about 4
+/// pieces (3 to 5) on a 3 by 3 patch, 64 Euler steps a strand, interpolated at 1,000 and 90,000
+/// random roots on the patch (the paper: 0.67 s for 1,000 on one 2.4 GHz core, about a minute for
+/// 90,000), against blending the guides' points (Blender's Interpolate Curves) at the same vertex
+/// count. Times include growing the strands.
+void benchmarkInterpolation(int reps)
+{
+    std::printf("\n== interpolation: 9 p-helicoid guides of ~4 pieces (the paper: 0.67 s for 1,000 strands, ~1 min for 90,000) ==\n");
+    Scene scene;
+    scene.seed = 1;
+    scene.step = 4.0 / 64.0;
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int g = 0; g < 9; ++g) {
+        SceneGuide guide;
+        guide.root = Vec3d(double(g % 3), double(g / 3), 0.0);
+        guide.frame = FrameD::fromTangentNormal(Vec3d(0.2 * u(rng), 0.2 * u(rng), 1.0), Vec3d(1, 0, 0));
+        const int pieces = 3 + g % 3;  // 3, 4, 5: four on average
+        for (int p = 0; p < pieces; ++p) {
+            guide.pieces.push_back({{1.5 + u(rng), 0.3 * u(rng), 0.5 * u(rng), 0.2 * u(rng)}, 4.0 / pieces, 0.3 * u(rng)});
+        }
+        scene.guides.push_back(guide);
+    }
+    const StrandSet guideStrands = growScene(scene);
+    for (std::size_t count : {std::size_t(1000), std::size_t(90000)}) {
+        InterpolationRoots roots;
+        for (std::size_t i = 0; i < count; ++i) roots.positions.emplace_back(1.0 + u(rng), 1.0 + u(rng), 0.0);
+        StrandSet h, p;
+        const double th = timeBest(reps, [&] { h = growScene(interpolateHelicoids(scene, roots, {})); });
+        const double tp = timeBest(reps, [&] { p = interpolatePoints(guideStrands, roots, {}); });
+        std::printf("%6zu strands: helicoid %.4f s (%.2f us a strand, %zu vertices)  points %.4f s (%.2f us a strand, %zu vertices)  "
+                    "helicoid/points %.2fx  vs the paper %.0fx\n",
+                    count, th, th / double(count) * 1e6, h.numVertices(), tp, tp / double(count) * 1e6, p.numVertices(), th / tp,
+                    0.67e-3 * double(count) / th);
+    }
+}
+
 /// What a helicoid field buys over a plain tangent field (issue 4): curly and wavy strands
 /// retraced from their roots through each, at vdbhair's suggested voxel size and coarser, and the
 /// mean vertex error against the input (same arc lengths), relative to the mean strand length.
@@ -407,7 +446,7 @@ int main(int argc, char** argv)
     std::size_t strands = 100000, vertices = 64;
     int reps = 3, threads = 0;
     double voxelSize = 0.0;
-    std::string sections = "field,helicoids,helicoid-fields,fit,roots";
+    std::string sections = "field,helicoids,helicoid-fields,fit,roots,interpolate";
     std::size_t fitStrands = 2000;
     std::vector<std::size_t> rootCounts{10000, 100000};
     std::string rootHeads;
@@ -418,7 +457,7 @@ int main(int argc, char** argv)
     app.add_option("--reps", reps, "Repetitions (the best time is reported)")->capture_default_str();
     app.add_option("--threads", threads, "Threads (0: all cores)")->capture_default_str();
     app.add_option("--voxel-size", voxelSize, "Voxel size (0: vdbhair's suggestion for each input)");
-    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots (comma-separated)")->capture_default_str();
+    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots, interpolate (comma-separated)")->capture_default_str();
     app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
     app.add_option("--root-counts", rootCounts, "Root counts of the follicle rows")->delimiter(',')->capture_default_str();
     app.add_option("--root-heads", rootHeads, "Only the shared heads whose path contains this");
@@ -448,5 +487,6 @@ int main(int argc, char** argv)
     if (wants("helicoid-fields")) benchmarkHelicoidFields(data, source);
     if (wants("fit")) benchmarkFitting(data, fitStrands, reps);
     if (wants("roots")) benchmarkRoots(data, rootCounts, rootHeads);
+    if (wants("interpolate")) benchmarkInterpolation(reps);
     return 0;
 }

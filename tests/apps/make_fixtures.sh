@@ -59,3 +59,8 @@ PY
 : > empty_mesh.obj
 printf 'ply\nformat ascii 1.0\nelement vertex 0\nend_header\n' > existing_roots.ply
 "$bin" roots scalp_sphere.vdb -o roots.ply --count 500 --quiet
+# Interpolation: guides with one mistake each, and roots without normals.
+printf '{"vdbhair": "scene/1", "guides": []}\n' > no_guides.json
+printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0, 0], "length": 0}]}]}\n' > zero_guide.json
+printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 1e999, 0, 0], "length": 1}]}]}\n' > inf_guide.json
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 10 0\n1 10 0\n0 10 1\n' > roots_no_normals.ply

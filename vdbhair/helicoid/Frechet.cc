@@ -152,4 +152,15 @@ double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_
     return prev[q - 1];
 }
 
+void densifyPolyline(const std::vector<Vec3d>& pts, std::size_t a, std::size_t b, double spacing, std::vector<Vec3d>& out)
+{
+    out.clear();
+    out.push_back(pts[a]);
+    for (std::size_t i = a; i < b; ++i) {
+        const Vec3d d = pts[i + 1] - pts[i];
+        const int n = std::max(1, int(std::ceil(d.length() / spacing - 1e-9)));
+        for (int k = 1; k <= n; ++k) out.push_back(pts[i] + d * (double(k) / n));
+    }
+}
+
 } // namespace vdbhair

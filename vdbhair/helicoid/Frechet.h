@@ -15,6 +15,7 @@
 #include <vdbhair/Types.h>
 
 #include <cstddef>
+#include <vector>
 
 namespace vdbhair {
 
@@ -30,5 +31,10 @@ bool discreteFrechetWithin(const Vec3d* a, std::size_t p, const Vec3d* b, std::s
 /// @brief Fréchet coupling: the smallest sum of coupled distances over monotone couplings.
 /// @param[out] steps optional: the number of pairs in that coupling (its mean leash is sum / steps)
 double frechetCoupling(const Vec3d* a, std::size_t p, const Vec3d* b, std::size_t q, std::size_t* steps = nullptr);
+
+/// @brief The polyline @a pts[a..b] with points inserted so that no gap exceeds @a spacing (world
+/// units), into @a out. Discrete Fréchet measures compare vertices: a sparse curve against a dense
+/// one reports half a segment even when they coincide, so both are brought to one spacing first.
+void densifyPolyline(const std::vector<Vec3d>& pts, std::size_t a, std::size_t b, double spacing, std::vector<Vec3d>& out);
 
 } // namespace vdbhair

@@ -50,20 +50,6 @@ struct Target
     double length = 0.0;
 };
 
-/// The polyline points[a..b] with points inserted so that no gap exceeds @a spacing. Discrete
-/// Fréchet measures compare vertices: a sparse target against a dense trace would report half a
-/// target segment even for a perfect fit, so targets are densified to the trace's spacing.
-void densify(const std::vector<Vec3d>& pts, std::size_t a, std::size_t b, double spacing, std::vector<Vec3d>& out)
-{
-    out.clear();
-    out.push_back(pts[a]);
-    for (std::size_t i = a; i < b; ++i) {
-        const Vec3d d = pts[i + 1] - pts[i];
-        const int n = std::max(1, int(std::ceil(d.length() / spacing - 1e-9)));
-        for (int k = 1; k <= n; ++k) out.push_back(pts[i] + d * (double(k) / n));
-    }
-}
-
 /// Everything one fit needs while it runs (one per strand).
 struct Fitter
 {
@@ -87,7 +73,7 @@ struct Fitter
         const std::vector<Vec3d>& get(const Target& target, std::size_t first, std::size_t last, double spacing)
         {
             if (first != a || last != b) {
-                densify(target.pts, first, last, spacing, pts);
+                densifyPolyline(target.pts, first, last, spacing, pts);
                 a = first;
                 b = last;
             }
@@ -790,7 +776,7 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
         }
     };
     // The whole fit, as grown, against the target densified to the same spacing.
-    densify(target.pts, 0, last, step, denseTarget);
+    densifyPolyline(target.pts, 0, last, step, denseTarget);
     auto measure = [&](StrandFit& f) {
         traceFit(f, trace);
         f.frechet = discreteFrechet(denseTarget.data(), denseTarget.size(), trace.points.data(), trace.points.size());

@@ -216,6 +216,9 @@ Scene readScene(const std::string& path)
         j = json::parse(bytes.begin(), bytes.end());
     } catch (const json::parse_error& e) {
         throw FormatError(path + ": not valid JSON (" + std::string(e.what()) + ")");
+    } catch (const json::out_of_range& e) {
+        // A number no double holds (1e999): the scene would carry a non-finite value.
+        throw FormatError(path + ": a number is out of range; every value must be a finite number (" + std::string(e.what()) + ")");
     }
     return sceneFromJson(j, path);
 }
@@ -289,6 +292,10 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
     auto traceGuides = [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t g = r.begin(); g != r.end(); ++g) {
             if (progress.stopped() || progress.add(1)) return;
+            // Only guides with wisps are traced ahead (their wisps need the trace); the others are
+            // traced where their strand is written, so many wispless guides (interpolated hair)
+            // never hold all their traces at once.
+            if (!scene.guides[g].wisp) continue;
             tracePHelicoid(scene.guides[g].root, scene.guides[g].frame, scene.guides[g].pieces, stepOf(scene.guides[g]),
                            integrator, guideTraces[g]);
         }
@@ -297,6 +304,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
         // Wisp strands of one guide are traced a batch at a time (see tracePHelicoids).
         constexpr std::size_t kBatch = 8;
         HelicoidTrace traces[kBatch];
+        HelicoidTrace own;  // a wispless guide's trace
         std::vector<Rng> rngs;
         for (std::size_t i = r.begin(); i != r.end();) {
             if (progress.stopped()) return;
@@ -305,7 +313,10 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
             std::size_t count = 1;
             rngs.assign(1, Rng(scene.seed, it.guide, it.wisp));
             const HelicoidTrace* batch[kBatch] = {&guideTraces[it.guide]};
-            if (it.wisp > 0) {
+            if (!guide.wisp) {
+                tracePHelicoid(guide.root, guide.frame, guide.pieces, stepOf(guide), integrator, own);
+                batch[0] = &own;
+            } else if (it.wisp > 0) {
                 while (count < kBatch && i + count != r.end() && items[i + count].guide == it.guide) {
                     rngs.emplace_back(scene.seed, it.guide, items[i + count].wisp);
                     ++count;

@@ -1,0 +1,123 @@
+// vdbhair reconstruct IN -o OUT --guides 10%: a hairstyle rebuilt from a share of its strands
+// (Piuze et al. 2011, §5.4), measured against the original both ways (helicoids and points).
+#include "../Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/Reconstruction.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/StrandIO.h>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace vdbhair::app {
+
+namespace {
+
+struct ReconstructCmdParams
+{
+    std::string input, output, guides = "10%", method = "helicoid", select = "random", errors;
+    ReconstructParams rec;
+    int neighbors = 0;
+    CLI::Option* neighborsOpt = nullptr;
+};
+
+/// "10%", "10 %" or "10": a percentage of the strands, as a fraction.
+double parsePercent(const std::string& text)
+{
+    std::string s = text;
+    while (!s.empty() && (s.back() == '%' || s.back() == ' ')) s.pop_back();
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || !std::isfinite(v)) throw ValueError("--guides '" + text + "': expected a percentage such as 10%");
+    if (!(v > 0.0 && v <= 100.0)) throw ValueError("--guides " + text + ": must be more than 0 % and at most 100 % of the strands");
+    return v / 100.0;
+}
+
+int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
+{
+    if (p.method != "helicoid" && p.method != "points") throw ValueError("--method '" + p.method + "' is not one of helicoid, points");
+    if (p.select == "random") p.rec.selection = GuideSelection::Random;
+    else if (p.select == "cluster") p.rec.selection = GuideSelection::Cluster;
+    else throw ValueError("--select '" + p.select + "' is not one of random, cluster");
+    p.rec.guideFraction = parsePercent(p.guides);
+    strandFormatFromPath(p.output, /*forWriting=*/true);
+    if (!(p.rec.helicoid.shepard.power > 0.0) || !std::isfinite(p.rec.helicoid.shepard.power)) {
+        throw ValueError("--power " + formatValue(p.rec.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
+    }
+    if (!(p.rec.fit.maxError > 0.0) || !std::isfinite(p.rec.fit.maxError)) throw ValueError("--max-error " + formatValue(p.rec.fit.maxError) + ": must be a positive fraction of the strand length");
+    if (p.neighborsOpt && p.neighborsOpt->count() > 0) {
+        if (p.neighbors < 1) throw ValueError("--neighbors " + std::to_string(p.neighbors) + ": must be at least 1 (omit it for each method's default)");
+        p.rec.helicoid.shepard.neighbors = p.neighbors;
+        p.rec.points.neighbors = p.neighbors;
+    }
+    const StrandSet strands = loadStrands("reconstruct", p.input, common);
+    const ReconstructResult r = reconstructHairstyle(strands, p.rec, true, common.interrupter);
+    {
+        const Stage stage(common, "writing " + p.output);
+        writeStrands(p.output, p.method == "points" ? r.points : r.helicoid);
+        if (!p.errors.empty()) {
+            std::ostringstream csv;
+            csv << "strand,guide,helicoid,points\n";
+            std::vector<char> isGuide(strands.numStrands(), 0);
+            for (std::size_t g : r.guides) isGuide[g] = 1;
+            char line[128];
+            for (std::size_t i = 0; i < strands.numStrands(); ++i) {
+                std::snprintf(line, sizeof line, "%zu,%d,%.9g,%.9g\n", i, int(isGuide[i]), r.helicoidErrors.relative[i], r.pointErrors.relative[i]);
+                csv << line;
+            }
+            writeFileAtomic(p.errors, csv.str(), "reconstruct(" + p.errors + ")");
+        }
+    }
+    auto stats = [](const ReconstructErrors& e) {
+        return nlohmann::json{{"mean", e.mean}, {"p95", e.p95}, {"mean_interpolated", e.meanInterpolated},
+                              {"p95_interpolated", e.p95Interpolated}, {"seconds", e.seconds}};
+    };
+    const std::size_t S = strands.numStrands();
+    if (common.json) {
+        printJson({{"output", p.output}, {"method", p.method}, {"strands", S}, {"guides", r.guides.size()}, {"unfitted", r.unfitted},
+                   {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", p.select},
+                   {"fit", {{"mean", r.fitSummary.meanRelative}, {"p95", r.fitSummary.p95Relative}, {"pieces_per_strand", r.fitSummary.piecesPerStrand}, {"seconds", r.fitSeconds}}},
+                   {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}}}});
+    } else if (!common.quiet) {
+        char buf[256];
+        std::cout << "reconstructed " << S << " strands from " << r.guides.size() << " guides (" << formatValue(100.0 * double(r.guides.size()) / double(S))
+                  << " %, " << p.select << "); fits: mean " << formatValue(100.0 * r.fitSummary.meanRelative) << " %, "
+                  << formatValue(r.fitSummary.piecesPerStrand) << " pieces, " << formatValue(r.fitSeconds) << " s\n"
+                  << "discrete Frechet distance / strand length:\n";
+        std::snprintf(buf, sizeof buf, "%-9s %10s %10s %14s %14s %9s\n", "method", "mean", "p95", "mean interp.", "p95 interp.", "time s");
+        std::cout << buf;
+        for (int m = 0; m < 2; ++m) {
+            const ReconstructErrors& e = m == 0 ? r.helicoidErrors : r.pointErrors;
+            std::snprintf(buf, sizeof buf, "%-9s %9.3f%% %9.3f%% %13.3f%% %13.3f%% %9.3f\n", m == 0 ? "helicoid" : "points", 100.0 * e.mean, 100.0 * e.p95,
+                          100.0 * e.meanInterpolated, 100.0 * e.p95Interpolated, e.seconds);
+            std::cout << buf;
+        }
+        std::cout << "wrote " << p.output << " (" << p.method << ")" << (p.errors.empty() ? "" : " and " + p.errors) << "\n";
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addReconstructCommand(CLI::App& app, CommonOptions& common)
+{
+    auto params = std::make_shared<ReconstructCmdParams>();
+    CLI::App* sub = app.add_subcommand("reconstruct", "Rebuild a hairstyle from a share of its strands: fit them, interpolate the rest, measure both ways (Piuze et al. 2011, 5.4)");
+    sub->add_option("input", params->input, "Strand file")->required();
+    sub->add_option("-o,--output", params->output, "The reconstructed strands (any strand format), by --method")->required();
+    sub->add_option("--guides", params->guides, "Share of the strands used as guides, in (0, 100] %")->capture_default_str();
+    sub->add_option("--method", params->method, "Which reconstruction to write: helicoid or points (both are measured)")->capture_default_str();
+    sub->add_option("--select", params->select, "Guide choice: random, or cluster (k-means of the roots)")->capture_default_str();
+    sub->add_option("--seed", params->rec.seed, "Seed of the guide choice")->capture_default_str();
+    sub->add_option("--power", params->rec.helicoid.shepard.power, "Shepard exponent p of helicoid interpolation")->capture_default_str();
+    params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair (default: every guide for helicoid, 4 for points)");
+    sub->add_option("--max-error", params->rec.fit.maxError, "Fits: accepted discrete Frechet distance, a fraction of the strand length")->capture_default_str();
+    sub->add_option("--errors", params->errors, "Also write every strand's relative error, both methods, as CSV");
+    addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair reconstruct straight.hair -o rebuilt.hair --guides 10% --json");
+    return {sub, [params, &common] { return runReconstruct(*params, common); }};
+}
+
+} // namespace vdbhair::app

@@ -1,0 +1,354 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/FrameAverage.h>
+#include <vdbhair/helicoid/HelicoidInterpolation.h>
+#include <vdbhair/helicoid/PointInterpolation.h>
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/helicoid/ShepardWeights.h>
+#include <vdbhair/strands/Resample.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <random>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+SceneGuide makeGuide(const Vec3d& root, const FrameD& frame, const std::vector<HelicoidPiece>& pieces)
+{
+    SceneGuide g;
+    g.root = root;
+    g.frame = frame;
+    g.pieces = pieces;
+    return g;
+}
+
+HelicoidPiece piece(double kT, double kN, double kB, double alpha, double length, double roll = 0.0)
+{
+    HelicoidPiece p;
+    p.k = {kT, kN, kB, alpha};
+    p.length = length;
+    p.roll = roll;
+    return p;
+}
+
+/// Discrete curvature at the interior vertices of strand @a i resampled to @a m points by arc length.
+std::vector<double> curvatureProfile(const StrandSet& s, std::size_t i, std::size_t m = 61)
+{
+    std::vector<Vec3f> r(m);
+    resamplePolyline(s.positions.data() + s.begin(i), s.size(i), m, r.data());
+    std::vector<double> k;
+    for (std::size_t j = 1; j + 1 < m; ++j) {
+        const Vec3d a(r[j] - r[j - 1]), b(r[j + 1] - r[j]);
+        const double c = std::clamp(a.dot(b) / (a.length() * b.length()), -1.0, 1.0);
+        k.push_back(std::acos(c) / (0.5 * (a.length() + b.length())));
+    }
+    return k;
+}
+
+double meanAbsDiff(const std::vector<double>& a, const std::vector<double>& b)
+{
+    double s = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) s += std::abs(a[i] - b[i]);
+    return s / double(a.size());
+}
+
+double mean(const std::vector<double>& a)
+{
+    double s = 0.0;
+    for (double v : a) s += v;
+    return s / double(a.size());
+}
+
+/// Roots on the segment from @a a to @a b, @a n of them, ends included.
+InterpolationRoots rootsOnLine(const Vec3d& a, const Vec3d& b, int n)
+{
+    InterpolationRoots r;
+    for (int i = 0; i < n; ++i) r.positions.push_back(a + (b - a) * (double(i) / double(n - 1)));
+    return r;
+}
+
+const FrameD kUp = FrameD::fromTangentNormal(Vec3d(0, 0, 1), Vec3d(1, 0, 0));
+
+} // namespace
+
+TEST_CASE("GuideLocator: Shepard and faded weights sum to 1; a coincident root takes its guide alone", "[helicoid][interp]")
+{
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<Vec3d> roots;
+    for (int i = 0; i < 40; ++i) roots.emplace_back(u(rng), u(rng), u(rng));
+    const GuideLocator loc(roots);
+    std::vector<GuideWeight> w;
+    for (int t = 0; t < 200; ++t) {
+        const Vec3d x(u(rng), u(rng), u(rng));
+        for (int k : {-1, 1, 3, 8, 100}) {
+            ShepardParams sp;
+            sp.neighbors = k;
+            sp.power = 1.0 + double(t % 4);
+            loc.shepardWeights(x, sp, w);
+            double sum = 0.0;
+            for (const GuideWeight& g : w) { sum += g.weight; REQUIRE(g.weight > 0.0); }
+            CAPTURE(t, k);
+            REQUIRE(sum == Approx(1.0).margin(1e-12));
+            REQUIRE(w.size() == (k < 0 || k > 40 ? 40u : std::size_t(k)));
+        }
+        loc.fadedWeights(x, 4, w);
+        double sum = 0.0;
+        for (const GuideWeight& g : w) sum += g.weight;
+        REQUIRE(sum == Approx(1.0).margin(1e-12));
+        REQUIRE(w.size() <= 4u);  // the fifth nearest is faded to zero
+    }
+    // Shepard by hand for two guides: w = d^-p / sum, p = 3.
+    const GuideLocator two({Vec3d(0, 0, 0), Vec3d(3, 0, 0)});
+    two.shepardWeights(Vec3d(1, 0, 0), ShepardParams{}, w);
+    REQUIRE(w.size() == 2u);
+    const double w0 = 1.0 / (1.0 + 1.0 / 8.0);
+    for (const GuideWeight& g : w) REQUIRE(g.weight == Approx(g.guide == 0 ? w0 : 1.0 - w0).epsilon(1e-12));
+    loc.shepardWeights(roots[17], ShepardParams{}, w);
+    REQUIRE(w.size() == 1u);
+    REQUIRE(w[0].guide == 17u);
+    REQUIRE(w[0].weight == 1.0);
+}
+
+TEST_CASE("averageFrames: sign-aligned quaternions; equal frames and halfway rotations", "[helicoid][interp]")
+{
+    const FrameD a = kUp;
+    const FrameD b = a.rolled(M_PI / 2.0);
+    std::vector<FrameD> frames{a, b};
+    const FrameD mid = averageFrames(frames, {{0, 0.5}, {1, 0.5}});
+    const FrameD expect = a.rolled(M_PI / 4.0);
+    REQUIRE((mid.t - expect.t).length() < 1e-12);
+    REQUIRE((mid.n - expect.n).length() < 1e-12);
+    // q and -q: a frame given by a quaternion of the other sign still averages to itself.
+    const std::array<double, 4> q = frameToQuaternion(b);
+    const FrameD back = quaternionToFrame({-q[0], -q[1], -q[2], -q[3]});
+    std::vector<FrameD> same{b, back};
+    const FrameD avg = averageFrames(same, {{0, 0.3}, {1, 0.7}});
+    REQUIRE((avg.t - b.t).length() < 1e-12);
+    REQUIRE((avg.n - b.n).length() < 1e-12);
+}
+
+TEST_CASE("interpolateHelicoids: Fig. 6, two pi-rotated guides vary smoothly, less than point blending", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.01;
+    const std::vector<HelicoidPiece> k{piece(1.0, -0.1, 0.3, 1.0, 3.0)};
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp, k));
+    // The second guide is the first turned by π about the hair's initial direction.
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), FrameD::fromTangentNormal(Vec3d(0, 0, 1), Vec3d(-1, 0, 0)), k));
+    const InterpolationRoots roots = rootsOnLine(Vec3d(0, 0, 0), Vec3d(1, 0, 0), 11);
+    const StrandSet helicoid = growScene(interpolateHelicoids(scene, roots, {}));
+    const StrandSet guides = growScene(scene);
+    const StrandSet points = interpolatePoints(guides, roots, {});
+    double varHelicoid = 0.0, varPoints = 0.0;
+    for (std::size_t i = 0; i + 1 < roots.positions.size(); ++i) {
+        varHelicoid += meanAbsDiff(curvatureProfile(helicoid, i), curvatureProfile(helicoid, i + 1));
+        varPoints += meanAbsDiff(curvatureProfile(points, i), curvatureProfile(points, i + 1));
+    }
+    CAPTURE(varHelicoid, varPoints);
+    // Same k everywhere: every interpolant has the guides' curvature; blended points straighten between them.
+    REQUIRE(varHelicoid < 0.2 * varPoints);
+    const double kGuide = mean(curvatureProfile(guides, 0));
+    REQUIRE(mean(curvatureProfile(helicoid, 5)) == Approx(kGuide).epsilon(0.02));
+    REQUIRE(mean(curvatureProfile(points, 5)) < 0.5 * kGuide);
+}
+
+TEST_CASE("interpolateHelicoids: the kT sign rule removes the straight helicoid between equal guides", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.01;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp, {piece(1.0, -0.1, 0.3, 1.0, 3.0)}));
+    // The same curve described with -kT and a frame turned by π about E_T.
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(M_PI), {piece(-1.0, -0.1, 0.3, 1.0, 3.0)}));
+    const StrandSet guides = growScene(scene);
+    float worst = 0.f;
+    for (std::size_t v = 0; v < guides.size(0); ++v) {
+        worst = std::max(worst, (guides.positions[guides.begin(1) + v] - Vec3f(1, 0, 0) - guides.positions[v]).length());
+    }
+    REQUIRE(worst < 1e-5f);  // the symmetry the rule relies on (a half turn about E_T)
+    const InterpolationRoots mid = rootsOnLine(Vec3d(0.5, 0, 0), Vec3d(0.5, 0, 0), 2);
+    HelicoidInterpolationParams with, without;
+    without.kTSignRule = false;
+    const StrandSet a = growScene(interpolateHelicoids(scene, mid, with));
+    const StrandSet b = growScene(interpolateHelicoids(scene, mid, without));
+    const std::vector<double> kGuide = curvatureProfile(guides, 0);
+    CAPTURE(mean(kGuide), mean(curvatureProfile(a, 0)), mean(curvatureProfile(b, 0)));
+    REQUIRE(meanAbsDiff(curvatureProfile(a, 0), kGuide) < 0.01 * mean(kGuide));
+    REQUIRE(mean(curvatureProfile(b, 0)) < 0.5 * mean(kGuide));
+}
+
+TEST_CASE("interpolateHelicoids: at a guide's root the guide itself, bit for bit", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.02;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp, {piece(1.0, 0.2, 0.3, 0.5, 1.0), piece(-2.0, 0.0, 0.1, 0.0, 1.5, 0.3)}));
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(0.4), {piece(0.5, 0.0, 0.0, 0.0, 2.0)}));
+    scene.guides.back().waviness = WavinessParams{0.01, 30.0, 0.2, 0.0};
+    scene.guides.push_back(makeGuide(Vec3d(0, 1, 0), kUp, {piece(2.0, 0.1, 0.0, 0.0, 0.7), piece(1.0, 0.0, 0.0, 0.0, 0.7), piece(0.0, 0.5, 0.0, 0.0, 0.7)}));
+    InterpolationRoots roots;
+    for (const SceneGuide& g : scene.guides) roots.positions.push_back(g.root);
+    const StrandSet grown = growScene(interpolateHelicoids(scene, roots, {}));
+    const StrandSet guides = growScene(scene);
+    REQUIRE(grown.offsets == guides.offsets);
+    REQUIRE(grown.positions == guides.positions);
+}
+
+TEST_CASE("interpolateHelicoids: a single guide reproduces itself at every root, moved and turned with the root frame", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.01;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 1), kUp, {piece(1.5, 0.2, 0.4, 0.3, 1.0), piece(0.5, 0.0, 0.0, 0.0, 1.0, 0.5)}));
+    const StrandSet guide = growScene(scene);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    InterpolationRoots world, surface;
+    for (int i = 0; i < 20; ++i) {
+        Vec3d n(u(rng), u(rng), u(rng));
+        n.normalize();
+        world.positions.push_back(Vec3d(u(rng), u(rng), u(rng)) * 5.0);
+        surface.positions.push_back(n);  // roots on the unit sphere, radial normals
+        surface.normals.push_back(n);
+    }
+    const StrandSet w = growScene(interpolateHelicoids(scene, world, {}));
+    for (std::size_t i = 0; i < world.positions.size(); ++i) {
+        REQUIRE(w.size(i) == guide.size(0));
+        const Vec3f shift = Vec3f(world.positions[i]) - guide.positions[0];
+        float worst = 0.f;
+        for (std::size_t v = 0; v < guide.size(0); ++v) worst = std::max(worst, (w.positions[w.begin(i) + v] - guide.positions[v] - shift).length());
+        CAPTURE(i);
+        REQUIRE(worst < 1e-5f);
+    }
+    const std::vector<Vec3d> guideNormal{Vec3d(0, 0, 1)};
+    const StrandSet s = growScene(interpolateHelicoids(scene, surface, {}, guideNormal));
+    const FrameD Wg = surfaceFrame(Vec3d(0, 0, 1), Vec3d(0, 1, 0));
+    for (std::size_t i = 0; i < surface.positions.size(); ++i) {
+        const FrameD Wr = surfaceFrame(surface.normals[i], Vec3d(0, 1, 0));
+        float worst = 0.f;
+        for (std::size_t v = 0; v < guide.size(0); ++v) {
+            const Vec3d d(guide.positions[v] - guide.positions[0]);
+            const Vec3d local(d.dot(Wg.t), d.dot(Wg.n), d.dot(Wg.b));
+            const Vec3d expect = surface.positions[i] + local.x() * Wr.t + local.y() * Wr.n + local.z() * Wr.b;
+            worst = std::max(worst, float((Vec3d(s.positions[s.begin(i) + v]) - expect).length()));
+        }
+        CAPTURE(i);
+        REQUIRE(worst < 1e-5f);
+    }
+}
+
+TEST_CASE("interpolateHelicoids: guides of 2 and 4 pieces blend with C1 joints and no jump between neighbours", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.01;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp, {piece(1.0, 0.1, 0.2, 0.3, 1.0), piece(2.0, -0.3, 0.0, 0.0, 1.0, 0.4)}));
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(0.3),
+                                     {piece(0.5, 0.0, 0.0, 0.0, 0.5), piece(2.5, 0.2, 0.3, 0.1, 0.5), piece(1.0, 0.0, 0.0, 0.0, 0.5, -0.3), piece(3.0, 0.0, 0.5, 0.0, 0.5)}));
+    const InterpolationRoots roots = rootsOnLine(Vec3d(0, 0, 0), Vec3d(1, 0, 0), 41);
+    HelicoidInterpolationParams most;
+    most.pieceCount = PieceCountRule::Most;  // the rule without a jump (the default keeps the heaviest's pieces)
+    const Scene interp = interpolateHelicoids(scene, roots, most);
+    for (std::size_t i = 1; i + 1 < interp.guides.size(); ++i) {
+        const SceneGuide& g = interp.guides[i];
+        REQUIRE(g.pieces.size() == 4u);
+        HelicoidTrace trace;
+        tracePHelicoid(g.root, g.frame, g.pieces, scene.step, HelicoidIntegrator::Euler, trace);
+        for (std::size_t j = 1; j < trace.pieces.size(); ++j) {
+            const std::size_t at = trace.joints[j];
+            const Helicoid& prev = trace.pieces[j - 1];
+            const FrameD end = prev.frameFromTheta(prev.theta(trace.points[at], 0.0));
+            // The next piece starts with the previous piece's end frame (Eq. 2), rolled about its tangent.
+            CAPTURE(i, j);
+            REQUIRE((trace.pieces[j].q.t - end.t).length() < 1e-9);
+            REQUIRE(std::abs(trace.pieces[j].q.n.dot(end.t)) < 1e-9);
+        }
+    }
+    // Neighbouring interpolants stay close (no jump in the piece structure between the guides).
+    const StrandSet s = growScene(interp);
+    double worstStep = 0.0;
+    for (std::size_t i = 1; i + 2 < roots.positions.size(); ++i) {
+        const std::vector<double> a = curvatureProfile(s, i), b = curvatureProfile(s, i + 1);
+        std::vector<Vec3f> ra(31), rb(31);
+        resamplePolyline(s.positions.data() + s.begin(i), s.size(i), 31, ra.data());
+        resamplePolyline(s.positions.data() + s.begin(i + 1), s.size(i + 1), 31, rb.data());
+        for (int v = 0; v < 31; ++v) worstStep = std::max(worstStep, double((rb[v] - rb[0] - (ra[v] - ra[0])).length()));
+    }
+    CAPTURE(worstStep);
+    REQUIRE(worstStep < 0.15);  // 40 steps across: ~0.025 of the root spacing per step at 2 units of length
+}
+
+TEST_CASE("interpolateHelicoids and interpolatePoints: identical for 1 and 2 threads", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.02;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int g = 0; g < 9; ++g) {
+        std::vector<HelicoidPiece> pcs;
+        for (int p = 0; p < 2 + g % 3; ++p) pcs.push_back(piece(2.0 * u(rng), u(rng), u(rng), u(rng), 0.5, u(rng)));
+        scene.guides.push_back(makeGuide(Vec3d(u(rng), u(rng), 0.0), kUp.rolled(u(rng)), pcs));
+    }
+    InterpolationRoots roots;
+    for (int i = 0; i < 3000; ++i) roots.positions.emplace_back(u(rng), u(rng), 0.0);
+    StrandSet h[2], p[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        h[t] = growScene(interpolateHelicoids(scene, roots, {}));
+        p[t] = interpolatePoints(growScene(scene), roots, {});
+    }
+    REQUIRE(h[0].offsets == h[1].offsets);
+    REQUIRE(h[0].positions == h[1].positions);
+    REQUIRE(p[0].offsets == p[1].offsets);
+    REQUIRE(p[0].positions == p[1].positions);
+}
+
+TEST_CASE("interpolation: bad input is refused before any work, naming the value and the rule", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp, {piece(1.0, 0.0, 0.0, 0.0, 1.0)}));
+    const InterpolationRoots roots = rootsOnLine(Vec3d(0, 0, 0), Vec3d(1, 0, 0), 3);
+    Scene none;
+    REQUIRE_THROWS_WITH(interpolateHelicoids(none, roots, {}), Contains("no guides"));
+    Scene zero = scene;
+    zero.guides[0].pieces[0].length = 0.0;
+    REQUIRE_THROWS_WITH(interpolateHelicoids(zero, roots, {}), Contains("guide 0: zero length"));
+    Scene nan = scene;
+    nan.guides[0].pieces[0].k.kB = std::nan("");
+    REQUIRE_THROWS_WITH(interpolateHelicoids(nan, roots, {}), Contains("guide 0: piece 0: k is not finite"));
+    HelicoidInterpolationParams bad;
+    bad.shepard.power = 0.0;
+    REQUIRE_THROWS_WITH(interpolateHelicoids(scene, roots, bad), Contains("power 0: must be a positive"));
+    bad = {};
+    bad.shepard.neighbors = 0;
+    REQUIRE_THROWS_WITH(interpolateHelicoids(scene, roots, bad), Contains("neighbors 0: must be at least 1"));
+    bad = {};
+    bad.maxVertices = 100;
+    REQUIRE_THROWS_AS(interpolateHelicoids(scene, roots, bad), LimitError);
+    PointInterpolationParams pbad;
+    pbad.neighbors = 0;
+    REQUIRE_THROWS_WITH(interpolatePoints(growScene(scene), roots, pbad), Contains("neighbors 0"));
+    StrandSet flat;
+    flat.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(0.f)});
+    REQUIRE_THROWS_WITH(interpolatePoints(flat, roots, {}), Contains("zero length"));
+}
+
+TEST_CASE("interpolateHelicoids: next to a guide's root the blend approaches that guide (the general path)", "[helicoid][interp]")
+{
+    Scene scene;
+    scene.step = 0.01;
+    scene.integrator = HelicoidIntegrator::RK4;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp.rolled(0.7),
+                                     {piece(1.0, 0.2, 0.3, 0.5, 1.0, 0.2), piece(2.0, 0.1, -0.4, 0.2, 0.6, 1.3), piece(0.5, -0.3, 0.0, 0.1, 0.9, -2.0)}));
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(-0.4), {piece(0.3, 0.0, 0.2, 0.0, 1.5), piece(1.0, 0.5, 0.0, 0.0, 1.0, 0.5)}));
+    const StrandSet guides = growScene(scene);
+    InterpolationRoots near;
+    near.positions.push_back(Vec3d(1e-4, 0, 0));  // weight of the other guide ~1e-12
+    const StrandSet s = growScene(interpolateHelicoids(scene, near, {}));
+    REQUIRE(s.size(0) == guides.size(0));
+    float worst = 0.f;
+    for (std::size_t v = 0; v < s.size(0); ++v) worst = std::max(worst, (s.positions[v] - Vec3f(1e-4f, 0.f, 0.f) - guides.positions[v]).length());
+    REQUIRE(worst < 1e-5f);
+}

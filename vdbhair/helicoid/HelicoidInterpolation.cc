@@ -1,0 +1,298 @@
+#include "HelicoidInterpolation.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
+#include <vdbhair/Progress.h>
+#include <vdbhair/helicoid/FrameAverage.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vdbhair {
+
+namespace {
+
+bool finite3(const Vec3d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+
+} // namespace
+
+FrameD surfaceFrame(const Vec3d& normal, const Vec3d& up)
+{
+    const double len = normal.length();
+    if (!(len > 0.0) || !std::isfinite(len)) throw ValueError("surface normal " + formatNumber(len) + " long: must be a non-zero finite vector");
+    const Vec3d n = normal / len;
+    // up, then x, then z: the first not within ~8° of the normal (as `vdbhair roots`).
+    const Vec3d candidates[3] = {up, Vec3d(1.0, 0.0, 0.0), Vec3d(0.0, 0.0, 1.0)};
+    for (const Vec3d& c : candidates) {
+        const Vec3d u = c - n * n.dot(c);
+        if (u.length() > 0.14 * c.length()) return FrameD::fromTangentNormal(n, u);
+    }
+    return FrameD::fromTangentNormal(n, Vec3d(0.0, 1.0, 0.0) - n * n.y());
+}
+
+void validateGuideScene(const Scene& guides)
+{
+    if (guides.guides.empty()) throw ValueError("no guides: interpolation needs at least one guide");
+    if (!(guides.step > 0.0) || !std::isfinite(guides.step)) throw ValueError("scene step " + formatNumber(guides.step) + ": must be a positive finite length");
+    for (std::size_t g = 0; g < guides.guides.size(); ++g) {
+        const SceneGuide& sg = guides.guides[g];
+        const std::string where = "guide " + std::to_string(g) + ": ";
+        if (sg.pieces.empty()) throw ValueError(where + "has no pieces");
+        if (!finite3(sg.root)) throw ValueError(where + "root is not finite");
+        if (!finite3(sg.frame.t) || !finite3(sg.frame.n)) throw ValueError(where + "frame is not finite");
+        if (!(sg.step >= 0.0) || !std::isfinite(sg.step)) throw ValueError(where + "step " + formatNumber(sg.step) + ": must be a positive finite length");
+        double total = 0.0;
+        for (std::size_t i = 0; i < sg.pieces.size(); ++i) {
+            const HelicoidPiece& p = sg.pieces[i];
+            const std::string pw = where + "piece " + std::to_string(i) + ": ";
+            if (!std::isfinite(p.k.kT) || !std::isfinite(p.k.kN) || !std::isfinite(p.k.kB) || !std::isfinite(p.k.alpha)) {
+                throw ValueError(pw + "k is not finite; every value of a piece must be a finite number");
+            }
+            if (!std::isfinite(p.roll)) throw ValueError(pw + "roll is not finite; every value of a piece must be a finite number");
+            if (!(p.length >= 0.0) || !std::isfinite(p.length)) throw ValueError(pw + "length " + formatNumber(p.length) + ": must be zero or a positive finite length");
+            total += p.length;
+        }
+        if (!(total > 0.0)) throw ValueError(where + "zero length: a guide must have a positive length");
+    }
+}
+
+/// One guide, normalized for blending (kT sign rule applied, roll of the first piece folded in).
+struct HelicoidInterpolator::Prepared
+{
+    double length = 0.0, step = 0.0;
+    std::vector<HelicoidParams> k;  ///< per piece, kT >= 0 under the sign rule
+    std::vector<double> entryRoll;  ///< per piece: its roll about E_T where it begins (index 0 unused)
+    std::vector<double> c;          ///< normalized arc length of each breakpoint, #P + 1
+};
+
+HelicoidInterpolator::HelicoidInterpolator(const Scene& guides, const HelicoidInterpolationParams& params,
+                                           const std::vector<Vec3d>& guideNormals)
+    : mScene(guides), mParams(params)
+{
+    validateGuideScene(guides);
+    validateShepardParams(params.shepard);
+    const std::size_t G = guides.guides.size();
+    if (!guideNormals.empty() && guideNormals.size() != G) {
+        throw ValueError(std::to_string(guideNormals.size()) + " guide normals for " + std::to_string(G) + " guides");
+    }
+    mSurface = !guideNormals.empty();
+    mGuides.resize(G);
+    mFirstFrames.resize(G);
+    std::vector<Vec3d> roots(G);
+    double minStep = std::numeric_limits<double>::max(), maxLength = 0.0;
+    std::size_t maxPieces = 0;
+    for (std::size_t g = 0; g < G; ++g) {
+        const SceneGuide& sg = guides.guides[g];
+        Prepared& p = mGuides[g];
+        roots[g] = sg.root;
+        p.step = sg.step > 0.0 ? sg.step : guides.step;
+        const std::size_t P = sg.pieces.size();
+        p.k.resize(P);
+        p.entryRoll.assign(P, 0.0);
+        p.c.assign(P + 1, 0.0);
+        bool previousFlip = false;
+        double firstRoll = 0.0;
+        for (std::size_t i = 0; i < P; ++i) {
+            const HelicoidPiece& pc = sg.pieces[i];
+            const bool flip = params.kTSignRule && pc.k.kT < 0.0;
+            p.k[i] = pc.k;
+            if (flip) p.k[i].kT = -pc.k.kT;
+            // A frame after a flipped piece is itself turned by π: a half turn only where the state changes.
+            const double roll = pc.roll + (flip != previousFlip ? M_PI : 0.0);
+            if (i == 0) firstRoll = roll;
+            else p.entryRoll[i] = roll;
+            previousFlip = flip;
+            p.length += pc.length;
+            p.c[i + 1] = p.length;
+        }
+        for (double& v : p.c) v /= p.length;
+        p.c[P] = 1.0;
+        FrameD q = sg.frame.rolled(firstRoll);
+        if (mSurface) q = relativeFrame(q, surfaceFrame(guideNormals[g], params.up));
+        mFirstFrames[g] = q;
+        minStep = std::min(minStep, p.step);
+        maxLength = std::max(maxLength, p.length);
+        maxPieces = std::max(maxPieces, P);
+    }
+    const double perHair = maxLength / minStep + double(maxPieces) + 1.0;
+    mMaxVertices = perHair < 1e18 ? std::size_t(std::ceil(perHair)) : std::numeric_limits<std::size_t>::max();
+    mNormals = guideNormals;
+    mLocator = std::make_unique<GuideLocator>(std::move(roots));
+}
+
+HelicoidInterpolator::~HelicoidInterpolator() = default;
+
+void HelicoidInterpolator::weights(const Vec3d& root, std::vector<GuideWeight>& out) const
+{
+    mLocator->shepardWeights(root, mParams.shepard, out);
+}
+
+SceneGuide HelicoidInterpolator::interpolate(const Vec3d& root, const Vec3d* normal) const
+{
+    thread_local std::vector<GuideWeight> ws;
+    weights(root, ws);
+    if (mParams.pieceCount == PieceCountRule::Heaviest && ws.size() > 1) {
+        // Only guides with the heaviest's piece count take part (weights renormalized over them).
+        std::size_t h = 0;
+        for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h].weight) h = i;
+        const std::size_t P = mGuides[ws[h].guide].k.size();
+        double sum = 0.0;
+        std::size_t kept = 0;
+        for (const GuideWeight& gw : ws) {
+            if (mGuides[gw.guide].k.size() != P) continue;
+            ws[kept++] = gw;
+            sum += gw.weight;
+        }
+        ws.resize(kept);
+        for (GuideWeight& gw : ws) gw.weight /= sum;
+    }
+    const bool surface = mSurface && normal;
+    const FrameD W = surface ? surfaceFrame(*normal, mParams.up) : FrameD();
+
+    // A single weight: the guide itself, moved to the root (and turned with the surface frame).
+    if (ws.size() == 1) {
+        SceneGuide out = mScene.guides[ws[0].guide];
+        out.root = root;
+        out.wisp.reset();
+        out.fit = nullptr;
+        if (surface) out.frame = composeFrames(W, relativeFrame(out.frame, surfaceFrame(mNormals[ws[0].guide], mParams.up)));
+        return out;
+    }
+
+    SceneGuide out;
+    out.root = root;
+    // Frame of the first piece (§4.1, §4.3).
+    const FrameD avg = averageFrames(mFirstFrames, ws);
+    out.frame = surface ? composeFrames(W, avg) : avg;
+    if (mSurface && !normal) {
+        // Guide frames are relative to their surface frames; without a normal here, use the heaviest's.
+        std::size_t h = 0;
+        for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h].weight) h = i;
+        out.frame = composeFrames(surfaceFrame(mNormals[ws[h].guide], mParams.up), avg);
+    }
+
+    // Length, step and the piece count.
+    double length = 0.0, step = 0.0;
+    std::size_t P = 0;
+    for (const GuideWeight& gw : ws) {
+        const Prepared& g = mGuides[gw.guide];
+        length += gw.weight * g.length;
+        step += gw.weight * g.step;
+        if (gw.weight > 0.0) P = std::max(P, g.k.size());
+    }
+    out.step = step;
+
+    // Breakpoints b_j = Σ w_i C_i(j / P) and the pieces (§4.2, the rule in the header).
+    auto C = [](const Prepared& g, double u) {
+        const std::size_t Pi = g.k.size();
+        const double x = u * double(Pi);
+        const std::size_t m = std::min<std::size_t>(std::size_t(x), Pi - 1);
+        return g.c[m] + (x - double(m)) * (g.c[m + 1] - g.c[m]);
+    };
+    auto pieceOf = [](const Prepared& g, std::size_t j, std::size_t P) {
+        const std::size_t Pi = g.k.size();
+        return std::min<std::size_t>(std::size_t((double(j) + 0.5) * double(Pi) / double(P)), Pi - 1);
+    };
+    out.pieces.resize(P);
+    double bPrev = 0.0;
+    for (std::size_t j = 0; j < P; ++j) {
+        double bNext = 1.0;
+        if (j + 1 < P) {
+            bNext = 0.0;
+            for (const GuideWeight& gw : ws) bNext += gw.weight * C(mGuides[gw.guide], double(j + 1) / double(P));
+        }
+        HelicoidPiece& pc = out.pieces[j];
+        double sinSum = 0.0, cosSum = 0.0;
+        for (const GuideWeight& gw : ws) {
+            const Prepared& g = mGuides[gw.guide];
+            const std::size_t m = pieceOf(g, j, P);
+            pc.k.kT += gw.weight * g.k[m].kT;
+            pc.k.kN += gw.weight * g.k[m].kN;
+            pc.k.kB += gw.weight * g.k[m].kB;
+            pc.k.alpha += gw.weight * g.k[m].alpha;
+            if (j > 0) {
+                const double r = (m != pieceOf(g, j - 1, P)) ? g.entryRoll[m] : 0.0;
+                sinSum += gw.weight * std::sin(r);
+                cosSum += gw.weight * std::cos(r);
+            }
+        }
+        pc.roll = (j > 0 && sinSum != 0.0) ? std::atan2(sinSum, cosSum) : 0.0;
+        pc.length = std::max(0.0, bNext - bPrev) * length;
+        bPrev = bNext;
+    }
+
+    // Waviness (Eq. 4) by the same weights.
+    double wavyWeight = 0.0;
+    for (const GuideWeight& gw : ws) if (mScene.guides[gw.guide].waviness) wavyWeight += gw.weight;
+    if (wavyWeight > 0.0) {
+        WavinessParams wp;
+        double s = 0.0, c = 0.0;
+        for (const GuideWeight& gw : ws) {
+            const auto& w = mScene.guides[gw.guide].waviness;
+            if (!w) continue;
+            wp.amplitude += gw.weight * w->amplitude;
+            wp.noise += gw.weight * w->noise;
+            wp.frequency += gw.weight / wavyWeight * w->frequency;
+            s += gw.weight * std::sin(w->phase);
+            c += gw.weight * std::cos(w->phase);
+        }
+        wp.phase = std::atan2(s, c);
+        out.waviness = wp;
+    }
+    return out;
+}
+
+Scene interpolateHelicoids(const Scene& guides, const InterpolationRoots& roots, const HelicoidInterpolationParams& params,
+                           const std::vector<Vec3d>& guideNormals, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    const std::size_t R = roots.positions.size();
+    if (R == 0) throw ValueError("no roots: interpolation needs at least one root");
+    if (!roots.normals.empty() && roots.normals.size() != R) {
+        throw ValueError(std::to_string(roots.normals.size()) + " root normals for " + std::to_string(R) + " roots");
+    }
+    for (std::size_t i = 0; i < R; ++i) {
+        if (!finite3(roots.positions[i])) throw ValueError("root " + std::to_string(i) + " is not finite");
+        if (!roots.normals.empty() && (!finite3(roots.normals[i]) || !(roots.normals[i].length() > 0.0))) {
+            throw ValueError("root " + std::to_string(i) + ": normal is zero or not finite");
+        }
+    }
+    // Guide normals: given, or those of the roots nearest the guides.
+    std::vector<Vec3d> gn = guideNormals;
+    if (gn.empty() && !roots.normals.empty()) {
+        validateGuideScene(guides);
+        const GuideLocator near(roots.positions);
+        gn.reserve(guides.guides.size());
+        for (const SceneGuide& g : guides.guides) gn.push_back(roots.normals[near.nearest(g.root)]);
+    }
+    const HelicoidInterpolator interp(guides, params, gn);
+    // Estimate first: never allocate from an unchecked count.
+    const double estimate = double(R) * double(interp.maxVerticesPerHair());
+    if (estimate > double(params.maxVertices)) {
+        throw LimitError(std::to_string(R) + " hairs would grow up to " + formatNumber(estimate) + " vertices, more than the cap of " +
+                         std::to_string(params.maxVertices) + " (fewer roots, shorter guides or a larger step)");
+    }
+    Scene out;
+    out.seed = guides.seed;
+    out.step = guides.step;
+    out.integrator = guides.integrator;
+    out.head = guides.head;
+    out.guides.resize(R);
+    ProgressCounter progress(interrupter, "interpolating helicoids", R, "hairs");
+    auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+        if (progress.stopped()) return;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            out.guides[i] = interp.interpolate(roots.positions[i], roots.normals.empty() ? nullptr : &roots.normals[i]);
+        }
+        progress.add(r.size());
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, R, 256), body);
+    else body(tbb::blocked_range<std::size_t>(0, R));
+    if (progress.stopped()) throw InterruptedError("interpolateHelicoids: interrupted");
+    return out;
+}
+
+} // namespace vdbhair

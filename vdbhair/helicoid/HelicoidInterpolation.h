@@ -1,0 +1,140 @@
+/// @file HelicoidInterpolation.h
+/// @brief New hairs from guide p-helicoids by interpolating their parameters (Piuze et al. 2011,
+/// §4.1-4.3), not their points: curvature then varies smoothly between guides (Fig. 6).
+///
+/// **Weights** (§4.1): Shepard's, ShepardWeights.h (power 3, every guide or the K nearest).
+///
+/// **kT sign rule** (§4.1): before blending, a piece with kT < 0 is described by -kT and a frame
+/// turned by π, the same curve; two geometrically identical guides that differ only in the sign of
+/// kT then no longer blend into a straight helicoid. The half turn is about E_T, not E_N as the
+/// paper writes: with Eq. 1 as printed (theta = atan2(kT y1 + kN y2, 1 + kN y1 - kT y2) + kB y3),
+/// negating kT and turning the frame about E_T maps (y1, y2, y3) to (y1, -y2, -y3), theta to
+/// -theta and leaves E_T unchanged everywhere (HelicoidFit.h flips its fits the same way); a turn
+/// about E_N does not preserve the field. Frames after a flipped piece are themselves turned by π,
+/// so a piece's half turn is added to its roll only where the flip state changes.
+///
+/// **Frames**: the first piece's frame Q (its roll folded in) is averaged by FrameAverage.h
+/// (quaternions sign-aligned to the heaviest guide, weighted, normalized).
+///
+/// **p-helicoids** (§4.2), the rule: a guide of P_i pieces is a step function k_i(s) over normalized
+/// arc length s ∈ [0, 1] with breakpoints c_i[0..P_i] (c_i[j] = length of its first j pieces / L_i).
+/// The new hair has P pieces: the heaviest guide's count, blending only the guides of that count
+/// (PieceCountRule::Heaviest, the default, where every C_i below is the identity on breakpoints), or
+/// the largest count among the guides with non-zero weight (Most: for Shepard over every guide the
+/// same P everywhere, so nothing jumps); with
+/// C_i(u) = c_i linearly interpolated at the fractional index u·P_i, its breakpoints are
+/// b_j = Σ w_i C_i(j / P) and piece j takes k_j = Σ w_i k_i(C_i((j + ½) / P)), i.e. each guide's k
+/// resampled along its own normalized arc length. Breakpoints and k are continuous in the weights,
+/// so for a fixed P guides of different piece counts blend without a jump; a guide with P_i = P
+/// is reproduced piece for piece at weight 1, and a guide with fewer pieces is split into
+/// sub-pieces of its own k — not the same curve, since each piece restarts the helicoid at its
+/// joint. Measured on fitted real hair (straight.hair, 1,000 strands at 30 vertices, 10 % guides,
+/// two neighbours), resampling the k of fits with other piece counts gave tips 50-70 % of the
+/// length away from the blend of the two guides' tips midway between them: a fit's piece k are
+/// only meaningful in their own frame chain. Hence the default Heaviest, which never resamples. The new hair's length is
+/// L = Σ w_i L_i, piece j is (b_{j+1} - b_j) L long, and as in the paper, pieces after the first take
+/// their frame from the end of the previous one (Eq. 2), so every joint is C¹ (frames continuous).
+/// Their roll about E_T (fits have one) is the weighted circular mean of each guide's roll at the
+/// piece where that guide's own piece begins (0 where the new piece continues a guide piece).
+/// The tracing step is Σ w_i step_i; waviness (Eq. 4) blends amplitude and noise over all guides
+/// (0 where a guide has none), frequency and phase over the guides that have it. Wisps are not
+/// carried over: each new hair is one strand.
+///
+/// **Arbitrary surfaces** (§4.3): when the new roots and the guides have surface normals, a surface
+/// frame W is built at each root from its normal n (W = [n, u, n × u], u the reference axis `up`
+/// projected onto the tangent plane; x, then z where up is nearly normal — the rule of
+/// `vdbhair roots`). Each guide's first frame is expressed in its own root's W_i, R_i = W_iᵀ Q_i;
+/// the R_i are averaged as above, and the new hair's frame is Q = W R̄: the hair leaves the scalp
+/// at the same angle to the surface as its guides, wherever the surface turns.
+///
+/// **Exactness**: a root with a single weight (a coincident root, or a single guide) returns that
+/// guide unchanged, translated to the root (and rotated by W W_iᵀ with surface frames).
+#pragma once
+
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/helicoid/ShepardWeights.h>
+
+#include <openvdb/util/NullInterrupter.h>
+
+#include <memory>
+#include <vector>
+
+namespace vdbhair {
+
+/// @brief How many pieces a new hair has when its guides' piece counts differ (§4.2, see above).
+enum class PieceCountRule
+{
+    Heaviest,  ///< the heaviest guide's count, blended only with the guides of that count (their
+               ///< weights renormalized): no piece is resampled; the shape jumps where the heaviest
+               ///< guide changes between guides of different counts
+    Most,      ///< the most pieces among the guides with weight: constant under Shepard over every
+               ///< guide (no jump anywhere), but a guide with fewer pieces is split and its shape changes
+};
+
+struct HelicoidInterpolationParams
+{
+    ShepardParams shepard;
+    PieceCountRule pieceCount = PieceCountRule::Heaviest;  ///< measured: Most is far worse on fitted real hair (see README)
+    bool kTSignRule = true;                    ///< §4.1; off only to show what it prevents
+    Vec3d up{0.0, 1.0, 0.0};                   ///< reference axis of surface frames (as `vdbhair roots --up`)
+    std::size_t maxVertices = std::size_t(1) << 28;  ///< refuse requests that would grow more (12 bytes each: 3 GB)
+};
+
+/// @brief Roots at which to interpolate: #R world positions and, for surface frames, #R unit
+/// outward normals (or none).
+struct InterpolationRoots
+{
+    std::vector<Vec3d> positions;
+    std::vector<Vec3d> normals;
+};
+
+/// @brief The surface frame W at a root with normal @a normal (see above).
+/// @throw ValueError for a zero or non-finite normal.
+FrameD surfaceFrame(const Vec3d& normal, const Vec3d& up);
+
+/// @brief Check a guide scene before interpolating from it.
+/// @throw ValueError naming the guide, the piece and the value: no guides, no pieces, a non-finite
+/// root, frame, k, length, roll or step, a negative piece length or a zero total length.
+void validateGuideScene(const Scene& guides);
+
+class HelicoidInterpolator
+{
+public:
+    /// @param guideNormals empty, or #G unit normals at the guide roots (surface frames)
+    /// @throw ValueError (validateGuideScene, validateShepardParams, normals of the wrong size).
+    HelicoidInterpolator(const Scene& guides, const HelicoidInterpolationParams& params,
+                         const std::vector<Vec3d>& guideNormals = {});
+    ~HelicoidInterpolator();
+
+    /// @brief The new hair at @a root; @a normal non-null (and guide normals given) for surface frames.
+    SceneGuide interpolate(const Vec3d& root, const Vec3d* normal = nullptr) const;
+
+    /// @brief The Shepard weights at @a root (they sum to 1).
+    void weights(const Vec3d& root, std::vector<GuideWeight>& out) const;
+
+    const GuideLocator& locator() const { return *mLocator; }
+    /// @brief An upper bound of the vertices one new hair grows (checked against overflow).
+    std::size_t maxVerticesPerHair() const { return mMaxVertices; }
+
+private:
+    struct Prepared;
+    const Scene& mScene;
+    HelicoidInterpolationParams mParams;
+    std::vector<Prepared> mGuides;
+    std::vector<FrameD> mFirstFrames;  ///< Q of each guide's first piece (relative to W_i with surface frames)
+    std::vector<Vec3d> mNormals;       ///< guide normals (surface frames) or empty
+    std::unique_ptr<GuideLocator> mLocator;
+    bool mSurface = false;
+    std::size_t mMaxVertices = 0;
+};
+
+/// @brief New hairs at every root: a scene of one guide per root (no wisps), with the guides'
+/// seed, step and integrator; grow it with growScene(). In parallel, identical for any thread count.
+/// With root normals and no @a guideNormals, each guide takes the normal of the root nearest it.
+/// @throw ValueError (see HelicoidInterpolator; no roots; normals of the wrong size), LimitError
+/// (more than params.maxVertices vertices would grow: estimated before any work), InterruptedError.
+Scene interpolateHelicoids(const Scene& guides, const InterpolationRoots& roots, const HelicoidInterpolationParams& params,
+                           const std::vector<Vec3d>& guideNormals = {}, bool threaded = true,
+                           openvdb::util::NullInterrupter* interrupter = nullptr);
+
+} // namespace vdbhair

@@ -1,0 +1,238 @@
+#include "Reconstruction.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
+#include <vdbhair/Random.h>
+#include <vdbhair/helicoid/Frechet.h>
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/helicoid/ShepardWeights.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace vdbhair {
+
+namespace {
+
+Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
+
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The strands @a idx of @a s, in that order.
+StrandSet subset(const StrandSet& s, const std::vector<std::size_t>& idx)
+{
+    StrandSet out;
+    out.offsets.assign(1, 0);
+    for (std::size_t i : idx) {
+        out.positions.insert(out.positions.end(), s.positions.begin() + std::ptrdiff_t(s.begin(i)),
+                             s.positions.begin() + std::ptrdiff_t(s.begin(i) + s.size(i)));
+        out.offsets.push_back(std::uint32_t(out.positions.size()));
+    }
+    return out;
+}
+
+void summarize(ReconstructErrors& e, const std::vector<char>& isGuide)
+{
+    std::vector<double> all = e.relative, interp;
+    for (std::size_t i = 0; i < all.size(); ++i) if (!isGuide[i]) interp.push_back(all[i]);
+    auto stats = [](std::vector<double>& v, double& mean, double& p95) {
+        mean = p95 = 0.0;
+        if (v.empty()) return;
+        double sum = 0.0;
+        for (double x : v) sum += x;  // in strand order: independent of threads
+        mean = sum / double(v.size());
+        const std::size_t k = std::min(v.size() - 1, std::size_t(std::ceil(0.95 * double(v.size()))) - 1);
+        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+        p95 = v[k];
+    };
+    stats(all, e.mean, e.p95);
+    stats(interp, e.meanInterpolated, e.p95Interpolated);
+}
+
+} // namespace
+
+std::vector<std::size_t> selectGuides(const StrandSet& strands, double fraction, GuideSelection selection, std::uint64_t seed)
+{
+    const std::size_t S = strands.numStrands();
+    if (S == 0) throw ValueError("no strands to select guides from");
+    if (!(fraction > 0.0 && fraction <= 1.0)) {
+        throw ValueError("guides " + formatNumber(fraction * 100.0) + " %: must be more than 0 % and at most 100 % of the strands");
+    }
+    const std::size_t G = std::min(S, std::max<std::size_t>(1, std::size_t(std::llround(fraction * double(S)))));
+    // A seeded shuffle (Fisher-Yates): the random order.
+    std::vector<std::size_t> order(S);
+    std::iota(order.begin(), order.end(), 0);
+    Rng rng(seed, 0x67756964ull);
+    for (std::size_t i = 0; i + 1 < S; ++i) {
+        const std::size_t j = i + std::size_t(rng.uniform() * double(S - i));
+        std::swap(order[i], order[std::min(j, S - 1)]);
+    }
+    std::vector<std::size_t> chosen(order.begin(), order.begin() + std::ptrdiff_t(G));
+    if (selection == GuideSelection::Cluster && G < S) {
+        std::vector<Vec3d> roots(S), centres(G);
+        for (std::size_t i = 0; i < S; ++i) roots[i] = toD(strands.root(i));
+        for (std::size_t c = 0; c < G; ++c) centres[c] = roots[chosen[c]];
+        std::vector<std::uint32_t> label(S);
+        for (int it = 0; it < 8; ++it) {
+            const GuideLocator loc(centres);
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) label[i] = loc.nearest(roots[i]);
+            });
+            std::vector<Vec3d> sum(G, Vec3d(0.0));
+            std::vector<std::size_t> count(G, 0);
+            for (std::size_t i = 0; i < S; ++i) {
+                sum[label[i]] += roots[i];
+                ++count[label[i]];
+            }
+            for (std::size_t c = 0; c < G; ++c) if (count[c]) centres[c] = sum[c] / double(count[c]);
+        }
+        std::vector<std::size_t> best(G, S);
+        std::vector<double> bestD(G, 0.0);
+        for (std::size_t i = 0; i < S; ++i) {
+            const std::uint32_t c = label[i];
+            const double d = (roots[i] - centres[c]).lengthSqr();
+            if (best[c] == S || d < bestD[c]) {
+                best[c] = i;
+                bestD[c] = d;
+            }
+        }
+        std::vector<char> taken(S, 0);
+        chosen.clear();
+        for (std::size_t c = 0; c < G; ++c) if (best[c] < S && !taken[best[c]]) { chosen.push_back(best[c]); taken[best[c]] = 1; }
+        for (std::size_t i = 0; chosen.size() < G && i < S; ++i) if (!taken[order[i]]) { chosen.push_back(order[i]); taken[order[i]] = 1; }
+    }
+    std::sort(chosen.begin(), chosen.end());
+    return chosen;
+}
+
+double relativeFrechet(const Vec3f* a, std::size_t na, const Vec3f* b, std::size_t nb, double spacing)
+{
+    const double length = polylineLength(a, na);
+    if (!(length > 0.0)) return 0.0;
+    std::vector<Vec3d> pa(na), pb(nb), da, db;
+    for (std::size_t i = 0; i < na; ++i) pa[i] = toD(a[i]);
+    for (std::size_t i = 0; i < nb; ++i) pb[i] = toD(b[i]);
+    densifyPolyline(pa, 0, na - 1, spacing, da);
+    // A reconstruction already at the spacing (a trace, stored in floats: its chords are a
+    // rounding longer than its step) is taken as it is; splitting every segment would change the
+    // discrete measure. Others are densified exactly as the original.
+    double longest = 0.0;
+    for (std::size_t i = 0; i + 1 < nb; ++i) longest = std::max(longest, (pb[i + 1] - pb[i]).length());
+    if (longest <= spacing * (1.0 + 1e-4)) db = pb;
+    else densifyPolyline(pb, 0, nb - 1, spacing, db);
+    return discreteFrechet(da.data(), da.size(), db.data(), db.size()) / length;
+}
+
+ReconstructResult reconstructHairstyle(const StrandSet& strands, const ReconstructParams& params, bool threaded,
+                                       openvdb::util::NullInterrupter* interrupter)
+{
+    validateShepardParams(params.helicoid.shepard);
+    if (params.points.neighbors < 1) throw ValueError("neighbors " + std::to_string(params.points.neighbors) + ": must be at least 1");
+    const std::size_t S = strands.numStrands();
+    ReconstructResult res;
+    const std::vector<std::size_t> selected = selectGuides(strands, params.guideFraction, params.selection, params.seed);
+
+    // Fit the guides (§5.2-5.3).
+    auto t0 = std::chrono::steady_clock::now();
+    const StrandSet guideStrands = subset(strands, selected);
+    std::vector<std::string> fitErrors;
+    const std::vector<StrandFit> fits = fitStrands(guideStrands, params.fit, threaded, &fitErrors, interrupter);
+    res.fitSeconds = seconds(t0);
+    res.fitSummary = summarizeFits(guideStrands, fits, fitErrors, params.fit.maxError);
+    Scene scene;
+    scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines (as `vdbhair fit` writes them)
+    std::vector<std::size_t> fittedGuides;
+    std::vector<double> fitStep(S, 0.0);  // a guide's errors are measured at its fit's step
+    for (std::size_t g = 0; g < fits.size(); ++g) {
+        if (!fitErrors[g].empty()) {
+            ++res.unfitted;
+            continue;
+        }
+        SceneGuide sg;
+        sg.root = fits[g].root;
+        sg.frame = fits[g].frame;
+        sg.pieces = fits[g].pieces;
+        sg.step = fits[g].step;
+        scene.guides.push_back(std::move(sg));
+        fittedGuides.push_back(selected[g]);
+        fitStep[selected[g]] = fits[g].step;
+    }
+    if (scene.guides.empty()) throw ValueError("no guide strand could be fitted (all have zero length)");
+    scene.step = scene.guides.front().step;
+    res.guides = fittedGuides;
+    std::vector<char> isGuide(S, 0);
+    for (std::size_t i : fittedGuides) isGuide[i] = 1;
+    std::vector<std::size_t> others;
+    InterpolationRoots roots;
+    for (std::size_t i = 0; i < S; ++i) {
+        if (isGuide[i]) continue;
+        others.push_back(i);
+        roots.positions.push_back(toD(strands.root(i)));
+    }
+
+    // Assemble #S strands: guides from @a guideSet (in guide order), the others from @a interp.
+    auto assemble = [&](const StrandSet& guideSet, const StrandSet& interp) {
+        StrandSet out;
+        out.offsets.assign(1, 0);
+        std::size_t g = 0, o = 0;
+        for (std::size_t i = 0; i < S; ++i) {
+            const StrandSet& src = isGuide[i] ? guideSet : interp;
+            const std::size_t k = isGuide[i] ? g++ : o++;
+            out.positions.insert(out.positions.end(), src.positions.begin() + std::ptrdiff_t(src.begin(k)),
+                                 src.positions.begin() + std::ptrdiff_t(src.begin(k) + src.size(k)));
+            out.offsets.push_back(std::uint32_t(out.positions.size()));
+        }
+        return out;
+    };
+
+    // The helicoid way: the fits regrown, interpolated hairs at the other roots.
+    const StrandSet grownGuides = growScene(scene, {}, threaded, interrupter);
+    StrandSet interpHelicoid, interpPoints;
+    if (!others.empty()) {
+        GrowOptions grow;
+        grow.maxVertices = params.helicoid.maxVertices;
+        interpHelicoid = growScene(interpolateHelicoids(scene, roots, params.helicoid, {}, threaded, interrupter), grow, threaded, interrupter);
+    }
+    res.helicoidErrors.seconds = seconds(t0);
+    res.helicoid = assemble(grownGuides, interpHelicoid);
+
+    // The points way from the same guides' raw strands.
+    t0 = std::chrono::steady_clock::now();
+    const StrandSet rawGuides = subset(strands, fittedGuides);
+    if (!others.empty()) interpPoints = interpolatePoints(rawGuides, roots, params.points, {}, threaded, interrupter);
+    res.pointErrors.seconds = seconds(t0);
+    res.points = assemble(rawGuides, interpPoints);
+
+    // Errors, every strand at the fits' spacing.
+    res.helicoidErrors.relative.assign(S, 0.0);
+    res.pointErrors.relative.assign(S, 0.0);
+    auto measure = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const std::size_t n = strands.size(i);
+            const Vec3f* a = strands.positions.data() + strands.begin(i);
+            const double length = polylineLength(a, n);
+            double spacing = fitStep[i] > 0.0      ? fitStep[i]
+                             : params.fit.step > 0.0 ? params.fit.step
+                                                     : 0.25 * length / double(std::max<std::size_t>(1, n - 1));
+            if (!(spacing > 0.0)) spacing = 1.0;
+            res.helicoidErrors.relative[i] = relativeFrechet(a, n, res.helicoid.positions.data() + res.helicoid.begin(i), res.helicoid.size(i), spacing);
+            res.pointErrors.relative[i] = relativeFrechet(a, n, res.points.positions.data() + res.points.begin(i), res.points.size(i), spacing);
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 16), measure);
+    else measure(tbb::blocked_range<std::size_t>(0, S));
+    summarize(res.helicoidErrors, isGuide);
+    summarize(res.pointErrors, isGuide);
+    return res;
+}
+
+} // namespace vdbhair
