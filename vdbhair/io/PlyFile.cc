@@ -7,6 +7,7 @@
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/TextScanner.h>
+#include <vdbhair/Format.h>
 
 #include <algorithm>
 #include <charconv>
@@ -183,10 +184,14 @@ int findProperty(const Element* e, const char* name, bool list = false)
 /// anything is allocated. @a onElement(e) runs before an element's items; @a onItem(e, n, values,
 /// list, src) after each item, with its scalar property values (by property index) and, for the
 /// list property @a listProp of @a listElement, the list's items (other lists are skipped).
+/// An element without properties holds no bytes, so its items are not visited at all (its count,
+/// up to 2^63-1, is bounded by nothing in the file). @a interrupter (may be null) is polled so
+/// that SIGTERM and Ctrl-C end the walk.
 template<typename ElementFn, typename ItemFn>
 void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std::string& where, const Element* listElement,
-                 int listProp, ElementFn&& onElement, ItemFn&& onItem)
+                 int listProp, openvdb::util::NullInterrupter* interrupter, ElementFn&& onElement, ItemFn&& onItem)
 {
+    InterruptPoll poll(interrupter, where);
     ByteReader bin(bytes, where);
     TextScanner text(bytes, where, hdr.bodyOffset);
     text.setLine(hdr.bodyLine);  // body line numbers continue the header's
@@ -202,8 +207,10 @@ void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std
                      std::to_string(minBytes) + " bytes but only " + std::to_string(src.remainingBytes()) + " bytes remain");
         }
         onElement(e);
+        if (e.props.empty()) continue;  // nothing to read, whatever the count
         values.assign(e.props.size(), 0.0);
         for (std::uint64_t n = 0; n < e.count; ++n) {
+            poll();
             for (std::size_t k = 0; k < e.props.size(); ++k) {
                 const Property& p = e.props[k];
                 if (!p.isList) {
@@ -221,6 +228,7 @@ void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std
                 const bool keep = &e == listElement && int(k) == listProp;
                 if (keep) list.clear();
                 for (std::uint64_t j = 0; j < cnt; ++j) {
+                    poll();
                     const double v = src.read(p.type, "list item");
                     if (keep) list.push_back(v);
                 }
@@ -257,7 +265,8 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     // Body
     std::vector<Vec3f> positions, colors;
     std::vector<std::uint64_t> counts;
-    readPlyBody(bytes, hdr, where, nullptr, -1, [&](const Element& e) {
+    std::uint64_t nsegsSum = 0;  // vertices the strands so far use, at most the vertex count
+    readPlyBody(bytes, hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
         if (&e == vertexEl) { positions.reserve(e.count); if (hasColor) colors.reserve(e.count); }
         if (&e == strandEl) counts.reserve(e.count);
     }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
@@ -269,6 +278,13 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
         } else if (&e == strandEl) {
             const double s = values[std::size_t(iseg)];
             if (s < 0 || s != std::floor(s)) src.fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
+            // Checked against the vertices before any sum (a float nsegs can be 1e19, and
+            // nsegs + 1 summed over strands would wrap 2^64).
+            if (!(s < double(vertexEl->count)) || std::uint64_t(s) + 1 > vertexEl->count - nsegsSum) {
+                src.fail("strand " + std::to_string(n) + " has nsegs " + formatNumber(s) + "; with the strands before it that needs more than the " +
+                         std::to_string(vertexEl->count) + " vertices of the 'vertex' element");
+            }
+            nsegsSum += std::uint64_t(s) + 1;
             counts.push_back(std::uint64_t(s) + 1);
         }
     });
@@ -375,7 +391,7 @@ TriangleMesh readPlyMesh(const std::string& path)
     if (iface < 0) throw FormatError(where + ": line " + std::to_string(faceEl->line) + ": the 'face' element needs a list 'vertex_indices'");
 
     TriangleMesh mesh;
-    readPlyBody(bytes, hdr, where, faceEl, iface, [&](const Element& e) {
+    readPlyBody(bytes, hdr, where, faceEl, iface, nullptr, [&](const Element& e) {
         if (&e == vertexEl) mesh.vertices.reserve(e.count);
         if (&e == faceEl) mesh.triangles.reserve(e.count);
     }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>& face, ValueSource& src) {
@@ -421,7 +437,7 @@ OrientedPoints readPlyPoints(const std::string& path)
     const bool hasN = inx >= 0 && iny >= 0 && inz >= 0, hasT = itx >= 0 && ity >= 0 && itz >= 0;
 
     OrientedPoints pts;
-    readPlyBody(bytes, hdr, where, nullptr, -1, [&](const Element& e) {
+    readPlyBody(bytes, hdr, where, nullptr, -1, nullptr, [&](const Element& e) {
         if (&e == vertexEl) pts.positions.reserve(e.count);
     }, [&](const Element& e, std::uint64_t, const std::vector<double>& v, const std::vector<double>&, ValueSource& src) {
         if (&e != vertexEl) return;

@@ -68,6 +68,8 @@ bool isStrandFile(const std::string& path)
 
 StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
+    // What the path is comes before what its extension says (a folder has none).
+    requireRegularFile(path, path);
     switch (strandFormatFromPath(path)) {
     case StrandFormat::Hair: return readHair(path, opts, report);
     case StrandFormat::Data: return readData(path, opts, report);
