@@ -123,8 +123,8 @@ CASES = [
     ("ply: big endian", ["convert", write("be.ply", "ply\nformat binary_big_endian 1.0\nend_header\n"), "{out}.obj"], ["be.ply", "binary_big_endian PLY is not supported"]),
     ("ply: negative element count", ["convert", write("negel.ply", "ply\nformat ascii 1.0\nelement vertex -2\nend_header\n"), "{out}.obj"], ["negel.ply", "negative count"]),
     ("ply: binary vertex count beyond the file", ["convert", write("bigv.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\n" + ply_strand + "\0" * 30), "{out}.obj"], ["bigv.ply", "declares 4000000000 items"]),
-    ("ply: 2^63-1 items without properties, then a bad nsegs", ["convert", write("junk.ply", b"ply\nformat binary_little_endian 1.0\nelement junk 9223372036854775807\n" + ply_head.split("1.0\n", 1)[1].encode() + ply_strand.encode() + bytes(24) + struct.pack("<H", 5)), "{out}.obj"], ["junk.ply", "strand 0 has nsegs 5"]),
-    ("ply: nsegs sum wrapping 2^64", ["convert", write("wrap.ply", ply_head + "element strand 2\nproperty double nsegs\nend_header\n0 0 0\n1 1 1\n9223372036854775808\n9223372036854775808\n"), "{out}.obj"], ["wrap.ply", "needs more than the 2 vertices"]),
+    ("ply: 2^63-1 items without properties, then a bad nsegs", ["convert", write("junk.ply", b"ply\nformat binary_little_endian 1.0\nelement junk 9223372036854775807\n" + ply_head.split("1.0\n", 1)[1].encode() + ply_strand.encode() + bytes(24) + struct.pack("<H", 5)), "{out}.obj"], ["junk.ply", "nsegs + 1 add up to 6 vertices but the 'vertex' element has 2"]),
+    ("ply: nsegs sum wrapping 2^64", ["convert", write("wrap.ply", ply_head + "element strand 2\nproperty double nsegs\nend_header\n0 0 0\n1 1 1\n9223372036854775808\n9223372036854775808\n"), "{out}.obj"], ["wrap.ply", "add up to more than 2^64-1 vertices"]),
     ("ply: NaN coordinate", ["convert", write("nan.ply", ply_head + ply_strand + "0 0 0\n1 nan 1\n1\n"), "{out}.obj"], ["nan.ply", "non-finite coordinate"]),
     # TressFX
     ("tfx: 2^32-1 strands of 0 vertices", ["convert", write("zero.tfx", tfx4(0xffffffff, 0)), "{out}.obj"], ["zero.tfx", "4294967295 strands of 0 vertices"]),
@@ -133,7 +133,7 @@ CASES = [
     ("tfx: ASCII strand count mismatch", ["convert", write("a.tfx", "version 2.0\nnumStrands 2\nstrand 0 numVerts 2 texcoord 0 0\n0 0 0\n1 1 1\n"), "{out}.obj"], ["a.tfx", "numStrands declares 2 strands but the file has 1"]),
     # HairNet convdata
     ("convdata: wrong magic", ["convert", write("magic.convdata", b"NUMPY" + bytes(20)), "{out}.obj"], ["magic.convdata", "not a NumPy .npy file"]),
-    ("convdata: shape product wrapping 2^64", ["convert", write("wrap.convdata", npy("(4611686018427387904, 4, 1)", bytes(64))), "{out}.obj"], ["wrap.convdata", "floats but only 64 bytes remain"]),
+    ("convdata: shape product wrapping 2^64", ["convert", write("wrap.convdata", npy("(4611686018427387904, 4, 1)", bytes(64))), "{out}.obj"], ["wrap.convdata", "floats, more than 2^64 bytes"]),
     ("convdata: dimension beyond 2^64", ["convert", write("dim.convdata", npy("(99999999999999999999999, 1, 1)", bytes(16))), "{out}.obj"], ["dim.convdata", "beyond 2^64-1"]),
     ("convdata: float64", ["convert", write("f8.convdata", npy("(4, 1, 1)", bytes(32), "<f8")), "{out}.obj"], ["f8.convdata", "dtype '<f8' is not supported"]),
     # OBJ

@@ -80,6 +80,6 @@ TEST_CASE("readPly: property-less elements and nsegs sums beyond the vertices (i
         const std::string b = "ply\nformat ascii 1.0\n" + vertex + "element strand 2\nproperty double nsegs\nend_header\n"
                               "0 0 0\n1 1 1\n9223372036854775808\n9223372036854775808\n";
         REQUIRE_THROWS_WITH(readPly(test::writeBytes("wrap.ply", b)),
-                            Contains("strand 0 has nsegs 9.22337e+18; with the strands before it that needs more than the 2 vertices"));
+                            Contains("the strands' nsegs + 1 add up to more than 2^64-1 vertices but the 'vertex' element has 2"));
     }
 }

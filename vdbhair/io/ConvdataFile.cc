@@ -71,9 +71,9 @@ StrandSet readConvdata(const std::string& path, const ReadOptions& opts, ReadRep
     // Each product is checked before it is formed (shape[0] * rows * cols can wrap 2^64).
     if (rows && cols > std::numeric_limits<std::uint32_t>::max() / rows) in.fail("shape " + shapeStr + " is too large");
     const std::uint64_t slots = rows * cols;
-    if (slots && shape[0] > in.remaining() / 4 / slots) {
+    if (slots && shape[0] > std::numeric_limits<std::uint64_t>::max() / 4 / slots) {
         in.fail("the array of shape " + shapeStr + " needs " + std::to_string(shape[0]) + " x " + std::to_string(slots) +
-                " floats but only " + std::to_string(in.remaining()) + " bytes remain in the file");
+                " floats, more than 2^64 bytes");
     }
     in.require(shape[0] * slots, 4, "the array of shape " + shapeStr);
     std::vector<float> data(std::size_t(shape[0] * slots));

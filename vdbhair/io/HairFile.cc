@@ -69,9 +69,9 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
                          " points; every strand has at least one point");
     }
     if (!(arrays & kSegments) && defSegments < 65536u && nS * (std::uint64_t(defSegments) + 1) != nP) {
-        in.failAt(8, "the header declares " + std::to_string(nS) + " strands of default segments " + std::to_string(defSegments) +
-                         " + 1 points, which is " + std::to_string(nS * (std::uint64_t(defSegments) + 1)) + " points, but " +
-                         std::to_string(nP) + " points (no segments array: every strand has the default)");
+        in.failAt(8, "the strands' point counts add up to " + std::to_string(nS * (std::uint64_t(defSegments) + 1)) +
+                         " but the header declares " + std::to_string(nP) + " points (no segments array: every strand has default segments " +
+                         std::to_string(defSegments) + " + 1 points)");
     }
 
     // Points per strand

@@ -265,7 +265,8 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     // Body
     std::vector<Vec3f> positions, colors;
     std::vector<std::uint64_t> counts;
-    std::uint64_t nsegsSum = 0;  // vertices the strands so far use, at most the vertex count
+    std::uint64_t nsegsSum = 0;    // vertices the strands use
+    bool nsegsSaturated = false;   // their sum exceeds 2^64-1
     readPlyBody(bytes, hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
         if (&e == vertexEl) { positions.reserve(e.count); if (hasColor) colors.reserve(e.count); }
         if (&e == strandEl) counts.reserve(e.count);
@@ -278,20 +279,17 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
         } else if (&e == strandEl) {
             const double s = values[std::size_t(iseg)];
             if (s < 0 || s != std::floor(s)) src.fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
-            // Checked against the vertices before any sum (a float nsegs can be 1e19, and
-            // nsegs + 1 summed over strands would wrap 2^64).
-            if (!(s < double(vertexEl->count)) || std::uint64_t(s) + 1 > vertexEl->count - nsegsSum) {
-                src.fail("strand " + std::to_string(n) + " has nsegs " + formatNumber(s) + "; with the strands before it that needs more than the " +
-                         std::to_string(vertexEl->count) + " vertices of the 'vertex' element");
-            }
-            nsegsSum += std::uint64_t(s) + 1;
-            counts.push_back(std::uint64_t(s) + 1);
+            // A float nsegs can be 1e19 or beyond 2^64, and nsegs + 1 summed over strands could
+            // wrap 2^64 back to the vertex count: the sum saturates instead (checked below).
+            const std::uint64_t c = s < 18446744073709549568.0 ? std::uint64_t(s) + 1 : std::numeric_limits<std::uint64_t>::max();
+            nsegsSaturated = nsegsSaturated || c > std::numeric_limits<std::uint64_t>::max() - nsegsSum;
+            if (!nsegsSaturated) nsegsSum += c;
+            counts.push_back(c);
         }
     });
-    std::uint64_t sum = 0;
-    for (std::uint64_t c : counts) sum += c;
-    if (sum != positions.size()) {
-        throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " + std::to_string(sum) +
+    if (nsegsSaturated || nsegsSum != positions.size()) {
+        throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " +
+                          (nsegsSaturated ? std::string("more than 2^64-1") : std::to_string(nsegsSum)) +
                           " vertices but the 'vertex' element has " + std::to_string(positions.size()));
     }
 
