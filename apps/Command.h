@@ -86,7 +86,7 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
                       bool strict = false, const std::string& vdbGrid = "strands");
 
 /// @brief Report the strands of zero length (every vertex at one point) that a verb using lengths
-/// (field, refine, retrace, fit) was given: a warning naming them, an error under @a strict, and
+/// (field, refine, retrace; fit has its own rule, --skip-degenerate) was given: a warning naming them, an error under @a strict, and
 /// always an error when every strand has zero length (there would be nothing to write).
 /// @throw FormatError naming @a path, the count and the first strands.
 void checkStrandLengths(const std::string& verb, const std::string& path, const StrandSet& strands,

@@ -31,7 +31,6 @@ int runFit(FitCmdParams p, const CommonOptions& common)
     if (p.fit.step != 0.0 && !(p.fit.step > 0.0 && std::isfinite(p.fit.step))) throw ValueError("--step " + formatValue(p.fit.step) + ": must be a positive finite length");
     if (p.fit.maxPieces < 1 || p.fit.maxPieces > 64) throw ValueError("--max-pieces " + std::to_string(p.fit.maxPieces) + ": must be between 1 and 64");
     const StrandSet strands = loadStrands("fit", p.input, common, p.strict);
-    checkStrandLengths("fit", p.input, strands, common, p.strict);
 
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<std::string> errors;

@@ -140,7 +140,7 @@ CASES = [
     ("obj: index beyond the vertices", ["convert", write("idx.obj", "v 0 0 0\nv 1 1 1\nl 1 5\n"), "{out}.hair"], ["idx.obj", "5"]),
     ("obj: NaN vertex", ["convert", write("nan.obj", "v 0 0 0\nv nan 1 1\nl 1 2\n"), "{out}.hair"], ["nan.obj", "non-finite"]),
     # VDB
-    ("vdb: not a VDB file", ["convert", write("junk.vdb", "this is not a vdb file"), "{out}.obj"], ["junk.vdb", "not a VDB file"]),
+    ("vdb: not a VDB file", ["convert", write("junk.vdb", "this is not a vdb file"), "{out}.obj"], ["junk.vdb", "not a readable VDB file"]),
     ("vdb: file metadata count beyond the file", ["convert", write("meta.vdb", patched(vdb, 57, "<I", 0xffffffff)), "{out}.obj"], ["meta.vdb", "metadata declares 4294967295 entries"]),
     ("vdb: grid count beyond the file", ["convert", write("count.vdb", patched(vdb, 61, "<I", 0x7fffffff)), "{out}.obj"], ["count.vdb", "declares 2147483647 grids"]),
     ("vdb: grid end beyond the file", ["convert", write("end.vdb", patched(vdb, desc + 16, "<q", len(vdb) + 1000)), "{out}.obj"], ["end.vdb", "<= start <= data <= end <="]),

@@ -122,7 +122,7 @@ void checkVdbFileLayout(const std::string& path, const std::string& where)
     // Header (io::Archive::readHeader): magic, format version, library version, whether grids
     // have offsets, (before format 222) one compression flag, then a 36-character UUID.
     if (end < 8 || in.read<std::int64_t>(end, "the magic number") != std::int64_t(openvdb::OPENVDB_MAGIC)) {
-        in.fail(0, "not a VDB file: the first 8 bytes are not OpenVDB's magic number");
+        throw FormatError(where + ": not a readable VDB file (the first 8 bytes are not OpenVDB's magic number)");
     }
     const std::uint32_t version = in.read<std::uint32_t>(end, "the file format version");
     if (version > openvdb::OPENVDB_FILE_VERSION) {
