@@ -63,6 +63,29 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
     return strands;
 }
 
+void checkStrandLengths(const std::string& verb, const std::string& path, const StrandSet& strands,
+                        const CommonOptions& common, bool strict)
+{
+    std::vector<std::size_t> zero;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
+        bool moves = false;
+        for (std::size_t v = strands.begin(i) + 1; v < strands.end(i) && !moves; ++v) moves = strands.positions[v] != strands.positions[strands.begin(i)];
+        if (!moves) zero.push_back(i);
+    }
+    if (zero.empty()) return;
+    std::string which;
+    for (std::size_t k = 0; k < zero.size() && k < 5; ++k) which += (k ? ", " : "") + std::to_string(zero[k]);
+    if (zero.size() > 5) which += ", ...";
+    const std::string what = path + ": " + std::to_string(zero.size()) + " of " + std::to_string(strands.numStrands()) +
+                             " strands have zero length (strand" + (zero.size() == 1 ? " " : "s ") + which +
+                             ": every vertex at one point), so they have no direction";
+    if (zero.size() == strands.numStrands()) throw FormatError(what + "; with no strand of non-zero length there is nothing to " + verb);
+    if (strict) throw FormatError(what + "; --strict rejects them");
+    ReadReport report;
+    report.warnings.push_back(what + "; they are ignored (--strict rejects them)");
+    printWarnings(verb, report, common);
+}
+
 StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
                              const std::string& vdbGrid, TriangleMesh* head)
 {
@@ -214,8 +237,9 @@ int run(int argc, char** argv)
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         for (const Command& c : commands) if (c.sub->parsed()) verb = c.sub->get_name();
-        std::cerr << "vdbhair" << (verb.empty() ? "" : " " + verb) << ": " << e.what() << "\n"
-                  << "Run 'vdbhair" << (verb.empty() ? "" : " " + verb) << " --help' for usage.\n";
+        // One line, as every error (a script reading stderr gets the message and the hint together).
+        std::cerr << "vdbhair" << (verb.empty() ? "" : " " + verb) << ": " << e.what() << " (run 'vdbhair"
+                  << (verb.empty() ? "" : " " + verb) << " --help' for usage)\n";
         return 2;
     }
 

@@ -85,6 +85,13 @@ void printJson(const nlohmann::json& j);
 StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common,
                       bool strict = false, const std::string& vdbGrid = "strands");
 
+/// @brief Report the strands of zero length (every vertex at one point) that a verb using lengths
+/// (field, refine, retrace; fit has its own rule, --skip-degenerate) was given: a warning naming them, an error under @a strict, and
+/// always an error when every strand has zero length (there would be nothing to write).
+/// @throw FormatError naming @a path, the count and the first strands.
+void checkStrandLengths(const std::string& verb, const std::string& path, const StrandSet& strands,
+                        const CommonOptions& common, bool strict);
+
 /// @brief As loadStrands(), and a helicoid scene (.json) is grown first.
 /// @param head when given and @a path is a scene with a "head" record, set to a mesh of that head
 /// (makeSphereMesh()); left as it is otherwise.

@@ -55,6 +55,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     if (p.helicoid && p.vectorName != "tangent") throw ValueError("--helicoid with --vector-name " + p.vectorName + ": retrace --helicoid reads the vector grid 'tangent'");
 
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
+    checkStrandLengths("field", p.input, strands, common, p.strict);
     FieldParams fp;
     fp.voxelSize = voxelGiven ? p.voxelSize : suggestVoxelSize(strands);
     fp.iterations = p.iterations;

@@ -152,6 +152,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
         throw ValueError("--save-field " + p.saveField + ": must end in .vdb");
     }
     const StrandSet strands = loadStrands("refine", p.input, common, p.strict);
+    checkStrandLengths("refine", p.input, strands, common, p.strict);
     const RefineParams rp = refineParamsFrom(p, strands);
     const RefineResult r = refineStrands(strands, rp, true, common.interrupter);
     // Write the field first: if the strands' write fails, nothing half-done is claimed.

@@ -93,6 +93,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         if (tp.vertices != RetraceVertices::Input) throw ValueError("--helicoid keeps the input's vertices; --vertices steps is not available with it");
         const HelicoidFieldGrids field = readHelicoidField(p.field);
         const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
+        checkStrandLengths("retrace", p.input, strands, common, p.strict);
         TraceStats stats;
         const StrandSet out = retraceHelicoidField(strands, field, tp, &stats, true, common.interrupter);
         // Coherence is measured against the tangent field when the file has one.
@@ -122,6 +123,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
                         " values; retrace needs a vector grid (vec3s or vec3d), such as 'tangent'");
     }
     const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
+    checkStrandLengths("retrace", p.input, strands, common, p.strict);
 
     TraceStats stats;
     const StrandSet out = retraceStrands(strands, *grid, tp, &stats, nullptr, true, common.interrupter);

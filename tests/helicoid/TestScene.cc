@@ -238,3 +238,16 @@ TEST_CASE("sceneFromJson: head, wisp normal and strays errors name the key path"
     REQUIRE_THROWS_WITH(parse(bad("\"head\": {\"sphere\": [0, 0, 0, 10.000000]}", "\"head\": {\"sphere\": [0, \"a\", 0, 1]}")),
                         Contains("head.sphere[1]: expected a number"));
 }
+
+TEST_CASE("readScene: nesting beyond the cap and numbers beyond a double name the key path (issue 22)", "[helicoid][fuzz]")
+{
+    // 200,000 levels overflowed the stack; now refused at kMaxSceneDepth + 1 before any json is built.
+    const std::size_t depth = 200000;
+    const std::string deep = "{\"vdbhair\": \"scene/1\", \"guides\": [{\"fit\": " + std::string(depth, '[') + std::string(depth, ']') + "}]}";
+    REQUIRE_THROWS_WITH(readScene(test::writeBytes("deep.json", deep)),
+                        Contains("deep.json: guides[0].fit[0][0][0]") && Contains("nested 65 levels deep; a scene nests at most 64 levels"));
+    REQUIRE_THROWS_WITH(readScene(test::writeBytes("big.json", "{\"vdbhair\": \"scene/1\", \"guides\": [], \"seed\": 1e400}")),
+                        Contains("big.json: seed: number 1e400 is beyond the range of a double"));
+    REQUIRE_THROWS_WITH(readScene(test::writeBytes("bad.json", "{\"vdbhair\": \"scene/1\", \"guides\": [tru]}")),
+                        Contains("bad.json: guides[0]: not valid JSON: parse error at line 1, column"));
+}

@@ -46,3 +46,13 @@ TEST_CASE("readConvdata: HairNet's blend reads with the counts of SOURCES.md", "
     REQUIRE(s.numStrands() == 940);
     REQUIRE(s.numVertices() == 94000);
 }
+
+TEST_CASE("readConvdata: shapes whose product wraps 2^64 or beyond 2^64 are refused by rule", "[io][fuzz]")
+{
+    const std::string wrap = npy("{'descr': '<f4', 'fortran_order': False, 'shape': (4611686018427387904, 4, 1), }", std::string(64, '\0'));
+    REQUIRE_THROWS_WITH(readConvdata(test::writeBytes("wrap.convdata", wrap)),
+                        Contains("needs 4611686018427387904 x 4 floats, more than 2^64 bytes"));
+    const std::string huge = npy("{'descr': '<f4', 'fortran_order': False, 'shape': (99999999999999999999999, 1, 1), }", std::string(16, '\0'));
+    REQUIRE_THROWS_WITH(readConvdata(test::writeBytes("huge.convdata", huge)),
+                        Contains("has dimension 99999999999999999999999, beyond 2^64-1"));
+}

@@ -148,3 +148,15 @@ TEST_CASE("readHair: each kind of bad input has its own error", "[io]")
         REQUIRE_THROWS_AS(readHair(test::tempPath("nope.hair")), IoError);
     }
 }
+
+TEST_CASE("readHair: strand counts beyond the point count are refused before allocating", "[io][fuzz]")
+{
+    // 2^32-1 strands of 0 points need no bytes, yet sized 16 GB of counts (issue 22).
+    REQUIRE_THROWS_WITH(readHair(test::writeBytes("nS_no_points.hair", hairHeader(0xffffffffu, 0, 2, 0))),
+                        Contains("at byte 4: the header declares 4294967295 strands but only 0 points"));
+    // Without a segments array every strand has default segments + 1 points.
+    std::string pts;
+    for (int i = 0; i < 6; ++i) test::put(pts, float(i));
+    REQUIRE_THROWS_WITH(readHair(test::writeBytes("nS_default.hair", hairHeader(2, 2, 2, 1) + pts)),
+                        Contains("at byte 8: the strands' point counts add up to 4 but the header declares 2 points (no segments array"));
+}

@@ -63,3 +63,23 @@ TEST_CASE("readPly: each kind of bad input has its own error", "[io]")
                         Contains("element 'vertex' declares 4000000000 items of at least 12 bytes but only 30 bytes remain"));
     REQUIRE_THROWS_WITH(readPly(test::writeBytes("p10.ply", head + strand + "0 0 0\n1 inf 1\n1\n")), Contains("vertex 1 has a non-finite coordinate"));
 }
+
+TEST_CASE("readPly: property-less elements and nsegs sums beyond the vertices (issue 22)", "[io][fuzz]")
+{
+    const std::string vertex = "element vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+    SECTION("an element of 2^63-1 items without properties holds no bytes and is skipped at once")
+    {
+        std::string b = "ply\nformat binary_little_endian 1.0\nelement junk 9223372036854775807\n" + vertex +
+                        "element strand 1\nproperty ushort nsegs\nend_header\n";
+        for (float f : {0.f, 0.f, 0.f, 1.f, 1.f, 1.f}) test::put(b, f);
+        test::put(b, std::uint16_t(1));
+        REQUIRE(readPly(test::writeBytes("junk.ply", b)).numVertices() == 2);
+    }
+    SECTION("nsegs whose sum + 1 wraps 2^64 back to the vertex count")
+    {
+        const std::string b = "ply\nformat ascii 1.0\n" + vertex + "element strand 2\nproperty double nsegs\nend_header\n"
+                              "0 0 0\n1 1 1\n9223372036854775808\n9223372036854775808\n";
+        REQUIRE_THROWS_WITH(readPly(test::writeBytes("wrap.ply", b)),
+                            Contains("the strands' nsegs + 1 add up to more than 2^64-1 vertices but the 'vertex' element has 2"));
+    }
+}

@@ -94,3 +94,15 @@ TEST_CASE("readTfx: each kind of bad input has its own error", "[io]")
     REQUIRE_THROWS_AS(readTfx(test::writeBytes("a3.tfx", "version 2.0\nrotation 0 90 0\nnumStrands 0\n")), UnsupportedError);
     REQUIRE(readTfx(test::writeBytes("a4.tfx", "version 2.0\nscale 1.0\nnumStrands 1\nstrand 0 numVerts 2 texcoord 0.5 000000\n0 0 0\n1 1 1\n")).rootUV.at(0) == Vec2f(0.5f, 0.f));
 }
+
+TEST_CASE("readTfx: 2^32-1 strands of 0 vertices are refused before allocating", "[io][fuzz]")
+{
+    std::string v4;
+    test::put(v4, 4.f);
+    test::put(v4, std::uint32_t(0xffffffffu));
+    test::put(v4, std::uint32_t(0));
+    test::put(v4, std::uint32_t(160));
+    v4.append(160 - v4.size(), '\0');
+    REQUIRE_THROWS_WITH(readTfx(test::writeBytes("t4_zero.tfx", v4)),
+                        Contains("at byte 8: 4294967295 strands of 0 vertices: every strand of a TressFX file has the same count, and a strand needs at least 2"));
+}

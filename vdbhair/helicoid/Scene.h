@@ -70,7 +70,13 @@ struct Scene
 Scene sceneFromJson(const nlohmann::json& j, const std::string& where);
 nlohmann::json sceneToJson(const Scene& scene);
 
-/// @throw IoError, FormatError (also for invalid JSON, with its line and column).
+/// How deep a scene file may nest arrays and objects (a scene needs 5; `fit` records a few more).
+/// Deeper documents are refused by key path before a json value is built, because building,
+/// copying and destroying one recurses on its depth (200,000 levels overflowed the stack).
+constexpr std::size_t kMaxSceneDepth = 64;
+
+/// @throw IoError, FormatError (also for invalid JSON, with its line and column; for nesting
+/// beyond kMaxSceneDepth and numbers beyond a double, with the key path).
 Scene readScene(const std::string& path);
 /// @brief Write atomically, one guide per line.
 void writeScene(const std::string& path, const Scene& scene);

@@ -4,6 +4,7 @@
 #include <vdbhair/io/FileUtil.h>
 
 #include <cctype>
+#include <charconv>
 #include <cstring>
 #include <limits>
 
@@ -55,15 +56,25 @@ StrandSet readConvdata(const std::string& path, const ReadOptions& opts, ReadRep
         std::size_t e = i;
         while (e < shapeStr.size() && std::isdigit(static_cast<unsigned char>(shapeStr[e]))) ++e;
         if (e == i) in.failAt(10, "cannot read the shape " + shapeStr);
-        shape.push_back(std::stoull(shapeStr.substr(i, e - i)));
+        std::uint64_t dim = 0;
+        const auto [end, ec] = std::from_chars(shapeStr.data() + i, shapeStr.data() + e, dim);
+        if (ec != std::errc() || end != shapeStr.data() + e) {
+            in.failAt(10, "shape " + shapeStr + " has dimension " + shapeStr.substr(i, e - i) + ", beyond 2^64-1");
+        }
+        shape.push_back(dim);
         i = e;
     }
     if (shape.size() != 3 || shape[0] % 4 != 0 || shape[0] == 0) {
         throw UnsupportedError(where + ": shape " + shapeStr + " is not (4·points, rows, columns)");
     }
     const std::uint64_t nP = shape[0] / 4, rows = shape[1], cols = shape[2];
-    const std::uint64_t slots = rows * cols;
+    // Each product is checked before it is formed (shape[0] * rows * cols can wrap 2^64).
     if (rows && cols > std::numeric_limits<std::uint32_t>::max() / rows) in.fail("shape " + shapeStr + " is too large");
+    const std::uint64_t slots = rows * cols;
+    if (slots && shape[0] > std::numeric_limits<std::uint64_t>::max() / 4 / slots) {
+        in.fail("the array of shape " + shapeStr + " needs " + std::to_string(shape[0]) + " x " + std::to_string(slots) +
+                " floats, more than 2^64 bytes");
+    }
     in.require(shape[0] * slots, 4, "the array of shape " + shapeStr);
     std::vector<float> data(std::size_t(shape[0] * slots));
     in.readArray(data.data(), shape[0] * slots, "array data");
@@ -73,7 +84,9 @@ StrandSet readConvdata(const std::string& path, const ReadOptions& opts, ReadRep
     ShortStrandFilter filter(opts, report, where);
     std::size_t empty = 0;
     std::vector<Vec3f> pts(nP);
+    InterruptPoll poll(opts.interrupter, where);
     for (std::uint64_t s = 0; s < slots; ++s) {
+        poll();
         bool allZero = true;
         for (std::uint64_t i = 0; i < nP; ++i) {
             for (int c = 0; c < 3; ++c) {

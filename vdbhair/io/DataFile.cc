@@ -21,7 +21,9 @@ StrandSet readData(const std::string& path, const ReadOptions& opts, ReadReport*
     out.offsets.reserve(std::size_t(nS) + 1);
     out.positions.reserve(in.remaining() / 12);  // bounded by the file size
     ShortStrandFilter filter(opts, report, where);
+    InterruptPoll poll(opts.interrupter, where);
     for (std::int32_t i = 0; i < nS; ++i) {
+        poll();
         const std::size_t at = in.offset();
         const std::int32_t nV = in.read<std::int32_t>("vertex count");
         if (nV < 0) in.failAt(at, "strand " + std::to_string(i) + " declares " + std::to_string(nV) + " vertices; counts must not be negative");

@@ -12,16 +12,30 @@
 #include <filesystem>
 #include <fstream>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace vdbhair {
 
 namespace fs = std::filesystem;
 
+void requireRegularFile(const std::string& path, const std::string& where)
+{
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0) throw IoError(where + ": cannot open for reading: " + std::strerror(errno));
+    if (S_ISREG(st.st_mode)) return;
+    const char* what = S_ISDIR(st.st_mode)    ? "a directory"
+                       : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                       : S_ISSOCK(st.st_mode) ? "a socket"
+                       : S_ISCHR(st.st_mode)  ? "a character device"
+                       : S_ISBLK(st.st_mode)  ? "a block device"
+                                              : "not a regular file";
+    throw IoError(where + ": is " + std::string(what) + ", not a regular file; inputs must be regular files");
+}
+
 std::vector<char> readFileBytes(const std::string& path, const std::string& where, openvdb::util::NullInterrupter* interrupter)
 {
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) throw IoError(where + ": is a directory, not a file");
+    requireRegularFile(path, where);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw IoError(where + ": cannot open for reading: " + std::strerror(errno));
     in.seekg(0, std::ios::end);

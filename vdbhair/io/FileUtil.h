@@ -10,6 +10,12 @@
 
 namespace vdbhair {
 
+/// @brief Fail unless @a path names an existing regular file (or a symbolic link to one), before
+/// anything opens it: a directory, a FIFO (whose open would block), a socket or a device says so.
+/// @param where prefix of error messages
+/// @throw IoError naming what @a path is instead.
+void requireRegularFile(const std::string& path, const std::string& where);
+
 /// @brief The whole content of @a path.
 /// @param where prefix of error messages, e.g. "readHair(a.hair)"
 /// @param interrupter optional progress (bytes read) and Ctrl-C (Progress.h)

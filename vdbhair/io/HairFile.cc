@@ -62,6 +62,18 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
                                    " bytes after the arrays the header describes were ignored");
     }
 
+    // Every strand has at least one point (segments + 1), so the point count bounds the strand
+    // count: checked before anything is sized by it (2^32-1 strands of 0 points need no bytes).
+    if (nS > nP) {
+        in.failAt(4, "the header declares " + std::to_string(nS) + " strands but only " + std::to_string(nP) +
+                         " points; every strand has at least one point");
+    }
+    if (!(arrays & kSegments) && defSegments < 65536u && nS * (std::uint64_t(defSegments) + 1) != nP) {
+        in.failAt(8, "the strands' point counts add up to " + std::to_string(nS * (std::uint64_t(defSegments) + 1)) +
+                         " but the header declares " + std::to_string(nP) + " points (no segments array: every strand has default segments " +
+                         std::to_string(defSegments) + " + 1 points)");
+    }
+
     // Points per strand
     std::vector<std::uint32_t> counts(nS);
     if (arrays & kSegments) {
@@ -99,8 +111,10 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
     out.defaults = defaults;
     out.reserve(nS, nP);
     ShortStrandFilter filter(opts, report, where);
+    InterruptPoll poll(opts.interrupter, where);
     std::size_t v = 0;
     for (std::size_t i = 0; i < nS; ++i) {
+        poll();
         const std::size_t n = counts[i];
         for (std::size_t k = v; k < v + n; ++k) {
             checkFinite(points[k], k, where, "at byte " + std::to_string(pointsAt + 12 * k));

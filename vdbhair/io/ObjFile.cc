@@ -64,7 +64,9 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
     std::vector<std::string_view> tok;
     std::vector<std::uint32_t> element;
 
+    InterruptPoll poll(opts.interrupter, where);
     while (text.nextLine(tok)) {
+        poll();
         if (tok.empty()) continue;
         const std::string_view key = tok[0];
         if (key == "v") {
@@ -138,6 +140,7 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
     std::vector<std::uint32_t> chain;
     std::size_t strand = 0;
     for (std::uint32_t v = 0; v < nV; ++v) {
+        poll();
         if (visited[v]) continue;
         chain.clear();
         std::string location;

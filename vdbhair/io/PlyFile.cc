@@ -7,6 +7,7 @@
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/TextScanner.h>
+#include <vdbhair/Format.h>
 
 #include <algorithm>
 #include <charconv>
@@ -183,10 +184,14 @@ int findProperty(const Element* e, const char* name, bool list = false)
 /// anything is allocated. @a onElement(e) runs before an element's items; @a onItem(e, n, values,
 /// list, src) after each item, with its scalar property values (by property index) and, for the
 /// list property @a listProp of @a listElement, the list's items (other lists are skipped).
+/// An element without properties holds no bytes, so its items are not visited at all (its count,
+/// up to 2^63-1, is bounded by nothing in the file). @a interrupter (may be null) is polled so
+/// that SIGTERM and Ctrl-C end the walk.
 template<typename ElementFn, typename ItemFn>
 void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std::string& where, const Element* listElement,
-                 int listProp, ElementFn&& onElement, ItemFn&& onItem)
+                 int listProp, openvdb::util::NullInterrupter* interrupter, ElementFn&& onElement, ItemFn&& onItem)
 {
+    InterruptPoll poll(interrupter, where);
     ByteReader bin(bytes, where);
     TextScanner text(bytes, where, hdr.bodyOffset);
     text.setLine(hdr.bodyLine);  // body line numbers continue the header's
@@ -202,8 +207,10 @@ void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std
                      std::to_string(minBytes) + " bytes but only " + std::to_string(src.remainingBytes()) + " bytes remain");
         }
         onElement(e);
+        if (e.props.empty()) continue;  // nothing to read, whatever the count
         values.assign(e.props.size(), 0.0);
         for (std::uint64_t n = 0; n < e.count; ++n) {
+            poll();
             for (std::size_t k = 0; k < e.props.size(); ++k) {
                 const Property& p = e.props[k];
                 if (!p.isList) {
@@ -221,6 +228,7 @@ void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std
                 const bool keep = &e == listElement && int(k) == listProp;
                 if (keep) list.clear();
                 for (std::uint64_t j = 0; j < cnt; ++j) {
+                    poll();
                     const double v = src.read(p.type, "list item");
                     if (keep) list.push_back(v);
                 }
@@ -257,7 +265,9 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     // Body
     std::vector<Vec3f> positions, colors;
     std::vector<std::uint64_t> counts;
-    readPlyBody(bytes, hdr, where, nullptr, -1, [&](const Element& e) {
+    std::uint64_t nsegsSum = 0;    // vertices the strands use
+    bool nsegsSaturated = false;   // their sum exceeds 2^64-1
+    readPlyBody(bytes, hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
         if (&e == vertexEl) { positions.reserve(e.count); if (hasColor) colors.reserve(e.count); }
         if (&e == strandEl) counts.reserve(e.count);
     }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
@@ -269,13 +279,17 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
         } else if (&e == strandEl) {
             const double s = values[std::size_t(iseg)];
             if (s < 0 || s != std::floor(s)) src.fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
-            counts.push_back(std::uint64_t(s) + 1);
+            // A float nsegs can be 1e19 or beyond 2^64, and nsegs + 1 summed over strands could
+            // wrap 2^64 back to the vertex count: the sum saturates instead (checked below).
+            const std::uint64_t c = s < 18446744073709549568.0 ? std::uint64_t(s) + 1 : std::numeric_limits<std::uint64_t>::max();
+            nsegsSaturated = nsegsSaturated || c > std::numeric_limits<std::uint64_t>::max() - nsegsSum;
+            if (!nsegsSaturated) nsegsSum += c;
+            counts.push_back(c);
         }
     });
-    std::uint64_t sum = 0;
-    for (std::uint64_t c : counts) sum += c;
-    if (sum != positions.size()) {
-        throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " + std::to_string(sum) +
+    if (nsegsSaturated || nsegsSum != positions.size()) {
+        throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " +
+                          (nsegsSaturated ? std::string("more than 2^64-1") : std::to_string(nsegsSum)) +
                           " vertices but the 'vertex' element has " + std::to_string(positions.size()));
     }
 
@@ -375,7 +389,7 @@ TriangleMesh readPlyMesh(const std::string& path)
     if (iface < 0) throw FormatError(where + ": line " + std::to_string(faceEl->line) + ": the 'face' element needs a list 'vertex_indices'");
 
     TriangleMesh mesh;
-    readPlyBody(bytes, hdr, where, faceEl, iface, [&](const Element& e) {
+    readPlyBody(bytes, hdr, where, faceEl, iface, nullptr, [&](const Element& e) {
         if (&e == vertexEl) mesh.vertices.reserve(e.count);
         if (&e == faceEl) mesh.triangles.reserve(e.count);
     }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>& face, ValueSource& src) {
@@ -421,7 +435,7 @@ OrientedPoints readPlyPoints(const std::string& path)
     const bool hasN = inx >= 0 && iny >= 0 && inz >= 0, hasT = itx >= 0 && ity >= 0 && itz >= 0;
 
     OrientedPoints pts;
-    readPlyBody(bytes, hdr, where, nullptr, -1, [&](const Element& e) {
+    readPlyBody(bytes, hdr, where, nullptr, -1, nullptr, [&](const Element& e) {
         if (&e == vertexEl) pts.positions.reserve(e.count);
     }, [&](const Element& e, std::uint64_t, const std::vector<double>& v, const std::vector<double>&, ValueSource& src) {
         if (&e != vertexEl) return;

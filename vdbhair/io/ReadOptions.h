@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,6 +83,28 @@ private:
     ReadReport* mReport;
     std::string mWhere;
     std::size_t mDropped = 0, mFirst = 0;
+};
+
+/// @brief What reader loops call once per item so that SIGTERM and Ctrl-C end them: every 4096
+/// calls it asks the interrupter (ReadOptions::interrupter, may be null) and throws
+/// InterruptedError when it says stop. Cheap enough for the innermost loop of a reader.
+class InterruptPoll
+{
+public:
+    InterruptPoll(openvdb::util::NullInterrupter* interrupter, std::string where)
+        : mInterrupter(interrupter), mWhere(std::move(where)) {}
+
+    /// @throw InterruptedError when the interrupter says stop.
+    void operator()()
+    {
+        if (!mInterrupter || (++mCalls & 4095u) != 0) return;
+        if (mInterrupter->wasInterrupted()) throw InterruptedError(mWhere + ": interrupted while reading");
+    }
+
+private:
+    openvdb::util::NullInterrupter* mInterrupter;
+    std::string mWhere;
+    std::uint32_t mCalls = 0;
 };
 
 /// @brief Throw unless @a p is finite.

@@ -10,6 +10,8 @@
 #include <vdbhair/io/TfxFile.h>
 #include <vdbhair/io/UsdFile.h>
 
+#include <filesystem>
+
 namespace vdbhair {
 
 namespace {
@@ -68,6 +70,10 @@ bool isStrandFile(const std::string& path)
 
 StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
+    // What the path is comes before what its extension says (a folder has none); a missing
+    // file is left to the reader, whose message names it.
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec)) requireRegularFile(path, path);
     switch (strandFormatFromPath(path)) {
     case StrandFormat::Hair: return readHair(path, opts, report);
     case StrandFormat::Data: return readData(path, opts, report);

@@ -23,6 +23,12 @@ StrandSet readBinaryStrands(ByteReader& in, std::uint32_t nS, std::uint32_t nV, 
     if (total > std::numeric_limits<std::uint32_t>::max()) {
         in.failAt(4, std::to_string(nS) + " strands of " + std::to_string(nV) + " vertices exceed 2^32-1 vertices");
     }
+    // A strand of fewer than 2 vertices is never kept, and strands of 0 vertices take no bytes:
+    // 2^32-1 of them would size the output and the loop by a count the file does not bound.
+    if (nS > 0 && nV < 2) {
+        in.failAt(8, std::to_string(nS) + " strands of " + std::to_string(nV) +
+                         " vertices: every strand of a TressFX file has the same count, and a strand needs at least 2");
+    }
     in.seek(posAt, "the vertex position offset");
     in.require(total, stride * 4, std::to_string(nS) + " strands of " + std::to_string(nV) + " vertices");
     std::vector<float> raw(total * stride);
@@ -44,7 +50,9 @@ StrandSet readBinaryStrands(ByteReader& in, std::uint32_t nS, std::uint32_t nV, 
     StrandSet out;
     out.reserve(nS, total);
     ShortStrandFilter filter(opts, report, where);
+    InterruptPoll poll(opts.interrupter, where);
     for (std::uint32_t i = 0; i < nS; ++i) {
+        poll();
         if (!filter.keep(i, nV, "at byte " + std::to_string(posAt + std::uint64_t(i) * nV * stride * 4))) continue;
         for (std::uint32_t k = 0; k < nV; ++k) {
             const std::size_t v = std::size_t(i) * nV + k;
@@ -66,10 +74,12 @@ StrandSet readAscii(const std::vector<char>& bytes, const std::string& where,
     TextScanner text(bytes, where);
     StrandSet out;
     ShortStrandFilter filter(opts, report, where);
+    InterruptPoll poll(opts.interrupter, where);
     std::int64_t declared = -1;
     std::size_t strandsSeen = 0;
     std::vector<std::string_view> tok;
     while (text.nextLine(tok)) {
+        poll();
         if (tok.empty() || tok[0][0] == '#') continue;
         const std::string_view key = tok[0];
         if (key == "strand") {
@@ -91,6 +101,7 @@ StrandSet readAscii(const std::vector<char>& bytes, const std::string& where,
             const std::size_t headerLine = text.line();
             const std::size_t first = out.positions.size();
             for (std::int64_t j = 0; j < k; ++j) {
+                poll();
                 if (!text.nextLine(tok)) text.fail("file ends inside strand " + std::to_string(strandsSeen) + " (" + std::to_string(j) + " of " + std::to_string(k) + " vertices read)");
                 if (tok.size() < 3) text.fail("a vertex line needs 3 numbers");
                 const Vec3f p(text.toFloat(tok[0], "x"), text.toFloat(tok[1], "y"), text.toFloat(tok[2], "z"));

@@ -375,7 +375,9 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
     ShortStrandFilter filter(opts, report, where);
     std::size_t strandIndex = 0;
     bool first = true;
+    InterruptPoll poll(opts.interrupter, where);
     for (const CurvesPrim& prim : doc.curves) {
+        poll();
         const std::string at = "prim \"" + prim.name + "\" (line " + std::to_string(prim.line) + ")";
         auto find = [&](const char* name) -> const Property* {
             const auto it = prim.props.find(name);
@@ -397,6 +399,7 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         const std::size_t nP = p.size() / 3, nC = n.size();
         std::uint64_t sum = 0;
         for (std::size_t i = 0; i < nC; ++i) {
+            poll();
             if (!(n[i] >= 0.0) || n[i] != std::floor(n[i]) || n[i] > 4294967295.0) {
                 throw FormatError(where + ": line " + std::to_string(counts->value.line) + ": " + at + ": curveVertexCounts[" +
                                   std::to_string(i) + "] is " + std::to_string(n[i]) + "; counts must be whole numbers of at least 0");
@@ -459,7 +462,7 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         for (std::size_t i = 0; i < nC; ++i) {
             const std::size_t cnt = std::size_t(n[i]);
             for (std::size_t k = v0; k < v0 + cnt; ++k) {
-                const Vec3f q(float(p[3 * k]), float(p[3 * k + 1]), float(p[3 * k + 2]));
+                const Vec3f q(static_cast<float>(p[3 * k]), static_cast<float>(p[3 * k + 1]), static_cast<float>(p[3 * k + 2]));
                 checkFinite(q, k, where, at);
             }
             if (filter.keep(strandIndex++, cnt, at + ", curve " + std::to_string(i))) {

@@ -205,7 +205,39 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
     std::vector<std::int32_t> sid(nPoints), vid(nPoints);
     std::size_t k = 0;
     std::int64_t maxStrand = -1;
+    InterruptPoll poll(opts.interrupter, where);
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+        // A leaf's offsets and arrays come from the file as they are: OpenVDB's handles index the
+        // arrays without bounds checks, so what they will index is checked first (one flipped
+        // bit in an offset otherwise reads and writes past the arrays).
+        if (!(leaf->attributeSet().descriptor() == desc)) {
+            throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) +
+                              " has other attributes than the first leaf; every leaf of a points grid shares one layout");
+        }
+        openvdb::Index32 last = 0;
+        for (openvdb::Index i = 0; i < pts::PointDataTree::LeafNodeType::SIZE; ++i) {
+            const openvdb::Index32 offset = leaf->getValue(i);
+            if (offset < last) {
+                throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) + " has point offset " +
+                                  std::to_string(offset) + " after " + std::to_string(last) + " (voxel " + std::to_string(i) +
+                                  "); a leaf's point offsets never decrease");
+            }
+            last = offset;
+        }
+        if (std::uint64_t(last) > nPoints - k) {
+            throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) + " holds " + std::to_string(last) +
+                              " points, more than the " + std::to_string(nPoints) + " the tree counts");
+        }
+        const std::pair<const char*, std::size_t> used[] = {{"P", iP}, {"strand", iS}, {"vertex", iV},
+                                                           {"Cd", iCd}, {"width", iW}, {"Alpha", iA}};
+        for (const auto& [name, index] : used) {
+            if (index == pts::AttributeSet::INVALID_POS) continue;
+            const pts::AttributeArray& array = leaf->constAttributeArray(index);
+            if (!array.isUniform() && array.size() < last) {
+                throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) + " has " + std::to_string(last) +
+                                  " points but its '" + std::string(name) + "' array holds " + std::to_string(array.size()) + "; each array holds one value per point");
+            }
+        }
         pts::AttributeHandle<openvdb::Vec3f> hP(leaf->constAttributeArray(iP));
         const WholeNumberAttribute hS(leaf->constAttributeArray(iS), typeS), hV(leaf->constAttributeArray(iV), typeV);
         std::unique_ptr<pts::AttributeHandle<openvdb::Vec3f>> hCd;
@@ -214,6 +246,7 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
         if (hasW) hW.reset(new pts::AttributeHandle<float>(leaf->constAttributeArray(iW)));
         if (hasA) hA.reset(new pts::AttributeHandle<float>(leaf->constAttributeArray(iA)));
         for (auto it = leaf->beginIndexOn(); it; ++it) {
+            poll();
             const openvdb::Vec3d ijk = it.getCoord().asVec3d();
             const openvdb::Vec3d world = grid.transform().indexToWorld(ijk + hP.get(*it));
             pos[k] = Vec3f(float(world.x()), float(world.y()), float(world.z()));

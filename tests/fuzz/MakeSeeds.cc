@@ -1,0 +1,153 @@
+// Seed corpora for the fuzz harnesses (FuzzReader.cc), made at build time from small synthetic
+// hairstyles so that nothing from the shared data (partly non-commercial) is ever committed.
+//
+// Usage: vdbhair_fuzz_seeds OUTDIR   (writes OUTDIR/<reader>/<seed files>)
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/DataFile.h>
+#include <vdbhair/io/HairFile.h>
+#include <vdbhair/io/ObjFile.h>
+#include <vdbhair/io/PlyFile.h>
+#include <vdbhair/io/UsdFile.h>
+#include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbStrands.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+namespace fs = std::filesystem;
+using namespace vdbhair;
+
+namespace {
+
+/// Three short strands (2, 3 and 5 vertices) with colours and thickness: every optional array.
+StrandSet tinyStyle()
+{
+    StrandSet s;
+    for (int i = 0; i < 3; ++i) {
+        std::vector<Vec3f> p;
+        const int n = i == 0 ? 2 : i == 1 ? 3 : 5;
+        for (int v = 0; v < n; ++v) p.emplace_back(float(i), 0.1f * float(v), 0.05f * std::sin(float(v)));
+        s.addStrand(p);
+    }
+    for (std::size_t v = 0; v < s.numVertices(); ++v) {
+        s.color.emplace_back(0.2f, 0.3f, 0.4f);
+        s.thickness.push_back(0.01f);
+    }
+    return s;
+}
+
+template<typename T>
+void put(std::string& b, T v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); }
+
+void writeRaw(const fs::path& p, const std::string& bytes) { std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size())); }
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    if (argc != 2) {
+        std::cerr << "usage: vdbhair_fuzz_seeds OUTDIR\n";
+        return 2;
+    }
+    const fs::path out = argv[1];
+    for (const char* r : {"hair", "data", "bin", "obj", "ply", "tfx", "convdata", "usda", "vdb", "mesh", "scene"}) fs::create_directories(out / r);
+    initializeOpenVdb();
+    const StrandSet s = tinyStyle();
+    StrandSet plain = s;
+    plain.color.clear();
+    plain.thickness.clear();
+
+    writeHair((out / "hair/all_arrays.hair").string(), s);
+    writeHair((out / "hair/plain.hair").string(), plain);
+    writeData((out / "data/tiny.data").string(), plain);
+    writeObj((out / "obj/edges.obj").string(), s, ObjLineStyle::Edges);
+    writeObj((out / "obj/polylines.obj").string(), plain, ObjLineStyle::Polylines);
+    writePly((out / "ply/binary.ply").string(), s, PlyEncoding::Binary);
+    writePly((out / "ply/ascii.ply").string(), plain, PlyEncoding::Ascii);
+    writeUsda((out / "usda/tiny.usda").string(), s);
+    writeVdbStrands((out / "vdb/float.vdb").string(), plain);
+    VdbPointsOptions fixed;
+    fixed.codec = PositionCodec::Fixed16;
+    writeVdbStrands((out / "vdb/fixed16_colour.vdb").string(), s, fixed);
+
+    // CT2Hair .bin: int32 strands; per strand int32 count and 7 floats per vertex.
+    std::string bin;
+    put(bin, std::int32_t(plain.numStrands()));
+    for (std::size_t i = 0; i < plain.numStrands(); ++i) {
+        put(bin, std::int32_t(plain.size(i)));
+        for (std::size_t v = plain.begin(i); v < plain.end(i); ++v) {
+            for (int c = 0; c < 3; ++c) put(bin, plain.positions[v][c]);
+            for (int c = 0; c < 4; ++c) put(bin, 0.5f);
+        }
+    }
+    writeRaw(out / "bin/tiny.bin", bin);
+
+    // TressFX: binary 4.x (160-byte header; positions as xyzw) and 3.0 (296 bytes), and ASCII 2.0.
+    for (const float version : {4.f, 3.f}) {
+        const std::uint32_t nS = 2, nV = 3, header = version == 4.f ? 160 : 296, stride = version == 4.f ? 4 : 3;
+        std::string t;
+        put(t, version);
+        put(t, nS);
+        put(t, nV);
+        if (version == 4.f) put(t, header);
+        t.resize(version == 4.f ? 160 : 144, '\0');
+        if (version == 3.f) {
+            put(t, header);
+            t.resize(296, '\0');
+        }
+        for (std::uint32_t i = 0; i < nS * nV; ++i)
+            for (std::uint32_t c = 0; c < stride; ++c) put(t, c == 3 ? 1.f : float(i) * 0.1f + float(c));
+        writeRaw(out / (version == 4.f ? "tfx/binary4.tfx" : "tfx/binary3.tfx"), t);
+    }
+    writeRaw(out / "tfx/ascii.tfx", "version 2.0\nscale 1.0\nnumStrands 2\nstrand 0 numVerts 2 texcoord 0.5 0.5\n0 0 0\n1 1 1\n"
+                                    "strand 1 numVerts 3 texcoord 0 1\n0 0 1\n0 1 1\n0 2 1.5\n");
+
+    // HairNet convdata: a float32 .npy of shape (4 * points, rows, columns).
+    {
+        std::string h = "{'descr': '<f4', 'fortran_order': False, 'shape': (8, 1, 2), }";
+        while ((10 + h.size() + 1) % 64) h += ' ';
+        h += '\n';
+        std::string b = "\x93NUMPY";
+        b += char(1);
+        b += char(0);
+        put(b, std::uint16_t(h.size()));
+        b += h;
+        for (int i = 0; i < 16; ++i) put(b, float(i % 5) * 0.25f);
+        writeRaw(out / "convdata/tiny.convdata", b);
+    }
+
+    // Meshes: a tetrahedron as PLY (ascii and binary faces) and OBJ.
+    writeRaw(out / "mesh/tet_ascii.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                                         "element face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                                         "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+    {
+        std::string b = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+        for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f}) put(b, f);
+        for (int face = 0; face < 2; ++face) {
+            put(b, std::uint8_t(4));
+            for (std::int32_t i : {0, 1, 2, 3}) put(b, i);
+        }
+        writeRaw(out / "mesh/quads_binary.ply", b);
+    }
+    writeRaw(out / "mesh/tet.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1/1 2/2 4/3\nf 1//1 4//1 3//1\nf -3 -2 -1\n");
+
+    // Scenes: every record the reader knows.
+    writeRaw(out / "scene/full.json", R"({"vdbhair": "scene/1", "seed": 7, "step": 0.05, "integrator": "rk4",
+ "head": {"sphere": [0, 0, 0, 0.5]},
+ "guides": [
+  {"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]},
+   "pieces": [{"k": [1.0, -0.1, 0.3, 1.0], "length": 0.5, "roll": 0.0}],
+   "waviness": {"amplitude": 0.02, "frequency": 40.0},
+   "wisp": {"count": 3, "radius": 0.05, "fanning": 0.1, "normal": [0, 1, 0], "strays": 0.1}},
+  {"root": [1,0,0], "frame": {"tangent": [0,0,1], "normal": [0,1,0]}, "step": 0.1,
+   "pieces": [{"k": [0.5, 0, 0, 0], "length": 0.3}, {"k": [0, 0, 2.0, 0.3], "length": 0.2, "roll": 1.0}],
+   "fit": {"frechet": 0.01, "nested": [[1, 2], {"a": null, "b": true}]}}]}
+)");
+    writeRaw(out / "scene/minimal.json", R"({"vdbhair": "scene/1", "guides": []})");
+    return 0;
+}
