@@ -6,6 +6,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 
 #include <sys/ioctl.h>
 #include <unistd.h>
@@ -19,6 +20,11 @@ volatile std::sig_atomic_t sSignal = 0;
 extern "C" void onInterrupt(int sig) { sSignal = sig; }
 
 bool commitRefused() { return sSignal != 0; }
+
+/// For tests of Ctrl-C that must not depend on the machine's speed: with
+/// VDBHAIR_TEST_INTERRUPT_AFTER=N in the environment, the first report of N or more items done
+/// raises SIGINT in the process itself, exactly as a Ctrl-C at that point would.
+std::uint64_t sInterruptAfter = 0;
 
 /// "12", "1.2k", "3.4M": three significant digits are all a progress line needs.
 std::string shortNumber(double v)
@@ -70,6 +76,7 @@ void installInterruptHandlers()
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
     setCommitInterruptCheck(commitRefused);
+    if (const char* n = std::getenv("VDBHAIR_TEST_INTERRUPT_AFTER"); n && *n) sInterruptAfter = std::strtoull(n, nullptr, 10);
 }
 
 bool interruptRequested() { return sSignal != 0; }
@@ -150,6 +157,7 @@ bool TerminalProgress::wasInterruptedAt(std::uint64_t done, int)
     // Keep the largest: threads report out of order.
     std::uint64_t seen = mDone.load(std::memory_order_relaxed);
     while (done > seen && !mDone.compare_exchange_weak(seen, done, std::memory_order_relaxed)) {}
+    if (sInterruptAfter != 0 && done >= sInterruptAfter && sSignal == 0) std::raise(SIGINT);
     return sSignal != 0;
 }
 
