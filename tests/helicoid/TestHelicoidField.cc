@@ -96,6 +96,19 @@ TEST_CASE("estimateHelicoidField / readHelicoidField: from strands, through a fi
     const HelicoidFieldGrids r = readHelicoidField(path);
     REQUIRE(r.k->activeVoxelCount() == f.k->activeVoxelCount());
     REQUIRE(r.k->metaValue<double>("vdbhair_voxel_size") == 0.5);
+    // Every value of every grid, voxel by voxel, as written (float grids: stored exactly).
+    auto sameValues = [](const auto& written, const auto& read) {
+        REQUIRE(read.activeVoxelCount() == written.activeVoxelCount());
+        REQUIRE(written.activeVoxelCount() > 0);
+        auto acc = read.getConstAccessor();
+        std::size_t differ = 0;
+        for (auto it = written.cbeginValueOn(); it; ++it) differ += !(acc.isValueOn(it.getCoord()) && acc.getValue(it.getCoord()) == *it);
+        REQUIRE(differ == 0);
+    };
+    sameValues(*f.k, *r.k);
+    sameValues(*f.alpha, *r.alpha);
+    sameValues(*f.frameT, *r.frameT);
+    sameValues(*f.frameN, *r.frameN);
     const std::string plain = test::tempPath("plain.vdb");
     writeVdbGrids(plain, {t.tangent}, "test");
     REQUIRE_THROWS_WITH(readHelicoidField(plain), Contains("no grid named 'helicoid_k'") && Contains("vdbhair field --helicoid"));
