@@ -46,11 +46,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
             continue;
         }
         const StrandFit& f = fits[i];
-        SceneGuide g;
-        g.step = f.step;
-        g.root = f.root;
-        g.frame = f.frame;
-        g.pieces = f.pieces;
+        SceneGuide g = guideFromFit(f);
         g.fit = {{"frechet", f.frechet}, {"coupling", f.coupling}, {"pieces", f.pieces.size()}, {"strand", i}};
         scene.guides.push_back(g);
     }

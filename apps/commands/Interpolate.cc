@@ -47,12 +47,7 @@ Scene loadGuides(const std::string& path, const CommonOptions& common, double& f
     scene.integrator = HelicoidIntegrator::RK4;
     for (std::size_t i = 0; i < fits.size(); ++i) {
         if (!errors[i].empty()) throw ValueError(path + ": guide " + errors[i] + "; a guide must have a positive length");
-        SceneGuide g;
-        g.root = fits[i].root;
-        g.frame = fits[i].frame;
-        g.pieces = fits[i].pieces;
-        g.step = fits[i].step;
-        scene.guides.push_back(std::move(g));
+        scene.guides.push_back(guideFromFit(fits[i]));
     }
     scene.step = scene.guides.front().step;
     return scene;

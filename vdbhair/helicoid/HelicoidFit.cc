@@ -864,4 +864,14 @@ FitSummary summarizeFits(const StrandSet& strands, const std::vector<StrandFit>&
     return s;
 }
 
+SceneGuide guideFromFit(const StrandFit& fit)
+{
+    SceneGuide g;
+    g.root = fit.root;
+    g.frame = fit.frame;
+    g.pieces = fit.pieces;
+    g.step = fit.step;
+    return g;
+}
+
 } // namespace vdbhair

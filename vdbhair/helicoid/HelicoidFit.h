@@ -132,6 +132,7 @@
 #pragma once
 
 #include <vdbhair/helicoid/Helicoid.h>
+#include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/strands/StrandSet.h>
 
 #include <openvdb/util/NullInterrupter.h>
@@ -190,6 +191,10 @@ struct StrandFit
     double length = 0.0;                ///< the target strand's length
     std::size_t evaluations = 0;        ///< objective evaluations spent
 };
+
+/// @brief A scene guide that regrows @a fit: its root, frame, pieces and step (no waviness, wisp or
+/// fit record).
+SceneGuide guideFromFit(const StrandFit& fit);
 
 /// @brief Fit one strand of @a n points.
 /// @throw ValueError for fewer than 2 distinct points or a zero length.

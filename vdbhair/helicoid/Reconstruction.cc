@@ -157,12 +157,7 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
             ++res.unfitted;
             continue;
         }
-        SceneGuide sg;
-        sg.root = fits[g].root;
-        sg.frame = fits[g].frame;
-        sg.pieces = fits[g].pieces;
-        sg.step = fits[g].step;
-        scene.guides.push_back(std::move(sg));
+        scene.guides.push_back(guideFromFit(fits[g]));
         fittedGuides.push_back(selected[g]);
         fitStep[selected[g]] = fits[g].step;
     }
