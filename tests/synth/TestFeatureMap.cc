@@ -1,0 +1,85 @@
+#include "SynthTestUtil.h"
+
+#include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/synth/FeatureMap.h>
+#include <vdbhair/synth/RootScatter.h>
+
+#include <catch2/catch.hpp>
+
+using namespace vdbhair;
+
+namespace {
+const ScalpMap& unitMap()
+{
+    static const ScalpMap map{ScalpSphere{}};
+    return map;
+}
+
+std::vector<Vec3d> capCoords(std::size_t n)
+{
+    const StrandSet hair = test::wispHairstyle(n, 1, nullptr, 2);
+    std::vector<Vec3d> out;
+    for (std::size_t s = 0; s < hair.numStrands(); ++s) out.push_back(unitMap().toScalp(Vec3d(hair.root(s))));
+    return out;
+}
+} // namespace
+
+TEST_CASE("buildFeatureMap: a linear feature is interpolated exactly at roots and between them within bounds", "[synth]")
+{
+    const std::vector<Vec3d> coords = capCoords(400);
+    std::vector<float> f;
+    for (const Vec3d& c : coords) f.insert(f.end(), {float(c.x()), float(2 * c.y())});
+    const UvGrid grid = uvGridAround(coords, 0.02);
+    const double radius = 2.0 * medianUvSpacing(coords);
+    const FeatureImage map = buildFeatureMap(grid, coords, f.data(), 2, coords, radius);
+    REQUIRE(map.width == grid.width);
+    std::size_t valid = 0;
+    for (int y = 0; y < map.height; ++y)
+        for (int x = 0; x < map.width; ++x) {
+            if (!map.isValid(x, y)) continue;
+            ++valid;
+            // Shepard weights reproduce a linear function up to the spread of the four neighbours.
+            CHECK(map.pixel(x, y)[0] == Approx(grid.u(x)).margin(2 * radius));
+            CHECK(map.pixel(x, y)[1] == Approx(2 * grid.v(y)).margin(4 * radius));
+        }
+    CHECK(valid > map.pixelCount() / 4);
+    CHECK(valid < map.pixelCount());  // the corners of the box around a cap are not hair
+    // nearestFeature from an invalid corner returns a valid pixel's value.
+    float out[2];
+    REQUIRE(nearestFeature(map, grid, grid.u(0), grid.v(0), out));
+    CHECK(out[0] > float(grid.u(0)));
+}
+
+TEST_CASE("scatterRoots: roots on the scalp, in the region, more even after relaxation, deterministic", "[synth]")
+{
+    const std::vector<Vec3d> coords = capCoords(2000);
+    const UvGrid grid = uvGridAround(coords, 0.02);
+    std::vector<float> f(coords.size(), 0.0f);
+    const FeatureImage mask = buildFeatureMap(grid, coords, f.data(), 1, coords, 2.0 * medianUvSpacing(coords));
+    RootScatterParams params;
+    params.count = 1500;
+    params.seed = 3;
+    const ScatteredRoots relaxed = scatterRoots(unitMap(), grid, mask, params);
+    REQUIRE(relaxed.positions.size() == 1500);
+    for (std::size_t i = 0; i < relaxed.positions.size(); ++i) {
+        CHECK(relaxed.positions[i].length() == Approx(1.0).margin(1e-9));
+        int x, y;
+        grid.pixelOf(relaxed.scalp[i].x(), relaxed.scalp[i].y(), x, y);
+        CHECK(mask.isValid(x, y));
+    }
+    params.iterations = 0;
+    const ScatteredRoots random = scatterRoots(unitMap(), grid, mask, params);
+    std::vector<Vec3f> a(relaxed.positions.begin(), relaxed.positions.end()), b(random.positions.begin(), random.positions.end());
+    const FollicleStats sa = measureFollicles(a), sb = measureFollicles(b);
+    CAPTURE(sa.nnCV, sb.nnCV);
+    CHECK(sa.nnCV < 0.6 * sb.nnCV);
+    CHECK(sa.nnCV < 0.25);
+    // The area of the region (a cap of the unit sphere from y = 0.375 up, padded by the mask) is
+    // near the cap's 2 pi (1 - 0.375).
+    CHECK(relaxed.area == Approx(2 * M_PI * 0.625).epsilon(0.15));
+    params.iterations = 10;
+    const ScatteredRoots again = scatterRoots(unitMap(), grid, mask, params, false);
+    CHECK(again.positions == relaxed.positions);
+    params.count = 0;
+    CHECK_THROWS_WITH(scatterRoots(unitMap(), grid, mask, params), Catch::Contains("count of 0"));
+}

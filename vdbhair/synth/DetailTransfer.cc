@@ -1,0 +1,210 @@
+#include "DetailTransfer.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/Frames.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vdbhair {
+
+ScalpFrame alignedFrame(const float* row, int vertices, const ScalpFrame& f)
+{
+    // v_g in root-frame coordinates (root at 0), projected onto the tangent plane (x, z).
+    double x = 0.0, z = 0.0;
+    for (int l = 1; l < vertices; ++l) {
+        x += row[3 * l];
+        z += row[3 * l + 2];
+    }
+    const double len = std::hypot(x, z);
+    if (len < 1e-12) return f;
+    const double c = x / len, s = z / len;
+    ScalpFrame a;
+    a.n = f.n;
+    a.t = f.t * c + f.b * s;
+    a.b = a.t.cross(a.n);
+    return a;
+}
+
+namespace {
+
+/// Row @a row of a sample re-expressed in @a to (from its root frame @a from).
+void reexpress(const float* row, int vertices, const ScalpFrame& from, const ScalpFrame& to, float* out)
+{
+    for (int l = 0; l < vertices; ++l) {
+        const Vec3d w = from.toWorld(Vec3d(row[3 * l], row[3 * l + 1], row[3 * l + 2]));
+        const Vec3d q = to.toLocal(w);
+        out[3 * l] = float(q.x());
+        out[3 * l + 1] = float(q.y());
+        out[3 * l + 2] = float(q.z());
+    }
+}
+
+std::vector<Vec3f> worldOf(const StrandSamples& s, std::size_t i, double radius)
+{
+    std::vector<Vec3f> p(std::size_t(s.vertices));
+    sampleToWorld(s.row(i), s.vertices, s.roots[i], s.frames[i], radius, p.data());
+    return p;
+}
+
+} // namespace
+
+StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
+                             const std::vector<Vec3d>& roots, const ScalpMap& map, int components,
+                             std::vector<std::uint32_t>* outLabel, TransferStats* stats, bool threaded,
+                             openvdb::util::NullInterrupter* interrupter)
+{
+    if (!source.strands || !source.centers || !source.label || source.strands->count() == 0 ||
+        source.centers->count() == 0 || source.label->size() != source.strands->count())
+        throw ValueError("transferDetail: the input level is incomplete or empty");
+    if (outCenters.count() == 0) throw ValueError("transferDetail: no coarser output strands to transfer onto");
+    const StrandSamples& inS = *source.strands;
+    const StrandSamples& inC = *source.centers;
+    const int ns = inS.vertices;
+    if (inC.vertices != ns || outCenters.vertices != ns)
+        throw ValueError("transferDetail: the levels have different vertex counts per strand");
+    const std::size_t dim = inS.dim(), nIn = inC.count(), nOut = outCenters.count(), n = roots.size();
+    const double radius = map.radius();
+    const auto forEach = [&](std::size_t count, auto&& fn) {
+        if (threaded)
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
+            });
+        else
+            for (std::size_t i = 0; i < count; ++i) fn(i);
+    };
+
+    // 1. Output clusters: each new root joins the nearest coarser output root.
+    std::vector<std::uint32_t> label(n, 0);
+    {
+        PointCloud cloud{&outCenters.roots};
+        PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+        tree.buildIndex();
+        forEach(n, [&](std::size_t i) {
+            std::uint32_t idx;
+            double d2;
+            const double q[3] = {roots[i].x(), roots[i].y(), roots[i].z()};
+            tree.knnSearch(q, 1, &idx, &d2);
+            label[i] = idx;
+        });
+    }
+    // 2. Aligned frames of every centre and their rows in them.
+    std::vector<ScalpFrame> inAligned(nIn), outAligned(nOut);
+    std::vector<float> rows((nIn + nOut) * dim);
+    forEach(nIn, [&](std::size_t c) {
+        inAligned[c] = alignedFrame(inC.row(c), ns, inC.frames[c]);
+        reexpress(inC.row(c), ns, inC.frames[c], inAligned[c], rows.data() + c * dim);
+    });
+    forEach(nOut, [&](std::size_t c) {
+        outAligned[c] = alignedFrame(outCenters.row(c), ns, outCenters.frames[c]);
+        reexpress(outCenters.row(c), ns, outCenters.frames[c], outAligned[c], rows.data() + (nIn + c) * dim);
+    });
+    // 3. Matching clusters through PCA features of both sets of centres.
+    const Pca pca = fitPca(rows.data(), nIn + nOut, dim, components);
+    const int nf = pca.components;
+    std::vector<float> feat((nIn + nOut) * std::size_t(nf));
+    forEach(nIn + nOut, [&](std::size_t r) { pca.project(rows.data() + r * dim, feat.data() + r * std::size_t(nf)); });
+    std::vector<std::uint32_t> match(nOut, 0);
+    forEach(nOut, [&](std::size_t c) {
+        const float* f = feat.data() + (nIn + c) * std::size_t(nf);
+        double best = std::numeric_limits<double>::max();
+        for (std::size_t j = 0; j < nIn; ++j) {
+            const double d = sampleDistance2(f, feat.data() + j * std::size_t(nf), std::size_t(nf));
+            if (d < best) {
+                best = d;
+                match[c] = std::uint32_t(j);
+            }
+        }
+    });
+    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("detail transfer interrupted");
+    // Members of each input cluster.
+    std::vector<std::vector<std::uint32_t>> members(nIn);
+    for (std::uint32_t s = 0; s < inS.count(); ++s) members[(*source.label)[s]].push_back(s);
+    // World geometry and rotation-minimizing frames of the centres used, computed once each.
+    std::vector<std::vector<Vec3f>> outWorld(nOut), inWorld(nIn);
+    std::vector<std::vector<Frame>> outRmf(nOut), inRmf(nIn);
+    std::vector<std::uint8_t> inUsed(nIn, 0), outUsed(nOut, 0);
+    for (std::uint32_t l : label) outUsed[l] = 1;
+    for (std::size_t c = 0; c < nOut; ++c)
+        if (outUsed[c]) inUsed[match[c]] = 1;
+    const auto prepare = [&](const StrandSamples& s, std::size_t i, const ScalpFrame& aligned, std::vector<Vec3f>& world,
+                             std::vector<Frame>& rmf) {
+        world = worldOf(s, i, radius);
+        rmf.resize(std::size_t(ns));
+        parallelTransportFrames(world.data(), world.size(), Vec3f(aligned.t), rmf.data());
+    };
+    forEach(nIn, [&](std::size_t c) { if (inUsed[c]) prepare(inC, c, inAligned[c], inWorld[c], inRmf[c]); });
+    forEach(nOut, [&](std::size_t c) { if (outUsed[c]) prepare(outCenters, c, outAligned[c], outWorld[c], outRmf[c]); });
+
+    // 4-5. Every new strand.
+    StrandSamples out;
+    out.vertices = ns;
+    out.local.assign(n * dim, 0.0f);
+    out.roots = roots;
+    out.scalp.resize(n);
+    out.frames.resize(n);
+    out.lengths.resize(n);
+    forEach(n, [&](std::size_t i) {
+        const std::uint32_t oc = label[i], ic = match[oc];
+        const ScalpFrame& mo = outAligned[oc];
+        const ScalpFrame& mi = inAligned[ic];
+        // 4. The input member whose root offset (aligned frame) is nearest to ours.
+        const Vec3d offOut = mo.toLocal(roots[i] - outCenters.roots[oc]);
+        std::uint32_t pick = 0;
+        double best = std::numeric_limits<double>::max();
+        for (std::uint32_t m : members[ic]) {
+            const double d = (mi.toLocal(inS.roots[m] - inC.roots[ic]) - offOut).lengthSqr();
+            if (d < best) {
+                best = d;
+                pick = m;
+            }
+        }
+        const std::vector<Vec3f> gin = worldOf(inS, pick, radius);
+        const std::vector<Vec3f>& cin = inWorld[ic];
+        const std::vector<Vec3f>& cout = outWorld[oc];
+        const std::vector<Frame>& fin = inRmf[ic];
+        const std::vector<Frame>& fout = outRmf[oc];
+        // 5. Eq. 5-8.
+        const auto inFrame = [&](const Frame& f, const Vec3d& w) { return Vec3d(f.t.dot(Vec3f(w)), f.n.dot(Vec3f(w)), f.b.dot(Vec3f(w))); };
+        const auto outOf = [&](const Frame& f, const Vec3d& d) { return Vec3d(f.t) * d.x() + Vec3d(f.n) * d.y() + Vec3d(f.b) * d.z(); };
+        const Vec3d rootIn = Vec3d(gin[0]) - Vec3d(cin[0]);
+        const Vec3d betaShift = roots[i] - Vec3d(cout[0]) - outOf(fout[0], inFrame(fin[0], rootIn));
+        const Vec3d sc = map.toScalp(roots[i]);
+        const ScalpFrame rf = map.frame(sc.x(), sc.y());
+        float* row = out.row(i);
+        double len = 0.0;
+        Vec3d prev = roots[i];
+        for (int l = 0; l < ns; ++l) {
+            const Vec3d dIn = Vec3d(gin[std::size_t(l)]) - Vec3d(cin[std::size_t(l)]);
+            const Vec3d dAlpha = mi.toLocal(dIn - rootIn);                         // Eq. 5
+            const Vec3d dBeta = inFrame(fin[std::size_t(l)], dIn);                 // Eq. 6
+            const Vec3d a = roots[i] + (Vec3d(cout[std::size_t(l)]) - Vec3d(cout[0])) + mo.toWorld(dAlpha);  // Eq. 8
+            const Vec3d b = Vec3d(cout[std::size_t(l)]) + outOf(fout[std::size_t(l)], dBeta) + betaShift;
+            const double s = ns > 1 ? double(l) / double(ns - 1) : 0.0;
+            const Vec3d p = l == 0 ? roots[i] : a * (1.0 - s) + b * s;             // Eq. 7
+            const Vec3d q = rf.toLocal((p - roots[i]) / radius);
+            row[3 * l] = float(q.x());
+            row[3 * l + 1] = float(q.y());
+            row[3 * l + 2] = float(q.z());
+            len += (p - prev).length();
+            prev = p;
+        }
+        out.scalp[i] = sc;
+        out.frames[i] = rf;
+        out.lengths[i] = float(len);
+    });
+    if (outLabel) *outLabel = label;
+    if (stats) {
+        stats->clusters = 0;
+        for (std::uint8_t u : outUsed) stats->clusters += u;
+        stats->distinctSources = 0;
+        for (std::uint8_t u : inUsed) stats->distinctSources += u;
+    }
+    return out;
+}
+
+} // namespace vdbhair

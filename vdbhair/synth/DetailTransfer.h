@@ -1,0 +1,59 @@
+/// @file DetailTransfer.h
+/// @brief Cluster-oriented detail transfer (Wang et al. 2009, §5.2, Eq. 4-8): the strands of a
+/// finer output level get the detail of an input cluster, superposed on their output centre.
+///
+/// 1. **Output clusters** (top-down, Kim & Neumann 2002): every output root of the finer level joins
+///    the coarser output strand whose root is nearest.
+/// 2. **Per-strand-aligned frames** (Eq. 4): a centre's root frame turned about its normal so its
+///    tangent follows the strand's average direction v_g = Σ_{i≥2} (γ(i) − γ(1)) projected onto
+///    the tangent plane (unchanged where that projection vanishes).
+/// 3. **Matching clusters**: PCA (n_f components, Pca.h) of the input and output centres together,
+///    in their aligned frames; each output centre takes the input centre nearest in feature space
+///    (exact search; ties to the lower index).
+/// 4. **Matching strands**: each output strand takes the member of the matched input cluster whose
+///    root offset from its centre, in the centre's aligned frame, is nearest to its own.
+/// 5. **Eq. 5-8**: D_α in the centre's aligned root frame, D_β in rotation-minimizing frames along
+///    the centre (Frames.h, started from the aligned tangent in both hairstyles), blended with
+///    weights (n_s − i)/(n_s − 1) and (i − 1)/(n_s − 1). The paper's γ_β is shifted by a constant
+///    so that both estimates, and so the strand, start at the prescribed output root (the paper's
+///    text swaps γ_α(1) and γ_β(1) there; this is its stated intent).
+/// Transferring a cluster onto its own centre gives the cluster back (tested).
+#pragma once
+
+#include <vdbhair/synth/Pca.h>
+#include <vdbhair/synth/StrandSamples.h>
+
+#include <openvdb/util/NullInterrupter.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace vdbhair {
+
+/// @brief The aligned frame of Eq. 4 for sample row @a row (root-relative, in @a rootFrame).
+ScalpFrame alignedFrame(const float* row, int vertices, const ScalpFrame& rootFrame);
+
+/// @brief What detail transfer needs of one level of the input hierarchy.
+struct TransferSource
+{
+    const StrandSamples* strands = nullptr;        ///< the input's finer level
+    const StrandSamples* centers = nullptr;        ///< the input's coarser level (centres of @c strands)
+    const std::vector<std::uint32_t>* label = nullptr;  ///< #strands: the centre of each strand
+};
+
+struct TransferStats
+{
+    std::size_t clusters = 0;             ///< output clusters (coarser output strands with members)
+    std::size_t distinctSources = 0;      ///< distinct input clusters used
+};
+
+/// @brief The finer output level: strands rooted at @a roots (world, on the scalp), detail from
+/// @a source, superposed on the coarser output strands @a outCenters.
+/// @param outLabel if given, receives each new strand's output centre
+/// @throw ValueError if @a source is incomplete or empty; InterruptedError.
+StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
+                             const std::vector<Vec3d>& roots, const ScalpMap& map, int components = Pca::kDefaultComponents,
+                             std::vector<std::uint32_t>* outLabel = nullptr, TransferStats* stats = nullptr,
+                             bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr);
+
+} // namespace vdbhair

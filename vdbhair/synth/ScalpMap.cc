@@ -1,0 +1,167 @@
+#include "ScalpMap.h"
+
+#include <vdbhair/Exceptions.h>
+
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/RayIntersector.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace vdbhair {
+
+namespace {
+
+/// Rodrigues: rotate @a v about the unit @a axis by the angle whose cosine is @a c and sine @a s.
+Vec3d rotate(const Vec3d& v, const Vec3d& axis, double c, double s)
+{
+    return v * c + axis.cross(v) * s + axis * (axis.dot(v) * (1.0 - c));
+}
+
+/// The shortest rotation taking @a from onto @a to (both unit), applied to @a v.
+Vec3d rotateShortest(const Vec3d& from, const Vec3d& to, const Vec3d& v, const Vec3d& halfTurnAxis)
+{
+    const Vec3d a = from.cross(to);
+    const double s = a.length(), c = from.dot(to);
+    if (s < 1e-12) return c > 0.0 ? v : rotate(v, halfTurnAxis, -1.0, 0.0);
+    return rotate(v, a / s, c, s);
+}
+
+} // namespace
+
+ScalpMap::ScalpMap(const ScalpSphere& sphere) : mSphere(sphere)
+{
+    // The sphere's own axes, as ScalpSpace.cc builds them (x kept near world x).
+    mUp = sphere.up.unitSafe();
+    if (mUp.lengthSqr() == 0.0) mUp = Vec3d(0.0, 1.0, 0.0);
+    mSphere.up = mUp;
+    Vec3d x(1.0, 0.0, 0.0);
+    if (std::abs(mUp.dot(x)) > 0.9) x = Vec3d(0.0, 0.0, -1.0);
+    mRight = (x - mUp * mUp.dot(x)).unitSafe();
+    mForward = mRight.cross(mUp);
+}
+
+ScalpMap::ScalpMap(const ScalpSphere& sphere, const openvdb::FloatGrid& surface, int resolution) : ScalpMap(sphere)
+{
+    if (surface.getGridClass() != openvdb::GRID_LEVEL_SET)
+        throw TypeError("scalp map: grid '" + surface.getName() + "' is not a level set (class " +
+                        openvdb::GridBase::gridClassToString(surface.getGridClass()) + ")");
+    if (resolution < 8)
+        throw ValueError("scalp map: resolution " + std::to_string(resolution) + " is below the minimum of 8");
+    using Sampler = openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler>;
+    {
+        const openvdb::FloatGrid::ConstAccessor acc = surface.getConstAccessor();
+        Sampler sampler(acc, surface.transform());
+        if (sampler.wsSample(mSphere.center) >= 0.0)
+            throw ValueError("scalp map: the parameterization's centre (" + std::to_string(mSphere.center.x()) + ", " +
+                             std::to_string(mSphere.center.y()) + ", " + std::to_string(mSphere.center.z()) +
+                             ") is not inside the scalp surface: rays from it must cross the scalp once");
+    }
+    mResolution = resolution;
+    const std::size_t count = std::size_t(resolution) * resolution;
+    mD.assign(count, 1.0f);
+    mNormal.assign(count, Vec3f(0.0f));
+    std::vector<std::uint8_t> missed(count, 0);
+    const double dx = surface.voxelSize()[0];
+    // One intersector per row (it holds accessors); rows are independent, so the table does not
+    // depend on the thread count.
+    tbb::parallel_for(tbb::blocked_range<int>(0, resolution), [&](const tbb::blocked_range<int>& rows) {
+        openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid> intersector(surface);
+        const openvdb::FloatGrid::ConstAccessor acc = surface.getConstAccessor();
+        Sampler sampler(acc, surface.transform());
+        for (int j = rows.begin(); j != rows.end(); ++j) {
+            for (int i = 0; i < resolution; ++i) {
+                const double u = M_PI * (i + 0.5) / resolution, v = M_PI * (j + 0.5) / resolution;
+                const Vec3d local = unitDirection(u, v);
+                const Vec3d dir = (mRight * local.x() + mUp * local.y() + mForward * local.z()).unitSafe();
+                const std::size_t k = std::size_t(j) * resolution + i;
+                openvdb::math::Ray<double> ray(mSphere.center, dir);
+                openvdb::Vec3d hit;
+                double t = 0.0;
+                Vec3d normal = dir;
+                if (intersector.intersectsWS(ray, hit, t) && t > 0.0) {
+                    mD[k] = float(t / mSphere.radius);
+                    // Central-difference gradient of the level set at the hit.
+                    Vec3d g(sampler.wsSample(hit + Vec3d(dx, 0, 0)) - sampler.wsSample(hit - Vec3d(dx, 0, 0)),
+                            sampler.wsSample(hit + Vec3d(0, dx, 0)) - sampler.wsSample(hit - Vec3d(0, dx, 0)),
+                            sampler.wsSample(hit + Vec3d(0, 0, dx)) - sampler.wsSample(hit - Vec3d(0, 0, dx)));
+                    if (g.length() > 1e-12) normal = g.unitSafe();
+                } else {
+                    missed[k] = 1;
+                }
+                mNormal[k] = Vec3f(normal);
+            }
+        }
+    });
+    for (std::uint8_t m : missed) mMisses += m;
+}
+
+Vec3d ScalpMap::unitDirection(double u, double v) const
+{
+    const double cu = 1.0 / std::tan(u), cv = 1.0 / std::tan(v);
+    const double h = 2.0 / (cu * cu + cv * cv + 1.0);
+    return Vec3d(h * cu, h - 1.0, h * cv);
+}
+
+void ScalpMap::lookup(double u, double v, double& d, Vec3d& normal) const
+{
+    const double fu = std::clamp(u / M_PI * mResolution - 0.5, 0.0, double(mResolution - 1));
+    const double fv = std::clamp(v / M_PI * mResolution - 0.5, 0.0, double(mResolution - 1));
+    const int i0 = std::min(int(fu), mResolution - 2), j0 = std::min(int(fv), mResolution - 2);
+    const double a = fu - i0, b = fv - j0;
+    const auto at = [&](int i, int j) { return std::size_t(j) * mResolution + i; };
+    const double w[4] = {(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b};
+    const std::size_t k[4] = {at(i0, j0), at(i0 + 1, j0), at(i0, j0 + 1), at(i0 + 1, j0 + 1)};
+    d = 0.0;
+    normal = Vec3d(0.0);
+    for (int q = 0; q < 4; ++q) {
+        d += w[q] * mD[k[q]];
+        normal += w[q] * Vec3d(mNormal[k[q]]);
+    }
+    normal = normal.unitSafe();
+}
+
+double ScalpMap::scalpDistance(double u, double v) const
+{
+    if (mD.empty()) return 1.0;
+    double d;
+    Vec3d n;
+    lookup(u, v, d, n);
+    return d;
+}
+
+Vec3d ScalpMap::toScalp(const Vec3d& worldPos) const
+{
+    Vec3d s = worldToScalp(mSphere, worldPos);  // w = |p'| - 1
+    if (!mD.empty()) s.z() += 1.0 - scalpDistance(s.x(), s.y());
+    return s;
+}
+
+Vec3d ScalpMap::toWorld(const Vec3d& uvw) const
+{
+    const double d = scalpDistance(uvw.x(), uvw.y());
+    return scalpToWorld(mSphere, Vec3d(uvw.x(), uvw.y(), uvw.z() + d - 1.0));
+}
+
+ScalpFrame ScalpMap::frame(double u, double v) const
+{
+    Vec3d n;
+    if (mD.empty()) {
+        const Vec3d local = unitDirection(u, v);
+        n = (mRight * local.x() + mUp * local.y() + mForward * local.z()).unitSafe();
+    } else {
+        double d;
+        lookup(u, v, d, n);
+    }
+    // The rotation taking the sphere's up (the paper's +y) onto n, applied to its x and z.
+    ScalpFrame f;
+    f.n = n;
+    f.t = rotateShortest(mUp, n, mRight, mRight);
+    f.b = rotateShortest(mUp, n, mForward, mRight);
+    return f;
+}
+
+} // namespace vdbhair

@@ -1,0 +1,84 @@
+/// @file ScalpMap.h
+/// @brief Wang et al.'s scalp space (2009, §3) on a real scalp: Eq. 1-2 with the distance
+/// d(x̂, ŷ, ẑ) from the centre to the scalp measured on a level set, and the local frame at every
+/// (u, v).
+///
+/// The parameterization's sphere (centre, radius, up) comes from ScalpSpace.h (by default the sphere
+/// fitted to the roots). Without a surface the scalp *is* that sphere (d ≡ 1, the paper's
+/// assumption). With a surface (a `surface` level set), d(u, v) is measured once along the ray from
+/// the centre in the direction of (u, v) with OpenVDB's LevelSetRayIntersector, in units of the
+/// radius, and tabulated on a resolution × resolution grid of (u, v) ∈ (0, π)² (bilinear between
+/// nodes); directions whose ray misses the surface take the sphere (d = 1), and are counted. So
+///   w = |p'| - d(u, v)   (units of the radius; 0 on the scalp, positive above it).
+/// The inverse (Eq. 2): p' = (w + d(u, v)) (h cot u, h - 1, h cot v), h = 2 / (cot²u + cot²v + 1).
+///
+/// Local frame (§3): R is the shortest rotation taking +y onto the scalp's unit outward normal at
+/// (u, v) (the sphere's radial direction, or the level set's normalized gradient, tabulated with d);
+/// the frame is n = R y (normal), t = R x (tangent), b = R z (binormal), in world space. Points in
+/// the hair volume use the frame of the scalp point with the same (u, v).
+#pragma once
+
+#include <vdbhair/Types.h>
+#include <vdbhair/field/ScalpSpace.h>
+
+#include <openvdb/openvdb.h>
+
+#include <vector>
+
+namespace vdbhair {
+
+/// @brief An orthonormal frame in world space: t (tangent, R x), n (normal, R y), b (binormal, R z).
+struct ScalpFrame
+{
+    Vec3d t{1.0, 0.0, 0.0}, n{0.0, 1.0, 0.0}, b{0.0, 0.0, 1.0};
+
+    /// World direction of local coordinates (x along t, y along n, z along b).
+    Vec3d toWorld(const Vec3d& local) const { return t * local.x() + n * local.y() + b * local.z(); }
+    /// Local coordinates of a world direction.
+    Vec3d toLocal(const Vec3d& world) const { return Vec3d(t.dot(world), n.dot(world), b.dot(world)); }
+};
+
+class ScalpMap
+{
+public:
+    static constexpr int kDefaultResolution = 256;  ///< table nodes per (u, v) axis: 0.7° apart
+
+    /// @brief The paper's scalp: the sphere itself (d ≡ 1).
+    explicit ScalpMap(const ScalpSphere& sphere);
+
+    /// @brief A real scalp: d(u, v) and normals tabulated from the level set @a surface.
+    /// @throw TypeError if @a surface is not a level set; ValueError if the sphere's centre is not
+    /// inside it (rays from outside cross the scalp twice) or @a resolution is below 8.
+    ScalpMap(const ScalpSphere& sphere, const openvdb::FloatGrid& surface, int resolution = kDefaultResolution);
+
+    /// (u, v, w) of a world point (Eq. 1; w in units of the radius).
+    Vec3d toScalp(const Vec3d& worldPos) const;
+    /// World point of (u, v, w) (Eq. 2).
+    Vec3d toWorld(const Vec3d& uvw) const;
+    /// The world point on the scalp with the (u, v) of @a worldPos (w set to 0).
+    Vec3d projectToScalp(const Vec3d& worldPos) const { Vec3d s = toScalp(worldPos); s.z() = 0.0; return toWorld(s); }
+    /// The local frame at (u, v).
+    ScalpFrame frame(double u, double v) const;
+    /// d(u, v) in units of the radius (1 on the sphere).
+    double scalpDistance(double u, double v) const;
+
+    const ScalpSphere& sphere() const { return mSphere; }
+    double radius() const { return mSphere.radius; }
+    bool hasSurface() const { return !mD.empty(); }
+    int resolution() const { return mResolution; }
+    /// Table directions whose ray missed the surface (they use the sphere).
+    std::size_t misses() const { return mMisses; }
+
+private:
+    Vec3d unitDirection(double u, double v) const;  ///< in the sphere's frame (y up), unit
+    void lookup(double u, double v, double& d, Vec3d& normal) const;
+
+    ScalpSphere mSphere;
+    Vec3d mRight{1.0, 0.0, 0.0}, mUp{0.0, 1.0, 0.0}, mForward{0.0, 0.0, 1.0};  ///< world axes of the sphere's x, y, z
+    int mResolution = 0;
+    std::vector<float> mD;        ///< #res² d(u, v), row v, column u
+    std::vector<Vec3f> mNormal;   ///< #res² unit normals in world space
+    std::size_t mMisses = 0;
+};
+
+} // namespace vdbhair

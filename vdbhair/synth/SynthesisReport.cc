@@ -1,0 +1,113 @@
+#include "SynthesisReport.h"
+
+#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/Resample.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vdbhair {
+
+double relativeWasserstein(std::vector<double> a, std::vector<double> b)
+{
+    if (a.empty() || b.empty()) return a.empty() && b.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    // W1 = ∫ |F_a⁻¹(q) − F_b⁻¹(q)| dq, summed over the merged quantile breakpoints.
+    double w = 0.0, q = 0.0;
+    std::size_t i = 0, j = 0;
+    const double na = double(a.size()), nb = double(b.size());
+    while (i < a.size() && j < b.size()) {
+        const double qa = double(i + 1) / na, qb = double(j + 1) / nb, next = std::min(qa, qb);
+        w += (next - q) * std::abs(a[i] - b[j]);
+        q = next;
+        if (qa <= next) ++i;
+        if (qb <= next) ++j;
+    }
+    double mean = 0.0;
+    for (double x : a) mean += x;
+    mean /= na;
+    return mean > 0.0 ? w / mean : w;
+}
+
+std::vector<double> turningPerLength(const StrandSet& strands)
+{
+    std::vector<double> out(strands.numStrands(), 0.0);
+    for (std::size_t s = 0; s < strands.numStrands(); ++s) {
+        const Vec3f* p = strands.data(s);
+        const std::size_t n = strands.size(s);
+        double len = 0.0, turn = 0.0;
+        for (std::size_t i = 1; i < n; ++i) {
+            const Vec3d e(p[i] - p[i - 1]);
+            len += e.length();
+            if (i + 1 < n) {
+                const Vec3d f(p[i + 1] - p[i]);
+                const double c = e.dot(f) / std::max(1e-30, e.length() * f.length());
+                turn += std::acos(std::clamp(c, -1.0, 1.0));
+            }
+        }
+        out[s] = len > 0.0 ? turn / len : 0.0;
+    }
+    return out;
+}
+
+NoveltyStats measureNovelty(const StrandSet& example, const StrandSet& output, double radius, int vertices, bool threaded)
+{
+    NoveltyStats st;
+    if (example.numStrands() < 2 || output.empty()) return st;
+    const StrandSet ex = resampleStrands(example, std::size_t(vertices)), out = resampleStrands(output, std::size_t(vertices));
+    std::vector<Vec3d> roots(ex.numStrands());
+    for (std::size_t s = 0; s < roots.size(); ++s) roots[s] = Vec3d(ex.root(s));
+    PointCloud cloud{&roots};
+    PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree.buildIndex();
+    const auto nearest = [&](const StrandSet& set, std::size_t s, bool skipSelf) {
+        constexpr std::size_t K = 9;
+        std::uint32_t idx[K];
+        double d2[K];
+        const Vec3f r = set.root(s);
+        const double q[3] = {r.x(), r.y(), r.z()};
+        const std::size_t got = tree.knnSearch(q, std::min(K, roots.size()), idx, d2);
+        double best = std::numeric_limits<double>::max();
+        for (std::size_t j = 0; j < got; ++j) {
+            if (skipSelf && idx[j] == s) continue;
+            double sum = 0.0;
+            for (int v = 0; v < vertices; ++v) sum += (Vec3d(set.data(s)[v]) - Vec3d(ex.data(idx[j])[v])).lengthSqr();
+            best = std::min(best, std::sqrt(sum / vertices) / radius);
+        }
+        return best;
+    };
+    const auto run = [&](const StrandSet& set, bool skipSelf) {
+        std::vector<double> d(set.numStrands());
+        const auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t s = r.begin(); s != r.end(); ++s) d[s] = nearest(set, s, skipSelf);
+        };
+        if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, d.size(), 256), body);
+        else body(tbb::blocked_range<std::size_t>(0, d.size()));
+        return d;
+    };
+    std::vector<double> a = run(out, false), b = run(ex, true);
+    std::size_t copies = 0;
+    for (double x : a) copies += x < 0.01;
+    st.copies = double(copies) / double(a.size());
+    std::nth_element(a.begin(), a.begin() + std::ptrdiff_t(a.size() / 2), a.end());
+    std::nth_element(b.begin(), b.begin() + std::ptrdiff_t(b.size() / 2), b.end());
+    st.outputMedian = a[a.size() / 2];
+    st.exampleMedian = b[b.size() / 2];
+    return st;
+}
+
+std::vector<double> clusterSizes(const std::vector<std::int32_t>& label)
+{
+    std::int32_t k = 0;
+    for (std::int32_t l : label) k = std::max(k, l + 1);
+    std::vector<double> size(std::size_t(k), 0.0);
+    for (std::int32_t l : label) size[std::size_t(l)] += 1.0;
+    size.erase(std::remove(size.begin(), size.end(), 0.0), size.end());
+    return size;
+}
+
+} // namespace vdbhair
