@@ -3,6 +3,7 @@
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
 
+#include <cmath>
 #include <limits>
 
 namespace vdbhair {
@@ -36,10 +37,14 @@ StrandSet readData(const std::string& path, const ReadOptions& opts, ReadReport*
         const std::size_t posAt = in.offset();
         out.positions.resize(first + std::size_t(nV));
         in.readArray(reinterpret_cast<float*>(out.positions.data() + first), 3 * std::uint64_t(nV), "vertices");
+        // The message's location is built only for a vertex that fails: building it for every
+        // vertex took three quarters of the time to read a 77 MB file.
         for (std::int32_t k = 0; k < nV; ++k) {
-            checkFinite(out.positions[first + k], first + k, where, "at byte " + std::to_string(posAt + 12 * std::size_t(k)));
+            const Vec3f& p = out.positions[first + k];
+            if (std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z())) continue;
+            checkFinite(p, first + k, where, "at byte " + std::to_string(posAt + 12 * std::size_t(k)));
         }
-        if (filter.keep(std::size_t(i), std::size_t(nV), "at byte " + std::to_string(at))) {
+        if (nV >= 2 || filter.keep(std::size_t(i), std::size_t(nV), "at byte " + std::to_string(at))) {
             if (out.positions.size() > std::numeric_limits<std::uint32_t>::max()) in.fail("more than 2^32-1 vertices");
             out.offsets.push_back(std::uint32_t(out.positions.size()));
         } else {

@@ -1,0 +1,660 @@
+// vdbhair.Grid, vdbhair.TangentField and the field operations: estimate_tangent_field, retrace,
+// refine, read_grid, read_grids, write_grids, suggest_voxel_size.
+#include "Common.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/field/StreamlineTracer.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/io/VdbFile.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+
+#include <pybind11/stl.h>
+
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <cstring>
+#include <memory>
+#include <optional>
+
+namespace vdbhair::py {
+
+namespace {
+
+using IndexBox = std::array<std::array<int, 3>, 2>;
+using StrandsPtr = std::shared_ptr<StrandSet>;
+
+/// A grid as Python sees it: a shared pointer to the OpenVDB grid (shared with a TangentField).
+struct PyGrid
+{
+    openvdb::GridBase::Ptr grid;
+};
+
+/// A field of one level as Python sees it.
+struct PyField
+{
+    TangentField field;
+};
+
+/// Call @a op with @a grid as a Vec3SGrid or a FloatGrid; other value types are refused.
+template <typename OpT>
+auto applyVoxelGrid(const openvdb::GridBase& grid, const std::string& where, OpT&& op)
+{
+    if (const auto* g = dynamic_cast<const openvdb::Vec3SGrid*>(&grid)) return op(*g);
+    if (const auto* g = dynamic_cast<const openvdb::FloatGrid*>(&grid)) return op(*g);
+    throw TypeError(where + ": grid '" + grid.getName() + "' holds " + grid.valueType() +
+                    " values; arrays are made of vec3s and float grids only");
+}
+
+/// Components per value of a grid type (3 for vectors, 0 for scalars: no last axis).
+template <typename GridT>
+constexpr std::size_t componentsOf()
+{
+    return std::is_same_v<typename GridT::ValueType, openvdb::Vec3s> ? 3 : 0;
+}
+
+/// Where each active value of a grid goes in active_coords() / values(): leaves in the tree's
+/// order, each in its own voxel order, then active tiles voxel by voxel.
+template <typename GridT>
+struct ActiveLayout
+{
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    std::vector<const LeafT*> leaves;
+    std::vector<std::size_t> leafStart;  ///< #leaves+1
+    std::vector<std::pair<openvdb::CoordBBox, typename GridT::ValueType>> tiles;
+    std::size_t total = 0;
+
+    explicit ActiveLayout(const GridT& grid)
+    {
+        const auto& tree = grid.tree();
+        leafStart.push_back(0);
+        for (auto it = tree.cbeginLeaf(); it; ++it) {
+            leaves.push_back(it.getLeaf());
+            leafStart.push_back(leafStart.back() + it->onVoxelCount());
+        }
+        total = leafStart.back();
+        if (tree.activeTileCount() > 0) {
+            for (auto it = tree.cbeginValueOn(); it; ++it) {
+                if (!it.isTileValue()) continue;
+                tiles.emplace_back(it.getBoundingBox(), *it);
+                total += it.getBoundingBox().volume();
+            }
+        }
+    }
+
+    /// Call @a f(index, coord, value) for every active value, leaves in parallel.
+    template <typename FuncT>
+    void forEach(FuncT&& f) const
+    {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                std::size_t n = leafStart[l];
+                for (auto v = leaves[l]->cbeginValueOn(); v; ++v) f(n++, v.getCoord(), *v);
+            }
+        });
+        std::size_t n = leafStart.back();
+        for (const auto& [box, value] : tiles) {
+            for (auto c = box.begin(); c; ++c) f(n++, *c, value);
+        }
+    }
+};
+
+pyb::array activeCoords(const openvdb::GridBase& grid)
+{
+    return applyVoxelGrid(grid, "active_coords", [](const auto& g) {
+        using GridT = std::decay_t<decltype(g)>;
+        const ActiveLayout<GridT> layout(g);
+        pyb::array_t<std::int32_t> out({pyb::ssize_t(layout.total), pyb::ssize_t(3)});
+        std::int32_t* data = out.mutable_data();
+        {
+            pyb::gil_scoped_release release;
+            layout.forEach([&](std::size_t n, const openvdb::Coord& c, const auto&) {
+                data[3 * n] = c.x();
+                data[3 * n + 1] = c.y();
+                data[3 * n + 2] = c.z();
+            });
+        }
+        return pyb::array(out);
+    });
+}
+
+pyb::array activeValues(const openvdb::GridBase& grid)
+{
+    return applyVoxelGrid(grid, "values", [](const auto& g) {
+        using GridT = std::decay_t<decltype(g)>;
+        constexpr std::size_t kC = componentsOf<GridT>();
+        const ActiveLayout<GridT> layout(g);
+        pyb::array_t<float> out = kC ? pyb::array_t<float>({pyb::ssize_t(layout.total), pyb::ssize_t(kC)})
+                                     : pyb::array_t<float>(pyb::ssize_t(layout.total));
+        float* data = out.mutable_data();
+        {
+            pyb::gil_scoped_release release;
+            layout.forEach([&](std::size_t n, const openvdb::Coord&, const auto& v) {
+                if constexpr (kC == 3) {
+                    data[3 * n] = v[0];
+                    data[3 * n + 1] = v[1];
+                    data[3 * n + 2] = v[2];
+                } else {
+                    data[n] = v;
+                }
+            });
+        }
+        return pyb::array(out);
+    });
+}
+
+std::optional<IndexBox> activeBox(const openvdb::GridBase& grid)
+{
+    const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+    if (box.empty()) return std::nullopt;
+    return IndexBox{{{box.min().x(), box.min().y(), box.min().z()}, {box.max().x(), box.max().y(), box.max().z()}}};
+}
+
+pyb::array toDense(const openvdb::GridBase& grid, const std::optional<IndexBox>& bboxArg)
+{
+    const std::string where = "to_dense(" + grid.getName() + ")";
+    std::optional<IndexBox> bbox = bboxArg ? bboxArg : activeBox(grid);
+    if (!bbox) throw ValueError(where + ": the grid has no active voxels; give bbox=((i0, j0, k0), (i1, j1, k1))");
+    const IndexBox& b = *bbox;
+    for (int a = 0; a < 3; ++a) {
+        if (b[1][a] < b[0][a]) {
+            throw ValueError(where + ": bbox max[" + std::to_string(a) + "] = " + std::to_string(b[1][a]) + " is below min[" +
+                             std::to_string(a) + "] = " + std::to_string(b[0][a]) + "; bbox is ((i0, j0, k0), (i1, j1, k1)), inclusive");
+        }
+    }
+    const openvdb::CoordBBox box(openvdb::Coord(b[0][0], b[0][1], b[0][2]), openvdb::Coord(b[1][0], b[1][1], b[1][2]));
+    return applyVoxelGrid(grid, where, [&](const auto& g) {
+        using GridT = std::decay_t<decltype(g)>;
+        using ValueT = typename GridT::ValueType;
+        constexpr std::size_t kC = componentsOf<GridT>();
+        const auto dim = box.dim();  // x, y, z
+        std::vector<pyb::ssize_t> shape{pyb::ssize_t(dim.z()), pyb::ssize_t(dim.y()), pyb::ssize_t(dim.x())};
+        if (kC) shape.push_back(pyb::ssize_t(kC));
+        pyb::array_t<float> out(shape);
+        ValueT* data = reinterpret_cast<ValueT*>(out.mutable_data());
+        {
+            pyb::gil_scoped_release release;
+            // LayoutXYZ: x varies fastest, so the array is [z][y][x] (D x H x W).
+            openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(box, data);
+            openvdb::tools::copyToDense(g, dense, /*serial=*/false);
+        }
+        return pyb::array(out);
+    });
+}
+
+/// Rows of @a points (N x 3) mapped by @a f(Vec3d) -> Vec3d, as float64.
+template <typename FuncT>
+pyb::array mapPoints(const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points, const char* where, FuncT&& f)
+{
+    if (points.ndim() != 2 || points.shape(1) != 3) throw ValueError(std::string(where) + ": points must be an (N, 3) array");
+    const std::size_t n = std::size_t(points.shape(0));
+    pyb::array_t<double> out({pyb::ssize_t(n), pyb::ssize_t(3)});
+    const double* in = points.data();
+    double* o = out.mutable_data();
+    for (std::size_t i = 0; i < n; ++i) {
+        const openvdb::Vec3d r = f(openvdb::Vec3d(in[3 * i], in[3 * i + 1], in[3 * i + 2]));
+        o[3 * i] = r.x();
+        o[3 * i + 1] = r.y();
+        o[3 * i + 2] = r.z();
+    }
+    return pyb::array(out);
+}
+
+pyb::dict metadataDict(const openvdb::GridBase& grid)
+{
+    pyb::dict d;
+    for (auto it = grid.beginMeta(); it != grid.endMeta(); ++it) {
+        const openvdb::Metadata& m = *it->second;
+        const std::string type = m.typeName();
+        pyb::object v;
+        if (const auto* s = dynamic_cast<const openvdb::StringMetadata*>(&m)) v = pyb::str(s->value());
+        else if (const auto* f = dynamic_cast<const openvdb::FloatMetadata*>(&m)) v = pyb::float_(f->value());
+        else if (const auto* dd = dynamic_cast<const openvdb::DoubleMetadata*>(&m)) v = pyb::float_(dd->value());
+        else if (const auto* i = dynamic_cast<const openvdb::Int32Metadata*>(&m)) v = pyb::int_(i->value());
+        else if (const auto* l = dynamic_cast<const openvdb::Int64Metadata*>(&m)) v = pyb::int_(l->value());
+        else if (const auto* b = dynamic_cast<const openvdb::BoolMetadata*>(&m)) v = pyb::bool_(b->value());
+        else if (const auto* vs = dynamic_cast<const openvdb::Vec3SMetadata*>(&m)) v = pyb::make_tuple(vs->value()[0], vs->value()[1], vs->value()[2]);
+        else if (const auto* vd = dynamic_cast<const openvdb::Vec3DMetadata*>(&m)) v = pyb::make_tuple(vd->value()[0], vd->value()[1], vd->value()[2]);
+        else if (const auto* vi = dynamic_cast<const openvdb::Vec3IMetadata*>(&m)) v = pyb::make_tuple(vi->value()[0], vi->value()[1], vi->value()[2]);
+        else v = pyb::str(m.str());
+        d[pyb::str(it->first)] = v;
+    }
+    return d;
+}
+
+/// The vector grid of a TangentField or Grid argument.
+openvdb::GridBase::ConstPtr fieldArgument(const pyb::handle& field, const char* where)
+{
+    if (pyb::isinstance<PyField>(field)) return field.cast<const PyField&>().field.tangent;
+    if (pyb::isinstance<PyGrid>(field)) return field.cast<const PyGrid&>().grid;
+    throw TypeError(std::string(where) + ": field must be a vdbhair.TangentField or a vdbhair.Grid, not " +
+                    std::string(pyb::str(field.get_type().attr("__name__"))));
+}
+
+pyb::dict traceStatsDict(const TraceStats& s)
+{
+    pyb::dict d;
+    d["strands"] = s.strands;
+    d["full_length"] = s.fullLength;
+    d["vanished"] = s.vanished;
+    d["left_field"] = s.leftField;
+    d["max_steps"] = s.maxSteps;
+    d["steps"] = s.steps;
+    return d;
+}
+
+RetraceVertices verticesFromName(const std::string& name)
+{
+    if (name == "input") return RetraceVertices::Input;
+    if (name == "steps") return RetraceVertices::Steps;
+    throw ValueError("vertices='" + name + "' is not one of input, steps");
+}
+const char* verticesName(RetraceVertices v) { return v == RetraceVertices::Input ? "input" : "steps"; }
+
+pyb::dict measuresDict(const RefineMeasures& m)
+{
+    pyb::dict d;
+    d["strands"] = m.strands;
+    d["full_length"] = m.fullLength;
+    d["left_hair_volume"] = m.leftVolume;
+    d["inside_head_before"] = m.insideHeadBefore;
+    d["inside_head_after"] = m.insideHeadAfter;
+    d["curvature_kept_vertex"] = m.curvatureKeptVertex;
+    d["curvature_kept_8"] = m.curvatureKept8;
+    d["tip_occupancy"] = m.tipOccupancy;
+    d["displacement_mean_voxels"] = m.displacementMean;
+    d["displacement_p95_voxels"] = m.displacementP95;
+    d["coherence_before"] = m.coherenceBefore;
+    d["coherence_after"] = m.coherenceAfter;
+    return d;
+}
+
+/// The array methods Grid and TangentField share (TangentField's act on its tangent grid).
+template <typename ClassT, typename GetT>
+void addArrayMethods(ClassT& cls, GetT get, const char* subject)
+{
+    const std::string s = subject;
+    cls.def_property_readonly(
+        "voxel_size", [get](const typename ClassT::type& self) { return get(self).voxelSize().x(); },
+        ("Voxel size of " + s + " in world units.").c_str());
+    cls.def_property_readonly(
+        "bbox", [get](const typename ClassT::type& self) { return activeBox(get(self)); },
+        ("Index bounding box of the active voxels of " + s +
+         ", ((i0, j0, k0), (i1, j1, k1)) inclusive, or None when there are none.").c_str());
+    cls.def_property_readonly(
+        "active_voxel_count", [get](const typename ClassT::type& self) { return get(self).activeVoxelCount(); },
+        ("Number of active voxels of " + s + ".").c_str());
+    cls.def(
+        "active_coords", [get](const typename ClassT::type& self) { return activeCoords(get(self)); },
+        ("(N, 3) int32 index coordinates (i, j, k) of the active voxels of " + s +
+         ", in the order of values(): leaf by leaf as the tree stores them, then active tiles voxel by voxel.")
+            .c_str());
+    cls.def(
+        "values", [get](const typename ClassT::type& self) { return activeValues(get(self)); },
+        ("Values of the active voxels of " + s +
+         " in the order of active_coords(): (N, 3) float32 for vector grids, (N,) float32 for scalar grids.")
+            .c_str());
+    cls.def(
+        "to_dense", [get](const typename ClassT::type& self, const std::optional<IndexBox>& bbox) { return toDense(get(self), bbox); },
+        pyb::arg("bbox") = pyb::none(),
+        ("A dense float32 copy of " + s +
+         " over the index box bbox = ((i0, j0, k0), (i1, j1, k1)), inclusive (default: the active voxels' box).\n\n"
+         "Shape (D, H, W, 3) for vector grids, (D, H, W) for scalar ones, with D = k1-k0+1 (z), H = j1-j0+1 (y), "
+         "W = i1-i0+1 (x): ``dense[k - k0, j - j0, i - i0]`` is the value at index (i, j, k), x varying fastest, the "
+         "layout learning code expects (e.g. NeuralHDHair's 96 x 128 x 128 x 3 orientation volume). Inactive voxels "
+         "hold the grid's background (zero for vdbhair's grids).")
+            .c_str());
+    cls.def(
+        "index_to_world",
+        [get](const typename ClassT::type& self, const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points) {
+            const openvdb::math::Transform& xform = get(self).transform();
+            return mapPoints(points, "index_to_world", [&](const openvdb::Vec3d& p) { return xform.indexToWorld(p); });
+        },
+        pyb::arg("points"), ("(N, 3) index coordinates of " + s + " to (N, 3) float64 world positions (voxel centres at integers).").c_str());
+    cls.def(
+        "world_to_index",
+        [get](const typename ClassT::type& self, const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points) {
+            const openvdb::math::Transform& xform = get(self).transform();
+            return mapPoints(points, "world_to_index", [&](const openvdb::Vec3d& p) { return xform.worldToIndex(p); });
+        },
+        pyb::arg("points"), ("(N, 3) world positions to (N, 3) float64 (fractional) index coordinates of " + s + ".").c_str());
+}
+
+} // namespace
+
+void bindFields(pyb::module_& m)
+{
+    // ---- Grid ----------------------------------------------------------------------------
+    pyb::class_<PyGrid> grid(m, "Grid", R"doc(One OpenVDB grid (a vec3s or float voxel grid) with NumPy access.
+
+Made by vdbhair.read_grid / read_grids, or taken from a TangentField (``field.density``). Grids
+are shared, not copied: a Grid taken from a field sees the same voxels.)doc");
+    grid.def_property_readonly("name", [](const PyGrid& g) { return g.grid->getName(); }, "The grid's name.");
+    grid.def_property_readonly("value_type", [](const PyGrid& g) { return g.grid->valueType(); }, "OpenVDB's value type name: 'vec3s', 'float', ...");
+    grid.def_property_readonly("grid_class", [](const PyGrid& g) { return openvdb::GridBase::gridClassToString(g.grid->getGridClass()); },
+                               "'unknown', 'level set', 'fog volume' or 'staggered'.");
+    grid.def_property_readonly("metadata", [](const PyGrid& g) { return metadataDict(*g.grid); },
+                               "The grid's metadata as a dict (vdbhair records the parameters that made it, e.g. vdbhair_voxel_size).");
+    addArrayMethods(grid, [](const PyGrid& g) -> const openvdb::GridBase& { return *g.grid; }, "the grid");
+    grid.def(
+        "write",
+        [](const PyGrid& g, const std::string& path) {
+            pyb::gil_scoped_release release;
+            writeVdbGrids(path, {g.grid}, "Grid.write(" + path + ")");
+        },
+        pyb::arg("path"), "Write this grid alone to a .vdb file, atomically.");
+    grid.def("__repr__", [](const PyGrid& g) {
+        return "<vdbhair.Grid '" + g.grid->getName() + "': " + g.grid->valueType() + ", " + std::to_string(g.grid->activeVoxelCount()) +
+               " active voxels>";
+    });
+
+    // ---- TangentField --------------------------------------------------------------------
+    pyb::class_<PyField> field(m, "TangentField", R"doc(The robust tangent field of a hairstyle at one voxel size
+(Wang et al. 2009, Eq. 9), as estimate_tangent_field returns it.
+
+The array methods (active_coords, values, to_dense, bbox, ...) act on the ``tangent`` grid: unit
+hair directions, root to tip, in world space. The other grids are attributes: ``density`` (fog
+volume in [0, 1]), ``hair_length`` (summed segment length per voxel, world units), ``coherence``
+and ``spread`` (both in [0, 1]).)doc");
+    field.def_property_readonly("tangent", [](const PyField& f) { return PyGrid{f.field.tangent}; }, "The vec3s grid 'tangent' (unit directions).");
+    field.def_property_readonly("density", [](const PyField& f) { return PyGrid{f.field.density}; }, "The float grid 'density' (fog volume in [0, 1]).");
+    field.def_property_readonly("hair_length", [](const PyField& f) { return PyGrid{f.field.hairLength}; },
+                                "The float grid 'hair_length' (world units per voxel).");
+    field.def_property_readonly("coherence", [](const PyField& f) { return PyGrid{f.field.coherence}; },
+                                "The float grid 'coherence' in [0, 1] (1: all contributions parallel).");
+    field.def_property_readonly("spread", [](const PyField& f) { return PyGrid{f.field.spread}; },
+                                "The float grid 'spread' in [0, 1] (mean squared sine to the robust direction).");
+    field.def_property_readonly("density_reference", [](const PyField& f) { return f.field.densityReference; },
+                                "The hair length per unit volume (world units^-2) that density 1 means.");
+    field.def_property_readonly("metadata", [](const PyField& f) { return metadataDict(*f.field.tangent); },
+                                "The tangent grid's metadata as a dict (creator and the parameters that made it).");
+    addArrayMethods(field, [](const PyField& f) -> const openvdb::GridBase& { return *f.field.tangent; }, "the tangent grid");
+    field.def(
+        "grids", [](const PyField& f) {
+            std::vector<PyGrid> out;
+            for (const auto& g : {openvdb::GridBase::Ptr(f.field.tangent), openvdb::GridBase::Ptr(f.field.density),
+                                  openvdb::GridBase::Ptr(f.field.hairLength), openvdb::GridBase::Ptr(f.field.coherence),
+                                  openvdb::GridBase::Ptr(f.field.spread)}) {
+                if (g) out.push_back(PyGrid{g});
+            }
+            return out;
+        },
+        "The grids [tangent, density, hair_length, coherence, spread] as Grid objects.");
+    field.def(
+        "write",
+        [](const PyField& f, const std::string& path) {
+            pyb::gil_scoped_release release;
+            writeVdbGrids(path, f.field.grids(), "TangentField.write(" + path + ")");
+        },
+        pyb::arg("path"),
+        "Write the five grids (tangent, density, hair_length, coherence, spread) to a .vdb file, atomically, as "
+        "``vdbhair field`` does; they open in Houdini, Blender and pyopenvdb.");
+    field.def("__repr__", [](const PyField& f) {
+        return "<vdbhair.TangentField: voxel size " + std::to_string(f.field.tangent->voxelSize().x()) + ", " +
+               std::to_string(f.field.tangent->activeVoxelCount()) + " active voxels>";
+    });
+
+    // ---- Reading and writing grids ---------------------------------------------------------
+    m.def(
+        "read_grid",
+        [](const std::string& path, const std::string& name) {
+            pyb::gil_scoped_release release;
+            return PyGrid{readVdbGrid(path, name, "read_grid(" + path + ")")};
+        },
+        pyb::arg("path"), pyb::arg("name") = "tangent",
+        R"doc(Read the grid ``name`` of a .vdb file (any OpenVDB writer's: pyopenvdb, Houdini, Blender).
+
+Raises:
+    vdbhair.NotFoundError (a LookupError) listing the grids the file has; vdbhair.IoError,
+    vdbhair.FormatError.)doc");
+    m.def(
+        "read_grids",
+        [](const std::string& path) {
+            openvdb::GridPtrVec grids;
+            {
+                pyb::gil_scoped_release release;
+                grids = readVdbGrids(path, "read_grids(" + path + ")");
+            }
+            pyb::dict d;
+            for (const auto& g : grids) d[pyb::str(g->getName())] = PyGrid{g};
+            return d;
+        },
+        pyb::arg("path"), "Every grid of a .vdb file as a dict name -> Grid, in file order (points grids included as Grids "
+                          "without array access; read strands with vdbhair.read).");
+    m.def(
+        "write_grids",
+        [](const std::string& path, const std::vector<pyb::object>& items) {
+            openvdb::GridCPtrVec grids;
+            for (const pyb::object& o : items) {
+                if (pyb::isinstance<PyGrid>(o)) grids.push_back(o.cast<const PyGrid&>().grid);
+                else if (pyb::isinstance<PyField>(o)) {
+                    for (const auto& g : o.cast<const PyField&>().field.grids()) grids.push_back(g);
+                } else {
+                    throw TypeError("write_grids(" + path + "): items must be vdbhair.Grid or vdbhair.TangentField, not " +
+                                    std::string(pyb::str(o.get_type().attr("__name__"))));
+                }
+            }
+            pyb::gil_scoped_release release;
+            writeVdbGrids(path, grids, "write_grids(" + path + ")");
+        },
+        pyb::arg("path"), pyb::arg("grids"),
+        "Write Grids (and every grid of TangentFields) to one .vdb file, atomically. Grid names should differ "
+        "(rename levels first if you write several fields).");
+
+    // ---- Operations ----------------------------------------------------------------------
+    m.def(
+        "suggest_voxel_size", [](const StrandSet& s) { return suggestVoxelSize(s); }, pyb::arg("strands"),
+        R"doc(The default finest voxel size of a hairstyle (world units): three times the median distance
+between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhair/field/Refine.h).)doc");
+
+    const FieldParams fieldDefaults;
+    m.def(
+        "estimate_tangent_field",
+        [](const StrandsPtr& strands, double voxelSize, int iterations, std::optional<int> levels, std::uint64_t maxVoxels,
+           double densityReference, int threads, const pyb::object& progress) -> pyb::object {
+            FieldParams fp;
+            fp.voxelSize = voxelSize;
+            fp.iterations = iterations;
+            fp.maxVoxels = maxVoxels;
+            fp.densityReference = densityReference;
+            if (levels && (*levels < 1 || *levels > 16)) {
+                throw ValueError("estimate_tangent_field: levels=" + std::to_string(*levels) + ": must be between 1 and 16");
+            }
+            auto fields = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                if (fp.voxelSize == 0.0) fp.voxelSize = suggestVoxelSize(*strands);
+                if (!levels) return std::vector<TangentField>{estimateTangentField(*strands, fp, true, interrupter)};
+                return estimateTangentFieldLevels(*strands, fp, *levels, true, interrupter);
+            });
+            if (!levels) return pyb::cast(PyField{fields.front()});
+            pyb::list out;
+            for (TangentField& f : fields) out.append(PyField{std::move(f)});
+            return out;
+        },
+        pyb::arg("strands"), pyb::arg("voxel_size") = fieldDefaults.voxelSize, pyb::kw_only(),
+        pyb::arg("iterations") = fieldDefaults.iterations, pyb::arg("levels") = pyb::none(),
+        pyb::arg("max_voxels") = fieldDefaults.maxVoxels, pyb::arg("density_reference") = fieldDefaults.densityReference,
+        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space: ``vdbhair field``.
+
+Every segment contributes its unit tangent to every voxel it passes through, weighted by its
+length there; each iteration reweights contributions by 0.5 (T . v + 1) and renormalizes.
+Results are bitwise identical for any thread count.
+
+Args:
+    strands: a Strands.
+    voxel_size: world units; 0 chooses suggest_voxel_size(strands) (the CLI's default).
+    iterations: Eq. 9 iterations, at least 1 (the paper's 2).
+    levels: None for one field; N (1-16) for a list of N fields, level l of voxel size
+        voxel_size * 2**l (element 0 the finest), as ``--levels N``.
+    max_voxels: refuse voxel sizes whose voxel visits could exceed this (vdbhair.LimitError).
+    density_reference: hair length per unit volume (world units^-2) that density 1 means;
+        0 chooses the 95th percentile of the hairstyle's.
+    threads: worker threads, 0 for all cores (results do not depend on it).
+    progress: optional callable ``progress(stage, done, total, unit)``, called at each stage's
+        start and then at most ten times a second; raising in it stops the work.
+
+Returns:
+    TangentField, or a list of them when ``levels`` is given.
+
+Raises:
+    vdbhair.ArgumentError / LimitError (ValueErrors), KeyboardInterrupt on Ctrl-C.)doc");
+
+    const TraceParams traceDefaults;
+    m.def(
+        "retrace",
+        [](const StrandsPtr& strands, const pyb::object& fieldArg, double step, const std::string& integrator, double vanish,
+           std::size_t maxSteps, int margin, const std::string& vertices, bool returnStats, int threads,
+           const pyb::object& progress) -> pyb::object {
+            const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");
+            TraceParams tp;
+            tp.step = step;
+            tp.integrator = integratorFromName(integrator);
+            tp.vanishThreshold = vanish;
+            tp.maxSteps = maxSteps;
+            if (margin < 0 || margin > 16) throw ValueError("retrace: margin=" + std::to_string(margin) + ": must be between 0 and 16 voxels");
+            tp.margin = margin;
+            tp.vertices = verticesFromName(vertices);
+            TraceStats stats;
+            auto out = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                return std::make_shared<StrandSet>(retraceStrands(*strands, *grid, tp, &stats, nullptr, true, interrupter));
+            });
+            if (!returnStats) return pyb::cast(out);
+            return pyb::make_tuple(out, traceStatsDict(stats));
+        },
+        pyb::arg("strands"), pyb::arg("field"), pyb::kw_only(), pyb::arg("step") = traceDefaults.step,
+        pyb::arg("integrator") = integratorName(traceDefaults.integrator), pyb::arg("vanish") = traceDefaults.vanishThreshold,
+        pyb::arg("max_steps") = traceDefaults.maxSteps, pyb::arg("margin") = traceDefaults.margin,
+        pyb::arg("vertices") = verticesName(traceDefaults.vertices), pyb::arg("return_stats") = false, pyb::arg("threads") = 0,
+        pyb::arg("progress") = pyb::none(),
+        R"doc(Retrace every strand through a vector field from its own root, for its own length
+(Wang et al. 2009, Sec. 5.3): ``vdbhair retrace``.
+
+Args:
+    strands: a Strands (roots, lengths and vertex spacing to follow).
+    field: a TangentField (its tangent grid is followed) or a vector Grid (vec3s), e.g. read with
+        read_grid from any OpenVDB writer.
+    step: integration step in world units; 0 picks half the field's voxel size.
+    integrator: "euler" (the papers' choice), "rk2" or "rk4".
+    vanish: stop where the blended direction's length falls below this fraction, in [0, 1).
+    max_steps: stop a strand after this many steps (0: no limit).
+    margin: voxels (0-16) a strand may continue straight past the field's active region
+        (0: stop there, the papers' rule).
+    vertices: "input" (the input's vertex count at its arc lengths) or "steps" (every step).
+    return_stats: also return a dict of stop reasons (strands, full_length, vanished,
+        left_field, max_steps, steps).
+    threads: worker threads, 0 for all cores (results do not depend on it).
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    Strands, or (Strands, stats) with return_stats.
+
+Raises:
+    vdbhair.GridTypeError (a TypeError) for a non-vector grid, vdbhair.ArgumentError,
+    KeyboardInterrupt on Ctrl-C.)doc");
+
+    const RefineParams refineDefaults;
+    m.def(
+        "refine",
+        [](const StrandsPtr& strands, double voxelSize, int levels, const std::string& mode, int iterations, double step,
+           double outlierStart, double outlierFull, double minSpread, const pyb::object& head, const std::string& headPolicy,
+           const std::string& integrator, int margin, std::uint64_t maxVoxels, bool measure, bool returnReport, int threads,
+           const pyb::object& progress) -> pyb::object {
+            RefineParams rp;
+            rp.field.voxelSize = voxelSize;
+            rp.levels = levels;
+            rp.mode = refineModeFromName(mode);
+            rp.field.iterations = iterations;
+            rp.trace.step = step;
+            rp.consistency.step = step;  // one step for both modes, as the CLI's --step
+            rp.consistency.zStart = outlierStart;
+            rp.consistency.zFull = outlierFull;
+            rp.consistency.minSpreadDeg = minSpread;
+            rp.trace.integrator = integratorFromName(integrator);
+            rp.trace.margin = margin;
+            rp.field.maxVoxels = maxVoxels;
+            rp.measure = measure;
+            const HeadPolicy policy = headPolicyFromName(headPolicy);
+            std::optional<std::string> headPath;
+            if (head.is_none()) {
+            } else if (pyb::isinstance<pyb::str>(head)) {
+                const std::string h = head.cast<std::string>();
+                if (h == "none") rp.head = HeadObstacle::none();
+                else headPath = h;
+            } else {
+                const auto s = head.cast<std::array<double, 4>>();
+                rp.head = HeadObstacle::sphere(Vec3d(s[0], s[1], s[2]), s[3], policy);
+            }
+            rp.validate("refine");
+            RefineResult result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                RefineParams p = rp;
+                if (headPath) p.head = readHeadObstacle(*headPath, "refine: head=" + *headPath, policy);
+                return refineStrands(*strands, p, true, interrupter);
+            });
+            auto out = std::make_shared<StrandSet>(std::move(result.strands));
+            if (!returnReport) return pyb::cast(out);
+            pyb::dict report = measure ? measuresDict(result.levels.front().measures) : pyb::dict();
+            report["mode"] = refineModeName(rp.mode);
+            report["voxel_size"] = result.voxelSize;
+            report["head"] = result.head.describe();
+            pyb::list perLevel, fields;
+            for (std::size_t l = 0; l < result.levels.size(); ++l) {
+                const RefineLevel& lv = result.levels[l];
+                pyb::dict e = measure ? measuresDict(lv.measures) : pyb::dict();
+                e["level"] = l;
+                e["voxel_size"] = lv.voxelSize;
+                if (rp.mode == RefineMode::Consistent) {
+                    e["corrected_strands"] = lv.consistency.corrected;
+                    e["reverted_strands"] = lv.consistency.reverted;
+                } else {
+                    e["trace"] = traceStatsDict(lv.trace);
+                }
+                perLevel.append(e);
+            }
+            for (TangentField& f : result.fields) fields.append(PyField{std::move(f)});
+            report["per_level"] = perLevel;
+            report["fields"] = fields;
+            return pyb::make_tuple(out, report);
+        },
+        pyb::arg("strands"), pyb::kw_only(), pyb::arg("voxel_size") = refineDefaults.field.voxelSize,
+        pyb::arg("levels") = refineDefaults.levels, pyb::arg("mode") = refineModeName(refineDefaults.mode),
+        pyb::arg("iterations") = refineDefaults.field.iterations, pyb::arg("step") = refineDefaults.trace.step,
+        pyb::arg("outlier_start") = refineDefaults.consistency.zStart, pyb::arg("outlier_full") = refineDefaults.consistency.zFull,
+        pyb::arg("min_spread") = refineDefaults.consistency.minSpreadDeg, pyb::arg("head") = pyb::none(),
+        pyb::arg("head_policy") = "no-deeper", pyb::arg("integrator") = integratorName(refineDefaults.trace.integrator),
+        pyb::arg("margin") = refineDefaults.trace.margin, pyb::arg("max_voxels") = refineDefaults.field.maxVoxels,
+        pyb::arg("measure") = refineDefaults.measure, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
+        pyb::arg("progress") = pyb::none(),
+        R"doc(Vector-field refinement (Wang et al. 2009, Sec. 5.3): estimate, retrace, repeat from the
+coarsest level to the finest: ``vdbhair refine``.
+
+Args:
+    strands: a Strands.
+    voxel_size: the finest level's voxel size in world units; 0 picks suggest_voxel_size().
+    levels: levels, coarse (voxel_size * 2**(levels-1)) to fine.
+    mode: "consistent" (fix only strands that stray from the flow) or "field" (the paper's rule:
+        every strand replaced by its streamline).
+    iterations: Eq. 9 iterations of each field.
+    step: integration step in world units; 0 is half of each level's voxel.
+    outlier_start, outlier_full: consistent mode: outlier scores where the field starts to take
+        over and from which it is followed.
+    min_spread: consistent mode: floor on a voxel's angular spread, degrees.
+    head: None (a sphere fitted to the roots), "none" (no head), a path to a mesh (.ply, .obj)
+        or a .vdb level set, or a sphere (cx, cy, cz, r) in world units.
+    head_policy: "no-deeper" (no vertex enters the head that was outside it) or "outside".
+    integrator: field mode: "euler", "rk2" or "rk4".
+    margin: field mode: voxels a strand may continue past the field's active region.
+    max_voxels: refuse voxel sizes whose voxel visits could exceed this.
+    measure: measure each level against the input (the report's numbers; costs a field a level).
+    return_report: also return a dict: the finest level's measures, mode, voxel_size, head,
+        per_level (a dict a level) and fields (the TangentField of each level, 0 the finest).
+    threads: worker threads, 0 for all cores (results do not depend on it).
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    Strands, or (Strands, report) with return_report.)doc");
+}
+
+} // namespace vdbhair::py

@@ -1,0 +1,338 @@
+// grow, fit, render and inspect.
+#include "Common.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/MeshFile.h>
+#include <vdbhair/io/VdbInspect.h>
+#include <vdbhair/render/Image.h>
+#include <vdbhair/render/StrandRenderer.h>
+
+#include <nlohmann/json.hpp>
+
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <memory>
+
+namespace vdbhair::py {
+
+namespace {
+
+using StrandsPtr = std::shared_ptr<StrandSet>;
+
+/// A JSON value as a Python object, through Python's json module (scenes are small).
+pyb::object toPython(const nlohmann::json& j)
+{
+    return pyb::module_::import("json").attr("loads")(j.dump());
+}
+
+/// A scene argument: a path to a scene .json, or the scene itself as a dict.
+Scene sceneArgument(const pyb::handle& scene)
+{
+    if (pyb::isinstance<pyb::str>(scene)) {
+        const std::string path = scene.cast<std::string>();
+        pyb::gil_scoped_release release;
+        return readScene(path);
+    }
+    if (pyb::isinstance<pyb::dict>(scene)) {
+        const std::string text = pyb::module_::import("json").attr("dumps")(scene).cast<std::string>();
+        nlohmann::json j;
+        try {
+            j = nlohmann::json::parse(text);
+        } catch (const nlohmann::json::exception& e) {
+            throw FormatError(std::string("grow(dict): ") + e.what());
+        }
+        return sceneFromJson(j, "grow(dict)");
+    }
+    throw TypeError("grow: scene must be a path to a scene .json or a dict, not " +
+                    std::string(pyb::str(scene.get_type().attr("__name__"))));
+}
+
+const char* colorByNameOf(ColorBy c)
+{
+    switch (c) {
+    case ColorBy::Shaded: return "shaded";
+    case ColorBy::Root: return "root";
+    case ColorBy::Tangent: return "tangent";
+    case ColorBy::Depth: return "depth";
+    case ColorBy::Curvature: return "curvature";
+    case ColorBy::Strand: return "strand";
+    }
+    return "shaded";
+}
+
+Vec3d unitAxis(const std::array<double, 3>& a, const char* name)
+{
+    const Vec3d v(a[0], a[1], a[2]);
+    const double len = v.length();
+    if (!(len > 0.0) || !std::isfinite(len)) throw ValueError(std::string("render: ") + name + " must be a non-zero finite vector");
+    return v / len;
+}
+
+pyb::dict valueStatsDict(const ValueStats& s)
+{
+    pyb::dict d;
+    d["count"] = s.count;
+    d["min"] = s.min;
+    d["max"] = s.max;
+    d["mean"] = s.mean;
+    d["stddev"] = s.stddev;
+    d["p01"] = s.p01;
+    d["p50"] = s.p50;
+    d["p99"] = s.p99;
+    return d;
+}
+
+pyb::object metaValue(const MetaValue& m)
+{
+    return std::visit([](const auto& v) -> pyb::object { return pyb::cast(v); }, m.value);
+}
+
+} // namespace
+
+void bindOperations(pyb::module_& m)
+{
+    const GrowOptions growDefaults;
+    m.def(
+        "grow",
+        [](const pyb::object& sceneArg, std::optional<std::string> integrator, std::size_t maxVertices, int threads,
+           const pyb::object& progress) {
+            const Scene scene = sceneArgument(sceneArg);
+            GrowOptions opts;
+            if (integrator) {
+                if (*integrator == "euler") opts.integrator = HelicoidIntegrator::Euler;
+                else if (*integrator == "rk4") opts.integrator = HelicoidIntegrator::RK4;
+                else throw ValueError("grow: integrator='" + *integrator + "' is not one of euler, rk4");
+            }
+            opts.maxVertices = maxVertices;
+            return runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                return std::make_shared<StrandSet>(growScene(scene, opts, true, interrupter));
+            });
+        },
+        pyb::arg("scene"), pyb::kw_only(), pyb::arg("integrator") = pyb::none(), pyb::arg("max_vertices") = growDefaults.maxVertices,
+        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(Grow the strands of a generalized-helicoid scene (Piuze et al. 2011): ``vdbhair grow``.
+
+Each guide, then its wisp strands; bitwise identical for any thread count.
+
+Args:
+    scene: a path to a scene .json ("vdbhair": "scene/1"), or the scene as a dict (what fit returns).
+    integrator: None (the scene's own, else Euler), "euler" (Eq. 3) or "rk4".
+    max_vertices: refuse scenes that would grow more vertices (vdbhair.LimitError).
+    threads: worker threads, 0 for all cores.
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    Strands.)doc");
+
+    const FitParams fitDefaults;
+    m.def(
+        "fit",
+        [](const StrandsPtr& strands, double maxError, double lambda, int maxPieces, int maxEvaluations, double step, bool roll,
+           bool skipDegenerate, bool returnSummary, int threads, const pyb::object& progress) -> pyb::object {
+            FitParams fp;
+            if (!(maxError > 0.0) || !std::isfinite(maxError)) throw ValueError("fit: max_error=" + std::to_string(maxError) + ": must be a positive fraction of the strand length");
+            if (!(lambda >= 0.0) || !std::isfinite(lambda)) throw ValueError("fit: lambda_=" + std::to_string(lambda) + ": must be zero or positive");
+            if (maxEvaluations < 10) throw ValueError("fit: max_evaluations=" + std::to_string(maxEvaluations) + ": must be at least 10");
+            if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) throw ValueError("fit: step=" + std::to_string(step) + ": must be a positive finite length (0: automatic)");
+            if (maxPieces < 1 || maxPieces > 64) throw ValueError("fit: max_pieces=" + std::to_string(maxPieces) + ": must be between 1 and 64");
+            fp.maxError = maxError;
+            fp.lambda = lambda;
+            fp.maxPieces = maxPieces;
+            fp.maxEvaluations = maxEvaluations;
+            fp.step = step;
+            fp.optimizeRoll = roll;
+            std::vector<std::string> errors;
+            const std::vector<StrandFit> fits = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                return fitStrands(*strands, fp, true, &errors, interrupter);
+            });
+            Scene scene;
+            scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines, regrown exactly (as `vdbhair fit`)
+            for (std::size_t i = 0; i < fits.size(); ++i) {
+                if (!errors[i].empty()) {
+                    if (!skipDegenerate) throw ValueError("fit: " + errors[i] + " (skip_degenerate=True leaves such strands out)");
+                    continue;
+                }
+                SceneGuide g = guideFromFit(fits[i]);
+                g.fit = {{"frechet", fits[i].frechet}, {"coupling", fits[i].coupling}, {"pieces", fits[i].pieces.size()}, {"strand", i}};
+                scene.guides.push_back(g);
+            }
+            pyb::object sceneObj = toPython(sceneToJson(scene));
+            if (!returnSummary) return sceneObj;
+            const FitSummary s = summarizeFits(*strands, fits, errors, fp.maxError);
+            pyb::dict d;
+            d["strands"] = s.strands;
+            d["fitted"] = s.fitted;
+            d["skipped"] = s.skipped;
+            d["over_max_error"] = s.overMaxError;
+            d["frechet_relative_mean"] = s.meanRelative;
+            d["frechet_relative_p95"] = s.p95Relative;
+            d["pieces_per_strand"] = s.piecesPerStrand;
+            d["fit_bytes"] = s.fitBytes;
+            d["point_bytes"] = s.pointBytes;
+            return pyb::make_tuple(sceneObj, d);
+        },
+        pyb::arg("strands"), pyb::kw_only(), pyb::arg("max_error") = fitDefaults.maxError, pyb::arg("lambda_") = fitDefaults.lambda,
+        pyb::arg("max_pieces") = fitDefaults.maxPieces, pyb::arg("max_evaluations") = fitDefaults.maxEvaluations,
+        pyb::arg("step") = fitDefaults.step, pyb::arg("roll") = fitDefaults.optimizeRoll, pyb::arg("skip_degenerate") = false,
+        pyb::arg("return_summary") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``.
+
+Args:
+    strands: a Strands.
+    max_error: accept a piece within this discrete Frechet distance, as a fraction of the
+        strand length.
+    lambda_: regularization weight of Eq. 5 (dimensionless, per turn of the piece); the CLI's
+        ``--lambda`` (``lambda`` is a Python keyword).
+    max_pieces: most pieces per strand (1-64).
+    max_evaluations: Nelder-Mead evaluations per piece and start (at least 10).
+    step: tracing step of the fits in world units; 0 is a quarter of each strand's mean
+        segment length.
+    roll: also fit a roll angle of each piece's frame about its tangent.
+    skip_degenerate: leave out strands of zero length instead of raising.
+    return_summary: also return a dict (fitted, skipped, Frechet distance relative to length:
+        mean and 95th percentile, pieces per strand, bytes of fits and of points).
+    threads: worker threads, 0 for all cores (results do not depend on it).
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    The scene as a dict (one guide per fitted strand, in input order), which grow() regrows
+    and ``json.dump`` saves as a scene file; or (scene, summary) with return_summary.)doc");
+
+    const RenderParams renderDefaults;
+    m.def(
+        "render",
+        [](const StrandsPtr& strands, std::optional<std::string> path, const std::string& view, int width, int height,
+           const std::string& colorBy, std::array<double, 3> up, std::optional<std::array<double, 3>> facing,
+           const std::string& title, bool sheet, const StrandsPtr& guides, std::optional<std::string> head, int threads,
+           const pyb::object& progress) -> pyb::object {
+            RenderParams rp;
+            rp.view = viewFromName(view);
+            rp.colorBy = colorByFromName(colorBy);
+            if (width < 1 || height < 1 || width > 16384 || height > 16384) {
+                throw ValueError("render: width x height " + std::to_string(width) + "x" + std::to_string(height) +
+                                 ": must be between 1 and 16384 pixels");
+            }
+            rp.width = width;
+            rp.height = height;
+            rp.title = title;
+            rp.up = unitAxis(up, "up");
+            if (facing) {
+                rp.facing = unitAxis(*facing, "facing");
+                if (std::abs(rp.facing->dot(rp.up)) > 0.5) throw ValueError("render: facing must be perpendicular to up");
+            }
+            if (path && !isImagePath(*path)) throw ValueError("render: " + *path + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
+            TriangleMesh headMesh;
+            const Image image = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                RenderParams p = rp;
+                p.interrupter = interrupter;
+                if (guides) p.guides = guides.get();
+                if (head) {
+                    headMesh = readTriangleMesh(*head);
+                    if (!headMesh.triangles.empty()) p.head = &headMesh;
+                }
+                return sheet ? renderSheet(*strands, p) : renderStrands(*strands, p);
+            });
+            if (path) {
+                pyb::gil_scoped_release release;
+                writeImage(*path, image);
+                return pyb::none();
+            }
+            // Linear to sRGB, 8 bits, opaque: what writeImage stores in a .png.
+            pyb::array_t<std::uint8_t> out({pyb::ssize_t(image.height), pyb::ssize_t(image.width), pyb::ssize_t(4)});
+            std::uint8_t* o = out.mutable_data();
+            const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
+            for (std::size_t i = 0; i < n; ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    float v = std::min(1.f, std::max(0.f, image.rgb[3 * i + c]));
+                    v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+                    o[4 * i + c] = std::uint8_t(std::lround(v * 255.f));
+                }
+                o[4 * i + 3] = 255;
+            }
+            return std::move(out);
+        },
+        pyb::arg("strands"), pyb::arg("path") = pyb::none(), pyb::kw_only(), pyb::arg("view") = viewName(renderDefaults.view),
+        pyb::arg("width") = renderDefaults.width, pyb::arg("height") = renderDefaults.height,
+        pyb::arg("color_by") = colorByNameOf(renderDefaults.colorBy),
+        pyb::arg("up") = std::array<double, 3>{renderDefaults.up.x(), renderDefaults.up.y(), renderDefaults.up.z()},
+        pyb::arg("facing") = pyb::none(), pyb::arg("title") = renderDefaults.title, pyb::arg("sheet") = false,
+        pyb::arg("guides") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(A preview image of strands: lit fibres, depth-correct, anti-aliased (``vdbhair render``).
+
+Args:
+    strands: a Strands.
+    path: write the image there (.png, .jpg: sRGB 8 bits; .exr: linear float) and return None;
+        None returns the image instead.
+    view: "front", "side", "top", "back" or "three-quarter" (perspective).
+    width, height: pixels (1-16384).
+    color_by: "shaded", "root", "tangent", "depth", "curvature" or "strand".
+    up: the hairstyle's up axis (x, y, z); (0, 0, 1) for Yuksel's cyHair models.
+    facing: the direction the face looks, perpendicular to up (default: +z, or -y for a z up).
+    title: text in the top-left corner.
+    sheet: one image with the front, side, top and three-quarter views.
+    guides: Strands drawn on top in red.
+    head: a head mesh (.ply, .obj) drawn behind the hair.
+    threads: worker threads, 0 for all cores.
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    None with a path; otherwise an (height, width, 4) uint8 RGBA array (sRGB, alpha 255).)doc");
+
+    m.def(
+        "inspect",
+        [](const std::string& path) {
+            std::vector<GridReport> reports;
+            {
+                pyb::gil_scoped_release release;
+                reports = inspectVdbFile(path);
+            }
+            pyb::list out;
+            for (const GridReport& r : reports) {
+                const GridInfo& g = r.info;
+                pyb::dict d;
+                d["name"] = g.name;
+                d["value_type"] = g.valueType;
+                d["grid_class"] = g.gridClass;
+                d["vector_type"] = g.vectorType;
+                d["voxel_size"] = pyb::make_tuple(g.voxelSize.x(), g.voxelSize.y(), g.voxelSize.z());
+                d["active_voxels"] = g.activeVoxels;
+                d["active_tiles"] = g.activeTiles;
+                d["leaf_nodes"] = g.leafNodes;
+                d["memory_bytes"] = g.memoryBytes;
+                if (!g.emptyBBox) {
+                    d["world_bbox"] = pyb::make_tuple(pyb::make_tuple(g.bboxMin.x(), g.bboxMin.y(), g.bboxMin.z()),
+                                                      pyb::make_tuple(g.bboxMax.x(), g.bboxMax.y(), g.bboxMax.z()));
+                }
+                if (!r.emptyIndexBBox) d["index_bbox"] = pyb::make_tuple(pyb::cast(r.indexMin), pyb::cast(r.indexMax));
+                d["values"] = valueStatsDict(r.values);
+                if (r.isVector) {
+                    d["unit_share"] = r.unitShare;
+                    d["zero_share"] = r.zeroShare;
+                    d["mean_vector"] = pyb::make_tuple(r.meanVector.x(), r.meanVector.y(), r.meanVector.z());
+                    d["coherence"] = r.coherence;
+                } else if (r.isScalar) {
+                    d["zero_share"] = r.zeroShare;
+                }
+                d["leaf_fill"] = pyb::make_tuple(r.leafFillMin, r.leafFillMean, r.leafFillMax);
+                pyb::dict meta;
+                for (const MetaValue& mv : g.metadata) meta[pyb::str(mv.name)] = metaValue(mv);
+                d["metadata"] = meta;
+                if (g.isPoints) d["point_count"] = g.pointCount;
+                d["explanation"] = r.explanation;
+                out.append(d);
+            }
+            return out;
+        },
+        pyb::arg("path"),
+        R"doc(Describe every grid of a .vdb file (``vdbhair inspect --json``): one dict a grid, in file order,
+with name, value_type, grid_class, vector_type, voxel_size, active_voxels, active_tiles,
+leaf_nodes, memory_bytes, world_bbox and index_bbox (when not empty), values (statistics of the
+values, or of the vector lengths: count, min, max, mean, stddev, p01, p50, p99), unit_share,
+zero_share, mean_vector and coherence for vectors, leaf_fill (min, mean, max), metadata (a
+dict), point_count for points grids, and explanation (the metadata in words).)doc");
+}
+
+} // namespace vdbhair::py

@@ -1,0 +1,371 @@
+// vdbhair.Strands (a StrandSet seen as NumPy arrays), vdbhair.read and vdbhair.write.
+#include "Common.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+namespace vdbhair::py {
+
+namespace {
+
+using StrandsPtr = std::shared_ptr<StrandSet>;
+
+std::string shapeText(const pyb::array& a)
+{
+    std::ostringstream os;
+    os << "(";
+    for (pyb::ssize_t d = 0; d < a.ndim(); ++d) os << (d ? ", " : "") << a.shape(d);
+    os << (a.ndim() == 1 ? ",)" : ")");
+    return os.str();
+}
+
+/// @a obj as a C-contiguous array of T with @a cols columns (0: one dimension) and, when
+/// @a rows is not -1, that many rows; a ValueError naming @a name and the rule otherwise.
+template <typename T>
+pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast> checkedArray(const pyb::handle& obj, const char* name,
+                                                                         pyb::ssize_t rows, pyb::ssize_t cols,
+                                                                         const std::string& rowsRule)
+{
+    const std::string where = std::string("Strands(") + name + ")";
+    pyb::array a = pyb::array::ensure(obj);
+    if (!a) throw ValueError(where + ": not convertible to a NumPy array");
+    const char kind = a.dtype().kind();
+    const bool integral = std::is_integral_v<T>;
+    if (integral ? (kind != 'i' && kind != 'u') : (kind != 'f' && kind != 'i' && kind != 'u')) {
+        throw ValueError(where + ": dtype " + std::string(pyb::str(a.dtype())) + "; must hold " +
+                               (integral ? "integers" : "real numbers"));
+    }
+    const std::string want = cols == 0 ? std::string("(") + rowsRule + ",)" : "(" + rowsRule + ", " + std::to_string(cols) + ")";
+    const bool shapeOk = cols == 0 ? a.ndim() == 1 : (a.ndim() == 2 && a.shape(1) == cols);
+    if (!shapeOk || (rows >= 0 && a.shape(0) != rows)) {
+        throw ValueError(where + ": shape " + shapeText(a) + "; must be " + want);
+    }
+    return pyb::array_t<T, pyb::array::c_style | pyb::array::forcecast>::ensure(a);
+}
+
+template <typename T>
+void checkFiniteValues(const T* data, std::size_t n, std::size_t cols, const char* name, const char* what)
+{
+    for (std::size_t i = 0; i < n * cols; ++i) {
+        if (!std::isfinite(data[i])) {
+            throw ValueError(std::string("Strands(") + name + "): " + what + " " + std::to_string(i / cols) +
+                                   " is not finite (" + std::to_string(data[i]) + "); values must be finite");
+        }
+    }
+}
+
+/// The constructor: arrays checked by the readers' rules (StrandSet::validate), one copy each.
+StrandsPtr makeStrands(const pyb::handle& positions, const pyb::handle& offsets, const pyb::handle& thickness,
+                       const pyb::handle& transparency, const pyb::handle& color, const pyb::handle& rootUV,
+                       const pyb::handle& strandId)
+{
+    auto set = std::make_shared<StrandSet>();
+    const auto p = checkedArray<float>(positions, "positions", -1, 3, "V");
+    const std::size_t nV = std::size_t(p.shape(0));
+    if (nV > std::numeric_limits<std::uint32_t>::max()) {
+        throw ValueError("Strands(positions): " + std::to_string(nV) + " vertices; at most 2^32-1 fit a strand set");
+    }
+    for (std::size_t v = 0; v < nV; ++v) {
+        const float* q = p.data() + 3 * v;
+        if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2])) {
+            std::ostringstream os;
+            os << "Strands(positions): vertex " << v << " has a non-finite coordinate (" << q[0] << ", " << q[1] << ", " << q[2]
+               << "); coordinates must be finite";
+            throw ValueError(os.str());
+        }
+    }
+    const auto o = checkedArray<std::int64_t>(offsets, "offsets", -1, 0, "S+1");
+    const std::size_t nO = std::size_t(o.shape(0));
+    if (nO == 0) throw ValueError("Strands(offsets): empty; must hold S+1 prefix sums starting at 0 ([0] for no strands)");
+    if (o.data()[0] != 0) throw ValueError("Strands(offsets): offsets[0] = " + std::to_string(o.data()[0]) + "; must be 0");
+    for (std::size_t i = 0; i + 1 < nO; ++i) {
+        const std::int64_t a = o.data()[i], b = o.data()[i + 1];
+        if (b - a < 2) {
+            throw ValueError("Strands(offsets): strand " + std::to_string(i) + " has " + std::to_string(b - a) +
+                                   " vertices (offsets[" + std::to_string(i) + "] = " + std::to_string(a) + ", offsets[" +
+                                   std::to_string(i + 1) + "] = " + std::to_string(b) + "); a strand needs at least 2");
+        }
+        if (b > std::int64_t(nV)) {
+            throw ValueError("Strands(offsets): offsets[" + std::to_string(i + 1) + "] = " + std::to_string(b) +
+                                   " is beyond the " + std::to_string(nV) + " positions");
+        }
+    }
+    if (o.data()[nO - 1] != std::int64_t(nV)) {
+        throw ValueError("Strands(offsets): the last offset is " + std::to_string(o.data()[nO - 1]) + " but positions has " +
+                               std::to_string(nV) + " rows; it must equal the vertex count");
+    }
+    const std::size_t nS = nO - 1;
+    set->positions.resize(nV);
+    static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
+    if (nV) std::memcpy(static_cast<void*>(set->positions.data()), p.data(), nV * sizeof(Vec3f));
+    set->offsets.assign(o.data(), o.data() + nO);
+
+    if (!thickness.is_none()) {
+        const auto a = checkedArray<float>(thickness, "thickness", pyb::ssize_t(nV), 0, "V");
+        checkFiniteValues(a.data(), nV, 1, "thickness", "vertex");
+        set->thickness.assign(a.data(), a.data() + nV);
+    }
+    if (!transparency.is_none()) {
+        const auto a = checkedArray<float>(transparency, "transparency", pyb::ssize_t(nV), 0, "V");
+        checkFiniteValues(a.data(), nV, 1, "transparency", "vertex");
+        set->transparency.assign(a.data(), a.data() + nV);
+    }
+    if (!color.is_none()) {
+        const auto a = checkedArray<float>(color, "color", pyb::ssize_t(nV), 3, "V");
+        checkFiniteValues(a.data(), nV, 3, "color", "vertex");
+        set->color.resize(nV);
+        if (nV) std::memcpy(static_cast<void*>(set->color.data()), a.data(), nV * sizeof(Vec3f));
+    }
+    if (!rootUV.is_none()) {
+        const auto a = checkedArray<float>(rootUV, "root_uv", pyb::ssize_t(nS), 2, "S");
+        checkFiniteValues(a.data(), nS, 2, "root_uv", "strand");
+        set->rootUV.resize(nS);
+        for (std::size_t i = 0; i < nS; ++i) set->rootUV[i] = Vec2f(a.data()[2 * i], a.data()[2 * i + 1]);
+    }
+    if (!strandId.is_none()) {
+        const auto a = checkedArray<std::int64_t>(strandId, "strand_id", pyb::ssize_t(nS), 0, "S");
+        set->strandId.resize(nS);
+        for (std::size_t i = 0; i < nS; ++i) {
+            const std::int64_t id = a.data()[i];
+            if (id < std::numeric_limits<std::int32_t>::min() || id > std::numeric_limits<std::int32_t>::max()) {
+                throw ValueError("Strands(strand_id): strand " + std::to_string(i) + " has id " + std::to_string(id) +
+                                       "; ids must fit in 32 bits");
+            }
+            set->strandId[i] = std::int32_t(id);
+        }
+    }
+    set->validate("Strands");  // the library's own rules, as the readers apply them
+    return set;
+}
+
+/// Strand @a i (negative counts from the end) as a read-only (n, 3) view kept alive by @a self.
+pyb::array strandView(const pyb::object& self, const StrandSet& s, std::ptrdiff_t i)
+{
+    const std::ptrdiff_t n = std::ptrdiff_t(s.numStrands());
+    if (i < 0) i += n;
+    if (i < 0 || i >= n) throw pyb::index_error("strand index out of range (" + std::to_string(n) + " strands)");
+    return readOnlyView(reinterpret_cast<const float*>(s.data(std::size_t(i))), s.size(std::size_t(i)), 3, self);
+}
+
+ReadOptions readOptions(bool strict, const std::string& grid, const std::optional<std::array<float, 3>>& rootNear)
+{
+    ReadOptions opts;
+    opts.shortStrands = strict ? ShortStrandPolicy::Reject : ShortStrandPolicy::Drop;
+    opts.vdbGrid = grid;
+    if (rootNear) opts.objRootNear = Vec3f((*rootNear)[0], (*rootNear)[1], (*rootNear)[2]);
+    return opts;
+}
+
+void writeWithOptions(const StrandSet& s, const std::string& path, const std::string& plyEncoding, const std::string& objLines)
+{
+    WriteOptions opts;
+    if (plyEncoding == "binary") opts.plyEncoding = PlyEncoding::Binary;
+    else if (plyEncoding == "ascii") opts.plyEncoding = PlyEncoding::Ascii;
+    else throw ValueError("ply_encoding='" + plyEncoding + "' is not one of binary, ascii");
+    opts.objLines = objLineStyleFromName(objLines);
+    pyb::gil_scoped_release release;
+    writeStrands(path, s, opts);
+}
+
+const char* kStrandsDoc = R"doc(A hairstyle: strands (polylines, root to tip) as flat NumPy arrays.
+
+Strand ``i`` is ``positions[offsets[i]:offsets[i+1]]``.
+
+Arrays (all read-only; copy to change them and build a new ``Strands``):
+
+- ``positions``: (V, 3) float32, world units, a **view** of the C++ storage (no copy; it keeps
+  this object alive).
+- ``offsets``: (S+1,) int64 prefix sums. The library stores 32-bit offsets, so this is **one copy**
+  made on each access.
+- ``thickness``, ``transparency``: (V,) float32 or None; ``color``: (V, 3) float32 linear RGB or
+  None; ``root_uv``: (S, 2) float32 or None; ``strand_id``: (S,) int32 or None. Views, no copy.
+
+``len(strands)`` is S; ``strands[i]`` and iteration give each strand as a read-only (n, 3) view.
+
+The constructor copies its arrays once and checks them by the readers' rules (finite positions,
+offsets from 0 to V, at least two vertices a strand, attribute lengths); a broken rule raises
+``ValueError`` naming the array and the rule, e.g.
+``Strands(offsets): strand 1 has 1 vertices (offsets[1] = 2, offsets[2] = 3); a strand needs at least 2``.)doc";
+
+} // namespace
+
+void bindStrands(pyb::module_& m)
+{
+    pyb::class_<StrandSet, StrandsPtr> cls(m, "Strands", kStrandsDoc);
+    cls.def(pyb::init(&makeStrands), pyb::arg("positions"), pyb::arg("offsets"), pyb::kw_only(),
+            pyb::arg("thickness") = pyb::none(), pyb::arg("transparency") = pyb::none(), pyb::arg("color") = pyb::none(),
+            pyb::arg("root_uv") = pyb::none(), pyb::arg("strand_id") = pyb::none(),
+            R"doc(Strands from arrays (each copied once, then checked).
+
+Args:
+    positions: (V, 3) real numbers, world units (converted to float32).
+    offsets: (S+1,) integers, offsets[0] = 0, offsets[-1] = V, at least 2 vertices a strand.
+    thickness: optional (V,) world units.
+    transparency: optional (V,), 0 = opaque.
+    color: optional (V, 3) linear RGB in [0, 1].
+    root_uv: optional (S, 2).
+    strand_id: optional (S,) integers that fit in 32 bits.
+
+Raises:
+    ValueError: naming the array and the rule it breaks.)doc");
+    cls.def_property_readonly(
+        "positions",
+        [](const pyb::object& self) {
+            const StrandSet& s = self.cast<const StrandSet&>();
+            return readOnlyView(reinterpret_cast<const float*>(s.positions.data()), s.positions.size(), 3, self);
+        },
+        "(V, 3) float32 world positions: a read-only view (no copy).");
+    cls.def_property_readonly(
+        "offsets",
+        [](const StrandSet& s) {
+            pyb::array_t<std::int64_t> a(pyb::ssize_t(s.offsets.size()));
+            std::copy(s.offsets.begin(), s.offsets.end(), a.mutable_data());
+            return a;
+        },
+        "(S+1,) int64 prefix sums into positions: a copy (the library stores uint32).");
+    cls.def_property_readonly(
+        "counts",
+        [](const StrandSet& s) {
+            pyb::array_t<std::int64_t> a(pyb::ssize_t(s.numStrands()));
+            for (std::size_t i = 0; i < s.numStrands(); ++i) a.mutable_data()[i] = std::int64_t(s.size(i));
+            return a;
+        },
+        "(S,) int64 vertices per strand: a copy.");
+    auto optionalView = [](auto member, std::size_t cols, const char* doc) {
+        return std::make_pair(
+            [member, cols](const pyb::object& self) -> pyb::object {
+                const StrandSet& s = self.cast<const StrandSet&>();
+                const auto& v = s.*member;
+                if (v.empty()) return pyb::none();
+                using ElemT = typename std::decay_t<decltype(v)>::value_type;
+                if constexpr (std::is_same_v<ElemT, float> || std::is_same_v<ElemT, std::int32_t>) {
+                    return readOnlyView(v.data(), v.size(), 0, self);
+                } else {
+                    return readOnlyView(reinterpret_cast<const float*>(v.data()), v.size(), cols, self);
+                }
+            },
+            doc);
+    };
+    {
+        auto [f, d] = optionalView(&StrandSet::thickness, 0, "(V,) float32 thickness in world units, or None: a view.");
+        cls.def_property_readonly("thickness", f, d);
+    }
+    {
+        auto [f, d] = optionalView(&StrandSet::transparency, 0, "(V,) float32 transparency (0 = opaque), or None: a view.");
+        cls.def_property_readonly("transparency", f, d);
+    }
+    {
+        auto [f, d] = optionalView(&StrandSet::color, 3, "(V, 3) float32 linear RGB, or None: a view.");
+        cls.def_property_readonly("color", f, d);
+    }
+    {
+        auto [f, d] = optionalView(&StrandSet::rootUV, 2, "(S, 2) float32 root UV, or None: a view.");
+        cls.def_property_readonly("root_uv", f, d);
+    }
+    {
+        auto [f, d] = optionalView(&StrandSet::strandId, 0, "(S,) int32 ids of an upstream source, or None: a view.");
+        cls.def_property_readonly("strand_id", f, d);
+    }
+    cls.def_property_readonly(
+        "defaults",
+        [](const StrandSet& s) {
+            pyb::dict d;
+            d["thickness"] = s.defaults.thickness;
+            d["transparency"] = s.defaults.transparency;
+            d["color"] = pyb::make_tuple(s.defaults.color.x(), s.defaults.color.y(), s.defaults.color.z());
+            return d;
+        },
+        "The per-vertex defaults used where an attribute array is None (cyHair's header): a dict.");
+    cls.def_property_readonly("num_strands", &StrandSet::numStrands, "S, the number of strands.");
+    cls.def_property_readonly("num_vertices", &StrandSet::numVertices, "V, the number of vertices.");
+    cls.def("__len__", &StrandSet::numStrands, "The number of strands S.");
+    cls.def(
+        "__getitem__", [](const pyb::object& self, std::ptrdiff_t i) { return strandView(self, self.cast<const StrandSet&>(), i); },
+        pyb::arg("i"), "Strand i (negative from the end) as a read-only (n, 3) float32 view.");
+    cls.def(
+        "__iter__",
+        [](const pyb::object& self) {
+            // A generator over the strands; each item is a view kept alive with this object.
+            pyb::module_ builtins = pyb::module_::import("builtins");
+            const std::size_t n = self.cast<const StrandSet&>().numStrands();
+            return builtins.attr("map")(self.attr("__getitem__"), builtins.attr("range")(n));
+        },
+        "Iterate over the strands, each a read-only (n, 3) float32 view.");
+    cls.def("__repr__", [](const StrandSet& s) {
+        return "<vdbhair.Strands: " + std::to_string(s.numStrands()) + " strands, " + std::to_string(s.numVertices()) + " vertices>";
+    });
+    cls.def("write", &writeWithOptions, pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = "binary",
+            pyb::arg("obj_lines") = "edges",
+            "Write to ``path`` in the format of its extension (.hair .data .obj .ply .vdb .usda), atomically; see vdbhair.write.");
+
+    m.def(
+        "read",
+        [](const std::string& path, bool strict, const std::string& grid, std::optional<std::array<float, 3>> rootNear,
+           const pyb::object& progress) {
+            ReadReport report;
+            const ReadOptions base = readOptions(strict, grid, rootNear);
+            auto set = runLong(0, progress, [&](WorkInterrupter* interrupter) {
+                ReadOptions opts = base;
+                opts.interrupter = interrupter;
+                return std::make_shared<StrandSet>(readStrands(path, opts, &report));
+            });
+            if (!report.warnings.empty()) {
+                pyb::module_ warnings = pyb::module_::import("warnings");
+                for (const std::string& w : report.warnings) warnings.attr("warn")(w, pyb::module_::import("builtins").attr("UserWarning"), 2);
+            }
+            return set;
+        },
+        pyb::arg("path"), pyb::kw_only(), pyb::arg("strict") = false, pyb::arg("grid") = ReadOptions{}.vdbGrid,
+        pyb::arg("root_near") = pyb::none(), pyb::arg("progress") = pyb::none(),
+        R"doc(Read strands from a file, the format chosen by extension (and checked by magic).
+
+Formats: .hair (cyHair), .data (USC-HairSalon), .obj (line elements), .ply (hairutil), .vdb
+(points grid), .usda (USD BasisCurves), .tfx (TressFX), .bin (CT2Hair), .convdata (HairNet).
+
+Args:
+    path: the file.
+    strict: reject strands of fewer than 2 vertices (FormatError) instead of dropping them with a
+        UserWarning (the CLI's ``--strict``).
+    grid: for a .vdb, the points grid holding the strands (the CLI's ``--grid``).
+    root_near: for an .obj, root each strand at its end nearest this (x, y, z) (world units)
+        instead of its end with the lower vertex index.
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    Strands.
+
+Raises:
+    vdbhair.IoError (an OSError), vdbhair.FormatError / UnsupportedError (ValueErrors) naming the
+    file, the byte offset or line and the rule; KeyboardInterrupt on Ctrl-C.)doc");
+    m.def(
+        "write",
+        [](const StrandSet& s, const std::string& path, const std::string& plyEncoding, const std::string& objLines) {
+            writeWithOptions(s, path, plyEncoding, objLines);
+        },
+        pyb::arg("strands"), pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = "binary", pyb::arg("obj_lines") = "edges",
+        R"doc(Write strands in the format of ``path``'s extension, atomically (a temporary file renamed
+into place: a failed write leaves nothing and never damages an existing file).
+
+Writable formats: .hair .data .obj .ply .vdb .usda.
+
+Args:
+    strands: a Strands.
+    path: the output file.
+    ply_encoding: "binary" (little-endian) or "ascii", for .ply (the CLI's ``--ply-encoding``).
+    obj_lines: "edges" (one two-vertex ``l`` per segment, what Blender reads whole) or
+        "polylines" (one ``l`` per strand), for .obj (the CLI's ``--obj-lines``).
+
+Raises:
+    vdbhair.ArgumentError (a ValueError) for a format that cannot be written, vdbhair.IoError.)doc");
+}
+
+} // namespace vdbhair::py

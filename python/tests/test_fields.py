@@ -1,0 +1,198 @@
+"""Fields: estimation, retracing, refinement, dense volumes, threads, pyopenvdb interop."""
+import numpy as np
+import pytest
+
+import vdbhair
+from conftest import straight_bundle, wavy_hairstyle
+
+
+def test_straight_field_is_uniform(bundle):
+    field = vdbhair.estimate_tangent_field(bundle, voxel_size=0.25)
+    assert field.voxel_size == pytest.approx(0.25)
+    coords, values = field.active_coords(), field.values()
+    assert coords.dtype == np.int32 and values.dtype == np.float32
+    assert coords.shape == values.shape and coords.shape[0] == field.active_voxel_count > 0
+    np.testing.assert_allclose(values, np.tile([1.0, 0.0, 0.0], (len(values), 1)), atol=1e-6)
+    # Every active voxel is one some strand passes: x index within the strands' span.
+    assert coords[:, 0].min() >= -1 and coords[:, 0].max() <= 4.0 / 0.25 + 1
+
+
+def test_straight_field_retraces_straight(bundle):
+    """A bent strand retraced through the field of parallel strands comes out straight along +x."""
+    field = vdbhair.estimate_tangent_field(bundle, voxel_size=0.25)
+    t = np.linspace(0.0, 1.0, 11, dtype=np.float32)
+    bent = np.stack([t, 0.3 * np.sin(3.0 * t), 0.2 * t * t], axis=1).astype(np.float32)
+    strand = vdbhair.Strands(bent, [0, len(bent)])
+    out, stats = vdbhair.retrace(strand, field, return_stats=True)
+    assert stats["full_length"] == 1 and stats["strands"] == 1
+    p = out.positions
+    length = np.linalg.norm(np.diff(bent, axis=0), axis=1).sum()
+    np.testing.assert_allclose(p[:, 1:], np.tile(bent[0, 1:], (len(p), 1)), atol=1e-5)  # no sideways motion
+    assert p[-1, 0] - p[0, 0] == pytest.approx(length, rel=1e-5)  # its own length, along +x
+    assert np.all(np.diff(p[:, 0]) > 0)
+    # The bundle's own strands retrace onto themselves.
+    again = vdbhair.retrace(bundle, field)
+    np.testing.assert_allclose(again.positions, bundle.positions, atol=1e-5)
+
+
+def test_to_dense_layout_is_z_y_x(wavy):
+    field = vdbhair.estimate_tangent_field(wavy, voxel_size=0.2)
+    (i0, j0, k0), (i1, j1, k1) = field.bbox
+    dense = field.to_dense()
+    assert dense.shape == (k1 - k0 + 1, j1 - j0 + 1, i1 - i0 + 1, 3) and dense.dtype == np.float32
+    c, v = field.active_coords(), field.values()
+    np.testing.assert_array_equal(dense[c[:, 2] - k0, c[:, 1] - j0, c[:, 0] - i0], v)
+    # Inactive voxels are zero: as many non-zero voxels as active non-zero values.
+    assert np.count_nonzero(np.any(dense != 0, axis=-1)) == np.count_nonzero(np.any(v != 0, axis=-1))
+    # A box of a chosen size (e.g. a network's input) around the hair, padded with zeros.
+    box = ((i0 - 2, j0 - 1, k0), (i0 + 9, j0 + 6, k0 + 3))
+    small = field.to_dense(box)
+    assert small.shape == (4, 8, 12, 3)
+    np.testing.assert_array_equal(small[:, 1:8, 2:12], dense[0:4, 0:7, 0:10])
+    assert np.all(small[:, 0] == 0) and np.all(small[:, :, :2] == 0)
+    density = field.density.to_dense(field.bbox)
+    assert density.shape == dense.shape[:3] and float(density.max()) <= 1.0
+    with pytest.raises(ValueError, match="bbox max"):
+        field.to_dense(((0, 0, 0), (-1, 0, 0)))
+
+
+def test_one_and_two_threads_identical(wavy):
+    f1 = vdbhair.estimate_tangent_field(wavy, voxel_size=0.15, threads=1)
+    f2 = vdbhair.estimate_tangent_field(wavy, voxel_size=0.15, threads=2)
+    np.testing.assert_array_equal(f1.active_coords(), f2.active_coords())
+    np.testing.assert_array_equal(f1.values(), f2.values())
+    np.testing.assert_array_equal(f1.density.values(), f2.density.values())
+    r1 = vdbhair.retrace(wavy, f1, threads=1)
+    r2 = vdbhair.retrace(wavy, f2, threads=2)
+    np.testing.assert_array_equal(r1.positions, r2.positions)
+    g1 = vdbhair.refine(wavy, voxel_size=0.15, levels=2, threads=1, measure=False)
+    g2 = vdbhair.refine(wavy, voxel_size=0.15, levels=2, threads=2, measure=False)
+    np.testing.assert_array_equal(g1.positions, g2.positions)
+    # ... and the retrace changed something, so the comparison could fail.
+    assert not np.array_equal(r1.positions, wavy.positions)
+
+
+def test_levels_and_defaults(wavy):
+    fields = vdbhair.estimate_tangent_field(wavy, voxel_size=0.1, levels=3)
+    assert [f.voxel_size for f in fields] == pytest.approx([0.1, 0.2, 0.4])
+    auto = vdbhair.estimate_tangent_field(wavy)
+    assert auto.voxel_size == pytest.approx(vdbhair.suggest_voxel_size(wavy))
+    assert auto.metadata["vdbhair_iterations"] == 2
+
+
+def test_refine_report(wavy):
+    out, report = vdbhair.refine(wavy, voxel_size=0.15, levels=2, return_report=True)
+    assert len(out) == len(wavy) and out.num_vertices == wavy.num_vertices
+    assert report["mode"] == "consistent" and len(report["per_level"]) == 2
+    assert [f.voxel_size for f in report["fields"]] == pytest.approx([0.15, 0.3])
+    assert 0.0 <= report["coherence_after"] <= 1.0
+    field_mode = vdbhair.refine(wavy, voxel_size=0.15, mode="field", head="none")
+    assert not np.array_equal(field_mode.positions, out.positions)
+    with pytest.raises(ValueError, match="mode"):
+        vdbhair.refine(wavy, mode="sideways")
+
+
+def test_argument_errors(bundle, tmp_path):
+    field = vdbhair.estimate_tangent_field(bundle, voxel_size=0.25)
+    with pytest.raises(vdbhair.ArgumentError, match="voxel size"):
+        vdbhair.estimate_tangent_field(bundle, voxel_size=-1.0)
+    with pytest.raises(ValueError, match="integrator"):
+        vdbhair.retrace(bundle, field, integrator="rk3")
+    with pytest.raises(vdbhair.LimitError):
+        vdbhair.estimate_tangent_field(bundle, voxel_size=1e-4, max_voxels=1000)
+    with pytest.raises(ValueError, match=r"threads=-1: must be 0 \(all cores\) or more"):
+        vdbhair.retrace(bundle, field, threads=-1)
+    with pytest.raises(TypeError, match="field must be a vdbhair.TangentField or a vdbhair.Grid"):
+        vdbhair.retrace(bundle, "field.vdb")
+    path = str(tmp_path / "f.vdb")
+    field.write(path)
+    with pytest.raises(vdbhair.GridTypeError):
+        vdbhair.retrace(bundle, vdbhair.read_grid(path, "density"))
+    with pytest.raises(LookupError) as info:
+        vdbhair.read_grid(path, "nothing")
+    assert isinstance(info.value, vdbhair.NotFoundError) and "tangent" in str(info.value)
+
+
+def test_write_and_read_back(tmp_path, wavy):
+    field = vdbhair.estimate_tangent_field(wavy, voxel_size=0.2)
+    path = str(tmp_path / "field.vdb")
+    field.write(path)
+    grids = vdbhair.read_grids(path)
+    assert sorted(grids) == ["coherence", "density", "hair_length", "spread", "tangent"]
+    np.testing.assert_array_equal(grids["tangent"].values(), field.values())
+    np.testing.assert_array_equal(grids["hair_length"].values(), field.hair_length.values())
+    assert grids["tangent"].metadata["creator"].startswith("vdbhair")
+    report = vdbhair.inspect(path)
+    assert [r["name"] for r in report] == list(grids)  # file order, both
+    tangent = next(r for r in report if r["name"] == "tangent")
+    assert tangent["active_voxels"] == field.active_voxel_count
+    assert tangent["unit_share"] > 0.9
+    world = field.index_to_world([[1, 2, 3]])
+    np.testing.assert_allclose(world, [[0.2, 0.4, 0.6]], atol=1e-12)
+    np.testing.assert_allclose(field.world_to_index(world), [[1, 2, 3]], atol=1e-12)
+
+
+def test_progress_callback_and_its_exception(wavy):
+    calls = []
+    vdbhair.estimate_tangent_field(wavy, voxel_size=0.2, progress=lambda *a: calls.append(a))
+    assert calls and all(len(c) == 4 for c in calls)
+    assert isinstance(calls[0][0], str) and calls[0][1] == 0
+
+    def stop(*_):
+        raise RuntimeError("stop here")
+    with pytest.raises(RuntimeError, match="stop here"):
+        vdbhair.retrace(wavy, vdbhair.estimate_tangent_field(wavy, voxel_size=0.2), progress=stop)
+
+
+def test_ctrl_c_raises_keyboard_interrupt(wavy):
+    """SIGINT during the work (sent from the progress callback, so the timing is certain) stops it
+    with KeyboardInterrupt, and Python's own handler is back afterwards."""
+    import os
+    import signal
+    field = vdbhair.estimate_tangent_field(wavy, voxel_size=0.2)
+    with pytest.raises(KeyboardInterrupt, match="interrupted"):
+        vdbhair.retrace(wavy, field, progress=lambda *a: os.kill(os.getpid(), signal.SIGINT))
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert len(vdbhair.retrace(wavy, field)) == len(wavy)  # later calls are not interrupted
+
+
+def test_pyopenvdb_reads_what_vdbhair_writes(tmp_path, wavy):
+    openvdb = pytest.importorskip("pyopenvdb", reason="pyopenvdb (Debian's python3-openvdb) is not installed")
+    field = vdbhair.estimate_tangent_field(wavy, voxel_size=0.2)
+    path = str(tmp_path / "field.vdb")
+    field.write(path)
+    grid = openvdb.read(path, "tangent")
+    assert isinstance(grid, openvdb.Vec3SGrid)
+    assert grid.activeVoxelCount() == field.active_voxel_count
+    assert grid.transform.voxelSize()[0] == pytest.approx(0.2)
+    acc = grid.getConstAccessor()
+    got = np.array([acc.getValue(tuple(int(x) for x in c)) for c in field.active_coords()], dtype=np.float32)
+    np.testing.assert_array_equal(got, field.values())
+    # pyopenvdb's dense copy agrees with to_dense (its array is [x][y][z], ours [z][y][x]).
+    (i0, j0, k0), (i1, j1, k1) = field.bbox
+    theirs = np.zeros((i1 - i0 + 1, j1 - j0 + 1, k1 - k0 + 1, 3), dtype=np.float32)
+    grid.copyToArray(theirs, ijk=(i0, j0, k0))
+    np.testing.assert_array_equal(theirs.transpose(2, 1, 0, 3), field.to_dense())
+
+
+def test_vdbhair_reads_what_pyopenvdb_writes(tmp_path):
+    openvdb = pytest.importorskip("pyopenvdb", reason="pyopenvdb (Debian's python3-openvdb) is not installed")
+    # A uniform field along the unit diagonal, made and written by pyopenvdb alone.
+    direction = np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
+    dense = np.tile(direction.astype(np.float32), (24, 24, 24, 1))
+    grid = openvdb.Vec3SGrid()
+    grid.copyFromArray(dense, ijk=(-4, -4, -4))
+    grid.name = "flow"
+    grid.transform = openvdb.createLinearTransform(voxelSize=0.25)
+    path = str(tmp_path / "pyopenvdb.vdb")
+    openvdb.write(path, grids=[grid])
+
+    flow = vdbhair.read_grid(path, "flow")
+    assert flow.value_type == "vec3s" and flow.voxel_size == pytest.approx(0.25)
+    assert flow.active_voxel_count == 24 ** 3
+    np.testing.assert_allclose(flow.values(), np.tile(direction, (24 ** 3, 1)), atol=1e-7)
+    # Strands traced through it run straight along the diagonal.
+    t = np.linspace(0.0, 1.0, 5, dtype=np.float32)
+    s = vdbhair.Strands(np.stack([t, np.zeros_like(t), np.zeros_like(t)], axis=1), [0, 5])
+    out = vdbhair.retrace(s, flow)
+    np.testing.assert_allclose(out.positions, t[:, None] * direction[None, :], atol=1e-5)

@@ -1,0 +1,62 @@
+"""grow, fit, render, inspect, and the module's documentation."""
+import inspect as pyinspect
+import json
+
+import numpy as np
+import pytest
+
+import vdbhair
+from conftest import straight_bundle, wavy_hairstyle
+
+
+def test_fit_then_grow_regrows_the_strands(tmp_path):
+    s = wavy_hairstyle(count=6, vertices=20, seed=3)
+    scene, summary = vdbhair.fit(s, return_summary=True)
+    assert summary["fitted"] == 6 and len(scene["guides"]) == 6
+    assert summary["frechet_relative_mean"] < 0.05
+    grown = vdbhair.grow(scene)
+    assert len(grown) == 6
+    # Each regrown strand starts at its root and ends near its tip (within the fit's error).
+    for a, b in zip(s, grown):
+        np.testing.assert_allclose(b[0], a[0], atol=1e-5)
+        length = np.linalg.norm(np.diff(a, axis=0), axis=1).sum()
+        assert np.linalg.norm(b[-1] - a[-1]) < 0.1 * length
+    # A scene file grows the same strands.
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene))
+    np.testing.assert_array_equal(vdbhair.grow(str(path)).positions, grown.positions)
+    with pytest.raises(vdbhair.FormatError):
+        vdbhair.grow({"vdbhair": "scene/1", "guides": "many"})
+
+
+def test_render_returns_rgba_or_writes_a_file(tmp_path):
+    s = straight_bundle(count=3)
+    image = vdbhair.render(s, width=64, height=48, view="front")
+    assert image.shape == (48, 64, 4) and image.dtype == np.uint8
+    assert np.all(image[:, :, 3] == 255)
+    # White background with darker hair somewhere.
+    hair = (image[:, :, :3] < 250).any(axis=-1)
+    assert not hair[0, 0] and hair.sum() > 20
+    path = tmp_path / "hair.png"
+    assert vdbhair.render(s, str(path), width=64, height=48) is None
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ValueError, match="view"):
+        vdbhair.render(s, view="sideways")
+
+
+def test_every_function_has_a_docstring_with_its_defaults():
+    names = ["read", "write", "estimate_tangent_field", "retrace", "refine", "grow", "fit", "render", "inspect",
+             "read_grid", "read_grids", "write_grids", "suggest_voxel_size"]
+    for name in names:
+        doc = getattr(vdbhair, name).__doc__
+        assert doc and len(doc) > 150, name
+    # help(vdbhair.retrace) shows the defaults of the library's TraceParams and the units.
+    doc = vdbhair.retrace.__doc__
+    assert "step: float = 0.0" in doc and "vanish: float = 0.001" in doc and "margin: int = 3" in doc
+    assert "integrator: str = 'euler'" in doc and "world units" in doc
+    assert "iterations: int = 2" in vdbhair.estimate_tangent_field.__doc__
+    for cls in (vdbhair.Strands, vdbhair.TangentField, vdbhair.Grid):
+        assert cls.__doc__
+        for attr, value in vars(cls).items():
+            if not attr.startswith("_"):
+                assert value.__doc__, f"{cls.__name__}.{attr}"

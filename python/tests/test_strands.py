@@ -1,0 +1,166 @@
+"""vdbhair.Strands: arrays, checks, iteration, and round trips through every writable format."""
+import numpy as np
+import pytest
+
+import vdbhair
+from conftest import straight_bundle, wavy_hairstyle
+
+
+def two_strands():
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 2, 0], [0, 3, 1]], dtype=np.float32)
+    return positions, np.array([0, 2, 5])
+
+
+def test_arrays_and_views():
+    positions, offsets = two_strands()
+    s = vdbhair.Strands(positions, offsets)
+    assert len(s) == 2 and s.num_vertices == 5
+    assert s.positions.dtype == np.float32 and s.positions.shape == (5, 3)
+    assert s.offsets.dtype == np.int64 and list(s.offsets) == [0, 2, 5]
+    assert list(s.counts) == [2, 3]
+    np.testing.assert_array_equal(s.positions, positions)
+    # positions is a view of the C++ storage (no copy): two reads share memory, and it is read-only.
+    assert np.shares_memory(s.positions, s.positions)
+    assert not s.positions.flags.writeable
+    with pytest.raises(ValueError):
+        s.positions[0, 0] = 5.0
+    # The view keeps the strands alive.
+    view = vdbhair.Strands(positions, offsets).positions
+    np.testing.assert_array_equal(view, positions)
+    assert s.thickness is None and s.color is None and s.root_uv is None and s.strand_id is None
+
+
+def test_iteration_and_indexing():
+    positions, offsets = two_strands()
+    s = vdbhair.Strands(positions, offsets)
+    items = list(s)
+    assert [a.shape for a in items] == [(2, 3), (3, 3)]
+    np.testing.assert_array_equal(items[1], positions[2:5])
+    np.testing.assert_array_equal(s[-1], positions[2:5])
+    with pytest.raises(IndexError):
+        s[2]
+
+
+def test_attributes():
+    positions, offsets = two_strands()
+    s = vdbhair.Strands(positions, offsets, thickness=np.arange(5) * 0.1, color=np.full((5, 3), 0.25),
+                        root_uv=[[0.1, 0.2], [0.3, 0.4]], strand_id=[7, 9])
+    np.testing.assert_allclose(s.thickness, np.arange(5) * 0.1, rtol=1e-6)
+    assert s.color.shape == (5, 3) and s.color.dtype == np.float32
+    assert list(s.strand_id) == [7, 9] and s.strand_id.dtype == np.int32
+    np.testing.assert_allclose(s.root_uv, [[0.1, 0.2], [0.3, 0.4]], rtol=1e-6)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(positions=np.zeros((5, 2)), offsets=[0, 2, 5]), "Strands(positions): shape (5, 2); must be (V, 3)"),
+    (dict(positions=np.array([["a", "b", "c"]] * 5), offsets=[0, 2, 5]), "Strands(positions): dtype <U1; must hold real numbers"),
+    (dict(positions=np.zeros((5, 3)), offsets=[0, 1, 5]), "Strands(offsets): strand 0 has 1 vertices (offsets[0] = 0, offsets[1] = 1); a strand needs at least 2"),
+    (dict(positions=np.zeros((5, 3)), offsets=[1, 3, 5]), "Strands(offsets): offsets[0] = 1; must be 0"),
+    (dict(positions=np.zeros((5, 3)), offsets=[0, 2, 4]), "Strands(offsets): the last offset is 4 but positions has 5 rows; it must equal the vertex count"),
+    (dict(positions=np.zeros((5, 3)), offsets=[0.0, 2.0, 5.0]), "Strands(offsets): dtype float64; must hold integers"),
+    (dict(positions=np.zeros((5, 3)), offsets=[0, 2, 5], thickness=np.ones(4)), "Strands(thickness): shape (4,); must be (V,)"),
+    (dict(positions=np.zeros((5, 3)), offsets=[0, 2, 5], strand_id=[1, 2**40]), "Strands(strand_id): strand 1 has id 1099511627776; ids must fit in 32 bits"),
+])
+def test_bad_arrays_rejected_with_their_message(kwargs, message):
+    with pytest.raises(ValueError) as info:
+        vdbhair.Strands(**kwargs)
+    assert str(info.value) == message
+    assert isinstance(info.value, vdbhair.Error)
+
+
+def test_non_finite_position_named():
+    positions, offsets = two_strands()
+    positions[3, 1] = np.nan
+    with pytest.raises(ValueError, match=r"^Strands\(positions\): vertex 3 has a non-finite coordinate \(0, nan, 0\); coordinates must be finite$"):
+        vdbhair.Strands(positions, offsets)
+
+
+# Binary formats keep float32 exactly; text formats (.obj, .usda, ascii .ply) to float32 rounding.
+@pytest.mark.parametrize("ext, exact", [(".hair", True), (".data", True), (".ply", True), (".vdb", False), (".obj", False), (".usda", False)])
+def test_round_trip_every_writable_format(tmp_path, ext, exact):
+    s = wavy_hairstyle(count=40, vertices=12)
+    path = str(tmp_path / ("hair" + ext))
+    vdbhair.write(s, path)
+    back = vdbhair.read(path)
+    assert len(back) == len(s)
+    np.testing.assert_array_equal(back.offsets, s.offsets)
+    if exact:
+        np.testing.assert_array_equal(back.positions, s.positions)
+    else:
+        scale = float(np.abs(s.positions).max())
+        np.testing.assert_allclose(back.positions, s.positions, rtol=0, atol=1e-6 * scale)
+    # The method writes the same file.
+    path2 = str(tmp_path / ("again" + ext))
+    s.write(path2)
+    np.testing.assert_array_equal(vdbhair.read(path2).positions, back.positions)
+
+
+def test_ascii_ply_and_polyline_obj(tmp_path):
+    s = straight_bundle(count=3)
+    vdbhair.write(s, str(tmp_path / "a.ply"), ply_encoding="ascii")
+    assert (tmp_path / "a.ply").read_bytes().startswith(b"ply\nformat ascii")
+    vdbhair.write(s, str(tmp_path / "p.obj"), obj_lines="polylines")
+    assert sum(1 for line in (tmp_path / "p.obj").read_text().splitlines() if line.startswith("l ")) == len(s)
+    with pytest.raises(ValueError, match="ply_encoding='big'"):
+        vdbhair.write(s, str(tmp_path / "b.ply"), ply_encoding="big")
+
+
+def test_read_errors_are_typed(tmp_path):
+    with pytest.raises(OSError) as info:
+        vdbhair.read(str(tmp_path / "missing.hair"))
+    assert isinstance(info.value, vdbhair.IoError) and "missing.hair" in str(info.value)
+    bad = tmp_path / "bad.hair"
+    bad.write_bytes(b"NOPE" + bytes(200))
+    with pytest.raises(vdbhair.FormatError) as info:
+        vdbhair.read(str(bad))
+    assert "bad.hair" in str(info.value) and isinstance(info.value, ValueError)
+    with pytest.raises(vdbhair.ArgumentError, match="tfx"):
+        vdbhair.write(straight_bundle(), str(tmp_path / "out.tfx"))
+    assert not (tmp_path / "out.tfx").exists()
+
+
+def test_short_strands_dropped_with_a_warning_or_rejected(tmp_path):
+    # A .data file with a strand of one vertex between two good ones.
+    path = tmp_path / "short.data"
+    body = [np.int32(3).tobytes()]
+    for n in (2, 1, 2):
+        body.append(np.int32(n).tobytes())
+        body.append(np.arange(3 * n, dtype=np.float32).tobytes())
+    path.write_bytes(b"".join(body))
+    with pytest.warns(UserWarning, match="dropped 1 strand"):
+        s = vdbhair.read(str(path))
+    assert len(s) == 2
+    with pytest.raises(vdbhair.FormatError, match="strand 1 has 1 vertices"):
+        vdbhair.read(str(path), strict=True)
+
+
+@pytest.mark.data
+def test_real_file_counts(shared_data):
+    s = vdbhair.read(str(shared_data / "hair/cyhair/straight.hair"))
+    assert (len(s), s.num_vertices) == (10000, 160000)
+    assert np.all(s.counts == 16)
+    # The same 100 strands in four formats read alike.
+    base = vdbhair.read(str(shared_data / "hair/cyhair/Bangs_100.hair"))
+    assert (len(base), base.num_vertices) == (100, 1165)
+    for rel in ("usc_data/Bangs_100.data", "ct2hair_bin/Bangs_100.bin", "ply/Bangs_100_binary.ply"):
+        other = vdbhair.read(str(shared_data / "hair" / rel))
+        np.testing.assert_array_equal(other.offsets, base.offsets, err_msg=rel)
+        np.testing.assert_allclose(other.positions, base.positions, rtol=0, atol=1e-3, err_msg=rel)
+
+
+@pytest.mark.data
+def test_real_data_file_as_numpy_would_read_it(shared_data):
+    """A .data file read by vdbhair matches numpy.fromfile plus the offsets a user would compute."""
+    path = shared_data / "hair/usc_data/harolongo.data"
+    raw = np.fromfile(path, dtype=np.uint8)
+    count = int(raw[:4].view(np.int32)[0])
+    pos, offsets, cursor = [], [0], 4
+    for _ in range(count):
+        n = int(raw[cursor:cursor + 4].view(np.int32)[0])
+        pos.append(raw[cursor + 4:cursor + 4 + 12 * n].view(np.float32).reshape(n, 3))
+        cursor += 4 + 12 * n
+        offsets.append(offsets[-1] + n)
+    s = vdbhair.read(str(path))
+    assert len(s) == count == 7905
+    np.testing.assert_array_equal(s.offsets, offsets)
+    np.testing.assert_array_equal(s.positions, np.concatenate(pos))
