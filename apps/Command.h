@@ -129,6 +129,7 @@ Command addScalpCommand(CLI::App& app, CommonOptions& common);
 Command addRootsCommand(CLI::App& app, CommonOptions& common);
 Command addInterpolateCommand(CLI::App& app, CommonOptions& common);
 Command addReconstructCommand(CLI::App& app, CommonOptions& common);
+Command addSynthCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief The verbs of @a verbs nearest to @a word (edit distance, a prefix counting as 1), for
 /// "did you mean"; empty when none is close.

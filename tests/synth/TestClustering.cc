@@ -167,11 +167,11 @@ TEST_CASE("clusterSamples: adaptive clustering splits until every strand is with
     CHECK(c.clusters.back() > c.clusters.front());
     CHECK(c.energy.back() < 0.01 * c.energy.front());
     CHECK(test::adjustedRandIndex(truth, std::vector<int>(c.label.begin(), c.label.end())) > 0.95);
-    // A threshold below the noise keeps splitting, up to the cap on clusters (a quarter of the strands).
+    // A threshold below the noise keeps splitting, up to the cap on clusters (a share of the strands).
     params.threshold = 1e-6;
     params.maxSplitRounds = 100;
     const Clustering d = clusterSamples(samples, unitMap(), 2, true, params);
-    CHECK(d.centers.count() == 200);
+    CHECK(d.centers.count() == std::size_t(800 * params.maxClusterFraction));
     params.threshold = -1.0;
     CHECK_THROWS_WITH(clusterSamples(samples, unitMap(), 2, true, params), Catch::Contains("cluster threshold"));
 }

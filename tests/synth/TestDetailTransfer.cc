@@ -40,8 +40,9 @@ TEST_CASE("transferDetail: a cluster transferred onto its own centre is the clus
     const TransferSource src{&strands, &c.centers, &c.label};
     std::vector<std::uint32_t> label;
     TransferStats stats;
-    for (bool threaded : {true, false}) {
-        const StrandSamples out = transferDetail(src, c.centers, strands.roots, unitMap(), 16, &label, &stats, threaded);
+    for (bool threaded : {true, false})
+        for (DetailBlend blend : {DetailBlend::RootFrame, DetailBlend::Paper}) {
+        const StrandSamples out = transferDetail(src, c.centers, strands.roots, unitMap(), 16, &label, &stats, blend, threaded);
         REQUIRE(out.count() == strands.count());
         CHECK(stats.clusters == 1);
         CHECK(stats.distinctSources == 1);

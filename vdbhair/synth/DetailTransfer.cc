@@ -9,8 +9,16 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 namespace vdbhair {
+
+DetailBlend detailBlendFromName(const std::string& name)
+{
+    if (name == "root-frame") return DetailBlend::RootFrame;
+    if (name == "paper") return DetailBlend::Paper;
+    throw ValueError("detail blend '" + name + "' is not one of root-frame, paper");
+}
 
 ScalpFrame alignedFrame(const float* row, int vertices, const ScalpFrame& f)
 {
@@ -55,7 +63,7 @@ std::vector<Vec3f> worldOf(const StrandSamples& s, std::size_t i, double radius)
 
 StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
                              const std::vector<Vec3d>& roots, const ScalpMap& map, int components,
-                             std::vector<std::uint32_t>* outLabel, TransferStats* stats, bool threaded,
+                             std::vector<std::uint32_t>* outLabel, TransferStats* stats, DetailBlend blend, bool threaded,
                              openvdb::util::NullInterrupter* interrupter)
 {
     if (!source.strands || !source.centers || !source.label || source.strands->count() == 0 ||
@@ -184,7 +192,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             const Vec3d dBeta = inFrame(fin[std::size_t(l)], dIn);                 // Eq. 6
             const Vec3d a = roots[i] + (Vec3d(cout[std::size_t(l)]) - Vec3d(cout[0])) + mo.toWorld(dAlpha);  // Eq. 8
             const Vec3d b = Vec3d(cout[std::size_t(l)]) + outOf(fout[std::size_t(l)], dBeta) + betaShift;
-            const double s = ns > 1 ? double(l) / double(ns - 1) : 0.0;
+            const double s = blend == DetailBlend::RootFrame ? 0.0 : (ns > 1 ? double(l) / double(ns - 1) : 0.0);
             const Vec3d p = l == 0 ? roots[i] : a * (1.0 - s) + b * s;             // Eq. 7
             const Vec3d q = rf.toLocal((p - roots[i]) / radius);
             row[3 * l] = float(q.x());

@@ -49,6 +49,7 @@ void TextureParams::validate(const char* where) const
         fail("robustExponent " + formatNumber(robustExponent) + " must be finite and in (0, 2] (Kwatra et al. use 0.8)");
     }
     if (pcaDims < 1 || pcaDims > 1024) fail("pcaDims " + std::to_string(pcaDims) + " must be between 1 and 1024");
+    if (!(nearbyRadius >= 0.0 && nearbyRadius <= 1.0)) fail("nearbyRadius " + std::to_string(nearbyRadius) + " must be between 0 and 1");
     if (keyTaps < 1 || keyTaps > 64) fail("keyTaps " + std::to_string(keyTaps) + " must be between 1 and 64");
     if (candidates < 1 || candidates > 256) fail("candidates " + std::to_string(candidates) + " must be between 1 and 256");
     if (!(searchEpsilon >= 0.0 && searchEpsilon <= 1e6)) fail("searchEpsilon " + formatNumber(searchEpsilon) + " must be finite and at least 0");
@@ -654,7 +655,22 @@ FeatureImage synthesizeTexture(const FeatureImage& example, int width, int heigh
         for (int j = 0; j < by; ++j) {
             for (int i = 0; i < bx; ++i) {
                 Rng rng(params.seed, std::uint64_t(j) * bx + i, 0x7e47u);
-                const std::uint32_t o = sources[std::min(sources.size() - 1, std::size_t(rng.uniform() * double(sources.size())))];
+                std::uint32_t o = sources[std::min(sources.size() - 1, std::size_t(rng.uniform() * double(sources.size())))];
+                if (params.init == TextureInit::Nearby) {
+                    // The patch's own place in the example, moved by a random offset; then the
+                    // nearest valid window (first on a tie).
+                    const double r = params.nearbyRadius * double(std::max(e.width, e.height));
+                    const double tx = double(i * w) * double(e.width) / double(x.width) + (2.0 * rng.uniform() - 1.0) * r;
+                    const double ty = double(j * w) * double(e.height) / double(x.height) + (2.0 * rng.uniform() - 1.0) * r;
+                    double best = std::numeric_limits<double>::max();
+                    for (std::uint32_t cand : sources) {
+                        const double dx = double(cand % std::uint32_t(e.width)) - tx, dy = double(cand / std::uint32_t(e.width)) - ty;
+                        if (dx * dx + dy * dy < best) {
+                            best = dx * dx + dy * dy;
+                            o = cand;
+                        }
+                    }
+                }
                 const int sx = int(o % std::uint32_t(e.width)), sy = int(o / std::uint32_t(e.width));
                 for (int y = j * w; y < std::min((j + 1) * w, x.height); ++y) {
                     std::copy_n(e.pixel(sx, sy + y - j * w), std::size_t(std::min(w, x.width - i * w)) * C, x.pixel(i * w, y));

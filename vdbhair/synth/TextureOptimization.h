@@ -19,7 +19,9 @@
 ///    is skipped. Repeated widths run once.
 /// 3. Initialization, at the coarsest level used: the output is tiled with w x w patches (w the
 ///    first stage's width) copied from example windows drawn uniformly among the wholly valid
-///    ones, patch i from the random stream (seed, i). Each later level starts from the previous
+///    ones (TextureInit::Anywhere), or from the valid window nearest to the patch's own place (in
+///    example pixels, scaled by the size ratio) moved by a random offset (TextureInit::Nearby),
+///    patch i from the random stream (seed, i). Each later level starts from the previous
 ///    level's output, upsampled bilinearly. Every output pixel remembers the example pixel it
 ///    came from (here; then, after each M-step, the one the heaviest window covering it gave).
 /// 4. Sources: every example window lying wholly in valid pixels (all positions, spacing 1). Its
@@ -70,6 +72,14 @@
 
 namespace vdbhair {
 
+/// Where the initial patches of step 3 come from.
+enum class TextureInit
+{
+    Anywhere,  ///< any wholly valid example window (Kwatra et al.): the output's layout is new
+    Nearby     ///< the valid window nearest to the patch's own place moved by a random offset of at
+               ///< most @c nearbyRadius: the example's large-scale layout is kept, its detail rearranged
+};
+
 struct TextureParams
 {
     static constexpr int kMaxLevels = 8;
@@ -106,6 +116,10 @@ struct TextureParams
     /// distance times (1 + searchEpsilon) is below the current k-th best. Ours: 4 (0, exact in
     /// key space, took about twice the time; 0, 1, 4 and 8 ended within 2 % of each other in E).
     double searchEpsilon = 4.0;
+    TextureInit init = TextureInit::Anywhere;
+    /// TextureInit::Nearby: the largest offset of a patch's source, as a fraction of the example's
+    /// larger side (0.15: about a fifth of a head's width of hair on a whole-scalp map).
+    double nearbyRadius = 0.15;
     /// Seed of the initial patches (step 3).
     std::uint64_t seed = 0;
 

@@ -1,0 +1,237 @@
+// vdbhair synth EXAMPLE -o OUT: a new hairstyle in the style of an example (Wang et al. 2009,
+// §3-5: hierarchical clustering, PCA feature maps and texture optimization, cluster-oriented
+// detail transfer, vector-field refinement per level).
+#include "../Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/RefineReport.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MeshFile.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/io/VdbFile.h>
+#include <vdbhair/render/StrandRenderer.h>
+#include <vdbhair/scalp/ScalpSurface.h>
+#include <vdbhair/strands/Measures.h>
+#include <vdbhair/synth/Synthesis.h>
+#include <vdbhair/synth/SynthesisReport.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+namespace vdbhair::app {
+
+namespace {
+
+struct SynthCmdParams
+{
+    std::string input, output, scalp, saveMaps, up = "auto", refineMode, layout = "example", detail = "root-frame";
+    std::int64_t strands = -1;  ///< -1: as many as the example
+    SynthParams synth;
+    bool noRefine = false;
+};
+
+/// The first three channels of a feature map as an RGB picture (each channel scaled by the input
+/// map's range over its valid pixels; invalid pixels grey), @a zoom pixels per map pixel, v down.
+Image mapImage(const FeatureImage& map, const FeatureImage& ref, int zoom)
+{
+    float lo[3], hi[3];
+    for (int c = 0; c < 3; ++c) {
+        lo[c] = std::numeric_limits<float>::max();
+        hi[c] = -lo[c];
+    }
+    for (int y = 0; y < ref.height; ++y)
+        for (int x = 0; x < ref.width; ++x)
+            if (ref.isValid(x, y))
+                for (int c = 0; c < std::min(3, ref.channels); ++c) {
+                    lo[c] = std::min(lo[c], ref.pixel(x, y)[c]);
+                    hi[c] = std::max(hi[c], ref.pixel(x, y)[c]);
+                }
+    Image img(map.width * zoom, map.height * zoom, Vec3f(0.5f));
+    for (int y = 0; y < map.height; ++y)
+        for (int x = 0; x < map.width; ++x) {
+            if (!map.isValid(x, y)) continue;
+            Vec3f col(0.0f);
+            for (int c = 0; c < std::min(3, map.channels); ++c)
+                col[c] = hi[c] > lo[c] ? std::clamp((map.pixel(x, y)[c] - lo[c]) / (hi[c] - lo[c]), 0.0f, 1.0f) : 0.5f;
+            for (int j = 0; j < zoom; ++j)
+                for (int i = 0; i < zoom; ++i) img.set(x * zoom + i, (map.height - 1 - y) * zoom + j, col);
+        }
+    return img;
+}
+
+nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, double voxelSize, nlohmann::json& checks)
+{
+    const double radius = r.map->radius();
+    nlohmann::json j;
+    // Per-strand measures: distances between distributions (relative 1-Wasserstein).
+    std::vector<double> le, lo;
+    for (float x : strandLengths(example)) le.push_back(x);
+    for (float x : strandLengths(r.strands)) lo.push_back(x);
+    j["length_distance"] = relativeWasserstein(le, lo);
+    j["turning_distance"] = relativeWasserstein(turningPerLength(example), turningPerLength(r.strands));
+    // Wisp sizes per level.
+    nlohmann::json wisps = nlohmann::json::array();
+    for (std::size_t l = 0; l < r.clusterOf.size(); ++l) {
+        // Example: sizes in strands of the level-(l+1) clusters (labels composed down to the strands).
+        std::vector<std::int32_t> ex(r.example.levels[0].count());
+        for (std::size_t s = 0; s < ex.size(); ++s) {
+            std::uint32_t c = std::uint32_t(s);
+            for (std::size_t k = 0; k <= l; ++k) c = r.example.clusterings[k].label[c];
+            ex[s] = std::int32_t(c);
+        }
+        const std::vector<double> a = clusterSizes(ex), b = clusterSizes(r.clusterOf[l]);
+        double ma = 0, mb = 0;
+        for (double x : a) ma += x;
+        for (double x : b) mb += x;
+        wisps.push_back({{"level", l + 1}, {"example_clusters", a.size()}, {"output_clusters", b.size()},
+                         {"example_mean_size", ma / double(a.size())}, {"output_mean_size", mb / double(b.size())},
+                         {"size_distance", relativeWasserstein(a, b)}});
+    }
+    j["wisps"] = wisps;
+    // Tangent coherence of both at the finest refinement voxel.
+    FieldParams fp;
+    fp.voxelSize = voxelSize;
+    const double ce = meanCoherence(estimateTangentField(example, fp)), co = meanCoherence(estimateTangentField(r.strands, fp));
+    j["coherence"] = {{"example", ce}, {"output", co}, {"voxel_size", voxelSize}};
+    const NoveltyStats nov = measureNovelty(example, r.strands, radius);
+    j["novelty"] = {{"output_to_example_median", nov.outputMedian}, {"example_to_example_median", nov.exampleMedian},
+                    {"copies", nov.copies}};
+    // The thresholds (README, "Synthesis", says why each).
+    checks = {{"length", j["length_distance"].get<double>() <= 0.15},
+              {"turning", j["turning_distance"].get<double>() <= 0.25},
+              {"coherence", co >= ce - 0.03},
+              {"new", nov.copies <= 0.01 && nov.outputMedian >= 0.5 * nov.exampleMedian}};
+    return j;
+}
+
+int runSynth(SynthCmdParams p, const CommonOptions& common)
+{
+    strandFormatFromPath(p.output, /*forWriting=*/true);
+    if (p.up != "auto") p.synth.up = axisFromName(p.up, "--up");
+    p.synth.refine = !p.noRefine;
+    if (!p.refineMode.empty()) p.synth.refineMode = refineModeFromName(p.refineMode);
+    p.synth.layout = synthLayoutFromName(p.layout);
+    p.synth.detailBlend = detailBlendFromName(p.detail);
+    if (p.strands == 0) throw ValueError("--strands 0: must be at least 1");
+    p.synth.validate("synth");
+    const StrandSet example = loadStrands("synth", p.input, common);
+    if (example.numStrands() < 2) throw ValueError(p.input + ": " + std::to_string(example.numStrands()) + " strand: synthesis needs an example of many strands");
+    if (p.strands > 0) {
+        p.synth.strandScale = double(p.strands) / double(example.numStrands());
+        const double estimate = double(p.strands) * p.synth.vertices;
+        if (estimate > double(p.synth.maxVertices))
+            throw LimitError("--strands " + std::to_string(p.strands) + ": " + formatValue(estimate) + " vertices exceed the cap of " +
+                             std::to_string(p.synth.maxVertices));
+    }
+    openvdb::FloatGrid::Ptr scalp;
+    if (!p.scalp.empty()) {
+        const Stage stage(common, "reading " + p.scalp);
+        if (fileExtension(p.scalp) == ".vdb") {
+            openvdb::GridBase::Ptr g = readVdbGrid(p.scalp, "surface", "synth(" + p.scalp + ")");
+            scalp = openvdb::GridBase::grid<openvdb::FloatGrid>(g);
+            if (!scalp || scalp->getGridClass() != openvdb::GRID_LEVEL_SET)
+                throw TypeError(p.scalp + ": grid 'surface' is not a float level set; vdbhair scalp makes one");
+        } else {
+            ScalpParams sp;
+            sp.source = p.scalp;
+            scalp = scalpFromMesh(readTriangleMesh(p.scalp), sp, nullptr, common.interrupter);
+        }
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    {
+        const Stage stage(common, "writing " + p.output);
+        writeStrands(p.output, r.strands);
+    }
+    if (!p.saveMaps.empty()) {
+        const Stage stage(common, "writing maps to " + p.saveMaps);
+        std::error_code ec;
+        std::filesystem::create_directories(p.saveMaps, ec);
+        if (ec) throw IoError(p.saveMaps + ": cannot create the folder: " + ec.message());
+        const int zoom = std::max(1, 400 / std::max(1, std::max(r.grid.width, r.grid.height)));
+        writeImage(p.saveMaps + "/input_map.png", mapImage(r.inputMap, r.inputMap, zoom));
+        writeImage(p.saveMaps + "/output_map.png", mapImage(r.outputMap, r.inputMap, zoom));
+        // The output's clusters at the coarsest level, a colour each.
+        StrandSet coloured = r.strands;
+        coloured.color.resize(coloured.numVertices());
+        const std::vector<std::int32_t>& top = r.clusterOf.back();
+        for (std::size_t s = 0; s < coloured.numStrands(); ++s)
+            for (std::size_t v = coloured.begin(s); v < coloured.end(s); ++v) coloured.color[v] = idColor(std::uint64_t(top[s]));
+        RenderParams rp;
+        rp.width = rp.height = 800;
+        // The world axis nearest the up used (views are named for axis-aligned heads).
+        Vec3d axis(0.0);
+        const int k = std::abs(r.up.x()) >= std::max(std::abs(r.up.y()), std::abs(r.up.z())) ? 0 : (std::abs(r.up.y()) >= std::abs(r.up.z()) ? 1 : 2);
+        axis[k] = r.up[k] < 0.0 ? -1.0 : 1.0;
+        rp.up = axis;
+        rp.title = "synth: coarsest clusters";
+        writeImage(p.saveMaps + "/clusters.png", renderStrands(coloured, rp));
+    }
+    const double finestVoxel = r.refineVoxelSizes.front();
+    nlohmann::json checks;
+    const nlohmann::json stats = statsJson(example, r, finestVoxel, checks);
+    if (common.json) {
+        nlohmann::json levels = nlohmann::json::array();
+        for (std::size_t l = 0; l < r.output.size(); ++l)
+            levels.push_back({{"level", l}, {"example", r.example.levels[l].count()}, {"output", r.output[l].count()},
+                              {"refine_corrected", r.refinedCorrected[l]}});
+        nlohmann::json energy = nlohmann::json::array();
+        for (const Clustering& c : r.example.clusterings)
+            energy.push_back({{"energy", c.energy}, {"clusters", c.clusters}, {"largest_distance", c.largestDistance}});
+        nlohmann::json stages = nlohmann::json::object();
+        for (const SynthStage& s : r.stages) stages[s.name] = s.seconds;
+        printJson({{"output", p.output}, {"example", p.input}, {"strands", r.strands.numStrands()},
+                   {"vertices", r.strands.numVertices()}, {"levels", levels}, {"clustering", energy},
+                   {"map", {{"width", r.grid.width}, {"height", r.grid.height}, {"components", r.pca.components},
+                            {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
+                   {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
+                   {"head_radius", r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", p.detail},
+                   {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}});
+    } else if (!common.quiet) {
+        std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
+        for (const SynthStage& s : r.stages) std::cout << "  " << s.name << ": " << s.seconds << " s\n";
+        for (std::size_t l = r.output.size(); l-- > 0;)
+            std::cout << "  level " << l << ": example " << r.example.levels[l].count() << ", output " << r.output[l].count() << "\n";
+        std::cout << "  length distance " << stats["length_distance"] << ", turning distance " << stats["turning_distance"]
+                  << ", coherence " << stats["coherence"]["output"] << " (example " << stats["coherence"]["example"] << ")"
+                  << ", copies " << stats["novelty"]["copies"] << "\nwrote " << p.output << "\n";
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addSynthCommand(CLI::App& app, CommonOptions& common)
+{
+    auto params = std::make_shared<SynthCmdParams>();
+    SynthParams& s = params->synth;
+    CLI::App* sub = app.add_subcommand("synth", "A new hairstyle in the style of an example (Wang et al. 2009: clustering, feature-map synthesis, detail transfer, refinement)");
+    sub->add_option("example", params->input, "The example hairstyle (any strand format)")->required();
+    sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format)")->required();
+    sub->add_option("--scalp", params->scalp, "The scalp: a .vdb with a level set 'surface' (vdbhair scalp) or a head mesh (.ply, .obj); default: the sphere fitted to the roots");
+    sub->add_option("--levels", s.cluster.levels, "Levels of the hierarchy, the strands included (the paper: 2 for simple styles, 3 otherwise)")->capture_default_str();
+    sub->add_option("--strands", params->strands, "Strands in the output (default: as many as the example; every level scales alike)");
+    sub->add_option("--seed", s.seed, "Random seed (clustering seeds, texture initialization, roots)")->capture_default_str();
+    sub->add_option("--vertices", s.vertices, "Vertices per strand, n_s (Table 1)")->capture_default_str();
+    sub->add_option("--threshold", s.cluster.threshold, "Adaptive clustering threshold epsilon (L2 over n_s vertices, head radii squared; Table 1: 0.1-0.3)")->capture_default_str();
+    sub->add_option("--initial-clusters", s.cluster.initialClusters, "k0 of adaptive clustering")->capture_default_str();
+    sub->add_option("--components", s.components, "PCA components of the feature maps, n_f")->capture_default_str();
+    sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();
+    sub->add_option("--layout", params->layout, "The coarsest level's feature map: example (the example's own; keeps its global flow) or synthesize (texture optimization, the paper; for hair that does not hang)")->capture_default_str();
+    sub->add_option("--detail", params->detail, "Detail transfer: root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
+    sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();
+    sub->add_option("--nearby", s.texture.nearbyRadius, "Texture synthesis: the reach of place guidance and of the initial patches' offsets, as a fraction of the map")->capture_default_str();
+    sub->add_option("--refine-mode", params->refineMode, "Refinement after each level: consistent (default, keeps detail) or field (the paper's retrace)");
+    sub->add_flag("--no-refine", params->noRefine, "Skip the vector-field refinement of every level");
+    sub->add_option("--up", params->up, "The scalp's up axis: auto (the mean direction from the head's centre to the roots), x, y, z, -x, -y or -z")->capture_default_str();
+    sub->add_option("--voxel-size", s.voxelSize, "Refinement voxel of the finest level, world units (0: refine's suggestion for the example; doubled per coarser level)")->capture_default_str();
+    sub->add_option("--save-maps", params->saveMaps, "Write input_map.png, output_map.png (first three PCA channels as RGB) and clusters.png to this folder");
+    addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair synth example.hair -o new.hair --levels 3 --seed 1 --json");
+    return {sub, [params, &common] { return runSynth(*params, common); }};
+}
+
+} // namespace vdbhair::app

@@ -1,0 +1,237 @@
+#include "Synthesis.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/synth/DetailTransfer.h>
+#include <vdbhair/synth/RootScatter.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+namespace vdbhair {
+
+SynthLayout synthLayoutFromName(const std::string& name)
+{
+    if (name == "example") return SynthLayout::Example;
+    if (name == "synthesize") return SynthLayout::Synthesize;
+    throw ValueError("layout '" + name + "' is not one of example, synthesize");
+}
+
+void SynthParams::validate(const char* where) const
+{
+    const auto fail = [&](const std::string& what) { throw ValueError(std::string(where) + ": " + what); };
+    if (vertices < 4 || vertices > 4096) fail("vertices per strand " + std::to_string(vertices) + ": 4 to 4096");
+    if (components < 1) fail("PCA components " + std::to_string(components) + ": at least 1");
+    if (!(mapSpacing >= 1e-3 && mapSpacing <= 0.5)) fail("map spacing " + std::to_string(mapSpacing) + ": 0.001 to 0.5 radians");
+    if (!(strandScale > 0.0) || !std::isfinite(strandScale)) fail("strand scale " + std::to_string(strandScale) + ": a positive finite factor");
+    if (rootIterations < 0 || rootIterations > 1000) fail("root iterations " + std::to_string(rootIterations) + ": 0 to 1000");
+    if (!(voxelSize >= 0.0) || !std::isfinite(voxelSize)) fail("voxel size " + std::to_string(voxelSize) + ": 0 (suggested) or a positive finite length");
+    if (!std::isfinite(up.length())) fail("up axis: a finite vector (or 0 for the roots' mean direction)");
+    if (!(placeWeight >= 0.0) || !std::isfinite(placeWeight)) fail("place weight " + std::to_string(placeWeight) + ": 0 or a positive finite weight");
+    cluster.validate(where);
+    texture.validate(where);
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct StageTimer
+{
+    std::vector<SynthStage>& stages;
+    std::string name;
+    Clock::time_point start = Clock::now();
+    ~StageTimer()
+    {
+        const double s = std::chrono::duration<double>(Clock::now() - start).count();
+        for (SynthStage& st : stages)
+            if (st.name == name) { st.seconds += s; return; }
+        stages.push_back({name, s});
+    }
+};
+
+} // namespace
+
+SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, openvdb::FloatGrid::ConstPtr scalp,
+                           bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    params.validate("synthesizeHair");
+    const int L = params.cluster.levels;
+    SynthResult res;
+    // 1. Scalp space.
+    {
+        StageTimer t{res.stages, "scalp"};
+        std::vector<Vec3f> roots(example.numStrands());
+        for (std::size_t s = 0; s < roots.size(); ++s) roots[s] = example.root(s);
+        ScalpSphere sphere = fitScalpSphere(roots, params.up.length() > 0.0 ? params.up : Vec3d(0.0, 1.0, 0.0));
+        if (params.up.length() == 0.0) {
+            Vec3d mean(0.0);
+            for (const Vec3f& r : roots) mean += (Vec3d(r) - sphere.center).unitSafe();
+            if (mean.length() > 1e-9 * double(roots.size())) sphere.up = mean.unitSafe();
+        }
+        res.up = sphere.up;
+        res.map = scalp ? std::make_shared<ScalpMap>(sphere, *scalp) : std::make_shared<ScalpMap>(sphere);
+    }
+    const ScalpMap& map = *res.map;
+    const double radius = map.radius();
+    // 2-3. Samples and the example's hierarchy.
+    StrandSamples samples;
+    {
+        StageTimer t{res.stages, "samples"};
+        samples = sampleStrands(example, map, params.vertices, threaded);
+    }
+    {
+        StageTimer t{res.stages, "clustering"};
+        ClusterParams cp = params.cluster;
+        cp.seed = params.seed;
+        res.example = buildHierarchy(samples, map, cp, interrupter);
+    }
+    samples = StrandSamples();
+    const StrandSamples& finest = res.example.levels.front();
+    const StrandSamples& coarsest = res.example.levels.back();
+    // Output counts per level and the memory estimate, before any output is made.
+    std::vector<std::size_t> counts(static_cast<std::size_t>(L));
+    for (int l = 0; l < L; ++l)
+        counts[std::size_t(l)] = std::max<std::size_t>(1, std::size_t(std::llround(double(res.example.levels[std::size_t(l)].count()) * params.strandScale)));
+    if (double(counts[0]) * params.vertices > double(params.maxVertices))
+        throw LimitError("synthesizeHair: " + std::to_string(counts[0]) + " strands of " + std::to_string(params.vertices) +
+                         " vertices exceed the cap of " + std::to_string(params.maxVertices) + " vertices");
+    // 4. Feature maps.
+    {
+        StageTimer t{res.stages, "feature maps"};
+        res.pca = fitPca(coarsest.local.data(), coarsest.count(), coarsest.dim(), params.components);
+        const int nf = res.pca.components;
+        std::vector<float> features(coarsest.count() * std::size_t(nf));
+        for (std::size_t s = 0; s < coarsest.count(); ++s) res.pca.project(coarsest.row(s), features.data() + s * std::size_t(nf));
+        res.grid = uvGridAround(finest.scalp, params.mapSpacing);
+        const double maskRadius = std::max(params.mapSpacing, 2.0 * medianUvSpacing(finest.scalp));
+        res.inputMap = buildFeatureMap(res.grid, coarsest.scalp, features.data(), nf, finest.scalp, maskRadius);
+    }
+    {
+        StageTimer t{res.stages, "texture optimization"};
+        if (params.layout == SynthLayout::Example) {
+            res.outputMap = res.inputMap;
+        } else {
+        TextureParams tp = params.texture;
+        tp.seed = params.seed;
+        // Two guidance channels hold each pixel's own place (see SynthParams::placeWeight).
+        const FeatureImage& in = res.inputMap;
+        const int C = in.channels, G = params.placeWeight > 0.0 ? 2 : 0;
+        double variance = 0.0;
+        std::size_t valid = 0;
+        for (int y = 0; y < in.height; ++y)
+            for (int x = 0; x < in.width; ++x)
+                if (in.isValid(x, y)) {
+                    ++valid;
+                    for (int ch = 0; ch < C; ++ch) variance += double(in.pixel(x, y)[ch]) * in.pixel(x, y)[ch];
+                }
+        const double sigma = valid ? std::sqrt(variance / double(valid)) : 1.0;
+        const double reach = std::max(1.0, tp.nearbyRadius * double(std::max(in.width, in.height)));
+        const float scale = float(params.placeWeight * (sigma > 0.0 ? sigma : 1.0) / reach);
+        FeatureImage guided(in.width, in.height, C + G);
+        guided.valid = in.valid;
+        for (int y = 0; y < in.height; ++y)
+            for (int x = 0; x < in.width; ++x) {
+                std::copy_n(in.pixel(x, y), C, guided.pixel(x, y));
+                if (G) {
+                    guided.pixel(x, y)[C] = float(x) * scale;
+                    guided.pixel(x, y)[C + 1] = float(y) * scale;
+                }
+            }
+        const FeatureImage out = synthesizeTexture(guided, res.grid.width, res.grid.height, tp, &res.texture, threaded, interrupter);
+        res.outputMap = FeatureImage(out.width, out.height, C);
+        for (int y = 0; y < out.height; ++y)
+            for (int x = 0; x < out.width; ++x) std::copy_n(out.pixel(x, y), C, res.outputMap.pixel(x, y));
+        res.outputMap.valid = in.valid;  // the output region is the example's
+        }
+    }
+    // Refinement of one output level (§5.3), in place.
+    res.output.resize(std::size_t(L));
+    res.refinedCorrected.assign(std::size_t(L), 0);
+    res.refineVoxelSizes.assign(std::size_t(L), 0.0);
+    {
+        const double finestVoxel = params.voxelSize > 0.0 ? params.voxelSize : suggestVoxelSize(example);
+        for (int l = 0; l < L; ++l) res.refineVoxelSizes[std::size_t(l)] = finestVoxel * double(1 << l);
+    }
+    StrandSet finestStrands;
+    const auto refineLevel = [&](int l) {
+        StrandSamples& level = res.output[std::size_t(l)];
+        StrandSet strands = samplesToStrands(level, radius);
+        if (params.refine) {
+            StageTimer t{res.stages, "refinement"};
+            RefineParams rp;
+            rp.levels = 1;
+            rp.mode = params.refineMode;
+            rp.measure = false;
+            rp.field.voxelSize = res.refineVoxelSizes[std::size_t(l)];
+            if (scalp) rp.head = HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper);
+            RefineResult rr = refineStrands(strands, rp, threaded, interrupter);
+            if (!rr.levels.empty()) res.refinedCorrected[std::size_t(l)] = rr.levels.front().consistency.corrected;
+            strands = std::move(rr.strands);
+            StrandSamples again = sampleStrands(strands, map, params.vertices, threaded);
+            // Keep the scattered roots' frames and positions exactly (refinement keeps roots).
+            level.local.swap(again.local);
+            level.lengths.swap(again.lengths);
+        }
+        if (l == 0) finestStrands = std::move(strands);
+    };
+    // 5. The coarsest level from the synthesized map.
+    {
+        StageTimer t{res.stages, "coarsest level"};
+        RootScatterParams rp;
+        rp.count = counts[std::size_t(L - 1)];
+        rp.iterations = params.rootIterations;
+        rp.seed = params.seed;
+        rp.stream = std::uint64_t(L - 1);
+        const ScatteredRoots roots = scatterRoots(map, res.grid, res.outputMap, rp, threaded);
+        StrandSamples& level = res.output[std::size_t(L - 1)];
+        level.vertices = params.vertices;
+        std::vector<float> f(std::size_t(res.pca.components)), row(coarsest.dim());
+        for (std::size_t i = 0; i < roots.positions.size(); ++i) {
+            if (!nearestFeature(res.outputMap, res.grid, roots.scalp[i].x(), roots.scalp[i].y(), f.data()))
+                throw ValueError("synthesizeHair: the output feature map has no valid pixel");
+            res.pca.reconstruct(f.data(), row.data());
+            row[0] = row[1] = row[2] = 0.0f;  // the root is the root
+            double len = 0.0;
+            for (int v = 1; v < params.vertices; ++v)
+                len += std::sqrt(double(row[3 * v] - row[3 * v - 3]) * (row[3 * v] - row[3 * v - 3]) +
+                                 double(row[3 * v + 1] - row[3 * v - 2]) * (row[3 * v + 1] - row[3 * v - 2]) +
+                                 double(row[3 * v + 2] - row[3 * v - 1]) * (row[3 * v + 2] - row[3 * v - 1]));
+            level.push(row.data(), roots.positions[i], roots.scalp[i], map.frame(roots.scalp[i].x(), roots.scalp[i].y()),
+                       float(len * radius));
+        }
+    }
+    refineLevel(L - 1);
+    // 6. Finer levels by detail transfer.
+    std::vector<std::vector<std::uint32_t>> parent(static_cast<std::size_t>(L));  // parent[l][i]: output strand of level l+1
+    for (int l = L - 2; l >= 0; --l) {
+        if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("synthesis interrupted");
+        {
+            StageTimer t{res.stages, "detail transfer"};
+            RootScatterParams rp;
+            rp.count = counts[std::size_t(l)];
+            rp.iterations = params.rootIterations;
+            rp.seed = params.seed;
+            rp.stream = std::uint64_t(l);
+            const ScatteredRoots roots = scatterRoots(map, res.grid, res.outputMap, rp, threaded);
+            const TransferSource src{&res.example.levels[std::size_t(l)], &res.example.levels[std::size_t(l + 1)],
+                                     &res.example.clusterings[std::size_t(l)].label};
+            res.output[std::size_t(l)] = transferDetail(src, res.output[std::size_t(l + 1)], roots.positions, map, params.components,
+                                                        &parent[std::size_t(l)], nullptr, params.detailBlend, threaded, interrupter);
+        }
+        refineLevel(l);
+    }
+    res.strands = std::move(finestStrands);
+    // Cluster of every output strand at each coarser level.
+    const std::size_t n = res.output[0].count();
+    std::vector<std::int32_t> at(n);
+    for (std::size_t i = 0; i < n; ++i) at[i] = std::int32_t(i);
+    for (int l = 0; l + 1 < L; ++l) {
+        for (std::size_t i = 0; i < n; ++i) at[i] = std::int32_t(parent[std::size_t(l)][std::size_t(at[i])]);
+        res.clusterOf.push_back(at);
+    }
+    return res;
+}
+
+} // namespace vdbhair

@@ -1,0 +1,142 @@
+/// @file Synthesis.h
+/// @brief Example-based hair synthesis (Wang et al. 2009, §3-5), end to end: a new hairstyle with
+/// the wisp structure and detail of an example, on the example's scalp region.
+///
+/// Stages (each its own file; timed in SynthResult::stages):
+/// 1. **scalp**: the scalp map (ScalpMap.h) on the sphere fitted to the example's roots, measured on
+///    the scalp level set when one is given.
+/// 2. **samples**: every strand resampled to n_s vertices in its root frame (StrandSamples.h).
+/// 3. **clustering**: the example's hierarchy (Clustering.h), @c cluster.levels levels.
+/// 4. **feature maps**: PCA (Pca.h) of the coarsest level to n_f components; the input map on a
+///    (u, v) grid of spacing @c mapSpacing, valid within two root spacings of the example's roots
+///    (FeatureMap.h); the output map is the example's or, with SynthLayout::Synthesize, made by
+///    texture optimization (TextureOptimization.h) at the same size.
+/// 5. **coarsest level**: output roots scattered over the valid region (RootScatter.h) at the
+///    example's density for that level (times @c strandScale); each root's strand rebuilt from the
+///    output map's nearest feature vector.
+/// 6. **detail transfer**, level by level to the finest (DetailTransfer.h), each level's roots
+///    scattered at the example's density for the level.
+/// 7. **refinement** after each level (§5.3, Refine.h with one level), the voxel size halving from
+///    level to level down to the finest, which is Refine.h's own default for the example
+///    (suggestVoxelSize(): three root spacings). The paper's 0.02 head radii at the coarsest level
+///    makes a finest voxel of 0.005 radii, ten times finer than the roots of a 10,000-strand head:
+///    each voxel then holds one strand, the field returns every strand as it is, and refining
+///    straight.hair took 120 s instead of a few.
+/// The output region is the example's (the valid pixels of its map). Deterministic for a seed and
+/// independent of the thread count.
+#pragma once
+
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/strands/StrandSet.h>
+#include <vdbhair/synth/Clustering.h>
+#include <vdbhair/synth/DetailTransfer.h>
+#include <vdbhair/synth/FeatureImage.h>
+#include <vdbhair/synth/FeatureMap.h>
+#include <vdbhair/synth/Pca.h>
+#include <vdbhair/synth/TextureOptimization.h>
+
+#include <openvdb/util/NullInterrupter.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace vdbhair {
+
+/// Where the coarsest level's feature map comes from.
+enum class SynthLayout
+{
+    /// The example's own map: the output keeps the example's global flow and gets new roots, new
+    /// wisps and their transferred detail at every level. The default, because texture
+    /// optimization of a whole-scalp map does not keep hanging hair (below).
+    Example,
+    /// Texture optimization (Kwatra et al. 2005), the paper's §5.1. Root-frame features of hair that
+    /// hangs are not stationary over the scalp (they turn with the frame from the crown to the
+    /// sides), and the synthesized map loses the extremes at the region's edges where hair hangs
+    /// at the sides and back: on straight.hair the output's hair sticks out sideways, 0.55-0.73
+    /// head radii RMS from the nearest example strand at any place weight (measured 0, 4, 16),
+    /// against 0.02 between neighbouring example strands. Right for hair whose shape in root frames
+    /// is the same all over the scalp (short, spiky, curly caps).
+    Synthesize
+};
+/// @throw ValueError unless "example" or "synthesize".
+SynthLayout synthLayoutFromName(const std::string& name);
+
+struct SynthParams
+{
+    SynthLayout layout = SynthLayout::Example;
+    DetailBlend detailBlend = DetailBlend::RootFrame;  ///< DetailTransfer.h says why
+    int vertices = StrandSamples::kDefaultVertices;  ///< n_s (Table 1)
+    int components = Pca::kDefaultComponents;        ///< n_f (§5.1)
+    ClusterParams cluster;                           ///< includes the level count and the seed
+    /// Texture optimization; synthesis starts it from patches near their own place (TextureInit::Nearby)
+    /// so the new hairstyle keeps the example's global flow: with scalp-space root frames a patch
+    /// moved across the head turns with the frame (hair from the back put on a side points
+    /// sideways), which Kwatra's random start does (measured on straight.hair: hair sticking out
+    /// sideways, RMS 0.8 radii from the nearest example strand).
+    TextureParams texture = [] {
+        TextureParams t;
+        t.init = TextureInit::Nearby;
+        return t;
+    }();
+    /// Feature-map pixel spacing in (u, v) radians: 0.02 (Wang et al. §6's grid spacing for a head
+    /// of radius 1; a radian of (u, v) is about a radius of arc near the crown).
+    double mapSpacing = 0.02;
+    /// Place guidance of the texture optimization: two extra channels hold each pixel's own (x, y),
+    /// scaled so that a source @c texture.nearbyRadius away costs @c placeWeight times the features'
+    /// RMS value. Hair features in root frames are not stationary over a scalp (hanging hair turns
+    /// with the frame from the crown to the sides), and an unguided synthesis of straight.hair's map
+    /// lost its gradient and combed the hair to one side (RMS 0.73 radii from the example); 0
+    /// turns the guidance off (Kwatra's and the paper's stationary synthesis).
+    double placeWeight = 1.0;
+    double strandScale = 1.0;  ///< output strands per example strand, at every level
+    int rootIterations = 10;   ///< RootScatter.h relaxation rounds
+    bool refine = true;        ///< §5.3 after every level
+    double voxelSize = 0.0;    ///< the finest level's refinement voxel, world units (0: suggestVoxelSize(example))
+    RefineMode refineMode = RefineMode::Consistent;
+    /// The scalp's up axis (the paper's +y, where u and v are least distorted); (0, 0, 0): the mean
+    /// direction from the fitted sphere's centre to the roots, so the hair sits on the upper
+    /// hemisphere of scalp space whatever the file's axes (cyHair files are z-up, USC's y-up).
+    Vec3d up{0.0, 0.0, 0.0};
+    std::uint64_t seed = 0;
+    /// Refuse outputs above this many vertices (16 bytes each with the samples, before refinement).
+    std::uint64_t maxVertices = std::uint64_t(1) << 28;
+
+    /// @throw ValueError naming the parameter, its value and the rule.
+    void validate(const char* where) const;
+};
+
+struct SynthStage
+{
+    std::string name;
+    double seconds = 0.0;
+};
+
+struct SynthResult
+{
+    StrandSet strands;                    ///< the new hairstyle (the finest level), n_s vertices a strand
+    /// element l-1 (l = 1 .. levels-1): for every output strand, its cluster at level l (the index of
+    /// its ancestor among the output strands of level l)
+    std::vector<std::vector<std::int32_t>> clusterOf;
+    ClusterHierarchy example;             ///< the example's hierarchy
+    std::vector<StrandSamples> output;    ///< the output's levels, 0 the finest
+    Pca pca;                              ///< of the example's coarsest level
+    UvGrid grid;
+    FeatureImage inputMap, outputMap;
+    TextureStats texture;
+    std::vector<SynthStage> stages;
+    std::shared_ptr<ScalpMap> map;
+    std::vector<std::size_t> refinedCorrected;  ///< per output level (0 the finest): strands refinement corrected
+    std::vector<double> refineVoxelSizes;       ///< per output level (0 the finest), world units
+    Vec3d up{0.0, 1.0, 0.0};                    ///< the up axis used
+};
+
+/// @brief Synthesize a hairstyle from @a example.
+/// @param scalp the scalp level set (`surface`), or null for the sphere fitted to the roots
+/// @throw ValueError (bad parameters, too few strands, strands of fewer than 2 vertices, an empty
+/// region), LimitError (an output beyond maxVertices), InterruptedError.
+SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params,
+                           openvdb::FloatGrid::ConstPtr scalp = nullptr, bool threaded = true,
+                           openvdb::util::NullInterrupter* interrupter = nullptr);
+
+} // namespace vdbhair
