@@ -69,6 +69,8 @@ struct Lloyd
     std::vector<std::uint32_t> seeds;    // k
     std::vector<std::uint32_t> label;    // N
     std::size_t islands = 0;
+    std::vector<std::uint32_t> memoCluster;
+    std::vector<double> memoDistance;
 
     std::size_t k() const { return seeds.size(); }
     double dist(std::size_t s, std::size_t c) const
@@ -84,9 +86,18 @@ struct Lloyd
         label.assign(n, kNone);
         using Item = std::tuple<double, std::uint32_t, std::uint32_t>;  // L², strand, cluster
         std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+        // A strand is offered to the same cluster by each assigned neighbour: an entry (distance,
+        // strand, cluster) already queued is not queued again (the same partition, a fifth of the work).
+        memoCluster.assign(n, kNone);
+        memoDistance.resize(n);
         const auto grow = [&](std::uint32_t s, std::uint32_t c) {
-            for (std::uint32_t nb : graph[s])
-                if (label[nb] == kNone) queue.emplace(dist(nb, c), nb, c);
+            for (std::uint32_t nb : graph[s]) {
+                if (label[nb] != kNone) continue;
+                if (memoCluster[nb] == c) continue;  // already queued with this tag: the same entry
+                memoCluster[nb] = c;
+                memoDistance[nb] = dist(nb, c);
+                queue.emplace(memoDistance[nb], nb, c);
+            }
         };
         const auto drain = [&] {
             while (!queue.empty()) {
