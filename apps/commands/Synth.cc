@@ -26,7 +26,7 @@ namespace {
 
 struct SynthCmdParams
 {
-    std::string input, output, scalp, saveMaps, up = "auto", refineMode, layout = "example", detail = "root-frame";
+    std::string input, output, scalp, saveMaps, up = "auto", refineMode, layout = "synthesize", detail = "root-frame";
     std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;
     bool noRefine = false;
@@ -220,7 +220,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--initial-clusters", s.cluster.initialClusters, "k0 of adaptive clustering")->capture_default_str();
     sub->add_option("--components", s.components, "PCA components of the feature maps, n_f")->capture_default_str();
     sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();
-    sub->add_option("--layout", params->layout, "The coarsest level's feature map: example (the example's own; keeps its global flow) or synthesize (texture optimization, the paper; for hair that does not hang)")->capture_default_str();
+    sub->add_option("--layout", params->layout, "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: a variation that keeps its global flow exactly)")->capture_default_str();
     sub->add_option("--detail", params->detail, "Detail transfer: root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
     sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();
     sub->add_option("--nearby", s.texture.nearbyRadius, "Texture synthesis: the reach of place guidance and of the initial patches' offsets, as a fraction of the map")->capture_default_str();

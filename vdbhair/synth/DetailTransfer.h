@@ -24,7 +24,10 @@
 /// output centres bend differently (the displacement turns with the two curves' rotation-minimizing
 /// frames): measured end to end, the bundled ponytail's turning per length came out 6.0 times
 /// the example's with Eq. 7 against 0.18 with γ_α alone, Curly_100's length 3.5 times against 0.12.
-/// Whether the cause is in the paper's rule or in this implementation of it is not settled.
+/// That is what offset curves do: a displacement held in a curve's moving frame traces a curve
+/// that loops wherever the displacement is longer than the curve's radius of curvature (|D| κ > 1),
+/// and cluster offsets (tenths of a head radius) exceed the radius of curvature of curly or tied
+/// centres; not proven here to be the whole cause.
 #pragma once
 
 #include <vdbhair/synth/Pca.h>

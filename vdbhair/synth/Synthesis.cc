@@ -129,11 +129,37 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
         const double sigma = valid ? std::sqrt(variance / double(valid)) : 1.0;
         const double reach = std::max(1.0, tp.nearbyRadius * double(std::max(in.width, in.height)));
         const float scale = float(params.placeWeight * (sigma > 0.0 ? sigma : 1.0) / reach);
+        // The example's invalid pixels take the value of the nearest valid one (breadth-first
+        // from the valid pixels, 4-neighbours, in index order) and count as valid: output windows
+        // at the region's edge then match windows that continue the edge outward instead of
+        // windows from inside, which averaged the edge's extremes away.
+        FeatureImage filled = in;
+        {
+            std::vector<std::size_t> queue;
+            std::vector<std::uint8_t> done(in.pixelCount(), 0);
+            for (std::size_t i = 0; i < in.pixelCount(); ++i)
+                if (in.isValid(int(i % std::size_t(in.width)), int(i / std::size_t(in.width)))) {
+                    done[i] = 1;
+                    queue.push_back(i);
+                }
+            for (std::size_t head = 0; head < queue.size(); ++head) {
+                const int x = int(queue[head] % std::size_t(in.width)), y = int(queue[head] / std::size_t(in.width));
+                const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+                for (int k = 0; k < 4; ++k) {
+                    if (nx[k] < 0 || ny[k] < 0 || nx[k] >= in.width || ny[k] >= in.height) continue;
+                    const std::size_t j = std::size_t(ny[k]) * in.width + nx[k];
+                    if (done[j]) continue;
+                    done[j] = 1;
+                    std::copy_n(filled.pixel(x, y), C, filled.pixel(nx[k], ny[k]));
+                    queue.push_back(j);
+                }
+            }
+            std::fill(filled.valid.begin(), filled.valid.end(), std::uint8_t(1));
+        }
         FeatureImage guided(in.width, in.height, C + G);
-        guided.valid = in.valid;
         for (int y = 0; y < in.height; ++y)
             for (int x = 0; x < in.width; ++x) {
-                std::copy_n(in.pixel(x, y), C, guided.pixel(x, y));
+                std::copy_n(filled.pixel(x, y), C, guided.pixel(x, y));
                 if (G) {
                     guided.pixel(x, y)[C] = float(x) * scale;
                     guided.pixel(x, y)[C + 1] = float(y) * scale;
