@@ -115,7 +115,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     p.synth.layout = synthLayoutFromName(p.layout);
     p.synth.detailBlend = detailBlendFromName(p.detail);
     if (p.strands == 0) throw ValueError("--strands 0: must be at least 1");
-    p.synth.validate("synth");
+    p.synth.validate("option");
     const StrandSet example = loadStrands("synth", p.input, common);
     if (example.numStrands() < 2) throw ValueError(p.input + ": " + std::to_string(example.numStrands()) + " strand: synthesis needs an example of many strands");
     if (p.strands > 0) {
