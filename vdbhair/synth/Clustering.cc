@@ -60,10 +60,25 @@ std::vector<std::vector<std::uint32_t>> neighbourGraph(const std::vector<Vec3d>&
 
 namespace {
 
+/// The root graph in compressed rows (one allocation: the region growing's neighbour loads are
+/// its hottest memory accesses).
+struct Graph
+{
+    std::vector<std::uint32_t> offsets, indices;
+    explicit Graph(const std::vector<std::vector<std::uint32_t>>& adj) : offsets(adj.size() + 1, 0)
+    {
+        for (std::size_t i = 0; i < adj.size(); ++i) offsets[i + 1] = offsets[i] + std::uint32_t(adj[i].size());
+        indices.reserve(offsets.back());
+        for (const auto& a : adj) indices.insert(indices.end(), a.begin(), a.end());
+    }
+    const std::uint32_t* begin(std::uint32_t s) const { return indices.data() + offsets[s]; }
+    const std::uint32_t* end(std::uint32_t s) const { return indices.data() + offsets[s + 1]; }
+};
+
 struct Lloyd
 {
     const StrandSamples& samples;
-    const std::vector<std::vector<std::uint32_t>>& graph;
+    const Graph& graph;
     std::size_t dim;
     std::vector<float> centers;          // k × dim
     std::vector<std::uint32_t> seeds;    // k
@@ -91,7 +106,8 @@ struct Lloyd
         memoCluster.assign(n, kNone);
         memoDistance.resize(n);
         const auto grow = [&](std::uint32_t s, std::uint32_t c) {
-            for (std::uint32_t nb : graph[s]) {
+            for (const std::uint32_t* it = graph.begin(s); it != graph.end(s); ++it) {
+                const std::uint32_t nb = *it;
                 if (label[nb] != kNone) continue;
                 if (memoCluster[nb] == c) continue;  // already queued with this tag: the same entry
                 memoCluster[nb] = c;
@@ -220,8 +236,8 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
     if (k == 0 || k > n)
         throw ValueError("clusterSamples: " + std::to_string(k) + " clusters of " + std::to_string(n) +
                          " strands: between 1 and the strand count");
-    const auto graph = neighbourGraph(samples.roots, params.neighbours);
-    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0};
+    const Graph graph(neighbourGraph(samples.roots, params.neighbours));
+    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}};
     lloyd.seeds = initialSeeds(samples, k, Rng(params.seed, 0x5eedc1u, stream));
     for (std::uint32_t s : lloyd.seeds) lloyd.centers.insert(lloyd.centers.end(), samples.row(s), samples.row(s) + lloyd.dim);
     Clustering out;

