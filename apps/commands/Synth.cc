@@ -26,7 +26,7 @@ namespace {
 
 struct SynthCmdParams
 {
-    std::string input, output, scalp, saveMaps, up = "auto", refineMode, layout = "synthesize", detail = "root-frame";
+    std::string input, output, scalp, saveMaps, up = "auto", refineMode, layout = synthLayoutName(SynthParams{}.layout), detail = detailBlendName(SynthParams{}.detailBlend);
     std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;
     bool noRefine = false;
@@ -128,16 +128,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     openvdb::FloatGrid::Ptr scalp;
     if (!p.scalp.empty()) {
         const Stage stage(common, "reading " + p.scalp);
-        if (fileExtension(p.scalp) == ".vdb") {
-            openvdb::GridBase::Ptr g = readVdbGrid(p.scalp, "surface", "synth(" + p.scalp + ")");
-            scalp = openvdb::GridBase::grid<openvdb::FloatGrid>(g);
-            if (!scalp || scalp->getGridClass() != openvdb::GRID_LEVEL_SET)
-                throw TypeError(p.scalp + ": grid 'surface' is not a float level set; vdbhair scalp makes one");
-        } else {
-            ScalpParams sp;
-            sp.source = p.scalp;
-            scalp = scalpFromMesh(readTriangleMesh(p.scalp), sp, nullptr, common.interrupter);
-        }
+        scalp = readScalp(p.scalp, common.interrupter);
     }
     const auto t0 = std::chrono::steady_clock::now();
     const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter);

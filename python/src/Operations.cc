@@ -8,6 +8,8 @@
 #include <vdbhair/io/VdbInspect.h>
 #include <vdbhair/render/Image.h>
 #include <vdbhair/render/StrandRenderer.h>
+#include <vdbhair/scalp/ScalpSurface.h>
+#include <vdbhair/synth/Synthesis.h>
 
 #include <nlohmann/json.hpp>
 
@@ -126,6 +128,101 @@ Args:
 
 Returns:
     Strands.)doc");
+
+    const SynthParams synthDefaults;
+    m.def(
+        "synth",
+        [](const StrandsPtr& example, int levels, std::optional<std::size_t> strands, std::uint64_t seed, int vertices,
+           double threshold, int initialClusters, int components, double mapSpacing, const std::string& layout,
+           const std::string& detail, double placeWeight, double nearby, bool refine, std::optional<std::string> refineMode,
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp, bool returnReport,
+           int threads, const pyb::object& progress) -> pyb::object {
+            SynthParams p;
+            p.cluster.levels = levels;
+            p.seed = seed;
+            p.vertices = vertices;
+            p.cluster.threshold = threshold;
+            p.cluster.initialClusters = initialClusters;
+            p.components = components;
+            p.mapSpacing = mapSpacing;
+            p.layout = synthLayoutFromName(layout);
+            p.detailBlend = detailBlendFromName(detail);
+            p.placeWeight = placeWeight;
+            p.texture.nearbyRadius = nearby;
+            p.refine = refine;
+            if (refineMode) p.refineMode = refineModeFromName(*refineMode);
+            p.voxelSize = voxelSize;
+            if (up) p.up = Vec3d((*up)[0], (*up)[1], (*up)[2]);
+            if (strands) {
+                if (*strands == 0) throw ValueError("synth: strands=0: must be at least 1");
+                if (example->empty()) throw ValueError("synth: the example has no strands");
+                p.strandScale = double(*strands) / double(example->numStrands());
+            }
+            p.validate("synth");
+            SynthResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
+                return synthesizeHair(*example, p, grid, true, interrupter);
+            });
+            auto out = std::make_shared<StrandSet>(std::move(r.strands));
+            if (!returnReport) return pyb::cast(out);
+            pyb::dict report;
+            pyb::list levelsList, stages, clusters;
+            for (std::size_t l = 0; l < r.output.size(); ++l) {
+                pyb::dict d;
+                d["example"] = r.example.levels[l].count();
+                d["output"] = r.output[l].count();
+                d["refine_voxel_size"] = r.refineVoxelSizes[l];
+                levelsList.append(d);
+            }
+            for (const SynthStage& s : r.stages) stages.append(pyb::make_tuple(s.name, s.seconds));
+            for (const std::vector<std::int32_t>& c : r.clusterOf)
+                clusters.append(pyb::array_t<std::int32_t>(pyb::ssize_t(c.size()), c.data()));
+            report["levels"] = levelsList;
+            report["stages"] = stages;
+            report["cluster_of"] = clusters;
+            report["head_radius"] = r.map->radius();
+            report["up"] = pyb::make_tuple(r.up.x(), r.up.y(), r.up.z());
+            return pyb::make_tuple(out, report);
+        },
+        pyb::arg("example"), pyb::kw_only(), pyb::arg("levels") = synthDefaults.cluster.levels, pyb::arg("strands") = pyb::none(),
+        pyb::arg("seed") = synthDefaults.seed, pyb::arg("vertices") = synthDefaults.vertices,
+        pyb::arg("threshold") = synthDefaults.cluster.threshold, pyb::arg("initial_clusters") = synthDefaults.cluster.initialClusters,
+        pyb::arg("components") = synthDefaults.components, pyb::arg("map_spacing") = synthDefaults.mapSpacing,
+        pyb::arg("layout") = synthLayoutName(synthDefaults.layout), pyb::arg("detail") = detailBlendName(synthDefaults.detailBlend), pyb::arg("place_weight") = synthDefaults.placeWeight,
+        pyb::arg("nearby") = synthDefaults.texture.nearbyRadius, pyb::arg("refine") = synthDefaults.refine,
+        pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(),
+        pyb::arg("scalp") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(A new hairstyle in the style of an example (Wang et al. 2009, §3-5): ``vdbhair synth``.
+
+Hierarchical clustering, PCA feature maps and texture optimization, cluster-oriented detail
+transfer and vector-field refinement per level; deterministic for a seed, the same for any
+thread count. README, "Example-based synthesis", explains every option and its measured default.
+
+Args:
+    example: Strands (many: at least 4^(levels-1)).
+    levels: levels of the hierarchy, the strands included (2 to 5).
+    strands: strands in the output (None: as many as the example).
+    seed: random seed.
+    vertices: vertices per strand, n_s.
+    threshold: adaptive clustering threshold epsilon (L2 over n_s vertices, head radii squared).
+    initial_clusters: k0 of adaptive clustering.
+    components: PCA components of the feature maps, n_f.
+    map_spacing: feature-map pixel spacing in scalp (u, v) radians.
+    layout: "synthesize" (texture optimization) or "example" (the example's own map).
+    detail: "root-frame" or "paper" (Eq. 7).
+    place_weight: texture synthesis place guidance (0: none).
+    nearby: reach of place guidance and initial patch offsets, a fraction of the map.
+    refine: refine every level (Wang et al. §5.3).
+    refine_mode: None (refine's default, "consistent") or "field".
+    voxel_size: refinement voxel of the finest level, world units (0: refine's suggestion).
+    up: the scalp's up axis (None: the roots' mean direction from the head's centre).
+    scalp: a path to a scalp: .vdb with a level set 'surface', or a head mesh (.ply, .obj).
+    return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up).
+    threads: worker threads, 0 for all cores.
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    Strands, or (Strands, report) with return_report.)doc");
 
     const FitParams fitDefaults;
     m.def(

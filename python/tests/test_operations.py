@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import vdbhair
-from conftest import straight_bundle, wavy_hairstyle
+from conftest import SOURCE_DIR, straight_bundle, wavy_hairstyle
 
 
 def test_fit_then_grow_regrows_the_strands(tmp_path):
@@ -60,3 +60,22 @@ def test_every_function_has_a_docstring_with_its_defaults():
         for attr, value in vars(cls).items():
             if not attr.startswith("_"):
                 assert value.__doc__, f"{cls.__name__}.{attr}"
+
+
+def test_synth(tmp_path):
+    # The bundled ponytail (4,933 strands), scaled down to 800 output strands for speed.
+    example = vdbhair.read(str(SOURCE_DIR / "scenes" / "default" / "ponytail.hair"))
+    out, report = vdbhair.synth(example, strands=800, seed=3, return_report=True)
+    assert len(out) == 800
+    assert [lv["output"] for lv in report["levels"]][0] == 800
+    assert [name for name, _ in report["stages"]][:3] == ["scalp", "samples", "clustering"]
+    assert len(report["cluster_of"]) == 2 and report["cluster_of"][0].shape == (800,)
+    # Deterministic for a seed and independent of the thread count; another seed differs.
+    again = vdbhair.synth(example, strands=800, seed=3, threads=1)
+    assert np.array_equal(again.positions, out.positions)
+    other = vdbhair.synth(example, strands=800, seed=4)
+    assert not np.array_equal(other.positions, out.positions)
+    with pytest.raises(ValueError, match="layout 'tiled' is not one of example, synthesize"):
+        vdbhair.synth(example, layout="tiled")
+    with pytest.raises(ValueError, match="strands=0"):
+        vdbhair.synth(example, strands=0)

@@ -6,6 +6,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/VariationalImplicit.h>
 
@@ -343,6 +344,20 @@ openvdb::FloatGrid::Ptr scalpFromPoints(const OrientedPoints& input, const Scalp
     grid->insertMeta("vdbhair_constraints", openvdb::Int64Metadata(std::int64_t(pts.size())));
     grid->insertMeta("vdbhair_offset", openvdb::DoubleMetadata(implicit.offset()));
     return grid;
+}
+
+openvdb::FloatGrid::Ptr readScalp(const std::string& path, openvdb::util::NullInterrupter* interrupter)
+{
+    if (fileExtension(path) == ".vdb") {
+        openvdb::GridBase::Ptr g = readVdbGrid(path, "surface", "readScalp(" + path + ")");
+        openvdb::FloatGrid::Ptr grid = openvdb::GridBase::grid<openvdb::FloatGrid>(g);
+        if (!grid || grid->getGridClass() != openvdb::GRID_LEVEL_SET)
+            throw TypeError(path + ": grid 'surface' is not a float level set; vdbhair scalp makes one");
+        return grid;
+    }
+    ScalpParams params;
+    params.source = path;
+    return scalpFromMesh(readTriangleMesh(path), params, nullptr, interrupter);
 }
 
 } // namespace vdbhair

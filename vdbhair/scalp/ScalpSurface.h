@@ -69,6 +69,13 @@ openvdb::FloatGrid::Ptr scalpFromMesh(const TriangleMesh& mesh, const ScalpParam
                                       ScalpMeshReport* report = nullptr,
                                       openvdb::util::NullInterrupter* interrupter = nullptr);
 
+/// @brief The scalp in @a path: a .vdb holding a float level set named `surface` (what `vdbhair
+/// scalp` writes), or a triangle mesh (.ply, .obj) made into one by scalpFromMesh() with default
+/// parameters (a voxel of 1/100 of the head).
+/// @throw IoError, FormatError, LookupError (no `surface` grid), TypeError (`surface` is not a
+/// float level set), and as scalpFromMesh().
+openvdb::FloatGrid::Ptr readScalp(const std::string& path, openvdb::util::NullInterrupter* interrupter = nullptr);
+
 /// @brief A scalp sphere (openvdb::tools::createLevelSetSphere).
 /// @param center, radius world units
 /// @throw ValueError (radius not positive), LimitError.

@@ -20,6 +20,8 @@ DetailBlend detailBlendFromName(const std::string& name)
     throw ValueError("detail blend '" + name + "' is not one of root-frame, paper");
 }
 
+const char* detailBlendName(DetailBlend blend) { return blend == DetailBlend::Paper ? "paper" : "root-frame"; }
+
 ScalpFrame alignedFrame(const float* row, int vertices, const ScalpFrame& f)
 {
     // v_g in root-frame coordinates (root at 0), projected onto the tangent plane (x, z).

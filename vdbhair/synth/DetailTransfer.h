@@ -59,6 +59,7 @@ enum class DetailBlend
 };
 /// @throw ValueError unless "root-frame" or "paper".
 DetailBlend detailBlendFromName(const std::string& name);
+const char* detailBlendName(DetailBlend blend);
 
 struct TransferStats
 {

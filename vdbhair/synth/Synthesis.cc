@@ -19,6 +19,8 @@ SynthLayout synthLayoutFromName(const std::string& name)
     throw ValueError("layout '" + name + "' is not one of example, synthesize");
 }
 
+const char* synthLayoutName(SynthLayout layout) { return layout == SynthLayout::Example ? "example" : "synthesize"; }
+
 void SynthParams::validate(const char* where) const
 {
     const auto fail = [&](const std::string& what) { throw ValueError(std::string(where) + ": " + what); };

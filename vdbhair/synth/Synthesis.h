@@ -55,6 +55,7 @@ enum class SynthLayout
 };
 /// @throw ValueError unless "example" or "synthesize".
 SynthLayout synthLayoutFromName(const std::string& name);
+const char* synthLayoutName(SynthLayout layout);
 
 struct SynthParams
 {
