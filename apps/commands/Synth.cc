@@ -10,6 +10,7 @@
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbStrands.h>
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/strands/Measures.h>
@@ -135,7 +136,15 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     {
         const Stage stage(common, "writing " + p.output);
-        writeStrands(p.output, r.strands);
+        if (fileExtension(p.output) == ".vdb") {
+            // Points carry each strand's cluster at every coarser level (cluster_level_1, ...).
+            VdbPointsOptions vo;
+            for (std::size_t l = 0; l < r.clusterOf.size(); ++l)
+                vo.strandAttributes.emplace_back("cluster_level_" + std::to_string(l + 1), r.clusterOf[l]);
+            writeVdbStrands(p.output, r.strands, vo);
+        } else {
+            writeStrands(p.output, r.strands);
+        }
     }
     if (!p.saveMaps.empty()) {
         const Stage stage(common, "writing maps to " + p.saveMaps);
@@ -201,7 +210,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     SynthParams& s = params->synth;
     CLI::App* sub = app.add_subcommand("synth", "A new hairstyle in the style of an example (Wang et al. 2009: clustering, feature-map synthesis, detail transfer, refinement)");
     sub->add_option("example", params->input, "The example hairstyle (any strand format)")->required();
-    sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format)")->required();
+    sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", params->scalp, "The scalp: a .vdb with a level set 'surface' (vdbhair scalp) or a head mesh (.ply, .obj); default: the sphere fitted to the roots");
     sub->add_option("--levels", s.cluster.levels, "Levels of the hierarchy, the strands included (the paper: 2 for simple styles, 3 otherwise)")->capture_default_str();
     sub->add_option("--strands", params->strands, "Strands in the output (default: as many as the example; every level scales alike)");

@@ -334,3 +334,33 @@ TEST_CASE("readVdbStrands: every single flipped bit of the checked layout reads 
     REQUIRE(read + refused == flipped);
     REQUIRE(refused > 0);
 }
+
+TEST_CASE("writeVdbStrands: extra per-strand attributes reach every point of their strand", "[io][vdb]")
+{
+    const StrandSet s = test::sampleStrands(false);
+    VdbPointsOptions opts;
+    std::vector<std::int32_t> ids(s.numStrands());
+    for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = std::int32_t(100 + 7 * i);
+    opts.strandAttributes.emplace_back("cluster_level_1", ids);
+    const std::string path = test::tempPath("extra_attr.vdb");
+    writeVdbStrands(path, s, opts);
+    // Every point's value is its strand's.
+    const auto grid = openvdb::GridBase::grid<openvdb::points::PointDataGrid>(readVdbGrid(path, "strands", "test"));
+    REQUIRE(grid);
+    std::size_t checked = 0;
+    for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+        openvdb::points::AttributeHandle<std::int32_t> strand(leaf->constAttributeArray("strand"));
+        openvdb::points::AttributeHandle<std::int32_t> cluster(leaf->constAttributeArray("cluster_level_1"));
+        for (auto it = leaf->beginIndexOn(); it; ++it, ++checked) CHECK(cluster.get(*it) == ids[std::size_t(strand.get(*it))]);
+    }
+    CHECK(checked == s.numVertices());
+    // The strands read back as they were.
+    test::requireSameStrands(readVdbStrands(path), s, 1e-4f);  // positions are stored relative to their voxel
+    // Wrong sizes and names are refused.
+    opts.strandAttributes = {{"cluster_level_1", std::vector<std::int32_t>(s.numStrands() + 1, 0)}};
+    CHECK_THROWS_WITH(writeVdbStrands(path, s, opts), Catch::Contains("has " + std::to_string(s.numStrands() + 1) + " values for"));
+    opts.strandAttributes = {{"vertex", ids}};
+    CHECK_THROWS_WITH(writeVdbStrands(path, s, opts), Catch::Contains("attribute name 'vertex'"));
+    opts.strandAttributes = {{"bad:name", ids}};
+    CHECK_THROWS_WITH(writeVdbStrands(path, s, opts), Catch::Contains("attribute name 'bad:name'"));
+}

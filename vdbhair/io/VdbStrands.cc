@@ -11,6 +11,8 @@
 #include <openvdb/points/PointGroup.h>
 #include <openvdb/tools/PointIndexGrid.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -145,6 +147,20 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
         for (std::size_t v = 0; v < nV; ++v) alpha[v] = 1.f - strands.transparency[v];
         pts::appendAttribute<float>(tree, "Alpha");
         pts::populateAttribute(tree, index->tree(), "Alpha", pts::PointAttributeVector<float>(alpha));
+    }
+
+    for (const auto& [name, values] : opts.strandAttributes) {
+        const bool nameOk = !name.empty() && !std::isdigit(static_cast<unsigned char>(name[0])) &&
+                            std::all_of(name.begin(), name.end(), [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; });
+        if (!nameOk || name == "P" || name == "strand" || name == "vertex" || name == "Cd" || name == "width" || name == "Alpha")
+            throw ValueError(where + ": attribute name '" + name + "' must be letters, digits and _ (not starting with a digit) and not one of P, strand, vertex, Cd, width, Alpha");
+        if (values.size() != strands.numStrands())
+            throw ValueError(where + ": attribute '" + name + "' has " + std::to_string(values.size()) + " values for " +
+                             std::to_string(strands.numStrands()) + " strands");
+        std::vector<std::int32_t> perVertex(nV);
+        for (std::size_t v = 0; v < nV; ++v) perVertex[v] = values[std::size_t(strandOf[v])];
+        pts::appendAttribute<std::int32_t>(tree, name);
+        pts::populateAttribute(tree, index->tree(), name, pts::PointAttributeVector<std::int32_t>(perVertex));
     }
 
     grid->setName("strands");

@@ -29,7 +29,10 @@
 #include <vdbhair/io/ReadOptions.h>
 #include <vdbhair/strands/StrandSet.h>
 
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace vdbhair {
 
@@ -41,6 +44,10 @@ struct VdbPointsOptions
     /// World units; 0 chooses it for about @a pointsPerVoxel points per active voxel.
     double voxelSize = 0.0;
     unsigned pointsPerVoxel = 8;
+    /// Extra per-strand int32 attributes, written on every point of the strand (for example
+    /// `cluster_level_1` from `vdbhair synth`): a name (letters, digits, `_`; not one of the
+    /// attributes written anyway) and #S values.
+    std::vector<std::pair<std::string, std::vector<std::int32_t>>> strandAttributes;
 };
 
 /// @brief Parse "float", "fixed16" or "fixed8". @throw ValueError otherwise.
@@ -48,7 +55,7 @@ PositionCodec positionCodecFromName(const std::string& name);
 const char* positionCodecName(PositionCodec codec);
 
 /// @brief Write @a strands as the grid `strands` of a new `.vdb` file (atomically).
-/// @throw ValueError (empty set, bad voxel size), IoError.
+/// @throw ValueError (empty set, bad voxel size, an extra attribute of the wrong size or name), IoError.
 void writeVdbStrands(const std::string& path, const StrandSet& strands, const VdbPointsOptions& opts = {});
 
 /// @brief Read the grid @a gridName (a PointDataGrid with `strand` and `vertex` attributes).
