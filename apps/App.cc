@@ -198,6 +198,8 @@ int run(int argc, char** argv)
     commands.push_back(addInterpolateCommand(app, common));
     commands.push_back(addReconstructCommand(app, common));
     commands.push_back(addSynthCommand(app, common));
+    commands.push_back(addTransferCommand(app, common));
+    commands.push_back(addCombCommand(app, common));
     commands.push_back(addInspectCommand(app, common));
     commands.push_back(addRenderCommand(app, common));
     commands.push_back(addDemoCommand(app, common));

@@ -21,6 +21,8 @@
 
 namespace vdbhair {
 struct FieldParams;
+struct SynthParams;
+struct TransferParams;
 }
 
 namespace vdbhair::app {
@@ -130,6 +132,33 @@ Command addRootsCommand(CLI::App& app, CommonOptions& common);
 Command addInterpolateCommand(CLI::App& app, CommonOptions& common);
 Command addReconstructCommand(CLI::App& app, CommonOptions& common);
 Command addSynthCommand(CLI::App& app, CommonOptions& common);
+Command addTransferCommand(CLI::App& app, CommonOptions& common);
+Command addCombCommand(CLI::App& app, CommonOptions& common);
+
+/// @brief The options of `synth`, `transfer` and `comb` that are not plain SynthParams fields.
+struct SynthOptionText
+{
+    std::string up = "auto", refineMode, detail, detailScale;
+    bool noRefine = false;
+};
+/// @brief The hierarchy's options (--levels, --seed, --vertices, --threshold, --initial-clusters, --up).
+void addSynthHierarchyOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
+/// @brief Detail transfer and refinement (--components, --detail, --detail-scale, --refine-mode, --no-refine, --voxel-size).
+void addSynthTransferOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
+/// @throw ValueError for a bad --up, --refine-mode or --detail.
+void applySynthOptionText(const SynthOptionText& text, SynthParams& params);
+
+/// @brief Write a synthesized hairstyle (`synth`, `transfer`): a `.vdb`'s points carry each
+/// strand's cluster at every coarser level (int32 cluster_level_1, ...); other formats the strands.
+void writeSynthStrands(const std::string& path, const StrandSet& strands,
+                       const std::vector<std::vector<std::int32_t>>& clusterOf);
+
+/// @brief `transfer DETAILS BASE` and `synth EXAMPLE --coarse BASE` (Transfer.cc).
+struct TransferJob
+{
+    std::string verb, details, base, output, scalp, detailsLabel = "DETAILS", baseLabel = "BASE";
+};
+int runTransferJob(const TransferJob& job, TransferParams params, const CommonOptions& common);
 
 /// @brief The verbs of @a verbs nearest to @a word (edit distance, a prefix counting as 1), for
 /// "did you mean"; empty when none is close.

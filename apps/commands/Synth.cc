@@ -14,6 +14,7 @@
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/strands/Measures.h>
+#include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
 #include <vdbhair/synth/SynthesisReport.h>
 
@@ -27,10 +28,12 @@ namespace {
 
 struct SynthCmdParams
 {
-    std::string input, output, scalp, saveMaps, up = "auto", refineMode, layout = synthLayoutName(SynthParams{}.layout), detail = detailBlendName(SynthParams{}.detailBlend);
+    std::string input, output, scalp, saveMaps, layout = synthLayoutName(SynthParams{}.layout);
+    SynthOptionText text;
     std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;
-    bool noRefine = false;
+    bool coarseGuides = false;
+    std::string coarse;
 };
 
 /// The first three channels of a feature map as an RGB picture (each channel scaled by the input
@@ -110,13 +113,25 @@ nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, double 
 int runSynth(SynthCmdParams p, const CommonOptions& common)
 {
     strandFormatFromPath(p.output, /*forWriting=*/true);
-    if (p.up != "auto") p.synth.up = axisFromName(p.up, "--up");
-    p.synth.refine = !p.noRefine;
-    if (!p.refineMode.empty()) p.synth.refineMode = refineModeFromName(p.refineMode);
+    if (p.coarseGuides && p.coarse.empty()) throw ValueError("--coarse-guides: needs --coarse FILE");
+    applySynthOptionText(p.text, p.synth);
     p.synth.layout = synthLayoutFromName(p.layout);
-    p.synth.detailBlend = detailBlendFromName(p.detail);
     if (p.strands == 0) throw ValueError("--strands 0: must be at least 1");
     p.synth.validate("option");
+    if (!p.coarse.empty()) {
+        // An imposed coarsest level: the example's finer levels transferred onto it (HairTransfer.h).
+        if (p.layout != synthLayoutName(SynthParams{}.layout)) throw ValueError("--layout: has no effect with --coarse (the coarsest level is imposed)");
+        TransferParams tp;
+        if (p.text.detailScale.empty()) p.synth.detailScale = tp.synth.detailScale;  // transfer's default
+        tp.synth = p.synth;
+        tp.guides = p.coarseGuides;
+        if (p.strands > 0) {
+            if (!p.coarseGuides) throw ValueError("--strands: with --coarse the output has BASE's strands; --strands needs --coarse-guides");
+            tp.strands = std::size_t(p.strands);
+        }
+        TransferJob job{"synth", p.input, p.coarse, p.output, p.scalp, "EXAMPLE", "--coarse"};
+        return runTransferJob(job, tp, common);
+    }
     const StrandSet example = loadStrands("synth", p.input, common);
     if (example.numStrands() < 2) throw ValueError(p.input + ": " + std::to_string(example.numStrands()) + " strand: synthesis needs an example of many strands");
     if (p.strands > 0) {
@@ -136,15 +151,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     {
         const Stage stage(common, "writing " + p.output);
-        if (fileExtension(p.output) == ".vdb") {
-            // Points carry each strand's cluster at every coarser level (cluster_level_1, ...).
-            VdbPointsOptions vo;
-            for (std::size_t l = 0; l < r.clusterOf.size(); ++l)
-                vo.strandAttributes.emplace_back("cluster_level_" + std::to_string(l + 1), r.clusterOf[l]);
-            writeVdbStrands(p.output, r.strands, vo);
-        } else {
-            writeStrands(p.output, r.strands);
-        }
+        writeSynthStrands(p.output, r.strands, r.clusterOf);
     }
     if (!p.saveMaps.empty()) {
         const Stage stage(common, "writing maps to " + p.saveMaps);
@@ -188,7 +195,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
                    {"map", {{"width", r.grid.width}, {"height", r.grid.height}, {"components", r.pca.components},
                             {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
                    {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
-                   {"head_radius", r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", p.detail},
+                   {"head_radius", r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)},
                    {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}});
     } else if (!common.quiet) {
         std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
@@ -202,7 +209,52 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     return 0;
 }
 
+
 } // namespace
+
+void addSynthHierarchyOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
+{
+    sub->add_option("--levels", s.cluster.levels, "Levels of the hierarchy, the strands included (the paper: 2 for simple styles, 3 otherwise)")->capture_default_str();
+    sub->add_option("--seed", s.seed, "Random seed (clustering seeds, texture initialization, roots)")->capture_default_str();
+    sub->add_option("--vertices", s.vertices, "Vertices per strand, n_s (Table 1)")->capture_default_str();
+    sub->add_option("--threshold", s.cluster.threshold, "Adaptive clustering threshold epsilon (L2 over n_s vertices, head radii squared; Table 1: 0.1-0.3)")->capture_default_str();
+    sub->add_option("--initial-clusters", s.cluster.initialClusters, "k0 of adaptive clustering")->capture_default_str();
+    sub->add_option("--up", t.up, "The scalp's up axis: auto (the mean direction from the head's centre to the roots), x, y, z, -x, -y or -z")->capture_default_str();
+}
+
+void addSynthTransferOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
+{
+    t.detail = detailBlendName(s.detailBlend);
+    sub->add_option("--components", s.components, "PCA components of the feature maps and of cluster matching, n_f")->capture_default_str();
+    sub->add_option("--detail", t.detail, "Detail transfer: root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
+    sub->add_option("--detail-scale", t.detailScale, std::string("How detail is laid along a longer or shorter centre: index (vertex by vertex, the paper's: curls stretch with the length) or arc-length (curls keep their size, mirrored along a longer strand); default: ") +
+                                                        detailScaleName(s.detailScale) + (s.detailScale == DetailScale::Index ? " (arc-length with --coarse, as transfer)" : ""));
+    sub->add_option("--refine-mode", t.refineMode, "Refinement after each level: consistent (default, keeps detail) or field (the paper's retrace)");
+    sub->add_flag("--no-refine", t.noRefine, "Skip the vector-field refinement of every level");
+    sub->add_option("--voxel-size", s.voxelSize, "Refinement voxel of the finest level, world units (0: refine's suggestion for the hairstyle; doubled per coarser level)")->capture_default_str();
+}
+
+void applySynthOptionText(const SynthOptionText& t, SynthParams& s)
+{
+    if (t.up != "auto") s.up = axisFromName(t.up, "--up");
+    s.refine = !t.noRefine;
+    if (!t.refineMode.empty()) s.refineMode = refineModeFromName(t.refineMode);
+    if (!t.detail.empty()) s.detailBlend = detailBlendFromName(t.detail);
+    if (!t.detailScale.empty()) s.detailScale = detailScaleFromName(t.detailScale);
+}
+
+void writeSynthStrands(const std::string& path, const StrandSet& strands, const std::vector<std::vector<std::int32_t>>& clusterOf)
+{
+    if (fileExtension(path) == ".vdb") {
+        // Points carry each strand's cluster at every coarser level (cluster_level_1, ...).
+        VdbPointsOptions vo;
+        for (std::size_t l = 0; l < clusterOf.size(); ++l)
+            vo.strandAttributes.emplace_back("cluster_level_" + std::to_string(l + 1), clusterOf[l]);
+        writeVdbStrands(path, strands, vo);
+    } else {
+        writeStrands(path, strands);
+    }
+}
 
 Command addSynthCommand(CLI::App& app, CommonOptions& common)
 {
@@ -212,22 +264,15 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("example", params->input, "The example hairstyle (any strand format)")->required();
     sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", params->scalp, "The scalp: a .vdb with a level set 'surface' (vdbhair scalp) or a head mesh (.ply, .obj); default: the sphere fitted to the roots");
-    sub->add_option("--levels", s.cluster.levels, "Levels of the hierarchy, the strands included (the paper: 2 for simple styles, 3 otherwise)")->capture_default_str();
+    addSynthHierarchyOptions(sub, s, params->text);
     sub->add_option("--strands", params->strands, "Strands in the output (default: as many as the example; every level scales alike)");
-    sub->add_option("--seed", s.seed, "Random seed (clustering seeds, texture initialization, roots)")->capture_default_str();
-    sub->add_option("--vertices", s.vertices, "Vertices per strand, n_s (Table 1)")->capture_default_str();
-    sub->add_option("--threshold", s.cluster.threshold, "Adaptive clustering threshold epsilon (L2 over n_s vertices, head radii squared; Table 1: 0.1-0.3)")->capture_default_str();
-    sub->add_option("--initial-clusters", s.cluster.initialClusters, "k0 of adaptive clustering")->capture_default_str();
-    sub->add_option("--components", s.components, "PCA components of the feature maps, n_f")->capture_default_str();
     sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();
     sub->add_option("--layout", params->layout, "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: a variation that keeps its global flow exactly)")->capture_default_str();
-    sub->add_option("--detail", params->detail, "Detail transfer: root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
     sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();
     sub->add_option("--nearby", s.texture.nearbyRadius, "Texture synthesis: the reach of place guidance and of the initial patches' offsets, as a fraction of the map")->capture_default_str();
-    sub->add_option("--refine-mode", params->refineMode, "Refinement after each level: consistent (default, keeps detail) or field (the paper's retrace)");
-    sub->add_flag("--no-refine", params->noRefine, "Skip the vector-field refinement of every level");
-    sub->add_option("--up", params->up, "The scalp's up axis: auto (the mean direction from the head's centre to the roots), x, y, z, -x, -y or -z")->capture_default_str();
-    sub->add_option("--voxel-size", s.voxelSize, "Refinement voxel of the finest level, world units (0: refine's suggestion for the example; doubled per coarser level)")->capture_default_str();
+    addSynthTransferOptions(sub, s, params->text);
+    sub->add_option("--coarse", params->coarse, "Impose a coarsest level instead of synthesizing one (Wang et al. §6): BASE's own coarsest level (a hairstyle, or a scene grown first); the example's finer levels are transferred onto it, on BASE's scalp, with BASE's roots (as vdbhair transfer EXAMPLE BASE)");
+    sub->add_flag("--coarse-guides", params->coarseGuides, "With --coarse: BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over the guides' region (--strands sets the output count)");
     sub->add_option("--save-maps", params->saveMaps, "Write input_map.png, output_map.png (first three PCA channels as RGB) and clusters.png to this folder");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair synth example.hair -o new.hair --levels 3 --seed 1 --json");

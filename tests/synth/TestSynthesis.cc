@@ -46,7 +46,7 @@ TEST_CASE("synthesizeHair: a wisp hairstyle gives a new one with its counts, len
     // Every stage ran and was timed.
     std::vector<std::string> names;
     for (const SynthStage& s : r.stages) names.push_back(s.name);
-    CHECK(names == std::vector<std::string>{"scalp", "samples", "clustering", "feature maps", "texture optimization",
+    CHECK(names == std::vector<std::string>{"scalp", "clustering", "feature maps", "texture optimization",
                                             "coarsest level", "refinement", "detail transfer"});
     // Roots on the scalp (the fitted unit sphere), strands of the example's lengths and bends.
     for (std::size_t s = 0; s < r.strands.numStrands(); ++s) CHECK(Vec3d(r.strands.root(s)).length() == Approx(1.0).margin(1e-3));

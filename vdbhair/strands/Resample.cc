@@ -6,6 +6,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -127,6 +128,39 @@ StrandSet resampleStrandsBySpacing(const StrandSet& strands, float spacing, std:
         offsets[i + 1] = std::uint32_t(total);
     }
     return resampleWithCounts(strands, offsets);
+}
+
+void smoothPolyline(const Vec3d* points, std::size_t n, double sigma, Vec3d* out)
+{
+    if (n == 0) return;
+    if (!(sigma > 0.0) || n < 3) {
+        std::copy(points, points + n, out);
+        return;
+    }
+    const long last = long(n) - 1;
+    // Truncated at 3σ, and at the polyline's own length so that one reflection reaches every tap.
+    const long radius = std::min(last, std::max(1L, long(std::ceil(3.0 * sigma))));
+    std::vector<double> kernel(std::size_t(radius) + 1);
+    for (long k = 0; k <= radius; ++k) kernel[std::size_t(k)] = std::exp(-0.5 * double(k * k) / (sigma * sigma));
+    // The point at index k (−last ≤ k ≤ 2 last) of the polyline extended by odd reflection.
+    const auto at = [&](long k) -> Vec3d {
+        if (k < 0) return points[0] * 2.0 - points[-k];
+        if (k > last) return points[last] * 2.0 - points[2 * last - k];
+        return points[k];
+    };
+    for (long i = 0; i <= last; ++i) {
+        if (i == 0 || i == last) {
+            out[i] = points[i];
+            continue;
+        }
+        Vec3d sum = points[i] * kernel[0];
+        double w = kernel[0];
+        for (long k = 1; k <= radius; ++k) {
+            sum += (at(i - k) + at(i + k)) * kernel[std::size_t(k)];
+            w += 2.0 * kernel[std::size_t(k)];
+        }
+        out[i] = sum / w;
+    }
 }
 
 } // namespace vdbhair

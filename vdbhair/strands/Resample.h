@@ -1,5 +1,5 @@
 /// @file Resample.h
-/// @brief Resampling strands by arc length.
+/// @brief Resampling strands by arc length, and smoothing polylines.
 #pragma once
 
 #include <vdbhair/strands/StrandSet.h>
@@ -24,5 +24,11 @@ StrandSet resampleStrands(const StrandSet& strands, std::size_t verticesPerStran
 /// exceed @a maxVertices vertices.
 StrandSet resampleStrandsBySpacing(const StrandSet& strands, float spacing,
                                    std::size_t maxVertices = std::size_t(1) << 31);
+
+/// @brief Gaussian smoothing of a polyline of @a n points with a kernel of σ = @a sigma vertices
+/// (truncated at 3σ): both ends stay where they are, because the polyline is extended by odd
+/// reflection about each end (p(−k) = 2 p(0) − p(k)), which also leaves a straight polyline as it
+/// is. @a sigma ≤ 0 copies. @a out may not alias @a points.
+void smoothPolyline(const Vec3d* points, std::size_t n, double sigma, Vec3d* out);
 
 } // namespace vdbhair

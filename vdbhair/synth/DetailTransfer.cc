@@ -22,6 +22,15 @@ DetailBlend detailBlendFromName(const std::string& name)
 
 const char* detailBlendName(DetailBlend blend) { return blend == DetailBlend::Paper ? "paper" : "root-frame"; }
 
+DetailScale detailScaleFromName(const std::string& name)
+{
+    if (name == "index") return DetailScale::Index;
+    if (name == "arc-length") return DetailScale::ArcLength;
+    throw ValueError("detail scale '" + name + "' is not one of index, arc-length");
+}
+
+const char* detailScaleName(DetailScale scale) { return scale == DetailScale::ArcLength ? "arc-length" : "index"; }
+
 ScalpFrame alignedFrame(const float* row, int vertices, const ScalpFrame& f)
 {
     // v_g in root-frame coordinates (root at 0), projected onto the tangent plane (x, z).
@@ -66,7 +75,8 @@ std::vector<Vec3f> worldOf(const StrandSamples& s, std::size_t i, double radius)
 StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
                              const std::vector<Vec3d>& roots, const ScalpMap& map, int components,
                              std::vector<std::uint32_t>* outLabel, TransferStats* stats, DetailBlend blend, bool threaded,
-                             openvdb::util::NullInterrupter* interrupter)
+                             openvdb::util::NullInterrupter* interrupter, const std::vector<std::uint32_t>* givenLabel,
+                             DetailScale scale)
 {
     if (!source.strands || !source.centers || !source.label || source.strands->count() == 0 ||
         source.centers->count() == 0 || source.label->size() != source.strands->count())
@@ -88,9 +98,15 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             for (std::size_t i = 0; i < count; ++i) fn(i);
     };
 
-    // 1. Output clusters: each new root joins the nearest coarser output root.
+    // 1. Output clusters: each new root joins the nearest coarser output root (or its given centre).
     std::vector<std::uint32_t> label(n, 0);
-    {
+    if (givenLabel) {
+        if (givenLabel->size() != n)
+            throw ValueError("transferDetail: " + std::to_string(givenLabel->size()) + " given centres for " + std::to_string(n) + " roots");
+        for (std::uint32_t c : *givenLabel)
+            if (c >= nOut) throw ValueError("transferDetail: given centre " + std::to_string(c) + " of " + std::to_string(nOut));
+        label = *givenLabel;
+    } else {
         PointCloud cloud{&outCenters.roots};
         PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         tree.buildIndex();
@@ -185,13 +201,50 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         const Vec3d betaShift = roots[i] - Vec3d(cout[0]) - outOf(fout[0], inFrame(fin[0], rootIn));
         const Vec3d sc = map.toScalp(roots[i]);
         const ScalpFrame rf = map.frame(sc.x(), sc.y());
+        // Eq. 5-6 per vertex of the input pair.
+        std::vector<Vec3d> dA(static_cast<std::size_t>(ns)), dB(static_cast<std::size_t>(ns));
+        for (int l = 0; l < ns; ++l) {
+            const Vec3d dIn = Vec3d(gin[std::size_t(l)]) - Vec3d(cin[std::size_t(l)]);
+            dA[std::size_t(l)] = mi.toLocal(dIn - rootIn);                          // Eq. 5
+            dB[std::size_t(l)] = inFrame(fin[std::size_t(l)], dIn);                 // Eq. 6
+        }
+        if (scale == DetailScale::ArcLength) {
+            // The displacement is read at the output centre's arc length along the input centre,
+            // mirrored back and forth beyond the input centre's end (DetailTransfer.h).
+            const auto arcs = [&](const std::vector<Vec3f>& c) {
+                std::vector<double> a(c.size(), 0.0);
+                for (std::size_t k = 1; k < c.size(); ++k) a[k] = a[k - 1] + (Vec3d(c[k]) - Vec3d(c[k - 1])).length();
+                return a;
+            };
+            const std::vector<double> ai = arcs(cin), ao = arcs(cout);
+            const double Li = ai.back();
+            const auto remap = [&](std::vector<Vec3d>& d) {
+                std::vector<Vec3d> out(d.size());
+                for (std::size_t k = 0; k < d.size(); ++k) {
+                    double a = ao[k];
+                    if (Li > 0.0) {
+                        a = std::fmod(a, 2.0 * Li);
+                        if (a > Li) a = 2.0 * Li - a;
+                    }
+                    const std::size_t j = std::size_t(std::upper_bound(ai.begin(), ai.end(), a) - ai.begin());
+                    if (j == 0) out[k] = d[0];
+                    else if (j >= ai.size()) out[k] = d.back();
+                    else {
+                        const double t = ai[j] > ai[j - 1] ? (a - ai[j - 1]) / (ai[j] - ai[j - 1]) : 0.0;
+                        out[k] = d[j - 1] * (1.0 - t) + d[j] * t;
+                    }
+                }
+                d.swap(out);
+            };
+            remap(dA);
+            remap(dB);
+        }
         float* row = out.row(i);
         double len = 0.0;
         Vec3d prev = roots[i];
         for (int l = 0; l < ns; ++l) {
-            const Vec3d dIn = Vec3d(gin[std::size_t(l)]) - Vec3d(cin[std::size_t(l)]);
-            const Vec3d dAlpha = mi.toLocal(dIn - rootIn);                         // Eq. 5
-            const Vec3d dBeta = inFrame(fin[std::size_t(l)], dIn);                 // Eq. 6
+            const Vec3d& dAlpha = dA[std::size_t(l)];
+            const Vec3d& dBeta = dB[std::size_t(l)];
             const Vec3d a = roots[i] + (Vec3d(cout[std::size_t(l)]) - Vec3d(cout[0])) + mo.toWorld(dAlpha);  // Eq. 8
             const Vec3d b = Vec3d(cout[std::size_t(l)]) + outOf(fout[std::size_t(l)], dBeta) + betaShift;
             const double s = blend == DetailBlend::RootFrame ? 0.0 : (ns > 1 ? double(l) / double(ns - 1) : 0.0);

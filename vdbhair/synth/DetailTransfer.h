@@ -61,6 +61,25 @@ enum class DetailBlend
 DetailBlend detailBlendFromName(const std::string& name);
 const char* detailBlendName(DetailBlend blend);
 
+/// How detail is laid along an output strand whose centre is longer or shorter than the input's.
+enum class DetailScale
+{
+    /// Vertex by vertex (Eq. 5-8 as printed): detail stretches with the length ratio, so curls
+    /// onto a wisp k times as long come out k times as long (the paper's stated limitation).
+    Index,
+    /// The displacement read at the same arc length along the input centre as along the output
+    /// centre, and mirrored back and forth beyond the input centre's end: curls keep their size
+    /// and spacing whatever the lengths, repeated along a longer strand (its wisp's spread
+    /// repeats too: strands gather and part again every two input lengths). Measured against a
+    /// split that kept the slowly varying part per index: Curly_100's detail onto straight.hair
+    /// arrived with turning per head radius 4.36 against 1.00 (the example's 7.92, index 0.51),
+    /// harolongo's 3.40 against 2.85 (its own 3.83, index 2.00).
+    ArcLength
+};
+/// @throw ValueError unless "index" or "arc-length".
+DetailScale detailScaleFromName(const std::string& name);
+const char* detailScaleName(DetailScale scale);
+
 struct TransferStats
 {
     std::size_t clusters = 0;             ///< output clusters (coarser output strands with members)
@@ -70,10 +89,13 @@ struct TransferStats
 /// @brief The finer output level: strands rooted at @a roots (world, on the scalp), detail from
 /// @a source, superposed on the coarser output strands @a outCenters.
 /// @param outLabel if given, receives each new strand's output centre
-/// @throw ValueError if @a source is incomplete or empty; InterruptedError.
+/// @param givenLabel if given (#roots, values below outCenters.count()), each new strand's output
+/// centre, in place of step 1's nearest root (transfer onto a hairstyle keeps its own wisps)
+/// @throw ValueError if @a source is incomplete or empty, or @a givenLabel does not fit; InterruptedError.
 StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
                              const std::vector<Vec3d>& roots, const ScalpMap& map, int components = Pca::kDefaultComponents,
                              std::vector<std::uint32_t>* outLabel = nullptr, TransferStats* stats = nullptr,
-                             DetailBlend blend = DetailBlend::RootFrame, bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr);
+                             DetailBlend blend = DetailBlend::RootFrame, bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr,
+                             const std::vector<std::uint32_t>* givenLabel = nullptr, DetailScale scale = DetailScale::Index);
 
 } // namespace vdbhair

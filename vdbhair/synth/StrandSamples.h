@@ -17,6 +17,10 @@ namespace vdbhair {
 struct StrandSamples
 {
     static constexpr int kDefaultVertices = 64;  ///< n_s, Wang et al. Table 1
+    /// What counts as detail along a strand (transfer's smoothing of the detail source's coarsest
+    /// strands, combing's strand directions): σ = 1/16 of its vertices, four of 64, which removes
+    /// waves shorter than about a quarter of the strand and keeps its overall bend.
+    static constexpr double kDetailSmoothing = 1.0 / 16.0;
 
     int vertices = kDefaultVertices;
     /// #N × 3 n_s: vertex l of strand s, coordinate c, at `local[(s * n_s + l) * 3 + c]`; the

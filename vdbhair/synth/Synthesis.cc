@@ -36,25 +36,46 @@ void SynthParams::validate(const char* where) const
     texture.validate(where);
 }
 
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-struct StageTimer
+SynthStageTimer::~SynthStageTimer()
 {
-    std::vector<SynthStage>& stages;
-    std::string name;
-    Clock::time_point start = Clock::now();
-    ~StageTimer()
-    {
-        const double s = std::chrono::duration<double>(Clock::now() - start).count();
-        for (SynthStage& st : stages)
-            if (st.name == name) { st.seconds += s; return; }
-        stages.push_back({name, s});
-    }
-};
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (SynthStage& st : stages)
+        if (st.name == name) {
+            st.seconds += s;
+            return;
+        }
+    stages.push_back({name, s});
+}
 
-} // namespace
+std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp, Vec3d* upUsed)
+{
+    std::vector<Vec3f> roots(strands.numStrands());
+    for (std::size_t s = 0; s < roots.size(); ++s) roots[s] = strands.root(s);
+    ScalpSphere sphere = fitScalpSphere(roots, up.length() > 0.0 ? up : Vec3d(0.0, 1.0, 0.0));
+    if (up.length() == 0.0) {
+        Vec3d mean(0.0);
+        for (const Vec3f& r : roots) mean += (Vec3d(r) - sphere.center).unitSafe();
+        if (mean.length() > 1e-9 * double(roots.size())) sphere.up = mean.unitSafe();
+    }
+    if (upUsed) *upUsed = sphere.up;
+    return scalp ? std::make_shared<ScalpMap>(sphere, *scalp) : std::make_shared<ScalpMap>(sphere);
+}
+
+ClusterHierarchy hairHierarchy(const StrandSet& strands, const ScalpMap& map, const SynthParams& params, bool threaded,
+                               openvdb::util::NullInterrupter* interrupter, std::vector<std::uint32_t>* orderOut)
+{
+    // In spatial order (Measures.h): clustering walks the root graph, and neighbours near in
+    // memory are what makes it fast (100,000 jittered strands in file order: 3.4 s).
+    const std::vector<std::uint32_t> order = spatialOrder(strands);
+    StrandSet ordered;
+    ordered.reserve(strands.numStrands(), strands.numVertices());
+    for (std::uint32_t s : order) ordered.addStrand(strands.data(s), strands.size(s));
+    const StrandSamples samples = sampleStrands(ordered, map, params.vertices, threaded);
+    ClusterParams cp = params.cluster;
+    cp.seed = params.seed;
+    if (orderOut) *orderOut = order;
+    return buildHierarchy(samples, map, cp, interrupter);
+}
 
 SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, openvdb::FloatGrid::ConstPtr scalp,
                            bool threaded, openvdb::util::NullInterrupter* interrupter)
@@ -64,39 +85,16 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     SynthResult res;
     // 1. Scalp space.
     {
-        StageTimer t{res.stages, "scalp"};
-        std::vector<Vec3f> roots(example.numStrands());
-        for (std::size_t s = 0; s < roots.size(); ++s) roots[s] = example.root(s);
-        ScalpSphere sphere = fitScalpSphere(roots, params.up.length() > 0.0 ? params.up : Vec3d(0.0, 1.0, 0.0));
-        if (params.up.length() == 0.0) {
-            Vec3d mean(0.0);
-            for (const Vec3f& r : roots) mean += (Vec3d(r) - sphere.center).unitSafe();
-            if (mean.length() > 1e-9 * double(roots.size())) sphere.up = mean.unitSafe();
-        }
-        res.up = sphere.up;
-        res.map = scalp ? std::make_shared<ScalpMap>(sphere, *scalp) : std::make_shared<ScalpMap>(sphere);
+        SynthStageTimer t{res.stages, "scalp"};
+        res.map = hairScalpMap(example, params.up, scalp, &res.up);
     }
     const ScalpMap& map = *res.map;
     const double radius = map.radius();
     // 2-3. Samples and the example's hierarchy.
-    StrandSamples samples;
     {
-        StageTimer t{res.stages, "samples"};
-        // In spatial order (Measures.h): clustering walks the root graph, and neighbours near in
-        // memory are what makes it fast (100,000 jittered strands in file order: 3.4 s).
-        const std::vector<std::uint32_t> order = spatialOrder(example);
-        StrandSet ordered;
-        ordered.reserve(example.numStrands(), example.numVertices());
-        for (std::uint32_t s : order) ordered.addStrand(example.data(s), example.size(s));
-        samples = sampleStrands(ordered, map, params.vertices, threaded);
+        SynthStageTimer t{res.stages, "clustering"};
+        res.example = hairHierarchy(example, map, params, threaded, interrupter);
     }
-    {
-        StageTimer t{res.stages, "clustering"};
-        ClusterParams cp = params.cluster;
-        cp.seed = params.seed;
-        res.example = buildHierarchy(samples, map, cp, interrupter);
-    }
-    samples = StrandSamples();
     const StrandSamples& finest = res.example.levels.front();
     const StrandSamples& coarsest = res.example.levels.back();
     // Output counts per level and the memory estimate, before any output is made.
@@ -108,7 +106,7 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
                          " vertices exceed the cap of " + std::to_string(params.maxVertices) + " vertices");
     // 4. Feature maps.
     {
-        StageTimer t{res.stages, "feature maps"};
+        SynthStageTimer t{res.stages, "feature maps"};
         res.pca = fitPca(coarsest.local.data(), coarsest.count(), coarsest.dim(), params.components);
         const int nf = res.pca.components;
         std::vector<float> features(coarsest.count() * std::size_t(nf));
@@ -118,7 +116,7 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
         res.inputMap = buildFeatureMap(res.grid, coarsest.scalp, features.data(), nf, finest.scalp, maskRadius);
     }
     {
-        StageTimer t{res.stages, "texture optimization"};
+        SynthStageTimer t{res.stages, "texture optimization"};
         if (params.layout == SynthLayout::Example) {
             res.outputMap = res.inputMap;
         } else {
@@ -181,45 +179,19 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
         res.outputMap.valid = in.valid;  // the output region is the example's
         }
     }
-    // Refinement of one output level (§5.3), in place.
-    res.output.resize(std::size_t(L));
-    res.refinedCorrected.assign(std::size_t(L), 0);
-    res.refineVoxelSizes.assign(std::size_t(L), 0.0);
-    {
-        const double finestVoxel = params.voxelSize > 0.0 ? params.voxelSize : suggestVoxelSize(example);
-        for (int l = 0; l < L; ++l) res.refineVoxelSizes[std::size_t(l)] = finestVoxel * double(1 << l);
-    }
-    StrandSet finestStrands;
-    const auto refineLevel = [&](int l) {
-        StrandSamples& level = res.output[std::size_t(l)];
-        StrandSet strands = samplesToStrands(level, radius);
-        if (params.refine) {
-            StageTimer t{res.stages, "refinement"};
-            RefineParams rp;
-            rp.levels = 1;
-            rp.mode = params.refineMode;
-            rp.measure = false;
-            rp.field.voxelSize = res.refineVoxelSizes[std::size_t(l)];
-            if (scalp) rp.head = HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper);
-            RefineResult rr = refineStrands(strands, rp, threaded, interrupter);
-            if (!rr.levels.empty()) res.refinedCorrected[std::size_t(l)] = rr.levels.front().consistency.corrected;
-            strands = std::move(rr.strands);
-            StrandSamples again = sampleStrands(strands, map, params.vertices, threaded);
-            // Keep the scattered roots' frames and positions exactly (refinement keeps roots).
-            level.local.swap(again.local);
-            level.lengths.swap(again.lengths);
-        }
-        if (l == 0) finestStrands = std::move(strands);
-    };
     // 5. The coarsest level from the synthesized map.
-    {
-        StageTimer t{res.stages, "coarsest level"};
+    res.output.resize(std::size_t(L));
+    const auto scatter = [&](int l) {
         RootScatterParams rp;
-        rp.count = counts[std::size_t(L - 1)];
+        rp.count = counts[std::size_t(l)];
         rp.iterations = params.rootIterations;
         rp.seed = params.seed;
-        rp.stream = std::uint64_t(L - 1);
-        const ScatteredRoots roots = scatterRoots(map, res.grid, res.outputMap, rp, threaded);
+        rp.stream = std::uint64_t(l);
+        return scatterRoots(map, res.grid, res.outputMap, rp, threaded);
+    };
+    {
+        SynthStageTimer t{res.stages, "coarsest level"};
+        const ScatteredRoots roots = scatter(L - 1);
         StrandSamples& level = res.output[std::size_t(L - 1)];
         level.vertices = params.vertices;
         std::vector<float> f(std::size_t(res.pca.components)), row(coarsest.dim());
@@ -237,36 +209,76 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
                        float(len * radius));
         }
     }
-    refineLevel(L - 1);
+    // 6-7. Finer levels, refined from the coarsest on.
+    const double finestVoxel = params.voxelSize > 0.0 ? params.voxelSize : suggestVoxelSize(example);
+    synthesizeFinerLevels(res, res.example, [&](int l) { return LevelRoots{scatter(l).positions, {}}; }, params, finestVoxel,
+                          /*refineCoarsest=*/true, scalp, threaded, interrupter);
+    return res;
+}
+
+void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
+                           const std::function<LevelRoots(int level)>& rootsOf, const SynthParams& params,
+                           double finestVoxel, bool refineCoarsest, openvdb::FloatGrid::ConstPtr scalp, bool threaded,
+                           openvdb::util::NullInterrupter* interrupter)
+{
+    const int L = int(source.levels.size());
+    if (L < 2 || res.output.size() != std::size_t(L) || res.output.back().count() == 0 || !res.map)
+        throw ValueError("synthesizeFinerLevels: the coarsest output level and the scalp map must be set for " +
+                         std::to_string(L) + " levels");
+    const ScalpMap& map = *res.map;
+    const double radius = map.radius();
+    res.refinedCorrected.assign(std::size_t(L), 0);
+    res.refineVoxelSizes.assign(std::size_t(L), 0.0);
+    for (int l = 0; l < L; ++l) res.refineVoxelSizes[std::size_t(l)] = finestVoxel * double(1 << l);
+    // Refinement of one output level (§5.3), in place.
+    StrandSet finestStrands;
+    const auto refineLevel = [&](int l, bool refine) {
+        StrandSamples& level = res.output[std::size_t(l)];
+        StrandSet strands = samplesToStrands(level, radius);
+        if (refine && params.refine) {
+            SynthStageTimer t{res.stages, "refinement"};
+            RefineParams rp;
+            rp.levels = 1;
+            rp.mode = params.refineMode;
+            rp.measure = false;
+            rp.field.voxelSize = res.refineVoxelSizes[std::size_t(l)];
+            if (scalp) rp.head = HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper);
+            RefineResult rr = refineStrands(strands, rp, threaded, interrupter);
+            if (!rr.levels.empty()) res.refinedCorrected[std::size_t(l)] = rr.levels.front().consistency.corrected;
+            strands = std::move(rr.strands);
+            StrandSamples again = sampleStrands(strands, map, params.vertices, threaded);
+            // Keep the scattered roots' frames and positions exactly (refinement keeps roots).
+            level.local.swap(again.local);
+            level.lengths.swap(again.lengths);
+        }
+        if (l == 0) finestStrands = std::move(strands);
+    };
+    refineLevel(L - 1, refineCoarsest);
     // 6. Finer levels by detail transfer.
     std::vector<std::vector<std::uint32_t>> parent(static_cast<std::size_t>(L));  // parent[l][i]: output strand of level l+1
     for (int l = L - 2; l >= 0; --l) {
         if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("synthesis interrupted");
         {
-            StageTimer t{res.stages, "detail transfer"};
-            RootScatterParams rp;
-            rp.count = counts[std::size_t(l)];
-            rp.iterations = params.rootIterations;
-            rp.seed = params.seed;
-            rp.stream = std::uint64_t(l);
-            const ScatteredRoots roots = scatterRoots(map, res.grid, res.outputMap, rp, threaded);
-            const TransferSource src{&res.example.levels[std::size_t(l)], &res.example.levels[std::size_t(l + 1)],
-                                     &res.example.clusterings[std::size_t(l)].label};
+            SynthStageTimer t{res.stages, "detail transfer"};
+            const LevelRoots roots = rootsOf(l);
+            const TransferSource src{&source.levels[std::size_t(l)], &source.levels[std::size_t(l + 1)],
+                                     &source.clusterings[std::size_t(l)].label};
             res.output[std::size_t(l)] = transferDetail(src, res.output[std::size_t(l + 1)], roots.positions, map, params.components,
-                                                        &parent[std::size_t(l)], nullptr, params.detailBlend, threaded, interrupter);
+                                                        &parent[std::size_t(l)], nullptr, params.detailBlend, threaded, interrupter,
+                                                        roots.parent.empty() ? nullptr : &roots.parent, params.detailScale);
         }
-        refineLevel(l);
+        refineLevel(l, true);
     }
     res.strands = std::move(finestStrands);
     // Cluster of every output strand at each coarser level.
     const std::size_t n = res.output[0].count();
     std::vector<std::int32_t> at(n);
     for (std::size_t i = 0; i < n; ++i) at[i] = std::int32_t(i);
+    res.clusterOf.clear();
     for (int l = 0; l + 1 < L; ++l) {
         for (std::size_t i = 0; i < n; ++i) at[i] = std::int32_t(parent[std::size_t(l)][std::size_t(at[i])]);
         res.clusterOf.push_back(at);
     }
-    return res;
 }
 
 } // namespace vdbhair

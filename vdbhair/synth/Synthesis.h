@@ -37,6 +37,8 @@
 
 #include <openvdb/util/NullInterrupter.h>
 
+#include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -61,6 +63,9 @@ struct SynthParams
 {
     SynthLayout layout = SynthLayout::Synthesize;
     DetailBlend detailBlend = DetailBlend::RootFrame;  ///< DetailTransfer.h says why
+    /// Vertex by vertex, the paper's: the output's centres come from the example, of its lengths
+    /// (transfer between hairstyles uses arc length, HairTransfer.h)
+    DetailScale detailScale = DetailScale::Index;
     int vertices = StrandSamples::kDefaultVertices;  ///< n_s (Table 1)
     int components = Pca::kDefaultComponents;        ///< n_f (§5.1)
     ClusterParams cluster;                           ///< includes the level count and the seed
@@ -125,6 +130,48 @@ struct SynthResult
     std::vector<std::size_t> refinedCorrected;  ///< per output level (0 the finest): strands refinement corrected
     std::vector<double> refineVoxelSizes;       ///< per output level (0 the finest), world units
     Vec3d up{0.0, 1.0, 0.0};                    ///< the up axis used
+};
+
+/// @brief Stage 1: the scalp map of a hairstyle: the sphere fitted to its roots (Wang et al. §3),
+/// measured on @a scalp when given; up @a up, or (0, 0, 0) for the mean root direction.
+/// @param upUsed if given, receives the up axis used
+std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp,
+                                       Vec3d* upUsed = nullptr);
+
+/// @brief Stages 2-3: every strand sampled on @a map (in spatial order, Measures.h) and the
+/// hierarchy of @a params.cluster with seed @a params.seed.
+/// @param order if given, receives the spatial order: row i of level 0 is strand (*order)[i]
+ClusterHierarchy hairHierarchy(const StrandSet& strands, const ScalpMap& map, const SynthParams& params, bool threaded = true,
+                               openvdb::util::NullInterrupter* interrupter = nullptr,
+                               std::vector<std::uint32_t>* order = nullptr);
+
+/// @brief The roots of one output level: positions, and optionally each root's centre among the
+/// coarser level's output strands (empty: the nearest coarser root, DetailTransfer.h step 1).
+struct LevelRoots
+{
+    std::vector<Vec3d> positions;
+    std::vector<std::uint32_t> parent;
+};
+
+/// @brief Stages 6-7 onto any coarsest level: from @a res.output[L-1] (set by the caller) level by
+/// level to the finest, each level's strands rooted at @a rootsOf(l), their detail transferred from
+/// @a source (DetailTransfer.h), and refined (§5.3) as @a params say, at voxel @a finestVoxel
+/// doubled per coarser level. The coarsest level itself is refined only if @a refineCoarsest.
+/// Fills res.output, res.strands, res.clusterOf, res.refinedCorrected, res.refineVoxelSizes and
+/// res.stages. Shared by synthesis, imposed coarsest levels and transfer (HairTransfer.h).
+void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
+                           const std::function<LevelRoots(int level)>& rootsOf, const SynthParams& params,
+                           double finestVoxel, bool refineCoarsest, openvdb::FloatGrid::ConstPtr scalp, bool threaded,
+                           openvdb::util::NullInterrupter* interrupter);
+
+/// @brief Adds the seconds from its construction to its destruction to the stage named @a name of
+/// @a stages (appended when new).
+struct SynthStageTimer
+{
+    std::vector<SynthStage>& stages;
+    std::string name;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+    ~SynthStageTimer();
 };
 
 /// @brief Synthesize a hairstyle from @a example.

@@ -1,6 +1,8 @@
 #include "SynthesisReport.h"
 
+#include <vdbhair/helicoid/Frechet.h>
 #include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
 
 #include <tbb/parallel_for.h>
@@ -50,6 +52,52 @@ std::vector<double> turningPerLength(const StrandSet& strands)
             }
         }
         out[s] = len > 0.0 ? turn / len : 0.0;
+    }
+    return out;
+}
+
+double meanTurningPerLength(const StrandSet& strands, int vertices)
+{
+    if (strands.empty()) return 0.0;
+    const std::vector<double> t = turningPerLength(resampleStrands(strands, std::size_t(vertices)));
+    double sum = 0.0;
+    for (double x : t) sum += x;
+    return sum / double(t.size());
+}
+
+std::vector<double> clusterMeanDeviation(const StrandSet& a, const std::vector<std::int32_t>& labelA, const StrandSet& b,
+                                         const std::vector<std::int32_t>& labelB, int vertices, double smoothing)
+{
+    std::int32_t K = 0;
+    for (std::int32_t l : labelA) K = std::max(K, l + 1);
+    for (std::int32_t l : labelB) K = std::max(K, l + 1);
+    const std::size_t m = std::size_t(std::max(2, vertices));
+    const auto means = [&](const StrandSet& set, const std::vector<std::int32_t>& label) {
+        std::vector<std::vector<Vec3d>> mean(std::size_t(K), std::vector<Vec3d>(m, Vec3d(0.0)));
+        std::vector<std::size_t> count(std::size_t(K), 0);
+        std::vector<Vec3f> pts(m);
+        for (std::size_t s = 0; s < set.numStrands() && s < label.size(); ++s) {
+            if (label[s] < 0 || set.size(s) < 2) continue;
+            resamplePolyline(set.data(s), set.size(s), m, pts.data());
+            for (std::size_t v = 0; v < m; ++v) mean[std::size_t(label[s])][v] += Vec3d(pts[v]);
+            ++count[std::size_t(label[s])];
+        }
+        std::vector<Vec3d> tmp(m);
+        for (std::size_t c = 0; c < mean.size(); ++c) {
+            for (Vec3d& p : mean[c]) p /= double(std::max<std::size_t>(1, count[c]));
+            smoothPolyline(mean[c].data(), m, smoothing * double(m), tmp.data());
+            mean[c].swap(tmp);
+        }
+        return std::make_pair(mean, count);
+    };
+    const auto [ma, ca] = means(a, labelA);
+    const auto [mb, cb] = means(b, labelB);
+    std::vector<double> out;
+    for (std::size_t c = 0; c < std::size_t(K); ++c) {
+        if (!ca[c] || !cb[c]) continue;
+        double len = 0.0;
+        for (std::size_t v = 1; v < m; ++v) len += (mb[c][v] - mb[c][v - 1]).length();
+        out.push_back(discreteFrechet(ma[c].data(), m, mb[c].data(), m) / std::max(1e-30, len));
     }
     return out;
 }

@@ -36,6 +36,19 @@ struct NoveltyStats
 NoveltyStats measureNovelty(const StrandSet& example, const StrandSet& output, double radius, int vertices = 16,
                             bool threaded = true);
 
+/// @brief Mean total turning per unit length of @a strands resampled to @a vertices vertices by arc
+/// length (hairstyles stored at different resolutions compare at one; 0 for no strands).
+double meanTurningPerLength(const StrandSet& strands, int vertices);
+
+/// @brief How far the wisps of @a a lie from those of @a b: for every cluster c with members in
+/// both (labelA[s] == c, labelB[s] == c), the mean strand of its members in each (resampled to
+/// @a vertices by arc length, averaged vertex by vertex, then smoothed with σ = @a smoothing ×
+/// @a vertices, smoothPolyline()), and the discrete Fréchet distance between the two means divided
+/// by the length of b's. Transfer keeps BASE's coarse shape and replaces its detail; with the
+/// transfer's smoothing this compares exactly the part that should be kept.
+std::vector<double> clusterMeanDeviation(const StrandSet& a, const std::vector<std::int32_t>& labelA, const StrandSet& b,
+                                         const std::vector<std::int32_t>& labelB, int vertices = 64, double smoothing = 0.0);
+
 /// @brief Sizes of the clusters given by @a label (#N, values in [0, k)).
 std::vector<double> clusterSizes(const std::vector<std::int32_t>& label);
 

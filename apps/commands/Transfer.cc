@@ -1,0 +1,142 @@
+// vdbhair transfer DETAILS BASE -o OUT: BASE's coarsest level with DETAILS' finer levels (Wang et
+// al. 2009, §6), and `synth EXAMPLE --coarse BASE`, which is the same operation.
+#include "../Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/scalp/ScalpSurface.h>
+#include <vdbhair/strands/Measures.h>
+#include <vdbhair/synth/HairTransfer.h>
+#include <vdbhair/synth/SynthesisReport.h>
+
+#include <algorithm>
+#include <chrono>
+
+namespace vdbhair::app {
+
+namespace {
+
+double mean(const std::vector<double>& v)
+{
+    double s = 0.0;
+    for (double x : v) s += x;
+    return v.empty() ? 0.0 : s / double(v.size());
+}
+
+double percentile(std::vector<double> v, double q)
+{
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, std::size_t(q * double(v.size() - 1) + 0.5))];
+}
+
+struct TransferCmdParams
+{
+    TransferJob job = [] { TransferJob j; j.verb = "transfer"; return j; }();
+    TransferParams params;
+    SynthOptionText text;
+    std::int64_t strands = -1;
+};
+
+} // namespace
+
+int runTransferJob(const TransferJob& job, TransferParams params, const CommonOptions& common)
+{
+    strandFormatFromPath(job.output, /*forWriting=*/true);
+    params.validate("option");
+    const StrandSet details = loadStrandsOrScene(job.verb, job.details, common);
+    const StrandSet base = loadStrandsOrScene(job.verb, job.base, common);
+    if (details.empty()) throw ValueError(job.details + ": no strands to take detail from");
+    if (base.empty()) throw ValueError(job.base + ": no strands to transfer onto");
+    openvdb::FloatGrid::Ptr scalp;
+    if (!job.scalp.empty()) {
+        const Stage stage(common, "reading " + job.scalp);
+        scalp = readScalp(job.scalp, common.interrupter);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    TransferResult tr;
+    try {
+        const Stage stage(common, "transferring detail");
+        tr = transferHairstyle(details, base, params, scalp, true, common.interrupter);
+    } catch (const ValueError& e) {
+        // The library names the hairstyles DETAILS and BASE; the message names the files.
+        std::string what = e.what();
+        const auto name = [&](const std::string& word, const std::string& by) {
+            for (std::size_t at = what.find(word); at != std::string::npos; at = what.find(word, at + by.size())) what.replace(at, word.size(), by);
+        };
+        name("DETAILS", job.detailsLabel + " (" + job.details + ")");
+        name("BASE", job.baseLabel + " (" + job.base + ")");
+        throw ValueError(what);
+    }
+    const SynthResult& r = tr.result;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    {
+        const Stage stage(common, "writing " + job.output);
+        writeSynthStrands(job.output, r.strands, r.clusterOf);
+    }
+    // What the transfer did (README, "Detail transfer and combing", says why each check).
+    const int ns = params.synth.vertices;
+    const double turnDetails = meanTurningPerLength(details, ns), turnBase = meanTurningPerLength(base, ns),
+                 turnOut = meanTurningPerLength(r.strands, ns);
+    const std::vector<double> dev = clusterMeanDeviation(r.strands, r.clusterOf.back(), base, tr.baseLabel, ns, params.smoothing);
+    // Turning per head radius: each hairstyle in units of its own head (detail arrives scaled so).
+    const double rd = tr.detailsMap->radius(), rb = r.map->radius();
+    const nlohmann::json checks = {{"detail", std::abs(turnOut * rb - turnDetails * rd) <= 0.1 * turnDetails * rd},
+                                   {"coarse_shape", mean(dev) <= 0.1}};
+    if (common.json) {
+        nlohmann::json levels = nlohmann::json::array();
+        for (std::size_t l = 0; l < r.output.size(); ++l)
+            levels.push_back({{"level", l}, {"details", r.example.levels[l].count()}, {"output", r.output[l].count()},
+                              {"refine_corrected", r.refinedCorrected[l]}});
+        nlohmann::json stages = nlohmann::json::object();
+        for (const SynthStage& s : r.stages) stages[s.name] = s.seconds;
+        printJson({{"output", job.output}, {"details", job.details}, {"base", job.base}, {"strands", r.strands.numStrands()},
+                   {"vertices", r.strands.numVertices()}, {"levels", levels}, {"guides", params.guides},
+                   {"smoothing", params.smoothing}, {"smooth_base", params.smoothBase}, {"detail", detailBlendName(params.synth.detailBlend)},
+                   {"head_radius", {{"details", tr.detailsMap->radius()}, {"base", r.map->radius()}}},
+                   {"detail_scale", tr.detailScale}, {"length_ratio", tr.lengthRatio},
+                   {"turning_per_length", {{"details", turnDetails}, {"base", turnBase}, {"output", turnOut}, {"vertices", ns}}},
+                   {"turning_per_head_radius", {{"details", turnDetails * rd}, {"base", turnBase * rb}, {"output", turnOut * rb}}},
+                   {"coarse_deviation", {{"mean", mean(dev)}, {"p90", percentile(dev, 0.9)}, {"clusters", dev.size()}}},
+                   {"stages", stages}, {"seconds", seconds}, {"checks", checks}});
+    } else if (!common.quiet) {
+        std::cout << "transferred the detail of " << job.details << " (" << details.numStrands() << " strands) onto "
+                  << job.base << " (" << base.numStrands() << "): " << r.strands.numStrands() << " strands in " << seconds << " s\n"
+                  << "  turning per head radius: details " << turnDetails * rd << ", base " << turnBase * rb << ", output " << turnOut * rb << "\n"
+                  << "  output wisps from the base's coarsest strands: " << mean(dev) * 100.0 << " % of their length (mean)\n"
+                  << "  wisp length ratio base/details " << tr.lengthRatio << ", detail scale " << tr.detailScale << "\n"
+                  << "wrote " << job.output << "\n";
+    }
+    return 0;
+}
+
+Command addTransferCommand(CLI::App& app, CommonOptions& common)
+{
+    auto p = std::make_shared<TransferCmdParams>();
+    SynthParams& s = p->params.synth;
+    CLI::App* sub = app.add_subcommand("transfer", "BASE's global flow with DETAILS' wisps and curls (Wang et al. 2009, section 6): BASE keeps its coarsest level, the finer levels come from DETAILS by cluster-oriented detail transfer");
+    sub->add_option("details", p->job.details, "The hairstyle whose detail is taken (any strand format, or a scene)")->required();
+    sub->add_option("base", p->job.base, "The hairstyle whose coarsest level is kept (any strand format, or a scene)")->required();
+    sub->add_option("-o,--output", p->job.output, "The result (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
+    sub->add_option("--scalp", p->job.scalp, "BASE's scalp: a .vdb with a level set 'surface' or a head mesh; default: the sphere fitted to BASE's roots");
+    sub->add_option("--smoothing", p->params.smoothing, "Sigma of the smoothing of DETAILS' coarsest strands, a fraction of their vertices (0: none)")->capture_default_str();
+    sub->add_flag_function("--keep-base-detail", [p](std::int64_t) { p->params.smoothBase = false; }, "Keep BASE's coarsest level unsmoothed (the paper's rule: BASE's own wisp-level waves stay, under DETAILS')");
+    sub->add_flag("--guides", p->params.guides, "BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over their region");
+    sub->add_option("--strands", p->strands, "With --guides: strands in the output (default: DETAILS' strands per coarsest strand, times the guides)");
+    addSynthHierarchyOptions(sub, s, p->text);
+    addSynthTransferOptions(sub, s, p->text);
+    addCommonOptions(sub, common);
+    sub->footer("Example: vdbhair transfer curly.hair straight.hair -o curly_straight.hair --json");
+    return {sub, [p, &common] {
+                TransferParams params = p->params;
+                applySynthOptionText(p->text, params.synth);
+                if (p->strands == 0) throw ValueError("--strands 0: must be at least 1");
+                if (p->strands > 0) {
+                    if (!params.guides) throw ValueError("--strands: the output has BASE's strands; --strands needs --guides");
+                    params.strands = std::size_t(p->strands);
+                }
+                return runTransferJob(p->job, params, common);
+            }};
+}
+
+} // namespace vdbhair::app

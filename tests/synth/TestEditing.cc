@@ -1,0 +1,318 @@
+// Editing hairstyles (Wang et al. 2009, §6): detail transfer between hairstyles, imposed coarsest
+// levels, and detail-preserving combing.
+#include "SynthTestUtil.h"
+#include "TestUtil.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/strands/Frames.h>
+#include <vdbhair/strands/Measures.h>
+#include <vdbhair/strands/Resample.h>
+#include <vdbhair/synth/Comb.h>
+#include <vdbhair/synth/HairTransfer.h>
+#include <vdbhair/synth/SynthesisReport.h>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <fstream>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+/// The wisp hairstyle with a curl wound around every strand: @a turns turns of radius @a amp
+/// (head radii) about the strand's root-to-tip direction, in phase within a wisp (the wisp curls
+/// together, so its centre curls too: the case the smoothing of transfer is for).
+StrandSet curlyHairstyle(std::size_t strands, int wisps, double amp = 0.03, double turns = 5.0, int vertices = 96)
+{
+    std::vector<int> wisp;
+    const StrandSet base = test::wispHairstyle(strands, wisps, &wisp, vertices, 0.0);
+    StrandSet out;
+    for (std::size_t s = 0; s < base.numStrands(); ++s) {
+        const Vec3f* p = base.data(s);
+        const std::size_t n = base.size(s);
+        const Vec3d axis = (Vec3d(p[n - 1]) - Vec3d(p[0])).unitSafe();
+        const Vec3d u = Vec3d(perpendicularTo(Vec3f(axis))).unitSafe(), v = axis.cross(u);
+        std::vector<Vec3f> q(n);
+        for (std::size_t l = 0; l < n; ++l) {
+            const double a = 2.0 * M_PI * turns * double(l) / double(n - 1) + 0.7 * double(wisp[s]);
+            // Grows in from zero at the root so the root stays on the scalp.
+            const double grow = std::min(1.0, 8.0 * double(l) / double(n - 1));
+            q[l] = Vec3f(Vec3d(p[l]) + (u * std::cos(a) + v * std::sin(a) - u * std::cos(0.7 * double(wisp[s]))  -
+                                        v * std::sin(0.7 * double(wisp[s]))) * (amp * grow));
+        }
+        out.addStrand(q);
+    }
+    return out;
+}
+
+TransferParams smallTransfer()
+{
+    TransferParams p;
+    p.synth.vertices = 64;
+    p.synth.cluster.levels = 3;
+    p.synth.cluster.initialClusters = 40;
+    p.synth.seed = 5;
+    return p;
+}
+
+double segmentLengthError(const StrandSet& a, const StrandSet& b)
+{
+    double worst = 0.0;
+    for (std::size_t s = 0; s < a.numStrands(); ++s)
+        for (std::size_t v = 0; v + 1 < a.size(s); ++v) {
+            const double la = (Vec3d(a.data(s)[v + 1]) - Vec3d(a.data(s)[v])).length();
+            const double lb = (Vec3d(b.data(s)[v + 1]) - Vec3d(b.data(s)[v])).length();
+            if (la > 0.0) worst = std::max(worst, std::abs(lb - la) / la);
+        }
+    return worst;
+}
+
+CombStroke strokeAcross(double strength, double radius = 0.35)
+{
+    // Across the front of the unit head, from +x to -x at z = 0.8 (the strands hang mostly up and out).
+    CombStroke s;
+    s.points = {Vec3d(0.9, 1.2, 0.9), Vec3d(0.0, 1.3, 1.1), Vec3d(-0.9, 1.2, 0.9)};
+    s.radius = radius;
+    s.strength = strength;
+    return s;
+}
+
+CombParams smallComb()
+{
+    CombParams p;
+    p.synth.vertices = 32;
+    p.synth.cluster.initialClusters = 40;
+    p.synth.seed = 3;
+    return p;
+}
+
+} // namespace
+
+TEST_CASE("smoothPolyline: ends kept, straight lines kept, waves damped", "[synth]")
+{
+    std::vector<Vec3d> line, wave;
+    for (int i = 0; i < 65; ++i) {
+        line.emplace_back(0.1 * i, 0.05 * i, -0.02 * i);
+        wave.emplace_back(0.1 * i, 0.2 * std::sin(2.0 * M_PI * i / 8.0), 0.0);  // a period of 8 vertices
+    }
+    std::vector<Vec3d> out(65);
+    smoothPolyline(line.data(), line.size(), 4.0, out.data());
+    for (int i = 0; i < 65; ++i) CHECK((out[i] - line[i]).length() < 1e-12);
+    smoothPolyline(wave.data(), wave.size(), 4.0, out.data());
+    CHECK(out.front() == wave.front());
+    CHECK(out.back() == wave.back());
+    double amp = 0.0;
+    for (int i = 8; i < 57; ++i) amp = std::max(amp, std::abs(out[i].y()));
+    // A Gaussian of sigma 4 passes exp(-2 pi^2 16 / 64) = 0.7 % of a period-8 wave.
+    CHECK(amp < 0.2 * 0.01);
+    smoothPolyline(wave.data(), wave.size(), 0.0, out.data());
+    CHECK(out == wave);
+}
+
+TEST_CASE("combPolyline: zero strength is the identity; a stroke turns the strand and keeps its lengths and root", "[synth]")
+{
+    // A strand along +y with a small curl, crossed by a stroke along +x at mid-height.
+    std::vector<Vec3d> p;
+    for (int i = 0; i < 64; ++i) {
+        const double a = 2.0 * M_PI * 6.0 * i / 63.0;
+        p.emplace_back(0.02 * std::sin(a), 0.03 * i, 0.02 * (std::cos(a) - 1.0));
+    }
+    CombStroke s;
+    s.points = {Vec3d(-1.0, 0.6, 0.0), Vec3d(1.0, 0.6, 0.0)};
+    s.radius = 0.4;
+    s.strength = 0.0;
+    std::vector<Vec3d> out;
+    std::vector<std::array<double, 4>> rot;
+    CHECK_FALSE(combPolyline(p, {}, s, 4.0, out, rot));
+    CHECK(out == p);
+    s.strength = 1.0;
+    REQUIRE(combPolyline(p, {}, s, 4.0, out, rot));
+    CHECK(out.front() == p.front());
+    double worstLen = 0.0, worstResidual = 0.0;
+    for (std::size_t i = 0; i + 1 < p.size(); ++i) {
+        const Vec3d e = p[i + 1] - p[i], f = out[i + 1] - out[i];
+        worstLen = std::max(worstLen, std::abs(f.length() - e.length()) / e.length());
+        // The least-squares reconstruction's residual |out_{i+1} - out_i - R_i e_i| is zero: the
+        // running sum is the exact minimizer (Comb.h).
+        const auto& q = rot[i];
+        const Vec3d u(q[1], q[2], q[3]);
+        const Vec3d t = u.cross(e) * 2.0;
+        const Vec3d re = e + t * q[0] + u.cross(t);
+        worstResidual = std::max(worstResidual, (f - re).length());
+    }
+    CHECK(worstLen < 1e-9);
+    CHECK(worstResidual < 1e-9);
+    // Beyond the stroke (at and above y = 1.0) the strand's overall direction is the stroke's (+x).
+    const Vec3d tip = (out[63] - out[40]).unitSafe();
+    CHECK(tip.x() > 0.95);
+    // Its curl rides along: turning per length within 10 %.
+    StrandSet a, b;
+    std::vector<Vec3f> pa(p.begin(), p.end()), pb(out.begin(), out.end());
+    a.addStrand(pa);
+    b.addStrand(pb);
+    const double ta = turningPerLength(a)[0], tb = turningPerLength(b)[0];
+    CHECK(std::abs(tb - ta) < 0.1 * ta);
+}
+
+TEST_CASE("combHair: zero strength and far strokes change nothing; a stroke turns its wisps and keeps lengths, roots and curls", "[synth]")
+{
+    const StrandSet hair = curlyHairstyle(1200, 12, 0.02, 4.0, 48);
+    const CombParams params = smallComb();
+    CombResult none = combHair(hair, {strokeAcross(0.0)}, params);
+    CHECK(none.strands.positions == hair.positions);
+    CHECK(none.stats.movedStrands == 0);
+    CombStroke far = strokeAcross(1.0);
+    for (Vec3d& q : far.points) q += Vec3d(0.0, 50.0, 0.0);
+    CHECK(combHair(hair, {far}, params).strands.positions == hair.positions);
+
+    const CombResult r = combHair(hair, {strokeAcross(1.0)}, params, nullptr, true);
+    const CombStats& st = r.stats;
+    INFO("moved " << st.movedStrands << " combed clusters " << st.combedClusters << "/" << st.clusters << " angle "
+                  << st.angleBefore << " -> " << st.angleAfter << " turning " << st.turningBefore << " -> " << st.turningAfter);
+    REQUIRE(st.movedStrands > 0);
+    CHECK(st.movedStrands < hair.numStrands());
+    CHECK(st.angleAfter < st.angleBefore - 10.0);
+    CHECK(std::abs(st.turningAfter - st.turningBefore) < 0.1 * st.turningBefore);
+    CHECK(segmentLengthError(hair, r.strands) < 1e-4);
+    std::size_t same = 0;
+    for (std::size_t s = 0; s < hair.numStrands(); ++s) {
+        CHECK(r.strands.root(s) == hair.root(s));
+        bool equal = true;
+        for (std::size_t v = 0; v < hair.size(s); ++v) equal = equal && r.strands.data(s)[v] == hair.data(s)[v];
+        same += equal;
+    }
+    // Strands of wisps no stroke reached are copied exactly.
+    CHECK(same == hair.numStrands() - st.movedStrands);
+    // One and two threads.
+    const CombResult serial = combHair(hair, {strokeAcross(1.0)}, params, nullptr, false);
+    CHECK(serial.strands.positions == r.strands.positions);
+    // Two strokes apply in order: the second undoes nothing of the first's lengths.
+    CombStroke back = strokeAcross(0.5);
+    std::reverse(back.points.begin(), back.points.end());
+    const CombResult two = combHair(hair, {strokeAcross(1.0), back}, params);
+    CHECK(segmentLengthError(hair, two.strands) < 1e-4);
+    CHECK(two.strands.positions != r.strands.positions);
+}
+
+TEST_CASE("readStrokes: the format and its errors", "[synth]")
+{
+    const auto write = [&](const std::string& name, const std::string& text) {
+        const std::string path = test::tempPath("strokes_" + name);
+        std::ofstream(path) << text;
+        return path;
+    };
+    const std::vector<CombStroke> ok = readStrokes(write("ok.json",
+        R"({"vdbhair": "strokes/1", "strokes": [{"points": [[0,0,0],[1,0,0]], "radius": 0.5, "strength": 0.25}, {"points": [[0,1,0],[0,2,0],[0,3,1]], "radius": 2}]})"));
+    REQUIRE(ok.size() == 2);
+    CHECK(ok[0].strength == 0.25);
+    CHECK(ok[1].strength == 1.0);
+    CHECK(ok[1].points.size() == 3);
+    CHECK(readStrokes(write("one.json", R"({"points": [[0,0,0],[1,0,0]], "radius": 0.5})")).size() == 1);
+    CHECK_THROWS_WITH(readStrokes(write("p1.json", R"({"strokes": [{"points": [[0,0,0]], "radius": 1}]})")),
+                      Contains("p1.json: strokes[0].points: 1 point: a stroke needs at least 2"));
+    CHECK_THROWS_WITH(readStrokes(write("r0.json", R"({"strokes": [{"points": [[0,0,0],[1,0,0]], "radius": 0}]})")),
+                      Contains("strokes[0].radius: 0.000000: must be a positive finite length"));
+    CHECK_THROWS_WITH(readStrokes(write("rn.json", R"({"strokes": [{"points": [[0,0,0],[1,0,0]], "radius": -2}]})")),
+                      Contains("strokes[0].radius: -2.000000: must be a positive finite length"));
+    CHECK_THROWS_WITH(readStrokes(write("inf.json", R"({"strokes": [{"points": [[0,0,1e400],[1,0,0]], "radius": 1}]})")),
+                      Contains("strokes[0].points[0][2]: number 1e400 is beyond the range of a double"));
+    CHECK_THROWS_WITH(readStrokes(write("s2.json", R"({"strokes": [{"points": [[0,0,0],[1,0,0]], "radius": 1, "strength": 2}]})")),
+                      Contains("strokes[0].strength: 2.000000: must be 0 to 1"));
+    CHECK_THROWS_WITH(readStrokes(write("key.json", R"({"strokes": [{"points": [[0,0,0],[1,0,0]], "radius": 1, "width": 2}]})")),
+                      Contains("strokes[0].width: unknown key"));
+    CHECK_THROWS_WITH(readStrokes(write("same.json", R"({"strokes": [{"points": [[1,1,1],[1,1,1]], "radius": 1}]})")),
+                      Contains("every point is the same"));
+    CHECK_THROWS_WITH(readStrokes(write("empty.json", R"({"strokes": []})")), Contains("strokes: empty"));
+}
+
+TEST_CASE("transferHairstyle: a hairstyle onto itself comes back", "[synth]")
+{
+    const StrandSet hair = test::wispHairstyle(1200, 12, nullptr, 32, 0.01);
+    TransferParams p = smallTransfer();
+    const TransferResult tr = transferHairstyle(hair, hair, p);
+    const StrandSet& out = tr.result.strands;
+    REQUIRE(out.numStrands() == hair.numStrands());
+    CHECK(tr.detailScale == Approx(1.0));
+    // BASE's roots, in BASE's order.
+    for (std::size_t s = 0; s < hair.numStrands(); ++s) CHECK((Vec3d(out.root(s)) - Vec3d(hair.root(s))).length() < 1e-5);
+    // Each strand near its original: RMS over 64 vertices by arc length, head radii (the unit sphere).
+    const StrandSet ref = resampleStrands(hair, 64);
+    std::vector<double> rms;
+    for (std::size_t s = 0; s < hair.numStrands(); ++s) {
+        double sum = 0.0;
+        for (std::size_t v = 0; v < 64; ++v) sum += (Vec3d(out.data(s)[v]) - Vec3d(ref.data(s)[v])).lengthSqr();
+        rms.push_back(std::sqrt(sum / 64.0));
+    }
+    std::sort(rms.begin(), rms.end());
+    INFO("median " << rms[rms.size() / 2] << " p90 " << rms[rms.size() * 9 / 10]);
+    // The tolerance: the transfer moves a strand by what its matched input strand differs from it
+    // (member matching by root offset, 4-5 % of strand length here) and the smoothing's effect.
+    CHECK(rms[rms.size() / 2] < 0.06);
+    CHECK(rms[rms.size() * 9 / 10] < 0.12);
+}
+
+TEST_CASE("transferHairstyle: curls onto a straight base keep the base's flow and take the detail", "[synth]")
+{
+    const StrandSet curly = curlyHairstyle(1500, 10, 0.03, 5.0, 96);
+    // The base: other wisps (other bends), straight, on the same head.
+    const StrandSet straight = test::wispHairstyle(1200, 7, nullptr, 40, 0.005, 99);
+    TransferParams p = smallTransfer();
+    const TransferResult tr = transferHairstyle(curly, straight, p);
+    const SynthResult& r = tr.result;
+    const double tc = meanTurningPerLength(curly, 64), ts = meanTurningPerLength(straight, 64), to = meanTurningPerLength(r.strands, 64);
+    const std::vector<double> dev = clusterMeanDeviation(r.strands, r.clusterOf.back(), straight, tr.baseLabel, 64, p.smoothing);
+    double meanDev = 0.0;
+    for (double d : dev) meanDev += d;
+    meanDev /= double(dev.size());
+    INFO("turning curly " << tc << " straight " << ts << " output " << to << "; centre deviation " << meanDev);
+    CHECK(std::abs(to - tc) < 0.1 * tc);
+    CHECK(meanDev < 0.1);
+    // The output's coarsest level is the base's, smoothed (and exactly the base's with the paper's rule).
+    StrandSamples smoothed = tr.base.levels.back();
+    smoothSamples(smoothed, p.smoothing, r.map->radius());
+    CHECK(r.output.back().local == smoothed.local);
+    TransferParams paper = p;
+    paper.smoothBase = false;
+    paper.synth.refine = false;
+    const TransferResult trPaper = transferHairstyle(curly, straight, paper);
+    CHECK(trPaper.result.output.back().local == trPaper.base.levels.back().local);
+    // Without the smoothing the wisps' shared curl stays in DETAILS' coarsest level, which BASE
+    // replaces: less of it arrives.
+    p.smoothing = 0.0;
+    const double unsmoothed = meanTurningPerLength(transferHairstyle(curly, straight, p).result.strands, 64);
+    INFO("unsmoothed " << unsmoothed);
+    CHECK(unsmoothed < to);
+    // One and two threads.
+    p = smallTransfer();
+    CHECK(transferHairstyle(curly, straight, p, nullptr, false).result.strands.positions == r.strands.positions);
+}
+
+TEST_CASE("transferHairstyle: guides as the coarsest level, and what is refused", "[synth]")
+{
+    const StrandSet curly = curlyHairstyle(1200, 10, 0.03, 5.0, 64);
+    const StrandSet guides = test::wispHairstyle(30, 5, nullptr, 20, 0.0, 4);
+    TransferParams p = smallTransfer();
+    p.guides = true;
+    p.strands = 900;
+    const TransferResult tr = transferHairstyle(curly, guides, p);
+    CHECK(tr.result.strands.numStrands() == 900);
+    CHECK(tr.result.output.back().count() == guides.numStrands());
+    CHECK(tr.base.levels.empty());
+    // Roots on the guides' head (the fitted unit sphere).
+    for (std::size_t s = 0; s < tr.result.strands.numStrands(); ++s)
+        CHECK(Vec3d(tr.result.strands.root(s)).length() == Approx(1.0).margin(2e-3));
+
+    // Wisps far too different in length cannot be matched.
+    StrandSet longHair;
+    const StrandSet b = test::wispHairstyle(1200, 7, nullptr, 40, 0.005, 99);
+    for (std::size_t s = 0; s < b.numStrands(); ++s) {
+        std::vector<Vec3f> q(b.data(s), b.data(s) + b.size(s));
+        for (Vec3f& x : q) x = b.root(s) + (x - b.root(s)) * 30.0f;
+        longHair.addStrand(q);
+    }
+    CHECK_THROWS_WITH(transferHairstyle(curly, longHair, smallTransfer()), Contains("too different for their clusters to be matched"));
+    CHECK_THROWS_WITH(transferHairstyle(StrandSet(), b, smallTransfer()), Contains("DETAILS has no strands"));
+    CHECK_THROWS_WITH(transferHairstyle(curly, test::wispHairstyle(6, 2), smallTransfer()), Contains("BASE: "));
+}

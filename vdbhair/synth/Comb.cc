@@ -1,0 +1,363 @@
+#include "Comb.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/JsonFile.h>
+#include <vdbhair/strands/Resample.h>
+#include <vdbhair/synth/SynthesisReport.h>
+
+#include <Eigen/Geometry>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace vdbhair {
+
+namespace {
+
+using Quat = Eigen::Quaterniond;
+using EVec = Eigen::Vector3d;
+
+EVec toE(const Vec3d& v) { return EVec(v.x(), v.y(), v.z()); }
+Vec3d fromE(const EVec& v) { return Vec3d(v.x(), v.y(), v.z()); }
+Quat toQuat(const std::array<double, 4>& q) { return Quat(q[0], q[1], q[2], q[3]); }
+std::array<double, 4> fromQuat(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+
+/// Distance from @a p to the stroke and the direction of its nearest segment.
+double strokeDistance(const CombStroke& s, const Vec3d& p, Vec3d* dir)
+{
+    double best = std::numeric_limits<double>::max();
+    for (std::size_t k = 0; k + 1 < s.points.size(); ++k) {
+        const Vec3d a = s.points[k], ab = s.points[k + 1] - a;
+        const double len2 = ab.lengthSqr();
+        const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+        const double d = (p - (a + ab * t)).length();
+        if (d < best && len2 > 0.0) {
+            best = d;
+            if (dir) *dir = ab / std::sqrt(len2);
+        }
+    }
+    return best;
+}
+
+double influence(const CombStroke& s, double d)
+{
+    if (!(d < s.radius)) return 0.0;
+    const double q = (d * d) / (s.radius * s.radius), x = 1.0 - q * q;
+    return s.strength * x * x;
+}
+
+/// A rotation turning unit @a u toward unit @a d by @a fraction of the angle between them.
+Quat turnToward(const EVec& u, const EVec& d, double fraction)
+{
+    const double c = std::clamp(u.dot(d), -1.0, 1.0);
+    const double angle = std::acos(c);
+    if (angle < 1e-12 || fraction <= 0.0) return Quat::Identity();
+    EVec axis = u.cross(d);
+    if (axis.norm() < 1e-9) {  // opposite: any axis perpendicular to u
+        axis = u.cross(std::abs(u.x()) < 0.9 ? EVec::UnitX() : EVec::UnitY());
+    }
+    return Quat(Eigen::AngleAxisd(fraction * angle, axis.normalized()));
+}
+
+} // namespace
+
+void validateStroke(const CombStroke& s, std::size_t index, const std::string& where)
+{
+    const std::string at = where + ": strokes[" + std::to_string(index) + "]";
+    if (s.points.size() < 2)
+        throw ValueError(at + ".points: " + std::to_string(s.points.size()) + " point" + (s.points.size() == 1 ? "" : "s") +
+                         ": a stroke needs at least 2");
+    for (std::size_t i = 0; i < s.points.size(); ++i)
+        if (!std::isfinite(s.points[i].x()) || !std::isfinite(s.points[i].y()) || !std::isfinite(s.points[i].z()))
+            throw ValueError(at + ".points[" + std::to_string(i) + "]: not finite");
+    bool moves = false;
+    for (std::size_t i = 1; i < s.points.size(); ++i) moves = moves || (s.points[i] - s.points[i - 1]).lengthSqr() > 0.0;
+    if (!moves) throw ValueError(at + ".points: every point is the same: a stroke needs a direction");
+    if (!(s.radius > 0.0) || !std::isfinite(s.radius))
+        throw ValueError(at + ".radius: " + std::to_string(s.radius) + ": must be a positive finite length");
+    if (!(s.strength >= 0.0 && s.strength <= 1.0))
+        throw ValueError(at + ".strength: " + std::to_string(s.strength) + ": must be 0 to 1");
+}
+
+std::vector<CombStroke> readStrokes(const std::string& path)
+{
+    const nlohmann::json j = readJsonFile(path, 8, "a stroke file");
+    const auto fail = [&](const std::string& where, const std::string& what) { throw FormatError(path + ": " + where + ": " + what); };
+    const auto number = [&](const nlohmann::json& v, const std::string& where) {
+        if (!v.is_number()) fail(where, "must be a number");
+        return v.get<double>();
+    };
+    std::vector<const nlohmann::json*> items;
+    if (!j.is_object()) fail("(top level)", "must be an object with \"strokes\" (or one stroke)");
+    if (j.contains("strokes")) {
+        for (auto it = j.begin(); it != j.end(); ++it)
+            if (it.key() != "strokes" && it.key() != "vdbhair") fail(it.key(), "unknown key (expected vdbhair, strokes)");
+        if (!j["strokes"].is_array()) fail("strokes", "must be an array of strokes");
+        for (const nlohmann::json& s : j["strokes"]) items.push_back(&s);
+        if (items.empty()) fail("strokes", "empty: at least one stroke is needed");
+    } else {
+        items.push_back(&j);
+    }
+    std::vector<CombStroke> out;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        const nlohmann::json& s = *items[i];
+        const std::string where = j.contains("strokes") ? "strokes[" + std::to_string(i) + "]" : std::string("(top level)");
+        if (!s.is_object()) fail(where, "must be an object with points, radius and strength");
+        for (auto it = s.begin(); it != s.end(); ++it)
+            if (it.key() != "points" && it.key() != "radius" && it.key() != "strength" && it.key() != "vdbhair")
+                fail(where + "." + it.key(), "unknown key (expected points, radius, strength)");
+        if (!s.contains("points") || !s["points"].is_array()) fail(where + ".points", "missing: an array of [x, y, z]");
+        if (!s.contains("radius")) fail(where + ".radius", "missing: the stroke's radius in world units");
+        CombStroke st;
+        for (std::size_t k = 0; k < s["points"].size(); ++k) {
+            const nlohmann::json& p = s["points"][k];
+            const std::string pw = where + ".points[" + std::to_string(k) + "]";
+            if (!p.is_array() || p.size() != 3) fail(pw, "must be [x, y, z]");
+            st.points.emplace_back(number(p[0], pw), number(p[1], pw), number(p[2], pw));
+        }
+        st.radius = number(s["radius"], where + ".radius");
+        if (s.contains("strength")) st.strength = number(s["strength"], where + ".strength");
+        try {
+            validateStroke(st, i, path);
+        } catch (const ValueError& e) {
+            throw FormatError(e.what());
+        }
+        out.push_back(std::move(st));
+    }
+    return out;
+}
+
+void CombParams::validate(const char* where) const
+{
+    synth.validate(where);
+    if (!(smoothing >= 0.0 && smoothing <= 1.0))
+        throw ValueError(std::string(where) + ": smoothing " + std::to_string(smoothing) + ": 0 to 1 (a fraction of the strand's vertices)");
+}
+
+bool combPolyline(const std::vector<Vec3d>& p, const std::vector<std::vector<Vec3d>>& members, const CombStroke& stroke,
+                  double sigma, std::vector<Vec3d>& out, std::vector<std::array<double, 4>>& rotations)
+{
+    const std::size_t n = p.size();
+    out = p;
+    rotations.assign(n > 0 ? n - 1 : 0, fromQuat(Quat::Identity()));
+    if (n < 2) return false;
+    std::vector<Vec3d> smooth(n);
+    smoothPolyline(p.data(), n, sigma, smooth.data());
+    // Where the stroke is felt: along the members (the wisp's strands, all of n points), or the strand itself.
+    std::vector<const std::vector<Vec3d>*> feel;
+    for (const std::vector<Vec3d>& m : members)
+        if (m.size() == n) feel.push_back(&m);
+    if (feel.empty()) feel.push_back(&p);
+    std::vector<EVec> at(feel.size());
+    for (std::size_t m = 0; m < feel.size(); ++m) at[m] = toE((*feel[m])[0]);
+    Quat C = Quat::Identity();
+    bool touched = false;
+    EVec q = toE(p[0]);
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+        const EVec e = toE(p[i + 1] - p[i]);
+        const double len = e.norm();
+        // The stroke's mean influence over the wisp at this vertex, and its direction weighted by it.
+        double w = 0.0;
+        Vec3d dir(0.0);
+        for (std::size_t m = 0; m < feel.size(); ++m) {
+            const EVec em = toE((*feel[m])[i + 1] - (*feel[m])[i]);
+            Vec3d d;
+            const double wm = influence(stroke, strokeDistance(stroke, fromE(at[m] + C * (0.5 * em)), &d));
+            w += wm;
+            dir += d * wm;
+        }
+        w /= double(feel.size());
+        if (w > 0.0 && len > 0.0 && dir.length() > 0.0) {
+            EVec t = toE(smooth[i + 1] - smooth[i]);
+            t = t.norm() > 0.0 ? EVec(t.normalized()) : EVec(e / len);
+            const double f = w >= 1.0 ? 1.0 : 1.0 - std::pow(1.0 - w, len / stroke.radius);
+            const Quat R = turnToward((C * t).normalized(), toE(dir.unitSafe()), f);
+            C = (R * C).normalized();
+            touched = true;
+        }
+        rotations[i] = fromQuat(C);
+        q += C * e;
+        out[i + 1] = fromE(q);
+        for (std::size_t m = 0; m < feel.size(); ++m) at[m] += C * toE((*feel[m])[i + 1] - (*feel[m])[i]);
+    }
+    if (!touched) out = p;
+    return touched;
+}
+
+CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& strokes, const CombParams& params,
+                    openvdb::FloatGrid::ConstPtr scalp, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    params.validate("combHair");
+    for (std::size_t i = 0; i < strokes.size(); ++i) validateStroke(strokes[i], i, "combHair");
+    if (strokes.empty()) throw ValueError("combHair: no strokes");
+    if (strands.numStrands() == 0) throw ValueError("combHair: no strands to comb");
+    const auto forEach = [&](std::size_t count, auto&& fn) {
+        if (threaded)
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
+            });
+        else
+            for (std::size_t i = 0; i < count; ++i) fn(i);
+    };
+    CombResult res;
+    const std::size_t n = strands.numStrands();
+    // The hierarchy, as synthesis builds it.
+    std::shared_ptr<ScalpMap> map;
+    ClusterHierarchy h;
+    std::vector<std::uint32_t> order;
+    {
+        SynthStageTimer t{res.stages, "clustering"};
+        map = hairScalpMap(strands, params.synth.up, scalp);
+        h = hairHierarchy(strands, *map, params.synth, threaded, interrupter, &order);
+    }
+    res.cluster.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        std::uint32_t c = std::uint32_t(i);
+        for (const Clustering& cl : h.clusterings) c = cl.label[c];
+        res.cluster[order[i]] = std::int32_t(c);
+    }
+    // 1. The coarsest strands, deformed stroke after stroke; their rotations composed per edge.
+    const StrandSamples& coarse = h.levels.back();
+    const std::size_t K = coarse.count(), ns = std::size_t(coarse.vertices);
+    const double sigma = params.smoothing * double(ns);
+    std::vector<std::vector<Vec3d>> centre(K);
+    std::vector<std::vector<Quat, Eigen::aligned_allocator<Quat>>> rot(K);
+    std::vector<std::uint8_t> touched(K, 0);
+    {
+        SynthStageTimer t{res.stages, "coarsest deformation"};
+        // The members of every coarsest cluster, as level 0's samples (rows in spatial order).
+        std::vector<std::vector<std::uint32_t>> members(K);
+        for (std::size_t i = 0; i < n; ++i) members[std::size_t(res.cluster[order[i]])].push_back(std::uint32_t(i));
+        const StrandSamples& fine = h.levels.front();
+        forEach(K, [&](std::size_t c) {
+            const auto world = [&](const StrandSamples& set, std::size_t i) {
+                std::vector<Vec3f> w(ns);
+                sampleToWorld(set.row(i), set.vertices, set.roots[i], set.frames[i], map->radius(), w.data());
+                return std::vector<Vec3d>(w.begin(), w.end());
+            };
+            std::vector<Vec3d> p = world(coarse, c), q;
+            std::vector<std::vector<Vec3d>> wisp;
+            for (std::uint32_t m : members[c]) wisp.push_back(world(fine, m));
+            rot[c].assign(ns - 1, Quat::Identity());
+            std::vector<std::array<double, 4>> r;
+            for (const CombStroke& s : strokes) {
+                if (!combPolyline(p, wisp, s, sigma, q, r)) continue;
+                touched[c] = 1;
+                for (std::size_t i = 0; i + 1 < ns; ++i) rot[c][i] = (toQuat(r[i]) * rot[c][i]).normalized();
+                // The members as the stroke left them: their edges turned by the same rotations.
+                for (std::vector<Vec3d>& m : wisp) {
+                    Vec3d at = m[0];
+                    for (std::size_t i = 0; i + 1 < ns; ++i) {
+                        const Vec3d e = m[i + 1] - m[i];
+                        m[i] = at;
+                        at += fromE(toQuat(r[i]) * toE(e));
+                    }
+                    m[ns - 1] = at;
+                }
+                p.swap(q);
+            }
+            centre[c] = std::move(p);
+        });
+    }
+    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("combing interrupted");
+    // 2. Every strand of a combed cluster: its edges turned by its centre's rotations at its arc length.
+    res.strands = strands;
+    {
+        SynthStageTimer t{res.stages, "detail re-transfer"};
+        // Arc length of every centre edge's midpoint (the original centre's).
+        std::vector<std::vector<double>> mids(K);
+        forEach(K, [&](std::size_t c) {
+            if (!touched[c]) return;
+            std::vector<Vec3f> w(ns);
+            sampleToWorld(coarse.row(c), coarse.vertices, coarse.roots[c], coarse.frames[c], map->radius(), w.data());
+            mids[c].resize(ns - 1);
+            double a = 0.0;
+            for (std::size_t i = 0; i + 1 < ns; ++i) {
+                const double len = (Vec3d(w[i + 1]) - Vec3d(w[i])).length();
+                mids[c][i] = a + 0.5 * len;
+                a += len;
+            }
+        });
+        forEach(n, [&](std::size_t s) {
+            const std::size_t c = std::size_t(res.cluster[s]);
+            if (!touched[c]) return;
+            const Vec3f* in = strands.data(s);
+            Vec3f* out = res.strands.data(s);
+            const std::vector<double>& m = mids[c];
+            const auto& R = rot[c];
+            EVec q = toE(Vec3d(in[0]));
+            double a = 0.0;
+            std::size_t k = 0;
+            for (std::size_t v = 0; v + 1 < strands.size(s); ++v) {
+                const EVec e = toE(Vec3d(in[v + 1]) - Vec3d(in[v]));
+                const double mid = a + 0.5 * e.norm();
+                a += e.norm();
+                while (k + 1 < m.size() && m[k + 1] <= mid) ++k;
+                Quat Q;
+                if (mid <= m.front()) Q = R.front();
+                else if (k + 1 >= m.size()) Q = R.back();
+                else Q = R[k].slerp((mid - m[k]) / std::max(1e-300, m[k + 1] - m[k]), R[k + 1]);
+                q += Q * e;
+                out[v + 1] = Vec3f(fromE(q));
+            }
+        });
+    }
+    // 3. What the strokes did.
+    CombStats& st = res.stats;
+    st.clusters = K;
+    for (std::uint8_t u : touched) st.combedClusters += u;
+    std::vector<std::uint8_t> moved(n, 0);
+    for (std::size_t s = 0; s < n; ++s) moved[s] = touched[std::size_t(res.cluster[s])];
+    for (std::uint8_t u : moved) st.movedStrands += u;
+    {
+        // Per strand partial sums, added in strand order (the same on any thread count).
+        std::vector<double> before(n, 0.0), after(n, 0.0);
+        std::vector<std::size_t> count(n, 0);
+        forEach(n, [&](std::size_t s) {
+            const Vec3f* a = strands.data(s);
+            const Vec3f* b = res.strands.data(s);
+            const std::size_t m = strands.size(s);
+            if (m < 2) return;
+            for (const CombStroke& k : strokes)
+                for (std::size_t v = 0; v < m; ++v) {
+                    Vec3d dirA, dirB;
+                    if (!(strokeDistance(k, Vec3d(a[v]), &dirA) < k.radius)) continue;
+                    strokeDistance(k, Vec3d(b[v]), &dirB);
+                    const std::size_t i = std::min(v, m - 2);
+                    const Vec3d ta = (Vec3d(a[i + 1]) - Vec3d(a[i])).unitSafe(), tb = (Vec3d(b[i + 1]) - Vec3d(b[i])).unitSafe();
+                    before[s] += std::acos(std::clamp(ta.dot(dirA), -1.0, 1.0));
+                    after[s] += std::acos(std::clamp(tb.dot(dirB), -1.0, 1.0));
+                    ++count[s];
+                }
+        });
+        double sb = 0.0, sa = 0.0;
+        for (std::size_t s = 0; s < n; ++s) {
+            sb += before[s];
+            sa += after[s];
+            st.reachVertices += count[s];
+        }
+        if (st.reachVertices) {
+            st.angleBefore = sb / double(st.reachVertices) * 180.0 / M_PI;
+            st.angleAfter = sa / double(st.reachVertices) * 180.0 / M_PI;
+        }
+    }
+    if (st.movedStrands) {
+        StrandSet a, b;
+        for (std::size_t s = 0; s < n; ++s)
+            if (moved[s]) {
+                a.addStrand(strands.data(s), strands.size(s));
+                b.addStrand(res.strands.data(s), res.strands.size(s));
+            }
+        const std::vector<double> ta = turningPerLength(a), tb = turningPerLength(b);
+        for (double x : ta) st.turningBefore += x;
+        for (double x : tb) st.turningAfter += x;
+        st.turningBefore /= double(ta.size());
+        st.turningAfter /= double(tb.size());
+    }
+    return res;
+}
+
+} // namespace vdbhair

@@ -1,0 +1,116 @@
+/// @file Comb.h
+/// @brief Detail-preserving combing (Wang et al. 2009, §6: "first applying detail-preserving
+/// deformations to the strands in the coarsest level and then transferring original finer-level
+/// details onto the edited coarsest level"; the deformation is Xu et al. 2007's §3.1).
+///
+/// **A stroke** is a polyline in world space with a radius r and a strength s in [0, 1]; its reach
+/// is the tube of radius r around it, where its influence is w(d) = s (1 − (d/r)⁴)² at distance d
+/// (flat near the axis, 0.88 s at r/2, smoothly zero at the wall; a comb's teeth hold what they
+/// pass through), and its direction at a point is that of the nearest segment.
+///
+/// **The coarsest level** is the coarsest level of the hairstyle's own hierarchy (Clustering.h,
+/// built as synthesis builds it). Each coarsest strand (n_s vertices) is deformed in the gradient
+/// domain: walking from the root, every edge e_i keeps its length and is turned by a rotation R_i,
+/// and the vertices are the root plus the running sum of the turned edges R_i e_i — the
+/// least-squares (Poisson) reconstruction of Xu et al. §3.1 from transformed edge vectors with the
+/// root as the only fixed vertex, whose normal equations (a tridiagonal Laplacian) the running sum
+/// solves exactly. The rotations are propagated along the strand: R_i is R_{i−1} turned further,
+/// by the fraction f = 1 − (1 − w)^(|e_i| / r) of the angle between the strand's *smoothed*
+/// direction at i (already turned by R_{i−1}) and the stroke's direction, w being the mean
+/// influence over the wisp's strands at vertex i, each where it has moved to (a comb that catches
+/// part of a wisp pulls the whole wisp part of the way; the centre alone would leave a wisp whose
+/// centre the stroke misses untouched while the stroke passes through its strands). So inside the reach the strand's overall direction
+/// turns toward the stroke's (fully for s = 1; for s < 1, the share s of the way over one r of its
+/// length at the tube's axis), beyond it the rest of the strand follows rigidly, and the strand's own
+/// waves and curls (which the smoothed direction, σ = StrandSamples::kDetailSmoothing, leaves out)
+/// turn with it instead of being straightened. Several strokes apply in order, each to the strands
+/// as the previous left them; their rotations compose.
+///
+/// **Detail re-transfer.** Every strand of the hairstyle (at its own vertices) gets the rotation
+/// field of its coarsest centre, read at its own arc length (rotations interpolated between the
+/// centre's edge midpoints, held beyond its ends), and is rebuilt from its root by the same running
+/// sum of turned edges. Composed through the levels, the paper's re-transfer of each finer level's
+/// detail onto the edited level above is this same rotation of every strand's edges, because each
+/// strand keeps its own detail relative to its own centre; in this form it keeps every segment's
+/// length and every root exactly, and a strand whose centre no stroke reaches is copied unchanged.
+#pragma once
+
+#include <vdbhair/synth/Synthesis.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace vdbhair {
+
+struct CombStroke
+{
+    std::vector<Vec3d> points;  ///< world positions, at least 2
+    double radius = 0.0;        ///< world units, positive
+    double strength = 1.0;      ///< 0 (no effect) to 1 (align fully)
+};
+
+/// @brief Strokes from a JSON file: `{"vdbhair": "strokes/1", "strokes": [{"points": [[x, y, z],
+/// ...], "radius": R, "strength": S}, ...]}` (strength optional, default 1), or one stroke object.
+/// @throw IoError, FormatError naming the file, the key path and the rule (fewer than two points,
+/// a radius that is not positive, a strength outside [0, 1], non-finite values, unknown keys).
+std::vector<CombStroke> readStrokes(const std::string& path);
+
+/// @throw ValueError naming @a where, the stroke's index and the rule.
+void validateStroke(const CombStroke& stroke, std::size_t index, const std::string& where);
+
+struct CombParams
+{
+    /// vertices (n_s), cluster (ε, up, seed): the hierarchy, built as synthesis builds it, of two
+    /// levels by default (the strands and their wisps, 16 strands or more each): a comb moves
+    /// wisps, and synthesis's third level (a quarter of the wisps) is a region of the head a
+    /// stroke would move as one.
+    SynthParams synth = [] {
+        SynthParams p;
+        p.cluster.levels = 2;
+        return p;
+    }();
+    double smoothing = StrandSamples::kDetailSmoothing;  ///< σ of the strand directions, a fraction of the vertices
+
+    /// @throw ValueError naming the parameter, its value and the rule.
+    void validate(const char* where) const;
+};
+
+struct CombStats
+{
+    std::size_t clusters = 0;        ///< coarsest clusters
+    std::size_t combedClusters = 0;  ///< coarsest strands some stroke reached
+    std::size_t movedStrands = 0;    ///< strands of those clusters
+    /// Over every (stroke, input vertex within its reach): mean angle in degrees between the
+    /// strand's tangent and the stroke's direction (at the nearest point), before and after
+    double angleBefore = 0.0, angleAfter = 0.0;
+    std::size_t reachVertices = 0;
+    /// Mean total turning per unit length of the moved strands, before and after (radians per unit)
+    double turningBefore = 0.0, turningAfter = 0.0;
+};
+
+struct CombResult
+{
+    StrandSet strands;                 ///< the input combed: same strands, vertices and attributes
+    std::vector<std::int32_t> cluster; ///< #strands: coarsest cluster of each
+    CombStats stats;
+    std::vector<SynthStage> stages;
+};
+
+/// @brief Deform one coarsest strand by one stroke (the deformation above).
+/// @param members the wisp's strands at as many vertices as @a points (world): the influence w at
+/// vertex i is the mean of the stroke's influence on them at vertex i (where each has moved to),
+/// its direction the influence-weighted mean; empty: the influence on @a points itself
+/// @param rotations receives one rotation per edge as quaternions (w, x, y, z)
+/// @return whether the stroke reached it (false: @a out equals @a points, rotations are identity)
+bool combPolyline(const std::vector<Vec3d>& points, const std::vector<std::vector<Vec3d>>& members, const CombStroke& stroke,
+                  double sigmaVertices, std::vector<Vec3d>& out, std::vector<std::array<double, 4>>& rotations);
+
+/// @brief Comb @a strands with @a strokes in order.
+/// @param scalp the scalp level set, or null for the sphere fitted to the roots (the hierarchy's frames)
+/// @throw ValueError (bad strokes or parameters, no strands, too few for the levels), InterruptedError.
+CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& strokes, const CombParams& params,
+                    openvdb::FloatGrid::ConstPtr scalp = nullptr, bool threaded = true,
+                    openvdb::util::NullInterrupter* interrupter = nullptr);
+
+} // namespace vdbhair

@@ -1,0 +1,173 @@
+#include "HairTransfer.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
+#include <vdbhair/strands/Resample.h>
+#include <vdbhair/synth/RootScatter.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace vdbhair {
+
+void TransferParams::validate(const char* where) const
+{
+    synth.validate(where);
+    if (!(smoothing >= 0.0 && smoothing <= 1.0))
+        throw ValueError(std::string(where) + ": smoothing " + std::to_string(smoothing) + ": 0 to 1 (a fraction of the strand's vertices)");
+    if (!(maxLengthRatio >= 1.0) || !std::isfinite(maxLengthRatio))
+        throw ValueError(std::string(where) + ": length ratio " + std::to_string(maxLengthRatio) + ": a finite ratio of at least 1");
+}
+
+void smoothSamples(StrandSamples& samples, double fraction, double radius)
+{
+    const int ns = samples.vertices;
+    std::vector<Vec3d> in(static_cast<std::size_t>(ns)), out(static_cast<std::size_t>(ns));
+    for (std::size_t s = 0; s < samples.count(); ++s) {
+        float* row = samples.row(s);
+        for (int l = 0; l < ns; ++l) in[std::size_t(l)] = Vec3d(row[3 * l], row[3 * l + 1], row[3 * l + 2]);
+        smoothPolyline(in.data(), in.size(), fraction * double(ns), out.data());
+        double len = 0.0;
+        for (int l = 0; l < ns; ++l) {
+            row[3 * l] = float(out[std::size_t(l)].x());
+            row[3 * l + 1] = float(out[std::size_t(l)].y());
+            row[3 * l + 2] = float(out[std::size_t(l)].z());
+            if (l > 0) len += (out[std::size_t(l)] - out[std::size_t(l - 1)]).length();
+        }
+        samples.lengths[s] = float(len * radius);
+    }
+}
+
+namespace {
+
+double medianLength(const StrandSamples& s, double radius)
+{
+    std::vector<double> v(s.lengths.begin(), s.lengths.end());
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+    return v[v.size() / 2] / radius;
+}
+
+} // namespace
+
+TransferResult transferHairstyle(const StrandSet& details, const StrandSet& base, const TransferParams& params,
+                                 openvdb::FloatGrid::ConstPtr baseScalp, bool threaded,
+                                 openvdb::util::NullInterrupter* interrupter)
+{
+    params.validate("transferHairstyle");
+    const SynthParams& sp = params.synth;
+    const int L = sp.cluster.levels;
+    if (details.numStrands() == 0) throw ValueError("DETAILS has no strands");
+    if (base.numStrands() == 0) throw ValueError("BASE has no strands");
+    TransferResult tr;
+    SynthResult& res = tr.result;
+    // 1. Both scalps.
+    {
+        SynthStageTimer t{res.stages, "scalp"};
+        tr.detailsMap = hairScalpMap(details, sp.up, nullptr);
+        res.map = hairScalpMap(base, sp.up, baseScalp, &res.up);
+    }
+    const ScalpMap& map = *res.map;
+    const double radius = map.radius();
+    tr.detailScale = radius / tr.detailsMap->radius();
+    // 2-3. DETAILS' hierarchy in BASE's scale, its coarsest level smoothed.
+    {
+        SynthStageTimer t{res.stages, "clustering"};
+        try {
+            res.example = hairHierarchy(details, *tr.detailsMap, sp, threaded, interrupter);
+        } catch (const ValueError& e) {
+            throw ValueError(std::string("DETAILS: ") + e.what());
+        }
+        for (StrandSamples& level : res.example.levels) {
+            for (Vec3d& r : level.roots) r *= tr.detailScale;
+            for (float& len : level.lengths) len = float(double(len) * tr.detailScale);
+        }
+        smoothSamples(res.example.levels.back(), params.smoothing, radius);
+    }
+    const StrandSamples& detailsCoarsest = res.example.levels.back();
+    // 4. The coarsest level: BASE's.
+    res.output.resize(std::size_t(L));
+    std::vector<std::size_t> counts(std::size_t(L), 0);
+    UvGrid grid;
+    FeatureImage region;
+    std::vector<std::uint32_t> baseOrder;
+    {
+        SynthStageTimer t{res.stages, "coarsest level"};
+        if (params.guides) {
+            res.output.back() = sampleStrands(base, map, sp.vertices, threaded);
+            // The guides' region: within two guide spacings of a guide's root.
+            const std::vector<Vec3d>& at = res.output.back().scalp;
+            grid = uvGridAround(at, sp.mapSpacing);
+            const std::vector<float> none(at.size(), 0.0f);
+            region = buildFeatureMap(grid, at, none.data(), 1, at, std::max(sp.mapSpacing, 2.0 * medianUvSpacing(at)));
+            // DETAILS' strands per coarsest strand at every level, scaled to the requested finest count.
+            const double g = double(base.numStrands());
+            const double perGuide = double(res.example.levels.front().count()) / double(detailsCoarsest.count());
+            const double f = params.strands > 0 ? double(params.strands) / (g * perGuide) : sp.strandScale;
+            for (int l = 0; l < L; ++l)
+                counts[std::size_t(l)] = std::max<std::size_t>(
+                    1, std::size_t(std::llround(g * double(res.example.levels[std::size_t(l)].count()) / double(detailsCoarsest.count()) * f)));
+            counts.back() = base.numStrands();
+        } else {
+            try {
+                tr.base = hairHierarchy(base, map, sp, threaded, interrupter, &baseOrder);
+            } catch (const ValueError& e) {
+                throw ValueError(std::string("BASE: ") + e.what());
+            }
+            res.output.back() = tr.base.levels.back();
+            for (int l = 0; l < L; ++l) counts[std::size_t(l)] = tr.base.levels[std::size_t(l)].count();
+        }
+    }
+    if (params.smoothBase) smoothSamples(res.output.back(), params.smoothing, radius);
+    if (double(counts[0]) * sp.vertices > double(sp.maxVertices))
+        throw LimitError("transferHairstyle: " + std::to_string(counts[0]) + " strands of " + std::to_string(sp.vertices) +
+                         " vertices exceed the cap of " + std::to_string(sp.maxVertices) + " vertices");
+    // Wisps too different in length cannot be matched (HairTransfer.h).
+    const double lb = medianLength(res.output.back(), radius), ld = medianLength(detailsCoarsest, radius);
+    tr.lengthRatio = ld > 0.0 ? lb / ld : 0.0;
+    if (!(tr.lengthRatio <= params.maxLengthRatio && tr.lengthRatio >= 1.0 / params.maxLengthRatio))
+        throw ValueError("coarsest wisps of BASE " + formatNumber(lb) + " head radii long (median), of DETAILS " + formatNumber(ld) +
+                         ": more than " + formatNumber(params.maxLengthRatio) + " times apart, too different for their clusters to be matched");
+    // 5. Finer levels.
+    const auto rootsOf = [&](int l) -> LevelRoots {
+        LevelRoots out;
+        if (params.guides) {
+            RootScatterParams rp;
+            rp.count = counts[std::size_t(l)];
+            rp.iterations = sp.rootIterations;
+            rp.seed = sp.seed;
+            rp.stream = std::uint64_t(l);
+            out.positions = scatterRoots(map, grid, region, rp, threaded).positions;
+            return out;
+        }
+        // BASE's roots and BASE's own wisps: each root's centre is its cluster in BASE's hierarchy.
+        const std::vector<std::uint32_t>& label = tr.base.clusterings[std::size_t(l)].label;
+        if (l == 0) {  // BASE's own strands, in BASE's order
+            out.positions.resize(base.numStrands());
+            out.parent.resize(base.numStrands());
+            for (std::size_t i = 0; i < baseOrder.size(); ++i) {
+                out.positions[baseOrder[i]] = Vec3d(base.root(baseOrder[i]));
+                out.parent[baseOrder[i]] = label[i];
+            }
+        } else {
+            out.positions = tr.base.levels[std::size_t(l)].roots;
+            out.parent = label;
+        }
+        return out;
+    };
+    double finestVoxel = sp.voxelSize;
+    if (finestVoxel <= 0.0) finestVoxel = params.guides ? suggestVoxelSize(details) * tr.detailScale : suggestVoxelSize(base);
+    synthesizeFinerLevels(res, res.example, rootsOf, sp, finestVoxel, /*refineCoarsest=*/false, baseScalp, threaded, interrupter);
+    tr.baseLabel.resize(base.numStrands());
+    for (std::size_t s = 0; s < base.numStrands(); ++s) tr.baseLabel[s] = std::int32_t(s);
+    if (!params.guides)
+        for (std::size_t i = 0; i < baseOrder.size(); ++i) {
+            std::uint32_t c = std::uint32_t(i);
+            for (const Clustering& cl : tr.base.clusterings) c = cl.label[c];
+            tr.baseLabel[baseOrder[i]] = std::int32_t(c);
+        }
+    return tr;
+}
+
+} // namespace vdbhair
