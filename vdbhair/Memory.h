@@ -7,12 +7,11 @@
 /// huge pages (2 MiB, one fault for 512 small pages) the same buffer faults in within 0.03 s.
 /// Linux gives them only to memory that asks (`transparent_hugepage` set to `madvise`, Debian's
 /// default), so the library asks for its large, freshly written arrays: readers' positions,
-/// retraced strands.
+/// retraced strands, the bytes writers assemble.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <vector>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -36,12 +35,13 @@ inline void adviseHugePages(const void* p, std::size_t bytes)
 #endif
 }
 
-/// @brief @a v.reserve(@a n), with its storage hinted for huge pages (adviseHugePages()).
-template<typename T>
-void reserveHugePages(std::vector<T>& v, std::size_t n)
+/// @brief @a v.reserve(@a n), with its storage hinted for huge pages (adviseHugePages()), for a
+/// std::vector or the std::string a writer builds its file in.
+template<typename ContainerT>
+void reserveHugePages(ContainerT& v, std::size_t n)
 {
     v.reserve(n);
-    adviseHugePages(v.data(), v.capacity() * sizeof(T));
+    adviseHugePages(v.data(), v.capacity() * sizeof(*v.data()));
 }
 
 } // namespace vdbhair

@@ -239,16 +239,36 @@ public:
         return Bricks::blend(mCell, float(p.x() - bx), float(p.y() - by), float(p.z() - bz));
     }
 
-    /// @brief sample() for scattered points, each likely in another cell than the last (the
-    /// vertices of a strand a voxel apart): no cached cell to compare and reload, so that the
-    /// samples of successive points overlap in the processor. Same values as sample().
-    Float4 sampleScattered(const openvdb::Vec3d& p)
+    /// @brief sample() at each of @a n scattered index-space points @a p (the vertices of a
+    /// strand, about a voxel apart), into @a out. Each point's cell is found and its corners'
+    /// cache lines requested first, then all are blended: with a field larger than the cache,
+    /// the loads of many points overlap instead of waiting one after another. Same values as
+    /// sample() at each point.
+    void sampleScattered(const openvdb::Vec3d* p, std::size_t n, Float4* out)
     {
-        const int bx = floorIndex(p.x()), by = floorIndex(p.y()), bz = floorIndex(p.z());
-        const typename Bricks::Brick* brick = mBricks.brickAt(bx >> 3, by >> 3, bz >> 3);
-        if (__builtin_expect(brick == mBricks.zeroBrick(), 0)) return sample(p);  // through the tree (load())
-        const Float4* cell = brick->cell + ((bx & 7) * N + (by & 7)) * N + (bz & 7);
-        return Bricks::blend(cell, float(p.x() - bx), float(p.y() - by), float(p.z() - bz));
+        mCells.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const int bx = floorIndex(p[i].x()), by = floorIndex(p[i].y()), bz = floorIndex(p[i].z());
+            const typename Bricks::Brick* brick = mBricks.brickAt(bx >> 3, by >> 3, bz >> 3);
+            if (brick == mBricks.zeroBrick()) {
+                mCells[i] = nullptr;  // no leaf holds the lower corner: through the tree below
+                continue;
+            }
+            const Float4* c = brick->cell + ((bx & 7) * N + (by & 7)) * N + (bz & 7);
+            __builtin_prefetch(c);
+            __builtin_prefetch(c + N);
+            __builtin_prefetch(c + N * N);
+            __builtin_prefetch(c + N * N + N);
+            mCells[i] = c;
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!mCells[i]) {
+                out[i] = sample(p[i]);
+                continue;
+            }
+            const openvdb::Vec3d& q = p[i];
+            out[i] = Bricks::blend(mCells[i], float(q.x() - floorIndex(q.x())), float(q.y() - floorIndex(q.y())), float(q.z() - floorIndex(q.z())));
+        }
     }
 
     /// @brief As above, as a vector and a weight.
@@ -302,6 +322,7 @@ private:
     const typename Bricks::Brick* mBrick = nullptr;
     const Float4* mCell = nullptr;
     Float4 mScratch[N * N + N + 2] = {};
+    std::vector<const Float4*> mCells;  ///< sampleScattered()'s cells (nullptr: through the tree)
 };
 
 } // namespace vdbhair

@@ -982,11 +982,15 @@ public:
         mTangents.resize(n);
         computeTangents(strands.data(i), n, mTangents.data());
         const Vec3f* p = strands.data(i);
+        mIndex.resize(n);
+        mSamples.resize(n);
+        for (std::size_t k = 0; k < n; ++k) mIndex[k] = mMap.worldToIndex(Vec3d(p[k]));
+        mSampler.sampleScattered(mIndex.data(), n, mSamples.data());
         float strandSum = 0.f;  // at most a few thousand angles of at most pi: float holds them
         std::size_t strandCount = 0;
         for (std::size_t k = 0; k < n; ++k) {
             const Vec3f& t = mTangents[k];
-            const Float4 r = mSampler.sampleScattered(mMap.worldToIndex(Vec3d(p[k])));
+            const Float4& r = mSamples[k];
             const float len2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
             const float limit = kThreshold * r[3];
             // Outside the field (no active corner), vanishing there, or a point without tangent.
@@ -1004,6 +1008,8 @@ private:
     FieldSampler<TreeT> mSampler;
     const FieldMapping& mMap;
     std::vector<Vec3f> mTangents;
+    std::vector<Vec3d> mIndex;
+    std::vector<Float4> mSamples;
 };
 
 /// @brief The mean angle in degrees of each set in @a sets against @a field, through one set of
@@ -1021,9 +1027,21 @@ std::vector<double> meanAnglesDeg(const std::vector<const StrandSet*>& sets, con
         using TreeT = typename std::decay_t<decltype(grid)>::TreeType;
         const FieldMapping map = FieldMapping::fromGrid(grid);
         const BrickedField<TreeT> bricks(grid.tree());
+        // Strands in spatial order (by the first set's roots): neighbours share bricks, which
+        // then come from the cache, where index order jumps across a field larger than the cache.
+        // Each strand's sums land in its own slot, so the order changes no result.
+        const std::vector<std::uint32_t> order = spatialOrder(*sets[0]);
         auto body = [&](const tbb::blocked_range<std::size_t>& r) {
             AngleMeter<TreeT> meter(bricks, map);
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            for (std::size_t j = r.begin(); j != r.end(); ++j) {
+                const std::size_t i = j < order.size() ? order[j] : j;  // strands only the other sets have: last
+                // The spatial order scatters strands over memory: fetch a later one meanwhile.
+                if (j + 2 < order.size()) {
+                    const std::size_t later = order[j + 2];
+                    for (const StrandSet* set : sets) {
+                        if (later < set->numStrands()) prefetchBytes(set->data(later), set->size(later) * sizeof(Vec3f));
+                    }
+                }
                 for (std::size_t s = 0; s < nSets; ++s) {
                     if (i < sets[s]->numStrands()) meter.measure(*sets[s], i, sum[i * nSets + s], count[i * nSets + s]);
                 }

@@ -102,8 +102,8 @@ struct TangentAngles
 };
 
 /// @brief meanTangentAngleDeg() of @a before and of @a after against @a field, in one parallel
-/// pass that builds the field's bricks once (the report of `retrace`: a tenth of the time of
-/// measuring each set on its own).
+/// pass that builds the field's bricks once, strand i of both sets together and the strands in
+/// spatial order (the report of `retrace`).
 TangentAngles meanTangentAnglesDeg(const StrandSet& before, const StrandSet& after, const openvdb::GridBase& field,
                                    bool threaded = true);
 

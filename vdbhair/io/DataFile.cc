@@ -1,5 +1,6 @@
 #include "DataFile.h"
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/MappedFile.h>
@@ -68,7 +69,7 @@ void writeData(const std::string& path, const StrandSet& strands)
         throw ValueError(where + ": " + std::to_string(strands.numStrands()) + " strands exceed the format's int32 count");
     }
     std::string out;
-    out.reserve(4 + 4 * strands.numStrands() + 12 * strands.numVertices());
+    reserveHugePages(out, 4 + 4 * strands.numStrands() + 12 * strands.numVertices());
     const std::int32_t nS = std::int32_t(strands.numStrands());
     out.append(reinterpret_cast<const char*>(&nS), 4);
     for (std::size_t i = 0; i < strands.numStrands(); ++i) {

@@ -1,5 +1,6 @@
 #include "HairFile.h"
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
@@ -181,7 +182,7 @@ void writeHair(const std::string& path, const StrandSet& strands)
     std::string out;
     auto put = [&out](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
     auto putU32 = [&](std::uint32_t v) { put(&v, 4); };
-    out.reserve(128 + 2 * nS + 28 * nP);
+    reserveHugePages(out, 128 + 2 * nS + 28 * nP);
     put("HAIR", 4);
     putU32(std::uint32_t(nS));
     putU32(std::uint32_t(nP));

@@ -435,7 +435,7 @@ void writePly(const std::string& path, const StrandSet& strands, PlyEncoding enc
     const bool binary = encoding == PlyEncoding::Binary;
 
     std::string out;
-    out.reserve(256 + (binary ? 15 : 40) * nV + 16 * nV);
+    reserveHugePages(out, 256 + (binary ? 15 : 40) * nV + 16 * nV);
     out += "ply\nformat ";
     out += binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
     out += std::string("comment ") + creatorString() + "\n";
