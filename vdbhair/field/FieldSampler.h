@@ -18,6 +18,7 @@
 /// tests the weight afterwards, with no branch per lane (StreamlineTracer.cc).
 #pragma once
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/field/Simd.h>
 
@@ -66,6 +67,7 @@ public:
         const std::size_t count = leaves.leafCount();
         // One more brick than leaves: the last stays all zero (see brickAt()).
         mBricks.reset(new Brick[count + 1]);
+        adviseHugePages(mBricks.get(), (count + 1) * sizeof(Brick));  // 11.7 KB a leaf, faulted in on first use (Memory.h)
         mState.reset(new std::atomic<std::uint8_t>[count + 1]);
         mLeaves.resize(count);
         for (std::size_t i = 0; i < count; ++i) {

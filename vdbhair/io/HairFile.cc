@@ -113,13 +113,13 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
     const char* transparency = arrayAt(kTransparency, 4);
     const char* colors = arrayAt(kColors, 12);
 
-    // Strands: each array is copied once, from the file's bytes to the set. The checks run over
-    // whole arrays; only a file that fails one is walked strand by strand, to name the culprit.
+    // Strands: each array is copied once, from the file's bytes to the set, the positions checked
+    // piece by piece as they are copied; only a file that fails the check or has strands to drop
+    // is walked strand by strand (to name the culprit, to filter).
     StrandSet out;
     out.defaults = defaults;
     out.reserve(nS, nP);
     ShortStrandFilter filter(opts, report, where);
-    const bool finite = allFinite(points, 3 * nP);
     const bool anyShort = std::any_of(counts.begin(), counts.end(), [](std::uint32_t c) { return c < 2; });
     auto copyRange = [&](auto& dst, const char* src, std::size_t bytesPerPoint, std::size_t v, std::size_t n) {
         if (!src) return;
@@ -127,14 +127,25 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
         dst.resize(old + n);
         std::memcpy(reinterpret_cast<char*>(dst.data() + old), src + bytesPerPoint * v, bytesPerPoint * n);
     };
+    // Positions in pieces that stay in the cache while they are copied and checked.
+    bool finite = true;
+    if (!anyShort) {
+        constexpr std::size_t kPiece = std::size_t(1) << 14;
+        for (std::size_t v = 0; v < nP && finite; v += kPiece) {
+            const std::size_t n = std::min<std::size_t>(kPiece, nP - v);
+            copyRange(out.positions, points, 12, v, n);
+            finite = allFinite(out.positions.data() + v, 3 * n);
+        }
+    }
     if (finite && !anyShort) {
-        copyRange(out.positions, points, 12, 0, nP);
         copyRange(out.thickness, thickness, 4, 0, nP);
         copyRange(out.transparency, transparency, 4, 0, nP);
         copyRange(out.color, colors, 12, 0, nP);
         out.offsets.resize(nS + 1);
         for (std::size_t i = 0; i < nS; ++i) out.offsets[i + 1] = out.offsets[i] + counts[i];
     } else {
+        out.positions.clear();
+        finite = allFinite(points, 3 * nP);
         InterruptPoll poll(opts.interrupter, where);
         std::size_t v = 0;
         for (std::size_t i = 0; i < nS; ++i) {
