@@ -14,6 +14,9 @@ namespace vdbhair {
 /// up front), or read into a buffer where a file cannot be mapped. The readers then copy each
 /// value once, from the file's pages to the StrandSet: reading a 77 MB file into a fresh buffer
 /// first cost more than all the parsing (zeroing and faulting in the buffer, then copying).
+/// @warning A file truncated by another process while it is mapped ends the process with SIGBUS
+/// when a page past the new end is read (the price of not copying; files being rewritten in place
+/// are not read safely by any reader, but a copy would fail with an error instead).
 class MappedFile
 {
 public:
