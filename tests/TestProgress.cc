@@ -8,6 +8,7 @@
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MappedFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/render/StrandRenderer.h>
 
@@ -266,6 +267,19 @@ TEST_CASE("Progress: reading a file reports its bytes and stops when told to", "
     CHECK(s.unit == "bytes");
     Recorder stop(1);
     CHECK_THROWS_AS(readFileBytes(path, "test", &stop), InterruptedError);
+
+    // Mapped, as the binary strand readers read: the same bytes, the same stage, the same stop.
+    Recorder mapRec;
+    {
+        const MappedFile mapped(path, "test", &mapRec);
+        REQUIRE(mapped.size() == bytes.size());
+        CHECK(std::equal(bytes.begin(), bytes.end(), mapped.data()));
+    }
+    CHECK(mapRec.stages.at("reading progress.bin").done == bytes.size());
+    Recorder mapStop(1);
+    CHECK_THROWS_AS(MappedFile(path, "test", &mapStop), InterruptedError);
+    CHECK(MappedFile(test::writeBytes("empty.bin", ""), "test").size() == 0);
+    CHECK_THROWS_AS(MappedFile(test::tempPath("no such file"), "test"), IoError);
 
     // Through a strand reader's options.
     const StrandSet strands = manyStrands(8);

@@ -9,6 +9,9 @@
 //   short) at 30 vertices and at full resolution
 //   follicles (Witkin & Heckbert repulsion on the    vs  tools::UniformPointScatter in the
 //   scalp level set, `vdbhair roots`)                    zero-crossing voxels + projection
+//   end to end (--sections e2e, opt-in): the         vs  vdbhair_peer (Peer.cc): the same jobs
+//   `vdbhair` verbs info, field, retrace, refine,        with stock OpenVDB and an ifstream
+//   --help as processes, as a user times them            reader, as processes on the same files
 //
 // Inputs: a real hairstyle from ../shared/data and a 100,000-strand, 64-vertex hairstyle made
 // deterministically from the bundled one (jittered copies), and, for reference, as many strands
@@ -45,8 +48,13 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <fcntl.h>
+#include <malloc.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -467,6 +475,119 @@ void benchmarkSynthesis(const std::string& data, const std::string& source, std:
     }
 }
 
+/// One finished child process: wall seconds, CPU seconds (user + system), peak resident MiB.
+struct ProcessRun
+{
+    double wall = 0.0, cpu = 0.0, peakMiB = 0.0;
+    int status = 0;
+};
+
+/// @brief Run @a args (a program and its arguments) as a process with stdout and stderr sent to
+/// /dev/null, and measure it from the outside (wait4's rusage: the child's own CPU and peak RSS).
+ProcessRun runProcess(const std::vector<std::string>& args)
+{
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    const double t0 = now();
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int devNull = open("/dev/null", O_WRONLY);
+        dup2(devNull, 1);
+        dup2(devNull, 2);
+        execv(argv[0], argv.data());
+        _exit(127);
+    }
+    ProcessRun r;
+    rusage u{};
+    if (pid < 0 || wait4(pid, &r.status, 0, &u) != pid) {
+        r.status = -1;
+        return r;
+    }
+    r.wall = now() - t0;
+    r.cpu = double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+    r.peakMiB = double(u.ru_maxrss) / 1024.0;
+    return r;
+}
+
+double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+/// @brief The end-to-end section: the `vdbhair` command and the stock-OpenVDB peer program
+/// (apps/benchmark/Peer.cc, the same operations as the library rows above, with an ifstream
+/// reader) as processes on the same files, as a user runs them from the shell: each verb and its
+/// peer in turn (A B A B ...), @a runs times after a warm-up, median wall and CPU time, peak
+/// resident memory, and the ratio of the peer's wall time to vdbhair's.
+void benchmarkEndToEnd(const std::string& source, std::size_t strands, std::size_t vertices, int runs, std::string ours)
+{
+    const std::filesystem::path bin = std::filesystem::read_symlink("/proc/self/exe").parent_path();
+    if (ours.empty()) ours = (bin / "vdbhair").string();
+    const std::string peer = (bin / "vdbhair_peer").string();
+    if (!std::filesystem::exists(ours) || !std::filesystem::exists(peer)) {
+        std::printf("\n(skipped the end-to-end section: %s or %s not found)\n", ours.c_str(), peer.c_str());
+        return;
+    }
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("vdbhair_e2e_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string hair = (dir / "hair.data").string(), field = (dir / "field.vdb").string();
+    char voxel[32];
+    {
+        // Freed before any child runs: a child's peak memory counts what it shares of this
+        // process when it is forked.
+        const StrandSet big = jitteredCopies(readStrands(source + "/scenes/default/ponytail.hair"), strands, vertices, 0.3f);
+        writeStrands(hair, big);
+        std::snprintf(voxel, sizeof voxel, "%.9g", suggestVoxelSize(big));
+    }
+    malloc_trim(0);
+    runProcess({ours, "field", hair, "-o", field, "--voxel-size", voxel});  // the field both retraces follow
+    std::printf("\n== end to end: %zu strands x %zu vertices (%.0f MB .data), voxel size %s, %d run(s) each, interleaved ==\n",
+                strands, vertices, double(std::filesystem::file_size(hair)) / 1e6, voxel, runs);
+
+    struct Verb
+    {
+        const char* name;
+        std::vector<std::string> ours, peer;
+    };
+    auto out = [&](const char* name) { return (dir / name).string(); };
+    const std::vector<Verb> verbs = {
+        {"info", {ours, "info", hair}, {peer, "info", hair}},
+        {"field", {ours, "field", hair, "-o", out("f_ours.vdb"), "--voxel-size", voxel},
+         {peer, "field", hair, "-o", out("f_peer.vdb"), "--voxel-size", voxel}},
+        {"retrace", {ours, "retrace", hair, "--field", field, "-o", out("r_ours.data")},
+         {peer, "retrace", hair, "--field", field, "-o", out("r_peer.data")}},
+        {"refine", {ours, "refine", hair, "-o", out("rf_ours.data"), "--voxel-size", voxel},
+         {peer, "refine", hair, "-o", out("rf_peer.data"), "--voxel-size", voxel}},
+        {"--help", {ours, "--help"}, {peer, "--help"}},
+    };
+    std::printf("%-8s | %-32s | %-32s | %s\n", "verb", "vdbhair: wall, CPU, peak", "peer: wall, CPU, peak", "peer/vdbhair wall (CPU)");
+    for (const Verb& v : verbs) {
+        std::vector<double> wall[2], cpu[2], rss[2];
+        int failed = 0;
+        for (int r = -1; r < runs; ++r) {  // run -1: the warm-up (page cache, lazy binding), not counted
+            for (int k = 0; k < 2; ++k) {
+                const ProcessRun p = runProcess(k == 0 ? v.ours : v.peer);
+                if (p.status != 0) ++failed;
+                if (r < 0) continue;
+                wall[k].push_back(p.wall);
+                cpu[k].push_back(p.cpu);
+                rss[k].push_back(p.peakMiB);
+            }
+        }
+        char a[64], b[64];
+        std::snprintf(a, sizeof a, "%7.3f s %7.3f s %6.0f MiB", median(wall[0]), median(cpu[0]), median(rss[0]));
+        std::snprintf(b, sizeof b, "%7.3f s %7.3f s %6.0f MiB", median(wall[1]), median(cpu[1]), median(rss[1]));
+        std::printf("%-8s | %-32s | %-32s | %.2fx (%.2fx)%s\n", v.name, a, b, median(wall[1]) / median(wall[0]),
+                    median(cpu[1]) / median(cpu[0]), failed ? "   (some runs failed: exit status not 0)" : "");
+        std::fflush(stdout);
+    }
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -478,6 +599,8 @@ int main(int argc, char** argv)
     int reps = 3, threads = 0;
     double voxelSize = 0.0;
     std::string sections = "field,helicoids,helicoid-fields,fit,roots,interpolate,synth";
+    int e2eRuns = 5;
+    std::string e2eCommand;
     std::size_t fitStrands = 2000;
     std::vector<std::size_t> rootCounts{10000, 100000};
     std::string rootHeads;
@@ -488,7 +611,11 @@ int main(int argc, char** argv)
     app.add_option("--reps", reps, "Repetitions (the best time is reported)")->capture_default_str();
     app.add_option("--threads", threads, "Threads (0: all cores)")->capture_default_str();
     app.add_option("--voxel-size", voxelSize, "Voxel size (0: vdbhair's suggestion for each input)");
-    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots, interpolate, synth (comma-separated)")->capture_default_str();
+    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots, interpolate, synth, "
+                                           "and e2e (the command and a stock-OpenVDB peer as processes; not run by default) (comma-separated)")->capture_default_str();
+    app.add_option("--e2e-runs", e2eRuns, "Counted runs of each command in the e2e section (after one warm-up)")->capture_default_str();
+    app.add_option("--e2e-command", e2eCommand, "The vdbhair command the e2e section runs (default: the one built next to this program; "
+                                                "another build's, for before and after)");
     app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
     app.add_option("--root-counts", rootCounts, "Root counts of the follicle rows")->delimiter(',')->capture_default_str();
     app.add_option("--root-heads", rootHeads, "Only the shared heads whose path contains this");
@@ -520,5 +647,6 @@ int main(int argc, char** argv)
     if (wants("roots")) benchmarkRoots(data, rootCounts, rootHeads);
     if (wants("interpolate")) benchmarkInterpolation(reps);
     if (wants("synth")) benchmarkSynthesis(data, source, strands, vertices);
+    if (wants("e2e")) benchmarkEndToEnd(source, strands, vertices, std::max(1, e2eRuns), e2eCommand);
     return 0;
 }

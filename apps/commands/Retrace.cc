@@ -49,12 +49,13 @@ void printTraceReport(const TraceStats& s, double before, double after, double d
 
 namespace {
 
-/// The mean angle between @a strands and @a field, NaN when no vertex lies inside the field.
-double angleOrNan(const StrandSet& strands, const openvdb::GridBase& field)
+/// The mean angles between the input and output strands and @a field, NaN for a set with no
+/// vertex inside the field.
+void anglesOrNan(const StrandSet& input, const StrandSet& output, const openvdb::GridBase& field, double& before, double& after)
 {
-    std::size_t counted = 0;
-    const double a = meanTangentAngleDeg(strands, field, &counted);
-    return counted ? a : std::nan("");
+    const TangentAngles a = meanTangentAnglesDeg(input, output, field);
+    before = a.countedBefore ? a.beforeDeg : std::nan("");
+    after = a.countedAfter ? a.afterDeg : std::nan("");
 }
 
 struct RetraceParams
@@ -101,8 +102,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         const std::vector<std::string> names = vdbGridNames(p.field, "retrace(" + p.field + ")");
         if (std::find(names.begin(), names.end(), p.grid) != names.end()) {
             const openvdb::GridBase::Ptr tangent = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
-            before = angleOrNan(strands, *tangent);
-            after = angleOrNan(out, *tangent);
+            anglesOrNan(strands, out, *tangent, before, after);
         }
         const double disp = meanVertexDisplacement(strands, out);
         writeStrands(p.output, out);
@@ -127,8 +127,8 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 
     TraceStats stats;
     const StrandSet out = retraceStrands(strands, *grid, tp, &stats, nullptr, true, common.interrupter);
-    const double before = angleOrNan(strands, *grid);
-    const double after = angleOrNan(out, *grid);
+    double before = 0.0, after = 0.0;
+    anglesOrNan(strands, out, *grid, before, after);
     const double disp = meanVertexDisplacement(strands, out);
     writeStrands(p.output, out);
     if (common.json) {

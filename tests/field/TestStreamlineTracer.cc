@@ -291,3 +291,39 @@ TEST_CASE("retraceStrands: bad parameters and grids", "[field]")
     REQUIRE_THROWS_WITH(retraceStrands(circles, *f.density, TraceParams{}), Contains("holds float values; tracing needs a vector grid"));
 }
 
+
+TEST_CASE("meanTangentAnglesDeg: strands at a known angle to a uniform field, both sets as each on its own", "[field]")
+{
+    // A uniform field along x (estimated from straight strands along x), then strands across it.
+    StrandSet along, tilted, outside;
+    const double angleDeg = 30.0;
+    const Vec3f tilt(float(std::cos(angleDeg * M_PI / 180.0)), float(std::sin(angleDeg * M_PI / 180.0)), 0.f);
+    for (int i = 0; i < 40; ++i) {
+        std::vector<Vec3f> a, t, o;
+        const Vec3f root(0.f, 0.2f * float(i % 8), 0.2f * float(i / 8));
+        for (int k = 0; k < 40; ++k) a.push_back(root + Vec3f(0.25f * float(k), 0.f, 0.f));
+        for (int k = 0; k < 6; ++k) t.push_back(root + Vec3f(2.f, 0.2f, 0.2f) + tilt * (0.1f * float(k)));
+        for (int k = 0; k < 6; ++k) o.push_back(root + Vec3f(100.f + float(k), 0.f, 0.f));  // far outside the field
+        along.addStrand(a);
+        tilted.addStrand(t);
+        outside.addStrand(o);
+    }
+    FieldParams p;
+    p.voxelSize = 0.5;
+    const TangentField f = estimateTangentField(along, p);
+    std::size_t n = 0;
+    REQUIRE(meanTangentAngleDeg(tilted, *f.tangent, &n) == Approx(angleDeg).margin(1e-3));
+    REQUIRE(n == tilted.numVertices());
+    const TangentAngles both = meanTangentAnglesDeg(tilted, along, *f.tangent);
+    std::size_t nAlong = 0;
+    REQUIRE(both.beforeDeg == meanTangentAngleDeg(tilted, *f.tangent));
+    REQUIRE(both.afterDeg == meanTangentAngleDeg(along, *f.tangent, &nAlong));
+    REQUIRE(both.afterDeg < 1e-2);
+    REQUIRE(both.countedBefore == n);
+    REQUIRE(both.countedAfter == nAlong);
+    // Outside the field nothing is counted; the threaded and serial passes agree exactly.
+    const TangentAngles none = meanTangentAnglesDeg(outside, tilted, *f.tangent, false);
+    REQUIRE(none.countedBefore == 0);
+    REQUIRE(none.beforeDeg == 0.0);
+    REQUIRE(none.afterDeg == meanTangentAnglesDeg(outside, tilted, *f.tangent, true).afterDeg);
+}

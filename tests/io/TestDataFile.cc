@@ -6,6 +6,7 @@
 #include <vdbhair/io/HairFile.h>
 
 #include <cstring>
+#include <limits>
 
 using namespace vdbhair;
 using Catch::Matchers::Contains;
@@ -113,5 +114,15 @@ TEST_CASE("readData / readBin: each kind of bad input has its own error", "[io]"
         test::put(b, std::int32_t(5));
         for (int i = 0; i < 7; ++i) test::put(b, 0.f);
         REQUIRE_THROWS_WITH(readBin(test::writeBytes("b.bin", b)), Contains("strand 0 declares 5 vertices (140 bytes) but only 28 bytes remain"));
+    }
+    SECTION("bin: a non-finite coordinate is named with its vertex's byte")
+    {
+        std::string b;
+        test::put(b, std::int32_t(1));
+        test::put(b, std::int32_t(3));
+        for (int v = 0; v < 3; ++v) {
+            for (int i = 0; i < 7; ++i) test::put(b, v == 1 && i == 2 ? std::numeric_limits<float>::quiet_NaN() : float(v));
+        }
+        REQUIRE_THROWS_WITH(readBin(test::writeBytes("nan.bin", b)), Contains("at byte 36: vertex 1 has a non-finite coordinate"));
     }
 }

@@ -94,6 +94,19 @@ double resolveStep(const openvdb::GridBase& field, const TraceParams& params);
 double meanTangentAngleDeg(const StrandSet& strands, const openvdb::GridBase& field,
                            std::size_t* counted = nullptr, bool threaded = true);
 
+/// meanTangentAngleDeg() of two sets, e.g. a retrace's input and output.
+struct TangentAngles
+{
+    double beforeDeg = 0.0, afterDeg = 0.0;
+    std::size_t countedBefore = 0, countedAfter = 0;  ///< vertices that entered each mean
+};
+
+/// @brief meanTangentAngleDeg() of @a before and of @a after against @a field, in one parallel
+/// pass that builds the field's bricks once, strand i of both sets together and the strands in
+/// spatial order (the report of `retrace`).
+TangentAngles meanTangentAnglesDeg(const StrandSet& before, const StrandSet& after, const openvdb::GridBase& field,
+                                   bool threaded = true);
+
 /// @brief Mean distance between corresponding vertices of @a a and @a b: each vertex of a
 /// strand of @a a against the point of the same strand of @a b at the same arc length (up to
 /// the shorter of the two strands). Both sets must have the same strand count.

@@ -22,11 +22,14 @@ class ByteReader
 public:
     /// @param where message prefix, e.g. "readHair(a.hair)"
     ByteReader(const std::vector<char>& bytes, std::string where)
-        : mBytes(bytes), mWhere(std::move(where)) {}
+        : ByteReader(bytes.data(), bytes.size(), std::move(where)) {}
+    /// @param data, size the bytes (e.g. a MappedFile's), which must outlive the reader
+    ByteReader(const char* data, std::size_t size, std::string where)
+        : mData(data), mSize(size), mWhere(std::move(where)) {}
 
     std::size_t offset() const { return mOffset; }
-    std::size_t size() const { return mBytes.size(); }
-    std::size_t remaining() const { return mBytes.size() - mOffset; }
+    std::size_t size() const { return mSize; }
+    std::size_t remaining() const { return mSize - mOffset; }
     const std::string& where() const { return mWhere; }
 
     /// @brief Fail unless @a count items of @a itemSize bytes remain (no overflow possible).
@@ -41,11 +44,18 @@ public:
     /// @brief Move to absolute byte @a off (which may be the end of the file).
     void seek(std::uint64_t off, const std::string& what)
     {
-        if (off > mBytes.size()) {
+        if (off > mSize) {
             fail(what + " points to byte " + std::to_string(off) + ", past the end of the " +
-                 std::to_string(mBytes.size()) + "-byte file");
+                 std::to_string(mSize) + "-byte file");
         }
         mOffset = std::size_t(off);
+    }
+
+    /// @brief Fail unless @a count items of @a itemSize bytes remain, with the message built only
+    /// on failure (for per-item loops: `what` is a string literal, no allocation).
+    void require(std::uint64_t count, std::size_t itemSize, const char* what) const
+    {
+        if (itemSize != 0 && count > remaining() / itemSize) require(count, itemSize, std::string(what));
     }
 
     template<typename T>
@@ -54,7 +64,7 @@ public:
         static_assert(std::is_trivially_copyable<T>::value, "plain data only");
         require(1, sizeof(T), what);
         T value;
-        std::memcpy(&value, mBytes.data() + mOffset, sizeof(T));
+        std::memcpy(&value, mData + mOffset, sizeof(T));
         mOffset += sizeof(T);
         return value;
     }
@@ -64,7 +74,7 @@ public:
     {
         static_assert(std::is_trivially_copyable<T>::value, "plain data only");
         require(count, sizeof(T), what);
-        if (count) std::memcpy(dst, mBytes.data() + mOffset, std::size_t(count) * sizeof(T));
+        if (count) std::memcpy(dst, mData + mOffset, std::size_t(count) * sizeof(T));
         mOffset += std::size_t(count) * sizeof(T);
     }
 
@@ -74,7 +84,7 @@ public:
         mOffset += std::size_t(bytes);
     }
 
-    const char* current() const { return mBytes.data() + mOffset; }
+    const char* current() const { return mData + mOffset; }
 
     [[noreturn]] void fail(const std::string& msg) const { failAt(mOffset, msg); }
     [[noreturn]] void failAt(std::size_t off, const std::string& msg) const
@@ -83,9 +93,25 @@ public:
     }
 
 private:
-    const std::vector<char>& mBytes;
+    const char* mData;
+    std::size_t mSize;
     std::string mWhere;
     std::size_t mOffset = 0;
 };
+
+/// @brief Whether the @a count floats at @a v (any alignment) are all finite: branch-free over the
+/// whole array, so that readers test a strand or an array at once and look for the culprit (to
+/// name it) only on failure.
+inline bool allFinite(const void* v, std::size_t count)
+{
+    const char* bytes = static_cast<const char*>(v);
+    std::uint32_t bad = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        std::uint32_t bits;
+        std::memcpy(&bits, bytes + 4 * i, 4);
+        bad |= std::uint32_t((bits & 0x7f800000u) == 0x7f800000u);  // all exponent bits: inf or NaN
+    }
+    return bad == 0;
+}
 
 } // namespace vdbhair

@@ -1,4 +1,5 @@
 #include "FileUtil.h"
+#include "MappedFile.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
@@ -12,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -57,6 +60,46 @@ std::vector<char> readFileBytes(const std::string& path, const std::string& wher
         if (progress.add(std::uint64_t(n))) throw InterruptedError(where + ": interrupted while reading");
     }
     return bytes;
+}
+
+MappedFile::MappedFile(const std::string& path, const std::string& where, openvdb::util::NullInterrupter* interrupter)
+{
+    requireRegularFile(path, where);
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw IoError(where + ": cannot open for reading: " + std::strerror(errno));
+    struct stat st;
+    if (::fstat(fd, &st) != 0 || st.st_size < 0) {
+        const std::string reason = std::strerror(errno);
+        ::close(fd);
+        throw IoError(where + ": cannot determine the file size: " + reason);
+    }
+    mSize = std::size_t(st.st_size);
+    const std::string stage = "reading " + fs::path(path).filename().string();
+    ProgressCounter progress(interrupter, stage.c_str(), std::uint64_t(mSize), "bytes");
+    if (mSize > 0) {
+        // MAP_POPULATE maps every page of the page cache in one call (no fault per page).
+        void* m = ::mmap(nullptr, mSize, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+        if (m != MAP_FAILED) {
+            mMap = m;
+            mData = static_cast<const char*>(m);
+        }
+    }
+    ::close(fd);
+    if (!mMap) {
+        // Not mappable (or empty): read it the ordinary way.
+        mBuffer = readFileBytes(path, where);
+        mSize = mBuffer.size();
+        mData = mBuffer.data();
+    }
+    if (progress.add(std::uint64_t(mSize))) {
+        if (mMap) ::munmap(mMap, mSize);  // the destructor does not run for a throwing constructor
+        throw InterruptedError(where + ": interrupted while reading");
+    }
+}
+
+MappedFile::~MappedFile()
+{
+    if (mMap) ::munmap(mMap, mSize);
 }
 
 std::string fileExtension(const std::string& path)

@@ -1,8 +1,10 @@
 #include "HairFile.h"
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MappedFile.h>
 
 #include <algorithm>
 #include <cstring>
@@ -16,15 +18,15 @@ enum : std::uint32_t { kSegments = 1, kPoints = 2, kThickness = 4, kTransparency
 StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readHair(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
-    ByteReader in(bytes, where);
+    const MappedFile file(path, where, opts.interrupter);
+    ByteReader in(file.data(), file.size(), where);
 
     // Header
-    if (bytes.size() < 4 || std::memcmp(bytes.data(), "HAIR", 4) != 0) {
+    if (file.size() < 4 || std::memcmp(file.data(), "HAIR", 4) != 0) {
         in.fail("not a cyHair file: the first 4 bytes must be \"HAIR\"");
     }
-    if (bytes.size() < 128) {
-        in.fail("the file has " + std::to_string(bytes.size()) +
+    if (file.size() < 128) {
+        in.fail("the file has " + std::to_string(file.size()) +
                 " bytes, shorter than the 128-byte cyHair header");
     }
     in.skip(4, "magic");
@@ -52,13 +54,13 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
     if (arrays & kThickness) expected += 4 * nP;
     if (arrays & kTransparency) expected += 4 * nP;
     if (arrays & kColors) expected += 12 * nP;
-    if (expected > bytes.size()) {
+    if (expected > file.size()) {
         in.failAt(4, "the header declares " + std::to_string(nS) + " strands and " +
                          std::to_string(nP) + " points, which need " + std::to_string(expected) +
-                         " bytes, but the file has only " + std::to_string(bytes.size()));
+                         " bytes, but the file has only " + std::to_string(file.size()));
     }
-    if (expected < bytes.size() && report) {
-        report->warnings.push_back(where + ": " + std::to_string(bytes.size() - expected) +
+    if (expected < file.size() && report) {
+        report->warnings.push_back(where + ": " + std::to_string(file.size() - expected) +
                                    " bytes after the arrays the header describes were ignored");
     }
 
@@ -96,37 +98,73 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
                                                           std::to_string(defSegments) + " + 1 points)"));
     }
 
-    // Arrays
+    // Arrays: where each one lies (the size check above covers them all).
     const std::size_t pointsAt = in.offset();
-    std::vector<Vec3f> points(nP);
-    in.readArray(reinterpret_cast<float*>(points.data()), 3 * nP, "points array");
-    std::vector<float> thickness, transparency;
-    std::vector<Vec3f> colors;
-    if (arrays & kThickness) { thickness.resize(nP); in.readArray(thickness.data(), nP, "thickness array"); }
-    if (arrays & kTransparency) { transparency.resize(nP); in.readArray(transparency.data(), nP, "transparency array"); }
-    if (arrays & kColors) { colors.resize(nP); in.readArray(reinterpret_cast<float*>(colors.data()), 3 * nP, "colours array"); }
+    in.require(nP, 12, "points array");
+    std::size_t at = pointsAt + 12 * nP;
+    auto arrayAt = [&](std::uint32_t bit, std::size_t bytesPerPoint) -> const char* {
+        if (!(arrays & bit)) return nullptr;
+        const char* p = file.data() + at;
+        at += bytesPerPoint * nP;
+        return p;
+    };
+    const char* points = file.data() + pointsAt;
+    const char* thickness = arrayAt(kThickness, 4);
+    const char* transparency = arrayAt(kTransparency, 4);
+    const char* colors = arrayAt(kColors, 12);
 
-    // Strands
+    // Strands: each array is copied once, from the file's bytes to the set, the positions checked
+    // piece by piece as they are copied; only a file that fails the check or has strands to drop
+    // is walked strand by strand (to name the culprit, to filter).
     StrandSet out;
     out.defaults = defaults;
     out.reserve(nS, nP);
     ShortStrandFilter filter(opts, report, where);
-    InterruptPoll poll(opts.interrupter, where);
-    std::size_t v = 0;
-    for (std::size_t i = 0; i < nS; ++i) {
-        poll();
-        const std::size_t n = counts[i];
-        for (std::size_t k = v; k < v + n; ++k) {
-            checkFinite(points[k], k, where, "at byte " + std::to_string(pointsAt + 12 * k));
+    const bool anyShort = std::any_of(counts.begin(), counts.end(), [](std::uint32_t c) { return c < 2; });
+    auto copyRange = [&](auto& dst, const char* src, std::size_t bytesPerPoint, std::size_t v, std::size_t n) {
+        if (!src) return;
+        const std::size_t old = dst.size();
+        dst.resize(old + n);
+        std::memcpy(reinterpret_cast<char*>(dst.data() + old), src + bytesPerPoint * v, bytesPerPoint * n);
+    };
+    // Positions in pieces that stay in the cache while they are copied and checked.
+    bool finite = true;
+    if (!anyShort) {
+        constexpr std::size_t kPiece = std::size_t(1) << 14;
+        for (std::size_t v = 0; v < nP && finite; v += kPiece) {
+            const std::size_t n = std::min<std::size_t>(kPiece, nP - v);
+            copyRange(out.positions, points, 12, v, n);
+            finite = allFinite(out.positions.data() + v, 3 * n);
         }
-        if (filter.keep(i, n, "strand at point " + std::to_string(v))) {
-            out.positions.insert(out.positions.end(), points.begin() + v, points.begin() + v + n);
-            out.offsets.push_back(std::uint32_t(out.positions.size()));
-            if (!thickness.empty()) out.thickness.insert(out.thickness.end(), thickness.begin() + v, thickness.begin() + v + n);
-            if (!transparency.empty()) out.transparency.insert(out.transparency.end(), transparency.begin() + v, transparency.begin() + v + n);
-            if (!colors.empty()) out.color.insert(out.color.end(), colors.begin() + v, colors.begin() + v + n);
+    }
+    if (finite && !anyShort) {
+        copyRange(out.thickness, thickness, 4, 0, nP);
+        copyRange(out.transparency, transparency, 4, 0, nP);
+        copyRange(out.color, colors, 12, 0, nP);
+        out.offsets.resize(nS + 1);
+        for (std::size_t i = 0; i < nS; ++i) out.offsets[i + 1] = out.offsets[i] + counts[i];
+    } else {
+        out.positions.clear();
+        finite = allFinite(points, 3 * nP);
+        InterruptPoll poll(opts.interrupter, where);
+        std::size_t v = 0;
+        for (std::size_t i = 0; i < nS; ++i) {
+            poll();
+            const std::size_t n = counts[i];
+            for (std::size_t k = v; !finite && k < v + n; ++k) {
+                Vec3f p;
+                std::memcpy(p.asPointer(), points + 12 * k, 12);
+                checkFinite(p, k, where, "at byte " + std::to_string(pointsAt + 12 * k));
+            }
+            if (filter.keep(i, n, "strand at point " + std::to_string(v))) {
+                copyRange(out.positions, points, 12, v, n);
+                out.offsets.push_back(std::uint32_t(out.positions.size()));
+                copyRange(out.thickness, thickness, 4, v, n);
+                copyRange(out.transparency, transparency, 4, v, n);
+                copyRange(out.color, colors, 12, v, n);
+            }
+            v += n;
         }
-        v += n;
     }
     filter.finish();
     return out;
@@ -155,7 +193,7 @@ void writeHair(const std::string& path, const StrandSet& strands)
     std::string out;
     auto put = [&out](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
     auto putU32 = [&](std::uint32_t v) { put(&v, 4); };
-    out.reserve(128 + 2 * nS + 28 * nP);
+    reserveHugePages(out, 128 + 2 * nS + 28 * nP);
     put("HAIR", 4);
     putU32(std::uint32_t(nS));
     putU32(std::uint32_t(nP));

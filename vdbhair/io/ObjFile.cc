@@ -1,5 +1,6 @@
 #include "ObjFile.h"
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/io/MeshFile.h>
 
 #include <vdbhair/Version.h>
@@ -190,7 +191,7 @@ void writeObj(const std::string& path, const StrandSet& strands, ObjLineStyle st
 {
     const std::string where = "writeObj(" + path + ")";
     std::string out;
-    out.reserve(40 * strands.numVertices() + 16 * strands.numVertices());
+    reserveHugePages(out, 40 * strands.numVertices() + 16 * strands.numVertices());
     out += "# ";
     out += creatorString();
     out += ": " + std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) +

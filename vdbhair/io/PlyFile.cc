@@ -3,15 +3,18 @@
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/PointFile.h>
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MappedFile.h>
 #include <vdbhair/io/TextScanner.h>
 #include <vdbhair/Format.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace vdbhair {
@@ -41,6 +44,23 @@ std::size_t plySize(PlyType t)
     case PlyType::Int32: case PlyType::UInt32: case PlyType::Float32: return 4;
     case PlyType::Float64: return 8;
     default: return 0;
+    }
+}
+
+/// The value of type @a t at @a p (any alignment, little-endian as the host).
+double loadValue(PlyType t, const char* p)
+{
+    auto get = [p](auto v) { std::memcpy(&v, p, sizeof v); return double(v); };
+    switch (t) {
+    case PlyType::Int8: return get(std::int8_t());
+    case PlyType::UInt8: return get(std::uint8_t());
+    case PlyType::Int16: return get(std::int16_t());
+    case PlyType::UInt16: return get(std::uint16_t());
+    case PlyType::Int32: return get(std::int32_t());
+    case PlyType::UInt32: return get(std::uint32_t());
+    case PlyType::Float32: return get(float());
+    case PlyType::Float64: return get(double());
+    default: return 0.0;
     }
 }
 
@@ -114,9 +134,9 @@ struct PlyHeader
     std::size_t bodyOffset = 0, bodyLine = 0;
 };
 
-PlyHeader parsePlyHeader(const std::vector<char>& bytes, const std::string& where)
+PlyHeader parsePlyHeader(const char* data, std::size_t size, const std::string& where)
 {
-    TextScanner header(bytes, where);
+    TextScanner header(data, size, where);
     std::vector<std::string_view> tok;
     if (!header.nextLine(tok) || tok.size() != 1 || tok[0] != "ply") header.fail("not a PLY file: the first line must be 'ply'");
     bool binary = false, sawFormat = false;
@@ -188,12 +208,12 @@ int findProperty(const Element* e, const char* name, bool list = false)
 /// up to 2^63-1, is bounded by nothing in the file). @a interrupter (may be null) is polled so
 /// that SIGTERM and Ctrl-C end the walk.
 template<typename ElementFn, typename ItemFn>
-void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std::string& where, const Element* listElement,
+void readPlyBody(const char* data, std::size_t size, const PlyHeader& hdr, const std::string& where, const Element* listElement,
                  int listProp, openvdb::util::NullInterrupter* interrupter, ElementFn&& onElement, ItemFn&& onItem)
 {
     InterruptPoll poll(interrupter, where);
-    ByteReader bin(bytes, where);
-    TextScanner text(bytes, where, hdr.bodyOffset);
+    ByteReader bin(data, size, where);
+    TextScanner text(data, size, where, hdr.bodyOffset);
     text.setLine(hdr.bodyLine);  // body line numbers continue the header's
     bin.seek(hdr.bodyOffset, "end_header");
     ValueSource src(hdr.binary ? &bin : nullptr, hdr.binary ? nullptr : &text);
@@ -238,14 +258,28 @@ void readPlyBody(const std::vector<char>& bytes, const PlyHeader& hdr, const std
     }
 }
 
+
+/// @brief The items of a binary element whose properties are all scalars lie @a stride bytes
+/// apart: where each property is within an item.
+std::vector<std::size_t> propertyOffsets(const Element& e, std::size_t& stride)
+{
+    std::vector<std::size_t> at;
+    stride = 0;
+    for (const Property& p : e.props) {
+        at.push_back(stride);
+        stride += plySize(p.type);
+    }
+    return at;
+}
+
 } // namespace
 
 StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readPly(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
+    const MappedFile file(path, where, opts.interrupter);
 
-    const PlyHeader hdr = parsePlyHeader(bytes, where);
+    const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
     const Element* vertexEl = nullptr;
     const Element* strandEl = nullptr;
     for (const Element& e : hdr.elements) {
@@ -262,50 +296,127 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     const bool hasColor = ir >= 0 && ig >= 0 && ib >= 0;
     const float colorScale = hasColor && vertexEl->props[std::size_t(ir)].type == PlyType::UInt8 ? 1.f / 255.f : 1.f;
 
-    // Body
-    std::vector<Vec3f> positions, colors;
+    // Body: positions and colours straight into the set's arrays, and each strand's count.
+    StrandSet out;
+    std::vector<Vec3f>& positions = out.positions;
+    std::vector<Vec3f>& colors = out.color;
     std::vector<std::uint64_t> counts;
     std::uint64_t nsegsSum = 0;    // vertices the strands use
     bool nsegsSaturated = false;   // their sum exceeds 2^64-1
-    readPlyBody(bytes, hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
-        if (&e == vertexEl) { positions.reserve(e.count); if (hasColor) colors.reserve(e.count); }
-        if (&e == strandEl) counts.reserve(e.count);
-    }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
-        if (&e == vertexEl) {
-            const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
-            checkFinite(pos, positions.size(), where, src.location());
-            positions.push_back(pos);
-            if (hasColor) colors.emplace_back(float(values[std::size_t(ir)]) * colorScale, float(values[std::size_t(ig)]) * colorScale, float(values[std::size_t(ib)]) * colorScale);
-        } else if (&e == strandEl) {
-            const double s = values[std::size_t(iseg)];
-            if (s < 0 || s != std::floor(s)) src.fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
-            // A float nsegs can be 1e19 or beyond 2^64, and nsegs + 1 summed over strands could
-            // wrap 2^64 back to the vertex count: the sum saturates instead (checked below).
-            const std::uint64_t c = s < 18446744073709549568.0 ? std::uint64_t(s) + 1 : std::numeric_limits<std::uint64_t>::max();
-            nsegsSaturated = nsegsSaturated || c > std::numeric_limits<std::uint64_t>::max() - nsegsSum;
-            if (!nsegsSaturated) nsegsSum += c;
-            counts.push_back(c);
-        }
+    // One strand's nsegs, checked; @a fail(msg) throws at the item's place.
+    auto addStrand = [&](std::uint64_t n, double s, auto&& fail) {
+        if (s < 0 || s != std::floor(s)) fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
+        // A float nsegs can be 1e19 or beyond 2^64, and nsegs + 1 summed over strands could
+        // wrap 2^64 back to the vertex count: the sum saturates instead (checked below).
+        const std::uint64_t c = s < 18446744073709549568.0 ? std::uint64_t(s) + 1 : std::numeric_limits<std::uint64_t>::max();
+        nsegsSaturated = nsegsSaturated || c > std::numeric_limits<std::uint64_t>::max() - nsegsSum;
+        if (!nsegsSaturated) nsegsSum += c;
+        counts.push_back(c);
+    };
+    const bool anyList = std::any_of(hdr.elements.begin(), hdr.elements.end(), [](const Element& e) {
+        return std::any_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.isList; });
     });
+    if (hdr.binary && !anyList) {
+        // Binary without lists (what hairutil, hapPLY and vdbhair write): items of a fixed size,
+        // read in place from the file's bytes, with the checks and messages of readPlyBody().
+        ByteReader bin(file.data(), file.size(), where);
+        bin.seek(hdr.bodyOffset, "end_header");
+        InterruptPoll poll(opts.interrupter, where);
+        for (const Element& e : hdr.elements) {
+            std::size_t stride = 0;
+            const std::vector<std::size_t> at = propertyOffsets(e, stride);
+            if (stride && e.count > bin.remaining() / stride) {
+                bin.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
+                         std::to_string(stride) + " bytes but only " + std::to_string(bin.remaining()) + " bytes remain");
+            }
+            if (!stride) continue;  // nothing to read, whatever the count
+            const std::size_t first = bin.offset();
+            const char* items = bin.current();
+            bin.skip(e.count * stride, "items");
+            if (&e == vertexEl) {
+                const std::size_t n = std::size_t(e.count);
+                reserveHugePages(positions, n);
+                positions.resize(n);
+                const PlyType tx = e.props[std::size_t(ix)].type, ty = e.props[std::size_t(iy)].type, tz = e.props[std::size_t(iz)].type;
+                const std::size_t ox = at[std::size_t(ix)], oy = at[std::size_t(iy)], oz = at[std::size_t(iz)];
+                if (tx == PlyType::Float32 && ty == PlyType::Float32 && tz == PlyType::Float32) {
+                    for (std::size_t k = 0; k < n; ++k) {
+                        const char* item = items + k * stride;
+                        float* p = positions[k].asPointer();
+                        std::memcpy(p, item + ox, 4);
+                        std::memcpy(p + 1, item + oy, 4);
+                        std::memcpy(p + 2, item + oz, 4);
+                    }
+                } else {
+                    for (std::size_t k = 0; k < n; ++k) {
+                        const char* item = items + k * stride;
+                        positions[k] = Vec3f(float(loadValue(tx, item + ox)), float(loadValue(ty, item + oy)), float(loadValue(tz, item + oz)));
+                    }
+                }
+                if (!allFinite(positions.data(), 3 * n)) {
+                    for (std::size_t k = 0; k < n; ++k) checkFinite(positions[k], k, where, "at byte " + std::to_string(first + (k + 1) * stride));
+                }
+                if (hasColor) {
+                    reserveHugePages(colors, n);
+                    colors.resize(n);
+                    const PlyType tc = e.props[std::size_t(ir)].type;
+                    const std::size_t o[3] = {at[std::size_t(ir)], at[std::size_t(ig)], at[std::size_t(ib)]};
+                    for (std::size_t k = 0; k < n; ++k) {
+                        const char* item = items + k * stride;
+                        for (int c = 0; c < 3; ++c) colors[k][c] = float(loadValue(tc, item + o[c])) * colorScale;
+                    }
+                }
+            } else if (&e == strandEl) {
+                counts.reserve(e.count);
+                const PlyType ts = e.props[std::size_t(iseg)].type;
+                for (std::uint64_t n = 0; n < e.count; ++n) {
+                    poll();
+                    addStrand(n, loadValue(ts, items + n * stride + at[std::size_t(iseg)]), [&](const std::string& msg) {
+                        bin.failAt(first + (n + 1) * stride, msg);
+                    });
+                }
+            }
+        }
+    } else {
+        readPlyBody(file.data(), file.size(), hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
+            if (&e == vertexEl) { reserveHugePages(positions, e.count); if (hasColor) colors.reserve(e.count); }
+            if (&e == strandEl) counts.reserve(e.count);
+        }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
+            if (&e == vertexEl) {
+                const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
+                if (!allFinite(&pos, 3)) checkFinite(pos, positions.size(), where, src.location());
+                positions.push_back(pos);
+                if (hasColor) colors.emplace_back(float(values[std::size_t(ir)]) * colorScale, float(values[std::size_t(ig)]) * colorScale, float(values[std::size_t(ib)]) * colorScale);
+            } else if (&e == strandEl) {
+                addStrand(n, values[std::size_t(iseg)], [&](const std::string& msg) { src.fail(msg); });
+            }
+        });
+    }
     if (nsegsSaturated || nsegsSum != positions.size()) {
         throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " +
                           (nsegsSaturated ? std::string("more than 2^64-1") : std::to_string(nsegsSum)) +
                           " vertices but the 'vertex' element has " + std::to_string(positions.size()));
     }
 
-    StrandSet out;
-    out.reserve(counts.size(), positions.size());
+    // Strands: the kept ones' vertices move down over the dropped ones' (in place: no copy when
+    // nothing is dropped).
+    out.offsets.reserve(counts.size() + 1);
     ShortStrandFilter filter(opts, report, where);
-    std::size_t v = 0;
+    std::size_t v = 0, kept = 0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
         const std::size_t n = std::size_t(counts[i]);
-        if (filter.keep(i, n, "vertex " + std::to_string(v))) {
-            out.positions.insert(out.positions.end(), positions.begin() + std::ptrdiff_t(v), positions.begin() + std::ptrdiff_t(v + n));
-            if (hasColor) out.color.insert(out.color.end(), colors.begin() + std::ptrdiff_t(v), colors.begin() + std::ptrdiff_t(v + n));
-            out.offsets.push_back(std::uint32_t(out.positions.size()));
+        if (n >= 2 || filter.keep(i, n, "vertex " + std::to_string(v))) {
+            if (kept != v) {
+                std::copy(positions.begin() + std::ptrdiff_t(v), positions.begin() + std::ptrdiff_t(v + n), positions.begin() + std::ptrdiff_t(kept));
+                if (hasColor) std::copy(colors.begin() + std::ptrdiff_t(v), colors.begin() + std::ptrdiff_t(v + n), colors.begin() + std::ptrdiff_t(kept));
+            }
+            kept += n;
+            out.offsets.push_back(std::uint32_t(kept));
         }
         v += n;
     }
+    positions.resize(kept);
+    if (hasColor) colors.resize(kept);
     filter.finish();
     return out;
 }
@@ -324,7 +435,7 @@ void writePly(const std::string& path, const StrandSet& strands, PlyEncoding enc
     const bool binary = encoding == PlyEncoding::Binary;
 
     std::string out;
-    out.reserve(256 + (binary ? 15 : 40) * nV + 16 * nV);
+    reserveHugePages(out, 256 + (binary ? 15 : 40) * nV + 16 * nV);
     out += "ply\nformat ";
     out += binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
     out += std::string("comment ") + creatorString() + "\n";
@@ -373,8 +484,8 @@ void writePly(const std::string& path, const StrandSet& strands, PlyEncoding enc
 TriangleMesh readPlyMesh(const std::string& path)
 {
     const std::string where = "readPlyMesh(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
-    const PlyHeader hdr = parsePlyHeader(bytes, where);
+    const MappedFile file(path, where);
+    const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
     const Element* vertexEl = nullptr;
     const Element* faceEl = nullptr;
     for (const Element& e : hdr.elements) {
@@ -389,7 +500,7 @@ TriangleMesh readPlyMesh(const std::string& path)
     if (iface < 0) throw FormatError(where + ": line " + std::to_string(faceEl->line) + ": the 'face' element needs a list 'vertex_indices'");
 
     TriangleMesh mesh;
-    readPlyBody(bytes, hdr, where, faceEl, iface, nullptr, [&](const Element& e) {
+    readPlyBody(file.data(), file.size(), hdr, where, faceEl, iface, nullptr, [&](const Element& e) {
         if (&e == vertexEl) mesh.vertices.reserve(e.count);
         if (&e == faceEl) mesh.triangles.reserve(e.count);
     }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>& face, ValueSource& src) {
@@ -421,8 +532,8 @@ namespace vdbhair {
 OrientedPoints readPlyPoints(const std::string& path)
 {
     const std::string where = "readPlyPoints(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where);
-    const PlyHeader hdr = parsePlyHeader(bytes, where);
+    const MappedFile file(path, where);
+    const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
     const Element* vertexEl = nullptr;
     for (const Element& e : hdr.elements) {
         if (e.name == "vertex") vertexEl = &e;
@@ -435,7 +546,7 @@ OrientedPoints readPlyPoints(const std::string& path)
     const bool hasN = inx >= 0 && iny >= 0 && inz >= 0, hasT = itx >= 0 && ity >= 0 && itz >= 0;
 
     OrientedPoints pts;
-    readPlyBody(bytes, hdr, where, nullptr, -1, nullptr, [&](const Element& e) {
+    readPlyBody(file.data(), file.size(), hdr, where, nullptr, -1, nullptr, [&](const Element& e) {
         if (&e == vertexEl) pts.positions.reserve(e.count);
     }, [&](const Element& e, std::uint64_t, const std::vector<double>& v, const std::vector<double>&, ValueSource& src) {
         if (&e != vertexEl) return;
@@ -456,7 +567,8 @@ OrientedPoints readPlyPoints(const std::string& path)
 std::uint64_t plyElementCount(const std::string& path, const std::string& element)
 {
     const std::string where = "readPly(" + path + ")";
-    const PlyHeader hdr = parsePlyHeader(readFileBytes(path, where), where);
+    const MappedFile file(path, where);
+    const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
     for (const Element& e : hdr.elements) {
         if (e.name == element) return e.count;
     }

@@ -20,6 +20,9 @@ public:
     /// @param begin offset of the first byte to scan (e.g. after a binary header)
     TextScanner(const std::vector<char>& bytes, std::string where, std::size_t begin = 0)
         : mData(bytes.data()), mSize(bytes.size()), mPos(begin), mWhere(std::move(where)) {}
+    /// @param data, size the text (e.g. a MappedFile's bytes), which must outlive the scanner
+    TextScanner(const char* data, std::size_t size, std::string where, std::size_t begin = 0)
+        : mData(data), mSize(size), mPos(begin), mWhere(std::move(where)) {}
 
     /// @brief Split the next line into whitespace-separated tokens.
     /// @return false at the end of the text.

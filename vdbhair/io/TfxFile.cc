@@ -2,8 +2,10 @@
 
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MappedFile.h>
 #include <vdbhair/io/TextScanner.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -16,7 +18,7 @@ namespace {
 /// Shared by binary 3.0 and 4.x: @a nS strands of @a nV vertices of @a stride floats at @a posAt.
 StrandSet readBinaryStrands(ByteReader& in, std::uint32_t nS, std::uint32_t nV, std::size_t stride,
                             std::uint64_t posAt, std::uint64_t uvAt, std::uint64_t thicknessAt,
-                            const ReadOptions& opts, ReadReport* report)
+                            const ReadOptions& opts)
 {
     const std::string& where = in.where();
     const std::uint64_t total = std::uint64_t(nS) * nV;
@@ -31,8 +33,7 @@ StrandSet readBinaryStrands(ByteReader& in, std::uint32_t nS, std::uint32_t nV, 
     }
     in.seek(posAt, "the vertex position offset");
     in.require(total, stride * 4, std::to_string(nS) + " strands of " + std::to_string(nV) + " vertices");
-    std::vector<float> raw(total * stride);
-    in.readArray(raw.data(), total * stride, "vertex positions");
+    const char* raw = in.current();  // the file's bytes, copied once below
 
     std::vector<Vec2f> uv;
     if (uvAt) {
@@ -47,31 +48,40 @@ StrandSet readBinaryStrands(ByteReader& in, std::uint32_t nS, std::uint32_t nV, 
         in.readArray(thickness.data(), nS, "strand thickness");
     }
 
+    // Every strand has nV >= 2 vertices (checked above), so none is dropped: positions are copied
+    // out of the file's bytes in one pass, and locations are built only for a non-finite vertex.
     StrandSet out;
     out.reserve(nS, total);
-    ShortStrandFilter filter(opts, report, where);
+    out.positions.resize(total);
+    out.offsets.resize(std::size_t(nS) + 1);
     InterruptPoll poll(opts.interrupter, where);
+    const std::size_t vertexBytes = stride * 4;
     for (std::uint32_t i = 0; i < nS; ++i) {
         poll();
-        if (!filter.keep(i, nV, "at byte " + std::to_string(posAt + std::uint64_t(i) * nV * stride * 4))) continue;
-        for (std::uint32_t k = 0; k < nV; ++k) {
-            const std::size_t v = std::size_t(i) * nV + k;
-            const Vec3f p(raw[v * stride], raw[v * stride + 1], raw[v * stride + 2]);
-            checkFinite(p, v, where, "at byte " + std::to_string(posAt + v * stride * 4));
-            out.positions.push_back(p);
+        const std::size_t first = std::size_t(i) * nV;
+        Vec3f* dst = out.positions.data() + first;
+        for (std::uint32_t k = 0; k < nV; ++k) std::memcpy(dst[k].asPointer(), raw + (first + k) * vertexBytes, 12);
+        if (!allFinite(dst, 3 * std::size_t(nV))) {
+            for (std::uint32_t k = 0; k < nV; ++k) {
+                checkFinite(dst[k], first + k, where, "at byte " + std::to_string(posAt + (first + k) * vertexBytes));
+            }
         }
-        out.offsets.push_back(std::uint32_t(out.positions.size()));
-        if (!uv.empty()) out.rootUV.push_back(uv[i]);
-        if (!thickness.empty()) out.thickness.insert(out.thickness.end(), nV, thickness[i]);
+        out.offsets[i + 1] = std::uint32_t(first + nV);
     }
-    filter.finish();
+    if (!uv.empty()) out.rootUV = std::move(uv);
+    if (!thickness.empty()) {
+        out.thickness.resize(total);
+        for (std::uint32_t i = 0; i < nS; ++i) {
+            std::fill_n(out.thickness.begin() + std::ptrdiff_t(std::size_t(i) * nV), nV, thickness[i]);
+        }
+    }
     return out;
 }
 
-StrandSet readAscii(const std::vector<char>& bytes, const std::string& where,
+StrandSet readAscii(const MappedFile& file, const std::string& where,
                     const ReadOptions& opts, ReadReport* report)
 {
-    TextScanner text(bytes, where);
+    TextScanner text(file.data(), file.size(), where);
     StrandSet out;
     ShortStrandFilter filter(opts, report, where);
     InterruptPoll poll(opts.interrupter, where);
@@ -152,31 +162,31 @@ StrandSet readAscii(const std::vector<char>& bytes, const std::string& where,
 StrandSet readTfx(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     const std::string where = "readTfx(" + path + ")";
-    const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
-    ByteReader in(bytes, where);
-    if (bytes.size() >= 4 && std::isalpha(static_cast<unsigned char>(bytes[0]))) {
-        return readAscii(bytes, where, opts, report);
+    const MappedFile file(path, where, opts.interrupter);
+    ByteReader in(file.data(), file.size(), where);
+    if (file.size() >= 4 && std::isalpha(static_cast<unsigned char>(file.data()[0]))) {
+        return readAscii(file, where, opts, report);
     }
     const float version = in.read<float>("version");
     if (version == 3.f) {
-        if (bytes.size() < 296) in.failAt(0, "the file has " + std::to_string(bytes.size()) + " bytes, shorter than the 296-byte TressFX 3 header");
+        if (file.size() < 296) in.failAt(0, "the file has " + std::to_string(file.size()) + " bytes, shorter than the 296-byte TressFX 3 header");
         const std::uint32_t nS = in.read<std::uint32_t>("strand count");
         const std::uint32_t nV = in.read<std::uint32_t>("vertices per strand");
         in.seek(144, "header");
         const std::uint32_t posAt = in.read<std::uint32_t>("vertex offset");
         const std::uint32_t thicknessAt = in.read<std::uint32_t>("thickness offset");
         const std::uint32_t uvAt = in.read<std::uint32_t>("texcoord offset");
-        return readBinaryStrands(in, nS, nV, 3, posAt ? posAt : 296, uvAt, thicknessAt, opts, report);
+        return readBinaryStrands(in, nS, nV, 3, posAt ? posAt : 296, uvAt, thicknessAt, opts);
     }
     if (version >= 4.f && version < 5.f) {
-        if (bytes.size() < 160) in.failAt(0, "the file has " + std::to_string(bytes.size()) + " bytes, shorter than the 160-byte TressFX 4 header");
+        if (file.size() < 160) in.failAt(0, "the file has " + std::to_string(file.size()) + " bytes, shorter than the 160-byte TressFX 4 header");
         const std::uint32_t nS = in.read<std::uint32_t>("strand count");
         const std::uint32_t nV = in.read<std::uint32_t>("vertices per strand");
         const std::uint32_t posAt = in.read<std::uint32_t>("position offset");
         const std::uint32_t uvAt = in.read<std::uint32_t>("strand UV offset");
         in.read<std::uint32_t>("vertex UV offset");
         const std::uint32_t thicknessAt = in.read<std::uint32_t>("strand thickness offset");
-        return readBinaryStrands(in, nS, nV, 4, posAt ? posAt : 160, uvAt, thicknessAt, opts, report);
+        return readBinaryStrands(in, nS, nV, 4, posAt ? posAt : 160, uvAt, thicknessAt, opts);
     }
     throw UnsupportedError(where + ": at byte 0: version " + std::to_string(version) +
                            " is not supported; vdbhair reads TressFX binary 3.0 and 4.x and ASCII 1.0/2.0");

@@ -1,5 +1,6 @@
 #include "UsdFile.h"
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/FileUtil.h>
@@ -496,7 +497,7 @@ void writeUsda(const std::string& path, const StrandSet& strands, const UsdWrite
     }
     const std::size_t nV = strands.numVertices(), nS = strands.numStrands();
     std::string out;
-    out.reserve(64 * nV + 8 * nS + 1024);
+    reserveHugePages(out, 64 * nV + 8 * nS + 1024);
     char buf[64];
     auto num = [&](double v, bool isFloat = true) {
         const auto res = isFloat ? std::to_chars(buf, buf + sizeof buf, float(v)) : std::to_chars(buf, buf + sizeof buf, v);

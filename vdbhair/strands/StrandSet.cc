@@ -1,6 +1,7 @@
 #include "StrandSet.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Memory.h>
 
 #include <cmath>
 #include <limits>
@@ -36,8 +37,8 @@ void StrandSet::clear()
 
 void StrandSet::reserve(std::size_t strands, std::size_t vertices)
 {
-    positions.reserve(vertices);
-    offsets.reserve(strands + 1);
+    reserveHugePages(positions, vertices);  // a fresh set's positions fault in 2 MiB at a time (Memory.h)
+    reserveHugePages(offsets, strands + 1);
 }
 
 void StrandSet::validate(const std::string& where) const
