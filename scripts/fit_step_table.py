@@ -11,8 +11,10 @@ divided by 1, 4 and 16 (`vdbhair grow`), and measure each regrown strand against
     relative to the input strand's length.
 
 Prints the issue's table: the mean error `fit` reported, the mean error regrown at h, h/4, h/16,
-and the share of strands flagged: at h/4 or h/16 more than twice the error `fit` reported for it,
-or more than 10 % of its length.
+the share of strands flagged: at h/4 or h/16 more than twice the error `fit` reported for it, or
+more than 10 % of its length; the largest error at h/4 or h/16 and the largest ratio of it to
+the strand's reported error; the mean step convergence `fit --json` reports; and fit strands/s
+(wall clock of `vdbhair fit`, all threads: the benchmark's fit section is the speed measure).
 
     /usr/bin/python3 scripts/fit_step_table.py [--strands 1000] [--vdbhair build/bin/vdbhair]
 """
@@ -126,7 +128,7 @@ def run(cmd):
 def style_row(name, path, args, tmp):
     tag = "".join(ch for ch in name.split()[0].lower() if ch.isalnum())
     r30 = os.path.join(tmp, tag + "_30.data")
-    run([args.vdbhair, "convert", path, "-o", r30, "--resample", "30", "--quiet"])
+    run([args.vdbhair, "convert", path, "-o", r30, "--quiet"] + (["--resample", str(args.vertices)] if args.vertices > 0 else []))
     strands = read_data(r30)
     stride = max(1, -(-len(strands) // args.strands)) if args.strands > 0 else 1
     strands = strands[::stride]
@@ -159,10 +161,11 @@ def style_row(name, path, args, tmp):
     fine = np.maximum(errs[4], errs[16])
     flagged = (fine > 2.0 * reported) | (fine > 0.10)
     conv = rep.get("step_convergence")
-    row = "| %s | %d | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% (%d) | %.2f %% | %.2f %% | %s | %.0f |" % (
+    ratio = fine / np.maximum(reported, 1e-12)
+    row = "| %s | %d | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% (%d) | %.2f %% | %.2f %% | %.2fx | %s | %.0f |" % (
         name, len(guides), 100 * reported.mean(), 100 * errs[1].mean(), 100 * errs[4].mean(), 100 * errs[16].mean(),
         100 * flagged.mean(), flagged.sum(), 100 * np.median(fine[flagged]) if flagged.any() else 0.0,
-        100 * fine.max(), "%.3f %%" % (100 * conv["mean"]) if conv else "-", rep["strands_per_second"])
+        100 * fine.max(), ratio.max(), "%.3f %%" % (100 * conv["mean"]) if conv else "-", rep["strands_per_second"])
     if args.details and flagged.any():
         for k in np.nonzero(flagged)[0][:args.details]:
             print("  flagged strand %d: reported %.3f %%, h %.3f %%, h/4 %.3f %%, h/16 %.3f %%" % (
@@ -175,10 +178,11 @@ def main():
     ap.add_argument("--strands", type=int, default=1000, help="most strands per style (an evenly strided subset; 0: all)")
     ap.add_argument("--vdbhair", default=os.path.join(ROOT, "build", "bin", "vdbhair"))
     ap.add_argument("--styles", default="", help="comma-separated name prefixes (default: all)")
+    ap.add_argument("--vertices", type=int, default=30, help="resample every strand to this many vertices (0: as stored)")
     ap.add_argument("--details", type=int, default=0, help="print up to N flagged strands per style on stderr")
     args = ap.parse_args()
-    print("| style (30 vertices) | strands | reported | grow @h | @h/4 | @h/16 | flagged strands | flagged: median error | worst @h/4, h/16 | fit's step convergence | fit strands/s |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| style (%s vertices) | strands | reported | grow @h | @h/4 | @h/16 | flagged strands | flagged: median error | worst @h/4, h/16 | worst / reported | fit's step convergence | fit strands/s |" % (args.vertices or "stored"))
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     want = [s.strip().lower() for s in args.styles.split(",") if s.strip()]
     with tempfile.TemporaryDirectory() as tmp:
         for name, path in STYLES:

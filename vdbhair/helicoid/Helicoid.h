@@ -73,12 +73,14 @@ struct Helicoid
 };
 
 /// @brief How close, in tracing steps, a trace may come to a helicoid's singular axis and still
-/// be a streamline: at r = 4 steps a step turns theta by at most a quarter radian, and RK4 traces
-/// at h and h/16 agree (tests); nearer the axis the trace depends on the step (issue 19: traces
-/// that passed within one step of it changed by up to 100 % of their length at a finer step).
-/// At a piece's root r = 1 / sqrt(kT² + kN²), so it is the bound |k| 4 h <= 1 extended along
-/// the trace.
-constexpr double kAxisClearanceSteps = 4.0;
+/// be a streamline: at r = 2 steps a step turns theta by about half a radian, and RK4 traces at
+/// h and h/16 agree to 3e-5 of their length (40 seeded pieces with kN < 0, tested to 1e-4);
+/// nearer the axis the trace depends on the step (issue 19: traces that passed within one step
+/// of it changed by up to 100 % of their length at a finer step). Measured for fitting: 2 steps
+/// fit as closely as 1 and 4 at 30 vertices and better than 4 at the stored resolutions
+/// (HelicoidFit.h). At a piece's root the axis is 1/sqrt(kT² + kN²) away, at least 4 steps by
+/// the fit's bounds on k.
+constexpr double kAxisClearanceSteps = 2.0;
 
 // theta() and tangent() are inline: tracing calls them four times per RK4 step, and fitting
 // traces thousands of times per strand.

@@ -135,8 +135,8 @@
 /// a vortex, 1/r per unit length at distance r; with kN < 0 the flow spirals onto it. The bound
 /// on k above keeps it 4 steps away at a piece's root only, and the optimizer found pieces whose
 /// trace at the scene's step h passed within a step of it, turning theta by 2-2.7 rad in one RK4
-/// step: they matched the strand at h, and regrown at h/4 or h/16 0.6-4 % of strands changed by
-/// more than twice their error (up to 100 % of their length). Now (`axisClearance`, 4 steps,
+/// step: they matched the strand at h, and regrown at h/4 or h/16 0.4-4 % of strands changed by
+/// more than twice their error (up to 100 % of their length). Now (`axisClearance`, 2 steps,
 /// kAxisClearanceSteps): within() accepts a piece only if its trace at h keeps that distance at
 /// every step; Eq. 5 adds a penalty below it (the objective's trace) and the pre-fit a residual
 /// (`prefitAxisWeight`, at the vertices), so that neither settles on what acceptance refuses.
@@ -145,18 +145,22 @@
 /// (fitStepDeviation, reported as `stepDeviation`) and one that moves by more than
 /// `stepDeviationLimit` (0.1) of the tolerance is refitted with every kept piece's curvatures
 /// scaled down until it keeps its distance, the better-converged fit kept. Why the distance
-/// rather than comparing traces at h and h/4 for every candidate: an RK4 trace at 4 steps from
-/// the axis or more agrees with the trace at h/16 to 1e-6 of its length (tested on seeded
-/// pieces), so one cheap test per step replaces a four times finer trace per candidate.
-/// Measured (scripts/fit_step_table.py, 30 vertices, up to 2,000 strands; mean error as
-/// reported / regrown at h/16, strands that change by more than 2x or exceed 10 % at h/4 or h/16):
-///   wavy 1.78 % / 2.57 %, 67 flagged -> 1.69 % / 1.69 %, none; straight 1.50 / 1.67 %, 18 ->
-///   1.52 / 1.52 %, none; curly 1.54 / 1.78 %, 4 -> 1.62 / 1.62 %, none; short 1.38 / 1.46 %,
-///   7 -> 1.36 / 1.36 %, none; ponytail 1.42 / 1.50 %, 6 -> 1.43 / 1.43 %, none.
-/// Variants measured: a clearance of 2 steps (wavy 1.76 %, straight 1.49 %, curly 1.59 %, none
-/// flagged); without the pre-fit residual (wavy 1.80 % and 2 strands still flagged); a pre-fit
-/// weight of 0.1 (wavy 1.73 %, curly 1.61 %); scaling down every unaccepted piece near the axis
-/// instead of refitting only unconverged fits (wavy 1.88 %: most such pieces are streamlines).
+/// rather than comparing traces at h and h/4 for every candidate: an RK4 trace 2 steps from the
+/// axis or more agrees with the trace at h/16 to 3e-5 of its length (tested on seeded pieces), so
+/// one cheap test per step replaces a four times finer trace per candidate.
+/// Measured (scripts/fit_step_table.py, up to 2,000 strands; mean error as reported / regrown at
+/// h/16, strands that change by more than 2x or exceed 10 % at h/4 or h/16), at 30 vertices:
+///   wavy 1.78 % / 2.57 %, 67 flagged -> 1.75 % / 1.75 %, none; straight 1.50 / 1.67 %, 18 ->
+///   1.50 / 1.50 %, none; curly 1.54 / 1.78 %, 4 -> 1.60 / 1.60 %, none; short 1.38 / 1.46 %,
+///   7 -> 1.36 / 1.36 %, none; ponytail 1.42 / 1.50 %, 6 -> 1.43 / 1.43 %, none;
+/// as stored (1,000 strands): wavy 21 vertices 2.79 % / 3.40 %, 28 -> 2.75 / 2.75 %, none;
+///   straight 16 vertices 1.61 / 1.78 %, 4 -> 1.66 / 1.66 %, none.
+/// Clearances measured: 4 steps (at 30 vertices wavy 1.69 %, straight 1.52 %, curly 1.62 %, but
+/// 10.5 pieces on wavy instead of 9.2, and as stored wavy 3.26 %, straight 1.84 %: the margin
+/// costs sharp turns at coarse steps); 1 step (as stored wavy 2.82 %, straight 1.63 %). With 4
+/// steps: without the pre-fit residual wavy 1.80 % and 2 strands still flagged, a weight of 0.1
+/// 1.73 %, 0.3 1.69 %; scaling down every unaccepted piece near the axis instead of refitting only
+/// unconverged fits 1.88 % (most such pieces are streamlines).
 #pragma once
 
 #include <vdbhair/helicoid/Helicoid.h>
@@ -206,7 +210,7 @@ struct FitParams
     double polishStep = 0.05;     ///< Nelder–Mead's initial step after a pre-fit (scaled parameters; 0.5 without)
     double polishTolerance = 1e-3; ///< Nelder–Mead's absolute tolerance on the scaled parameters
     double step = 0.0;            ///< the regrown strands' tracing step (world units); 0: a quarter of the mean segment length
-    double axisClearance = kAxisClearanceSteps; ///< a piece is accepted only if its trace stays this many steps from its singular axis (0: no check; see below)
+    double axisClearance = kAxisClearanceSteps; ///< a piece is accepted only if its trace stays this many steps from its singular axis (0: no check, the former fitter; see below)
     double prefitAxisWeight = 0.3; ///< pre-fit weight of the residual that keeps the trace axisClearance steps from the singular axis
     double stepDeviationLimit = 0.1; ///< a fit whose trace at a quarter of its step moves by more than this fraction of the tolerance is refitted with every piece clear of its axis
 };

@@ -87,9 +87,9 @@ struct GrowOptions
     std::optional<HelicoidIntegrator> integrator;  ///< overrides the scene's
     std::size_t maxVertices = std::size_t(1) << 30;  ///< refuse scenes that would grow more
     /// A guide whose trace comes within this many steps of a piece's singular axis is reported
-    /// (GrowReport). One step, not the fitter's kAxisClearanceSteps margin: between 1 and 4 steps
-    /// RK4 traces at h and h/16 still agree to 1e-4 of their length (seeded pieces, kN < 0), and
-    /// every strand issue 19 found changing with the step had passed within one step of the axis.
+    /// (GrowReport). One step, not the fitter's kAxisClearanceSteps margin: between 1 and 2 steps
+    /// RK4 traces at h and h/16 still agree to about 1e-4 of their length (seeded pieces, kN < 0),
+    /// and every strand issue 19 found changing with the step had passed within one step of the axis.
     double nearAxisSteps = 1.0;
 };
 
