@@ -16,7 +16,7 @@ more than 10 % of its length; the largest error at h/4 or h/16 and the largest r
 the strand's reported error; the mean step convergence `fit --json` reports; and fit strands/s
 (wall clock of `vdbhair fit`, all threads: the benchmark's fit section is the speed measure).
 
-    /usr/bin/python3 scripts/fit_step_table.py [--strands 1000] [--vdbhair build/bin/vdbhair]
+    /usr/bin/python3 scripts/fit_step_table.py [--strands 2000] [--vertices 30|0] [--styles wavy,...] [--vdbhair build/bin/vdbhair]
 """
 import argparse
 import json
