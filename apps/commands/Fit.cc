@@ -47,27 +47,35 @@ int runFit(FitCmdParams p, const CommonOptions& common)
         }
         const StrandFit& f = fits[i];
         SceneGuide g = guideFromFit(f);
-        g.fit = {{"frechet", f.frechet}, {"coupling", f.coupling}, {"pieces", f.pieces.size()}, {"strand", i}};
+        g.fit = {{"frechet", f.frechet}, {"coupling", f.coupling}, {"pieces", f.pieces.size()}, {"strand", i},
+                 {"step_deviation", f.stepDeviation}};
         scene.guides.push_back(g);
     }
     if (scene.guides.empty()) throw ValueError(p.input + ": no strand could be fitted");
     writeScene(p.output, scene);
 
     // Summary: errors relative to strand length, pieces, and how much smaller the fit is.
-    const FitSummary s = summarizeFits(strands, fits, errors, p.fit.maxError);
+    const FitSummary s = summarizeFits(strands, fits, errors, p.fit.maxError, p.fit.stepDeviationLimit);
     if (s.overMaxError && !common.quiet) {
         std::cerr << "vdbhair fit: warning: " << s.overMaxError << " of " << s.fitted << " fits end above --max-error "
                   << formatValue(p.fit.maxError) << " (a last piece takes what remains at the most pieces a strand may have, or under twice the shortest fragment)\n";
     }
+    if (s.unconverged && !common.quiet) {
+        std::cerr << "vdbhair fit: warning: " << s.unconverged << " of " << s.fitted << " fits move by more than " << formatValue(p.fit.stepDeviationLimit) << " of --max-error when traced at a quarter of their step "
+                  << "(largest: " << formatValue(100.0 * s.stepDeviationMax) << " % of the strand's length); they pass near a piece's singular axis\n";
+    }
     if (common.json) {
         printJson({{"output", p.output}, {"strands", s.strands}, {"fitted", s.fitted}, {"skipped", s.skipped}, {"over_max_error", s.overMaxError},
                    {"frechet_relative", {{"mean", s.meanRelative}, {"p95", s.p95Relative}}}, {"pieces_per_strand", s.piecesPerStrand},
+                   {"step_convergence", {{"mean", s.stepDeviationMean}, {"max", s.stepDeviationMax}, {"unconverged", s.unconverged}}},
                    {"bytes", {{"fit", s.fitBytes}, {"points", s.pointBytes}}}, {"compression", s.pointBytes / s.fitBytes},
                    {"strands_per_second", double(s.fitted) / seconds}});
     } else if (!common.quiet) {
         std::cout << "fitted " << s.fitted << " of " << s.strands << " strands with " << s.piecesPerStrand << " pieces each on average in "
                   << seconds << " s (" << double(s.fitted) / seconds << " strands/s)\n"
                   << "discrete Frechet distance relative to strand length: mean " << s.meanRelative << ", 95th percentile " << s.p95Relative << "\n"
+                  << "step convergence (trace at the step against a quarter of it, relative to strand length): mean " << s.stepDeviationMean
+                  << ", largest " << s.stepDeviationMax << "\n"
                   << "size: " << s.fitBytes << " bytes of helicoid parameters for " << s.pointBytes << " bytes of points ("
                   << s.pointBytes / s.fitBytes << "x smaller)\nwrote " << p.output << " (regrow it with 'vdbhair grow')\n";
     }

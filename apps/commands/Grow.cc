@@ -7,6 +7,7 @@
 #include <vdbhair/strands/Measures.h>
 
 #include <chrono>
+#include <cstdio>
 
 namespace vdbhair::app {
 
@@ -28,16 +29,25 @@ int runGrow(const GrowParams& p, const CommonOptions& common)
     opts.maxVertices = p.maxVertices;
     const Scene scene = readScene(p.scene);
     const auto t0 = std::chrono::steady_clock::now();
-    const StrandSet strands = growScene(scene, opts, true, common.interrupter);
+    GrowReport report;
+    const StrandSet strands = growScene(scene, opts, true, common.interrupter, &report);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (strands.empty()) throw FormatError(p.scene + ": the scene has no guides; nothing to write");
     {
         const Stage stage(common, "writing " + p.output);
         writeStrands(p.output, strands);
     }
+    if (report.nearAxis && !common.quiet) {
+        char nearest[32];
+        std::snprintf(nearest, sizeof nearest, "%.2g", report.nearestClearance);
+        std::cerr << "vdbhair grow: warning: " << report.nearAxis << " of " << scene.guides.size() << " guides pass within "
+                  << formatValue(opts.nearAxisSteps) << " step of a piece's singular axis (guide " << report.nearestGuide << ": " << nearest
+                  << " steps), where a trace depends on the step: their strands change with a smaller 'step' (refit them, or grow at a finer step to see)\n";
+    }
     if (common.json) {
         printJson({{"scene", p.scene}, {"output", p.output}, {"guides", scene.guides.size()},
-                   {"strands", strands.numStrands()}, {"vertices", strands.numVertices()}, {"seconds", seconds}});
+                   {"strands", strands.numStrands()}, {"vertices", strands.numVertices()}, {"seconds", seconds},
+                   {"guides_near_axis", report.nearAxis}});
     } else if (!common.quiet) {
         std::cout << "grew " << strands.numStrands() << " strands (" << scene.guides.size() << " guides and their wisps), "
                   << strands.numVertices() << " vertices in " << seconds << " s\nwrote " << p.output << "\n";

@@ -253,7 +253,8 @@ Returns:
                     continue;
                 }
                 SceneGuide g = guideFromFit(fits[i]);
-                g.fit = {{"frechet", fits[i].frechet}, {"coupling", fits[i].coupling}, {"pieces", fits[i].pieces.size()}, {"strand", i}};
+                g.fit = {{"frechet", fits[i].frechet}, {"coupling", fits[i].coupling}, {"pieces", fits[i].pieces.size()}, {"strand", i},
+                         {"step_deviation", fits[i].stepDeviation}};
                 scene.guides.push_back(g);
             }
             pyb::object sceneObj = toPython(sceneToJson(scene));
@@ -267,6 +268,9 @@ Returns:
             d["frechet_relative_mean"] = s.meanRelative;
             d["frechet_relative_p95"] = s.p95Relative;
             d["pieces_per_strand"] = s.piecesPerStrand;
+            d["step_deviation_mean"] = s.stepDeviationMean;
+            d["step_deviation_max"] = s.stepDeviationMax;
+            d["unconverged"] = s.unconverged;
             d["fit_bytes"] = s.fitBytes;
             d["point_bytes"] = s.pointBytes;
             return pyb::make_tuple(sceneObj, d);
@@ -290,7 +294,9 @@ Args:
     roll: also fit a roll angle of each piece's frame about its tangent.
     skip_degenerate: leave out strands of zero length instead of raising.
     return_summary: also return a dict (fitted, skipped, Frechet distance relative to length:
-        mean and 95th percentile, pieces per strand, bytes of fits and of points).
+        mean and 95th percentile, pieces per strand, step convergence: the largest distance
+        between each fit traced at its step and at a quarter of it relative to length, mean and
+        max, and how many fits exceed a tenth of max_error; bytes of fits and of points).
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``.
 

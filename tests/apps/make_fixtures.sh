@@ -38,6 +38,8 @@ printf 'v 0 0 0\nv 1 1 1\nl 1\nl 2\n' > only_short.obj
 printf 'v 0 0 0\nv 1 0 0\nv 2 1 0\nv 3 3 3\nv 3 3 3\nl 1 2 3\nl 4 5\n' > zero_length.obj
 # Scenes with one mistake each.
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0], "length": 1}]}]}\n' > bad_scene.json
+# A piece whose RK4 trace at step 0.05 steps across its singular axis (issue 19): grow warns.
+printf '{"vdbhair": "scene/1", "step": 0.05, "integrator": "rk4", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1.742, -1.385, -0.373, 0.049], "length": 4}]}]}\n' > near_axis.json
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0, 0], "length": 1}], "wisp": {"count": 2, "radiuss": 1}}]}\n' > unknown_key.json
 printf '{"vdbhair": "scene/1", "guides": [' > not_json.json
 # Scalps: the default head's sphere with the region of its hairstyle's roots; oriented points on

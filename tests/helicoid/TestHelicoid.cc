@@ -2,8 +2,12 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/Helicoid.h>
+#include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/helicoid/Waviness.h>
 #include <vdbhair/helicoid/Wisp.h>
+
+#include <cmath>
+#include <random>
 
 using namespace vdbhair;
 
@@ -73,6 +77,66 @@ TEST_CASE("tracePHelicoid: k = (0,kN,0,0) gives straight streamlines fanning out
             REQUIRE((d - dir * d.dot(dir)).length() < 1e-9);  // on the ray from the sink through the start
         }
     }
+}
+
+TEST_CASE("Helicoid::axisDistance: zero on the singular axis, 1/|k| at the root, and theta turns about it like a vortex", "[helicoid]")
+{
+    Helicoid h;
+    h.k = {0.7, -0.4, 0.3, 0.2};
+    h.q = FrameD::fromTangentNormal(Vec3d(0.3, -1, 0.2), Vec3d(1, 0, 0.5));
+    h.p0 = Vec3d(1, 2, 3);
+    const double K2 = 0.7 * 0.7 + 0.4 * 0.4;
+    REQUIRE(h.axisDistance(h.p0) == Approx(1.0 / std::sqrt(K2)).epsilon(1e-12));
+    // The axis: both arguments of Eq. 1's atan2 vanish at y = (-kN, kT, s) / (kT² + kN²), for any s.
+    const Vec3d axis = h.p0 + (h.q.t * 0.4 + h.q.n * 0.7) / K2;
+    for (double s : {-1.0, 0.0, 2.5}) REQUIRE(h.axisDistance(axis + s * h.q.b) < 1e-12);
+    // At distance r in the plane normal to the axis, theta is the polar angle psi about it plus
+    // arg(kN + i kT) (v + i u = r (kN + i kT) e^{i psi}): its gradient is 1/r.
+    for (double r : {1e-3, 0.1, 2.0}) {
+        double ref = 0.0;
+        const double t0 = h.theta(axis + r * h.q.t, ref);
+        for (double psi : {0.5, 1.5, 3.0}) {
+            const Vec3d p = axis + r * (std::cos(psi) * h.q.t + std::sin(psi) * h.q.n);
+            CAPTURE(r, psi);
+            REQUIRE(h.axisDistance(p) == Approx(r).epsilon(1e-9));
+            REQUIRE(std::remainder(h.theta(p, ref) - t0 - psi, 2.0 * M_PI) == Approx(0.0).margin(1e-6));
+        }
+    }
+    h.k = {0.0, 0.0, 0.5, 0.1};  // no axis
+    REQUIRE(std::isinf(h.axisDistance(h.p0)));
+}
+
+TEST_CASE("tracePHelicoid: RK4 at h and h/16 agree where the trace keeps kAxisClearanceSteps from the axis, not across it", "[helicoid]")
+{
+    // Seeded pieces with kN < 0 (the flow spirals onto the axis), traced at h and h/16: a trace
+    // that keeps its distance is a streamline, one that steps near the axis is an artefact of h.
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const double h = 0.05;
+    int clear = 0, crossing = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const HelicoidParams k{2.0 * std::abs(u(rng)), -2.0 * std::abs(u(rng)), u(rng), u(rng)};
+        for (double L : {0.5, 1.0, 2.0, 4.0}) {
+            const HelicoidTrace a = trace(k, L, h, HelicoidIntegrator::RK4), b = trace(k, L, h / 16, HelicoidIntegrator::RK4);
+            const double clearance = traceClearance(a, h), moved = (a.points.back() - b.points.back()).length();
+            CAPTURE(trial, k.kT, k.kN, k.kB, k.alpha, L, clearance, moved);
+            if (clearance >= kAxisClearanceSteps) {
+                ++clear;
+                REQUIRE(moved < 1e-4 * L);
+            } else if (clearance >= GrowOptions{}.nearAxisSteps) {
+                REQUIRE(moved < 1e-3 * L);  // grow does not warn about these
+            } else if (clearance < 0.1) {
+                ++crossing;
+            }
+        }
+    }
+    REQUIRE(clear >= 40);
+    REQUIRE(crossing >= 20);
+    // One crossing, by name: within 0.04 steps of the axis, the end moves by 60 % of the length.
+    const HelicoidParams k{1.742, -1.385, -0.373, 0.049};
+    const HelicoidTrace a = trace(k, 4.0, h, HelicoidIntegrator::RK4), b = trace(k, 4.0, h / 16, HelicoidIntegrator::RK4);
+    REQUIRE(traceClearance(a, h) < 0.1);
+    REQUIRE((a.points.back() - b.points.back()).length() > 0.5 * 4.0);
 }
 
 TEST_CASE("tracePHelicoid: theta unwraps through full turns, so phi = alpha·theta stays continuous", "[helicoid]")

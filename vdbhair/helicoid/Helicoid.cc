@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vdbhair {
 
@@ -44,6 +45,18 @@ FrameD Helicoid::frameFromTheta(double th) const
     f.n = (-st) * q.t + ct * q.n;
     f.b = (-sp * ct) * q.t + (-sp * st) * q.n + cp * q.b;
     return f;
+}
+
+double traceClearance(const HelicoidTrace& trace, double step)
+{
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < trace.pieces.size() && i < trace.joints.size(); ++i) {
+        const std::size_t end = i + 1 < trace.joints.size() ? trace.joints[i + 1] + 1 : trace.points.size();
+        for (std::size_t j = trace.joints[i]; j < end && j < trace.points.size(); ++j) {
+            nearest = std::min(nearest, trace.pieces[i].axisDistance(trace.points[j]));
+        }
+    }
+    return nearest / step;
 }
 
 std::size_t stepCount(double length, double step)

@@ -129,6 +129,38 @@
 /// maxError).
 /// Kept fits have kT >= 0: a negative kT is flipped with a half-turn roll of the frame, the same
 /// curve (§3's sign symmetry; with Eq. 1 as printed it is a half turn about E_T).
+///
+/// Step convergence (issue 19): a fit must be a streamline, not an artefact of the step it was
+/// traced with. Eq. 1 has a singular axis (Helicoid::axisDistance) about which theta turns like
+/// a vortex, 1/r per unit length at distance r; with kN < 0 the flow spirals onto it. The bound
+/// on k above keeps it 4 steps away at a piece's root only, and the optimizer found pieces whose
+/// trace at the scene's step h passed within a step of it, turning theta by 2-2.7 rad in one RK4
+/// step: they matched the strand at h, and regrown at h/4 or h/16 0.4-4 % of strands changed by
+/// more than twice their error (up to 100 % of their length). Now (`axisClearance`, 2 steps,
+/// kAxisClearanceSteps): within() accepts a piece only if its trace at h keeps that distance at
+/// every step; Eq. 5 adds a penalty below it (the objective's trace) and the pre-fit a residual
+/// (`prefitAxisWeight`, at the vertices), so that neither settles on what acceptance refuses.
+/// Pieces kept without acceptance (the last piece allowed, a fragment with no acceptable
+/// candidate) are not checked: most are streamlines still; instead every fit is traced at h/4 too
+/// (fitStepDeviation, reported as `stepDeviation`) and one that moves by more than
+/// `stepDeviationLimit` (0.1) of the tolerance is refitted with every kept piece's curvatures
+/// scaled down until it keeps its distance, the better-converged fit kept. Why the distance
+/// rather than comparing traces at h and h/4 for every candidate: an RK4 trace 2 steps from the
+/// axis or more agrees with the trace at h/16 to 3e-5 of its length (tested on seeded pieces), so
+/// one cheap test per step replaces a four times finer trace per candidate.
+/// Measured (scripts/fit_step_table.py, up to 2,000 strands; mean error as reported / regrown at
+/// h/16, strands that change by more than 2x or exceed 10 % at h/4 or h/16), at 30 vertices:
+///   wavy 1.78 % / 2.57 %, 67 flagged -> 1.75 % / 1.75 %, none; straight 1.50 / 1.67 %, 18 ->
+///   1.50 / 1.50 %, none; curly 1.54 / 1.78 %, 4 -> 1.60 / 1.60 %, none; short 1.38 / 1.46 %,
+///   7 -> 1.36 / 1.36 %, none; ponytail 1.42 / 1.50 %, 6 -> 1.43 / 1.43 %, none;
+/// as stored (1,000 strands): wavy 21 vertices 2.79 % / 3.40 %, 28 -> 2.75 / 2.75 %, none;
+///   straight 16 vertices 1.61 / 1.78 %, 4 -> 1.66 / 1.66 %, none.
+/// Clearances measured: 4 steps (at 30 vertices wavy 1.69 %, straight 1.52 %, curly 1.62 %, but
+/// 10.5 pieces on wavy instead of 9.2, and as stored wavy 3.26 %, straight 1.84 %: the margin
+/// costs sharp turns at coarse steps); 1 step (as stored wavy 2.82 %, straight 1.63 %). With 4
+/// steps: without the pre-fit residual wavy 1.80 % and 2 strands still flagged, a weight of 0.1
+/// 1.73 %, 0.3 1.69 %; scaling down every unaccepted piece near the axis instead of refitting only
+/// unconverged fits 1.88 % (most such pieces are streamlines).
 #pragma once
 
 #include <vdbhair/helicoid/Helicoid.h>
@@ -178,6 +210,9 @@ struct FitParams
     double polishStep = 0.05;     ///< Nelder–Mead's initial step after a pre-fit (scaled parameters; 0.5 without)
     double polishTolerance = 1e-3; ///< Nelder–Mead's absolute tolerance on the scaled parameters
     double step = 0.0;            ///< the regrown strands' tracing step (world units); 0: a quarter of the mean segment length
+    double axisClearance = kAxisClearanceSteps; ///< a piece is accepted only if its trace stays this many steps from its singular axis (0: no check, the former fitter; see below)
+    double prefitAxisWeight = 0.3; ///< pre-fit weight of the residual that keeps the trace axisClearance steps from the singular axis
+    double stepDeviationLimit = 0.1; ///< a fit whose trace at a quarter of its step moves by more than this fraction of the tolerance is refitted with every piece clear of its axis
 };
 
 struct StrandFit
@@ -190,6 +225,8 @@ struct StrandFit
     double coupling = 0.0;              ///< its Fréchet coupling's mean leash (world units)
     double length = 0.0;                ///< the target strand's length
     std::size_t evaluations = 0;        ///< objective evaluations spent
+    double stepDeviation = 0.0;         ///< fitStepDeviation(): how far the trace at `step` is from the streamline (world units)
+    double clearance = 0.0;             ///< least distance of the trace from a piece's singular axis, in steps
 };
 
 /// @brief A scene guide that regrows @a fit: its root, frame, pieces and step (no waviness, wisp or
@@ -213,6 +250,14 @@ std::vector<StrandFit> fitStrands(const StrandSet& strands, const FitParams& par
 /// @brief The trace of a fit (as grown from a scene with the fit's step).
 void traceFit(const StrandFit& fit, HelicoidTrace& out);
 
+/// @brief Step convergence of a fit: the largest distance (world units) between its trace at its
+/// step h and at h / @a refinement, compared at the same arc lengths (every step point of the
+/// coarse trace and every piece's end). A fit that is a streamline gives RK4's O(h⁴) error, far
+/// below its Fréchet error; a fit that exploits a discretization artefact (a step across a
+/// piece's singular axis) changes by a large fraction of its length (issue 19).
+/// @param clearance optional: the coarse trace's least distance from a piece's singular axis, in steps.
+double fitStepDeviation(const StrandFit& fit, int refinement = 4, double* clearance = nullptr);
+
 /// @brief What `vdbhair fit` and the benchmark report about a set of fits.
 struct FitSummary
 {
@@ -224,11 +269,16 @@ struct FitSummary
     double fitBytes = 0.0;          ///< floats: root, frame (t, n) per strand; k, length, roll per piece
     double pointBytes = 0.0;        ///< 3 floats per input vertex
     double evaluationsPerStrand = 0.0;
+    double stepDeviationMean = 0.0; ///< mean StrandFit::stepDeviation relative to strand length
+    double stepDeviationMax = 0.0;  ///< its maximum
+    std::size_t unconverged = 0;    ///< fits whose stepDeviation exceeds stepDeviationLimit · maxError · length
 };
 
 /// @brief Summarize @a fits of @a strands (@a errors as from fitStrands: non-empty where a strand
-/// was not fitted, and left out).
+/// was not fitted, and left out); a fit counts as unconverged above @a stepDeviationLimit ·
+/// @a maxError of its length (FitParams).
 FitSummary summarizeFits(const StrandSet& strands, const std::vector<StrandFit>& fits,
-                         const std::vector<std::string>& errors, double maxError);
+                         const std::vector<std::string>& errors, double maxError,
+                         double stepDeviationLimit = FitParams{}.stepDeviationLimit);
 
 } // namespace vdbhair

@@ -246,7 +246,8 @@ std::size_t sceneVertexCount(const Scene& scene)
     return total;
 }
 
-StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded, openvdb::util::NullInterrupter* interrupter)
+StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded, openvdb::util::NullInterrupter* interrupter,
+                    GrowReport* report)
 {
     if (!(scene.step > 0.0) || !std::isfinite(scene.step)) {
         throw ValueError("growScene: step " + std::to_string(scene.step) + " must be a positive length");
@@ -279,6 +280,8 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
 
     // Guides first (wisps need their traces), then all strands in parallel.
     std::vector<HelicoidTrace> guideTraces(scene.guides.size());
+    // Each guide's clearance from its pieces' singular axes, in steps (written once per guide).
+    std::vector<double> clearance(report ? scene.guides.size() : 0, std::numeric_limits<double>::infinity());
     // Progress: guides traced, then strands grown (a guide's own strand copies its trace).
     ProgressCounter progress(interrupter, "growing strands", scene.guides.size() + items.size(), "traces");
     auto traceGuides = [&](const tbb::blocked_range<std::size_t>& r) {
@@ -290,6 +293,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
             if (!scene.guides[g].wisp) continue;
             tracePHelicoid(scene.guides[g].root, scene.guides[g].frame, scene.guides[g].pieces, stepOf(scene.guides[g]),
                            integrator, guideTraces[g]);
+            if (report) clearance[g] = traceClearance(guideTraces[g], stepOf(scene.guides[g]));
         }
     };
     auto growItems = [&](const tbb::blocked_range<std::size_t>& r) {
@@ -307,6 +311,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
             const HelicoidTrace* batch[kBatch] = {&guideTraces[it.guide]};
             if (!guide.wisp) {
                 tracePHelicoid(guide.root, guide.frame, guide.pieces, stepOf(guide), integrator, own);
+                if (report) clearance[it.guide] = traceClearance(own, stepOf(guide));
                 batch[0] = &own;
             } else if (it.wisp > 0) {
                 while (count < kBatch && i + count != r.end() && items[i + count].guide == it.guide) {
@@ -340,6 +345,16 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
         growItems(tbb::blocked_range<std::size_t>(0, items.size()));
     }
     if (progress.stopped()) throw InterruptedError("growScene: interrupted");
+    if (report) {
+        *report = GrowReport{};
+        for (std::size_t g = 0; g < clearance.size(); ++g) {
+            if (clearance[g] < options.nearAxisSteps) ++report->nearAxis;
+            if (clearance[g] < report->nearestClearance) {
+                report->nearestClearance = clearance[g];
+                report->nearestGuide = g;
+            }
+        }
+    }
     return out;
 }
 

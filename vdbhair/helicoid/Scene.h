@@ -32,6 +32,7 @@
 #include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -85,15 +86,31 @@ struct GrowOptions
 {
     std::optional<HelicoidIntegrator> integrator;  ///< overrides the scene's
     std::size_t maxVertices = std::size_t(1) << 30;  ///< refuse scenes that would grow more
+    /// A guide whose trace comes within this many steps of a piece's singular axis is reported
+    /// (GrowReport). One step, not the fitter's kAxisClearanceSteps margin: between 1 and 2 steps
+    /// RK4 traces at h and h/16 still agree to about 1e-4 of their length (seeded pieces, kN < 0),
+    /// and every strand issue 19 found changing with the step had passed within one step of the axis.
+    double nearAxisSteps = 1.0;
+};
+
+/// @brief What growScene() found while tracing: guides whose trace is not a converged
+/// streamline because it passes within GrowOptions::nearAxisSteps of a piece's singular axis,
+/// where the strand changes with the step (issue 19).
+struct GrowReport
+{
+    std::size_t nearAxis = 0;       ///< guides whose trace comes nearer than GrowOptions::nearAxisSteps
+    std::size_t nearestGuide = 0;   ///< the guide that comes nearest
+    double nearestClearance = std::numeric_limits<double>::infinity();  ///< its distance, in steps (traceClearance)
 };
 
 /// @brief Strands of a scene: each guide, then its wisp strands. Bitwise identical for any
 /// thread count (each strand's randomness comes from (seed, guide, strand)).
 /// @param interrupter optional progress and Ctrl-C (Progress.h).
+/// @param[out] report optional: guides whose trace does not converge (checked on every guide's trace).
 /// @throw LimitError if the scene would exceed options.maxVertices vertices; InterruptedError
 /// when the interrupter stops the work.
 StrandSet growScene(const Scene& scene, const GrowOptions& options = {}, bool threaded = true,
-                    openvdb::util::NullInterrupter* interrupter = nullptr);
+                    openvdb::util::NullInterrupter* interrupter = nullptr, GrowReport* report = nullptr);
 
 /// @brief The vertex count growScene() would produce (checked against overflow).
 std::size_t sceneVertexCount(const Scene& scene);
