@@ -9,6 +9,8 @@
 #include <vdbhair/render/Image.h>
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/ScalpSurface.h>
+#include <vdbhair/synth/Comb.h>
+#include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
 
 #include <nlohmann/json.hpp>
@@ -223,6 +225,145 @@ Args:
 
 Returns:
     Strands, or (Strands, report) with return_report.)doc");
+
+    const TransferParams transferDefaults;
+    m.def(
+        "transfer",
+        [](const StrandsPtr& details, const StrandsPtr& base, bool guides, std::optional<std::size_t> strands, double smoothing,
+           bool smoothBase, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters, int components,
+           const std::string& detail, const std::string& detailScale, bool refine, std::optional<std::string> refineMode,
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp, bool returnReport,
+           int threads, const pyb::object& progress) -> pyb::object {
+            TransferParams p;
+            p.guides = guides;
+            if (strands) {
+                if (*strands == 0) throw ValueError("transfer: strands=0: must be at least 1");
+                if (!guides) throw ValueError("transfer: strands: the output has the base's strands; strands needs guides=True");
+                p.strands = *strands;
+            }
+            p.smoothing = smoothing;
+            p.smoothBase = smoothBase;
+            SynthParams& s = p.synth;
+            s.cluster.levels = levels;
+            s.seed = seed;
+            s.vertices = vertices;
+            s.cluster.threshold = threshold;
+            s.cluster.initialClusters = initialClusters;
+            s.components = components;
+            s.detailBlend = detailBlendFromName(detail);
+            s.detailScale = detailScaleFromName(detailScale);
+            s.refine = refine;
+            if (refineMode) s.refineMode = refineModeFromName(*refineMode);
+            s.voxelSize = voxelSize;
+            if (up) s.up = Vec3d((*up)[0], (*up)[1], (*up)[2]);
+            p.validate("transfer");
+            TransferResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
+                return transferHairstyle(*details, *base, p, grid, true, interrupter);
+            });
+            auto out = std::make_shared<StrandSet>(std::move(r.result.strands));
+            if (!returnReport) return pyb::cast(out);
+            pyb::dict report;
+            pyb::list clusters;
+            for (const std::vector<std::int32_t>& c : r.result.clusterOf)
+                clusters.append(pyb::array_t<std::int32_t>(pyb::ssize_t(c.size()), c.data()));
+            report["cluster_of"] = clusters;
+            report["base_label"] = pyb::array_t<std::int32_t>(pyb::ssize_t(r.baseLabel.size()), r.baseLabel.data());
+            report["head_radius"] = pyb::make_tuple(r.detailsMap->radius(), r.result.map->radius());
+            report["detail_scale"] = r.detailScale;
+            report["length_ratio"] = r.lengthRatio;
+            return pyb::make_tuple(out, report);
+        },
+        pyb::arg("details"), pyb::arg("base"), pyb::kw_only(), pyb::arg("guides") = transferDefaults.guides, pyb::arg("strands") = pyb::none(),
+        pyb::arg("smoothing") = transferDefaults.smoothing, pyb::arg("smooth_base") = transferDefaults.smoothBase,
+        pyb::arg("levels") = transferDefaults.synth.cluster.levels, pyb::arg("seed") = transferDefaults.synth.seed,
+        pyb::arg("vertices") = transferDefaults.synth.vertices, pyb::arg("threshold") = transferDefaults.synth.cluster.threshold,
+        pyb::arg("initial_clusters") = transferDefaults.synth.cluster.initialClusters, pyb::arg("components") = transferDefaults.synth.components,
+        pyb::arg("detail") = detailBlendName(transferDefaults.synth.detailBlend), pyb::arg("detail_scale") = detailScaleName(transferDefaults.synth.detailScale),
+        pyb::arg("refine") = transferDefaults.synth.refine, pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = transferDefaults.synth.voxelSize,
+        pyb::arg("up") = pyb::none(), pyb::arg("scalp") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0,
+        pyb::arg("progress") = pyb::none(),
+        R"doc(The base's global flow with the details' wisps and waves (Wang et al. 2009, §6): ``vdbhair transfer``.
+
+README, "Editing hairstyles", explains every option and its measured default.
+
+Args:
+    details: Strands whose detail is taken.
+    base: Strands whose coarsest level (smoothed, unless smooth_base=False) and wisps are kept.
+    guides: the base's strands are the coarsest level as they are; finer roots spread over their region.
+    strands: with guides, strands in the output.
+    smoothing: sigma of the coarsest levels' smoothing, a fraction of their vertices.
+    smooth_base: smooth the base's coarsest level too (False: the paper's rule).
+    detail_scale: "arc-length" (curls keep their size) or "index" (the paper's, vertex by vertex).
+    Other options as synth.
+
+Returns:
+    Strands, or (Strands, report) with return_report.)doc");
+
+    const CombParams combDefaults;
+    m.def(
+        "comb",
+        [](const StrandsPtr& strands, const pyb::object& strokes, double smoothing, int levels, std::uint64_t seed, int vertices,
+           double threshold, int initialClusters, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp,
+           bool returnReport, int threads, const pyb::object& progress) -> pyb::object {
+            std::vector<CombStroke> list;
+            if (pyb::isinstance<pyb::str>(strokes)) {
+                list = readStrokes(strokes.cast<std::string>());
+            } else {
+                for (const pyb::handle& h : strokes) {
+                    const pyb::dict d = h.cast<pyb::dict>();
+                    CombStroke st;
+                    for (const pyb::handle& q : d["points"]) {
+                        const auto xyz = q.cast<std::array<double, 3>>();
+                        st.points.emplace_back(xyz[0], xyz[1], xyz[2]);
+                    }
+                    st.radius = d["radius"].cast<double>();
+                    if (d.contains("strength")) st.strength = d["strength"].cast<double>();
+                    validateStroke(st, list.size(), "comb");
+                    list.push_back(std::move(st));
+                }
+            }
+            CombParams p;
+            p.smoothing = smoothing;
+            p.synth.cluster.levels = levels;
+            p.synth.seed = seed;
+            p.synth.vertices = vertices;
+            p.synth.cluster.threshold = threshold;
+            p.synth.cluster.initialClusters = initialClusters;
+            if (up) p.synth.up = Vec3d((*up)[0], (*up)[1], (*up)[2]);
+            p.validate("comb");
+            CombResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
+                return combHair(*strands, list, p, grid, true, interrupter);
+            });
+            auto out = std::make_shared<StrandSet>(std::move(r.strands));
+            if (!returnReport) return pyb::cast(out);
+            pyb::dict report;
+            report["combed_clusters"] = r.stats.combedClusters;
+            report["clusters"] = r.stats.clusters;
+            report["moved_strands"] = r.stats.movedStrands;
+            report["angle_before"] = r.stats.angleBefore;
+            report["angle_after"] = r.stats.angleAfter;
+            report["turning_before"] = r.stats.turningBefore;
+            report["turning_after"] = r.stats.turningAfter;
+            report["cluster"] = pyb::array_t<std::int32_t>(pyb::ssize_t(r.cluster.size()), r.cluster.data());
+            return pyb::make_tuple(out, report);
+        },
+        pyb::arg("strands"), pyb::arg("strokes"), pyb::kw_only(), pyb::arg("smoothing") = combDefaults.smoothing,
+        pyb::arg("levels") = combDefaults.synth.cluster.levels, pyb::arg("seed") = combDefaults.synth.seed,
+        pyb::arg("vertices") = combDefaults.synth.vertices, pyb::arg("threshold") = combDefaults.synth.cluster.threshold,
+        pyb::arg("initial_clusters") = combDefaults.synth.cluster.initialClusters, pyb::arg("up") = pyb::none(),
+        pyb::arg("scalp") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(Detail-preserving combing (Wang et al. 2009, §6): ``vdbhair comb``.
+
+Args:
+    strands: Strands to comb.
+    strokes: a path to a stroke file, or a list of dicts {"points": [[x, y, z], ...], "radius": r, "strength": s}.
+    smoothing: sigma of the strand directions the strokes turn, a fraction of the vertices.
+    levels, seed, vertices, threshold, initial_clusters, up, scalp: the hierarchy, as synth.
+
+Returns:
+    Strands (same vertices, attributes kept), or (Strands, report) with return_report.)doc");
 
     const FitParams fitDefaults;
     m.def(

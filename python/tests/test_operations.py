@@ -69,7 +69,7 @@ def test_synth(tmp_path):
     out, report = vdbhair.synth(example, strands=800, seed=3, return_report=True)
     assert len(out) == 800
     assert [lv["output"] for lv in report["levels"]][0] == 800
-    assert [name for name, _ in report["stages"]][:3] == ["scalp", "samples", "clustering"]
+    assert [name for name, _ in report["stages"]][:3] == ["scalp", "clustering", "feature maps"]
     assert len(report["cluster_of"]) == 2 and report["cluster_of"][0].shape == (800,)
     # Deterministic for a seed and independent of the thread count; another seed differs.
     again = vdbhair.synth(example, strands=800, seed=3, threads=1)
@@ -80,3 +80,27 @@ def test_synth(tmp_path):
         vdbhair.synth(example, layout="tiled")
     with pytest.raises(ValueError, match="strands=0"):
         vdbhair.synth(example, strands=0)
+
+
+def test_transfer_and_comb():
+    pony = vdbhair.read(str(SOURCE_DIR / "scenes" / "default" / "ponytail.hair"))
+    # A hairstyle onto itself keeps its strands' roots, in order.
+    out, report = vdbhair.transfer(pony, pony, refine=False, return_report=True)
+    assert len(out) == len(pony)
+    roots = pony.positions[pony.offsets[:-1]]
+    assert np.allclose(out.positions[out.offsets[:-1]], roots, atol=1e-3)
+    assert report["detail_scale"] == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="strands needs guides=True"):
+        vdbhair.transfer(pony, pony, strands=10)
+    # Zero strength changes nothing; a stroke keeps every segment's length.
+    stroke = {"points": [[0, 60, 0], [20, 40, 0]], "radius": 30.0}
+    same = vdbhair.comb(pony, [dict(stroke, strength=0.0)])
+    assert np.array_equal(same.positions, pony.positions)
+    combed, rep = vdbhair.comb(pony, [stroke], return_report=True)
+    assert rep["moved_strands"] > 0 and rep["angle_after"] < rep["angle_before"]
+    seg = lambda s: np.linalg.norm(np.diff(s.positions, axis=0), axis=1)
+    inner = np.ones(len(pony.positions) - 1, bool)
+    inner[pony.offsets[1:-1] - 1] = False
+    assert np.allclose(seg(combed)[inner], seg(pony)[inner], rtol=1e-4)
+    with pytest.raises(ValueError, match="radius"):
+        vdbhair.comb(pony, [{"points": [[0, 0, 0], [1, 0, 0]], "radius": 0.0}])

@@ -66,3 +66,8 @@ printf '{"vdbhair": "scene/1", "guides": []}\n' > no_guides.json
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 0, 0, 0], "length": 0}]}]}\n' > zero_guide.json
 printf '{"vdbhair": "scene/1", "guides": [{"root": [0,0,0], "frame": {"tangent": [1,0,0], "normal": [0,1,0]}, "pieces": [{"k": [1, 1e999, 0, 0], "length": 1}]}]}\n' > inf_guide.json
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 10 0\n1 10 0\n0 10 1\n' > roots_no_normals.ply
+# Comb strokes with one mistake each.
+printf '{"strokes": [{"points": [[0, 0, -15]], "radius": 4}]}\n' > stroke_one_point.json
+printf '{"strokes": [{"points": [[0, 2, -15], [9, -10, -15]], "radius": 0}]}\n' > stroke_zero_radius.json
+printf '{"strokes": [{"points": [[0, 2, -15], [9, -10, -15]], "radius": 4, "strength": 0}]}\n' > stroke_zero_strength.json
+printf '{"strokes": [{"points": [[0, 2, 1e999], [9, -10, -15]], "radius": 4}]}\n' > stroke_inf.json
