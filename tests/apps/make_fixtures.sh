@@ -71,3 +71,4 @@ printf '{"strokes": [{"points": [[0, 0, -15]], "radius": 4}]}\n' > stroke_one_po
 printf '{"strokes": [{"points": [[0, 2, -15], [9, -10, -15]], "radius": 0}]}\n' > stroke_zero_radius.json
 printf '{"strokes": [{"points": [[0, 2, -15], [9, -10, -15]], "radius": 4, "strength": 0}]}\n' > stroke_zero_strength.json
 printf '{"strokes": [{"points": [[0, 2, 1e999], [9, -10, -15]], "radius": 4}]}\n' > stroke_inf.json
+printf '{"strokes": [{"points": [[0, 60, 0], [20, 40, 0]], "radius": 30}]}\n' > stroke_pony.json
