@@ -87,7 +87,7 @@ Command addCombCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--smoothing", p->params.smoothing, "Sigma of the strand directions the strokes turn, a fraction of the vertices (detail below it rides along)")->capture_default_str();
     addSynthHierarchyOptions(sub, p->params.synth, p->text);
     addCommonOptions(sub, common);
-    sub->footer("Example: vdbhair comb hair.hair --stroke scenes/comb/part.json -o combed.hair --json");
+    sub->footer("Example: vdbhair comb scenes/default/head.json --stroke scenes/comb/sweep_ponytail.json -o combed.hair --json");
     return {sub, [p, &common] { return runComb(*p, common); }};
 }
 
