@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <vdbhair/Progress.h>
+#include <openvdb/openvdb.h>
 #include <vdbhair/io/ReadOptions.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbInfo.h>
@@ -147,6 +148,10 @@ void addSynthHierarchyOptions(CLI::App* sub, SynthParams& params, SynthOptionTex
 void addSynthTransferOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
 /// @throw ValueError for a bad --up, --refine-mode or --detail.
 void applySynthOptionText(const SynthOptionText& text, SynthParams& params);
+
+/// @brief The scalp named by a verb's --scalp option (ScalpSurface.h's readScalp(), shown as a
+/// stage), or null when @a path is empty.
+openvdb::FloatGrid::Ptr readScalpOption(const std::string& path, const CommonOptions& common);
 
 /// @brief Write a synthesized hairstyle (`synth`, `transfer`): a `.vdb`'s points carry each
 /// strand's cluster at every coarser level (int32 cluster_level_1, ...); other formats the strands.

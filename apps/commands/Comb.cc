@@ -27,11 +27,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
     const std::vector<CombStroke> strokes = readStrokes(p.stroke);
     const StrandSet in = loadStrandsOrScene("comb", p.input, common);
     if (in.empty()) throw ValueError(p.input + ": no strands to comb");
-    openvdb::FloatGrid::Ptr scalp;
-    if (!p.scalp.empty()) {
-        const Stage stage(common, "reading " + p.scalp);
-        scalp = readScalp(p.scalp, common.interrupter);
-    }
+    const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
     const auto t0 = std::chrono::steady_clock::now();
     CombResult r;
     {

@@ -141,11 +141,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
             throw LimitError("--strands " + std::to_string(p.strands) + ": " + formatValue(estimate) + " vertices exceed the cap of " +
                              std::to_string(p.synth.maxVertices));
     }
-    openvdb::FloatGrid::Ptr scalp;
-    if (!p.scalp.empty()) {
-        const Stage stage(common, "reading " + p.scalp);
-        scalp = readScalp(p.scalp, common.interrupter);
-    }
+    const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
     const auto t0 = std::chrono::steady_clock::now();
     const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -241,6 +237,13 @@ void applySynthOptionText(const SynthOptionText& t, SynthParams& s)
     if (!t.refineMode.empty()) s.refineMode = refineModeFromName(t.refineMode);
     if (!t.detail.empty()) s.detailBlend = detailBlendFromName(t.detail);
     if (!t.detailScale.empty()) s.detailScale = detailScaleFromName(t.detailScale);
+}
+
+openvdb::FloatGrid::Ptr readScalpOption(const std::string& path, const CommonOptions& common)
+{
+    if (path.empty()) return nullptr;
+    const Stage stage(common, "reading " + path);
+    return readScalp(path, common.interrupter);
 }
 
 void writeSynthStrands(const std::string& path, const StrandSet& strands, const std::vector<std::vector<std::int32_t>>& clusterOf)

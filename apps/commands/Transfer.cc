@@ -48,11 +48,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
     const StrandSet base = loadStrandsOrScene(job.verb, job.base, common);
     if (details.empty()) throw ValueError(job.details + ": no strands to take detail from");
     if (base.empty()) throw ValueError(job.base + ": no strands to transfer onto");
-    openvdb::FloatGrid::Ptr scalp;
-    if (!job.scalp.empty()) {
-        const Stage stage(common, "reading " + job.scalp);
-        scalp = readScalp(job.scalp, common.interrupter);
-    }
+    const openvdb::FloatGrid::Ptr scalp = readScalpOption(job.scalp, common);
     const auto t0 = std::chrono::steady_clock::now();
     TransferResult tr;
     try {

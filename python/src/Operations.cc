@@ -96,6 +96,23 @@ pyb::object metaValue(const MetaValue& m)
 
 } // namespace
 
+namespace {
+
+/// The hierarchy's keywords (as the commands' addSynthHierarchyOptions()), shared by synth,
+/// transfer and comb.
+void setHierarchy(SynthParams& p, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters,
+                  const std::optional<std::array<double, 3>>& up)
+{
+    p.cluster.levels = levels;
+    p.seed = seed;
+    p.vertices = vertices;
+    p.cluster.threshold = threshold;
+    p.cluster.initialClusters = initialClusters;
+    if (up) p.up = Vec3d((*up)[0], (*up)[1], (*up)[2]);
+}
+
+} // namespace
+
 void bindOperations(pyb::module_& m)
 {
     const GrowOptions growDefaults;
@@ -140,11 +157,7 @@ Returns:
            double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp, bool returnReport,
            int threads, const pyb::object& progress) -> pyb::object {
             SynthParams p;
-            p.cluster.levels = levels;
-            p.seed = seed;
-            p.vertices = vertices;
-            p.cluster.threshold = threshold;
-            p.cluster.initialClusters = initialClusters;
+            setHierarchy(p, levels, seed, vertices, threshold, initialClusters, up);
             p.components = components;
             p.mapSpacing = mapSpacing;
             p.layout = synthLayoutFromName(layout);
@@ -154,7 +167,6 @@ Returns:
             p.refine = refine;
             if (refineMode) p.refineMode = refineModeFromName(*refineMode);
             p.voxelSize = voxelSize;
-            if (up) p.up = Vec3d((*up)[0], (*up)[1], (*up)[2]);
             if (strands) {
                 if (*strands == 0) throw ValueError("synth: strands=0: must be at least 1");
                 if (example->empty()) throw ValueError("synth: the example has no strands");
@@ -244,18 +256,13 @@ Returns:
             p.smoothing = smoothing;
             p.smoothBase = smoothBase;
             SynthParams& s = p.synth;
-            s.cluster.levels = levels;
-            s.seed = seed;
-            s.vertices = vertices;
-            s.cluster.threshold = threshold;
-            s.cluster.initialClusters = initialClusters;
+            setHierarchy(s, levels, seed, vertices, threshold, initialClusters, up);
             s.components = components;
             s.detailBlend = detailBlendFromName(detail);
             s.detailScale = detailScaleFromName(detailScale);
             s.refine = refine;
             if (refineMode) s.refineMode = refineModeFromName(*refineMode);
             s.voxelSize = voxelSize;
-            if (up) s.up = Vec3d((*up)[0], (*up)[1], (*up)[2]);
             p.validate("transfer");
             TransferResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
@@ -325,12 +332,7 @@ Returns:
             }
             CombParams p;
             p.smoothing = smoothing;
-            p.synth.cluster.levels = levels;
-            p.synth.seed = seed;
-            p.synth.vertices = vertices;
-            p.synth.cluster.threshold = threshold;
-            p.synth.cluster.initialClusters = initialClusters;
-            if (up) p.synth.up = Vec3d((*up)[0], (*up)[1], (*up)[2]);
+            setHierarchy(p.synth, levels, seed, vertices, threshold, initialClusters, up);
             p.validate("comb");
             CombResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
