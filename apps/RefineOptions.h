@@ -4,6 +4,7 @@
 #pragma once
 
 #include "Command.h"
+#include "HeadOptions.h"
 
 #include <vdbhair/field/Refine.h>
 
@@ -21,8 +22,7 @@ struct RefineCmdParams
     CLI::Option* stepOpt = nullptr;   ///< whether --step was given
     std::string mode = "consistent";
     std::string integrator = "euler";
-    std::string head;                 ///< --head: a mesh, a .vdb level set, or "none"
-    std::string headPolicy = "no-deeper";
+    HeadOptions head;
     bool strict = false;
     ScalpOptions scalp;
 };

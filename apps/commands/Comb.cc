@@ -1,5 +1,6 @@
 // vdbhair comb IN --stroke STROKE.json -o OUT: detail-preserving combing (Wang et al. 2009, §6).
 #include "../Command.h"
+#include "../HeadOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/StrandIO.h>
@@ -17,6 +18,7 @@ struct CombCmdParams
     std::string input, output, stroke, scalp;
     CombParams params;
     SynthOptionText text;
+    HeadOptions head;
 };
 
 int runComb(CombCmdParams p, const CommonOptions& common)
@@ -28,6 +30,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
     const StrandSet in = loadStrandsOrScene("comb", p.input, common);
     if (in.empty()) throw ValueError(p.input + ": no strands to comb");
     const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
+    p.params.head = headFromOptions(p.head);
     const auto t0 = std::chrono::steady_clock::now();
     CombResult r;
     {
@@ -48,7 +51,8 @@ int runComb(CombCmdParams p, const CommonOptions& common)
     // curl kept within 10 % on the moved strands.
     const nlohmann::json checks = {
         {"turned", s.reachVertices == 0 || s.angleAfter < s.angleBefore},
-        {"curl_kept", s.movedStrands == 0 || std::abs(s.turningAfter - s.turningBefore) <= 0.1 * s.turningBefore}};
+        {"curl_kept", s.movedStrands == 0 || std::abs(s.turningAfter - s.turningBefore) <= 0.1 * s.turningBefore},
+        {"kept_out_of_head", s.insideHeadAfter <= s.insideHeadBefore}};
     if (s.combedClusters == 0 && !common.quiet)
         std::cerr << "vdbhair comb: warning: no stroke reaches a wisp of " << p.input << "; the output equals the input\n";
     if (common.json) {
@@ -58,6 +62,8 @@ int runComb(CombCmdParams p, const CommonOptions& common)
                    {"clusters", s.clusters}, {"combed_clusters", s.combedClusters}, {"moved_strands", s.movedStrands},
                    {"angle_to_stroke_deg", {{"before", s.angleBefore}, {"after", s.angleAfter}, {"vertices", s.reachVertices}}},
                    {"turning_per_length", {{"before", s.turningBefore}, {"after", s.turningAfter}}},
+                   {"head", {{"head", s.head}, {"deflected_strands", s.headDeflected},
+                             {"inside_vertices", {{"before", s.insideHeadBefore}, {"after", s.insideHeadAfter}}}}},
                    {"stages", stages}, {"seconds", seconds}, {"checks", checks}});
     } else if (!common.quiet) {
         std::cout << "combed " << s.movedStrands << " of " << r.strands.numStrands() << " strands (" << s.combedClusters << " of "
@@ -65,6 +71,8 @@ int runComb(CombCmdParams p, const CommonOptions& common)
                   << seconds << " s\n"
                   << "  angle to the stroke within its reach: " << s.angleBefore << " -> " << s.angleAfter << " degrees\n"
                   << "  turning per length of the moved strands: " << s.turningBefore << " -> " << s.turningAfter << "\n"
+                  << "  head: " << s.head << "; " << s.headDeflected << " strands turned aside by it, moved vertices inside it "
+                  << s.insideHeadBefore << " -> " << s.insideHeadAfter << "\n"
                   << "wrote " << p.output << "\n";
     }
     return 0;
@@ -81,6 +89,7 @@ Command addCombCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", p->output, "The combed hairstyle (any strand format)")->required();
     sub->add_option("--scalp", p->scalp, "The scalp: a .vdb with a level set 'surface' or a head mesh; default: the sphere fitted to the roots");
     sub->add_option("--smoothing", p->params.smoothing, "Sigma of the strand directions the strokes turn, a fraction of the vertices (detail below it rides along)")->capture_default_str();
+    addHeadOptions(sub, p->head, "--scalp's level set if given, else a sphere fitted to the roots");
     addSynthHierarchyOptions(sub, p->params.synth, p->text);
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair comb scenes/default/head.json --stroke scenes/comb/sweep_ponytail.json -o combed.hair --json");

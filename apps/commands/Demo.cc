@@ -32,9 +32,9 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common, "strands", &head);
     RefineParams rp = refineParamsFrom(p.refine, strands);
     // A scene's own head is the obstacle refinement keeps strands out of, unless --head says otherwise.
-    if (p.refine.head.empty() && fileExtension(p.refine.input) == ".json") {
+    if (p.refine.head.path.empty() && fileExtension(p.refine.input) == ".json") {
         const Scene scene = readScene(p.refine.input);
-        if (scene.head) rp.head = HeadObstacle::sphere(scene.head->center, scene.head->radius, headPolicyFromName(p.refine.headPolicy));
+        if (scene.head) rp.head = HeadObstacle::sphere(scene.head->center, scene.head->radius, p.refine.head.headPolicy());
     }
     std::error_code ec;
     fs::create_directories(p.outDir, ec);

@@ -42,13 +42,8 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     rp.mode = refineModeFromName(p.mode);
     rp.trace.integrator = integratorFromName(p.integrator);
     applyScalpOptions(p.scalp, strands, rp.field);
-    if (p.head == "none") {
-        rp.head = HeadObstacle::none();
-    } else if (!p.head.empty()) {
-        rp.head = readHeadObstacle(p.head, "--head " + p.head, headPolicyFromName(p.headPolicy));
-    } else if (!p.scalp.sphere.empty()) {
-        rp.head = HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, headPolicyFromName(p.headPolicy));
-    }
+    rp.head = headFromOptions(p.head, p.scalp.sphere.empty() ? HeadObstacle()
+                                      : HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, p.head.headPolicy()));
     return rp;
 }
 
@@ -191,10 +186,7 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
                     "consistent mode: outlier score from which the field's direction is followed")->capture_default_str();
     sub->add_option("--min-spread", rp.consistency.minSpreadDeg,
                     "consistent mode: deviations below this many degrees are never outliers")->capture_default_str();
-    sub->add_option("--head", p.head, "The head strands may not enter: a triangle mesh (.ply, .obj), a .vdb with a level set grid "
-                                      "('surface' or the first one), or 'none' (default: --scalp's sphere if given, else a sphere fitted to the roots)");
-    sub->add_option("--head-policy", p.headPolicy, "no-deeper: no vertex enters the head that the input had outside it, "
-                                                   "hair already inside is left as it was; outside: every vertex is moved out")->capture_default_str();
+    addHeadOptions(sub, p.head, "--scalp's sphere if given, else a sphere fitted to the roots");
     sub->add_option("--integrator", p.integrator, "field mode: euler (the papers' choice), rk2 or rk4")->capture_default_str();
     sub->add_option("--margin", rp.trace.margin, "field mode: voxels a strand may continue straight past the field's active region")->capture_default_str();
     sub->add_option("--max-voxels", rp.field.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();

@@ -1,6 +1,8 @@
 // The exception mapping, the interrupter and Ctrl-C for the vdbhair Python module.
 #include "Common.h"
 
+#include <pybind11/stl.h>
+
 #include <vdbhair/Exceptions.h>
 
 #include <csignal>
@@ -167,6 +169,24 @@ void PyInterrupter::report(std::uint64_t done, bool force)
         mError.emplace(std::move(e));
         mCallbackFailed.store(true);
     }
+}
+
+HeadArgument::HeadArgument(const pyb::object& h, const std::string& policyName) : policy(headPolicyFromName(policyName))
+{
+    if (h.is_none()) return;
+    if (pyb::isinstance<pyb::str>(h)) {
+        const std::string name = h.cast<std::string>();
+        if (name == "none") head = HeadObstacle::none();
+        else path = name;
+        return;
+    }
+    const auto s = h.cast<std::array<double, 4>>();
+    head = HeadObstacle::sphere(Vec3d(s[0], s[1], s[2]), s[3], policy);
+}
+
+HeadObstacle HeadArgument::get(const std::string& where) const
+{
+    return path ? readHeadObstacle(*path, where + ": head=" + *path, policy) : head;
 }
 
 } // namespace vdbhair::py

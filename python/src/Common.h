@@ -6,6 +6,7 @@
 #pragma once
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/Progress.h>
 
 #include <pybind11/numpy.h>
@@ -121,6 +122,22 @@ pyb::array readOnlyView(const T* data, std::size_t count, std::size_t cols, pyb:
     a.attr("setflags")(pyb::arg("write") = false);
     return a;
 }
+
+/// @brief The head= and head_policy= keywords of refine and comb: None (the operation's default
+/// head), "none" (no head), a path (a mesh, or a .vdb with a level set, read by get()), or
+/// (x, y, z, r), a sphere.
+struct HeadArgument
+{
+    /// @throw ValueError for a policy that is not one of no-deeper, outside.
+    HeadArgument(const pyb::object& head, const std::string& policy);
+    /// @brief The head (reading the file of a path: call it inside runLong()).
+    /// @param where the operation, for messages ("refine")
+    HeadObstacle get(const std::string& where) const;
+
+    HeadObstacle head;  ///< unset (None), none() or a sphere
+    std::optional<std::string> path;
+    HeadPolicy policy;
+};
 
 // The bindings of each file.
 void bindStrands(pyb::module_& m);

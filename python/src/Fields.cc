@@ -576,21 +576,12 @@ Raises:
             rp.trace.margin = margin;
             rp.field.maxVoxels = maxVoxels;
             rp.measure = measure;
-            const HeadPolicy policy = headPolicyFromName(headPolicy);
-            std::optional<std::string> headPath;
-            if (head.is_none()) {
-            } else if (pyb::isinstance<pyb::str>(head)) {
-                const std::string h = head.cast<std::string>();
-                if (h == "none") rp.head = HeadObstacle::none();
-                else headPath = h;
-            } else {
-                const auto s = head.cast<std::array<double, 4>>();
-                rp.head = HeadObstacle::sphere(Vec3d(s[0], s[1], s[2]), s[3], policy);
-            }
+            const HeadArgument headArg(head, headPolicy);
+            rp.head = headArg.head;
             rp.validate("refine");
             RefineResult result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 RefineParams p = rp;
-                if (headPath) p.head = readHeadObstacle(*headPath, "refine: head=" + *headPath, policy);
+                p.head = headArg.get("refine");
                 return refineStrands(*strands, p, true, interrupter);
             });
             auto out = std::make_shared<StrandSet>(std::move(result.strands));

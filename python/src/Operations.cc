@@ -312,7 +312,9 @@ Returns:
         "comb",
         [](const StrandsPtr& strands, const pyb::object& strokes, double smoothing, int levels, std::uint64_t seed, int vertices,
            double threshold, int initialClusters, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp,
-           bool returnReport, int threads, const pyb::object& progress) -> pyb::object {
+           const pyb::object& head, const std::string& headPolicy, bool returnReport, int threads,
+           const pyb::object& progress) -> pyb::object {
+            const HeadArgument headArg(head, headPolicy);
             std::vector<CombStroke> list;
             if (pyb::isinstance<pyb::str>(strokes)) {
                 list = readStrokes(strokes.cast<std::string>());
@@ -336,7 +338,9 @@ Returns:
             p.validate("comb");
             CombResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
-                return combHair(*strands, list, p, grid, true, interrupter);
+                CombParams q = p;
+                q.head = headArg.get("comb");
+                return combHair(*strands, list, q, grid, true, interrupter);
             });
             auto out = std::make_shared<StrandSet>(std::move(r.strands));
             if (!returnReport) return pyb::cast(out);
@@ -348,6 +352,10 @@ Returns:
             report["angle_after"] = r.stats.angleAfter;
             report["turning_before"] = r.stats.turningBefore;
             report["turning_after"] = r.stats.turningAfter;
+            report["head"] = r.stats.head;
+            report["head_deflected"] = r.stats.headDeflected;
+            report["inside_head_before"] = r.stats.insideHeadBefore;
+            report["inside_head_after"] = r.stats.insideHeadAfter;
             report["cluster"] = pyb::array_t<std::int32_t>(pyb::ssize_t(r.cluster.size()), r.cluster.data());
             return pyb::make_tuple(out, report);
         },
@@ -355,7 +363,8 @@ Returns:
         pyb::arg("levels") = combDefaults.synth.cluster.levels, pyb::arg("seed") = combDefaults.synth.seed,
         pyb::arg("vertices") = combDefaults.synth.vertices, pyb::arg("threshold") = combDefaults.synth.cluster.threshold,
         pyb::arg("initial_clusters") = combDefaults.synth.cluster.initialClusters, pyb::arg("up") = pyb::none(),
-        pyb::arg("scalp") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        pyb::arg("scalp") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("head_policy") = "no-deeper",
+        pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(Detail-preserving combing (Wang et al. 2009, §6): ``vdbhair comb``.
 
 Args:
@@ -363,6 +372,9 @@ Args:
     strokes: a path to a stroke file, or a list of dicts {"points": [[x, y, z], ...], "radius": r, "strength": s}.
     smoothing: sigma of the strand directions the strokes turn, a fraction of the vertices.
     levels, seed, vertices, threshold, initial_clusters, up, scalp: the hierarchy, as synth.
+    head: the head strands may not enter: None (scalp's level set if given, else a sphere fitted
+        to the roots), "none", a mesh or .vdb level set path, or (x, y, z, r) a sphere.
+    head_policy: "no-deeper" (no vertex goes deeper into the head than the input's) or "outside".
 
 Returns:
     Strands (same vertices, attributes kept), or (Strands, report) with return_report.)doc");

@@ -104,3 +104,18 @@ def test_transfer_and_comb():
     assert np.allclose(seg(combed)[inner], seg(pony)[inner], rtol=1e-4)
     with pytest.raises(ValueError, match="radius"):
         vdbhair.comb(pony, [{"points": [[0, 0, 0], [1, 0, 0]], "radius": 0.0}])
+    # A stroke into the head: without a head hair goes in; a sphere head turns it aside (the
+    # ponytail's roots lie inside this ball: "outside" moves the combed strands out of it).
+    into = {"points": [[0, 150, 40], [0, 100, 15]], "radius": 35.0}
+    ball = (0.32, 87.9, 7.3, 32.0)
+    def inside(s):
+        r = np.linalg.norm(s.positions - np.array(ball[:3], np.float32), axis=1)
+        return int((r < ball[3] - 1e-3).sum())
+    through = vdbhair.comb(pony, [into], head="none")
+    kept, rep = vdbhair.comb(pony, [into], head=ball, head_policy="outside", return_report=True)
+    no_deeper = vdbhair.comb(pony, [into], head=ball)
+    assert inside(through) > inside(pony) + 5000
+    assert inside(kept) < inside(pony) // 2 and inside(no_deeper) <= inside(pony)
+    assert rep["head_deflected"] > 0 and rep["head"].startswith("sphere")
+    with pytest.raises(ValueError, match="head policy"):
+        vdbhair.comb(pony, [into], head_policy="sideways")

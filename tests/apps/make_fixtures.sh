@@ -72,3 +72,5 @@ printf '{"strokes": [{"points": [[0, 2, -15], [9, -10, -15]], "radius": 0}]}\n' 
 printf '{"strokes": [{"points": [[0, 2, -15], [9, -10, -15]], "radius": 4, "strength": 0}]}\n' > stroke_zero_strength.json
 printf '{"strokes": [{"points": [[0, 2, 1e999], [9, -10, -15]], "radius": 4}]}\n' > stroke_inf.json
 printf '{"strokes": [{"points": [[0, 60, 0], [20, 40, 0]], "radius": 30}]}\n' > stroke_pony.json
+# Down and back into the ponytail's head (the sphere fitted to its roots: centre (0.3, 87.9, 7.3), radius 32).
+printf '{"strokes": [{"points": [[0, 150, 40], [0, 100, 15]], "radius": 35}]}\n' > stroke_into_head.json

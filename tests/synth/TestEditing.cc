@@ -196,6 +196,54 @@ TEST_CASE("combHair: zero strength and far strokes change nothing; a stroke turn
     CHECK(two.strands.positions != r.strands.positions);
 }
 
+TEST_CASE("combHair: a stroke into the head turns strands aside at the head, lengths and roots kept", "[synth]")
+{
+    const StrandSet hair = curlyHairstyle(1200, 12, 0.02, 4.0, 48);
+    // Down and back into the unit head's front, through the hair standing out of it.
+    CombStroke into;
+    into.points = {Vec3d(0.0, 2.3, 1.5), Vec3d(0.0, 0.9, 0.45)};
+    into.radius = 0.8;
+    into.strength = 1.0;
+    // Vertices after the root closer to the centre than the unit head's surface.
+    const auto inside = [](const StrandSet& s) {
+        std::size_t k = 0;
+        for (std::size_t i = 0; i < s.numStrands(); ++i)
+            for (std::size_t v = 1; v < s.size(i); ++v) k += Vec3d(s.data(i)[v]).length() < 1.0 - 1e-6;
+        return k;
+    };
+    REQUIRE(inside(hair) == 0);
+    CombParams params = smallComb();
+    params.head = HeadObstacle::none();
+    const CombResult through = combHair(hair, {into}, params);
+    INFO("without a head: " << inside(through.strands) << " vertices inside");
+    REQUIRE(inside(through.strands) > 500);  // the stroke alone pulls hair into the head
+    CHECK(through.stats.head == "none");
+
+    for (const HeadPolicy policy : {HeadPolicy::KeepOutside, HeadPolicy::NoDeeper}) {
+        params.head = HeadObstacle::sphere(Vec3d(0.0), 1.0, policy);
+        const CombResult kept = combHair(hair, {into}, params);
+        const CombStats& st = kept.stats;
+        INFO("policy " << int(policy) << ": deflected " << st.headDeflected << " of " << st.movedStrands << ", inside "
+                       << st.insideHeadBefore << " -> " << st.insideHeadAfter << ", angle " << st.angleBefore << " -> " << st.angleAfter);
+        CHECK(inside(kept.strands) == 0);
+        CHECK(st.headDeflected > 0);
+        CHECK(st.headDeflected <= st.movedStrands);
+        CHECK(st.angleAfter < st.angleBefore - 10.0);  // still combed toward the stroke
+        CHECK(segmentLengthError(hair, kept.strands) < 1e-4);
+        for (std::size_t s = 0; s < hair.numStrands(); ++s) CHECK(kept.strands.root(s) == hair.root(s));
+        // The same on one thread.
+        CHECK(combHair(hair, {into}, params, nullptr, false).strands.positions == kept.strands.positions);
+    }
+    // Unset: the sphere fitted to the roots (the unit head here), no deeper than the input.
+    params.head = HeadObstacle();
+    const CombResult fitted = combHair(hair, {into}, params);
+    CHECK_THAT(fitted.stats.head, Contains("fitted to the roots"));
+    std::size_t deep = 0;
+    for (std::size_t i = 0; i < fitted.strands.numStrands(); ++i)
+        for (std::size_t v = 1; v < fitted.strands.size(i); ++v) deep += Vec3d(fitted.strands.data(i)[v]).length() < 1.0 - 1e-3;
+    CHECK(deep == 0);
+}
+
 TEST_CASE("readStrokes: the format and its errors", "[synth]")
 {
     const auto write = [&](const std::string& name, const std::string& text) {

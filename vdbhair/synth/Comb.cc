@@ -1,6 +1,7 @@
 #include "Comb.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/Refine.h>
 #include <vdbhair/io/JsonFile.h>
 #include <vdbhair/strands/Resample.h>
 #include <vdbhair/synth/SynthesisReport.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 namespace vdbhair {
@@ -263,7 +265,13 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
         });
     }
     if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("combing interrupted");
-    // 2. Every strand of a combed cluster: its edges turned by its centre's rotations at its arc length.
+    // 2. Every strand of a combed cluster: its edges turned by its centre's rotations at its arc
+    // length, and turned aside where the head is in the way.
+    const HeadObstacle head = !params.head.unset() ? params.head
+                              : scalp             ? HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper)
+                                                  : headFromRoots(strands);
+    const bool relative = head.policy() == HeadPolicy::NoDeeper;
+    std::vector<std::uint8_t> deflected(n, 0);
     res.strands = strands;
     {
         SynthStageTimer t{res.stages, "detail re-transfer"};
@@ -284,6 +292,9 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
         forEach(n, [&](std::size_t s) {
             const std::size_t c = std::size_t(res.cluster[s]);
             if (!touched[c]) return;
+            std::optional<HeadObstacle::Probe> probe;
+            if (!head.empty()) probe.emplace(head);
+            Quat aside = Quat::Identity();  // what the head turned the strand by so far
             const Vec3f* in = strands.data(s);
             Vec3f* out = res.strands.data(s);
             const std::vector<double>& m = mids[c];
@@ -300,7 +311,34 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
                 if (mid <= m.front()) Q = R.front();
                 else if (k + 1 >= m.size()) Q = R.back();
                 else Q = R[k].slerp((mid - m[k]) / std::max(1e-300, m[k + 1] - m[k]), R[k + 1]);
-                q += Q * e;
+                EVec step = aside * (Q * e);
+                if (probe) {
+                    // An edge that would take its end into the head (deeper than the input's end,
+                    // under NoDeeper) is slid along the surface at its own length; the rest of
+                    // the strand turns with it.
+                    const Vec3d at = fromE(q);
+                    Vec3d end = fromE(q + step);
+                    const double d = probe->distance(end);
+                    const double floor = d < 0.0 && relative ? std::min(0.0, probe->distance(Vec3d(in[v + 1]))) : 0.0;
+                    if (d < floor) {
+                        const double len = step.norm();
+                        Vec3d dir = fromE(step);
+                        const Vec3d nrm = probe->normal(at);
+                        const double dn = dir.dot(nrm);
+                        const Vec3d slide = dir - dn * nrm;
+                        if (dn < 0.0 && slide.length() > 1e-9 * len) dir = slide * (len / slide.length());
+                        end = at + dir;
+                        for (int it = 0; it < 4 && probe->pushOut(end, floor); ++it) {
+                            const Vec3d g = end - at;
+                            if (g.length() > 0.0) end = at + g * (len / g.length());
+                        }
+                        const EVec turned = toE(end - at);
+                        aside = (Quat::FromTwoVectors(step, turned) * aside).normalized();
+                        step = turned;
+                        deflected[s] = 1;
+                    }
+                }
+                q += step;
                 out[v + 1] = Vec3f(fromE(q));
             }
         });
@@ -308,6 +346,8 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
     // 3. What the strokes did.
     CombStats& st = res.stats;
     st.clusters = K;
+    st.head = head.empty() ? std::string("none") : head.describe();
+    for (std::uint8_t u : deflected) st.headDeflected += u;
     for (std::uint8_t u : touched) st.combedClusters += u;
     std::vector<std::uint8_t> moved(n, 0);
     for (std::size_t s = 0; s < n; ++s) moved[s] = touched[std::size_t(res.cluster[s])];
@@ -315,11 +355,18 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
     {
         // Per strand partial sums, added in strand order (the same on any thread count).
         std::vector<double> before(n, 0.0), after(n, 0.0);
-        std::vector<std::size_t> count(n, 0);
+        std::vector<std::size_t> count(n, 0), insideBefore(n, 0), insideAfter(n, 0);
         forEach(n, [&](std::size_t s) {
             const Vec3f* a = strands.data(s);
             const Vec3f* b = res.strands.data(s);
             const std::size_t m = strands.size(s);
+            if (moved[s] && !head.empty()) {
+                HeadObstacle::Probe probe(head);
+                for (std::size_t v = 0; v < m; ++v) {
+                    insideBefore[s] += probe.distance(Vec3d(a[v])) < 0.0;
+                    insideAfter[s] += probe.distance(Vec3d(b[v])) < 0.0;
+                }
+            }
             if (m < 2) return;
             for (const CombStroke& k : strokes)
                 for (std::size_t v = 0; v < m; ++v) {
@@ -338,6 +385,8 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
             sb += before[s];
             sa += after[s];
             st.reachVertices += count[s];
+            st.insideHeadBefore += insideBefore[s];
+            st.insideHeadAfter += insideAfter[s];
         }
         if (st.reachVertices) {
             st.angleBefore = sb / double(st.reachVertices) * 180.0 / M_PI;

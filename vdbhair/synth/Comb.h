@@ -35,6 +35,7 @@
 /// length and every root exactly, and a strand whose centre no stroke reaches is copied unchanged.
 #pragma once
 
+#include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/synth/Synthesis.h>
 
 #include <array>
@@ -71,6 +72,14 @@ struct CombParams
         return p;
     }();
     double smoothing = StrandSamples::kDetailSmoothing;  ///< σ of the strand directions, a fraction of the vertices
+    /// The head the combed strands may not enter, with its policy (HeadObstacle.h): under NoDeeper
+    /// (readHeadObstacle()'s default) no vertex goes deeper into it than the input's vertex of the
+    /// same index was, so a vertex outside stays outside. A strand edge that would enter it is
+    /// turned aside (slid along the surface at its own length) and the rest of the strand turns
+    /// with it, curl and all, as hair drapes over a head. Unset: the scalp's level set when
+    /// combHair() is given one, else the sphere fitted to the roots (headFromRoots(), NoDeeper);
+    /// HeadObstacle::none(): no head.
+    HeadObstacle head;
 
     /// @throw ValueError naming the parameter, its value and the rule.
     void validate(const char* where) const;
@@ -87,6 +96,10 @@ struct CombStats
     std::size_t reachVertices = 0;
     /// Mean total turning per unit length of the moved strands, before and after (radians per unit)
     double turningBefore = 0.0, turningAfter = 0.0;
+    std::string head;               ///< the head used (HeadObstacle::describe()), "none" without one
+    std::size_t headDeflected = 0;  ///< moved strands whose edges the head turned aside
+    /// Vertices of the moved strands inside the head (signed distance below 0), before and after
+    std::size_t insideHeadBefore = 0, insideHeadAfter = 0;
 };
 
 struct CombResult
@@ -107,7 +120,8 @@ bool combPolyline(const std::vector<Vec3d>& points, const std::vector<std::vecto
                   double sigmaVertices, std::vector<Vec3d>& out, std::vector<std::array<double, 4>>& rotations);
 
 /// @brief Comb @a strands with @a strokes in order.
-/// @param scalp the scalp level set, or null for the sphere fitted to the roots (the hierarchy's frames)
+/// @param scalp the scalp level set, or null for the sphere fitted to the roots (the hierarchy's
+/// frames; the head too when CombParams::head is unset)
 /// @throw ValueError (bad strokes or parameters, no strands, too few for the levels), InterruptedError.
 CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& strokes, const CombParams& params,
                     openvdb::FloatGrid::ConstPtr scalp = nullptr, bool threaded = true,
