@@ -72,8 +72,14 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
     }
     // What the transfer did (README, "Detail transfer and combing", says why each check).
     const int ns = params.synth.vertices;
-    const double turnDetails = meanTurningPerLength(details, ns), turnBase = meanTurningPerLength(base, ns),
-                 turnOut = meanTurningPerLength(r.strands, ns);
+    // Turning compared at one sample spacing in head radii, DETAILS' own: its median strand
+    // length over n_s - 1 (a fixed vertex count would undersample the longer hairstyle's curls).
+    std::vector<float> lengths = strandLengths(details);
+    std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
+    const double spacing = double(lengths[lengths.size() / 2]) / tr.detailsMap->radius() / double(ns - 1);
+    const double turnDetails = meanTurningPerLengthAtSpacing(details, spacing * tr.detailsMap->radius()),
+                 turnBase = meanTurningPerLengthAtSpacing(base, spacing * r.map->radius()),
+                 turnOut = meanTurningPerLengthAtSpacing(r.strands, spacing * r.map->radius());
     const std::vector<double> dev = clusterMeanDeviation(r.strands, r.clusterOf.back(), base, tr.baseLabel, ns, params.smoothing);
     // Turning per head radius: each hairstyle in units of its own head (detail arrives scaled so).
     const double rd = tr.detailsMap->radius(), rb = r.map->radius();
@@ -91,7 +97,8 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                    {"smoothing", params.smoothing}, {"smooth_base", params.smoothBase}, {"detail", detailBlendName(params.synth.detailBlend)},
                    {"head_radius", {{"details", tr.detailsMap->radius()}, {"base", r.map->radius()}}},
                    {"detail_scale", tr.detailScale}, {"length_ratio", tr.lengthRatio},
-                   {"turning_per_length", {{"details", turnDetails}, {"base", turnBase}, {"output", turnOut}, {"vertices", ns}}},
+                   {"turning_per_length", {{"details", turnDetails}, {"base", turnBase}, {"output", turnOut}, {"spacing_head_radii", spacing}}},
+                   {"output_vertices", tr.outputVertices}, {"details_smoothing", tr.detailsSmoothing},
                    {"turning_per_head_radius", {{"details", turnDetails * rd}, {"base", turnBase * rb}, {"output", turnOut * rb}}},
                    {"coarse_deviation", {{"mean", mean(dev)}, {"p90", percentile(dev, 0.9)}, {"clusters", dev.size()}}},
                    {"stages", stages}, {"seconds", seconds}, {"checks", checks}});

@@ -63,6 +63,23 @@ void reexpress(const float* row, int vertices, const ScalpFrame& from, const Sca
     }
 }
 
+/// Row @a row of @a from vertices at @a to vertices, linearly between vertices at the same fraction
+/// of the vertices (the samples are even in arc length); a copy when the counts agree.
+void resampleRow(const float* row, int from, int to, float* out)
+{
+    if (from == to) {
+        std::copy(row, row + 3 * from, out);
+        return;
+    }
+    for (int k = 0; k < to; ++k) {
+        const double x = double(k) * double(from - 1) / double(to - 1);
+        const int j = std::min(int(x), from - 1);
+        const double t = x - double(j);
+        for (int c = 0; c < 3; ++c)
+            out[3 * k + c] = j + 1 < from && t > 0.0 ? float(row[3 * j + c] * (1.0 - t) + row[3 * (j + 1) + c] * t) : row[3 * j + c];
+    }
+}
+
 std::vector<Vec3f> worldOf(const StrandSamples& s, std::size_t i, double radius)
 {
     std::vector<Vec3f> p(std::size_t(s.vertices));
@@ -76,7 +93,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
                              const std::vector<Vec3d>& roots, const ScalpMap& map, int components,
                              std::vector<std::uint32_t>* outLabel, TransferStats* stats, DetailBlend blend, bool threaded,
                              openvdb::util::NullInterrupter* interrupter, const std::vector<std::uint32_t>* givenLabel,
-                             DetailScale scale)
+                             DetailScale scale, int outVertices)
 {
     if (!source.strands || !source.centers || !source.label || source.strands->count() == 0 ||
         source.centers->count() == 0 || source.label->size() != source.strands->count())
@@ -84,9 +101,10 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
     if (outCenters.count() == 0) throw ValueError("transferDetail: no coarser output strands to transfer onto");
     const StrandSamples& inS = *source.strands;
     const StrandSamples& inC = *source.centers;
-    const int ns = inS.vertices;
-    if (inC.vertices != ns || outCenters.vertices != ns)
-        throw ValueError("transferDetail: the levels have different vertex counts per strand");
+    const int ns = inS.vertices, nc = outCenters.vertices, no = outVertices > 0 ? outVertices : nc;
+    if (inC.vertices != ns)
+        throw ValueError("transferDetail: the input levels have different vertex counts per strand");
+    if (ns < 2 || nc < 2 || no < 2) throw ValueError("transferDetail: strands need at least 2 vertices");
     const std::size_t dim = inS.dim(), nIn = inC.count(), nOut = outCenters.count(), n = roots.size();
     const double radius = map.radius();
     const auto forEach = [&](std::size_t count, auto&& fn) {
@@ -126,8 +144,11 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         reexpress(inC.row(c), ns, inC.frames[c], inAligned[c], rows.data() + c * dim);
     });
     forEach(nOut, [&](std::size_t c) {
-        outAligned[c] = alignedFrame(outCenters.row(c), ns, outCenters.frames[c]);
-        reexpress(outCenters.row(c), ns, outCenters.frames[c], outAligned[c], rows.data() + (nIn + c) * dim);
+        // Compared at the input's n_s vertices (the same row when the counts agree).
+        std::vector<float> row(dim);
+        resampleRow(outCenters.row(c), nc, ns, row.data());
+        outAligned[c] = alignedFrame(row.data(), ns, outCenters.frames[c]);
+        reexpress(row.data(), ns, outCenters.frames[c], outAligned[c], rows.data() + (nIn + c) * dim);
     });
     // 3. Matching clusters through PCA features of both sets of centres.
     const Pca pca = fitPca(rows.data(), nIn + nOut, dim, components);
@@ -157,19 +178,23 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
     for (std::uint32_t l : label) outUsed[l] = 1;
     for (std::size_t c = 0; c < nOut; ++c)
         if (outUsed[c]) inUsed[match[c]] = 1;
-    const auto prepare = [&](const StrandSamples& s, std::size_t i, const ScalpFrame& aligned, std::vector<Vec3f>& world,
-                             std::vector<Frame>& rmf) {
-        world = worldOf(s, i, radius);
-        rmf.resize(std::size_t(ns));
+    // (The output centres at the output's vertex count.)
+    const auto prepare = [&](const StrandSamples& s, std::size_t i, const ScalpFrame& aligned, int vertices,
+                             std::vector<Vec3f>& world, std::vector<Frame>& rmf) {
+        std::vector<float> row(std::size_t(3 * vertices));
+        resampleRow(s.row(i), s.vertices, vertices, row.data());
+        world.resize(std::size_t(vertices));
+        sampleToWorld(row.data(), vertices, s.roots[i], s.frames[i], radius, world.data());
+        rmf.resize(std::size_t(vertices));
         parallelTransportFrames(world.data(), world.size(), Vec3f(aligned.t), rmf.data());
     };
-    forEach(nIn, [&](std::size_t c) { if (inUsed[c]) prepare(inC, c, inAligned[c], inWorld[c], inRmf[c]); });
-    forEach(nOut, [&](std::size_t c) { if (outUsed[c]) prepare(outCenters, c, outAligned[c], outWorld[c], outRmf[c]); });
+    forEach(nIn, [&](std::size_t c) { if (inUsed[c]) prepare(inC, c, inAligned[c], ns, inWorld[c], inRmf[c]); });
+    forEach(nOut, [&](std::size_t c) { if (outUsed[c]) prepare(outCenters, c, outAligned[c], no, outWorld[c], outRmf[c]); });
 
     // 4-5. Every new strand.
     StrandSamples out;
-    out.vertices = ns;
-    out.local.assign(n * dim, 0.0f);
+    out.vertices = no;
+    out.local.assign(n * out.dim(), 0.0f);
     out.roots = roots;
     out.scalp.resize(n);
     out.frames.resize(n);
@@ -208,9 +233,11 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             dA[std::size_t(l)] = mi.toLocal(dIn - rootIn);                          // Eq. 5
             dB[std::size_t(l)] = inFrame(fin[std::size_t(l)], dIn);                 // Eq. 6
         }
+        // Where each output vertex reads the input's displacement: a fractional input vertex.
+        std::vector<double> at(static_cast<std::size_t>(no));
         if (scale == DetailScale::ArcLength) {
-            // The displacement is read at the output centre's arc length along the input centre,
-            // mirrored back and forth beyond the input centre's end (DetailTransfer.h).
+            // At the output centre's arc length along the input centre, mirrored back and forth
+            // beyond the input centre's end (DetailTransfer.h).
             const auto arcs = [&](const std::vector<Vec3f>& c) {
                 std::vector<double> a(c.size(), 0.0);
                 for (std::size_t k = 1; k < c.size(); ++k) a[k] = a[k - 1] + (Vec3d(c[k]) - Vec3d(c[k - 1])).length();
@@ -218,36 +245,41 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             };
             const std::vector<double> ai = arcs(cin), ao = arcs(cout);
             const double Li = ai.back();
-            const auto remap = [&](std::vector<Vec3d>& d) {
-                std::vector<Vec3d> out(d.size());
-                for (std::size_t k = 0; k < d.size(); ++k) {
-                    double a = ao[k];
-                    if (Li > 0.0) {
-                        a = std::fmod(a, 2.0 * Li);
-                        if (a > Li) a = 2.0 * Li - a;
-                    }
-                    const std::size_t j = std::size_t(std::upper_bound(ai.begin(), ai.end(), a) - ai.begin());
-                    if (j == 0) out[k] = d[0];
-                    else if (j >= ai.size()) out[k] = d.back();
-                    else {
-                        const double t = ai[j] > ai[j - 1] ? (a - ai[j - 1]) / (ai[j] - ai[j - 1]) : 0.0;
-                        out[k] = d[j - 1] * (1.0 - t) + d[j] * t;
-                    }
+            for (std::size_t k = 0; k < at.size(); ++k) {
+                double a = ao[k];
+                if (Li > 0.0) {
+                    a = std::fmod(a, 2.0 * Li);
+                    if (a > Li) a = 2.0 * Li - a;
                 }
-                d.swap(out);
-            };
-            remap(dA);
-            remap(dB);
+                const std::size_t j = std::size_t(std::upper_bound(ai.begin(), ai.end(), a) - ai.begin());
+                if (j == 0) at[k] = 0.0;
+                else if (j >= ai.size()) at[k] = double(ns - 1);
+                else at[k] = double(j - 1) + (ai[j] > ai[j - 1] ? (a - ai[j - 1]) / (ai[j] - ai[j - 1]) : 0.0);
+            }
+        } else {
+            // Vertex by vertex (the same fraction of the vertices).
+            for (std::size_t k = 0; k < at.size(); ++k) at[k] = double(k) * double(ns - 1) / double(no - 1);
         }
+        const auto read = [&](const std::vector<Vec3d>& d) {
+            std::vector<Vec3d> r(at.size());
+            for (std::size_t k = 0; k < at.size(); ++k) {
+                const std::size_t j = std::min(std::size_t(at[k]), std::size_t(ns - 1));
+                const double t = at[k] - double(j);
+                r[k] = j + 1 < std::size_t(ns) && t > 0.0 ? d[j] * (1.0 - t) + d[j + 1] * t : d[j];
+            }
+            return r;
+        };
+        dA = read(dA);
+        dB = read(dB);
         float* row = out.row(i);
         double len = 0.0;
         Vec3d prev = roots[i];
-        for (int l = 0; l < ns; ++l) {
+        for (int l = 0; l < no; ++l) {
             const Vec3d& dAlpha = dA[std::size_t(l)];
             const Vec3d& dBeta = dB[std::size_t(l)];
             const Vec3d a = roots[i] + (Vec3d(cout[std::size_t(l)]) - Vec3d(cout[0])) + mo.toWorld(dAlpha);  // Eq. 8
             const Vec3d b = Vec3d(cout[std::size_t(l)]) + outOf(fout[std::size_t(l)], dBeta) + betaShift;
-            const double s = blend == DetailBlend::RootFrame ? 0.0 : (ns > 1 ? double(l) / double(ns - 1) : 0.0);
+            const double s = blend == DetailBlend::RootFrame ? 0.0 : double(l) / double(no - 1);
             const Vec3d p = l == 0 ? roots[i] : a * (1.0 - s) + b * s;             // Eq. 7
             const Vec3d q = rf.toLocal((p - roots[i]) / radius);
             row[3 * l] = float(q.x());

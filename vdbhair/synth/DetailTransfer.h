@@ -91,11 +91,15 @@ struct TransferStats
 /// @param outLabel if given, receives each new strand's output centre
 /// @param givenLabel if given (#roots, values below outCenters.count()), each new strand's output
 /// centre, in place of step 1's nearest root (transfer onto a hairstyle keeps its own wisps)
+/// @param outVertices vertices per new strand (0: as @a outCenters'); the input's displacement is
+/// read between its vertices (linearly), so a longer output strand can carry the input's detail
+/// at the input's own spacing (DetailScale::ArcLength)
 /// @throw ValueError if @a source is incomplete or empty, or @a givenLabel does not fit; InterruptedError.
 StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
                              const std::vector<Vec3d>& roots, const ScalpMap& map, int components = Pca::kDefaultComponents,
                              std::vector<std::uint32_t>* outLabel = nullptr, TransferStats* stats = nullptr,
                              DetailBlend blend = DetailBlend::RootFrame, bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr,
-                             const std::vector<std::uint32_t>* givenLabel = nullptr, DetailScale scale = DetailScale::Index);
+                             const std::vector<std::uint32_t>* givenLabel = nullptr, DetailScale scale = DetailScale::Index,
+                             int outVertices = 0);
 
 } // namespace vdbhair

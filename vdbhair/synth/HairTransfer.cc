@@ -83,7 +83,6 @@ TransferResult transferHairstyle(const StrandSet& details, const StrandSet& base
             for (Vec3d& r : level.roots) r *= tr.detailScale;
             for (float& len : level.lengths) len = float(double(len) * tr.detailScale);
         }
-        smoothSamples(res.example.levels.back(), params.smoothing, radius);
     }
     const StrandSamples& detailsCoarsest = res.example.levels.back();
     // 4. The coarsest level: BASE's.
@@ -119,16 +118,26 @@ TransferResult transferHairstyle(const StrandSet& details, const StrandSet& base
             for (int l = 0; l < L; ++l) counts[std::size_t(l)] = tr.base.levels[std::size_t(l)].count();
         }
     }
-    if (params.smoothBase) smoothSamples(res.output.back(), params.smoothing, radius);
-    if (double(counts[0]) * sp.vertices > double(sp.maxVertices))
-        throw LimitError("transferHairstyle: " + std::to_string(counts[0]) + " strands of " + std::to_string(sp.vertices) +
-                         " vertices exceed the cap of " + std::to_string(sp.maxVertices) + " vertices");
     // Wisps too different in length cannot be matched (HairTransfer.h).
     const double lb = medianLength(res.output.back(), radius), ld = medianLength(detailsCoarsest, radius);
     tr.lengthRatio = ld > 0.0 ? lb / ld : 0.0;
     if (!(tr.lengthRatio <= params.maxLengthRatio && tr.lengthRatio >= 1.0 / params.maxLengthRatio))
         throw ValueError("coarsest wisps of BASE " + formatNumber(lb) + " head radii long (median), of DETAILS " + formatNumber(ld) +
                          ": more than " + formatNumber(params.maxLengthRatio) + " times apart, too different for their clusters to be matched");
+    // Both coarsest levels smoothed at one scale in head radii: σ = smoothing × BASE's wisp length.
+    tr.detailsSmoothing = std::min(1.0, params.smoothing * tr.lengthRatio);
+    smoothSamples(res.example.levels.back(), tr.detailsSmoothing, radius);
+    if (params.smoothBase) smoothSamples(res.output.back(), params.smoothing, radius);
+    // Detail laid by arc length onto longer wisps keeps DETAILS' spacing: n_s × the ratio of the
+    // smoothed wisps' lengths (the centres along which the detail is laid) vertices.
+    const double smoothedRatio = medianLength(res.output.back(), radius) / std::max(1e-300, medianLength(detailsCoarsest, radius));
+    tr.outputVertices = sp.vertices;
+    if (sp.detailScale == DetailScale::ArcLength && smoothedRatio > 1.0)
+        tr.outputVertices = int(std::max(double(sp.vertices), std::min({double(kMaxOutputVertices), std::round(double(sp.vertices) * smoothedRatio),
+                                                                          std::floor(double(params.outputVertexBudget) / double(counts[0]))})));
+    if (double(counts[0]) * tr.outputVertices > double(sp.maxVertices))
+        throw LimitError("transferHairstyle: " + std::to_string(counts[0]) + " strands of " + std::to_string(tr.outputVertices) +
+                         " vertices exceed the cap of " + std::to_string(sp.maxVertices) + " vertices");
     // 5. Finer levels.
     const auto rootsOf = [&](int l) -> LevelRoots {
         LevelRoots out;
@@ -158,7 +167,8 @@ TransferResult transferHairstyle(const StrandSet& details, const StrandSet& base
     };
     double finestVoxel = sp.voxelSize;
     if (finestVoxel <= 0.0) finestVoxel = params.guides ? suggestVoxelSize(details) * tr.detailScale : suggestVoxelSize(base);
-    synthesizeFinerLevels(res, res.example, rootsOf, sp, finestVoxel, /*refineCoarsest=*/false, baseScalp, threaded, interrupter);
+    synthesizeFinerLevels(res, res.example, rootsOf, sp, finestVoxel, /*refineCoarsest=*/false, baseScalp, threaded, interrupter,
+                          tr.outputVertices);
     tr.baseLabel.resize(base.numStrands());
     for (std::size_t s = 0; s < base.numStrands(); ++s) tr.baseLabel[s] = std::int32_t(s);
     if (!params.guides)

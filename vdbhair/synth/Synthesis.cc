@@ -219,7 +219,7 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
 void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
                            const std::function<LevelRoots(int level)>& rootsOf, const SynthParams& params,
                            double finestVoxel, bool refineCoarsest, openvdb::FloatGrid::ConstPtr scalp, bool threaded,
-                           openvdb::util::NullInterrupter* interrupter)
+                           openvdb::util::NullInterrupter* interrupter, int outputVertices)
 {
     const int L = int(source.levels.size());
     if (L < 2 || res.output.size() != std::size_t(L) || res.output.back().count() == 0 || !res.map)
@@ -246,7 +246,7 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
             RefineResult rr = refineStrands(strands, rp, threaded, interrupter);
             if (!rr.levels.empty()) res.refinedCorrected[std::size_t(l)] = rr.levels.front().consistency.corrected;
             strands = std::move(rr.strands);
-            StrandSamples again = sampleStrands(strands, map, params.vertices, threaded);
+            StrandSamples again = sampleStrands(strands, map, level.vertices, threaded);
             // Keep the scattered roots' frames and positions exactly (refinement keeps roots).
             level.local.swap(again.local);
             level.lengths.swap(again.lengths);
@@ -265,7 +265,8 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
                                      &source.clusterings[std::size_t(l)].label};
             res.output[std::size_t(l)] = transferDetail(src, res.output[std::size_t(l + 1)], roots.positions, map, params.components,
                                                         &parent[std::size_t(l)], nullptr, params.detailBlend, threaded, interrupter,
-                                                        roots.parent.empty() ? nullptr : &roots.parent, params.detailScale);
+                                                        roots.parent.empty() ? nullptr : &roots.parent, params.detailScale,
+                                                        outputVertices);
         }
         refineLevel(l, true);
     }

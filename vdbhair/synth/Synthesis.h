@@ -159,10 +159,12 @@ struct LevelRoots
 /// doubled per coarser level. The coarsest level itself is refined only if @a refineCoarsest.
 /// Fills res.output, res.strands, res.clusterOf, res.refinedCorrected, res.refineVoxelSizes and
 /// res.stages. Shared by synthesis, imposed coarsest levels and transfer (HairTransfer.h).
+/// @param outputVertices vertices per strand of the finer output levels (0: n_s); transfer onto
+/// longer hair gives them more, so that detail laid by arc length is not undersampled
 void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
                            const std::function<LevelRoots(int level)>& rootsOf, const SynthParams& params,
                            double finestVoxel, bool refineCoarsest, openvdb::FloatGrid::ConstPtr scalp, bool threaded,
-                           openvdb::util::NullInterrupter* interrupter);
+                           openvdb::util::NullInterrupter* interrupter, int outputVertices = 0);
 
 /// @brief Adds the seconds from its construction to its destruction to the stage named @a name of
 /// @a stages (appended when new).

@@ -65,6 +65,15 @@ double meanTurningPerLength(const StrandSet& strands, int vertices)
     return sum / double(t.size());
 }
 
+double meanTurningPerLengthAtSpacing(const StrandSet& strands, double spacing)
+{
+    if (strands.empty()) return 0.0;
+    const std::vector<double> t = turningPerLength(resampleStrandsBySpacing(strands, float(spacing)));
+    double sum = 0.0;
+    for (double x : t) sum += x;
+    return sum / double(t.size());
+}
+
 std::vector<double> clusterMeanDeviation(const StrandSet& a, const std::vector<std::int32_t>& labelA, const StrandSet& b,
                                          const std::vector<std::int32_t>& labelB, int vertices, double smoothing)
 {

@@ -40,6 +40,13 @@ NoveltyStats measureNovelty(const StrandSet& example, const StrandSet& output, d
 /// length (hairstyles stored at different resolutions compare at one; 0 for no strands).
 double meanTurningPerLength(const StrandSet& strands, int vertices);
 
+/// @brief Mean total turning per unit length of @a strands resampled at one @a spacing (world
+/// units) by arc length (resampleStrandsBySpacing()): hairstyles whose strands differ in length
+/// compare at one sample spacing, where a fixed vertex count would undersample the longer ones'
+/// curls (0 for no strands).
+/// @throw ValueError unless @a spacing is positive and finite.
+double meanTurningPerLengthAtSpacing(const StrandSet& strands, double spacing);
+
 /// @brief How far the wisps of @a a lie from those of @a b: for every cluster c with members in
 /// both (labelA[s] == c, labelB[s] == c), the mean strand of its members in each (resampled to
 /// @a vertices by arc length, averaged vertex by vertex, then smoothed with σ = @a smoothing ×
