@@ -1,13 +1,13 @@
 #include "Comb.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parallel.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/io/JsonFile.h>
 #include <vdbhair/strands/Resample.h>
 #include <vdbhair/synth/SynthesisReport.h>
 
 #include <Eigen/Geometry>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -196,14 +196,7 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
     for (std::size_t i = 0; i < strokes.size(); ++i) validateStroke(strokes[i], i, "combHair");
     if (strokes.empty()) throw ValueError("combHair: no strokes");
     if (strands.numStrands() == 0) throw ValueError("combHair: no strands to comb");
-    const auto forEach = [&](std::size_t count, auto&& fn) {
-        if (threaded)
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& r) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
-            });
-        else
-            for (std::size_t i = 0; i < count; ++i) fn(i);
-    };
+    const auto forEach = [&](std::size_t count, auto&& fn) { forEachIndex(count, threaded, fn, 16); };
     CombResult res;
     const std::size_t n = strands.numStrands();
     // The hierarchy, as synthesis builds it.

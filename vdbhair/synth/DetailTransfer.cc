@@ -4,7 +4,7 @@
 #include <vdbhair/scalp/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
 
-#include <tbb/parallel_for.h>
+#include <vdbhair/Parallel.h>
 
 #include <algorithm>
 #include <cmath>
@@ -107,14 +107,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
     if (ns < 2 || nc < 2 || no < 2) throw ValueError("transferDetail: strands need at least 2 vertices");
     const std::size_t dim = inS.dim(), nIn = inC.count(), nOut = outCenters.count(), n = roots.size();
     const double radius = map.radius();
-    const auto forEach = [&](std::size_t count, auto&& fn) {
-        if (threaded)
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
-            });
-        else
-            for (std::size_t i = 0; i < count; ++i) fn(i);
-    };
+    const auto forEach = [&](std::size_t count, auto&& fn) { forEachIndex(count, threaded, fn, 64); };
 
     // 1. Output clusters: each new root joins the nearest coarser output root (or its given centre).
     std::vector<std::uint32_t> label(n, 0);

@@ -4,7 +4,7 @@
 #include <vdbhair/Random.h>
 #include <vdbhair/scalp/PointCloud.h>
 
-#include <tbb/parallel_for.h>
+#include <vdbhair/Parallel.h>
 
 #include <algorithm>
 #include <cmath>
@@ -51,14 +51,7 @@ ScatteredRoots scatterRoots(const ScalpMap& map, const UvGrid& grid, const Featu
     const std::size_t n = params.count;
     out.positions.resize(n);
     out.scalp.resize(n);
-    const auto forEach = [&](auto&& fn) {
-        if (threaded)
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
-            });
-        else
-            for (std::size_t i = 0; i < n; ++i) fn(i);
-    };
+    const auto forEach = [&](auto&& fn) { forEachIndex(n, threaded, fn, 512); };
     // 2. Random roots, area-weighted.
     forEach([&](std::size_t i) {
         Rng rng(params.seed, 0x700754u + params.stream, i);
