@@ -40,16 +40,8 @@ Scene loadGuides(const std::string& path, const CommonOptions& common, double& f
     if (fileExtension(path) == ".json") return readScene(path);
     const StrandSet strands = loadStrands("interpolate", path, common);
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<std::string> errors;
-    const std::vector<StrandFit> fits = fitStrands(strands, FitParams{}, true, &errors, common.interrupter);
+    Scene scene = guideSceneFromStrands(strands, FitParams{}, path, true, common.interrupter);
     fitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    Scene scene;
-    scene.integrator = HelicoidIntegrator::RK4;
-    for (std::size_t i = 0; i < fits.size(); ++i) {
-        if (!errors[i].empty()) throw ValueError(path + ": guide " + errors[i] + "; a guide must have a positive length");
-        scene.guides.push_back(guideFromFit(fits[i]));
-    }
-    scene.step = scene.guides.front().step;
     return scene;
 }
 
@@ -127,19 +119,14 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
     }
     // Guide normals: radial on the scene's head sphere, else those of the nearest roots (the library's rule).
     std::vector<Vec3d> guideNormals;
-    if (!roots.normals.empty() && guides.head) {
-        for (const SceneGuide& g : guides.guides) guideNormals.push_back(g.root - guides.head->center);
-    }
+    if (!roots.normals.empty()) guideNormals = sceneGuideNormals(guides);
 
     const auto t0 = std::chrono::steady_clock::now();
     StrandSet strands;
     Scene out;
     if (points) {
         // The guides' own strands (no wisps), blended point by point.
-        Scene bare = guides;
-        for (SceneGuide& g : bare.guides) g.wisp.reset();
-        const StrandSet guideStrands = growScene(bare, {}, true, common.interrupter);
-        strands = interpolatePoints(guideStrands, roots, p.points, guideNormals, true, common.interrupter);
+        strands = interpolatePoints(guides, roots, p.points, guideNormals, true, common.interrupter);
     } else {
         out = interpolateHelicoids(guides, roots, p.helicoid, guideNormals, true, common.interrupter);
         out.seed = p.seed;

@@ -4,6 +4,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/Refine.h>
+#include <vdbhair/field/ScalpSpace.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/VdbFile.h>
@@ -454,12 +455,32 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
     m.def(
         "estimate_tangent_field",
         [](const StrandsPtr& strands, double voxelSize, int iterations, std::optional<int> levels, std::uint64_t maxVoxels,
-           double densityReference, int threads, const pyb::object& progress) -> pyb::object {
+           double densityReference, const std::string& space, std::optional<std::array<double, 4>> scalp, std::array<double, 3> up,
+           int threads, const pyb::object& progress) -> pyb::object {
             FieldParams fp;
             fp.voxelSize = voxelSize;
             fp.iterations = iterations;
             fp.maxVoxels = maxVoxels;
             fp.densityReference = densityReference;
+            // Scalp space (as `field --space scalp --scalp CX,CY,CZ,R --up`): the sphere given, or fitted to the roots.
+            fp.space = fieldSpaceFromName(space);
+            const Vec3d upAxis(up[0], up[1], up[2]);
+            if (!(upAxis.length() > 0.0) || !std::isfinite(upAxis.length())) throw ValueError("estimate_tangent_field: up must be a non-zero finite vector");
+            if (fp.space == FieldSpace::Scalp) {
+                if (scalp) {
+                    if (!((*scalp)[3] > 0.0) || !std::isfinite((*scalp)[3]))
+                        throw ValueError("estimate_tangent_field: scalp=(cx, cy, cz, r) needs r > 0");
+                    fp.scalp.center = Vec3d((*scalp)[0], (*scalp)[1], (*scalp)[2]);
+                    fp.scalp.radius = (*scalp)[3];
+                    fp.scalp.up = upAxis / upAxis.length();
+                } else {
+                    std::vector<Vec3f> roots;
+                    for (std::size_t i = 0; i < strands->numStrands(); ++i) roots.push_back(strands->root(i));
+                    fp.scalp = fitScalpSphere(roots, upAxis / upAxis.length());
+                }
+            } else if (scalp) {
+                throw ValueError("estimate_tangent_field: scalp= is for space='scalp'");
+            }
             if (levels && (*levels < 1 || *levels > 16)) {
                 throw ValueError("estimate_tangent_field: levels=" + std::to_string(*levels) + ": must be between 1 and 16");
             }
@@ -476,8 +497,9 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
         pyb::arg("strands"), pyb::arg("voxel_size") = fieldDefaults.voxelSize, pyb::kw_only(),
         pyb::arg("iterations") = fieldDefaults.iterations, pyb::arg("levels") = pyb::none(),
         pyb::arg("max_voxels") = fieldDefaults.maxVoxels, pyb::arg("density_reference") = fieldDefaults.densityReference,
-        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space: ``vdbhair field``.
+        pyb::arg("space") = fieldSpaceName(fieldDefaults.space), pyb::arg("scalp") = pyb::none(),
+        pyb::arg("up") = std::array<double, 3>{0.0, 1.0, 0.0}, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space by default: ``vdbhair field``.
 
 Every segment contributes its unit tangent to every voxel it passes through, weighted by its
 length there; each iteration reweights contributions by 0.5 (T . v + 1) and renormalizes.
@@ -492,6 +514,10 @@ Args:
     max_voxels: refuse voxel sizes whose voxel visits could exceed this (vdbhair.LimitError).
     density_reference: hair length per unit volume (world units^-2) that density 1 means;
         0 chooses the 95th percentile of the hairstyle's.
+    space: "world" (any hairstyle) or "scalp" (Wang et al.'s (u, v, w) over a scalp sphere), as
+        ``--space``.
+    scalp: with space="scalp", the sphere (cx, cy, cz, r) in world units; None fits it to the roots.
+    up: the scalp's up axis for space="scalp".
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``, called at each stage's
         start and then at most ten times a second; raising in it stops the work.

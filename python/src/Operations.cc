@@ -3,6 +3,8 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/HelicoidInterpolation.h>
+#include <vdbhair/helicoid/PointInterpolation.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbInspect.h>
@@ -33,7 +35,7 @@ pyb::object toPython(const nlohmann::json& j)
 }
 
 /// A scene argument: a path to a scene .json, or the scene itself as a dict.
-Scene sceneArgument(const pyb::handle& scene)
+Scene sceneArgument(const pyb::handle& scene, const std::string& where = "grow")
 {
     if (pyb::isinstance<pyb::str>(scene)) {
         const std::string path = scene.cast<std::string>();
@@ -46,12 +48,27 @@ Scene sceneArgument(const pyb::handle& scene)
         try {
             j = nlohmann::json::parse(text);
         } catch (const nlohmann::json::exception& e) {
-            throw FormatError(std::string("grow(dict): ") + e.what());
+            throw FormatError(where + "(dict): " + e.what());
         }
-        return sceneFromJson(j, "grow(dict)");
+        return sceneFromJson(j, where + "(dict)");
     }
-    throw TypeError("grow: scene must be a path to a scene .json or a dict, not " +
+    throw TypeError(where + ": scene must be a path to a scene .json or a dict, not " +
                     std::string(pyb::str(scene.get_type().attr("__name__"))));
+}
+
+/// An (N, 3) array of finite numbers as points; @a what names it in messages ("interpolate: roots").
+std::vector<Vec3d> pointsArgument(const pyb::handle& obj, const std::string& what)
+{
+    const auto a = pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>::ensure(obj);
+    if (!a || a.ndim() != 2 || a.shape(1) != 3) throw ValueError(what + ": must be an (N, 3) array of points");
+    std::vector<Vec3d> out(std::size_t(a.shape(0)));
+    const double* d = a.data();
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        out[i] = Vec3d(d[3 * i], d[3 * i + 1], d[3 * i + 2]);
+        if (!std::isfinite(d[3 * i]) || !std::isfinite(d[3 * i + 1]) || !std::isfinite(d[3 * i + 2]))
+            throw ValueError(what + "[" + std::to_string(i) + "]: not finite");
+    }
+    return out;
 }
 
 const char* colorByNameOf(ColorBy c)
@@ -458,6 +475,99 @@ Args:
 Returns:
     The scene as a dict (one guide per fitted strand, in input order), which grow() regrows
     and ``json.dump`` saves as a scene file; or (scene, summary) with return_summary.)doc");
+
+    const HelicoidInterpolationParams interpDefaults;
+    m.def(
+        "interpolate",
+        [](const pyb::object& guidesArg, const pyb::object& rootsArg, const pyb::object& normalsArg, const std::string& method,
+           double power, std::optional<int> neighbors, const std::string& frames, std::array<double, 3> up, std::uint64_t seed,
+           std::size_t maxVertices, bool returnScene, int threads, const pyb::object& progress) -> pyb::object {
+            // Arguments first, as the command checks them.
+            const bool points = method == "points";
+            if (method != "helicoid" && !points) throw ValueError("interpolate: method '" + method + "' is not one of helicoid, points");
+            if (frames != "auto" && frames != "world" && frames != "surface")
+                throw ValueError("interpolate: frames '" + frames + "' is not one of auto, world, surface");
+            if (returnScene && points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
+            HelicoidInterpolationParams hp;
+            PointInterpolationParams pp;
+            if (!(power > 0.0) || !std::isfinite(power))
+                throw ValueError("interpolate: power=" + std::to_string(power) + ": must be a positive finite exponent (the paper uses 3)");
+            hp.shepard.power = power;
+            if (neighbors) {
+                if (*neighbors < 1) throw ValueError("interpolate: neighbors=" + std::to_string(*neighbors) + ": must be at least 1 (None: each method's default)");
+                hp.shepard.neighbors = *neighbors;
+                pp.neighbors = *neighbors;
+            }
+            const Vec3d u(up[0], up[1], up[2]);
+            if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("interpolate: up must be a non-zero finite vector");
+            hp.up = u / u.length();
+            hp.maxVertices = pp.maxVertices = maxVertices;
+            InterpolationRoots roots;
+            if (pyb::isinstance<StrandSet>(rootsArg)) {
+                const StrandSet& r = rootsArg.cast<const StrandSet&>();
+                for (std::size_t i = 0; i < r.numStrands(); ++i) roots.positions.push_back(Vec3d(r.root(i)));
+            } else {
+                roots.positions = pointsArgument(rootsArg, "interpolate: roots");
+            }
+            if (roots.positions.empty()) throw ValueError("interpolate: no roots");
+            if (!normalsArg.is_none()) {
+                roots.normals = pointsArgument(normalsArg, "interpolate: normals");
+                if (roots.normals.size() != roots.positions.size())
+                    throw ValueError("interpolate: " + std::to_string(roots.normals.size()) + " normals for " +
+                                     std::to_string(roots.positions.size()) + " roots");
+            }
+            if (frames == "world") roots.normals.clear();
+            if (frames == "surface" && roots.normals.empty()) throw ValueError("interpolate: frames='surface' needs normals");
+            const bool fromStrands = pyb::isinstance<StrandSet>(guidesArg);
+            std::shared_ptr<StrandSet> guideStrands = fromStrands ? guidesArg.cast<std::shared_ptr<StrandSet>>() : nullptr;
+            Scene guides = fromStrands ? Scene() : sceneArgument(guidesArg, "interpolate");
+            std::pair<Scene, StrandSet> result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                if (fromStrands) guides = guideSceneFromStrands(*guideStrands, FitParams{}, "interpolate(guides)", true, interrupter);
+                validateGuideScene(guides);
+                const std::vector<Vec3d> guideNormals = roots.normals.empty() ? std::vector<Vec3d>() : sceneGuideNormals(guides);
+                std::pair<Scene, StrandSet> r;
+                if (points) {
+                    r.second = interpolatePoints(guides, roots, pp, guideNormals, true, interrupter);
+                } else {
+                    r.first = interpolateHelicoids(guides, roots, hp, guideNormals, true, interrupter);
+                    r.first.seed = seed;
+                    if (!returnScene) {
+                        GrowOptions grow;
+                        grow.maxVertices = maxVertices;
+                        r.second = growScene(r.first, grow, true, interrupter);
+                    }
+                }
+                return r;
+            });
+            if (returnScene) return toPython(sceneToJson(result.first));
+            return pyb::cast(std::make_shared<StrandSet>(std::move(result.second)));
+        },
+        pyb::arg("guides"), pyb::arg("roots"), pyb::kw_only(), pyb::arg("normals") = pyb::none(), pyb::arg("method") = "helicoid",
+        pyb::arg("power") = interpDefaults.shepard.power, pyb::arg("neighbors") = pyb::none(), pyb::arg("frames") = "auto",
+        pyb::arg("up") = std::array<double, 3>{interpDefaults.up.x(), interpDefaults.up.y(), interpDefaults.up.z()},
+        pyb::arg("seed") = 0, pyb::arg("max_vertices") = interpDefaults.maxVertices, pyb::arg("return_scene") = false,
+        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(New hairs from guide hairs (Piuze et al. 2011, Sec. 4): ``vdbhair interpolate``.
+
+Args:
+    guides: a scene (a path to a scene .json or a dict, as fit() returns) or a Strands, each of
+        whose strands is fitted first.
+    roots: an (N, 3) array of root positions (world units), or a Strands whose roots are used.
+    normals: None, or an (N, 3) array of outward normals at the roots (surface frames, Sec. 4.3).
+    method: "helicoid" (blend the guides' helicoid parameters, the paper's) or "points" (blend
+        their points, as Blender's and Houdini's interpolation do).
+    power: Shepard exponent p of the weights |x - x_i|^-p (the paper: 3).
+    neighbors: blend only the K nearest guides by root; None: every guide (helicoid), 4 (points).
+    frames: "auto" (surface frames when normals are given), "world" or "surface".
+    up: reference axis of the surface frames.
+    seed: the scene's seed (recorded; the new hairs have no wisps).
+    max_vertices: refuse requests that would grow more vertices (estimated before any work).
+    return_scene: return the new hairs as a scene dict (helicoid only) instead of growing them.
+    threads: worker threads, 0 for all cores (results do not depend on it).
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    Strands (one per root, in order), or the scene dict with return_scene.)doc");
 
     const RenderParams renderDefaults;
     m.def(

@@ -196,3 +196,27 @@ def test_vdbhair_reads_what_pyopenvdb_writes(tmp_path):
     s = vdbhair.Strands(np.stack([t, np.zeros_like(t), np.zeros_like(t)], axis=1), [0, 5])
     out = vdbhair.retrace(s, flow)
     np.testing.assert_allclose(out.positions, t[:, None] * direction[None, :], atol=1e-5)
+
+
+def test_scalp_space_matches_the_command(wavy, tmp_path):
+    import pathlib
+    import subprocess
+    # The same field as `vdbhair field --space scalp`, value for value (the sphere fitted to the roots).
+    field = vdbhair.estimate_tangent_field(wavy, space="scalp")
+    assert field.metadata["vdbhair_space"] == "scalp"
+    cli = pathlib.Path(vdbhair.__file__).resolve().parents[1] / "bin" / "vdbhair"
+    if not cli.exists():
+        pytest.skip(f"no command-line vdbhair at {cli}")
+    hair = tmp_path / "wavy.hair"
+    vdbhair.write(wavy, str(hair))
+    subprocess.run([str(cli), "field", str(hair), "--space", "scalp", "-o", str(tmp_path / "f.vdb"), "-q"], check=True)
+    grid = vdbhair.read_grid(str(tmp_path / "f.vdb"), "tangent")
+    assert np.array_equal(field.active_coords(), grid.active_coords())
+    assert np.array_equal(field.values(), grid.values())
+    # A given sphere is used as given; scalp= is refused in world space.
+    given = vdbhair.estimate_tangent_field(wavy, space="scalp", scalp=(0.0, 0.0, 0.0, 1.0))
+    assert given.metadata["vdbhair_scalp_radius"] == 1.0
+    with pytest.raises(ValueError, match="scalp= is for space='scalp'"):
+        vdbhair.estimate_tangent_field(wavy, scalp=(0.0, 0.0, 0.0, 1.0))
+    with pytest.raises(ValueError, match="r > 0"):
+        vdbhair.estimate_tangent_field(wavy, space="scalp", scalp=(0.0, 0.0, 0.0, 0.0))

@@ -47,7 +47,7 @@ def test_render_returns_rgba_or_writes_a_file(tmp_path):
 
 def test_every_function_has_a_docstring_with_its_defaults():
     names = ["read", "write", "estimate_tangent_field", "retrace", "refine", "grow", "fit", "render", "inspect",
-             "read_grid", "read_grids", "write_grids", "suggest_voxel_size"]
+             "read_grid", "read_grids", "write_grids", "suggest_voxel_size", "interpolate", "synth", "transfer", "comb"]
     for name in names:
         doc = getattr(vdbhair, name).__doc__
         assert doc and len(doc) > 150, name
@@ -119,3 +119,41 @@ def test_transfer_and_comb():
     assert rep["head_deflected"] > 0 and rep["head"].startswith("sphere")
     with pytest.raises(ValueError, match="head policy"):
         vdbhair.comb(pony, [into], head_policy="sideways")
+
+
+def test_interpolate():
+    # Straight parallel guides along x: every new hair between them is straight, as long, along x.
+    guides = straight_bundle(count=5, vertices=9, length=4.0, spacing=0.25)
+    roots = np.array([[0.0, 0.1, 0.0], [0.0, 0.6, 0.0], [0.0, 0.35, 0.0]])
+    for method in ("helicoid", "points"):
+        out = vdbhair.interpolate(guides, roots, method=method)
+        assert len(out) == 3
+        for i, strand in enumerate(out):
+            assert np.allclose(strand[0], roots[i], atol=1e-5), method
+            chord = strand[-1] - strand[0]
+            length = np.linalg.norm(np.diff(strand, axis=0), axis=1).sum()
+            assert length == pytest.approx(4.0, rel=1e-3), method
+            assert np.linalg.norm(chord) == pytest.approx(length, rel=1e-3), method  # straight
+            assert chord[0] / np.linalg.norm(chord) == pytest.approx(1.0, abs=1e-4), method
+    # A root on a guide's root gives that guide back; the scene grows to the same strands; one or two threads.
+    on_guide = vdbhair.interpolate(guides, guides.positions[guides.offsets[:-1]][:2])
+    for i in range(2):
+        for end in (0, -1):  # the fit regrown at its own step: the same root and tip
+            assert np.allclose(on_guide[i][end], guides[i][end], atol=1e-3)
+    scene = vdbhair.interpolate(vdbhair.fit(guides), roots, return_scene=True)
+    assert len(scene["guides"]) == 3
+    assert np.array_equal(vdbhair.grow(scene).positions, vdbhair.interpolate(vdbhair.fit(guides), roots).positions)
+    assert np.array_equal(vdbhair.interpolate(guides, roots, threads=1).positions,
+                          vdbhair.interpolate(guides, roots, threads=2).positions)
+    # Roots as a Strands, normals (surface frames) and the errors.
+    assert len(vdbhair.interpolate(guides, guides, normals=np.tile([1.0, 0.0, 0.0], (25, 1)))) == 25
+    with pytest.raises(ValueError, match="roots: must be an .N, 3. array"):
+        vdbhair.interpolate(guides, np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="power=0"):
+        vdbhair.interpolate(guides, roots, power=0.0)
+    with pytest.raises(ValueError, match="2 normals for 3 roots"):
+        vdbhair.interpolate(guides, roots, normals=np.ones((2, 3)))
+    with pytest.raises(ValueError, match="frames='surface' needs normals"):
+        vdbhair.interpolate(guides, roots, frames="surface")
+    with pytest.raises(ValueError, match="return_scene=True needs method='helicoid'"):
+        vdbhair.interpolate(guides, roots, method="points", return_scene=True)

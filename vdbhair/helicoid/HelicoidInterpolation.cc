@@ -295,4 +295,28 @@ Scene interpolateHelicoids(const Scene& guides, const InterpolationRoots& roots,
     return out;
 }
 
+Scene guideSceneFromStrands(const StrandSet& strands, const FitParams& fit, const std::string& where, bool threaded,
+                            openvdb::util::NullInterrupter* interrupter)
+{
+    if (strands.empty()) throw ValueError(where + ": no guides: interpolation needs at least one");
+    std::vector<std::string> errors;
+    const std::vector<StrandFit> fits = fitStrands(strands, fit, threaded, &errors, interrupter);
+    Scene scene;
+    scene.integrator = HelicoidIntegrator::RK4;
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+        if (!errors[i].empty()) throw ValueError(where + ": guide " + errors[i] + "; a guide must have a positive length");
+        scene.guides.push_back(guideFromFit(fits[i]));
+    }
+    scene.step = scene.guides.front().step;
+    return scene;
+}
+
+std::vector<Vec3d> sceneGuideNormals(const Scene& guides)
+{
+    std::vector<Vec3d> normals;
+    if (!guides.head) return normals;
+    for (const SceneGuide& g : guides.guides) normals.push_back(g.root - guides.head->center);
+    return normals;
+}
+
 } // namespace vdbhair

@@ -51,12 +51,14 @@
 /// guide unchanged, translated to the root (and rotated by W W_iᵀ with surface frames).
 #pragma once
 
+#include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/helicoid/ShepardWeights.h>
 
 #include <openvdb/util/NullInterrupter.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace vdbhair {
@@ -136,5 +138,18 @@ private:
 Scene interpolateHelicoids(const Scene& guides, const InterpolationRoots& roots, const HelicoidInterpolationParams& params,
                            const std::vector<Vec3d>& guideNormals = {}, bool threaded = true,
                            openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// @brief Guides from plain strands (`interpolate` given a strand file, not a scene): every strand
+/// fitted (fitStrands() with @a fit), one guide each in order, traced with RK4 at the first fit's
+/// step (fits are streamlines, regrown exactly).
+/// @param where names the strands in messages (a path, "interpolate(guides)")
+/// @throw ValueError naming the strand that cannot be fitted (a zero length), InterruptedError.
+Scene guideSceneFromStrands(const StrandSet& strands, const FitParams& fit, const std::string& where, bool threaded = true,
+                            openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// @brief Normals at the guide roots for surface frames: radial from the scene's head sphere if it
+/// has one, else none (interpolateHelicoids() and interpolatePoints() then give each guide the
+/// normal of the root nearest it).
+std::vector<Vec3d> sceneGuideNormals(const Scene& guides);
 
 } // namespace vdbhair

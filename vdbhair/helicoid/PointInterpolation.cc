@@ -146,4 +146,13 @@ StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& r
     return out;
 }
 
+StrandSet interpolatePoints(const Scene& guides, const InterpolationRoots& roots, const PointInterpolationParams& params,
+                            const std::vector<Vec3d>& guideNormals, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    Scene bare = guides;
+    for (SceneGuide& g : bare.guides) g.wisp.reset();
+    const StrandSet guideStrands = growScene(bare, {}, threaded, interrupter);
+    return interpolatePoints(guideStrands, roots, params, guideNormals, threaded, interrupter);
+}
+
 } // namespace vdbhair

@@ -35,4 +35,10 @@ StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& r
                             const std::vector<Vec3d>& guideNormals = {}, bool threaded = true,
                             openvdb::util::NullInterrupter* interrupter = nullptr);
 
+/// @brief interpolatePoints() from a guide scene: its guides grown without their wisps (growScene()).
+/// @throw as growScene() and interpolatePoints().
+StrandSet interpolatePoints(const Scene& guides, const InterpolationRoots& roots, const PointInterpolationParams& params,
+                            const std::vector<Vec3d>& guideNormals = {}, bool threaded = true,
+                            openvdb::util::NullInterrupter* interrupter = nullptr);
+
 } // namespace vdbhair
