@@ -12,6 +12,7 @@
 #include <vdbhair/scalp/ScalpRegion.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 
+#include <algorithm>
 #include <chrono>
 
 namespace vdbhair::app {
@@ -20,7 +21,8 @@ namespace {
 
 struct ScalpCmdParams
 {
-    std::string input, output, region;
+    std::string input, output, region, regionMask, regionGrid;
+    double regionThreshold = 0.5;
     double voxelSize = 0.0;
     CLI::Option* voxelOpt = nullptr;
     std::vector<double> sphere;  ///< cx, cy, cz, r
@@ -57,6 +59,9 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
     if (!p.sphere.empty() && !p.input.empty()) throw ValueError("both an input (" + p.input + ") and --sphere: give one");
     if (p.regionRadius < 0.0 || !std::isfinite(p.regionRadius)) throw ValueError("--region-radius " + formatValue(p.regionRadius) + ": must be a positive length");
     if (p.regionRadius > 0.0 && p.region.empty()) throw ValueError("--region-radius without --region STRANDS");
+    if (!p.region.empty() && !p.regionMask.empty()) throw ValueError("both --region and --region-mask: give one");
+    if (!p.regionGrid.empty() && p.regionMask.empty()) throw ValueError("--region-grid without --region-mask MASK.vdb");
+    if (!std::isfinite(p.regionThreshold)) throw ValueError("--region-threshold " + formatValue(p.regionThreshold) + ": must be finite");
 
     ScalpParams sp;
     sp.voxelSize = voxelGiven ? p.voxelSize : 0.0;
@@ -124,6 +129,23 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         region = regionFromRoots(*surface, roots, radius, p.region, std::uint64_t(1) << 28, maxDistance);
         grids.push_back(region);
         detail["region"] = {{"roots", roots.size()}, {"radius", radius}, {"active_voxels", region->activeVoxelCount()}};
+    } else if (!p.regionMask.empty()) {
+        // The mask: the grid named, else 'region', else the file's first bool or float grid that is not a level set.
+        std::string name = p.regionGrid;
+        if (name.empty()) {
+            const std::vector<std::string> names = vdbGridNames(p.regionMask, p.regionMask);
+            if (std::find(names.begin(), names.end(), "region") != names.end()) name = "region";
+            for (std::size_t i = 0; name.empty() && i < names.size(); ++i) {
+                const openvdb::GridBase::Ptr g = readVdbGrid(p.regionMask, names[i], p.regionMask);
+                if ((g->isType<openvdb::BoolGrid>() || g->isType<openvdb::FloatGrid>()) && g->getGridClass() != openvdb::GRID_LEVEL_SET) name = names[i];
+            }
+            if (name.empty()) throw LookupError(p.regionMask + ": no bool or float grid to use as a region mask (--region-grid NAME)");
+        }
+        const openvdb::GridBase::Ptr mask = readVdbGrid(p.regionMask, name, p.regionMask);
+        const Stage stage(common, "region from the mask '" + name + "' of " + p.regionMask);
+        region = regionFromMask(*surface, *mask, p.regionThreshold, p.regionMask);
+        grids.push_back(region);
+        detail["region"] = {{"mask", name}, {"threshold", p.regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     {
@@ -144,8 +166,12 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
                       << detail["welded_vertices"].get<std::size_t>() << " vertices welded)";
         }
         std::cout << "\n";
-        if (region) std::cout << "region: " << region->activeVoxelCount() << " voxels within " << formatValue(detail["region"]["radius"].get<double>())
-                              << " of the roots of " << p.region << "\n";
+        if (region && !p.region.empty())
+            std::cout << "region: " << region->activeVoxelCount() << " voxels within " << formatValue(detail["region"]["radius"].get<double>())
+                      << " of the roots of " << p.region << "\n";
+        if (region && !p.regionMask.empty())
+            std::cout << "region: " << region->activeVoxelCount() << " voxels covered by the mask '" << detail["region"]["mask"].get<std::string>()
+                      << "' of " << p.regionMask << "\n";
         std::cout << "wrote " << p.output << "\n";
     }
     return 0;
@@ -168,6 +194,9 @@ Command addScalpCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--max-constraints", params->maxConstraints, "Points input: thin to this many constraint points (the solve is cubic)")->capture_default_str();
     sub->add_option("--region", params->region, "Strand file: the region is where its roots are (grid 'region')");
     sub->add_option("--region-radius", params->regionRadius, "Radius around each root, world units (default: twice the roots' mean spacing)");
+    sub->add_option("--region-mask", params->regionMask, "A .vdb whose bool or float grid paints the region: surface voxels it covers (a bool grid's true values, a float grid's values above --region-threshold)");
+    sub->add_option("--region-grid", params->regionGrid, "The mask's grid (default: 'region', else the file's first bool or float grid that is not a level set)");
+    sub->add_option("--region-threshold", params->regionThreshold, "A float mask covers where its value exceeds this")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Examples:\n  vdbhair scalp head.ply -o scalp.vdb --voxel-size 0.5 --region hair.hair\n"
                 "  vdbhair scalp --sphere 0,0,0,10 -o ball.vdb --voxel-size 0.2");

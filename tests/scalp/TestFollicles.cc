@@ -90,6 +90,53 @@ TEST_CASE("sampleFollicles: a cap region holds every root", "[scalp]")
     CHECK(st.nnMean == Approx(fp.spacing).epsilon(0.1));
 }
 
+TEST_CASE("regionFromMask: a painted cap, as a float weight and as a bool mask on another transform", "[scalp]")
+{
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.05);
+    // A weight painted by height on a coarser grid of its own: 0 below y = 0.4, 1 above y = 0.6.
+    openvdb::FloatGrid::Ptr weight = openvdb::FloatGrid::create(0.0f);
+    weight->setTransform(openvdb::math::Transform::createLinearTransform(0.1));
+    weight->setName("paint");
+    openvdb::BoolGrid::Ptr mask = openvdb::BoolGrid::create(false);
+    mask->setTransform(openvdb::math::Transform::createLinearTransform(0.07));
+    {
+        auto acc = weight->getAccessor();
+        for (int i = -15; i <= 15; ++i)
+            for (int j = -15; j <= 15; ++j)
+                for (int k = -15; k <= 15; ++k) acc.setValue(openvdb::Coord(i, j, k), float(std::clamp((0.1 * j - 0.4) / 0.2, 0.0, 1.0)));
+        auto b = mask->getAccessor();
+        for (int i = -20; i <= 20; ++i)
+            for (int j = -20; j <= 20; ++j)
+                for (int k = -20; k <= 20; ++k)
+                    if (0.07 * j > 0.5) b.setValue(openvdb::Coord(i, j, k), true);
+    }
+    const openvdb::BoolGrid::Ptr fromWeight = regionFromMask(*g, *weight, 0.5, "paint.vdb");
+    const openvdb::BoolGrid::Ptr fromBool = regionFromMask(*g, *mask);
+    CHECK(fromWeight->getName() == "region");
+    CHECK(fromWeight->metaValue<std::string>("vdbhair_region_kind") == "mask");
+    for (const openvdb::BoolGrid::Ptr& region : {fromWeight, fromBool}) {
+        double lowest = 1e9, highestOutside = -1e9;
+        for (auto it = region->cbeginValueOn(); it; ++it) lowest = std::min(lowest, g->indexToWorld(it.getCoord()).y());
+        // Every band voxel above the cut is in: none is left out.
+        const ScalpSampler s(g, region);
+        for (auto it = g->cbeginValueOn(); it; ++it)
+            if (std::abs(*it) < g->background() && !region->tree().isValueOn(it.getCoord()))
+                highestOutside = std::max(highestOutside, g->indexToWorld(it.getCoord()).y());
+        INFO("region voxels " << region->activeVoxelCount() << ", lowest " << lowest << ", highest outside " << highestOutside);
+        CHECK(lowest > 0.5 - 0.08);
+        CHECK(highestOutside < 0.5 + 0.08);
+        CHECK(region->activeVoxelCount() > 100);
+    }
+    // Follicles in it stay above the cut.
+    FollicleParams fp;
+    fp.count = 300;
+    for (const Vec3f& p : sampleFollicles(g, fromWeight, fp).positions) CHECK(p.y() > 0.5 - 0.08f);
+    // What is refused.
+    CHECK_THROWS_AS(regionFromMask(*g, *weight, 2.0), LookupError);  // a weight that never exceeds 2: empty
+    CHECK_THROWS_AS(regionFromMask(*g, *openvdb::Vec3SGrid::create()), TypeError);
+    CHECK_THROWS_AS(regionFromMask(*g, *weight, std::nan("")), ValueError);
+}
+
 TEST_CASE("sampleFollicles: the same roots with 1 and 2 threads, bit for bit", "[scalp]")
 {
     const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.05);

@@ -12,6 +12,9 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <optional>
+
+#include <openvdb/tools/Interpolation.h>
 
 namespace vdbhair {
 
@@ -93,6 +96,45 @@ openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const 
     region->insertMeta("vdbhair_region_kind", openvdb::StringMetadata("roots"));
     region->insertMeta("vdbhair_region_radius", openvdb::DoubleMetadata(radius));
     region->insertMeta("vdbhair_region_roots", openvdb::Int64Metadata(std::int64_t(used)));
+    if (!source.empty()) region->insertMeta("vdbhair_source", openvdb::StringMetadata(source));
+    return region;
+}
+
+openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const openvdb::GridBase& mask, double threshold,
+                                      const std::string& source)
+{
+    const std::string where = "regionFromMask(" + (source.empty() ? mask.getName() : source + ": grid '" + mask.getName() + "'") + ")";
+    if (!std::isfinite(threshold)) throw ValueError(where + ": threshold " + std::to_string(threshold) + " must be finite");
+    const auto* boolMask = dynamic_cast<const openvdb::BoolGrid*>(&mask);
+    const auto* floatMask = dynamic_cast<const openvdb::FloatGrid*>(&mask);
+    if (!boolMask && !floatMask)
+        throw TypeError(where + ": a region mask is a bool or float grid, not " + mask.valueType());
+    openvdb::BoolGrid::Ptr region = openvdb::BoolGrid::create(false);
+    region->setTransform(surface.transform().copy());
+    auto out = region->getAccessor();
+    const double band = double(surface.background());
+    std::optional<openvdb::BoolGrid::ConstAccessor> bAcc;
+    std::optional<openvdb::FloatGrid::ConstAccessor> fAcc;
+    if (boolMask) bAcc.emplace(boolMask->getConstAccessor());
+    if (floatMask) fAcc.emplace(floatMask->getConstAccessor());
+    for (auto it = surface.cbeginValueOn(); it; ++it) {
+        if (!(std::abs(double(*it)) < band)) continue;
+        const openvdb::Coord c = it.getCoord();
+        const Vec3d w = surface.transform().indexToWorld(c);
+        bool in = false;
+        if (boolMask) {
+            in = bAcc->getValue(boolMask->transform().worldToIndexNodeCentered(w));
+        } else {
+            in = double(openvdb::tools::BoxSampler::sample(*fAcc, floatMask->transform().worldToIndex(w))) > threshold;
+        }
+        if (in) out.setValueOn(c, true);
+    }
+    if (region->activeVoxelCount() == 0)
+        throw LookupError(where + ": the mask covers no voxel of the surface's band; the region would be empty (is it on the same head, in the same units?)");
+    region->setName("region");
+    region->setCreator("vdbhair " VDBHAIR_VERSION_STRING);
+    region->insertMeta("vdbhair_region_kind", openvdb::StringMetadata("mask"));
+    if (floatMask) region->insertMeta("vdbhair_region_threshold", openvdb::DoubleMetadata(threshold));
     if (!source.empty()) region->insertMeta("vdbhair_source", openvdb::StringMetadata(source));
     return region;
 }
