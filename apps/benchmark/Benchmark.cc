@@ -172,7 +172,7 @@ void benchmark(const std::string& name, const StrandSet& strands, double voxelSi
 
     // --- tracing through the same field, same roots, same step, forward Euler / RK1.
     TraceParams tp;
-    tp.step = 0.5 * voxelSize;
+    tp.step = kDefaultStepVoxels * voxelSize;  // the default step, the peer's too
     TraceStats stats;
     StrandSet traced;
     const double tTrace = timeBest(reps, [&] { traced = retraceStrands(strands, *field.tangent, tp, &stats); });
@@ -204,6 +204,14 @@ void benchmark(const std::string& name, const StrandSet& strands, double voxelSi
                 "                       into a reused output: vdbhair %.3f s (%.1f M steps/s), ratio ours/peer %.2fx (the %.0f MB output's fresh pages cost %.3f s above)\n",
                 tp.step, tTrace, oursRate / 1e6, stats.steps, stats.fullLength, nS, tPeerTrace, peerRate / 1e6, peerSteps, oursRate / peerRate,
                 tInto, intoRate / 1e6, intoRate / peerRate, double(traced.positions.size() * sizeof(Vec3f)) / 1e6, tTrace - tInto);
+    // The streamline engine's general path on the same job (TraceKernel::Scalar, one streamline at
+    // a time in double): what the lane kernel, its fast path, buys.
+    TraceParams scalar = tp;
+    scalar.kernel = TraceKernel::Scalar;
+    TraceStats scalarStats;
+    const double tScalar = timeBest(reps, [&] { retraceStrands(strands, *field.tangent, scalar, &scalarStats); });
+    std::printf("                       the engine's general path (scalar kernel): %.3f s (%.1f M steps/s, %zu steps); lanes / scalar %.2fx steps/s\n",
+                tScalar, double(scalarStats.steps) / tScalar / 1e6, scalarStats.steps, oursRate / (double(scalarStats.steps) / tScalar));
     std::printf("estimated + retraced   vdbhair %.3f s together\n", tOurs + tTrace);
     std::printf("peak memory            %.0f MiB after vdbhair's estimation, %.0f MiB at the end (process peak)\n", memAfterOurs, peakMiB());
 }

@@ -3,6 +3,8 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/StreamlineTracer.h>
+#include <vdbhair/field/TangentAngles.h>
+#include <vdbhair/strands/Measures.h>
 #include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
@@ -83,7 +85,9 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
     if (!(p.vanish >= 0.0 && p.vanish < 1.0)) throw ValueError("--vanish " + formatValue(p.vanish) + ": must be in [0, 1)");
     tp.vanishThreshold = p.vanish;
     tp.maxSteps = p.maxSteps;
-    if (p.margin < 0 || p.margin > 16) throw ValueError("--margin " + std::to_string(p.margin) + ": must be between 0 and 16 voxels");
+    if (p.margin < 0 || p.margin > TraceParams::kMaxMargin) {
+        throw ValueError("--margin " + std::to_string(p.margin) + ": must be between 0 and " + std::to_string(TraceParams::kMaxMargin) + " voxels");
+    }
     tp.margin = p.margin;
     if (p.vertices == "input") tp.vertices = RetraceVertices::Input;
     else if (p.vertices == "steps") tp.vertices = RetraceVertices::Steps;
@@ -91,7 +95,6 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
     strandFormatFromPath(p.output, /*forWriting=*/true);
 
     if (p.helicoid) {
-        if (tp.vertices != RetraceVertices::Input) throw ValueError("--helicoid keeps the input's vertices; --vertices steps is not available with it");
         const HelicoidFieldGrids field = readHelicoidField(p.field);
         const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
         checkStrandLengths("retrace", p.input, strands, common, p.strict);

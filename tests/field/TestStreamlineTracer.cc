@@ -1,8 +1,10 @@
 #include "../TestUtil.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Random.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/StreamlineTracer.h>
+#include <vdbhair/field/TangentAngles.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/strands/Measures.h>
@@ -326,4 +328,145 @@ TEST_CASE("meanTangentAnglesDeg: strands at a known angle to a uniform field, bo
     REQUIRE(none.countedBefore == 0);
     REQUIRE(none.beforeDeg == 0.0);
     REQUIRE(none.afterDeg == meanTangentAnglesDeg(outside, tilted, *f.tangent, true).afterDeg);
+}
+
+namespace {
+
+/// A smooth swirling field over the voxels [-R, R]³ of a grid of voxel size @a h whose origin
+/// lies at @a offset: a drift plus a rotation about a random axis (so streamlines curve, and
+/// leave the box).
+openvdb::Vec3SGrid::Ptr swirlField(Rng& rng, double h, const Vec3d& offset, int R)
+{
+    auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3f(0.f));
+    openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(h);
+    xf->postTranslate(offset);
+    grid->setTransform(xf);
+    grid->setName("tangent");
+    const Vec3d drift = Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 2.0;
+    const Vec3d axis = Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * (1.5 / R);
+    auto acc = grid->getAccessor();
+    for (int x = -R; x <= R; ++x) {
+        for (int y = -R; y <= R; ++y) {
+            for (int z = -R; z <= R; ++z) {
+                const Vec3d v = drift + axis.cross(Vec3d(x, y, z));
+                acc.setValue(openvdb::Coord(x, y, z), openvdb::Vec3f(float(v.x()), float(v.y()), float(v.z())));
+            }
+        }
+    }
+    return grid;
+}
+
+/// Straight input strands (only their roots and arc lengths matter) rooted inside the box of
+/// swirlField(), some long enough to leave it.
+StrandSet randomRoots(Rng& rng, double h, const Vec3d& offset, int R, std::size_t count)
+{
+    StrandSet s;
+    for (std::size_t i = 0; i < count; ++i) {
+        const Vec3d root = offset + Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * (1.6 * R * h);
+        const Vec3d dir = Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5).unitSafe();
+        const double length = (0.2 + 2.0 * rng.uniform()) * R * h;
+        const std::size_t n = 2 + std::size_t(rng.uniform() * 40.0);
+        std::vector<Vec3f> pts;
+        for (std::size_t k = 0; k < n; ++k) {
+            const Vec3d p = root + dir * (length * double(k) / double(n - 1));
+            pts.emplace_back(float(p.x()), float(p.y()), float(p.z()));
+        }
+        s.addStrand(pts);
+    }
+    return s;
+}
+
+} // namespace
+
+TEST_CASE("retraceStrands: the lane kernel holds to the general engine, its two clones bitwise to each other", "[field]")
+{
+    // Seeded cases across voxel sizes, grid offsets, integrators, margins and vertex modes.
+    for (std::uint64_t seed = 0; seed < 24; ++seed) {
+        Rng rng(2024, seed);
+        const double h = std::pow(10.0, -2.0 + 3.0 * rng.uniform());  // 0.01 .. 10
+        const Vec3d offset = Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * (20.0 * h);
+        const int R = 6 + int(rng.uniform() * 10.0);
+        const openvdb::Vec3SGrid::Ptr field = swirlField(rng, h, offset, R);
+        const StrandSet in = randomRoots(rng, h, offset, R, 60);
+        TraceParams tp;
+        tp.integrator = seed % 4 == 3 ? Integrator::RK4 : seed % 4 == 2 ? Integrator::RK2 : Integrator::Euler;
+        tp.margin = int(seed % 3);
+        tp.vertices = seed % 5 == 4 ? RetraceVertices::Steps : RetraceVertices::Input;
+        tp.step = seed % 2 ? 0.0 : (0.2 + 0.6 * rng.uniform()) * h;
+        CAPTURE(seed, h, R, integratorName(tp.integrator), tp.margin, tp.step);
+
+        tp.kernel = TraceKernel::Scalar;
+        TraceStats scalarStats;
+        std::vector<StopReason> scalarReasons;
+        const StrandSet scalar = retraceStrands(in, *field, tp, &scalarStats, &scalarReasons);
+        tp.kernel = TraceKernel::Auto;
+        TraceStats laneStats;
+        std::vector<StopReason> laneReasons;
+        const StrandSet lanes = retraceStrands(in, *field, tp, &laneStats, &laneReasons);
+
+        REQUIRE(laneReasons == scalarReasons);
+        REQUIRE(laneStats.steps == scalarStats.steps);
+        REQUIRE(lanes.offsets == scalar.offsets);
+        // Beyond the rounding of the output floats themselves (a float world coordinate far from
+        // the origin in voxels resolves less than 1e-6 voxel): within 1e-6 voxel where the lanes
+        // step through the engine (RK2, RK4), within 1e-5 voxel for their own Euler steps, whose
+        // positions are float offsets within a brick (2^-21 voxel apart: over a strand's steps
+        // the rounding adds up to a few 1e-6 voxel; 3.1e-6 at most over these cases).
+        double worst = 0.0;
+        for (std::size_t v = 0; v < scalar.numVertices(); ++v) {
+            const Vec3f& a = lanes.positions[v];
+            const Vec3f& b = scalar.positions[v];
+            for (int c = 0; c < 3; ++c) {
+                const double ulp = double(std::nextafter(std::abs(b[c]), INFINITY) - std::abs(b[c]));
+                worst = std::max(worst, (std::abs(double(a[c]) - double(b[c])) - 2.0 * ulp) / h);
+            }
+        }
+        CAPTURE(worst);
+        REQUIRE(worst <= (tp.integrator == Integrator::Euler ? 1e-5 : 1e-6));
+
+        // The baseline and AVX2 clones of the lane loop: bitwise the same.
+        tp.kernel = TraceKernel::LanesSse;
+        const StrandSet sse = retraceStrands(in, *field, tp);
+        REQUIRE(sse.offsets == lanes.offsets);
+        REQUIRE(std::memcmp(sse.positions.data(), lanes.positions.data(), sse.positions.size() * sizeof(Vec3f)) == 0);
+        if (__builtin_cpu_supports("avx2")) {
+            tp.kernel = TraceKernel::LanesAvx2;
+            const StrandSet avx = retraceStrands(in, *field, tp);
+            REQUIRE(avx.offsets == lanes.offsets);
+            REQUIRE(std::memcmp(avx.positions.data(), lanes.positions.data(), avx.positions.size() * sizeof(Vec3f)) == 0);
+        }
+    }
+}
+
+TEST_CASE("retraceStrands: the scalar kernel is bitwise identical with 1 and 2 threads", "[field]")
+{
+    Rng rng(7);
+    const openvdb::Vec3SGrid::Ptr field = swirlField(rng, 0.3, Vec3d(0.1, -0.2, 0.05), 10);
+    const StrandSet in = randomRoots(rng, 0.3, Vec3d(0.1, -0.2, 0.05), 10, 300);
+    TraceParams tp;
+    tp.kernel = TraceKernel::Scalar;
+    StrandSet one, two;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        one = retraceStrands(in, *field, tp);
+    }
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        two = retraceStrands(in, *field, tp);
+    }
+    REQUIRE(one.numStrands() == in.numStrands());
+    REQUIRE(one.offsets == two.offsets);
+    REQUIRE(std::memcmp(one.positions.data(), two.positions.data(), one.positions.size() * sizeof(Vec3f)) == 0);
+}
+
+TEST_CASE("resolveStepLength: the default step is half a voxel; a negative step is an error naming it", "[field]")
+{
+    REQUIRE(kDefaultStepVoxels == 0.5);
+    REQUIRE(resolveStepLength(0.0, 0.4, "here") == Approx(0.2).margin(1e-15));
+    REQUIRE(resolveStepLength(0.03, 0.4, "here") == 0.03);
+    REQUIRE_THROWS_WITH(resolveStepLength(-0.1, 0.4, "here"), Contains("here: step -0.1") && Contains("must be 0 (half a voxel) or a positive finite length"));
+    REQUIRE_THROWS_AS(resolveStepLength(std::nan(""), 0.4, "here"), ValueError);
+    TraceParams tp;
+    tp.margin = TraceParams::kMaxMargin + 1;
+    REQUIRE_THROWS_WITH(tp.validate("retraceStrands"), Contains("retraceStrands: margin 17 voxels must be between 0 and 16"));
 }

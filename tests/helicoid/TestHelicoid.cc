@@ -1,6 +1,8 @@
 #include "../TestUtil.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Random.h>
+#include <vdbhair/helicoid/AnalyticHelicoidSampler.h>
 #include <vdbhair/helicoid/Helicoid.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/helicoid/Waviness.h>
@@ -214,4 +216,67 @@ TEST_CASE("applyWaviness: the offset is exactly the amplitude, in the normal pla
     }
     // Eq. 4 at s = 0: a·E_B.
     REQUIRE((Vec3d(wavy[0]) - (t.points[0] + 0.02 * t.frames[0].b)).length() < 1e-6);
+}
+
+TEST_CASE("traceStreamline: the analytic helicoid sampler traces tracePHelicoid's RK4 streamline, theta unwrapped through turns", "[helicoid]")
+{
+    int fullTurns = 0;
+    for (std::uint64_t seed = 0; seed < 12; ++seed) {
+        Rng rng(99, seed);
+        Helicoid h;
+        // Curvatures of up to 3 / world unit, alpha up to 0.5: several full turns over L.
+        h.k = {3.0 * (rng.uniform() - 0.5) * 2.0, 0.5 * rng.uniform(), 2.0 * (rng.uniform() - 0.5), rng.uniform() - 0.5};
+        h.q = FrameD::fromTangentNormal(Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, 1.0), Vec3d(1.0, rng.uniform(), 0.0));
+        h.p0 = Vec3d(rng.uniform(), rng.uniform(), rng.uniform());
+        const double L = 4.0 + 8.0 * rng.uniform(), step = 0.01;
+        CAPTURE(seed, h.k.kT, h.k.kN, h.k.kB, h.k.alpha, L);
+        HelicoidPiece piece;
+        piece.k = h.k;
+        piece.length = L;
+        HelicoidTrace expected;
+        tracePHelicoid(h.p0, h.q, {piece}, step, HelicoidIntegrator::RK4, expected);
+
+        AnalyticHelicoidSampler sampler(h);
+        StreamlineRules rules;
+        rules.integrator = Integrator::RK4;
+        rules.step = step;
+        std::vector<Vec3d> points;
+        REQUIRE(traceStreamline(sampler, h.p0, L, rules, points) == StopReason::FullLength);
+        REQUIRE(points.size() == expected.points.size());
+        double worst = 0.0;
+        for (std::size_t i = 0; i < points.size(); ++i) worst = std::max(worst, (points[i] - expected.points[i]).length());
+        CAPTURE(worst);
+        REQUIRE(worst < 1e-12 * L);
+        // Through full turns (theta unwrapped past 2π), where a sampler that did not track theta
+        // would turn phi = alpha·theta back by 2π·alpha.
+        double th = 0.0;
+        for (const Vec3d& p : expected.points) th = h.theta(p, th);
+        if (std::abs(th) > 2.0 * M_PI && h.k.alpha != 0.0) ++fullTurns;
+    }
+    REQUIRE(fullTurns >= 2);  // seeds 0-11 turn past 2π twice with alpha != 0
+}
+
+TEST_CASE("tracePHelicoids: the wisps' SIMD Euler lanes hold to the engine's Euler through each root's own trace", "[helicoid]")
+{
+    const std::vector<HelicoidPiece> pieces{{{2.0, -0.3, 0.7, 0.8}, 3.0, 0.0}};
+    HelicoidTrace guide;
+    tracePHelicoid(Vec3d(0.2, -0.1, 0.4), FrameD::fromTangentNormal(Vec3d(1, 0.2, 0), Vec3d(0, 1, 0.3)), pieces, 0.01,
+                   HelicoidIntegrator::Euler, guide);
+    Rng rng(5);
+    std::vector<Vec3d> roots(11);  // more than one group of eight lanes, the last one partly idle
+    for (Vec3d& r : roots) r = guide.points[0] + Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 0.1;
+    std::vector<HelicoidTrace> lanes(roots.size());
+    tracePHelicoids(roots.data(), roots.size(), guide.pieces[0].q, pieces, 0.01, HelicoidIntegrator::Euler, lanes.data(), &guide.pieces);
+    for (std::size_t i = 0; i < roots.size(); ++i) {
+        AnalyticHelicoidSampler sampler(guide.pieces[0]);
+        StreamlineRules rules;
+        rules.step = 0.01;
+        std::vector<Vec3d> points;
+        REQUIRE(traceStreamline(sampler, roots[i], pieces[0].length, rules, points) == StopReason::FullLength);
+        REQUIRE(points.size() == lanes[i].points.size());
+        double worst = 0.0;
+        for (std::size_t k = 0; k < points.size(); ++k) worst = std::max(worst, (points[k] - lanes[i].points[k]).length());
+        CAPTURE(i, worst);
+        REQUIRE(worst < 1e-9 * pieces[0].length);  // the lanes' own atan2 and sin/cos (FastMath.h)
+    }
 }

@@ -4,6 +4,7 @@
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/strands/Measures.h>
 
 using namespace vdbhair;
 using Catch::Matchers::Contains;
@@ -112,4 +113,45 @@ TEST_CASE("estimateHelicoidField / readHelicoidField: from strands, through a fi
     const std::string plain = test::tempPath("plain.vdb");
     writeVdbGrids(plain, {t.tangent}, "test");
     REQUIRE_THROWS_WITH(readHelicoidField(plain), Contains("no grid named 'helicoid_k'") && Contains("vdbhair field --helicoid"));
+}
+
+TEST_CASE("retraceHelicoidField: the engine's rules: a negative step is an error naming it, every step on request, attributes kept", "[helicoid]")
+{
+    initializeOpenVdb();
+    StrandSet s;
+    std::vector<Vec3f> pts;
+    for (int a = 0; a <= 40; ++a) pts.emplace_back(float(7.5 * std::cos(a * 0.05)), float(7.5 * std::sin(a * 0.05)), 0.1f);
+    s.addStrand(pts);
+    s.strandId = {42};
+    s.thickness.assign(pts.size(), 0.25f);
+    const auto g = circleField(0.5);
+    const HelicoidFieldGrids f = estimateHelicoidField(*g);
+    TraceParams tp;
+    tp.step = -0.1;
+    REQUIRE_THROWS_WITH(retraceHelicoidField(s, f, tp), Contains("retraceHelicoidField: step -0.1") && Contains("must be 0 (half a voxel)"));
+    tp.step = 0.0;
+    tp.margin = -1;
+    REQUIRE_THROWS_WITH(retraceHelicoidField(s, f, tp), Contains("retraceHelicoidField: margin -1"));
+    tp.margin = 3;
+
+    // The default step is half a voxel: the strand's length (2 · 7.5 · sin(1) as a chord sum,
+    // about 7.5 · 2) over 0.25 steps.
+    tp.vertices = RetraceVertices::Steps;
+    TraceStats stats;
+    const StrandSet steps = retraceHelicoidField(s, f, tp, &stats);
+    std::vector<double> arc(pts.size());
+    arcLengths(pts.data(), pts.size(), arc.data());
+    REQUIRE(stats.fullLength == 1);
+    REQUIRE(stats.steps == stepCount(arc.back(), 0.25));
+    REQUIRE(steps.numVertices() == stats.steps + 1);
+    REQUIRE(steps.strandId == s.strandId);
+    REQUIRE(steps.thickness.empty());  // per-vertex attributes only where the input's vertices are kept
+
+    tp.vertices = RetraceVertices::Input;
+    const StrandSet kept = retraceHelicoidField(s, f, tp, &stats);
+    REQUIRE(kept.offsets == s.offsets);
+    REQUIRE(kept.strandId == s.strandId);
+    REQUIRE(kept.thickness == s.thickness);
+    // Its vertices lie on the steps' polyline: the tip is the last step point exactly.
+    REQUIRE(kept.positions.back() == steps.positions.back());
 }

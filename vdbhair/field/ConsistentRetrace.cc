@@ -5,6 +5,7 @@
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
 #include <vdbhair/field/HairVolume.h>
+#include <vdbhair/field/Streamline.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -18,7 +19,7 @@ namespace vdbhair {
 void ConsistencyParams::validate(const char* where) const
 {
     auto fail = [&](const std::string& what) { throw ValueError(std::string(where) + ": " + what); };
-    if (!(step >= 0.0) || !std::isfinite(step)) fail("step " + std::to_string(step) + " must be 0 (half a voxel) or a positive finite length");
+    resolveStepLength(step, 1.0, where);  // the engine's rule for a step (Streamline.h)
     if (!(zStart >= 0.0) || !std::isfinite(zStart)) fail("outlier score zStart " + std::to_string(zStart) + " must be finite and at least 0");
     if (!(zFull > zStart) || !std::isfinite(zFull)) fail("outlier score zFull " + std::to_string(zFull) + " must be finite and above zStart " + std::to_string(zStart));
     if (!(minSpreadDeg >= 0.0 && minSpreadDeg < 90.0)) fail("minimum spread " + std::to_string(minSpreadDeg) + " degrees must be in [0, 90)");
@@ -260,7 +261,7 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
     params.validate("retraceConsistent");
     if (!field.tangent || !field.spread) throw ValueError("retraceConsistent: the field needs its tangent and spread grids");
     const FieldMapping map = FieldMapping::fromGrid(*field.tangent);
-    const double step = params.step > 0.0 ? params.step : 0.5 * map.worldVoxelSize();
+    const double step = resolveStepLength(params.step, map.worldVoxelSize(), "retraceConsistent");
     // A strand needs about length / step sub-steps: refuse a step that would take forever.
     double total = 0.0;
     for (std::size_t i = 0; i < strands.numStrands(); ++i) {

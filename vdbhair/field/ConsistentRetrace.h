@@ -50,7 +50,7 @@ namespace vdbhair {
 
 struct ConsistencyParams
 {
-    double step = 0.0;         ///< world units; 0: half the field's voxel size
+    double step = 0.0;         ///< world units; 0: kDefaultStepVoxels (half a voxel) of the field's voxel size
     double zStart = 2.0;       ///< outlier score where the field starts to take over (see the file comment)
     double zFull = 4.0;        ///< outlier score from which the field's direction is followed
     double minSpreadDeg = 3.0; ///< floor on a voxel's angular spread, degrees: deviations below it are never outliers

@@ -15,11 +15,15 @@
 /// Bricks are found by leaf coordinates in a dense table over the leaves' bounding box (a hash
 /// map only for scattered leaves), and where no leaf is BrickedField::brickAt() returns an
 /// all-zero brick rather than nullptr: the streamline tracer's SIMD kernel then blends first and
-/// tests the weight afterwards, with no branch per lane (StreamlineTracer.cc).
+/// tests the weight afterwards, with no branch per lane (impl/LaneTracer.h).
+///
+/// FieldDirectionSampler is the streamline engine's sampler for a vector grid (Streamline.h).
 #pragma once
 
 #include <vdbhair/Memory.h>
+#include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/Simd.h>
 
 #include <openvdb/math/Coord.h>
@@ -325,6 +329,37 @@ private:
     const Float4* mCell = nullptr;
     Float4 mScratch[N * N + N + 2] = {};
     std::vector<const Float4*> mCells;  ///< sampleScattered()'s cells (nullptr: through the tree)
+};
+
+/// @brief The streamline engine's sampler for a vector grid (the sampler concept of
+/// Streamline.h): the unit direction of the trilinear blend (FieldSampler) at a world point,
+/// Left where no corner of the cell is active, Vanished where the blend is no longer than
+/// @a vanishThreshold times the active corners' weight (opposing directions cancel, or zero
+/// vectors). The test and the normalization are in float, as the lane kernel's.
+/// @warning Not thread-safe: one per thread.
+template<typename TreeT>
+class FieldDirectionSampler
+{
+public:
+    FieldDirectionSampler(const BrickedField<TreeT>& bricks, const FieldMapping& map, double vanishThreshold)
+        : mSampler(bricks), mMap(map), mThreshold(float(vanishThreshold)) {}
+
+    SampleStatus direction(const openvdb::Vec3d& worldPos, openvdb::Vec3d& unitDir)
+    {
+        const Float4 r = mSampler.sample(mMap.worldToIndex(worldPos));
+        if (!(r[3] > 0.f)) return SampleStatus::Left;
+        const float len2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        const float limit = mThreshold * r[3];
+        if (!(len2 > limit * limit)) return SampleStatus::Vanished;
+        const float inv = 1.f / std::sqrt(len2);
+        unitDir = openvdb::Vec3d(r[0] * inv, r[1] * inv, r[2] * inv);
+        return SampleStatus::Ok;
+    }
+
+private:
+    FieldSampler<TreeT> mSampler;
+    const FieldMapping& mMap;
+    float mThreshold;
 };
 
 } // namespace vdbhair

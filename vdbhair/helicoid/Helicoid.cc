@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/FastMath.h>
+#include <vdbhair/helicoid/AnalyticHelicoidSampler.h>
 
 #include <algorithm>
 #include <cmath>
@@ -57,12 +58,6 @@ double traceClearance(const HelicoidTrace& trace, double step)
         }
     }
     return nearest / step;
-}
-
-std::size_t stepCount(double length, double step)
-{
-    if (!(length > 0.0)) return 0;
-    return std::max<std::size_t>(1, std::size_t(std::ceil(length / step - 1e-9)));
 }
 
 namespace {
@@ -182,6 +177,21 @@ void traceFieldEuler(const Vec3d* roots, std::size_t count, const std::vector<He
     }
 }
 
+/// @brief One step of the streamline engine through helicoid @a h from @a p, whose E_T @a k1 and
+/// theta @a theta the trace already has (Euler: Eq. 3, p + h E_T(p); RK4: every stage unwrapped
+/// against theta at p). Not inlined on purpose: inlined into tracePHelicoids(), this TU's lane
+/// math stopped being inlined into EulerLanes::step (perf: 3x its time) and wisps grew 1.5x
+/// slower (measured, issue 12).
+__attribute__((noinline)) Vec3d engineStep(const Helicoid& h, double theta, const Vec3d& p, const Vec3d& k1, double hstep,
+                                           Integrator integrator)
+{
+    AnalyticHelicoidSampler sampler(h, theta);
+    StreamlineIntegrator<AnalyticHelicoidSampler> step(sampler, integrator);
+    Vec3d q;
+    step.advanceFrom(p, k1, hstep, q);
+    return q;
+}
+
 } // namespace
 
 void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame, const std::vector<HelicoidPiece>& pieces,
@@ -248,16 +258,7 @@ void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame,
                 const double hstep = (j + 1 == n) ? pc.length - double(n - 1) * step : step;
                 s += hstep;
                 for (std::size_t l = 0; l < lanes; ++l) {
-                    if (integrator == HelicoidIntegrator::Euler) {
-                        p[l] += hstep * fr[l].t;  // Eq. 3: p_{i+1} = p_i + h E_T(p_i)
-                    } else {
-                        double t2 = th[l], t3 = th[l], t4 = th[l];
-                        const Vec3d k1 = fr[l].t;
-                        const Vec3d k2 = h[l].tangent(p[l] + 0.5 * hstep * k1, t2);
-                        const Vec3d k3 = h[l].tangent(p[l] + 0.5 * hstep * k2, t3);
-                        const Vec3d k4 = h[l].tangent(p[l] + hstep * k3, t4);
-                        p[l] += (hstep / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-                    }
+                    p[l] = engineStep(h[l], th[l], p[l], fr[l].t, hstep, toIntegrator(integrator));
                     th[l] = h[l].theta(p[l], th[l]);
                     fr[l] = h[l].frameFromTheta(th[l]);
                     HelicoidTrace& out = outs[first + l];

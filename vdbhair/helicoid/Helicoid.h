@@ -19,6 +19,7 @@
 #pragma once
 
 #include <vdbhair/Types.h>
+#include <vdbhair/field/Streamline.h>
 #include <vdbhair/helicoid/FastMath.h>
 
 #include <cmath>
@@ -116,8 +117,15 @@ inline Vec3d Helicoid::tangent(const Vec3d& world, double& thetaRef) const
 }
 
 /// @brief Integrators for helicoid streamlines: forward Euler is Eq. 3, the paper's choice;
-/// RK4 (with theta unwrapped at every stage) is for when the streamline must be exact.
+/// RK4 (with theta unwrapped at every stage) is for when the streamline must be exact. Both are
+/// the streamline engine's (field/Streamline.h) over an AnalyticHelicoidSampler
+/// (AnalyticHelicoidSampler.h); toIntegrator() maps them.
 enum class HelicoidIntegrator { Euler, RK4 };
+
+inline Integrator toIntegrator(HelicoidIntegrator integrator)
+{
+    return integrator == HelicoidIntegrator::Euler ? Integrator::Euler : Integrator::RK4;
+}
 
 /// @brief One piece of a p-helicoid: parameters, length (world units) and a roll about E_T applied
 /// to the frame it starts with.
@@ -139,10 +147,6 @@ struct HelicoidTrace
     std::vector<std::size_t> joints; ///< index of each piece's first point
 };
 
-/// @brief Number of steps of @a step that trace @a length: ceil(length / step) (the last step
-/// shortened), 0 for a zero length.
-std::size_t stepCount(double length, double step);
-
 /// @brief Trace a p-helicoid from @a root with @a frame (Eq. 3, piece by piece, §3.4): piece i+1
 /// starts at the end of piece i with the frame of Eq. 2 there (then rolled by its roll), so
 /// tangents — and whole frames — are continuous at the joints.
@@ -158,7 +162,10 @@ void tracePHelicoid(const Vec3d& root, const FrameD& frame, const std::vector<He
 double traceClearance(const HelicoidTrace& trace, double step);
 
 /// @brief tracePHelicoid() for @a count strands from @a roots at once, all with the same pieces
-/// (and the same @a field when given), traced in lockstep a few at a time for speed.
+/// (and the same @a field when given), traced in lockstep a few at a time for speed. Steps go
+/// through the streamline engine (StreamlineIntegrator over an AnalyticHelicoidSampler), except
+/// forward Euler through a shared @a field (wisps), which has its own SIMD fast path (the same
+/// steps, eight strands per vector loop; tests hold it to tracePHelicoid()).
 void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame, const std::vector<HelicoidPiece>& pieces,
                      double step, HelicoidIntegrator integrator, HelicoidTrace* outs, const std::vector<Helicoid>* field = nullptr);
 

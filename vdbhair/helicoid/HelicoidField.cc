@@ -6,7 +6,9 @@
 #include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/field/SamplerRetrace.h>
 #include <vdbhair/helicoid/Helicoid.h>
+#include <vdbhair/helicoid/HelicoidFieldSampler.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/strands/Measures.h>
@@ -167,164 +169,19 @@ HelicoidFieldGrids readHelicoidField(const std::string& path)
     return f;
 }
 
-namespace {
-
-/// The blended helicoid direction at world points (one per thread).
-class HelicoidSampler
-{
-public:
-    explicit HelicoidSampler(const HelicoidFieldGrids& f)
-        : mK(f.k->tree()), mA(f.alpha->tree()), mT(f.frameT->tree()), mN(f.frameN->tree()),
-          mInv(1.0 / f.k->voxelSize().x()), mH(f.k->voxelSize().x()), mOff(f.k->transform().indexToWorld(Vec3d(0.0))) {}
-
-    /// @return the summed weight of the active corners (0: outside the field).
-    double direction(const Vec3d& world, double threshold, Vec3d& dir)
-    {
-        const Vec3d ip = (world - mOff) * mInv;
-        const int bx = floorToInt(ip.x()), by = floorToInt(ip.y()), bz = floorToInt(ip.z());
-        const double fx = ip.x() - bx, fy = ip.y() - by, fz = ip.z() - bz;
-        Vec3d sum(0.0);
-        double active = 0.0;
-        for (int i = 0; i < 8; ++i) {
-            const int dx = i >> 2, dy = (i >> 1) & 1, dz = i & 1;
-            const Coord c(bx + dx, by + dy, bz + dz);
-            openvdb::Vec3f k;
-            if (!mK.probeValue(c, k)) continue;
-            const double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
-            if (w <= 0.0) continue;
-            Helicoid hel;
-            hel.k = {k.x(), k.y(), k.z(), mA.getValue(c)};
-            const Vec3d t(mT.getValue(c)), n(mN.getValue(c));
-            if (!(t.lengthSqr() > 0.0)) continue;
-            hel.q.t = t;
-            hel.q.n = n;
-            hel.q.b = t.cross(n);
-            hel.p0 = mOff + c.asVec3d() * mH;
-            double th = 0.0;
-            sum += w * hel.tangent(world, th);
-            active += w;
-        }
-        if (!(active > 0.0)) return 0.0;
-        const double len = sum.length();
-        if (!(len > threshold * active)) return -1.0;
-        dir = sum / len;
-        return active;
-    }
-
-private:
-    openvdb::tree::ValueAccessor<const openvdb::Vec3STree> mK;
-    openvdb::tree::ValueAccessor<const openvdb::FloatTree> mA;
-    openvdb::tree::ValueAccessor<const openvdb::Vec3STree> mT, mN;
-    double mInv, mH;
-    Vec3d mOff;
-};
-
-} // namespace
-
 StrandSet retraceHelicoidField(const StrandSet& in, const HelicoidFieldGrids& field, const TraceParams& params,
                                TraceStats* stats, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
-    const double step = params.step > 0.0 ? params.step : 0.5 * field.k->voxelSize().x();
-    const double marginLength = double(params.margin) * field.k->voxelSize().x();
-    const std::size_t nS = in.numStrands();
-    std::vector<std::vector<Vec3f>> traced(nS);
-    std::vector<StopReason> reasons(nS, StopReason::FullLength);
-    std::vector<std::size_t> steps(nS, 0);
-    ProgressCounter progress(interrupter, "tracing through the helicoid field", nS, "strands");
-    auto body = [&](const tbb::blocked_range<std::size_t>& r) {
-        if (progress.stopped()) return;
-        HelicoidSampler sampler(field);
-        std::vector<double> target;
-        std::vector<Vec3d> pts;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const std::size_t n = in.size(i);
-            target.resize(n);
-            arcLengths(in.data(i), n, target.data());
-            const double length = target.back();
-            const std::size_t needed = stepCount(length, step);
-            const std::size_t limit = params.maxSteps ? std::min(needed, params.maxSteps) : needed;
-            pts.assign(1, Vec3d(in.root(i)));
-            Vec3d p = pts[0], last(0.0);
-            double outside = 0.0;
-            StopReason reason = limit == needed ? StopReason::FullLength : StopReason::MaxSteps;
-            auto dirAt = [&](const Vec3d& x, Vec3d& d) {
-                const double a = sampler.direction(x, params.vanishThreshold, d);
-                return a > 0.0 ? 0 : (a == 0.0 ? 1 : 2);  // 0 ok, 1 left, 2 vanished
-            };
-            for (std::size_t k = 0; k < limit; ++k) {
-                const double h = k + 1 == needed ? length - double(needed - 1) * step : step;
-                Vec3d k1, k2, k3, k4, q;
-                int st = dirAt(p, k1);
-                if (st == 0 && params.integrator == Integrator::RK2) {
-                    st = dirAt(p + 0.5 * h * k1, k2);
-                    q = p + h * k2;
-                } else if (st == 0 && params.integrator == Integrator::RK4) {
-                    st = dirAt(p + 0.5 * h * k1, k2);
-                    if (st == 0) st = dirAt(p + 0.5 * h * k2, k3);
-                    if (st == 0) st = dirAt(p + h * k3, k4);
-                    q = p + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-                } else {
-                    q = p + h * k1;
-                }
-                if (st == 0) {
-                    last = (q - p) / h;
-                    outside = 0.0;
-                } else if (st == 1 && k > 0 && outside + h <= marginLength * (1.0 + 1e-9)) {
-                    q = p + h * last;  // past the active region, within the margin: straight on
-                    outside += h;
-                } else {
-                    reason = st == 1 ? StopReason::LeftField : StopReason::Vanished;
-                    break;
-                }
-                p = q;
-                pts.push_back(p);
-                steps[i] = k + 1;
-            }
-            if (steps[i] < limit && reason == StopReason::FullLength) reason = StopReason::LeftField;
-            // Output vertices at the input's arc lengths (step m spans [m·step, (m+1)·step]).
-            std::vector<Vec3f>& out = traced[i];
-            const std::size_t taken = pts.size() - 1;
-            const double reached = taken == needed ? length : double(taken) * step;
-            for (std::size_t j = 0; j < n && target[j] <= reached + 1e-12 * length; ++j) {
-                if (taken == 0) { out.push_back(toF(pts[0])); continue; }
-                const std::size_t m = std::min(std::size_t(target[j] / step), taken - 1);
-                const double seg = m + 1 == needed ? length - double(needed - 1) * step : step;
-                const double f = std::min(1.0, std::max(0.0, (target[j] - double(m) * step) / seg));
-                out.push_back(toF(pts[m] + f * (pts[m + 1] - pts[m])));
-            }
-            if (reason == StopReason::FullLength) out.back() = toF(pts.back());
-            else if (out.back() != toF(pts.back())) out.push_back(toF(pts.back()));
-            if (out.size() < 2) out.push_back(out.back());
-            if (out.size() > n) out.resize(n);
-            reasons[i] = reason;
-        }
-    };
-    // Blocks of 64 strands, each counted when done (the whole range at once would never report).
-    auto counted = [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t b = r.begin(); b < r.end(); b += 64) {
-            const std::size_t e = std::min(r.end(), b + 64);
-            body(tbb::blocked_range<std::size_t>(b, e));
-            if (progress.add(e - b)) return;
-        }
-    };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 64), counted);
-    else counted(tbb::blocked_range<std::size_t>(0, nS));
-    if (progress.stopped()) throw InterruptedError("retraceHelicoidField: interrupted");
-
+    const char* where = "retraceHelicoidField";
+    params.validate(where);
+    const double voxelSize = field.k->voxelSize().x();
+    const double step = resolveStepLength(params.step, voxelSize, where);
     StrandSet out;
-    out.defaults = in.defaults;
-    for (std::size_t i = 0; i < nS; ++i) out.addStrand(traced[i]);
-    if (stats) {
-        *stats = TraceStats();
-        stats->strands = nS;
-        for (std::size_t i = 0; i < nS; ++i) {
-            stats->steps += steps[i];
-            stats->fullLength += reasons[i] == StopReason::FullLength;
-            stats->vanished += reasons[i] == StopReason::Vanished;
-            stats->leftField += reasons[i] == StopReason::LeftField;
-            stats->maxSteps += reasons[i] == StopReason::MaxSteps;
-        }
-    }
+    std::vector<StopReason> reasons;
+    std::vector<std::size_t> steps;
+    retraceWithSampler(in, params, step, voxelSize, [&] { return HelicoidFieldSampler(field, params.vanishThreshold); }, out,
+                       reasons, steps, threaded, interrupter, "tracing through the helicoid field", where);
+    if (stats) *stats = TraceStats::count(reasons, steps);
     return out;
 }
 

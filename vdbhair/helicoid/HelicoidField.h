@@ -51,9 +51,12 @@ HelicoidFieldGrids readHelicoidField(const std::string& path);
 /// @brief Retrace strands through a helicoid field: at a point, each active corner of the
 /// sampling cell predicts a direction by evaluating its own helicoid (the exact Eq. 1, origin at
 /// the voxel centre) at that point, and the predictions are blended with trilinear weights and
-/// normalized. Same parameters, stop reasons and outputs as retraceStrands().
+/// normalized (HelicoidFieldSampler). The streamline engine's general path (SamplerRetrace.h):
+/// same parameters, stop rules, write-out and statistics as retraceStrands() (params.kernel is
+/// ignored: there is no lane kernel for helicoid fields).
 /// @param interrupter optional progress and Ctrl-C (Progress.h).
-/// @throw InterruptedError when the interrupter stops the work.
+/// @throw ValueError (TraceParams::validate(): a negative step, a margin or vanish threshold out
+/// of range), InterruptedError when the interrupter stops the work.
 StrandSet retraceHelicoidField(const StrandSet& strands, const HelicoidFieldGrids& field, const TraceParams& params,
                                TraceStats* stats = nullptr, bool threaded = true,
                                openvdb::util::NullInterrupter* interrupter = nullptr);

@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/helicoid/AnalyticHelicoidSampler.h>
 #include <vdbhair/helicoid/Frechet.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/strands/Measures.h>
@@ -112,18 +113,18 @@ struct Fitter
         const std::size_t n = stepCount(L, h);
         out.resize(n + 1);
         Vec3d p = p0;
-        double th = hel.theta(p, 0.0);
-        Vec3d k1 = hel.frameFromTheta(th).t;
+        // The streamline engine's RK4 through the analytic helicoid, theta unwrapped from the root.
+        AnalyticHelicoidSampler sampler(hel);
+        StreamlineIntegrator<AnalyticHelicoidSampler> rk4(sampler, Integrator::RK4);
+        Vec3d k1 = sampler.tangent(p);
         out[0] = p;
         double clearance = hel.axisDistance(p);
         for (std::size_t j = 0; j < n; ++j) {
             const double hs = (j + 1 == n) ? L - double(n - 1) * h : h;
-            double t2 = th, t3 = th, t4 = th;
-            const Vec3d k2 = hel.tangent(p + 0.5 * hs * k1, t2);
-            const Vec3d k3 = hel.tangent(p + 0.5 * hs * k2, t3);
-            const Vec3d k4 = hel.tangent(p + hs * k3, t4);
-            p += (hs / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            k1 = hel.tangent(p, th);
+            Vec3d q;
+            rk4.advanceFrom(p, k1, hs, q);
+            p = q;
+            k1 = sampler.tangent(p);
             out[j + 1] = p;
             clearance = std::min(clearance, hel.axisDistance(p));
         }

@@ -1,6 +1,7 @@
 #include "SliceRenderer.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/Streamline.h>
 #include <vdbhair/io/VdbFile.h>
 
 #include <openvdb/openvdb.h>
@@ -107,6 +108,28 @@ Sampled makeScalarSampler(const GridT& grid)
     };
     return s;
 }
+
+/// The in-plane projection of a vector slice's field at a world point, as a sampler of the
+/// streamline engine (field/Streamline.h): Left off the grid's active voxels, Vanished where the
+/// in-plane part is no longer than @a minLength.
+struct InPlaneSampler
+{
+    const Sampled& s;
+    int axis;
+    double minLength;
+
+    SampleStatus direction(const openvdb::Vec3d& w, openvdb::Vec3d& d)
+    {
+        openvdb::Vec3d probe;
+        if (!s.nearest(w, probe)) return SampleStatus::Left;
+        openvdb::Vec3d v = s.linear(w);
+        v[axis] = 0.0;
+        const double len = v.length();
+        if (!(len > minLength)) return SampleStatus::Vanished;
+        d = v / len;
+        return SampleStatus::Ok;
+    }
+};
 
 } // namespace
 
@@ -244,43 +267,30 @@ SliceResult renderSlice(const std::string& path, const std::string& gridName, co
         }
     }
 
-    // Streamlines of the in-plane projection, seeded evenly over the active pixels.
+    // Streamlines of the in-plane projection, seeded evenly over the active pixels: the
+    // streamline engine's midpoint rule at its default step (of the smallest voxel side), both
+    // ways from each seed, stopping where a step's stages reverse (a sink, or a sign flip).
     if (params.streamlines > 0 && s.vector) {
         std::vector<std::size_t> on;
         for (std::size_t i = 0; i < active.size(); ++i) if (active[i]) on.push_back(i);
         const Vec3d vs = xf.voxelSize();
-        const double h = 0.5 * std::min(vs.x(), std::min(vs.y(), vs.z()));
-        const int maxSteps = int(std::min(1e6, 4.0 * ((uHi - uLo) + (vHi - vLo)) / h));
-        auto inPlane = [&](const Vec3d& w, Vec3d& d) {
-            Vec3d probe;
-            if (!s.nearest(w, probe)) return false;
-            Vec3d v = s.linear(w);
-            v[axis] = 0.0;
-            const double len = v.length();
-            if (!(len > 1e-6 * ref)) return false;
-            d = v / len;
-            return true;
-        };
-        const int n = std::min<int>(params.streamlines, int(on.size()));
+        StreamlineRules rules;
+        rules.integrator = Integrator::RK2;
+        rules.reversal = StageReversal::Stop;
+        rules.step = kDefaultStepVoxels * std::min(vs.x(), std::min(vs.y(), vs.z()));
+        rules.maxSteps = std::size_t(std::max(0.0, std::min(1e6, 4.0 * ((uHi - uLo) + (vHi - vLo)) / rules.step)));
+        const double length = double(rules.maxSteps + 1) * rules.step;  // the step cap ends every streamline
+        InPlaneSampler forward{s, axis, 1e-6 * ref};
+        ReversedSampler<InPlaneSampler> backward(forward);
+        const int n = rules.maxSteps ? std::min<int>(params.streamlines, int(on.size())) : 0;
+        std::vector<Vec3d> half;
         for (int k = 0; k < n; ++k) {
             const std::size_t i = on[std::size_t((double(k) + 0.5) * double(on.size()) / double(n))];
             const Vec3d seed = worldAt(double(i % std::size_t(plotW)) + 0.5, double(i / std::size_t(plotW)) + 0.5);
-            std::vector<Vec3d> line;
-            for (int dir = -1; dir <= 1; dir += 2) {
-                std::vector<Vec3d> half{seed};
-                Vec3d p = seed;
-                for (int step = 0; step < maxSteps; ++step) {
-                    Vec3d d1, d2;
-                    if (!inPlane(p, d1)) break;
-                    const Vec3d mid = p + d1 * (0.5 * h * dir);
-                    if (!inPlane(mid, d2)) break;
-                    if (d2.dot(d1) < 0.0) break;  // a reversal within one step: a sink or a sign flip
-                    p = p + d2 * (h * dir);
-                    half.push_back(p);
-                }
-                if (dir < 0) line.assign(half.rbegin(), half.rend());
-                else line.insert(line.end(), half.begin() + 1, half.end());
-            }
+            traceStreamline(backward, seed, length, rules, half);
+            std::vector<Vec3d> line(half.rbegin(), half.rend());
+            traceStreamline(forward, seed, length, rules, half);
+            line.insert(line.end(), half.begin() + 1, half.end());
             if (line.size() < 2) continue;
             ++res.streamlinesDrawn;
             for (int pass = 0; pass < 2; ++pass) {

@@ -1,10 +1,13 @@
 #include "Measures.h"
 
+#include <vdbhair/Exceptions.h>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace vdbhair {
 
@@ -217,6 +220,45 @@ std::vector<std::uint32_t> spatialOrder(const StrandSet& strands)
     std::vector<std::uint32_t> order(nS);
     for (std::size_t i = 0; i < nS; ++i) order[i] = std::uint32_t(keys[i] & 0xffffffffu);
     return order;
+}
+
+double meanVertexDisplacement(const StrandSet& a, const StrandSet& b, bool threaded)
+{
+    if (a.numStrands() != b.numStrands()) {
+        throw ValueError("meanVertexDisplacement: " + std::to_string(a.numStrands()) + " strands against " +
+                         std::to_string(b.numStrands()) + "; the sets must correspond strand by strand");
+    }
+    const std::size_t nS = a.numStrands();
+    std::vector<double> sum(nS, 0.0);
+    std::vector<std::size_t> count(nS, 0);
+    auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<double> sa, sb;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const std::size_t na = a.size(i), nb = b.size(i);
+            sa.resize(na);
+            sb.resize(nb);
+            arcLengths(a.data(i), na, sa.data());
+            arcLengths(b.data(i), nb, sb.data());
+            const Vec3f* pb = b.data(i);
+            std::size_t j = 0;
+            for (std::size_t k = 0; k < na; ++k) {
+                const double s = sa[k];
+                if (s > sb[nb - 1] + 1e-6 * std::max(1.0, sb[nb - 1])) break;
+                while (j + 2 < nb && sb[j + 1] < s) ++j;
+                const double len = sb[j + 1] - sb[j];
+                const double f = len > 0.0 ? std::min(1.0, std::max(0.0, (s - sb[j]) / len)) : 0.0;
+                const Vec3d q = toD(pb[j]) + f * (toD(pb[j + 1]) - toD(pb[j]));
+                sum[i] += (toD(a.positions[a.begin(i) + k]) - q).length();
+                ++count[i];
+            }
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 64), body);
+    else body(tbb::blocked_range<std::size_t>(0, nS));
+    double total = 0.0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < nS; ++i) { total += sum[i]; n += count[i]; }
+    return n ? total / double(n) : 0.0;
 }
 
 } // namespace vdbhair

@@ -74,4 +74,10 @@ namespace vdbhair {
 /// A deterministic function of the roots only.
 std::vector<std::uint32_t> spatialOrder(const StrandSet& strands);
 
+/// @brief Mean distance between corresponding vertices of @a a and @a b: each vertex of a
+/// strand of @a a against the point of the same strand of @a b at the same arc length (up to
+/// the shorter of the two strands). Both sets must have the same strand count.
+/// @throw ValueError if the strand counts differ.
+double meanVertexDisplacement(const StrandSet& a, const StrandSet& b, bool threaded = true);
+
 } // namespace vdbhair
