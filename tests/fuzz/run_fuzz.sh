@@ -9,5 +9,8 @@ mkdir -p "$work/corpus"
 set -- -max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=512 -timeout=10 \
        -max_len=65536 -print_final_stats=1 -artifact_prefix="$work/"
 [ -n "$dict" ] && set -- "$@" -dict="$dict"
+# Third-party leaks only, each with its reason (tests/sanitizers/lsan.supp).
+LSAN_OPTIONS="suppressions=$(cd "$(dirname "$0")/../sanitizers" && pwd)/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+export LSAN_OPTIONS
 # shellcheck disable=SC2086
 exec "$harness" "$@" ${VDBHAIR_FUZZ_FLAGS:-} "$work/corpus" "$seeds"

@@ -6,6 +6,7 @@
 #include <vdbhair/io/VdbInfo.h>
 #include <vdbhair/io/VdbStrandGrid.h>
 
+#include <openvdb/io/Stream.h>
 #include <openvdb/points/PointAttribute.h>
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/tools/PointIndexGrid.h>
@@ -13,6 +14,8 @@
 #include <vdbhair/io/StrandIO.h>
 
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 
 using namespace vdbhair;
 using Catch::Matchers::Contains;
@@ -290,6 +293,132 @@ TEST_CASE("checkVdbFileLayout: sizes and offsets in the file are checked against
         setU32(b, m, 0x7fffffffu);
         REQUIRE_THROWS_WITH(readVdbStrands(test::writeBytes("value.vdb", b)),
                             Contains("grid 'strands' metadata entry 0 declares a value of 2147483647 bytes"));
+    }
+}
+
+namespace {
+/// The offset of the value size of the first entry of type @a type in the MetaMap at @a at.
+std::size_t metadataValueSizeAt(const std::string& b, std::size_t at, const std::string& type)
+{
+    const std::uint32_t entries = u32At(b, at);
+    at += 4;
+    for (std::uint32_t e = 0; e < entries; ++e) {
+        at += 4 + u32At(b, at);  // name
+        const std::string t = b.substr(at + 4, u32At(b, at));
+        at += 4 + t.size();
+        if (t == type) return at;
+        at += 4 + u32At(b, at);  // value
+    }
+    return std::string::npos;
+}
+} // namespace
+
+TEST_CASE("checkVdbFileLayout: what OpenVDB reads differently by version, type and offsets flag is checked as OpenVDB reads it (issue 22)", "[io][vdb][fuzz]")
+{
+    initializeOpenVdb();
+    SECTION("fuzz_vdb's finding: a format 'version 0' file whose first grid name declares 1 GB")
+    {
+        // Before format 211 the version is three numbers and there are no offsets flag, library
+        // version or UUID text: the check stopped at the header and OpenVDB's
+        // GridDescriptor::read allocated a 0x3d3d3d3d-character name (malloc(1027423550)).
+        static const char input[] =
+            "\x20\x42\x44\x56\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x23\x00"
+            "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x3d\x3d\x3d\x3d\x3d\x3d\x3d\x3d\x3d"
+            "\x3d\x3d\x3d\x3d\x3d\x3d\x3d\x3d\x3d\x3d\x3d\x00\x4e\x53\x74\x36\x6c\x6f\x63\x61\x6c\x65\x35\x00\x10\x00";
+        REQUIRE(sizeof(input) - 1 == 78);
+        const std::string path = test::writeBytes("oom-952876811b.vdb", std::string(input, sizeof(input) - 1));
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("at byte 40: the file declares 1023410176 grids but only 34 bytes remain"));
+    }
+    SECTION("fuzz_vdb's leak input: a tree OpenVDB cannot read is refused with vdbhair's own error")
+    {
+        // A points tree whose first leaf's chunk is cut short: OpenVDB's RootNode::readTopology
+        // throws and leaks the child it was reading (tests/sanitizers/lsan.supp says why that
+        // leak is OpenVDB's); vdbhair turns the throw into its one-line error.
+        const std::string path = (std::filesystem::path(__FILE__).parent_path() / "data" / "fuzz_vdb_rootnode_leak.vdb").string();
+        REQUIRE(std::filesystem::file_size(path) == 10822);
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("cannot read grid 'strands' (RuntimeError: Expected to read a 480-byte uncompressed chunk"));
+    }
+    const std::string good = test::tempPath("typed.vdb");
+    writeVdbStrands(good, test::sampleStrands(false));
+    const std::string bytes = test::readBytes(good);
+    std::size_t at = 65;
+    for (int k = 0; k < 3; ++k) at += 4 + u32At(bytes, at);
+    std::int64_t gridPos;
+    std::memcpy(&gridPos, bytes.data() + at, 8);
+    const std::size_t gridMeta = std::size_t(gridPos) + 4;
+    SECTION("a fixed-size metadata value declaring another size (OpenVDB reads its own size and goes astray)")
+    {
+        const std::size_t m = metadataValueSizeAt(bytes, gridMeta, "int64");
+        REQUIRE(m != std::string::npos);
+        REQUIRE(u32At(bytes, m) == 8);
+        std::string b = bytes;
+        setU32(b, m, 9);
+        REQUIRE_THROWS_WITH(readVdbStrands(test::writeBytes("int64.vdb", b)), Contains("declares a 'int64' value of 9 bytes; a 'int64' value is 8 bytes"));
+    }
+    SECTION("delayed-load metadata declaring more leaves than the grid has bytes")
+    {
+        // OpenVDB's io::File writes it for value grids (not for points grids).
+        auto fog = openvdb::FloatGrid::create(0.f);
+        fog->setName("density");
+        for (int i = 0; i < 40; ++i) fog->tree().setValue(openvdb::Coord(8 * i, 0, 0), 1.f);
+        const std::string byOpenVdb = test::tempPath("byopenvdb.vdb");
+        writeVdbGrids(byOpenVdb, {fog}, "test");
+        const std::string ob = test::readBytes(byOpenVdb);
+        REQUIRE_NOTHROW(checkVdbFileLayout(byOpenVdb, "t"));
+        std::size_t oat = 65;
+        for (int k = 0; k < 3; ++k) oat += 4 + u32At(ob, oat);
+        std::int64_t oGridPos;
+        std::memcpy(&oGridPos, ob.data() + oat, 8);
+        const std::size_t m = metadataValueSizeAt(ob, std::size_t(oGridPos) + 4, "__delayedload");
+        REQUIRE(m != std::string::npos);
+        std::string b = ob;
+        setU32(b, m + 4, 0x40000000u);  // the leaf count, first in the value
+        REQUIRE_THROWS_WITH(checkVdbFileLayout(test::writeBytes("delayed.vdb", b), "t"),
+                            Contains("grid 'density' metadata entry") && Contains("(delayed-load metadata) declares 1073741824 leaves but the grid holds only"));
+    }
+    SECTION("a UUID that is not hexadecimal (OpenVDB's stream fails, and its next string length is uninitialized)")
+    {
+        std::string b = bytes;
+        b[21 + 9] = 'x';  // inside the second group
+        REQUIRE_THROWS_WITH(readVdbStrands(test::writeBytes("uuid.vdb", b)), Contains("at byte 21: the UUID is not 32 hexadecimal digits"));
+        b = bytes;
+        b[21 + 8] = ' ';  // a dash turned into white space, which OpenVDB skips
+        REQUIRE_THROWS_WITH(readVdbStrands(test::writeBytes("uuid2.vdb", b)), Contains("the UUID is not"));
+    }
+    SECTION("a grid's transform type name longer than the grid's head")
+    {
+        // The transform follows the grid's metadata.
+        std::size_t t = gridMeta;
+        const std::uint32_t entries = u32At(bytes, t);
+        t += 4;
+        for (std::uint32_t e = 0; e < entries; ++e)
+            for (int k = 0; k < 3; ++k) t += 4 + u32At(bytes, t);
+        REQUIRE(bytes.substr(t + 4, u32At(bytes, t)) == "UniformScaleMap");
+        std::string b = bytes;
+        setU32(b, t, 0x7ffffff0u);
+        REQUIRE_THROWS_WITH(readVdbStrands(test::writeBytes("transform.vdb", b)),
+                            Contains("the grid's transform type name of 2147483632 characters") && Contains("before the grid's data"));
+    }
+    SECTION("a file written without grid offsets (io::Stream): read whole, its first grid's head checked")
+    {
+        const std::string path = test::tempPath("stream.vdb");
+        {
+            std::ofstream out(path, std::ios::binary);
+            openvdb::io::Stream(out).write(openvdb::GridCPtrVec{createStrandGrid(test::sampleStrands(false))});
+        }
+        REQUIRE_NOTHROW(checkVdbFileLayout(path, "t"));
+        REQUIRE(readVdbStrands(path).numStrands() == test::sampleStrands(false).numStrands());
+        const std::string s = test::readBytes(path);
+        REQUIRE(s[20] == 0);  // no offsets
+        std::string b = s;
+        setU32(b, 65, 0x3d3d3d3du);  // the first grid's name
+        REQUIRE_THROWS_WITH(readVdbStrands(test::writeBytes("stream-name.vdb", b)), Contains("a grid name of 1027423549 characters"));
+        b = s;
+        std::size_t g = 65;
+        for (int k = 0; k < 3; ++k) g += 4 + u32At(s, g);
+        g += 24 + 4;  // offsets, compression flags: the grid's metadata count
+        setU32(b, g, 0x10000000u);
+        REQUIRE_THROWS_WITH(readVdbStrands(test::writeBytes("stream-meta.vdb", b)), Contains("grid 'strands' metadata declares 268435456 entries"));
     }
 }
 

@@ -3,11 +3,15 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
 
+#include <openvdb/io/DelayedLoadMetadata.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <cstdint>
+#include <limits>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -26,7 +30,9 @@ void initializeOpenVdb()
 namespace {
 
 /// Reads a .vdb file's plain values at known offsets, every size checked against the file size
-/// before it is used (nothing is allocated from the file).
+/// before it is used (nothing is allocated from the file). It follows OpenVDB 10's readers value
+/// by value (io::Archive::readHeader, MetaMap::readMeta, io::GridDescriptor::read,
+/// io::DelayedLoadMetadata::readValue, math::Transform::read), format version by format version.
 class LayoutReader
 {
 public:
@@ -84,8 +90,35 @@ public:
         seek(mOffset + n);
         return s;
     }
+    /// @brief The file's UUID as OpenVDB reads it from format 218 on (boost's operator>> for a
+    /// uuid): 32 hexadecimal digits with dashes after the 8th, 12th, 16th and 20th, each character
+    /// after any white space. Anything else leaves OpenVDB's stream failed, and a failed stream
+    /// makes its next string length an uninitialized value (openvdb::readString).
+    void uuidText(std::uint64_t limit)
+    {
+        const std::uint64_t at = mOffset;
+        auto next = [&]() {
+            char c;
+            do {
+                c = read<char>(limit, "the UUID");
+            } while (c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r');
+            return c;
+        };
+        for (int i = 0; i < 16; ++i) {
+            for (int k = 0; k < 2; ++k) {
+                if (!std::isxdigit(static_cast<unsigned char>(next()))) {
+                    fail(at, "the UUID is not 32 hexadecimal digits with 4 dashes (8-4-4-4-12)");
+                }
+            }
+            if ((i == 3 || i == 5 || i == 7 || i == 9) && next() != '-') {
+                fail(at, "the UUID is not 32 hexadecimal digits with 4 dashes (8-4-4-4-12)");
+            }
+        }
+    }
     /// A MetaMap (uint32 count; name, type name, uint32 value size and value each) within @a limit.
-    void metadata(std::uint64_t limit, const std::string& what)
+    /// @a treeBytes bounds the leaf count of a grid's delayed-load metadata (each leaf of the tree
+    /// takes at least a byte of the file).
+    void metadata(std::uint64_t limit, const std::string& what, std::uint64_t treeBytes)
     {
         const std::uint64_t at = mOffset;
         const std::uint32_t count = read<std::uint32_t>(limit, "metadata count");
@@ -95,19 +128,82 @@ public:
                          " bytes remain for them (at least 12 each)");
         }
         for (std::uint32_t i = 0; i < count; ++i) {
+            const std::string entry = what + " entry " + std::to_string(i);
             string(limit, "a metadata name");
-            string(limit, "a metadata type name");
+            const std::string type = string(limit, "a metadata type name");
             const std::uint64_t sizeAt = mOffset;
             const std::uint32_t bytes = read<std::uint32_t>(limit, "a metadata value size");
             if (bytes > limit - mOffset) {
-                fail(sizeAt, what + " entry " + std::to_string(i) + " declares a value of " + std::to_string(bytes) +
+                fail(sizeAt, entry + " declares a value of " + std::to_string(bytes) +
                                  " bytes but only " + std::to_string(limit - mOffset) + " remain");
             }
-            seek(mOffset + bytes);
+            // What OpenVDB reads of the value depends on its type: a string or an unknown type
+            // the declared bytes, a fixed-size type its own size whatever is declared.
+            if (type == openvdb::io::DelayedLoadMetadata::staticTypeName()) {
+                delayedLoad(bytes, limit, entry, treeBytes);
+            } else if (type != openvdb::StringMetadata::staticTypeName() && openvdb::Metadata::isRegisteredType(type)) {
+                const std::uint32_t fixed = openvdb::Metadata::createMetadata(type)->size();
+                if (bytes != fixed) {
+                    fail(sizeAt, entry + " declares a '" + type + "' value of " + std::to_string(bytes) + " bytes; a '" + type +
+                                     "' value is " + std::to_string(fixed) + " bytes");
+                }
+                seek(mOffset + bytes);
+            } else {
+                seek(mOffset + bytes);
+            }
         }
     }
+    /// The type name of a grid's transform (math::Transform::read); the map after it is not read.
+    void transform(std::uint64_t limit) { string(limit, "the grid's transform type name"); }
 
 private:
+    /// @brief io::DelayedLoadMetadata (`__delayedload`): a leaf count, then a mask byte and a
+    /// compressed size per leaf, each array raw or Blosc-compressed. OpenVDB allocates the count
+    /// and the Blosc header's uncompressed size before it decompresses anything.
+    void delayedLoad(std::uint32_t declared, std::uint64_t limit, const std::string& entry, std::uint64_t treeBytes)
+    {
+        if (declared == 0) return;  // OpenVDB reads nothing then
+        const std::uint64_t start = mOffset;
+        const std::uint32_t count = read<std::uint32_t>(limit, "the delayed-load leaf count");
+        if (count > treeBytes) {
+            fail(start, entry + " (delayed-load metadata) declares " + std::to_string(count) + " leaves but the grid holds only " +
+                            std::to_string(treeBytes) + " bytes (a leaf takes at least one)");
+        }
+        const auto array = [&](std::uint32_t bytes, std::uint64_t itemSize, const char* what) {
+            const std::uint64_t expected = std::uint64_t(count) * itemSize;
+            if (bytes == 0) {
+                skip(expected, limit, std::string("the delayed-load ") + what);
+                return;
+            }
+            // A Blosc buffer: a 16-byte header whose uncompressed size (bytes 4-7) OpenVDB
+            // allocates and whose compressed size (bytes 12-15) Blosc reads up to.
+            const std::uint64_t at = mOffset;
+            require(bytes, limit, std::string("the compressed delayed-load ") + what);
+            if (bytes < 16) fail(at, entry + ": a compressed delayed-load " + what + " of " + std::to_string(bytes) + " bytes is shorter than Blosc's 16-byte header");
+            std::uint32_t header[4];
+            mIn.read(reinterpret_cast<char*>(header), sizeof(header));
+            if (!mIn) fail(at, std::string("cannot read the Blosc header of the delayed-load ") + what);
+            const std::uint32_t rawBytes = header[1], blockBytes = header[3];
+            if (!(rawBytes == expected || (expected <= 128 && rawBytes == 128))) {  // 128: OpenVDB pads small arrays
+                fail(at, entry + ": the compressed delayed-load " + what + " declares " + std::to_string(rawBytes) + " bytes uncompressed; " +
+                             std::to_string(count) + " leaves make " + std::to_string(expected));
+            }
+            if (blockBytes > bytes) {
+                fail(at, entry + ": the compressed delayed-load " + what + " declares " + std::to_string(blockBytes) +
+                             " compressed bytes in a buffer of " + std::to_string(bytes));
+            }
+            seek(at + bytes);
+        };
+        array(read<std::uint32_t>(limit, "the delayed-load mask size"), sizeof(openvdb::io::DelayedLoadMetadata::MaskType), "mask");
+        const std::uint32_t sizesBytes = read<std::uint32_t>(limit, "the delayed-load sizes size");
+        if (sizesBytes != std::numeric_limits<std::uint32_t>::max()) {
+            array(sizesBytes, sizeof(openvdb::io::DelayedLoadMetadata::CompressedSizeType), "compressed sizes");
+        }
+        // OpenVDB skips what the value declares beyond what it read.
+        const std::uint64_t used = mOffset - start;
+        if (used < declared) seek(start + declared);
+    }
+
     std::ifstream mIn;
     std::string mWhere;
     std::uint64_t mSize = 0, mOffset = 0;
@@ -117,50 +213,76 @@ private:
 
 void checkVdbFileLayout(const std::string& path, const std::string& where)
 {
+    initializeOpenVdb();  // the metadata types OpenVDB will read by are registered then
     LayoutReader in(path, where);
     const std::uint64_t end = in.size();
-    // Header (io::Archive::readHeader): magic, format version, library version, whether grids
-    // have offsets, (before format 222) one compression flag, then a 36-character UUID.
+    // Header (io::Archive::readHeader): magic, format version (before 211 as three numbers),
+    // library version (from 211), whether grids have offsets (from 212), one compression flag
+    // (220 and 221), then the UUID (36 characters from 218, 16 bytes before).
     if (end < 8 || in.read<std::int64_t>(end, "the magic number") != std::int64_t(openvdb::OPENVDB_MAGIC)) {
         throw FormatError(where + ": not a readable VDB file (the first 8 bytes are not OpenVDB's magic number)");
     }
-    const std::uint32_t version = in.read<std::uint32_t>(end, "the file format version");
+    std::uint32_t version = in.read<std::uint32_t>(end, "the file format version");
+    if (version < 211) {
+        // OpenVDB's arithmetic, wrapping as its uint32 does.
+        const std::uint32_t minor = in.read<std::uint32_t>(end, "the file format minor version");
+        const std::uint32_t patch = in.read<std::uint32_t>(end, "the file format patch version");
+        version = 100u * version + 10u * minor + patch;
+    }
     if (version > openvdb::OPENVDB_FILE_VERSION) {
         in.fail(8, "format version " + std::to_string(version) + " is newer than the " +
                        std::to_string(openvdb::OPENVDB_FILE_VERSION) + " this OpenVDB reads");
     }
-    if (version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) return;  // see the header
-    in.skip(8, end, "the library version");
-    const char hasOffsets = in.read<char>(end, "the grid offsets flag");
-    in.skip(36, end, "the UUID");
-    in.metadata(end, "the file's metadata");
-    if (!hasOffsets) return;  // grids follow one another without descriptors' offsets
+    if (version >= 211) in.skip(8, end, "the library version");
+    bool hasOffsets = true;
+    if (version >= 212) hasOffsets = in.read<char>(end, "the grid offsets flag") != 0;
+    if (version >= openvdb::OPENVDB_FILE_VERSION_SELECTIVE_COMPRESSION && version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) {
+        in.skip(1, end, "the compression flag");
+    }
+    if (version >= openvdb::OPENVDB_FILE_VERSION_BOOST_UUID) in.uuidText(end);
+    else in.skip(16, end, "the UUID");
+    in.metadata(end, "the file's metadata", end);
 
-    // Grid descriptors (io::GridDescriptor::read): name, type, instance parent, then the grid's
-    // start, data block start and end; the next descriptor starts at the grid's end.
+    // Grid descriptors (io::GridDescriptor::read): name, type, instance parent (from 216), then the
+    // grid's start, data block start and end; the next descriptor starts at the grid's end.
+    const bool instancing = version >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING;
+    const std::uint64_t minDescriptor = instancing ? 36 : 32;
     const std::uint64_t countAt = in.offset();
     const std::uint32_t count = in.read<std::uint32_t>(end, "the grid count");
-    if (count > (end - in.offset()) / 36) {
+    if (count > (end - in.offset()) / minDescriptor) {
         in.fail(countAt, "the file declares " + std::to_string(std::int32_t(count)) + " grids but only " +
-                             std::to_string(end - in.offset()) + " bytes remain (a grid descriptor alone needs 36)");
+                             std::to_string(end - in.offset()) + " bytes remain (a grid descriptor alone needs " +
+                             std::to_string(minDescriptor) + ")");
     }
+    // Each grid: its compression flags (from 222) and metadata, then (from 216) its transform's
+    // type name, all before its data block.
+    const auto gridHead = [&](const std::string& name, std::uint64_t limit, std::uint64_t treeBytes) {
+        if (version >= openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) in.read<std::uint32_t>(limit, "the grid's compression flags");
+        in.metadata(limit, "grid '" + name + "' metadata", treeBytes);
+        if (instancing) in.transform(limit);
+    };
     for (std::uint32_t g = 0; g < count; ++g) {
         const std::uint64_t descAt = in.offset();
         const std::string name = in.string(end, "a grid name");
         in.string(end, "a grid type name");
-        in.string(end, "a grid's instance parent name");
+        if (instancing) in.string(end, "a grid's instance parent name");
         const std::int64_t gridPos = in.read<std::int64_t>(end, "a grid start offset");
         const std::int64_t blockPos = in.read<std::int64_t>(end, "a grid data offset");
         const std::int64_t endPos = in.read<std::int64_t>(end, "a grid end offset");
+        if (!hasOffsets) {
+            // Grids follow their descriptors one after another (a stream written without offsets):
+            // the first grid's head is checked; where it ends and the next begins only OpenVDB's
+            // tree reader knows.
+            gridHead(name, end, end - in.offset());
+            return;
+        }
         if (!(std::int64_t(in.offset()) <= gridPos && gridPos <= blockPos && blockPos <= endPos && std::uint64_t(endPos) <= end)) {
             in.fail(descAt, "grid " + std::to_string(g) + " ('" + name + "') has start " + std::to_string(gridPos) + ", data " +
                                 std::to_string(blockPos) + " and end " + std::to_string(endPos) + "; they must satisfy " +
                                 std::to_string(in.offset()) + " <= start <= data <= end <= " + std::to_string(end) + " (the file size)");
         }
-        // The grid's compression flags and metadata come before its data block.
         in.seek(std::uint64_t(gridPos));
-        in.read<std::uint32_t>(std::uint64_t(blockPos), "the grid's compression flags");
-        in.metadata(std::uint64_t(blockPos), "grid '" + name + "' metadata");
+        gridHead(name, std::uint64_t(blockPos), std::uint64_t(endPos - gridPos));
         in.seek(std::uint64_t(endPos));
     }
 }

@@ -19,16 +19,25 @@ void initializeOpenVdb();
 /// OpenVDB trusts the sizes in the file and allocates what they declare (a flipped bit can ask
 /// for terabytes before any error).
 ///
-/// Checked, against the file size and without allocating by any size read: the magic number;
-/// the file-level metadata (every name, type name and value size within the bytes that remain);
-/// the grid count (each descriptor needs at least 36 bytes); each grid descriptor's names and its
-/// offsets (descriptor end <= grid start <= data block start <= grid end <= file size); and each
-/// grid's compression flags and metadata within the grid's bytes before its data block.
+/// Checked, against the file size and without allocating by any size read, value by value as
+/// OpenVDB 10 reads them for the file's format version (from the three-number versions before
+/// 211 on): the magic number and version; the UUID (36 characters from format 218, which OpenVDB
+/// parses as text: anything else fails its stream and makes its next string length an
+/// uninitialized value); the file-level metadata (every name, type name and value within the
+/// bytes that remain; fixed-size types such as `int64` must declare their own size, since OpenVDB
+/// reads that size whatever is declared; a grid's delayed-load metadata with its leaf count
+/// within the grid's bytes and its Blosc headers' sizes matching it); the grid count (each
+/// descriptor needs at least 36 bytes, 32 before format 216); each grid descriptor's names and
+/// its offsets (descriptor end <= grid start <= data block start <= grid end <= file size); and
+/// each grid's compression flags, metadata and transform type name within the grid's bytes before
+/// its data block. A file written without grid offsets (io::Stream) holds its grids one after
+/// another: there the first grid's descriptor and head are checked, and no more.
 ///
-/// Not checked (OpenVDB's tree reader would have to be reimplemented): the transform, the tree
-/// topology (root table, node masks) and the leaf buffers, including points attribute arrays and
-/// their compressed sizes (io::bloscFromStream allocates what the stream declares). Files older
-/// than format 222 (OpenVDB 3) get only the magic and header checks.
+/// Not checked (OpenVDB's tree reader would have to be reimplemented): the transform's map, the
+/// tree topology (root table, node masks) and the leaf buffers, including points attribute arrays
+/// and their compressed sizes (io::bloscFromStream allocates what the stream declares); the heads
+/// of the second and later grids of a file without offsets; and, before format 216, the
+/// transform (it follows the tree there).
 /// @throw IoError if the file cannot be read; FormatError naming the byte and the rule.
 void checkVdbFileLayout(const std::string& path, const std::string& where);
 
