@@ -8,6 +8,7 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/RootGrid.h>
+#include <vdbhair/scalp/ScalpInput.h>
 
 #include <algorithm>
 #include <chrono>
@@ -22,9 +23,7 @@ struct RootsCmdParams
     std::int64_t count = -1;  ///< -1: not given
     double spacing = 0.0;
     CLI::Option* spacingOpt = nullptr;
-    std::uint64_t seed = 0;
-    int iterations = 200;
-    double stepScale = 0.5;
+    FollicleParams follicle;  ///< the library's defaults; count, spacing and up set from the options
     bool noRegion = false;
 };
 
@@ -37,32 +36,18 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     if (p.count >= 0 && spacingGiven) throw ValueError("--count and --spacing: give one");
     if (p.count == 0) throw ValueError("--count 0: must be at least 1");
     if (spacingGiven && (!(p.spacing > 0.0) || !std::isfinite(p.spacing))) throw ValueError("--spacing " + formatValue(p.spacing) + ": must be a positive finite length");
-    if (p.iterations < 0) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 0");
-    FollicleParams fp;
+    if (p.follicle.maxIterations < 0) throw ValueError("--iterations " + std::to_string(p.follicle.maxIterations) + ": must be at least 0");
+    FollicleParams fp = p.follicle;
     if (p.count > 0) fp.count = std::size_t(p.count);
     if (spacingGiven) fp.spacing = p.spacing;
-    fp.seed = p.seed;
-    fp.maxIterations = p.iterations;
-    fp.stepScale = p.stepScale;
     fp.up = axisFromName(p.up, "--up");
 
     openvdb::FloatGrid::Ptr surface;
     openvdb::BoolGrid::Ptr region;
     {
         const Stage stage(common, "reading " + p.input);
-        const std::string where = "roots(" + p.input + ")";
-        openvdb::GridBase::Ptr g = readVdbGrid(p.input, "surface", where);
-        surface = openvdb::GridBase::grid<openvdb::FloatGrid>(g);
-        if (!surface) throw TypeError(p.input + ": grid 'surface' holds " + g->valueType() + " values; a scalp is a float level set (vdbhair scalp makes one)");
-        if (surface->getGridClass() != openvdb::GRID_LEVEL_SET) throw TypeError(p.input + ": grid 'surface' is not a level set; vdbhair scalp makes one");
-        if (!p.noRegion) {
-            const std::vector<std::string> names = vdbGridNames(p.input, where);
-            if (std::find(names.begin(), names.end(), "region") != names.end()) {
-                openvdb::GridBase::Ptr r = readVdbGrid(p.input, "region", where);
-                region = openvdb::GridBase::grid<openvdb::BoolGrid>(r);
-                if (!region) throw TypeError(p.input + ": grid 'region' holds " + r->valueType() + " values; a region is a bool grid");
-            }
-        }
+        surface = readScalp(p.input, common.interrupter);
+        if (!p.noRegion) region = readScalpRegion(p.input);
     }
     const auto t0 = std::chrono::steady_clock::now();
     const Follicles f = sampleFollicles(surface, region, fp, true, common.interrupter);
@@ -99,13 +84,13 @@ Command addRootsCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<RootsCmdParams>();
     CLI::App* sub = app.add_subcommand("roots", "Spread follicles (roots) evenly over a scalp level set, in its region (Witkin & Heckbert 1994)");
-    sub->add_option("scalp", params->input, "Scalp .vdb with grid 'surface' (and 'region'), as vdbhair scalp writes")->required();
+    sub->add_option("scalp", params->input, "Scalp .vdb with grid 'surface' (and 'region'), as vdbhair scalp writes; or a head mesh (.ply, .obj), made into one at 1/100 of its size")->required();
     sub->add_option("-o,--output", params->output, "Output roots: .ply (x y z nx ny nz tx ty tz) or .vdb (points P, N, tangent, group root)")->required();
     sub->add_option("--count", params->count, "Number of roots");
     params->spacingOpt = sub->add_option("--spacing", params->spacing, "Target nearest-neighbour spacing in world units (instead of --count)");
-    sub->add_option("--seed", params->seed, "Random seed of the initial placement")->capture_default_str();
-    sub->add_option("--iterations", params->iterations, "Most relaxation iterations")->capture_default_str();
-    sub->add_option("--step-scale", params->stepScale, "Relaxation step as a multiple of sigma^2 times the energy gradient")->capture_default_str();
+    sub->add_option("--seed", params->follicle.seed, "Random seed of the initial placement")->capture_default_str();
+    sub->add_option("--iterations", params->follicle.maxIterations, "Most relaxation iterations")->capture_default_str();
+    sub->add_option("--step-scale", params->follicle.stepScale, "Relaxation step as a multiple of sigma^2 times the energy gradient")->capture_default_str();
     sub->add_option("--up", params->up, "Reference axis of the tangent frame: x, y, z, -x, -y or -z")->capture_default_str();
     sub->add_flag("--no-region", params->noRegion, "Ignore the file's 'region' grid: roots over the whole surface");
     addCommonOptions(sub, common);

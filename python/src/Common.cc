@@ -5,6 +5,7 @@
 
 #include <vdbhair/Exceptions.h>
 
+#include <cmath>
 #include <csignal>
 
 namespace vdbhair::py {
@@ -187,6 +188,20 @@ HeadArgument::HeadArgument(const pyb::object& h, const std::string& policyName) 
 HeadObstacle HeadArgument::get(const std::string& where) const
 {
     return path ? readHeadObstacle(*path, where + ": head=" + *path, policy) : head;
+}
+
+std::vector<Vec3d> pointsArgument(const pyb::handle& obj, const std::string& what)
+{
+    const auto a = pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>::ensure(obj);
+    if (!a || a.ndim() != 2 || a.shape(1) != 3) throw ValueError(what + ": must be an (N, 3) array of points");
+    std::vector<Vec3d> out(std::size_t(a.shape(0)));
+    const double* d = a.data();
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        out[i] = Vec3d(d[3 * i], d[3 * i + 1], d[3 * i + 2]);
+        if (!std::isfinite(d[3 * i]) || !std::isfinite(d[3 * i + 1]) || !std::isfinite(d[3 * i + 2]))
+            throw ValueError(what + "[" + std::to_string(i) + "]: not finite");
+    }
+    return out;
 }
 
 } // namespace vdbhair::py

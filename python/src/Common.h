@@ -8,9 +8,12 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/Types.h>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+
+#include <openvdb/Grid.h>
 
 #include <tbb/global_control.h>
 
@@ -21,6 +24,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace vdbhair::py {
 
@@ -123,6 +127,21 @@ pyb::array readOnlyView(const T* data, std::size_t count, std::size_t cols, pyb:
     return a;
 }
 
+/// @brief An (N, 3) array of finite numbers (any real dtype) as points.
+/// @param what names the array in messages ("interpolate: roots")
+/// @throw ValueError (another shape, a non-finite value).
+std::vector<Vec3d> pointsArgument(const pyb::handle& obj, const std::string& what);
+
+/// @brief One OpenVDB grid as Python sees it (vdbhair.Grid, registered in Fields.cc): a shared
+/// pointer to the grid, which a TangentField may share. Cast it with std::dynamic_pointer_cast,
+/// never GridBase::grid<T>() or isType<T>(): those instantiate Tree::treeType()'s std::call_once
+/// in the module, whose exported helper libopenvdb then binds to, and openvdb::initialize()
+/// crashes at import (the lambda fills the module's hidden copy of the type name, not libopenvdb's).
+struct PyGrid
+{
+    openvdb::GridBase::Ptr grid;
+};
+
 /// @brief The head= and head_policy= keywords of refine and comb: None (the operation's default
 /// head), "none" (no head), a path (a mesh, or a .vdb with a level set, read by get()), or
 /// (x, y, z, r), a sphere.
@@ -143,5 +162,6 @@ struct HeadArgument
 void bindStrands(pyb::module_& m);
 void bindFields(pyb::module_& m);
 void bindOperations(pyb::module_& m);
+void bindScalp(pyb::module_& m);
 
 } // namespace vdbhair::py

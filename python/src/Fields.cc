@@ -28,12 +28,6 @@ namespace {
 using IndexBox = std::array<std::array<int, 3>, 2>;
 using StrandsPtr = std::shared_ptr<StrandSet>;
 
-/// A grid as Python sees it: a shared pointer to the OpenVDB grid (shared with a TangentField).
-struct PyGrid
-{
-    openvdb::GridBase::Ptr grid;
-};
-
 /// A field of one level as Python sees it.
 struct PyField
 {

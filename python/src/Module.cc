@@ -31,4 +31,5 @@ one-line messages.)doc";
     py::bindStrands(m);
     py::bindFields(m);
     py::bindOperations(m);
+    py::bindScalp(m);
 }

@@ -5,6 +5,7 @@
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
+#include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbInspect.h>
@@ -56,19 +57,11 @@ Scene sceneArgument(const pyb::handle& scene, const std::string& where = "grow")
                     std::string(pyb::str(scene.get_type().attr("__name__"))));
 }
 
-/// An (N, 3) array of finite numbers as points; @a what names it in messages ("interpolate: roots").
-std::vector<Vec3d> pointsArgument(const pyb::handle& obj, const std::string& what)
+/// The max_error= keyword of fit and reconstruct.
+void checkMaxError(double maxError, const char* where)
 {
-    const auto a = pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>::ensure(obj);
-    if (!a || a.ndim() != 2 || a.shape(1) != 3) throw ValueError(what + ": must be an (N, 3) array of points");
-    std::vector<Vec3d> out(std::size_t(a.shape(0)));
-    const double* d = a.data();
-    for (std::size_t i = 0; i < out.size(); ++i) {
-        out[i] = Vec3d(d[3 * i], d[3 * i + 1], d[3 * i + 2]);
-        if (!std::isfinite(d[3 * i]) || !std::isfinite(d[3 * i + 1]) || !std::isfinite(d[3 * i + 2]))
-            throw ValueError(what + "[" + std::to_string(i) + "]: not finite");
-    }
-    return out;
+    if (!(maxError > 0.0) || !std::isfinite(maxError))
+        throw ValueError(std::string(where) + ": max_error=" + std::to_string(maxError) + ": must be a positive fraction of the strand length");
 }
 
 const char* colorByNameOf(ColorBy c)
@@ -402,7 +395,7 @@ Returns:
         [](const StrandsPtr& strands, double maxError, double lambda, int maxPieces, int maxEvaluations, double step, bool roll,
            bool skipDegenerate, bool returnSummary, int threads, const pyb::object& progress) -> pyb::object {
             FitParams fp;
-            if (!(maxError > 0.0) || !std::isfinite(maxError)) throw ValueError("fit: max_error=" + std::to_string(maxError) + ": must be a positive fraction of the strand length");
+            checkMaxError(maxError, "fit");
             if (!(lambda >= 0.0) || !std::isfinite(lambda)) throw ValueError("fit: lambda_=" + std::to_string(lambda) + ": must be zero or positive");
             if (maxEvaluations < 10) throw ValueError("fit: max_evaluations=" + std::to_string(maxEvaluations) + ": must be at least 10");
             if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) throw ValueError("fit: step=" + std::to_string(step) + ": must be a positive finite length (0: automatic)");
@@ -568,6 +561,75 @@ Args:
 
 Returns:
     Strands (one per root, in order), or the scene dict with return_scene.)doc");
+
+    const ReconstructParams reconstructDefaults;
+    m.def(
+        "reconstruct",
+        [](const StrandsPtr& strands, double guides, const std::string& select, std::uint64_t seed, double power,
+           std::optional<int> neighbors, double maxError, int threads, const pyb::object& progress) {
+            ReconstructParams p;
+            p.guideFraction = guides;
+            if (select == "random") p.selection = GuideSelection::Random;
+            else if (select == "cluster") p.selection = GuideSelection::Cluster;
+            else throw ValueError("reconstruct: select '" + select + "' is not one of random, cluster");
+            p.seed = seed;
+            p.helicoid.shepard.power = power;
+            if (neighbors) {
+                if (*neighbors < 1) throw ValueError("reconstruct: neighbors=" + std::to_string(*neighbors) + ": must be at least 1 (None: each method's default)");
+                p.helicoid.shepard.neighbors = *neighbors;
+                p.points.neighbors = *neighbors;
+            }
+            checkMaxError(maxError, "reconstruct");
+            p.fit.maxError = maxError;
+            ReconstructResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                return reconstructHairstyle(*strands, p, true, interrupter);
+            });
+            auto stats = [](const ReconstructErrors& e) {
+                pyb::dict d;
+                d["relative"] = pyb::array_t<double>(e.relative.size(), e.relative.data());
+                d["mean"] = e.mean;
+                d["p95"] = e.p95;
+                d["mean_interpolated"] = e.meanInterpolated;
+                d["p95_interpolated"] = e.p95Interpolated;
+                d["seconds"] = e.seconds;
+                return d;
+            };
+            pyb::dict report;
+            report["guides"] = pyb::array_t<std::int64_t>(r.guides.size(), reinterpret_cast<const std::int64_t*>(r.guides.data()));
+            report["unfitted"] = r.unfitted;
+            report["fit"] = pyb::dict(pyb::arg("mean") = r.fitSummary.meanRelative, pyb::arg("p95") = r.fitSummary.p95Relative,
+                                      pyb::arg("pieces_per_strand") = r.fitSummary.piecesPerStrand, pyb::arg("seconds") = r.fitSeconds);
+            report["helicoid"] = stats(r.helicoidErrors);
+            report["points"] = stats(r.pointErrors);
+            return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.helicoid)), std::make_shared<StrandSet>(std::move(r.points)), report);
+        },
+        pyb::arg("strands"), pyb::kw_only(), pyb::arg("guides") = reconstructDefaults.guideFraction, pyb::arg("select") = "random",
+        pyb::arg("seed") = reconstructDefaults.seed, pyb::arg("power") = reconstructDefaults.helicoid.shepard.power,
+        pyb::arg("neighbors") = pyb::none(), pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("threads") = 0,
+        pyb::arg("progress") = pyb::none(),
+        R"doc(Rebuild a hairstyle from a share of its strands (Piuze et al. 2011, Sec. 5.4):
+``vdbhair reconstruct``. The guides are fitted with p-helicoids and new hairs interpolated at every
+other root; the same guides' points are blended too (the peers' way), and both are measured
+against the original by the discrete Frechet distance relative to each strand's length.
+
+Args:
+    strands: a Strands.
+    guides: share of the strands used as guides, a fraction in (0, 1] (the CLI's ``--guides``
+        takes a percentage).
+    select: "random" (a seeded shuffle) or "cluster" (k-means of the roots: guides spread
+        evenly).
+    seed: seed of the guide choice.
+    power: Shepard exponent p of the helicoid interpolation (the paper: 3).
+    neighbors: guides per new hair; None: every guide (helicoid), 4 (points).
+    max_error: the fits' accepted discrete Frechet distance, a fraction of the strand length.
+    threads: worker threads, 0 for all cores (results do not depend on it).
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    (helicoid, points, report): both reconstructions as Strands in input order, and a dict with
+    ``guides`` (the guide strands' indices), ``unfitted``, ``fit`` (mean, p95, pieces_per_strand,
+    seconds) and for ``helicoid`` and ``points``: ``relative`` (each strand's error), ``mean``,
+    ``p95``, ``mean_interpolated``, ``p95_interpolated``, ``seconds``.)doc");
 
     const RenderParams renderDefaults;
     m.def(

@@ -47,7 +47,8 @@ def test_render_returns_rgba_or_writes_a_file(tmp_path):
 
 def test_every_function_has_a_docstring_with_its_defaults():
     names = ["read", "write", "estimate_tangent_field", "retrace", "refine", "grow", "fit", "render", "inspect",
-             "read_grid", "read_grids", "write_grids", "suggest_voxel_size", "interpolate", "synth", "transfer", "comb"]
+             "read_grid", "read_grids", "write_grids", "suggest_voxel_size", "interpolate", "synth", "transfer", "comb",
+             "scalp", "roots", "reconstruct"]
     for name in names:
         doc = getattr(vdbhair, name).__doc__
         assert doc and len(doc) > 150, name

@@ -59,24 +59,33 @@ openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const 
     const ScalpSampler sampler(surf);
     const double h = sampler.voxelSize();
     const int r = int(std::ceil(radius / h));
+    // The roots that count: those with surface near them (projected within maxDistance). Counted
+    // first, so roots in other units or another place are reported as such, not as a cost.
+    std::vector<char> ok;
+    const std::vector<Vec3f> projected = projectOntoSurface(surface, roots, &ok);
+    std::size_t used = 0;
+    for (std::size_t k = 0; k < roots.size(); ++k) {
+        if (ok[k] && (Vec3d(projected[k]) - Vec3d(roots[k])).length() > maxDistance) ok[k] = 0;
+        used += ok[k] ? 1 : 0;
+    }
+    if (used == 0) {
+        throw LookupError(where + ": none of the " + std::to_string(roots.size()) + " roots is within " + formatNumber(maxDistance) +
+                          " of the surface; the region is empty (are the roots and the scalp in the same units and place?)");
+    }
     const std::uint64_t perRoot = std::uint64_t(2 * r + 1) * std::uint64_t(2 * r + 1) * std::uint64_t(2 * r + 1);
-    if (perRoot > maxVoxels / roots.size() + 1) {
-        throw LimitError(where + ": radius " + std::to_string(radius) + " over " + std::to_string(roots.size()) + " roots visits about " +
-                         std::to_string(perRoot * roots.size()) + " voxels, more than the cap of " + std::to_string(maxVoxels));
+    if (perRoot > maxVoxels / used + 1) {
+        throw LimitError(where + ": radius " + formatNumber(radius) + " (" + std::to_string(r) + " voxels) over " + std::to_string(used) +
+                         " roots visits about " + std::to_string(perRoot * used) + " voxels, more than the cap of " + std::to_string(maxVoxels) +
+                         " (is the radius in the scalp's units?)");
     }
     openvdb::BoolGrid::Ptr region = openvdb::BoolGrid::create(false);
     region->setTransform(surface.transform().copy());
     auto out = region->getAccessor();
     auto in = surface.getConstAccessor();
     const double band = double(surface.background());
-    std::size_t used = 0;
-    std::vector<char> ok;
-    const std::vector<Vec3f> projected = projectOntoSurface(surface, roots, &ok);
     for (std::size_t k = 0; k < roots.size(); ++k) {
-        const Vec3d p(projected[k]);
         if (!ok[k]) continue;  // no surface near this root
-        if ((p - Vec3d(roots[k])).length() > maxDistance) continue;
-        ++used;
+        const Vec3d p(projected[k]);
         const openvdb::Coord c = surface.transform().worldToIndexNodeCentered(p);
         for (int dx = -r; dx <= r; ++dx)
             for (int dy = -r; dy <= r; ++dy)
@@ -87,9 +96,9 @@ openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const 
                     out.setValueOn(q, true);
                 }
     }
-    if (used == 0 || region->activeVoxelCount() == 0) {
-        throw LookupError(where + ": none of the " + std::to_string(roots.size()) +
-                          " roots is within " + formatNumber(maxDistance) + " of the surface; the region is empty (are the roots and the scalp in the same units and place?)");
+    if (region->activeVoxelCount() == 0) {
+        throw LookupError(where + ": the " + std::to_string(used) + " roots near the surface cover no band voxel within " +
+                          formatNumber(radius) + " of their projections; the region is empty");
     }
     region->setName("region");
     region->setCreator("vdbhair " VDBHAIR_VERSION_STRING);

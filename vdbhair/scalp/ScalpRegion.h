@@ -32,6 +32,10 @@ openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const 
                                        std::uint64_t maxVoxels = std::uint64_t(1) << 28,
                                        double maxDistance = std::numeric_limits<double>::max());
 
+/// A float mask's default threshold (regionFromMask()): painted weights in [0, 1] cover where
+/// they are more than half.
+constexpr double kDefaultRegionThreshold = 0.5;
+
 /// @brief The region from a mask grid: the surface's band voxels whose centre the mask covers. A
 /// BoolGrid covers where it is true (active or not: the value is what counts; its background too);
 /// a FloatGrid where its trilinear value exceeds @a threshold (a painted weight, a fog volume). The
@@ -39,7 +43,7 @@ openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const 
 /// `vdbhair_region_kind` "mask", `vdbhair_region_threshold` and `vdbhair_source`.
 /// @throw TypeError (neither a BoolGrid nor a FloatGrid), ValueError (a non-finite threshold),
 /// LookupError (the mask covers no surface voxel: the region would be empty).
-openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const openvdb::GridBase& mask, double threshold = 0.5,
+openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const openvdb::GridBase& mask, double threshold = kDefaultRegionThreshold,
                                       const std::string& source = "");
 
 } // namespace vdbhair

@@ -233,12 +233,11 @@ openvdb::FloatGrid::Ptr scalpFromSphere(const Vec3d& center, double radius, cons
     return grid;
 }
 
-openvdb::FloatGrid::Ptr scalpFromPoints(const OrientedPoints& input, const ScalpParams& params, std::size_t maxConstraints,
-                                        bool threaded, openvdb::util::NullInterrupter* interrupter)
+openvdb::FloatGrid::Ptr scalpFromPoints(const OrientedPoints& input, const ScalpParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
     initializeOpenVdb();
     const std::string where = "scalpFromPoints(" + (params.source.empty() ? std::string("points") : params.source) + ")";
-    const std::size_t n = input.size();
+    const std::size_t n = input.size(), maxConstraints = params.maxConstraints;
     if (n < 5) throw ValueError(where + ": " + std::to_string(n) + " constraint points; the implicit needs at least 5 (4 fix its affine part)");
     if (input.normals.size() != n) throw ValueError(where + ": the points have no normals (nx ny nz); the implicit needs one per point to know inside from outside");
     if (maxConstraints < 5) throw ValueError(where + ": maxConstraints " + std::to_string(maxConstraints) + " must be at least 5");

@@ -31,6 +31,9 @@ struct ScalpParams
     /// Refuse a band estimated at more voxels than this: 2^27 float voxels are about 0.7 GB with
     /// the tree's overhead, which is more than any head needs (a 1/1000 voxel head is ~3e7).
     std::uint64_t maxVoxels = std::uint64_t(1) << 27;
+    /// Points: more constraint points than this are thinned to an evenly spread subset (the
+    /// dense solve is cubic in their number).
+    std::size_t maxConstraints = 2000;
     std::string source;  ///< stored as `vdbhair_source` (a file name, "sphere")
 };
 
@@ -86,12 +89,10 @@ openvdb::FloatGrid::Ptr scalpFromSphere(const Vec3d& center, double radius, cons
 /// narrow band. Voxels are evaluated by a front that starts at the constraint points and walks
 /// the band (so only band voxels and their neighbours are evaluated); a voxel's value is
 /// f / |grad f|, the first-order distance to the zero set, and the interior is sign-filled.
-/// @param maxConstraints points beyond this are thinned to an evenly spread subset (the dense
-/// solve is cubic in their number)
+/// Points beyond ScalpParams::maxConstraints are thinned by farthest-point sampling.
 /// @throw ValueError (fewer than 5 points, missing normals, coplanar points), LimitError,
 /// FormatError (the implicit has no zero crossing near the points).
-openvdb::FloatGrid::Ptr scalpFromPoints(const OrientedPoints& points, const ScalpParams& params,
-                                        std::size_t maxConstraints = 2000, bool threaded = true,
+openvdb::FloatGrid::Ptr scalpFromPoints(const OrientedPoints& points, const ScalpParams& params, bool threaded = true,
                                         openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// @brief Name the grid `surface`, class level set, and store `creator`, `vdbhair_source`,

@@ -1,0 +1,252 @@
+// scalp and roots: scalp level sets and follicles on them (`vdbhair scalp`, `vdbhair roots`).
+#include "Common.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/ScalpInput.h>
+#include <vdbhair/scalp/ScalpRegion.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <memory>
+#include <optional>
+
+namespace vdbhair::py {
+
+namespace {
+
+using StrandsPtr = std::shared_ptr<StrandSet>;
+
+std::vector<Vec3f> toFloat(const std::vector<Vec3d>& points)
+{
+    return std::vector<Vec3f>(points.begin(), points.end());
+}
+
+/// An (N, 3) float32 array copied from @a v.
+pyb::array_t<float> pointsArray(const std::vector<Vec3f>& v)
+{
+    pyb::array_t<float> a({v.size(), std::size_t(3)});
+    float* d = a.mutable_data();
+    for (std::size_t i = 0; i < v.size(); ++i)
+        for (int c = 0; c < 3; ++c) d[3 * i + c] = v[i][c];
+    return a;
+}
+
+/// Roots for a region: a Strands' roots or an (N, 3) array.
+std::vector<Vec3f> rootsArgument(const pyb::handle& obj, const std::string& what)
+{
+    if (pyb::isinstance<StrandSet>(obj)) {
+        const StrandSet& s = obj.cast<const StrandSet&>();
+        std::vector<Vec3f> roots;
+        for (std::size_t i = 0; i < s.numStrands(); ++i) roots.push_back(s.root(i));
+        return roots;
+    }
+    return toFloat(pointsArgument(obj, what));
+}
+
+/// A scalp= argument: a vdbhair.Grid holding a float level set, or a path (readScalp()).
+openvdb::FloatGrid::Ptr scalpGridArgument(const pyb::handle& obj, const std::string& where)
+{
+    if (pyb::isinstance<PyGrid>(obj)) {
+        const openvdb::GridBase::Ptr& g = obj.cast<const PyGrid&>().grid;
+        openvdb::FloatGrid::Ptr grid = std::dynamic_pointer_cast<openvdb::FloatGrid>(g);
+        if (!grid || grid->getGridClass() != openvdb::GRID_LEVEL_SET)
+            throw TypeError(where + ": grid '" + g->getName() + "' is not a float level set; vdbhair.scalp() makes one");
+        return grid;
+    }
+    throw TypeError(where + ": scalp must be a vdbhair.Grid (a level set) or a path to a scalp .vdb or a head mesh");
+}
+
+} // namespace
+
+void bindScalp(pyb::module_& m)
+{
+    const ScalpParams scalpDefaults;
+    m.def(
+        "scalp",
+        [](const pyb::object& source, const pyb::object& normals, std::optional<std::array<double, 4>> sphere, double voxelSize,
+           float halfWidth, std::uint64_t maxVoxels, std::size_t maxConstraints, const pyb::object& regionArg, double regionRadius,
+           const pyb::object& regionMask, double regionThreshold, int threads, const pyb::object& progress) {
+            const bool hasSource = !source.is_none();
+            if (hasSource == bool(sphere)) throw ValueError("scalp: give one of source (a path, a Strands or (N, 3) points) and sphere=(cx, cy, cz, r)");
+            if (sphere && (!((*sphere)[3] > 0.0) || !std::isfinite((*sphere)[3]))) throw ValueError("scalp: sphere=(cx, cy, cz, r) needs r > 0");
+            if (voxelSize < 0.0 || !std::isfinite(voxelSize)) throw ValueError("scalp: voxel_size=" + std::to_string(voxelSize) + ": must be a positive finite length (0: 1/100 of the input's size)");
+            if (regionRadius < 0.0 || !std::isfinite(regionRadius)) throw ValueError("scalp: region_radius=" + std::to_string(regionRadius) + ": must be a positive length (0: the default)");
+            if (!regionArg.is_none() && !regionMask.is_none()) throw ValueError("scalp: both region and region_mask: give one");
+            if (!normals.is_none() && (pyb::isinstance<pyb::str>(source) || pyb::isinstance<StrandSet>(source)))
+                throw ValueError("scalp: normals go with an (N, 3) array of points as the source");
+            ScalpParams sp;
+            sp.voxelSize = voxelSize;
+            sp.halfWidth = halfWidth;
+            sp.maxVoxels = maxVoxels;
+            sp.maxConstraints = maxConstraints;
+            // Arrays are read with the GIL held, before the work.
+            std::optional<std::string> path;
+            OrientedPoints points;
+            if (pyb::isinstance<pyb::str>(source)) {
+                path = source.cast<std::string>();
+            } else if (pyb::isinstance<StrandSet>(source)) {
+                points = orientedRoots(source.cast<const StrandSet&>());
+                sp.source = "roots of Strands";
+            } else if (hasSource) {
+                points.positions = toFloat(pointsArgument(source, "scalp: source"));
+                if (normals.is_none()) throw ValueError("scalp: points need normals=, an (N, 3) array of outward normals");
+                points.normals = toFloat(pointsArgument(normals, "scalp: normals"));
+                if (points.normals.size() != points.positions.size())
+                    throw ValueError("scalp: " + std::to_string(points.normals.size()) + " normals for " + std::to_string(points.positions.size()) + " points");
+                sp.source = "points";
+            }
+            std::vector<Vec3f> regionRoots;
+            if (!regionArg.is_none()) regionRoots = rootsArgument(regionArg, "scalp: region");
+            openvdb::GridBase::Ptr mask;
+            if (!regionMask.is_none()) {
+                if (!pyb::isinstance<PyGrid>(regionMask)) throw TypeError("scalp: region_mask must be a vdbhair.Grid (a bool or float grid)");
+                mask = regionMask.cast<const PyGrid&>().grid;
+            }
+            const bool wantRegion = !regionArg.is_none();
+            auto grids = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                openvdb::FloatGrid::Ptr surface;
+                if (sphere) surface = scalpFromSphere(Vec3d((*sphere)[0], (*sphere)[1], (*sphere)[2]), (*sphere)[3], sp);
+                else if (path) surface = scalpFromFile(*path, sp, nullptr, true, interrupter);
+                else surface = scalpFromPoints(points, sp, true, interrupter);
+                openvdb::BoolGrid::Ptr region;
+                if (wantRegion) {
+                    const double radius = regionRadius > 0.0 ? regionRadius : defaultRegionRadius(*surface, regionRoots);
+                    region = regionFromRoots(*surface, regionRoots, radius, "region", std::uint64_t(1) << 28, defaultRootDistance(*surface));
+                } else if (mask) {
+                    region = regionFromMask(*surface, *mask, regionThreshold, "region_mask");
+                }
+                return std::make_pair(surface, region);
+            });
+            return pyb::make_tuple(PyGrid{grids.first}, grids.second ? pyb::cast(PyGrid{grids.second}) : pyb::none());
+        },
+        pyb::arg("source") = pyb::none(), pyb::kw_only(), pyb::arg("normals") = pyb::none(), pyb::arg("sphere") = pyb::none(),
+        pyb::arg("voxel_size") = scalpDefaults.voxelSize, pyb::arg("half_width") = scalpDefaults.halfWidth,
+        pyb::arg("max_voxels") = scalpDefaults.maxVoxels, pyb::arg("max_constraints") = scalpDefaults.maxConstraints,
+        pyb::arg("region") = pyb::none(), pyb::arg("region_radius") = 0.0, pyb::arg("region_mask") = pyb::none(),
+        pyb::arg("region_threshold") = kDefaultRegionThreshold, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(A scalp as a VDB level set (Piuze et al. 2011, Sec. 4.3): ``vdbhair scalp``.
+
+Args:
+    source: a path (a head mesh .obj / .ply with faces: meshToLevelSet with open boundaries
+        capped; points .ply with nx ny nz, or a strand file whose roots are the points: Turk &
+        O'Brien's variational implicit), a Strands (its roots, first segments as normals), or an
+        (N, 3) array of points with ``normals``. None with ``sphere``.
+    normals: (N, 3) outward normals of an array source.
+    sphere: (cx, cy, cz, r) in world units, instead of a source.
+    voxel_size: world units; 0 is 1/100 of the input's largest extent.
+    half_width: narrow-band half width in voxels.
+    max_voxels: refuse voxel sizes whose band is estimated at more voxels (vdbhair.LimitError).
+    max_constraints: points are thinned to this many constraints (the solve is cubic).
+    region: a Strands or (N, 3) roots: the hair region is the band within ``region_radius`` of
+        their projections onto the surface (roots farther than a tenth of the head are left out).
+    region_radius: world units; 0 is twice the roots' mean nearest-neighbour spacing.
+    region_mask: a vdbhair.Grid painting the region instead: a bool grid's true values, or a
+        float grid's values above ``region_threshold``.
+    threads: worker threads, 0 for all cores.
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    (surface, region): the float level set named 'surface' (negative inside, world units) and
+    the bool grid 'region' or None. ``vdbhair.write_grids(path, [surface, region])`` writes what
+    ``vdbhair scalp`` writes.)doc");
+
+    const FollicleParams follicleDefaults;
+    m.def(
+        "roots",
+        [](const pyb::object& scalp, std::optional<std::size_t> count, std::optional<double> spacing, const pyb::object& regionArg,
+           std::uint64_t seed, int iterations, double stepScale, std::array<double, 3> up, int threads, const pyb::object& progress) {
+            if (bool(count) == bool(spacing)) throw ValueError("roots: give one of count= and spacing=");
+            if (iterations < 0) throw ValueError("roots: iterations=" + std::to_string(iterations) + ": must be at least 0");
+            FollicleParams fp;
+            if (count) fp.count = *count;
+            if (spacing) {
+                if (!(*spacing > 0.0) || !std::isfinite(*spacing)) throw ValueError("roots: spacing=" + std::to_string(*spacing) + ": must be a positive finite length");
+                fp.spacing = *spacing;
+            }
+            fp.seed = seed;
+            fp.maxIterations = iterations;
+            fp.stepScale = stepScale;
+            const Vec3d u(up[0], up[1], up[2]);
+            if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("roots: up must be a non-zero finite vector");
+            fp.up = u / u.length();
+            const bool fromPath = pyb::isinstance<pyb::str>(scalp);
+            const std::string path = fromPath ? scalp.cast<std::string>() : std::string();
+            openvdb::FloatGrid::Ptr surface = fromPath ? nullptr : scalpGridArgument(scalp, "roots");
+            openvdb::BoolGrid::Ptr region;
+            const bool noRegion = pyb::isinstance<pyb::bool_>(regionArg) && !regionArg.cast<bool>();
+            const bool regionFromFile = regionArg.is_none();
+            if (!regionArg.is_none() && !noRegion) {
+                if (!pyb::isinstance<PyGrid>(regionArg)) throw TypeError("roots: region must be a vdbhair.Grid (bool), False or None");
+                region = std::dynamic_pointer_cast<openvdb::BoolGrid>(regionArg.cast<const PyGrid&>().grid);
+                if (!region) throw TypeError("roots: region grid '" + regionArg.cast<const PyGrid&>().grid->getName() + "' is not a bool grid");
+            }
+            struct Out
+            {
+                Follicles f;
+                FollicleStats stats;
+                bool region;
+            };
+            const Out out = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                if (fromPath) {
+                    surface = readScalp(path, interrupter);
+                    if (regionFromFile) region = readScalpRegion(path);
+                }
+                Out o;
+                o.f = sampleFollicles(surface, region, fp, true, interrupter);
+                o.stats = measureFollicles(o.f.positions, surface);
+                o.region = bool(region);
+                return o;
+            });
+            pyb::dict d;
+            d["positions"] = pointsArray(out.f.positions);
+            d["normals"] = pointsArray(out.f.normals);
+            d["tangents"] = pointsArray(out.f.tangents);
+            d["region"] = out.region;
+            d["area"] = out.f.area;
+            d["target_spacing"] = out.f.targetSpacing;
+            d["iterations"] = out.f.iterations;
+            d["last_move"] = out.f.lastMove;
+            d["removed"] = out.f.removed;
+            pyb::dict sp;
+            sp["mean"] = out.stats.nnMean;
+            sp["cv"] = out.stats.nnCV;
+            sp["min"] = out.stats.nnMin;
+            sp["max"] = out.stats.nnMax;
+            d["spacing"] = sp;
+            d["max_surface_distance_voxels"] = out.stats.maxSurfaceDistanceVoxels;
+            return d;
+        },
+        pyb::arg("scalp"), pyb::kw_only(), pyb::arg("count") = pyb::none(), pyb::arg("spacing") = pyb::none(),
+        pyb::arg("region") = pyb::none(), pyb::arg("seed") = follicleDefaults.seed, pyb::arg("iterations") = follicleDefaults.maxIterations,
+        pyb::arg("step_scale") = follicleDefaults.stepScale,
+        pyb::arg("up") = std::array<double, 3>{follicleDefaults.up.x(), follicleDefaults.up.y(), follicleDefaults.up.z()},
+        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        R"doc(Follicles spread evenly over a scalp (Witkin & Heckbert 1994 repulsion on the zero level
+set, as Piuze et al. 2011 place roots): ``vdbhair roots``. Identical for any thread count.
+
+Args:
+    scalp: a vdbhair.Grid holding a level set (what scalp() returns), or a path to a scalp .vdb
+        (its 'surface' and 'region' grids) or to a head mesh.
+    count: the number of roots; or
+    spacing: the target mean nearest-neighbour spacing, world units.
+    region: a bool vdbhair.Grid (scalp()'s region); None: the file's 'region' grid when scalp
+        is a path, else the whole surface; False: the whole surface.
+    seed: random seed of the initial placement.
+    iterations: most relaxation iterations.
+    step_scale: relaxation step as a multiple of sigma^2 times the energy gradient.
+    up: reference axis of the tangents.
+    threads: worker threads, 0 for all cores.
+    progress: optional callable ``progress(stage, done, total, unit)``.
+
+Returns:
+    A dict: ``positions``, ``normals`` (outward), ``tangents``: (N, 3) float32 arrays (the
+    roots and their frames, ready for interpolate(guides, r["positions"], normals=r["normals"]));
+    ``region`` (whether one confined them), ``area``, ``target_spacing``, ``iterations``,
+    ``last_move``, ``removed``, ``spacing`` (nearest-neighbour mean, cv, min, max) and
+    ``max_surface_distance_voxels``.)doc");
+}
+
+} // namespace vdbhair::py
