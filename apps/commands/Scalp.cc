@@ -4,6 +4,8 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MeshFile.h>
+#include <vdbhair/io/PointFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/ScalpInput.h>
@@ -19,7 +21,7 @@ namespace {
 
 struct ScalpCmdParams
 {
-    std::string input, output, region, regionMask, regionGrid;
+    std::string input, output, region, regionMask, regionGrid, regionVertex;
     double regionThreshold = kDefaultRegionThreshold;
     ScalpParams scalp;  ///< the library's defaults (voxelSize 0: suggested from the input)
     CLI::Option* voxelOpt = nullptr;
@@ -40,7 +42,11 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
     if (!p.sphere.empty() && !p.input.empty()) throw ValueError("both an input (" + p.input + ") and --sphere: give one");
     if (p.regionRadius < 0.0 || !std::isfinite(p.regionRadius)) throw ValueError("--region-radius " + formatValue(p.regionRadius) + ": must be a positive length");
     if (p.regionRadius > 0.0 && p.region.empty()) throw ValueError("--region-radius without --region STRANDS");
-    if (!p.region.empty() && !p.regionMask.empty()) throw ValueError("both --region and --region-mask: give one");
+    if (int(!p.region.empty()) + int(!p.regionMask.empty()) + int(!p.regionVertex.empty()) > 1)
+        throw ValueError("more than one of --region, --region-mask and --region-vertex: give one");
+    if (!p.regionVertex.empty() && fileExtension(p.input) != ".ply")
+        throw ValueError("--region-vertex " + p.regionVertex + ": reads a vertex property of a PLY mesh, and the input " +
+                         (p.input.empty() ? std::string("is a sphere") : "'" + p.input + "' is not one"));
     if (!p.regionGrid.empty() && p.regionMask.empty()) throw ValueError("--region-grid without --region-mask MASK.vdb");
     if (!std::isfinite(p.regionThreshold)) throw ValueError("--region-threshold " + formatValue(p.regionThreshold) + ": must be finite");
 
@@ -79,6 +85,11 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         region = regionFromRoots(*surface, roots, radius, p.region, std::uint64_t(1) << 28, defaultRootDistance(*surface));
         grids.push_back(region);
         detail["region"] = {{"roots", roots.size()}, {"radius", radius}, {"active_voxels", region->activeVoxelCount()}};
+    } else if (!p.regionVertex.empty()) {
+        const Stage stage(common, "region from the vertex values '" + p.regionVertex + "' of " + p.input);
+        region = regionFromVertexValues(*surface, readTriangleMesh(p.input), readPlyVertexValues(p.input, p.regionVertex), p.regionThreshold, p.input);
+        grids.push_back(region);
+        detail["region"] = {{"vertex", p.regionVertex}, {"threshold", p.regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
     } else if (!p.regionMask.empty()) {
         // The mask: the grid named, else 'region', else the file's first bool or float grid that is not a level set.
         std::string name = p.regionGrid;
@@ -119,6 +130,9 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         if (region && !p.region.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels within " << formatValue(detail["region"]["radius"].get<double>())
                       << " of the roots of " << p.region << "\n";
+        if (region && !p.regionVertex.empty())
+            std::cout << "region: " << region->activeVoxelCount() << " voxels where the vertex value '" << p.regionVertex << "' exceeds "
+                      << formatValue(p.regionThreshold) << "\n";
         if (region && !p.regionMask.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels covered by the mask '" << detail["region"]["mask"].get<std::string>()
                       << "' of " << p.regionMask << "\n";
@@ -146,7 +160,9 @@ Command addScalpCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--region-radius", params->regionRadius, "Radius around each root, world units (default: twice the roots' mean spacing)");
     sub->add_option("--region-mask", params->regionMask, "A .vdb whose bool or float grid paints the region: surface voxels it covers (a bool grid's true values, a float grid's values above --region-threshold)");
     sub->add_option("--region-grid", params->regionGrid, "The mask's grid (default: 'region', else the file's first bool or float grid that is not a level set)");
-    sub->add_option("--region-threshold", params->regionThreshold, "A float mask covers where its value exceeds this")->capture_default_str();
+    sub->add_option("--region-vertex", params->regionVertex,
+                    "A PLY mesh input's vertex property paints the region: a colour channel (red, green, blue, alpha; uchar scaled to 0-1) or any named scalar, above --region-threshold");
+    sub->add_option("--region-threshold", params->regionThreshold, "A float mask or vertex value covers where it exceeds this")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Examples:\n  vdbhair scalp head.ply -o scalp.vdb --voxel-size 0.5 --region hair.hair\n"
                 "  vdbhair scalp --sphere 0,0,0,10 -o ball.vdb --voxel-size 0.2");

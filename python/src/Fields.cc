@@ -41,7 +41,7 @@ auto applyVoxelGrid(const openvdb::GridBase& grid, const std::string& where, OpT
     if (const auto* g = dynamic_cast<const openvdb::Vec3SGrid*>(&grid)) return op(*g);
     if (const auto* g = dynamic_cast<const openvdb::FloatGrid*>(&grid)) return op(*g);
     throw TypeError(where + ": grid '" + grid.getName() + "' holds " + grid.valueType() +
-                    " values; arrays are made of vec3s and float grids only");
+                    " values; value arrays are made of vec3s and float grids only (a bool grid has active_coords())");
 }
 
 /// Components per value of a grid type (3 for vectors, 0 for scalars: no last axis).
@@ -99,7 +99,7 @@ struct ActiveLayout
 
 pyb::array activeCoords(const openvdb::GridBase& grid)
 {
-    return applyVoxelGrid(grid, "active_coords", [](const auto& g) {
+    auto coords = [](const auto& g) {
         using GridT = std::decay_t<decltype(g)>;
         const ActiveLayout<GridT> layout(g);
         pyb::array_t<std::int32_t> out({pyb::ssize_t(layout.total), pyb::ssize_t(3)});
@@ -113,7 +113,10 @@ pyb::array activeCoords(const openvdb::GridBase& grid)
             });
         }
         return pyb::array(out);
-    });
+    };
+    // A bool grid (a scalp's region) is its active voxels: coordinates, not values.
+    if (const auto* g = dynamic_cast<const openvdb::BoolGrid*>(&grid)) return coords(*g);
+    return applyVoxelGrid(grid, "active_coords", coords);
 }
 
 pyb::array activeValues(const openvdb::GridBase& grid)

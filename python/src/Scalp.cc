@@ -2,6 +2,9 @@
 #include "Common.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MeshFile.h>
+#include <vdbhair/io/PointFile.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/scalp/ScalpRegion.h>
@@ -68,13 +71,17 @@ void bindScalp(pyb::module_& m)
         "scalp",
         [](const pyb::object& source, const pyb::object& normals, std::optional<std::array<double, 4>> sphere, double voxelSize,
            float halfWidth, std::uint64_t maxVoxels, std::size_t maxConstraints, const pyb::object& regionArg, double regionRadius,
-           const pyb::object& regionMask, double regionThreshold, int threads, const pyb::object& progress) {
+           const pyb::object& regionMask, std::optional<std::string> regionVertex, double regionThreshold, int threads,
+           const pyb::object& progress) {
             const bool hasSource = !source.is_none();
             if (hasSource == bool(sphere)) throw ValueError("scalp: give one of source (a path, a Strands or (N, 3) points) and sphere=(cx, cy, cz, r)");
             if (sphere && (!((*sphere)[3] > 0.0) || !std::isfinite((*sphere)[3]))) throw ValueError("scalp: sphere=(cx, cy, cz, r) needs r > 0");
             if (voxelSize < 0.0 || !std::isfinite(voxelSize)) throw ValueError("scalp: voxel_size=" + std::to_string(voxelSize) + ": must be a positive finite length (0: 1/100 of the input's size)");
             if (regionRadius < 0.0 || !std::isfinite(regionRadius)) throw ValueError("scalp: region_radius=" + std::to_string(regionRadius) + ": must be a positive length (0: the default)");
-            if (!regionArg.is_none() && !regionMask.is_none()) throw ValueError("scalp: both region and region_mask: give one");
+            if (int(!regionArg.is_none()) + int(!regionMask.is_none()) + int(bool(regionVertex)) > 1)
+                throw ValueError("scalp: more than one of region, region_mask and region_vertex: give one");
+            if (regionVertex && !(pyb::isinstance<pyb::str>(source) && fileExtension(source.cast<std::string>()) == ".ply"))
+                throw ValueError("scalp: region_vertex='" + *regionVertex + "' reads a vertex property of a PLY mesh; the source is not a .ply path");
             if (!normals.is_none() && (pyb::isinstance<pyb::str>(source) || pyb::isinstance<StrandSet>(source)))
                 throw ValueError("scalp: normals go with an (N, 3) array of points as the source");
             ScalpParams sp;
@@ -117,6 +124,8 @@ void bindScalp(pyb::module_& m)
                     region = regionFromRoots(*surface, regionRoots, radius, "region", std::uint64_t(1) << 28, defaultRootDistance(*surface));
                 } else if (mask) {
                     region = regionFromMask(*surface, *mask, regionThreshold, "region_mask");
+                } else if (regionVertex) {
+                    region = regionFromVertexValues(*surface, readTriangleMesh(*path), readPlyVertexValues(*path, *regionVertex), regionThreshold, *path);
                 }
                 return std::make_pair(surface, region);
             });
@@ -126,7 +135,7 @@ void bindScalp(pyb::module_& m)
         pyb::arg("voxel_size") = scalpDefaults.voxelSize, pyb::arg("half_width") = scalpDefaults.halfWidth,
         pyb::arg("max_voxels") = scalpDefaults.maxVoxels, pyb::arg("max_constraints") = scalpDefaults.maxConstraints,
         pyb::arg("region") = pyb::none(), pyb::arg("region_radius") = 0.0, pyb::arg("region_mask") = pyb::none(),
-        pyb::arg("region_threshold") = kDefaultRegionThreshold, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        pyb::arg("region_vertex") = pyb::none(), pyb::arg("region_threshold") = kDefaultRegionThreshold, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(A scalp as a VDB level set (Piuze et al. 2011, Sec. 4.3): ``vdbhair scalp``.
 
 Args:
@@ -145,6 +154,10 @@ Args:
     region_radius: world units; 0 is twice the roots' mean nearest-neighbour spacing.
     region_mask: a vdbhair.Grid painting the region instead: a bool grid's true values, or a
         float grid's values above ``region_threshold``.
+    region_vertex: the name of a vertex property of a PLY mesh source that paints the region: a
+        colour channel ("red", "green", "blue", "alpha"; uchar scaled to 0-1) or any named scalar,
+        above ``region_threshold`` (each band voxel takes the inverse-distance average of its 4
+        nearest vertices' values).
     threads: worker threads, 0 for all cores.
     progress: optional callable ``progress(stage, done, total, unit)``.
 

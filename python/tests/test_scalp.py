@@ -148,3 +148,24 @@ def test_reconstruct_straight_hair():
         vdbhair.reconstruct(hair, select="grid")
     with pytest.raises(ValueError, match="max_error="):
         vdbhair.reconstruct(hair, max_error=0.0)
+
+
+def test_scalp_region_painted_on_vertices(tmp_path):
+    # An octahedron of radius 10, its top vertex painted red: the region is around the top, as the command makes it.
+    ply = tmp_path / "painted.ply"
+    ply.write_text("ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\n"
+                   "property uchar red\nelement face 8\nproperty list uchar int vertex_indices\nend_header\n"
+                   "10 0 0 0\n-10 0 0 0\n0 10 0 255\n0 -10 0 0\n0 0 10 0\n0 0 -10 0\n"
+                   "3 0 2 4\n3 4 2 1\n3 1 2 5\n3 5 2 0\n3 0 4 3\n3 4 1 3\n3 1 5 3\n3 5 0 3\n")
+    surface, region = vdbhair.scalp(str(ply), voxel_size=0.5, region_vertex="red")
+    assert region.metadata["vdbhair_region_kind"] == "vertex"
+    y = region.active_coords()[:, 1] * region.voxel_size
+    assert y.min() > 0.0 and y.max() > 9.0  # the upper half's painted apex, none of the lower half
+    cli = cli_or_skip()
+    subprocess.run([str(cli), "scalp", str(ply), "--voxel-size", "0.5", "--region-vertex", "red", "-o", str(tmp_path / "p.vdb"), "-q"],
+                   check=True)
+    assert np.array_equal(region.active_coords(), vdbhair.read_grid(str(tmp_path / "p.vdb"), "region").active_coords())
+    with pytest.raises(ValueError, match="no scalar property 'hair'"):
+        vdbhair.scalp(str(ply), region_vertex="hair")
+    with pytest.raises(ValueError, match="the source is not a .ply path"):
+        vdbhair.scalp(sphere=(0.0, 0.0, 0.0, 1.0), region_vertex="red")

@@ -19,6 +19,8 @@ cp "$src/scenes/figures/fig2_waviness.json" existing.json
 "$bin" convert k_vectors.hair k_vectors30.hair --resample 30 --quiet
 # A head for render --head: a tetrahedron around the fixture hairstyle's roots.
 printf 'v -40 0 -40\nv 40 0 -40\nv 0 0 40\nv 0 80 0\nf 1 2 3\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' > head.obj
+# An octahedron of radius 10 with its top vertex painted (red 255, the others 0): scalp --region-vertex.
+printf 'ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nelement face 8\nproperty list uchar int vertex_indices\nend_header\n10 0 0 0\n-10 0 0 0\n0 10 0 255\n0 -10 0 0\n0 0 10 0\n0 0 -10 0\n3 0 2 4\n3 4 2 1\n3 1 2 5\n3 5 2 0\n3 0 4 3\n3 4 1 3\n3 1 5 3\n3 5 0 3\n' > painted_octahedron.ply
 # Bad inputs, one rule each.
 { printf 'HAIX'; head -c 124 /dev/zero; } > bad_magic.hair
 head -c 200 good.hair > truncated.hair

@@ -5,6 +5,7 @@
 #include <vdbhair/io/PointFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/render/SphereMesh.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/RootGrid.h>
 #include <vdbhair/scalp/ScalpRegion.h>
@@ -14,6 +15,7 @@
 #include <openvdb/points/PointCount.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 
@@ -88,6 +90,12 @@ TEST_CASE("sampleFollicles: a cap region holds every root", "[scalp]")
     }
     CHECK(farthest <= capRadius + 0.5 * std::sqrt(3.0) * h);
     CHECK(st.nnMean == Approx(fp.spacing).epsilon(0.1));
+    CHECK(st.nnCV < 0.1);
+    // The free roots reach the rim by themselves (the region's hard edge lines them up).
+    double outermost = 0.0;
+    for (const Vec3f& p : f.positions) outermost = std::max(outermost, (Vec3d(p) - pole).length());
+    std::cout << "cap: outermost root " << outermost << " (rim " << capRadius << ")\n";
+    CHECK(outermost > capRadius - 0.5 * f.targetSpacing);
 }
 
 TEST_CASE("regionFromMask: a painted cap, as a float weight and as a bool mask on another transform", "[scalp]")
@@ -135,6 +143,48 @@ TEST_CASE("regionFromMask: a painted cap, as a float weight and as a bool mask o
     CHECK_THROWS_AS(regionFromMask(*g, *weight, 2.0), LookupError);  // a weight that never exceeds 2: empty
     CHECK_THROWS_AS(regionFromMask(*g, *openvdb::Vec3SGrid::create()), TypeError);
     CHECK_THROWS_AS(regionFromMask(*g, *weight, std::nan("")), ValueError);
+}
+
+TEST_CASE("regionFromVertexValues: a cap painted on a mesh's vertices, read from PLY colour and a named property", "[scalp]")
+{
+    // A sphere mesh whose vertices above y = 0.5 are painted: red 255 (uchar, scaled to 1) and
+    // hair 2.0 (a float, as stored); the others red 0, hair 0.
+    const TriangleMesh mesh = makeSphereMesh(Vec3d(0.0), 1.0, 48, 96);
+    std::string ply = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(mesh.vertices.size()) +
+                      "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty float hair\nelement face " +
+                      std::to_string(mesh.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const Vec3f& v : mesh.vertices) {
+        const bool painted = v.y() > 0.5f;
+        ply += std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z()) + (painted ? " 255 2.0\n" : " 0 0.0\n");
+    }
+    for (const auto& t : mesh.triangles) ply += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+    const std::string path = test::writeBytes("painted_sphere.ply", ply);
+    const std::vector<float> red = readPlyVertexValues(path, "red"), hair = readPlyVertexValues(path, "hair");
+    REQUIRE(red.size() == mesh.vertices.size());
+    CHECK(*std::max_element(red.begin(), red.end()) == 1.0f);  // uchar colour scaled to [0, 1]
+    CHECK(*std::max_element(hair.begin(), hair.end()) == 2.0f);  // other properties as stored
+    CHECK_THROWS_WITH(readPlyVertexValues(path, "green"), Contains("no scalar property 'green' (it has x, y, z, red, hair)"));
+
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.05);
+    const TriangleMesh back = readTriangleMesh(path);
+    for (const auto& [values, threshold] : {std::make_pair(red, 0.5), std::make_pair(hair, 1.0)}) {
+        const openvdb::BoolGrid::Ptr region = regionFromVertexValues(*g, back, values, threshold, path);
+        CHECK(region->getName() == "region");
+        CHECK(region->metaValue<std::string>("vdbhair_region_kind") == "vertex");
+        double lowest = 1e9, highestOutside = -1e9;
+        for (auto it = region->cbeginValueOn(); it; ++it) lowest = std::min(lowest, g->indexToWorld(it.getCoord()).y());
+        for (auto it = g->cbeginValueOn(); it; ++it)
+            if (std::abs(*it) < g->background() && !region->tree().isValueOn(it.getCoord()))
+                highestOutside = std::max(highestOutside, g->indexToWorld(it.getCoord()).y());
+        // The rim lies between painted and unpainted vertices: within a ring of the mesh (1/48 of
+        // the circumference, 0.065 in y near y = 0.5) and the band's half width.
+        INFO("region voxels " << region->activeVoxelCount() << ", lowest " << lowest << ", highest outside " << highestOutside);
+        CHECK(lowest > 0.5 - 0.2);
+        CHECK(highestOutside < 0.5 + 0.2);
+        CHECK(region->activeVoxelCount() > 100);
+    }
+    CHECK_THROWS_AS(regionFromVertexValues(*g, back, hair, 5.0), LookupError);  // nothing exceeds 5
+    CHECK_THROWS_WITH(regionFromVertexValues(*g, back, std::vector<float>(3, 1.f)), Contains("3 values for"));
 }
 
 TEST_CASE("sampleFollicles: the same roots with 1 and 2 threads, bit for bit", "[scalp]")

@@ -564,6 +564,39 @@ OrientedPoints readPlyPoints(const std::string& path)
     return pts;
 }
 
+std::vector<float> readPlyVertexValues(const std::string& path, const std::string& property)
+{
+    const std::string where = "readPlyVertexValues(" + path + ")";
+    const MappedFile file(path, where);
+    const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
+    const Element* vertexEl = nullptr;
+    for (const Element& e : hdr.elements) {
+        if (e.name == "vertex") vertexEl = &e;
+    }
+    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    const int ip = findProperty(vertexEl, property.c_str());
+    if (ip < 0) {
+        std::string names;
+        for (const Property& p : vertexEl->props) names += (names.empty() ? "" : ", ") + p.name;
+        throw FormatError(where + ": the 'vertex' element has no scalar property '" + property + "' (it has " + names + ")");
+    }
+    const bool colour = property == "red" || property == "green" || property == "blue" || property == "alpha";
+    const double scale = colour && vertexEl->props[std::size_t(ip)].type == PlyType::UInt8 ? 1.0 / 255.0 : 1.0;
+    std::vector<float> values;
+    readPlyBody(file.data(), file.size(), hdr, where, nullptr, -1, nullptr, [&](const Element& e) {
+        if (&e == vertexEl) values.reserve(e.count);
+    }, [&](const Element& e, std::uint64_t, const std::vector<double>& v, const std::vector<double>&, ValueSource& src) {
+        if (&e != vertexEl) return;
+        const double x = v[std::size_t(ip)] * scale;
+        if (!std::isfinite(x) || std::abs(x) > double(std::numeric_limits<float>::max())) {
+            throw FormatError(where + ": " + src.location() + ": vertex " + std::to_string(values.size()) + " has " + property + " " +
+                              std::to_string(x) + "; values must be finite floats");
+        }
+        values.push_back(float(x));
+    });
+    return values;
+}
+
 std::uint64_t plyElementCount(const std::string& path, const std::string& element)
 {
     const std::string where = "readPly(" + path + ")";

@@ -32,6 +32,14 @@ OrientedPoints readPlyPoints(const std::string& path);
 /// @throw IoError, FormatError.
 std::uint64_t plyElementCount(const std::string& path, const std::string& element);
 
+/// @brief One scalar property of the `vertex` element of a PLY file, one value per vertex: a
+/// painted mask such as a vertex colour channel (`red`, `green`, `blue`, `alpha`) or any named
+/// property (`quality`, `hair`, ...). Integer colour channels of type uchar are scaled to [0, 1]
+/// (value / 255, the PLY colour convention); every other property is returned as stored.
+/// @throw IoError, FormatError (no vertex element, no such scalar property: the message lists the
+/// vertex element's properties; a non-finite value), UnsupportedError (big-endian).
+std::vector<float> readPlyVertexValues(const std::string& path, const std::string& property);
+
 /// @brief Write binary little-endian PLY with x y z, and nx ny nz / tx ty tz when present,
 /// atomically (FileUtil.h).
 /// @throw ValueError (normals or tangents of the wrong size), IoError.

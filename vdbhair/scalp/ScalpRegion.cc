@@ -148,4 +148,45 @@ openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const o
     return region;
 }
 
+openvdb::BoolGrid::Ptr regionFromVertexValues(const openvdb::FloatGrid& surface, const TriangleMesh& mesh, const std::vector<float>& values,
+                                              double threshold, const std::string& source)
+{
+    const std::string where = "regionFromVertexValues(" + (source.empty() ? std::string("mesh") : source) + ")";
+    if (values.size() != mesh.vertices.size())
+        throw ValueError(where + ": " + std::to_string(values.size()) + " values for " + std::to_string(mesh.vertices.size()) + " vertices; give one per vertex");
+    if (!std::isfinite(threshold)) throw ValueError(where + ": threshold " + std::to_string(threshold) + " must be finite");
+    if (mesh.vertices.empty()) throw ValueError(where + ": the mesh has no vertices");
+    const std::vector<Vec3d> verts(mesh.vertices.begin(), mesh.vertices.end());
+    const PointCloud cloud{&verts};
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    const std::size_t k = std::min<std::size_t>(4, verts.size());
+    openvdb::BoolGrid::Ptr region = openvdb::BoolGrid::create(false);
+    region->setTransform(surface.transform().copy());
+    auto out = region->getAccessor();
+    const double band = double(surface.background());
+    for (auto it = surface.cbeginValueOn(); it; ++it) {
+        if (!it.isVoxelValue() || !(std::abs(double(*it)) < band)) continue;
+        const Vec3d w = surface.transform().indexToWorld(it.getCoord());
+        std::uint32_t idx[4];
+        double d2[4];
+        const std::size_t found = tree.knnSearch(w.asPointer(), k, idx, d2);
+        double sum = 0.0, weight = 0.0;
+        for (std::size_t j = 0; j < found; ++j) {
+            if (d2[j] == 0.0) { sum = values[idx[j]]; weight = 1.0; break; }
+            const double wj = 1.0 / std::sqrt(d2[j]);
+            sum += wj * double(values[idx[j]]);
+            weight += wj;
+        }
+        if (weight > 0.0 && sum / weight > threshold) out.setValueOn(it.getCoord(), true);
+    }
+    if (region->activeVoxelCount() == 0)
+        throw LookupError(where + ": no vertex value near the surface exceeds the threshold " + formatNumber(threshold) + "; the region would be empty");
+    region->setName("region");
+    region->setCreator("vdbhair " VDBHAIR_VERSION_STRING);
+    region->insertMeta("vdbhair_region_kind", openvdb::StringMetadata("vertex"));
+    region->insertMeta("vdbhair_region_threshold", openvdb::DoubleMetadata(threshold));
+    if (!source.empty()) region->insertMeta("vdbhair_source", openvdb::StringMetadata(source));
+    return region;
+}
+
 } // namespace vdbhair

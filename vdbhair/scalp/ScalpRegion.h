@@ -4,6 +4,7 @@
 #pragma once
 
 #include <vdbhair/Types.h>
+#include <vdbhair/io/MeshFile.h>
 
 #include <openvdb/openvdb.h>
 
@@ -45,5 +46,18 @@ constexpr double kDefaultRegionThreshold = 0.5;
 /// LookupError (the mask covers no surface voxel: the region would be empty).
 openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const openvdb::GridBase& mask, double threshold = kDefaultRegionThreshold,
                                       const std::string& source = "");
+
+/// @brief The region painted on a mesh: a value per vertex (a vertex colour channel or a named
+/// property, readPlyVertexValues()), thresholded. Each band voxel of @a surface takes the
+/// inverse-distance average (weights 1/d, an exact hit its vertex's value) of the values at the 4
+/// mesh vertices nearest its centre, and is in the region where that exceeds @a threshold; the
+/// region's rim thus lies between painted and unpainted vertices, at the mesh's resolution. Named
+/// `region`, with `creator`, `vdbhair_region_kind` "vertex", `vdbhair_region_threshold` and
+/// `vdbhair_source`.
+/// @param values #V, one per vertex of @a mesh
+/// @throw ValueError (a value count that is not the vertex count, a non-finite threshold),
+/// LookupError (no voxel's value exceeds the threshold: the region would be empty).
+openvdb::BoolGrid::Ptr regionFromVertexValues(const openvdb::FloatGrid& surface, const TriangleMesh& mesh, const std::vector<float>& values,
+                                              double threshold = kDefaultRegionThreshold, const std::string& source = "");
 
 } // namespace vdbhair
