@@ -16,6 +16,8 @@ work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 # shellcheck disable=SC2206
 files=($glob)
 [ -f "${files[0]}" ] || { echo "bench_batch.sh: no file matches $glob" >&2; exit 1; }
+# Normalized paths (no "..") as batch records them: the field's vdbhair_source metadata names the input.
+mapfile -t files < <(realpath -s "${files[@]}")
 n=${#files[@]}
 printf '%s\n' "${files[@]}" > "$work/list.txt"
 args_json=$(printf '"%s",' $field_args); args_json="[${args_json%,}]"
