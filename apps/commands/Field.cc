@@ -179,7 +179,8 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_option("--dense", params->dense,
                     "Also write the orientation volume as NumPy .npy: float32 (D, H, W, 4), [k][j][i] = sample (i, j, k) along (x, y, z), "
-                    "channels tx, ty, tz (unit, root to tip; 0 outside the hair) and occupancy (the active voxels' mask, trilinear, in [0,1])");
+                    "channels tx, ty, tz (unit, root to tip; 0 outside the hair) and occupancy (the active voxels' mask, trilinear, in [0,1]); "
+                    "from level 0 (the finest); world space only");
     sub->add_option("--dense-box", params->denseBox, "The world box of --dense: X0,Y0,Z0,X1,Y1,Z1; samples at the centres of its D x H x W cells")
         ->delimiter(',')->expected(6);
     sub->add_option("--dense-size", params->denseSize, "Samples of --dense: D,H,W (along z, y, x; NeuralHDHair's 96,128,128 by default)")
