@@ -203,6 +203,7 @@ int run(int argc, char** argv)
     commands.push_back(addInspectCommand(app, common));
     commands.push_back(addRenderCommand(app, common));
     commands.push_back(addDemoCommand(app, common));
+    commands.push_back(addBatchCommand(app, common));
 
     std::vector<std::string> verbs;
     for (const Command& c : commands) verbs.push_back(c.sub->get_name());

@@ -60,6 +60,17 @@ int terminalColumns()
     return 80;
 }
 
+/// SIGINT and SIGTERM set sSignal, with sigaction's @a flags.
+void setHandlers(int flags)
+{
+    struct sigaction sa{};
+    sa.sa_handler = onInterrupt;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = flags;
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
 constexpr double kShowAfter = 0.25;   ///< seconds a stage runs before its line appears
 constexpr double kRedrawEvery = 0.1;  ///< seconds between redraws
 
@@ -67,32 +78,40 @@ constexpr double kRedrawEvery = 0.1;  ///< seconds between redraws
 
 void installInterruptHandlers()
 {
-    struct sigaction sa{};
-    sa.sa_handler = onInterrupt;
-    sigemptyset(&sa.sa_mask);
     // One-shot (a second Ctrl-C terminates at once); system calls restart rather than fail
     // with EINTR (a read in progress would otherwise report an I/O error, not the interruption).
-    sa.sa_flags = SA_RESETHAND | SA_RESTART;
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
+    setHandlers(SA_RESETHAND | SA_RESTART);
     setCommitInterruptCheck(commitRefused);
     if (const char* n = std::getenv("VDBHAIR_TEST_INTERRUPT_AFTER"); n && *n) sInterruptAfter = std::strtoull(n, nullptr, 10);
 }
 
 bool interruptRequested() { return sSignal != 0; }
 
+int interruptSignal() { return int(sSignal); }
+
+void interruptBlockingCalls() { setHandlers(SA_RESETHAND); }  // still one-shot; no SA_RESTART
+
 TerminalProgress::TerminalProgress(std::string verb, bool quiet)
     : mVerb(std::move(verb)), mDraw(!quiet && ::isatty(STDERR_FILENO) == 1)
 {
     // A ticker redraws the line, so it moves (and the time counts) even while the library is
     // in a step that reports rarely or not at all (reading a file).
-    if (mDraw) mTicker = std::thread([this] {
+    // The ticker blocks SIGINT and SIGTERM, so that they reach the main thread and end its
+    // blocking calls (batch's wait for its children).
+    if (!mDraw) return;
+    sigset_t block, old;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &block, &old);
+    mTicker = std::thread([this] {
         std::unique_lock<std::mutex> lock(mMutex);
         while (!mQuit) {
             mWake.wait_for(lock, std::chrono::duration<double>(kRedrawEvery));
             if (!mQuit && mActive) draw();
         }
     });
+    pthread_sigmask(SIG_SETMASK, &old, nullptr);
 }
 
 TerminalProgress::~TerminalProgress()

@@ -34,6 +34,14 @@ void installInterruptHandlers();
 /// @brief Whether Ctrl-C (or SIGTERM) has arrived.
 bool interruptRequested();
 
+/// @brief The signal that interrupted the command (SIGINT or SIGTERM), or 0.
+int interruptSignal();
+
+/// @brief Let Ctrl-C and SIGTERM end a blocking system call with EINTR instead of restarting it
+/// (`batch` waits for its children in wait4() and must wake to pass the signal on). Call after
+/// installInterruptHandlers().
+void interruptBlockingCalls();
+
 class TerminalProgress : public WorkInterrupter
 {
 public:

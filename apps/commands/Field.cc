@@ -2,10 +2,12 @@
 #include "../Command.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/DenseArray.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/NpyFile.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrandGrid.h>
 
@@ -31,7 +33,31 @@ struct FieldCmdParams
     ScalpOptions scalp;
     double densityReference = 0.0;
     std::string vectorName = "tangent";
+    std::string dense;                       ///< --dense OUT.npy: the orientation volume
+    std::vector<double> denseBox;            ///< x0,y0,z0,x1,y1,z1 (world units)
+    std::vector<int> denseSize{96, 128, 128};  ///< D,H,W: samples along z, y, x
 };
+
+/// --dense-box and --dense-size as a DenseBox (DenseArray.h), checked.
+DenseBox denseBoxOption(const FieldCmdParams& p)
+{
+    if (p.denseBox.size() != 6) throw ValueError("--dense needs --dense-box X0,Y0,Z0,X1,Y1,Z1 (world units): one box for every hairstyle of a dataset");
+    DenseBox box;
+    box.worldMin = openvdb::Vec3d(p.denseBox[0], p.denseBox[1], p.denseBox[2]);
+    box.worldMax = openvdb::Vec3d(p.denseBox[3], p.denseBox[4], p.denseBox[5]);
+    for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(box.worldMin[a]) || !std::isfinite(box.worldMax[a]) || !(box.worldMax[a] > box.worldMin[a])) {
+            throw ValueError("--dense-box " + formatValue(box.worldMin[a]) + ".." + formatValue(box.worldMax[a]) + " along " + "xyz"[a] +
+                             ": each max must be above its min (X0,Y0,Z0,X1,Y1,Z1)");
+        }
+    }
+    if (p.denseSize.size() != 3 || *std::min_element(p.denseSize.begin(), p.denseSize.end()) < 1 ||
+        double(p.denseSize[0]) * p.denseSize[1] * p.denseSize[2] > double(1 << 28)) {
+        throw ValueError("--dense-size: must be D,H,W (samples along z, y, x), each at least 1, at most 2^28 samples in all");
+    }
+    box.size = openvdb::Coord(p.denseSize[2], p.denseSize[1], p.denseSize[0]);
+    return box;
+}
 
 int runField(const FieldCmdParams& p, const CommonOptions& common)
 {
@@ -52,6 +78,10 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         std::isdigit(static_cast<unsigned char>(p.vectorName[0]))) {
         throw ValueError("--vector-name '" + p.vectorName + "': must be a valid attribute name (letters, digits, _; not starting with a digit)");
     }
+    if (!p.dense.empty() && fileExtension(p.dense) != ".npy") throw ValueError("--dense " + p.dense + ": the orientation volume is written as NumPy; it must end in .npy");
+    if (!p.dense.empty() && p.scalp.space != "world") throw ValueError("--dense with --space " + p.scalp.space + ": the dense box is in world space; use --space world");
+    if (p.dense.empty() && !p.denseBox.empty()) throw ValueError("--dense-box without --dense: name the .npy to write (--dense OUT.npy)");
+    const DenseBox denseBox = p.dense.empty() ? DenseBox{} : denseBoxOption(p);
     if (p.helicoid && p.vectorName != "tangent") throw ValueError("--helicoid with --vector-name " + p.vectorName + ": retrace --helicoid reads the vector grid 'tangent'");
 
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
@@ -89,15 +119,27 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         }
     }
     if (p.withStrands) grids.push_back(createStrandGrid(strands));
+    std::vector<float> volume;
+    if (!p.dense.empty()) {
+        const Stage stage(common, "resampling the orientation volume");
+        volume = orientationVolume(*fields[0].tangent, denseBox);
+    }
     {
         const Stage stage(common, "writing " + p.output);
         writeVdbGrids(p.output, grids, "field(" + p.output + ")");
+        if (!p.dense.empty()) writeNpy(p.dense, {std::size_t(p.denseSize[0]), std::size_t(p.denseSize[1]), std::size_t(p.denseSize[2]), 4}, volume.data());
     }
 
     if (common.json) {
         nlohmann::json j = {{"output", p.output}, {"strands", strands.numStrands()}, {"voxel_size", fp.voxelSize},
                             {"iterations", fp.iterations}, {"levels", p.levels}, {"space", fieldSpaceName(fp.space)},
                             {"grids", gridsJson}, {"seconds", seconds}};
+        if (!p.dense.empty()) {
+            std::size_t occupied = 0;
+            for (std::size_t i = 3; i < volume.size(); i += 4) occupied += volume[i] > 0.0f;
+            j["dense"] = {{"output", p.dense}, {"shape", {p.denseSize[0], p.denseSize[1], p.denseSize[2], 4}}, {"occupied", occupied},
+                          {"box", p.denseBox}};
+        }
         if (fp.space == FieldSpace::Scalp) {
             j["scalp"] = {{"center", {fp.scalp.center.x(), fp.scalp.center.y(), fp.scalp.center.z()}}, {"radius", fp.scalp.radius}};
         }
@@ -110,6 +152,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
                       << " active voxels of size " << g["voxel_size"].get<double>() << "\n";
         }
         std::cout << "wrote " << p.output << "\n";
+        if (!p.dense.empty()) std::cout << "wrote " << p.dense << ": orientation volume " << p.denseSize[0] << " x " << p.denseSize[1] << " x " << p.denseSize[2] << " x 4\n";
     }
     return 0;
 }
@@ -134,9 +177,18 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--helicoid", params->helicoid, "Also fit a helicoid per voxel: grids helicoid_k, helicoid_alpha, frame_T, frame_N");
     sub->add_flag("--with-strands", params->withStrands, "Also write the strands as the points grid 'strands'");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    sub->add_option("--dense", params->dense,
+                    "Also write the orientation volume as NumPy .npy: float32 (D, H, W, 4), [k][j][i] = sample (i, j, k) along (x, y, z), "
+                    "channels tx, ty, tz (unit, root to tip; 0 outside the hair) and occupancy (the active voxels' mask, trilinear, in [0,1]); "
+                    "from level 0 (the finest); world space only");
+    sub->add_option("--dense-box", params->denseBox, "The world box of --dense: X0,Y0,Z0,X1,Y1,Z1; samples at the centres of its D x H x W cells")
+        ->delimiter(',')->expected(6);
+    sub->add_option("--dense-size", params->denseSize, "Samples of --dense: D,H,W (along z, y, x; NeuralHDHair's 96,128,128 by default)")
+        ->delimiter(',')->expected(3);
     addScalpOptions(sub, params->scalp);
     addCommonOptions(sub, common);
-    sub->footer("Example: vdbhair field hair.hair -o field.vdb --voxel-size 0.5 --levels 3");
+    sub->footer("Example: vdbhair field hair.hair -o field.vdb --voxel-size 0.5 --levels 3\n"
+                "Orientation volume: vdbhair field hair.data -o f.vdb --dense f.npy --dense-box -0.32,-0.32,-0.24,0.32,0.32,0.24");
     return {sub, [params, &common] { return runField(*params, common); }};
 }
 

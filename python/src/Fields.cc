@@ -3,6 +3,7 @@
 #include "Common.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/DenseArray.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/ScalpSpace.h>
 #include <vdbhair/field/StreamlineTracer.h>
@@ -10,7 +11,6 @@
 #include <vdbhair/io/VdbFile.h>
 
 #include <openvdb/openvdb.h>
-#include <openvdb/tools/Dense.h>
 
 #include <pybind11/stl.h>
 
@@ -166,21 +166,38 @@ pyb::array toDense(const openvdb::GridBase& grid, const std::optional<IndexBox>&
     const openvdb::CoordBBox box(openvdb::Coord(b[0][0], b[0][1], b[0][2]), openvdb::Coord(b[1][0], b[1][1], b[1][2]));
     return applyVoxelGrid(grid, where, [&](const auto& g) {
         using GridT = std::decay_t<decltype(g)>;
-        using ValueT = typename GridT::ValueType;
         constexpr std::size_t kC = componentsOf<GridT>();
         const auto dim = box.dim();  // x, y, z
         std::vector<pyb::ssize_t> shape{pyb::ssize_t(dim.z()), pyb::ssize_t(dim.y()), pyb::ssize_t(dim.x())};
         if (kC) shape.push_back(pyb::ssize_t(kC));
         pyb::array_t<float> out(shape);
-        ValueT* data = reinterpret_cast<ValueT*>(out.mutable_data());
+        float* data = out.mutable_data();
         {
             pyb::gil_scoped_release release;
-            // LayoutXYZ: x varies fastest, so the array is [z][y][x] (D x H x W).
-            openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(box, data);
-            openvdb::tools::copyToDense(g, dense, /*serial=*/false);
+            copyToDenseArray(g, box, data);  // x varies fastest: the array is [z][y][x] (D x H x W)
         }
         return pyb::array(out);
     });
+}
+
+using WorldBox = std::array<std::array<double, 3>, 2>;
+
+pyb::array orientationVolumeArray(const openvdb::GridBase& grid, const WorldBox& box, const std::array<int, 3>& shape)
+{
+    const auto* tangent = dynamic_cast<const openvdb::Vec3SGrid*>(&grid);
+    if (!tangent) throw TypeError("orientation_volume: grid '" + grid.getName() + "' holds " + grid.valueType() + " values; it needs a vec3s tangent grid");
+    DenseBox dense;
+    dense.worldMin = openvdb::Vec3d(box[0][0], box[0][1], box[0][2]);
+    dense.worldMax = openvdb::Vec3d(box[1][0], box[1][1], box[1][2]);
+    dense.size = openvdb::Coord(shape[2], shape[1], shape[0]);
+    std::vector<float> volume;
+    {
+        pyb::gil_scoped_release release;
+        volume = orientationVolume(*tangent, dense);
+    }
+    pyb::array_t<float> out({pyb::ssize_t(shape[0]), pyb::ssize_t(shape[1]), pyb::ssize_t(shape[2]), pyb::ssize_t(4)});
+    std::copy(volume.begin(), volume.end(), out.mutable_data());
+    return pyb::array(out);
 }
 
 /// Rows of @a points (N x 3) mapped by @a f(Vec3d) -> Vec3d, as float64.
@@ -304,6 +321,18 @@ void addArrayMethods(ClassT& cls, GetT get, const char* subject)
          "W = i1-i0+1 (x): ``dense[k - k0, j - j0, i - i0]`` is the value at index (i, j, k), x varying fastest, the "
          "layout learning code expects (e.g. NeuralHDHair's 96 x 128 x 128 x 3 orientation volume). Inactive voxels "
          "hold the grid's background (zero for vdbhair's grids).")
+            .c_str());
+    cls.def(
+        "orientation_volume",
+        [get](const typename ClassT::type& self, const WorldBox& box, const std::array<int, 3>& shape) {
+            return orientationVolumeArray(get(self), box, shape);
+        },
+        pyb::arg("box"), pyb::arg("shape") = std::array<int, 3>{96, 128, 128},
+        ("The orientation volume of " + s +
+         " resampled over the world box box = ((x0, y0, z0), (x1, y1, z1)) at shape = (D, H, W) samples along (z, y, x), "
+         "each at the centre of its cell: float32 (D, H, W, 4), channels tx, ty, tz (the trilinear tangent of the active voxels, "
+         "normalized; zero outside the hair) and occupancy (the active mask, trilinear, in [0, 1]). The same array as "
+         "``vdbhair field --dense``.")
             .c_str());
     cls.def(
         "index_to_world",

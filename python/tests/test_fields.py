@@ -56,6 +56,23 @@ def test_to_dense_layout_is_z_y_x(wavy):
         field.to_dense(((0, 0, 0), (-1, 0, 0)))
 
 
+def test_orientation_volume_of_a_uniform_field_is_constant():
+    # Straight strands along +x filling [0, 10]^3 with voxel size 1: every voxel holds (1, 0, 0).
+    line = np.stack([np.arange(11.0), np.zeros(11), np.zeros(11)], axis=1)
+    positions = np.concatenate([line + (0.0, 0.5 * j, 0.5 * k) for j in range(21) for k in range(21)])
+    strands = vdbhair.Strands(positions, np.arange(0, 11 * 441 + 1, 11))
+    field = vdbhair.estimate_tangent_field(strands, voxel_size=1.0)
+    inside = field.orientation_volume(((2, 3, 4), (8, 7, 6)), (5, 6, 7))
+    assert inside.shape == (5, 6, 7, 4) and inside.dtype == np.float32
+    np.testing.assert_array_equal(inside, np.broadcast_to(np.float32([1, 0, 0, 1]), inside.shape))
+    # Far outside the hair: zeros; the density grid has no direction to resample.
+    assert not np.any(field.orientation_volume(((20, 20, 20), (30, 30, 30)), (2, 2, 2)))
+    with pytest.raises(TypeError, match="vec3s tangent grid"):
+        field.density.orientation_volume(((0, 0, 0), (1, 1, 1)), (2, 2, 2))
+    with pytest.raises(ValueError, match="max must be above min"):
+        field.orientation_volume(((0, 0, 0), (1, 0, 1)), (2, 2, 2))
+
+
 def test_one_and_two_threads_identical(wavy):
     f1 = vdbhair.estimate_tangent_field(wavy, voxel_size=0.15, threads=1)
     f2 = vdbhair.estimate_tangent_field(wavy, voxel_size=0.15, threads=2)

@@ -1,0 +1,142 @@
+#!/usr/bin/env bash
+# `vdbhair batch` for real: a generated dataset, runs killed halfway and resumed, a corrupt input,
+# shards and their merge, and a one-node Slurm cluster when Debian's slurm-wlm is installed.
+#   batch_test.sh CLI SOURCE_DIR WORK_DIR CASE
+# CASE: resume-term | resume-kill | corrupt | shard | slurm
+# Each case works in WORK_DIR/CASE (removed first) and prints "ok: ..." when it passes.
+set -u
+cli=$1; src=$2; work=$3/$4; case=$4
+fail() { echo "FAIL: $*" >&2; exit 1; }
+rm -rf "$work"; mkdir -p "$work/data"
+cd "$work" || exit 1
+
+# The dataset: N copies of the bundled ponytail at 8 vertices a strand (one convert, then copies:
+# a process start is most of a small run's time). Each output names its input in its metadata.
+make_data() {
+  local n=$1 i
+  "$cli" convert "$src/scenes/default/ponytail.hair" data/style00.hair --resample 8 --quiet || fail "convert"
+  for i in $(seq 1 $((n - 1))); do cp data/style00.hair "data/style$(printf %02d "$i").hair"; done
+}
+# JOB: field over data/*.hair, outputs {stem}.vdb.
+write_job() {
+  cat > job.json <<JSON
+{"inputs": "data/*.hair", "verb": "field", "args": ["--voxel-size", "2"], "output": "{stem}.vdb"}
+JSON
+}
+# Outputs of two folders equal, .vdb compared after the header's random file UUID (bytes 22-57).
+same_outputs() {
+  local a=$1 b=$2 f n=0
+  for f in "$a"/*.vdb; do
+    cmp -s -i 57 "$f" "$b/$(basename "$f")" || fail "$(basename "$f") differs between $a and $b"
+    n=$((n + 1))
+  done
+  [ "$(ls "$b"/*.vdb | wc -l)" -eq "$n" ] || fail "$b holds other outputs than $a"
+  echo "$n"
+}
+# Records of each input (the latest per input): "input output status" lines, sorted.
+record_set() {
+  /usr/bin/python3 - "$1" <<'PY'
+import json, sys
+latest = {}
+for line in open(sys.argv[1]):
+    try:
+        r = json.loads(line)
+    except ValueError:
+        continue
+    latest[r["input"]] = (r["output"], r["status"])
+for k in sorted(latest):
+    print(k, *latest[k])
+PY
+}
+lines() { if [ -f "$1" ]; then grep -c . "$1"; else echo 0; fi; }
+
+# A batch killed by SIGNAL once RECORDS inputs are recorded, resumed, against an uninterrupted run.
+resume_case() {
+  local signal=$1 n=8
+  make_data $n; write_job
+  "$cli" batch job.json -o ref --jobs 2 --quiet || fail "the uninterrupted run failed"
+  "$cli" batch job.json -o run --jobs 2 --quiet &
+  local pid=$! t=0
+  while [ "$(lines run/batch.jsonl)" -lt 3 ] && [ $t -lt 600 ]; do sleep 0.05; t=$((t + 1)); done
+  kill -"$signal" $pid
+  wait $pid; local status=$?
+  local done_before; done_before=$(lines run/batch.jsonl)
+  echo "killed by SIG$signal with $done_before of $n inputs recorded (exit $status)"
+  if [ "$signal" = TERM ]; then
+    [ $status -eq 143 ] || fail "expected exit status 143 after SIGTERM, got $status"
+  else
+    [ $status -eq 137 ] || fail "expected the shell's 137 after SIGKILL, got $status"
+  fi
+  [ "$done_before" -lt $n ] || fail "every input finished before the kill: the test proves nothing (make the inputs bigger)"
+  # The children die with the batch (SIGTERM forwarded, or PR_SET_PDEATHSIG after SIGKILL).
+  for t in $(seq 100); do pgrep -f "$work/run/" >/dev/null || break; sleep 0.05; done
+  ! pgrep -f "$work/run/" >/dev/null || fail "children of the killed batch still run"
+  ! ls -a run | grep -q "vdbhair-tmp" || fail "a temporary output was left in run/: $(ls -a run)"
+  "$cli" batch job.json -o run --jobs 2 --json > resume.json 2> resume.err || fail "the resumed run failed: $(cat resume.err)"
+  grep -q "\"skipped\":$done_before" resume.json || fail "the resumed run did not skip the $done_before recorded inputs: $(cat resume.json)"
+  grep -q "\"ok\":$((n - done_before))" resume.json || fail "the resumed run did not run the other $((n - done_before)): $(cat resume.json)"
+  local m; m=$(same_outputs ref run)
+  [ "$(record_set ref/batch.jsonl)" = "$(record_set run/batch.jsonl | sed "s#/run/#/ref/#g")" ] || fail "the records differ from the uninterrupted run's"
+  echo "ok: killed by SIG$signal after $done_before of $n, resumed: $m outputs identical to the uninterrupted run"
+}
+
+case "$case" in
+resume-term) resume_case TERM ;;
+resume-kill) resume_case KILL ;;
+corrupt)
+  make_data 4
+  printf 'HAIRxxxx' > data/corrupt.hair
+  printf 'data/style00.hair\n# a comment\n\ndata/corrupt.hair\ndata/missing.hair\ndata/style01.hair\ndata/style02.hair\ndata/style03.hair\n' > list.txt
+  echo '{"inputs": {"list": "list.txt"}, "verb": "field", "args": ["--voxel-size", "2"], "output": "{stem}.vdb"}' > job.json
+  "$cli" batch job.json -o out --jobs 2 --json > run1.json 2> run1.err; status=$?
+  [ $status -eq 1 ] || fail "expected exit status 1 with failed inputs, got $status"
+  grep -q '"ok":4,' run1.json && grep -q '"failed":2,' run1.json || fail "expected 4 ok and 2 failed: $(cat run1.json)"
+  grep -q 'corrupt.hair.*"status":"failed"' out/batch.jsonl || fail "no failed record for corrupt.hair"
+  grep '"input":"[^"]*corrupt.hair"' out/batch.jsonl | grep -q '"error":"vdbhair field: readHair([^)]*corrupt.hair): ' || fail "the corrupt input's record lacks its error: $(cat out/batch.jsonl)"
+  grep '"input":"[^"]*missing.hair"' out/batch.jsonl | grep -q '"exit_code":1' || fail "the missing input's record lacks exit_code 1"
+  grep -q "failed: .*corrupt.hair: vdbhair field: readHair" run1.err || fail "the summary does not list the failure: $(cat run1.err)"
+  [ -f out/style03.vdb ] && [ ! -e out/corrupt.vdb ] || fail "outputs: $(ls out)"
+  "$cli" batch job.json -o out --jobs 2 --retry-failed --json > run2.json 2>/dev/null
+  grep -q '"skipped":4,' run2.json && grep -q '"failed":2,' run2.json || fail "--retry-failed should rerun only the 2 failures: $(cat run2.json)"
+  # A changed job (other args) does not count the old records.
+  sed -i 's/"2"/"3"/' job.json
+  "$cli" batch job.json -o out --jobs 2 --json > run3.json 2>/dev/null
+  grep -q '"skipped":0,' run3.json && grep -q '"ok":4,' run3.json || fail "a changed job must run again: $(cat run3.json)"
+  echo "ok: the corrupt and the missing input are recorded with their errors, the others written; --retry-failed reruns the failures only"
+  ;;
+shard)
+  make_data 7; write_job
+  "$cli" batch job.json -o whole --jobs 2 --quiet || fail "the unsharded run failed"
+  "$cli" batch job.json -o parts --shard 0/3 --jobs 1 --quiet || fail "shard 0/3"
+  # Shard 1 from a Slurm array task's environment (an array 5-7: task 6 is shard 1 of 3).
+  SLURM_ARRAY_TASK_ID=6 SLURM_ARRAY_TASK_MIN=5 SLURM_ARRAY_TASK_COUNT=3 "$cli" batch job.json -o parts --jobs 1 --quiet || fail "shard 1/3 from Slurm's variables"
+  [ -f parts/batch.1-of-3.jsonl ] || fail "the Slurm task did not write batch.1-of-3.jsonl: $(ls parts)"
+  "$cli" batch --merge parts > merge1.out 2> merge1.err; status=$?
+  [ $status -eq 1 ] && grep -q "batch.2-of-3.jsonl missing" merge1.err || fail "--merge with a shard missing: exit $status, $(cat merge1.err)"
+  "$cli" batch job.json -o parts --shard 2/3 --jobs 1 --quiet || fail "shard 2/3"
+  [ "$(lines parts/batch.0-of-3.jsonl)" -eq 3 ] && [ "$(lines parts/batch.1-of-3.jsonl)" -eq 2 ] && [ "$(lines parts/batch.2-of-3.jsonl)" -eq 2 ] || fail "shards of 7 should hold 3, 2, 2"
+  "$cli" batch --merge parts --json > merge.json || fail "--merge failed"
+  grep -q '"inputs":7,"merged":3' merge.json || grep -q '"merged":3' merge.json || fail "merge summary: $(cat merge.json)"
+  [ "$(record_set whole/batch.jsonl)" = "$(record_set parts/batch.jsonl | sed "s#/parts/#/whole/#g")" ] || fail "merged records differ from the unsharded run's"
+  m=$(same_outputs whole parts)
+  echo "ok: 3 shards (one from SLURM_ARRAY_TASK_*) merged equal the unsharded run: $m outputs, the same records"
+  ;;
+slurm)
+  for p in slurmctld slurmd munged mungekey sbatch squeue; do
+    command -v $p >/dev/null || { echo "SKIPPED: $p not found; install Debian's slurm-wlm to run the Slurm array test"; exit 0; }
+  done
+  make_data 4; write_job
+  "$cli" batch job.json -o whole --jobs 2 --quiet || fail "the single-machine run failed"
+  "$src/tests/apps/slurm_cluster.sh" start "$work/cluster" || fail "the one-node cluster did not start: $(tail -n 5 "$work"/cluster/log/* 2>/dev/null)"
+  trap '"$src/tests/apps/slurm_cluster.sh" stop "$work/cluster"' EXIT
+  export SLURM_CONF=$work/cluster/slurm.conf
+  jid=$(VDBHAIR=$cli sbatch --parsable --array=0-3 --export=ALL -o "$work/slurm-%a.log" -D "$work" "$src/scenes/batch/field.sbatch" job.json array) || fail "sbatch"
+  for t in $(seq 600); do [ -z "$(squeue -h -j "$jid" 2>/dev/null)" ] && break; sleep 0.1; done
+  [ -z "$(squeue -h -j "$jid" 2>/dev/null)" ] || fail "the array job did not finish in 60 s: $(squeue)"
+  "$cli" batch --merge array --json > merge.json || fail "--merge of the array's shards: $(cat "$work"/slurm-*.log)"
+  [ "$(record_set whole/batch.jsonl)" = "$(record_set array/batch.jsonl | sed "s#/array/#/whole/#g")" ] || fail "the array's records differ from the single machine's"
+  m=$(same_outputs whole array)
+  echo "ok: a 4-task Slurm array on a one-node cluster (127.0.0.1) equals the single-machine run: $m outputs"
+  ;;
+*) fail "unknown case $case" ;;
+esac
