@@ -1,5 +1,5 @@
 #include "Command.h"
-#include "Progress.h"
+#include "TerminalProgress.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>

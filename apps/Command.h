@@ -35,7 +35,7 @@ struct CommonOptions
     bool json = false;    ///< one JSON object on stdout instead of prose
     bool quiet = false;   ///< no progress, no warnings
     bool noClobber = false;  ///< refuse to replace existing outputs (--no-clobber)
-    /// The progress bar and Ctrl-C (Progress.h), set by run() before the verb runs: hand it to
+    /// The progress bar and Ctrl-C (TerminalProgress.h), set by run() before the verb runs: hand it to
     /// every library call that takes an interrupter.
     WorkInterrupter* interrupter = nullptr;
 };

@@ -1,4 +1,4 @@
-#include "Progress.h"
+#include "TerminalProgress.h"
 
 #include <vdbhair/io/FileUtil.h>
 
