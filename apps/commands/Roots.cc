@@ -18,13 +18,14 @@ namespace {
 
 struct RootsCmdParams
 {
-    std::string input, output, up = "y";
+    // Defaults from the library's FollicleParams.
+    std::string input, output, up = axisName(FollicleParams{}.up);
     std::int64_t count = -1;  ///< -1: not given
     double spacing = 0.0;
     CLI::Option* spacingOpt = nullptr;
-    std::uint64_t seed = 0;
-    int iterations = 200;
-    double stepScale = 0.5;
+    std::uint64_t seed = FollicleParams{}.seed;
+    int iterations = FollicleParams{}.maxIterations;
+    double stepScale = FollicleParams{}.stepScale;
     bool noRegion = false;
 };
 

@@ -22,13 +22,14 @@ namespace {
 struct ScalpCmdParams
 {
     std::string input, output, region, regionMask, regionGrid;
-    double regionThreshold = 0.5;
+    double regionThreshold = kDefaultMaskThreshold;
     double voxelSize = 0.0;
     CLI::Option* voxelOpt = nullptr;
     std::vector<double> sphere;  ///< cx, cy, cz, r
-    float halfWidth = 3.f;
-    std::uint64_t maxVoxels = std::uint64_t(1) << 27;
-    std::size_t maxConstraints = 2000;
+    // Defaults from the library's ScalpParams.
+    float halfWidth = ScalpParams{}.halfWidth;
+    std::uint64_t maxVoxels = ScalpParams{}.maxVoxels;
+    std::size_t maxConstraints = ScalpParams::kDefaultMaxConstraints;
     double regionRadius = 0.0;
 };
 

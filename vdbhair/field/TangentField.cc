@@ -263,7 +263,8 @@ void checkParams(const StrandSet& strands, const FieldParams& p, const char* whe
 {
     if (strands.empty()) throw ValueError(std::string(where) + ": the hairstyle has no strands");
     if (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize)) {
-        throw ValueError(std::string(where) + ": voxel size " + std::to_string(p.voxelSize) + " must be a positive finite length");
+        throw ValueError(std::string(where) + ": voxel size " + std::to_string(p.voxelSize) +
+                         " must be a positive finite length (0 picks suggestVoxelSize())");
     }
     if (p.densityReference < 0.0 || !std::isfinite(p.densityReference)) {
         throw ValueError(std::string(where) + ": density reference " + std::to_string(p.densityReference) +
@@ -402,7 +403,7 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     if (bound > p.maxVoxels) {
         throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) + " needs up to " +
                          std::to_string(bound) + " voxel visits, more than the cap of " +
-                         std::to_string(p.maxVoxels) + " (raise --max-voxels or the voxel size)");
+                         std::to_string(p.maxVoxels) + " (raise maxVoxels or the voxel size)");
     }
 
     // Accumulate the moments, chunk by chunk (each chunk in strand order).
@@ -553,28 +554,49 @@ openvdb::GridCPtrVec TangentField::grids() const
     return out;
 }
 
+double resolveVoxelSize(const StrandSet& strands, const FieldParams& params)
+{
+    return params.voxelSize == 0.0 ? suggestVoxelSize(strands) : params.voxelSize;
+}
+
+namespace {
+
+/// @a params with the voxel size resolved (resolveVoxelSize()) and checked (checkParams()).
+FieldParams resolvedParams(const StrandSet& strands, const FieldParams& params, const char* where)
+{
+    FieldParams p = params;
+    if (!strands.empty()) p.voxelSize = resolveVoxelSize(strands, params);
+    checkParams(strands, p, where);
+    return p;
+}
+
+} // namespace
+
 std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params)
 {
-    checkParams(strands, params, "estimateVoxelVisits");
-    return visitBound(strands, mappingFor(params, params.voxelSize));
+    const FieldParams p = resolvedParams(strands, params, "estimateVoxelVisits");
+    return visitBound(strands, mappingFor(p, p.voxelSize));
 }
 
 TangentField estimateTangentField(const StrandSet& strands, const FieldParams& params, bool threaded,
                                   openvdb::util::NullInterrupter* interrupter)
 {
-    checkParams(strands, params, "estimateTangentField");
-    return estimateLevel(strands, params, params.voxelSize, 0, 1, threaded, interrupter);
+    const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
+    return estimateLevel(strands, p, p.voxelSize, 0, 1, threaded, interrupter);
 }
 
 std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, const FieldParams& params, int levels,
                                                      bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
-    checkParams(strands, params, "estimateTangentField");
-    if (levels < 1 || levels > 16) throw ValueError("estimateTangentField: levels " + std::to_string(levels) + " must be between 1 and 16");
+    if (levels < 1 || levels > FieldParams::kMaxLevels) {
+        throw ValueError("estimateTangentField: levels " + std::to_string(levels) + " must be between 1 and " +
+                         std::to_string(FieldParams::kMaxLevels));
+    }
+    FieldParams lp = resolvedParams(strands, params, "estimateTangentField");
+    const double voxelSize = lp.voxelSize;
     std::vector<TangentField> out;
-    FieldParams lp = params;
     for (int l = 0; l < levels; ++l) {
-        out.push_back(estimateLevel(strands, lp, params.voxelSize * double(1 << l), l, levels, threaded, interrupter));
+        out.push_back(estimateLevel(strands, lp, voxelSize * double(1 << l), l, levels, threaded, interrupter));
         lp.densityReference = out.front().densityReference;  // one meaning for every level
     }
     return out;

@@ -33,13 +33,16 @@ openvdb::BoolGrid::Ptr regionFromRoots(const openvdb::FloatGrid& surface, const 
                                        double maxDistance = std::numeric_limits<double>::max());
 
 /// @brief The region from a mask grid: the surface's band voxels whose centre the mask covers. A
+/// @brief regionFromMask()'s default threshold: a float mask covers where it exceeds one half.
+constexpr double kDefaultMaskThreshold = 0.5;
+
 /// BoolGrid covers where it is true (active or not: the value is what counts; its background too);
 /// a FloatGrid where its trilinear value exceeds @a threshold (a painted weight, a fog volume). The
 /// mask may have any transform (sampled at world positions). Named `region`, with `creator`,
 /// `vdbhair_region_kind` "mask", `vdbhair_region_threshold` and `vdbhair_source`.
 /// @throw TypeError (neither a BoolGrid nor a FloatGrid), ValueError (a non-finite threshold),
 /// LookupError (the mask covers no surface voxel: the region would be empty).
-openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const openvdb::GridBase& mask, double threshold = 0.5,
+openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const openvdb::GridBase& mask, double threshold = kDefaultMaskThreshold,
                                       const std::string& source = "");
 
 } // namespace vdbhair

@@ -32,6 +32,10 @@ struct ScalpParams
     /// the tree's overhead, which is more than any head needs (a 1/1000 voxel head is ~3e7).
     std::uint64_t maxVoxels = std::uint64_t(1) << 27;
     std::string source;  ///< stored as `vdbhair_source` (a file name, "sphere")
+
+    /// scalpFromPoints()'s default cap on constraint points (the dense solve is cubic in their
+    /// number: 2000 solve in about a second).
+    static constexpr std::size_t kDefaultMaxConstraints = 2000;
 };
 
 /// @brief How a mesh was made into a level set (ScalpMeshReport is filled by scalpFromMesh()).
@@ -91,7 +95,7 @@ openvdb::FloatGrid::Ptr scalpFromSphere(const Vec3d& center, double radius, cons
 /// @throw ValueError (fewer than 5 points, missing normals, coplanar points), LimitError,
 /// FormatError (the implicit has no zero crossing near the points).
 openvdb::FloatGrid::Ptr scalpFromPoints(const OrientedPoints& points, const ScalpParams& params,
-                                        std::size_t maxConstraints = 2000, bool threaded = true,
+                                        std::size_t maxConstraints = ScalpParams::kDefaultMaxConstraints, bool threaded = true,
                                         openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// @brief Name the grid `surface`, class level set, and store `creator`, `vdbhair_source`,
