@@ -1,5 +1,5 @@
 #include "Command.h"
-#include "Progress.h"
+#include "TerminalProgress.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
@@ -13,6 +13,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <cctype>
 #include <limits>
 #include <memory>
 #include <cmath>
@@ -118,6 +119,15 @@ Vec3d axisFromName(const std::string& name, const std::string& option)
     throw ValueError(option + " '" + name + "' is not one of x, y, z, -x, -y, -z");
 }
 
+std::string axisName(const Vec3d& axis)
+{
+    for (const char* name : {"x", "y", "z", "-x", "-y", "-z"}) {
+        if (axisFromName(name, "axis") == axis) return name;
+    }
+    throw ValueError("axis (" + formatValue(axis.x()) + ", " + formatValue(axis.y()) + ", " + formatValue(axis.z()) +
+                     ") is not one of x, y, z, -x, -y, -z");
+}
+
 void applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params)
 {
     params.space = fieldSpaceFromName(opts.space);
@@ -174,17 +184,8 @@ std::vector<std::string> nearestVerbs(const std::string& word, const std::vector
     return out;
 }
 
-int run(int argc, char** argv)
+std::vector<Command> addCommands(CLI::App& app, CommonOptions& common)
 {
-    CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
-                 ": hair geometry on OpenVDB - strands, tangent fields and generalized helicoids.\n"
-                 "Formats: .hair .data .obj .ply .vdb .usda (read and write), .tfx .bin .convdata (read).",
-                 "vdbhair"};
-    app.set_version_flag("--version", "vdbhair " VDBHAIR_VERSION_STRING);
-    app.require_subcommand(1, 1);
-    app.footer("Run 'vdbhair <verb> --help' for a verb's options. Errors go to stderr as\n"
-               "'vdbhair <verb>: <what, the value, the rule>' with a non-zero exit status.");
-    CommonOptions common;
     std::vector<Command> commands;
     commands.push_back(addInfoCommand(app, common));
     commands.push_back(addConvertCommand(app, common));
@@ -204,6 +205,42 @@ int run(int argc, char** argv)
     commands.push_back(addRenderCommand(app, common));
     commands.push_back(addDemoCommand(app, common));
     commands.push_back(addBatchCommand(app, common));
+    return commands;
+}
+
+std::string withFlagNames(const std::string& message, const FlagNames& names)
+{
+    auto wordChar = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; };
+    std::string out = message;
+    for (const auto& [name, flag] : names) {
+        const bool identifier = std::any_of(name.begin(), name.end(), [](char c) { return std::isupper(static_cast<unsigned char>(c)); });
+        for (std::size_t at = out.find(name); at != std::string::npos; at = out.find(name, at)) {
+            const std::size_t end = at + name.size();
+            const bool word = (at == 0 || !wordChar(out[at - 1])) && (end == out.size() || !wordChar(out[end]));
+            const bool named = at == 0 || (at >= 2 && out.compare(at - 2, 2, ": ") == 0);
+            if (word && (identifier || named)) {
+                out.replace(at, name.size(), flag);
+                at += flag.size();
+            } else {
+                at = end;
+            }
+        }
+    }
+    return out;
+}
+
+int run(int argc, char** argv)
+{
+    CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
+                 ": hair geometry on OpenVDB - strands, tangent fields and generalized helicoids.\n"
+                 "Formats: .hair .data .obj .ply .vdb .usda (read and write), .tfx .bin .convdata (read).",
+                 "vdbhair"};
+    app.set_version_flag("--version", "vdbhair " VDBHAIR_VERSION_STRING);
+    app.require_subcommand(1, 1);
+    app.footer("Run 'vdbhair <verb> --help' for a verb's options. Errors go to stderr as\n"
+               "'vdbhair <verb>: <what, the value, the rule>' with a non-zero exit status.");
+    CommonOptions common;
+    const std::vector<Command> commands = addCommands(app, common);
 
     std::vector<std::string> verbs;
     for (const Command& c : commands) verbs.push_back(c.sub->get_name());
@@ -263,10 +300,13 @@ int run(int argc, char** argv)
         installInterruptHandlers();
         TerminalProgress progress(verb, common.quiet);
         common.interrupter = &progress;
-        // Errors: one line, after the progress line is erased.
+        // Errors: one line, after the progress line is erased, with the library's parameter names
+        // spelled as this verb's flags.
+        FlagNames flags = c.flags;
+        flags.emplace_back("OverwritePolicy::NoClobber", "--no-clobber");
         auto fail = [&](int code, const std::string& message) {
             progress.clear();
-            std::cerr << "vdbhair " << verb << ": " << message << "\n";
+            std::cerr << "vdbhair " << verb << ": " << withFlagNames(message, flags) << "\n";
             return code;
         };
         try {

@@ -18,6 +18,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vdbhair {
@@ -35,7 +36,7 @@ struct CommonOptions
     bool json = false;    ///< one JSON object on stdout instead of prose
     bool quiet = false;   ///< no progress, no warnings
     bool noClobber = false;  ///< refuse to replace existing outputs (--no-clobber)
-    /// The progress bar and Ctrl-C (Progress.h), set by run() before the verb runs: hand it to
+    /// The progress bar and Ctrl-C (TerminalProgress.h), set by run() before the verb runs: hand it to
     /// every library call that takes an interrupter.
     WorkInterrupter* interrupter = nullptr;
 };
@@ -60,12 +61,28 @@ private:
     WorkInterrupter* mI;
 };
 
-/// A registered subcommand: its CLI11 node and the function that runs it (returns the exit code).
+/// @brief The library's names of parameters, as its error messages spell them (a struct field
+/// such as maxVoxels, or a word such as margin), each with the flag of a verb that sets it.
+/// The library names parameters, never flags; the app maps them (withFlagNames()).
+using FlagNames = std::vector<std::pair<std::string, std::string>>;
+
+/// @brief @a message with the parameter names of @a names spelled as their flags: a name with a
+/// capital letter (an identifier: maxVoxels) wherever it stands as a word, a lower-case name
+/// (margin) only where a message names its parameter, at its start or after ": ".
+std::string withFlagNames(const std::string& message, const FlagNames& names);
+
+/// A registered subcommand: its CLI11 node, the function that runs it (returns the exit code)
+/// and the flags of the library parameters its errors may name.
 struct Command
 {
     CLI::App* sub = nullptr;
     std::function<int()> run;
+    FlagNames flags = {};
 };
+
+/// @brief What a voxel size of 0 picks (suggestVoxelSize(), vdbhair/field/TangentField.h), for
+/// the help of the verbs whose --voxel-size defaults to it.
+inline const std::string kSuggestedVoxelSizeHelp = "3 x the median root spacing, within 1/64..1/4 of the head radius";
 
 /// @brief Add --threads, --json and --quiet to @a sub.
 void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson = true);
@@ -104,6 +121,10 @@ StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, c
 /// @brief The axis named by an option such as --up: x, y, z, -x, -y or -z.
 /// @throw ValueError naming the option, the value and the choices.
 Vec3d axisFromName(const std::string& name, const std::string& option);
+
+/// @brief The name axisFromName() reads as @a axis (x, y, z, -x, -y, -z).
+/// @throw ValueError for a vector that is not a unit axis.
+std::string axisName(const Vec3d& axis);
 
 /// @brief The scalp sphere options of `field` and `refine` (`--space scalp`).
 struct ScalpOptions
@@ -165,6 +186,9 @@ struct TransferJob
     std::string verb, details, base, output, scalp, detailsLabel = "DETAILS", baseLabel = "BASE";
 };
 int runTransferJob(const TransferJob& job, TransferParams params, const CommonOptions& common);
+
+/// @brief Every verb, registered on @a app in the order `vdbhair --help` lists them.
+std::vector<Command> addCommands(CLI::App& app, CommonOptions& common);
 
 /// @brief The verbs of @a verbs nearest to @a word (edit distance, a prefix counting as 1), for
 /// "did you mean"; empty when none is close.

@@ -14,7 +14,7 @@ namespace vdbhair::app {
 struct HeadOptions
 {
     std::string path;                   ///< --head: a mesh, a .vdb level set, or "none"
-    std::string policy = "no-deeper";  ///< --head-policy
+    std::string policy = headPolicyName(kDefaultHeadPolicy);  ///< --head-policy
     /// @throw ValueError naming --head-policy for a policy that is not one of no-deeper, outside.
     HeadPolicy headPolicy() const;
 };

@@ -25,14 +25,14 @@ struct ConvertParams
     std::size_t resample = 0;  ///< vertices per strand; 0 keeps them
     double scale = 1.0;
     std::string plyEncoding = "binary";
-    std::string codec = "float";
+    std::string codec = positionCodecName(WriteOptions{}.vdb.codec);
     double voxelSize = 0.0;
     bool strict = false;
     std::string objLines = "edges";
     std::vector<double> rootNear;  ///< x, y, z; empty: OBJ roots at the lower-index end
-    std::string grid = "strands";
-    std::string usdUp = "y";
-    double metersPerUnit = 0.01;
+    std::string grid = ReadOptions{}.vdbGrid;
+    std::string usdUp = WriteOptions{}.usd.upAxis == "Z" ? "z" : "y";
+    double metersPerUnit = WriteOptions{}.usd.metersPerUnit;
     std::string format;  ///< the format of `-` (standard input or output), e.g. "obj"
     std::string up = "y";  ///< the input's up axis; rotated onto +Y
 };

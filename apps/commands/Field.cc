@@ -22,16 +22,17 @@ namespace {
 struct FieldCmdParams
 {
     std::string input, output;
-    double voxelSize = 0.0;
+    // Defaults from the library's FieldParams (one home for each).
+    double voxelSize = FieldParams{}.voxelSize;
     CLI::Option* voxelOpt = nullptr;  ///< whether --voxel-size was given
-    int iterations = 2;
+    int iterations = FieldParams{}.iterations;
     int levels = 1;
-    std::uint64_t maxVoxels = std::uint64_t(1) << 26;
+    std::uint64_t maxVoxels = FieldParams{}.maxVoxels;
     bool withStrands = false;
     bool helicoid = false;
     bool strict = false;
     ScalpOptions scalp;
-    double densityReference = 0.0;
+    double densityReference = FieldParams{}.densityReference;
     std::string vectorName = "tangent";
     std::string dense;                       ///< --dense OUT.npy: the orientation volume
     std::vector<double> denseBox;            ///< x0,y0,z0,x1,y1,z1 (world units)
@@ -68,7 +69,9 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive finite length");
     }
     if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
-    if (p.levels < 1 || p.levels > 16) throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and 16");
+    if (p.levels < 1 || p.levels > FieldParams::kMaxLevels) {
+        throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and " + std::to_string(FieldParams::kMaxLevels));
+    }
     if (p.helicoid && p.levels != 1) throw ValueError("--helicoid with --levels " + std::to_string(p.levels) + ": a helicoid field has one level; use --levels 1");
     if (p.helicoid && p.scalp.space != "world") throw ValueError("--helicoid with --space " + p.scalp.space + ": helicoid fields are world-space");
     if (p.densityReference < 0.0 || !std::isfinite(p.densityReference)) {
@@ -87,7 +90,8 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
     checkStrandLengths("field", p.input, strands, common, p.strict);
     FieldParams fp;
-    fp.voxelSize = voxelGiven ? p.voxelSize : suggestVoxelSize(strands);
+    fp.voxelSize = voxelGiven ? p.voxelSize : 0.0;
+    fp.voxelSize = resolveVoxelSize(strands, fp);  // 0: the library's suggestion (reported below)
     fp.iterations = p.iterations;
     fp.maxVoxels = p.maxVoxels;
     fp.densityReference = p.densityReference;
@@ -165,7 +169,7 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = app.add_subcommand("field", "Estimate the robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9) as VDB grids");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent', 'density' (fog volume in [0,1]) and 'hair_length' (or *_level_<l>)")->required();
-    params->voxelOpt = sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: twice the mean segment length)");
+    params->voxelOpt = sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: " + kSuggestedVoxelSizeHelp + ")");
     sub->add_option("--iterations", params->iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
     sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
     sub->add_option("--max-voxels", params->maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
@@ -187,9 +191,10 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
         ->delimiter(',')->expected(3);
     addScalpOptions(sub, params->scalp);
     addCommonOptions(sub, common);
-    sub->footer("Example: vdbhair field hair.hair -o field.vdb --voxel-size 0.5 --levels 3\n"
+    sub->footer("Example: vdbhair field hair.hair -o field.vdb --voxel-size 0.5 --levels 3
+"
                 "Orientation volume: vdbhair field hair.data -o f.vdb --dense f.npy --dense-box -0.32,-0.32,-0.24,0.32,0.32,0.24");
-    return {sub, [params, &common] { return runField(*params, common); }};
+    return {sub, [params, &common] { return runField(*params, common); }, {{"maxVoxels", "--max-voxels"}}};
 }
 
 } // namespace vdbhair::app

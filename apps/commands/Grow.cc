@@ -16,7 +16,7 @@ namespace {
 struct GrowParams
 {
     std::string scene, output, integrator;
-    std::size_t maxVertices = std::size_t(1) << 30;
+    std::size_t maxVertices = GrowOptions{}.maxVertices;
 };
 
 int runGrow(const GrowParams& p, const CommonOptions& common)

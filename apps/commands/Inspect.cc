@@ -17,8 +17,8 @@ struct InspectParams
 {
     std::string input, grid, slice, output;
     bool hsv = false;
-    int streamlines = 0;
-    int width = 1024;
+    int streamlines = SliceParams{}.streamlines;  // the library checks both (SliceParams' limits)
+    int width = SliceParams{}.width;
 };
 
 std::string g6(double v)
@@ -197,7 +197,8 @@ Command addInspectCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     sub->footer("Examples: vdbhair inspect field.vdb\n"
                 "          vdbhair inspect field.vdb --slice z=0 -o slice.png --hsv --streamlines 300");
-    return {sub, [params, &common] { return runInspect(*params, common); }};
+    return {sub, [params, &common] { return runInspect(*params, common); },
+            {{"slice", "--slice"}, {"width", "--width"}, {"streamlines", "--streamlines"}}};
 }
 
 } // namespace vdbhair::app

@@ -23,7 +23,8 @@ namespace {
 
 struct InterpolateCmdParams
 {
-    std::string guides, output, roots, scalp, method = "helicoid", frames = "auto", up = "y";
+    std::string guides, output, roots, scalp, method = "helicoid", frames = "auto";
+    std::string up = axisName(HelicoidInterpolationParams{}.up);
     std::int64_t count = -1;  ///< -1: not given
     std::uint64_t seed = 0;
     HelicoidInterpolationParams helicoid;
@@ -169,7 +170,8 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--count", params->count, "Number of roots on --scalp");
     sub->add_option("--method", params->method, "helicoid (Piuze et al.) or points (Blender's Interpolate Curves)")->capture_default_str();
     sub->add_option("--power", params->helicoid.shepard.power, "Shepard exponent p: weights |x - x_i|^-p")->capture_default_str();
-    params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair, nearest by root (default: every guide for helicoid, 4 for points)");
+    params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair, nearest by root (default: every guide for helicoid, " +
+                                           std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
     sub->add_option("--frames", params->frames, "auto (surface when the roots have normals), world, or surface (the scalp's frame, 4.3)")->capture_default_str();
     sub->add_option("--up", params->up, "Reference axis of surface frames: x, y, z, -x, -y or -z")->capture_default_str();
     sub->add_option("--seed", params->seed, "Seed of the roots on --scalp and of waviness noise")->capture_default_str();

@@ -17,7 +17,8 @@ namespace {
 
 struct ReconstructCmdParams
 {
-    std::string input, output, guides = "10%", method = "helicoid", select = "random", errors;
+    std::string input, output, method = "helicoid", select = "random", errors;
+    std::string guides = formatValue(100.0 * ReconstructParams{}.guideFraction) + "%";
     ReconstructParams rec;
     int neighbors = 0;
     CLI::Option* neighborsOpt = nullptr;
@@ -112,7 +113,8 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--select", params->select, "Guide choice: random, or cluster (k-means of the roots)")->capture_default_str();
     sub->add_option("--seed", params->rec.seed, "Seed of the guide choice")->capture_default_str();
     sub->add_option("--power", params->rec.helicoid.shepard.power, "Shepard exponent p of helicoid interpolation")->capture_default_str();
-    params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair (default: every guide for helicoid, 4 for points)");
+    params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair (default: every guide for helicoid, " +
+                                           std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
     sub->add_option("--max-error", params->rec.fit.maxError, "Fits: accepted discrete Frechet distance, a fraction of the strand length")->capture_default_str();
     sub->add_option("--errors", params->errors, "Also write every strand's relative error, both methods, as CSV");
     addCommonOptions(sub, common);

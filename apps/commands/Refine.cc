@@ -28,7 +28,9 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     if (rp.levels < 1 || rp.levels > RefineParams::kMaxLevels) {
         throw ValueError("--levels " + std::to_string(rp.levels) + ": must be between 1 and " + std::to_string(RefineParams::kMaxLevels));
     }
-    if (rp.trace.margin < 0 || rp.trace.margin > 16) throw ValueError("--margin " + std::to_string(rp.trace.margin) + ": must be between 0 and 16 voxels");
+    if (rp.trace.margin < 0 || rp.trace.margin > TraceParams::kMaxMargin) {
+        throw ValueError("--margin " + std::to_string(rp.trace.margin) + ": must be between 0 and " + std::to_string(TraceParams::kMaxMargin) + " voxels");
+    }
     if (!(rp.consistency.zStart >= 0.0) || !std::isfinite(rp.consistency.zStart)) {
         throw ValueError("--outlier-start " + formatValue(rp.consistency.zStart) + ": must be finite and at least 0");
     }
@@ -174,12 +176,12 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
 {
     RefineParams& rp = p.refine;
     p.voxelOpt = sub->add_option("--voxel-size", rp.field.voxelSize,
-                                 "Finest voxel size in world units (default: 3 x the median root spacing, within 1/64..1/4 of the head radius)");
+                                 "Finest voxel size in world units (default: " + kSuggestedVoxelSizeHelp + ")");
     sub->add_option("--levels", rp.levels, "Levels, coarse (h*2^(n-1)) to fine (h)")->capture_default_str();
     sub->add_option("--mode", p.mode, "consistent: fix only strands that stray from the flow, keep every strand's detail; "
                                       "field: replace every strand by the field's streamline (Wang et al.)")->capture_default_str();
     sub->add_option("--iterations", rp.field.iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
-    p.stepOpt = sub->add_option("--step", rp.trace.step, "Integration step in world units (default: half of each level's voxel)");
+    p.stepOpt = sub->add_option("--step", rp.trace.step, "Integration step in world units (default: " + formatValue(kDefaultStepVoxels) + " of each level's voxel size)");
     sub->add_option("--outlier-start", rp.consistency.zStart,
                     "consistent mode: outlier score (deviation over the voxel's spread) where the field starts to take over")->capture_default_str();
     sub->add_option("--outlier-full", rp.consistency.zFull,
@@ -204,7 +206,7 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
     addRefineOptions(sub, *params);
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --json");
-    return {sub, [params, &common] { return runRefine(*params, common); }};
+    return {sub, [params, &common] { return runRefine(*params, common); }, {{"maxVoxels", "--max-voxels"}}};
 }
 
 } // namespace vdbhair::app

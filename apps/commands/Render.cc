@@ -13,11 +13,14 @@ namespace vdbhair::app {
 
 namespace {
 
+/// The command line of render; defaults from the library's RenderParams and ReadOptions.
 struct RenderCmdParams
 {
-    std::string input, output, view = "three-quarter", colorBy = "shaded", guides, title, up = "y", facing, head;
-    std::string grid = "strands";
-    int width = 1024, height = 1024;
+    std::string input, output, guides, title, facing, head;
+    std::string view = viewName(RenderParams{}.view), colorBy = colorByName(RenderParams{}.colorBy);
+    std::string up = axisName(RenderParams{}.up);
+    std::string grid = ReadOptions{}.vdbGrid;
+    int width = RenderParams{}.width, height = RenderParams{}.height;
     bool sheet = false;
 };
 
@@ -38,9 +41,9 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
         }
         rp.facing = facing;
     }
-    if (p.width < 1 || p.height < 1 || p.width > 16384 || p.height > 16384) {
+    if (p.width < 1 || p.height < 1 || p.width > RenderParams::kMaxSize || p.height > RenderParams::kMaxSize) {
         throw ValueError("--width/--height " + std::to_string(p.width) + "x" + std::to_string(p.height) +
-                         ": must be between 1 and 16384 pixels");
+                         ": must be between 1 and " + std::to_string(RenderParams::kMaxSize) + " pixels");
     }
     if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
     // Roots (a PLY of points with normals, as `vdbhair roots` writes) are drawn as dots: stubs
@@ -109,7 +112,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--sheet", params->sheet, "One image with the front, side, top and three-quarter views");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair render scenes/default/head.json -o head.png --sheet");
-    return {sub, [params, &common] { return runRender(*params, common); }};
+    return {sub, [params, &common] { return runRender(*params, common); }, {{"colorBy", "--color-by"}}};
 }
 
 } // namespace vdbhair::app

@@ -60,35 +60,31 @@ void anglesOrNan(const StrandSet& input, const StrandSet& output, const openvdb:
     after = a.countedAfter ? a.afterDeg : std::nan("");
 }
 
+/// The command line of retrace: the numeric options bind to the library's TraceParams fields,
+/// the named ones start from its defaults, so `--help` shows the library's defaults.
 struct RetraceParams
 {
     std::string input, output, field, grid = "tangent";
-    double step = 0.0;
+    TraceParams trace;
     CLI::Option* stepOpt = nullptr;
-    std::string integrator = "euler", vertices = "input";
-    double vanish = 1e-3;
-    std::size_t maxSteps = 0;
-    int margin = 3;
+    std::string integrator = integratorName(TraceParams{}.integrator);
+    std::string vertices = TraceParams{}.vertices == RetraceVertices::Input ? "input" : "steps";
     bool helicoid = false;
     bool strict = false;
 };
 
 int runRetrace(const RetraceParams& p, const CommonOptions& common)
 {
-    TraceParams tp;
+    TraceParams tp = p.trace;
     tp.integrator = integratorFromName(p.integrator);
     const bool stepGiven = p.stepOpt && p.stepOpt->count() > 0;
-    if (stepGiven && (!(p.step > 0.0) || !std::isfinite(p.step))) {
-        throw ValueError("--step " + formatValue(p.step) + ": must be a positive finite length");
+    if (stepGiven && (!(tp.step > 0.0) || !std::isfinite(tp.step))) {
+        throw ValueError("--step " + formatValue(tp.step) + ": must be a positive finite length");
     }
-    tp.step = stepGiven ? p.step : 0.0;
-    if (!(p.vanish >= 0.0 && p.vanish < 1.0)) throw ValueError("--vanish " + formatValue(p.vanish) + ": must be in [0, 1)");
-    tp.vanishThreshold = p.vanish;
-    tp.maxSteps = p.maxSteps;
-    if (p.margin < 0 || p.margin > TraceParams::kMaxMargin) {
-        throw ValueError("--margin " + std::to_string(p.margin) + ": must be between 0 and " + std::to_string(TraceParams::kMaxMargin) + " voxels");
+    if (!(tp.vanishThreshold >= 0.0 && tp.vanishThreshold < 1.0)) throw ValueError("--vanish " + formatValue(tp.vanishThreshold) + ": must be in [0, 1)");
+    if (tp.margin < 0 || tp.margin > TraceParams::kMaxMargin) {
+        throw ValueError("--margin " + std::to_string(tp.margin) + ": must be between 0 and " + std::to_string(TraceParams::kMaxMargin) + " voxels");
     }
-    tp.margin = p.margin;
     if (p.vertices == "input") tp.vertices = RetraceVertices::Input;
     else if (p.vertices == "steps") tp.vertices = RetraceVertices::Steps;
     else throw ValueError("--vertices '" + p.vertices + "' is not one of input, steps");
@@ -157,17 +153,18 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--field", params->field, "A .vdb file holding the field")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
-    params->stepOpt = sub->add_option("--step", params->step, "Integration step in world units (default: half a voxel)");
+    params->stepOpt = sub->add_option("--step", params->trace.step, "Integration step in world units (default: " + formatValue(kDefaultStepVoxels) + " of the field's voxel size)");
     sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
-    sub->add_option("--vanish", params->vanish, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
-    sub->add_option("--max-steps", params->maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
-    sub->add_option("--margin", params->margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
+    sub->add_option("--vanish", params->trace.vanishThreshold, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
+    sub->add_option("--max-steps", params->trace.maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
+    sub->add_option("--margin", params->trace.margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
     sub->add_option("--vertices", params->vertices, "input: the input's vertex count and arc lengths; steps: every step")->capture_default_str();
     sub->add_flag("--helicoid", params->helicoid, "Trace through the file's helicoid field (vdbhair field --helicoid) instead of the tangent grid");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --json");
-    return {sub, [params, &common] { return runRetrace(*params, common); }};
+    return {sub, [params, &common] { return runRetrace(*params, common); },
+            {{"step", "--step"}, {"margin", "--margin"}, {"vanishThreshold", "--vanish"}, {"maxSteps", "--max-steps"}}};
 }
 
 } // namespace vdbhair::app

@@ -19,7 +19,8 @@ namespace {
 
 struct RootsCmdParams
 {
-    std::string input, output, up = "y";
+    // Defaults from the library's FollicleParams.
+    std::string input, output, up = axisName(FollicleParams{}.up);
     std::int64_t count = -1;  ///< -1: not given
     double spacing = 0.0;
     CLI::Option* spacingOpt = nullptr;

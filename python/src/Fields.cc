@@ -507,11 +507,11 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
             } else if (scalp) {
                 throw ValueError("estimate_tangent_field: scalp= is for space='scalp'");
             }
-            if (levels && (*levels < 1 || *levels > 16)) {
-                throw ValueError("estimate_tangent_field: levels=" + std::to_string(*levels) + ": must be between 1 and 16");
+            if (levels && (*levels < 1 || *levels > FieldParams::kMaxLevels)) {
+                throw ValueError("estimate_tangent_field: levels=" + std::to_string(*levels) + ": must be between 1 and " +
+                                 std::to_string(FieldParams::kMaxLevels));
             }
             auto fields = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                if (fp.voxelSize == 0.0) fp.voxelSize = suggestVoxelSize(*strands);
                 if (!levels) return std::vector<TangentField>{estimateTangentField(*strands, fp, true, interrupter)};
                 return estimateTangentFieldLevels(*strands, fp, *levels, true, interrupter);
             });
@@ -524,7 +524,8 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
         pyb::arg("iterations") = fieldDefaults.iterations, pyb::arg("levels") = pyb::none(),
         pyb::arg("max_voxels") = fieldDefaults.maxVoxels, pyb::arg("density_reference") = fieldDefaults.densityReference,
         pyb::arg("space") = fieldSpaceName(fieldDefaults.space), pyb::arg("scalp") = pyb::none(),
-        pyb::arg("up") = std::array<double, 3>{0.0, 1.0, 0.0}, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        pyb::arg("up") = std::array<double, 3>{fieldDefaults.scalp.up.x(), fieldDefaults.scalp.up.y(), fieldDefaults.scalp.up.z()},
+        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space by default: ``vdbhair field``.
 
 Every segment contributes its unit tangent to every voxel it passes through, weighted by its
@@ -566,7 +567,10 @@ Raises:
             tp.integrator = integratorFromName(integrator);
             tp.vanishThreshold = vanish;
             tp.maxSteps = maxSteps;
-            if (margin < 0 || margin > 16) throw ValueError("retrace: margin=" + std::to_string(margin) + ": must be between 0 and 16 voxels");
+            if (margin < 0 || margin > TraceParams::kMaxMargin) {
+                throw ValueError("retrace: margin=" + std::to_string(margin) + ": must be between 0 and " +
+                                 std::to_string(TraceParams::kMaxMargin) + " voxels");
+            }
             tp.margin = margin;
             tp.vertices = verticesFromName(vertices);
             TraceStats stats;
@@ -666,7 +670,7 @@ Raises:
         pyb::arg("iterations") = refineDefaults.field.iterations, pyb::arg("step") = refineDefaults.trace.step,
         pyb::arg("outlier_start") = refineDefaults.consistency.zStart, pyb::arg("outlier_full") = refineDefaults.consistency.zFull,
         pyb::arg("min_spread") = refineDefaults.consistency.minSpreadDeg, pyb::arg("head") = pyb::none(),
-        pyb::arg("head_policy") = "no-deeper", pyb::arg("integrator") = integratorName(refineDefaults.trace.integrator),
+        pyb::arg("head_policy") = headPolicyName(kDefaultHeadPolicy), pyb::arg("integrator") = integratorName(refineDefaults.trace.integrator),
         pyb::arg("margin") = refineDefaults.trace.margin, pyb::arg("max_voxels") = refineDefaults.field.maxVoxels,
         pyb::arg("measure") = refineDefaults.measure, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),

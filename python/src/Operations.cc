@@ -64,19 +64,6 @@ void checkMaxError(double maxError, const char* where)
         throw ValueError(std::string(where) + ": max_error=" + std::to_string(maxError) + ": must be a positive fraction of the strand length");
 }
 
-const char* colorByNameOf(ColorBy c)
-{
-    switch (c) {
-    case ColorBy::Shaded: return "shaded";
-    case ColorBy::Root: return "root";
-    case ColorBy::Tangent: return "tangent";
-    case ColorBy::Depth: return "depth";
-    case ColorBy::Curvature: return "curvature";
-    case ColorBy::Strand: return "strand";
-    }
-    return "shaded";
-}
-
 Vec3d unitAxis(const std::array<double, 3>& a, const char* name)
 {
     const Vec3d v(a[0], a[1], a[2]);
@@ -373,7 +360,7 @@ Returns:
         pyb::arg("levels") = combDefaults.synth.cluster.levels, pyb::arg("seed") = combDefaults.synth.seed,
         pyb::arg("vertices") = combDefaults.synth.vertices, pyb::arg("threshold") = combDefaults.synth.cluster.threshold,
         pyb::arg("initial_clusters") = combDefaults.synth.cluster.initialClusters, pyb::arg("up") = pyb::none(),
-        pyb::arg("scalp") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("head_policy") = "no-deeper",
+        pyb::arg("scalp") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("head_policy") = headPolicyName(kDefaultHeadPolicy),
         pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(Detail-preserving combing (Wang et al. 2009, §6): ``vdbhair comb``.
 
@@ -686,7 +673,7 @@ Returns:
         },
         pyb::arg("strands"), pyb::arg("path") = pyb::none(), pyb::kw_only(), pyb::arg("view") = viewName(renderDefaults.view),
         pyb::arg("width") = renderDefaults.width, pyb::arg("height") = renderDefaults.height,
-        pyb::arg("color_by") = colorByNameOf(renderDefaults.colorBy),
+        pyb::arg("color_by") = colorByName(renderDefaults.colorBy),
         pyb::arg("up") = std::array<double, 3>{renderDefaults.up.x(), renderDefaults.up.y(), renderDefaults.up.z()},
         pyb::arg("facing") = pyb::none(), pyb::arg("title") = renderDefaults.title, pyb::arg("sheet") = false,
         pyb::arg("guides") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),

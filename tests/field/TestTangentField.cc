@@ -165,18 +165,35 @@ TEST_CASE("estimateTangentFieldLevels: level l has voxel size h*2^l and its own 
     REQUIRE(levels[2].tangent->activeVoxelCount() < levels[0].tangent->activeVoxelCount());
 }
 
+TEST_CASE("estimateTangentField: voxel size 0 is the library's suggestion, at every level", "[field]")
+{
+    const StrandSet s = parallelStrands(Vec3f(1, 0, 0), 6, 2.f, 10.f, 5);
+    FieldParams p;
+    REQUIRE(p.voxelSize == 0.0);
+    const double h = suggestVoxelSize(s);
+    REQUIRE(resolveVoxelSize(s, p) == h);
+    REQUIRE(estimateTangentField(s, p).tangent->voxelSize().x() == Approx(h).epsilon(1e-12));
+    const std::vector<TangentField> levels = estimateTangentFieldLevels(s, p, 2);
+    REQUIRE(levels[1].tangent->voxelSize().x() == Approx(2.0 * h).epsilon(1e-12));
+    p.voxelSize = 0.5;
+    REQUIRE(resolveVoxelSize(s, p) == 0.5);
+    REQUIRE_THROWS_WITH(estimateTangentFieldLevels(s, p, FieldParams::kMaxLevels + 1),
+                        Contains("levels " + std::to_string(FieldParams::kMaxLevels + 1) + " must be between 1 and " +
+                                 std::to_string(FieldParams::kMaxLevels)));
+}
+
 TEST_CASE("estimateTangentField: bad parameters are clear errors before any work", "[field]")
 {
     const StrandSet s = parallelStrands(Vec3f(1, 0, 0), 2, 1.f, 100.f, 3);
     FieldParams p;
-    p.voxelSize = 0.0;
-    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("voxel size 0.000000 must be a positive finite length"));
     p.voxelSize = -1.0;
-    REQUIRE_THROWS_AS(estimateTangentField(s, p), ValueError);
+    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("voxel size -1.000000 must be a positive finite length"));
     p.voxelSize = 1e-4;  // 4 strands of 2 segments of 50: 8 x (5e5 + 1) visits
     p.maxVoxels = 1000000;
     REQUIRE_THROWS_AS(estimateTangentField(s, p), LimitError);
-    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("voxel size 0.000100 needs up to 40000") && Contains("voxel visits, more than the cap of 1000000"));
+    // The library names its parameter (maxVoxels), never a command's flag.
+    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("voxel size 0.000100 needs up to 40000") &&
+                                                        Contains("voxel visits, more than the cap of 1000000 (raise maxVoxels"));
     p.maxVoxels = FieldParams().maxVoxels;
     p.voxelSize = 1e-6;
     REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("below OpenVDB's smallest voxel size"));

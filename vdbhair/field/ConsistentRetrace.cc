@@ -24,7 +24,7 @@ void ConsistencyParams::validate(const char* where) const
     if (!(zFull > zStart) || !std::isfinite(zFull)) fail("outlier score zFull " + std::to_string(zFull) + " must be finite and above zStart " + std::to_string(zStart));
     if (!(minSpreadDeg >= 0.0 && minSpreadDeg < 90.0)) fail("minimum spread " + std::to_string(minSpreadDeg) + " degrees must be in [0, 90)");
     if (!(returnVoxels > 0.0) || !std::isfinite(returnVoxels)) fail("return length " + std::to_string(returnVoxels) + " voxels must be positive and finite");
-    if (!(vanishThreshold >= 0.0 && vanishThreshold < 1.0)) fail("vanish threshold " + std::to_string(vanishThreshold) + " must be in [0, 1)");
+    if (!(vanishThreshold >= 0.0 && vanishThreshold < 1.0)) fail("vanishThreshold " + std::to_string(vanishThreshold) + " must be in [0, 1)");
 }
 
 namespace {

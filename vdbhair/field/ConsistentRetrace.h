@@ -39,6 +39,7 @@
 #pragma once
 
 #include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -57,7 +58,7 @@ struct ConsistencyParams
     /// voxels over which a strand that a correction moved off its own path steers back to it
     /// (the own direction t becomes t + offset / (returnVoxels · voxel size), renormalized)
     double returnVoxels = 4.0;
-    double vanishThreshold = 1e-3;  ///< as TraceParams::vanishThreshold
+    double vanishThreshold = kDefaultVanishThreshold;  ///< as TraceParams::vanishThreshold
 
     /// @throw ValueError (parameter @a where names the offender) for values out of range.
     void validate(const char* where) const;

@@ -140,6 +140,11 @@ bool HeadObstacle::Probe::pushOut(Vec3d& p, double minDistance)
     return moved;
 }
 
+const char* headPolicyName(HeadPolicy policy)
+{
+    return policy == HeadPolicy::NoDeeper ? "no-deeper" : "outside";
+}
+
 HeadPolicy headPolicyFromName(const std::string& name)
 {
     if (name == "no-deeper") return HeadPolicy::NoDeeper;

@@ -119,7 +119,7 @@ HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up)
     (void)up;
     ScalpSphere sphere;
     if (!plausibleRootSphere(strands, sphere)) return HeadObstacle::none();
-    HeadObstacle head = HeadObstacle::sphere(sphere.center, sphere.radius, HeadPolicy::NoDeeper);
+    HeadObstacle head = HeadObstacle::sphere(sphere.center, sphere.radius, kDefaultHeadPolicy);
     head.setLabel("fitted to the roots");
     return head;
 }

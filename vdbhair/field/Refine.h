@@ -15,7 +15,7 @@
 ///   scale: waves are combed straight and crossing wisps are merged. Strands stop where the
 ///   field ends (margin 0: no straight spikes past the hair).
 ///
-/// The default voxel size follows the hair's own scale (suggestVoxelSize()).
+/// The default voxel size follows the hair's own scale (suggestVoxelSize(), TangentField.h).
 #pragma once
 
 #include <vdbhair/field/ConsistentRetrace.h>
@@ -37,7 +37,7 @@ const char* refineModeName(RefineMode mode);
 
 struct RefineParams
 {
-    static constexpr int kMaxLevels = 8;
+    static constexpr int kMaxLevels = 8;  ///< each level costs an estimate and a retrace
 
     FieldParams field;  ///< field.voxelSize is the finest level's; 0 picks suggestVoxelSize()
     int levels = 1;     ///< 1 to kMaxLevels
@@ -76,14 +76,6 @@ struct RefineResult
     double voxelSize = 0.0;            ///< the finest voxel size used
     HeadObstacle head;                 ///< the obstacle used
 };
-
-/// @brief The default finest voxel size of a hairstyle, from its own scale: three times the
-/// median distance between neighbouring roots (so that a voxel near the scalp holds about nine
-/// strands, enough for a robust direction and its spread), kept between 1/64 and 1/4 of the head
-/// radius (the radius of the sphere fitted to the roots, or half the hair's largest extent when
-/// that fit is implausible) so that the finest level resolves wisps whatever the strand count.
-/// Coarser levels double it, as Wang et al. halve their spacing from coarse to fine.
-double suggestVoxelSize(const StrandSet& strands);
 
 /// @brief The fallback head: the sphere fitted to the roots (fitScalpSphere()) with the up axis @a up.
 HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up = Vec3d(0.0, 1.0, 0.0));

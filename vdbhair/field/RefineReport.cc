@@ -186,7 +186,7 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
     // Coherence of each hairstyle's own field at this voxel size.
     m.coherenceBefore = meanCoherence(inputField);
     FieldParams fp = params;
-    fp.maxVoxels = std::max<std::uint64_t>(fp.maxVoxels, std::uint64_t(1) << 26);
+    fp.maxVoxels = std::max(fp.maxVoxels, FieldParams().maxVoxels);  // a measure: never below the default cap
     m.coherenceAfter = meanCoherence(estimateTangentField(output, fp, threaded));
     return m;
 }

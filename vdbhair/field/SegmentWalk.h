@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
+#include <algorithm>
 
 namespace vdbhair {
 
@@ -22,56 +24,61 @@ inline int floorToInt(double x)
 /// on each axis, OpenVDB's cell-centred convention) and call `fn(ijk, t0, t1)` for every voxel it
 /// passes through, in order, where [t0, t1] ⊂ [0, 1] is the segment parameter range inside it.
 /// Pieces of zero length (exact corner crossings) are skipped.
-/// @return the number of voxels visited.
+///
+/// A 3D DDA restricted to the axes whose voxel coordinate changes: each such axis crosses exactly
+/// |Δ| voxel boundaries, so the walk takes exactly that many steps and ends in @a last whatever
+/// the rounding (the crossing parameters are clamped to stay monotone in [0, 1]). This is the walk
+/// the tangent field's estimate ships (TangentField.cc).
+/// @param first, last the voxels of @a a and @a b (voxelOf() below), which the caller often has
+/// @return the number of voxels stepped through (|Δx| + |Δy| + |Δz| + 1).
+template<typename Fn>
+inline std::uint64_t walkSegment(const openvdb::Vec3d& a, const openvdb::Vec3d& b, openvdb::Coord first,
+                                 const openvdb::Coord& last, Fn&& fn)
+{
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    openvdb::Coord& ijk = first;
+    int step[3], left[3];
+    double tMax[3], tDelta[3];
+    int total = 0;
+    for (int k = 0; k < 3; ++k) {
+        const int n = last[k] - ijk[k];
+        left[k] = std::abs(n);
+        total += left[k];
+        if (n == 0) {
+            step[k] = 0;
+            tMax[k] = tDelta[k] = inf;
+        } else {
+            // The boundary on the way out of the first voxel, and the next ones 1 / |d| apart.
+            const double inv = 1.0 / (b[k] - a[k]);
+            step[k] = n > 0 ? 1 : -1;
+            tDelta[k] = std::abs(inv);
+            tMax[k] = (double(ijk[k]) + 0.5 * double(step[k]) - a[k]) * inv;
+        }
+    }
+    double t = 0.0;
+    for (int s = 0; s < total; ++s) {
+        const int axis = (tMax[0] < tMax[1]) ? (tMax[0] < tMax[2] ? 0 : 2) : (tMax[1] < tMax[2] ? 1 : 2);
+        const double tNext = std::min(std::max(tMax[axis], t), 1.0);  // monotone despite rounding
+        if (tNext > t) fn(static_cast<const openvdb::Coord&>(ijk), t, tNext);
+        t = tNext;
+        ijk[axis] += step[axis];
+        tMax[axis] = --left[axis] > 0 ? tMax[axis] + tDelta[axis] : inf;
+    }
+    if (1.0 > t) fn(static_cast<const openvdb::Coord&>(ijk), t, 1.0);
+    return std::uint64_t(total) + 1;
+}
+
+/// @brief The voxel holding index position @a p (voxel ijk spans [ijk - 0.5, ijk + 0.5)).
+inline openvdb::Coord voxelOf(const openvdb::Vec3d& p)
+{
+    return openvdb::Coord(floorToInt(p.x() + 0.5), floorToInt(p.y() + 0.5), floorToInt(p.z() + 0.5));
+}
+
+/// @brief walkSegment() with the voxels of @a a and @a b found here.
 template<typename Fn>
 inline std::uint64_t walkSegment(const openvdb::Vec3d& a, const openvdb::Vec3d& b, Fn&& fn)
 {
-    const openvdb::Vec3d d = b - a;
-    openvdb::Coord ijk(floorToInt(a.x() + 0.5), floorToInt(a.y() + 0.5), floorToInt(a.z() + 0.5));
-    const openvdb::Coord last(floorToInt(b.x() + 0.5), floorToInt(b.y() + 0.5), floorToInt(b.z() + 0.5));
-    if (ijk == last) {  // the common case for segments shorter than a voxel
-        fn(ijk, 0.0, 1.0);
-        return 1;
-    }
-    int step[3];
-    double tMax[3], tDelta[3];
-    constexpr double inf = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 3; ++k) {
-        if (d[k] > 0.0) {
-            step[k] = 1;
-            tDelta[k] = 1.0 / d[k];
-            tMax[k] = (double(ijk[k]) + 0.5 - a[k]) * tDelta[k];
-        } else if (d[k] < 0.0) {
-            step[k] = -1;
-            tDelta[k] = -1.0 / d[k];
-            tMax[k] = (a[k] - double(ijk[k]) + 0.5) * tDelta[k];
-        } else {
-            step[k] = 0;
-            tMax[k] = inf;
-            tDelta[k] = inf;
-        }
-    }
-    // At most one voxel per crossed boundary plus the first: a hard bound against rounding loops.
-    const std::uint64_t maxVisits = std::uint64_t(std::abs(last.x() - ijk.x())) +
-                                    std::uint64_t(std::abs(last.y() - ijk.y())) +
-                                    std::uint64_t(std::abs(last.z() - ijk.z())) + 1;
-    double t = 0.0;
-    std::uint64_t visits = 0;
-    while (true) {
-        const int axis = (tMax[0] < tMax[1]) ? (tMax[0] < tMax[2] ? 0 : 2) : (tMax[1] < tMax[2] ? 1 : 2);
-        const double tNext = tMax[axis];
-        if (tNext >= 1.0 || visits + 1 >= maxVisits) {
-            if (1.0 > t) fn(ijk, t, 1.0);
-            return visits + 1;
-        }
-        if (tNext > t) {
-            fn(ijk, t, tNext);
-            t = tNext;
-        }
-        ijk[axis] += step[axis];
-        tMax[axis] += tDelta[axis];
-        ++visits;
-    }
+    return walkSegment(a, b, voxelOf(a), voxelOf(b), std::forward<Fn>(fn));
 }
 
 /// @brief An upper bound on the voxels walkSegment() visits, cheap enough to compute for every

@@ -58,7 +58,7 @@ void TraceParams::validate(const std::string& where) const
         throw ValueError(where + ": margin " + std::to_string(margin) + " voxels must be between 0 and " + std::to_string(kMaxMargin));
     }
     if (vanishThreshold < 0.0 || !(vanishThreshold < 1.0)) {
-        throw ValueError(where + ": vanish threshold " + std::to_string(vanishThreshold) + " must be in [0, 1)");
+        throw ValueError(where + ": vanishThreshold " + std::to_string(vanishThreshold) + " must be in [0, 1)");
     }
 }
 

@@ -82,6 +82,11 @@ inline StopReason stopReasonOf(SampleStatus status)
 /// applies it.
 constexpr double kDefaultStepVoxels = 0.5;
 
+/// @brief The default vanish threshold: a streamline stops where the blended direction's length
+/// falls below this fraction of the blend's weight (see the file comment). The one place this
+/// default lives: TraceParams, ConsistencyParams and the tangent-angle measure use it.
+constexpr double kDefaultVanishThreshold = 1e-3;
+
 /// @brief The step in world units: @a step if positive, else kDefaultStepVoxels · @a voxelSize.
 /// @throw ValueError "<where>: step <value> must be 0 (half a voxel) or a positive finite length"
 /// for a negative or non-finite step (never silently the default).
@@ -121,7 +126,7 @@ struct TraceParams
     /// world units; 0 picks kDefaultStepVoxels (half a voxel) of the field's voxel size
     double step = 0.0;
     Integrator integrator = Integrator::Euler;
-    double vanishThreshold = 1e-3;  ///< see the file comment
+    double vanishThreshold = kDefaultVanishThreshold;  ///< see the file comment; [0, 1)
     std::size_t maxSteps = 0;       ///< 0: as many as the length needs
     int margin = 3;                 ///< voxels a strand may continue straight past the active region (0: none)
     RetraceVertices vertices = RetraceVertices::Input;
@@ -129,8 +134,9 @@ struct TraceParams
 
     static constexpr int kMaxMargin = 16;  ///< voxels
 
-    /// @throw ValueError "<where>: <parameter> <value> must ..." for a negative or non-finite
-    /// step, a margin outside [0, kMaxMargin], a vanish threshold outside [0, 1).
+    /// @throw ValueError "<where>: <parameter> <value> must ..." (the parameter by its field
+    /// name: step, margin, vanishThreshold) for a negative or non-finite step, a margin outside
+    /// [0, kMaxMargin], a vanish threshold outside [0, 1).
     void validate(const std::string& where) const;
 };
 

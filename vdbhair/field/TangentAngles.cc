@@ -4,6 +4,7 @@
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
 #include <vdbhair/field/Simd.h>
+#include <vdbhair/field/Streamline.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <openvdb/openvdb.h>
@@ -73,7 +74,7 @@ public:
     }
 
 private:
-    static constexpr float kThreshold = 1e-3f;
+    static constexpr float kThreshold = float(kDefaultVanishThreshold);  // the tracer's rule
     FieldSampler<TreeT> mSampler;
     const FieldMapping& mMap;
     std::vector<Vec3f> mTangents;

@@ -183,9 +183,8 @@ private:
 /// Consecutive pieces in the same voxel (strands often take several segments per voxel) are summed
 /// in registers and written to the chunk when the walk moves on. Per segment: the world segment
 /// gives the moments of the whole segment once (Moments::ofSegment); the index-space segment
-/// gives the voxels and the fraction of its length in each, by a 3D DDA restricted to the axes
-/// whose voxel coordinate changes — each such axis crosses exactly |Δ| voxel boundaries, so the
-/// walk takes exactly that many steps and ends in the end vertex's voxel.
+/// gives the voxels and the fraction of its length in each, by walkSegment() (SegmentWalk.h: a 3D
+/// DDA that takes exactly |Δ| steps per axis and ends in the end vertex's voxel).
 template<typename ToIndex>
 class SegmentAccumulator
 {
@@ -226,12 +225,6 @@ public:
     }
 
 private:
-    /// The voxel holding index position @a p (voxel ijk spans [ijk - 0.5, ijk + 0.5)).
-    static Coord voxelOf(const Vec3d& p)
-    {
-        return Coord(floorToInt(p.x() + 0.5), floorToInt(p.y() + 0.5), floorToInt(p.z() + 0.5));
-    }
-
     void add(const Coord& ijk, const Moments& u)
     {
         if (!ChunkWriter::sameCoord(ijk, mCurrent)) {
@@ -250,38 +243,11 @@ private:
         mPending.addScaled(u, f);
     }
 
-    /// The DDA of a segment from @a a (voxel @a va) to @a b (voxel @a vb != va), index space.
-    void walk(const Vec3d& a, const Vec3d& b, Coord c, const Coord& vb, const Moments& u)
+    /// The segment from @a a (voxel @a va) to @a b (voxel @a vb != va), index space, through
+    /// every voxel it passes (SegmentWalk.h).
+    void walk(const Vec3d& a, const Vec3d& b, const Coord& va, const Coord& vb, const Moments& u)
     {
-        constexpr double inf = std::numeric_limits<double>::infinity();
-        int step[3], left[3];
-        double tMax[3], tDelta[3];
-        int total = 0;
-        for (int k = 0; k < 3; ++k) {
-            const int n = vb[k] - c[k];
-            left[k] = std::abs(n);
-            total += left[k];
-            if (n == 0) {
-                step[k] = 0;
-                tMax[k] = tDelta[k] = inf;
-            } else {
-                // The boundary on the way out of the first voxel, and the next ones 1 / |d| apart.
-                const double inv = 1.0 / (b[k] - a[k]);
-                step[k] = n > 0 ? 1 : -1;
-                tDelta[k] = std::abs(inv);
-                tMax[k] = (double(c[k]) + 0.5 * double(step[k]) - a[k]) * inv;
-            }
-        }
-        double t = 0.0;
-        for (int s = 0; s < total; ++s) {
-            const int axis = (tMax[0] < tMax[1]) ? (tMax[0] < tMax[2] ? 0 : 2) : (tMax[1] < tMax[2] ? 1 : 2);
-            const double tNext = std::min(std::max(tMax[axis], t), 1.0);  // monotone despite rounding
-            if (tNext > t) add(c, u, float(tNext - t));  // pieces of zero length are skipped
-            t = tNext;
-            c[axis] += step[axis];
-            tMax[axis] = --left[axis] > 0 ? tMax[axis] + tDelta[axis] : inf;
-        }
-        if (1.0 > t) add(c, u, float(1.0 - t));
+        walkSegment(a, b, va, vb, [&](const Coord& c, double t0, double t1) { add(c, u, float(t1 - t0)); });
     }
 
     ChunkWriter mWriter;
@@ -297,7 +263,8 @@ void checkParams(const StrandSet& strands, const FieldParams& p, const char* whe
 {
     if (strands.empty()) throw ValueError(std::string(where) + ": the hairstyle has no strands");
     if (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize)) {
-        throw ValueError(std::string(where) + ": voxel size " + std::to_string(p.voxelSize) + " must be a positive finite length");
+        throw ValueError(std::string(where) + ": voxel size " + std::to_string(p.voxelSize) +
+                         " must be a positive finite length (0 picks suggestVoxelSize())");
     }
     if (p.densityReference < 0.0 || !std::isfinite(p.densityReference)) {
         throw ValueError(std::string(where) + ": density reference " + std::to_string(p.densityReference) +
@@ -347,7 +314,7 @@ void withToIndex(const FieldMapping& map, Fn&& fn)
     else fn(MappedToIndex{map});
 }
 
-/// The bounding box of the vertices and the voxel visit bound, in one parallel pass.
+/// The bounding box of the vertices and the voxel visit bound, in one pass (parallel when threaded).
 struct Extent
 {
     BBox box;
@@ -358,49 +325,50 @@ struct Extent
 /// Voxel visit bounds saturate here (beyond any cap).
 constexpr std::uint64_t kSaturated = std::uint64_t(1) << 62;
 
-Extent measure(const StrandSet& strands, const FieldMapping& map)
+Extent measure(const StrandSet& strands, const FieldMapping& map, bool threaded)
 {
     Extent result;
     withToIndex(map, [&](const auto& toIndex) {
-        result = tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, strands.numStrands(), 256), Extent(),
-            [&](const tbb::blocked_range<std::size_t>& r, Extent e) {
-                Float4 lo = loadFloat3(e.box.min.asPointer()), hi = loadFloat3(e.box.max.asPointer());
-                Int4 nan = {0, 0, 0, 0};
-                for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                    const Vec3f* v = strands.data(i);
-                    const std::size_t n = strands.size(i);
-                    Vec3d a = toIndex(v[0]);
-                    for (std::size_t j = 0; j < n; ++j) {
-                        const Float4 p = loadFloat3(v[j].asPointer());
-                        lo = p < lo ? p : lo;
-                        hi = p > hi ? p : hi;
-                        nan |= p != p;
-                        if (j == 0 || e.visits > kSaturated) continue;
-                        const Vec3d b = toIndex(v[j]);
-                        e.visits += segmentVoxelBound(a, b);
-                        a = b;
-                    }
+        // Min, max and integer sums: the same result however the range is split.
+        const tbb::blocked_range<std::size_t> all(0, strands.numStrands(), 256);
+        const auto extend = [&](const tbb::blocked_range<std::size_t>& r, Extent e) {
+            Float4 lo = loadFloat3(e.box.min.asPointer()), hi = loadFloat3(e.box.max.asPointer());
+            Int4 nan = {0, 0, 0, 0};
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const Vec3f* v = strands.data(i);
+                const std::size_t n = strands.size(i);
+                Vec3d a = toIndex(v[0]);
+                for (std::size_t j = 0; j < n; ++j) {
+                    const Float4 p = loadFloat3(v[j].asPointer());
+                    lo = p < lo ? p : lo;
+                    hi = p > hi ? p : hi;
+                    nan |= p != p;
+                    if (j == 0 || e.visits > kSaturated) continue;
+                    const Vec3d b = toIndex(v[j]);
+                    e.visits += segmentVoxelBound(a, b);
+                    a = b;
                 }
-                e.box.min = Vec3f(lo[0], lo[1], lo[2]);
-                e.box.max = Vec3f(hi[0], hi[1], hi[2]);
-                e.nan = e.nan || any(nan);
-                return e;
-            },
-            [](Extent a, const Extent& b) {
-                a.box.expand(b.box.min);
-                a.box.expand(b.box.max);
-                a.nan = a.nan || b.nan;
-                a.visits = std::min(a.visits + b.visits, kSaturated);
-                return a;
-            });
+            }
+            e.box.min = Vec3f(lo[0], lo[1], lo[2]);
+            e.box.max = Vec3f(hi[0], hi[1], hi[2]);
+            e.nan = e.nan || any(nan);
+            return e;
+        };
+        const auto join = [](Extent a, const Extent& b) {
+            a.box.expand(b.box.min);
+            a.box.expand(b.box.max);
+            a.nan = a.nan || b.nan;
+            a.visits = std::min(a.visits + b.visits, kSaturated);
+            return a;
+        };
+        result = threaded ? tbb::parallel_reduce(all, Extent(), extend, join) : extend(all, Extent());
     });
     return result;
 }
 
 std::uint64_t visitBound(const StrandSet& strands, const FieldMapping& map)
 {
-    return std::min(measure(strands, map).visits, kSaturated);
+    return std::min(measure(strands, map, true).visits, kSaturated);
 }
 
 TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, double voxelSize, int level, int levels,
@@ -414,7 +382,12 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     // strands share voxels, so a chunk's moments stay small and in cache.
     Extent extent;
     std::vector<std::uint32_t> order;
-    tbb::parallel_invoke([&] { extent = measure(strands, map); }, [&] { order = spatialOrder(strands); });
+    if (threaded) {
+        tbb::parallel_invoke([&] { extent = measure(strands, map, true); }, [&] { order = spatialOrder(strands); });
+    } else {
+        extent = measure(strands, map, false);
+        order = spatialOrder(strands);
+    }
     if (extent.nan) extent.box.min = Vec3f(std::numeric_limits<float>::quiet_NaN());  // fails below
     for (const Vec3f& corner : {extent.box.min, extent.box.max}) {
         const Vec3d ip = map.worldToIndex(Vec3d(corner));
@@ -430,7 +403,7 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     if (bound > p.maxVoxels) {
         throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) + " needs up to " +
                          std::to_string(bound) + " voxel visits, more than the cap of " +
-                         std::to_string(p.maxVoxels) + " (raise --max-voxels or the voxel size)");
+                         std::to_string(p.maxVoxels) + " (raise maxVoxels or the voxel size)");
     }
 
     // Accumulate the moments, chunk by chunk (each chunk in strand order).
@@ -581,28 +554,49 @@ openvdb::GridCPtrVec TangentField::grids() const
     return out;
 }
 
+double resolveVoxelSize(const StrandSet& strands, const FieldParams& params)
+{
+    return params.voxelSize == 0.0 ? suggestVoxelSize(strands) : params.voxelSize;
+}
+
+namespace {
+
+/// @a params with the voxel size resolved (resolveVoxelSize()) and checked (checkParams()).
+FieldParams resolvedParams(const StrandSet& strands, const FieldParams& params, const char* where)
+{
+    FieldParams p = params;
+    if (!strands.empty()) p.voxelSize = resolveVoxelSize(strands, params);
+    checkParams(strands, p, where);
+    return p;
+}
+
+} // namespace
+
 std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params)
 {
-    checkParams(strands, params, "estimateVoxelVisits");
-    return visitBound(strands, mappingFor(params, params.voxelSize));
+    const FieldParams p = resolvedParams(strands, params, "estimateVoxelVisits");
+    return visitBound(strands, mappingFor(p, p.voxelSize));
 }
 
 TangentField estimateTangentField(const StrandSet& strands, const FieldParams& params, bool threaded,
                                   openvdb::util::NullInterrupter* interrupter)
 {
-    checkParams(strands, params, "estimateTangentField");
-    return estimateLevel(strands, params, params.voxelSize, 0, 1, threaded, interrupter);
+    const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
+    return estimateLevel(strands, p, p.voxelSize, 0, 1, threaded, interrupter);
 }
 
 std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, const FieldParams& params, int levels,
                                                      bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
-    checkParams(strands, params, "estimateTangentField");
-    if (levels < 1 || levels > 16) throw ValueError("estimateTangentField: levels " + std::to_string(levels) + " must be between 1 and 16");
+    if (levels < 1 || levels > FieldParams::kMaxLevels) {
+        throw ValueError("estimateTangentField: levels " + std::to_string(levels) + " must be between 1 and " +
+                         std::to_string(FieldParams::kMaxLevels));
+    }
+    FieldParams lp = resolvedParams(strands, params, "estimateTangentField");
+    const double voxelSize = lp.voxelSize;
     std::vector<TangentField> out;
-    FieldParams lp = params;
     for (int l = 0; l < levels; ++l) {
-        out.push_back(estimateLevel(strands, lp, params.voxelSize * double(1 << l), l, levels, threaded, interrupter));
+        out.push_back(estimateLevel(strands, lp, voxelSize * double(1 << l), l, levels, threaded, interrupter));
         lp.densityReference = out.front().densityReference;  // one meaning for every level
     }
     return out;

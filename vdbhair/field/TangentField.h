@@ -33,13 +33,18 @@ namespace vdbhair {
 
 struct FieldParams
 {
-    double voxelSize = 0.0;   ///< world units (>= 2e-5, OpenVDB's limit); in scalp space, world units at the scalp
+    /// Most levels of estimateTangentFieldLevels() (level 15 has 32768 times the voxel size).
+    static constexpr int kMaxLevels = 16;
+
+    /// World units (>= 2e-5, OpenVDB's limit); in scalp space, world units at the scalp.
+    /// 0 picks suggestVoxelSize() of the strands (resolveVoxelSize()).
+    double voxelSize = 0.0;
     int iterations = 2;       ///< Eq. 9 iterations (>= 1)
     FieldSpace space = FieldSpace::World;
     ScalpSphere scalp;        ///< used in scalp space
     /// Cap on the voxel visits the segments could need (an upper bound computed before any
     /// allocation); about 40 bytes each at most. A voxel size too small for the hairstyle fails
-    /// with LimitError instead of exhausting memory.
+    /// with LimitError (naming maxVoxels) instead of exhausting memory.
     std::uint64_t maxVoxels = std::uint64_t(1) << 26;
     /// The hair length per unit volume (world units^-2) that `density` maps to 1; 0 chooses it
     /// (see TangentField::density).
@@ -72,10 +77,24 @@ struct TangentField
     openvdb::GridCPtrVec grids() const;
 };
 
-/// @brief Estimate the field of @a strands at one voxel size.
-/// @throw ValueError (empty hairstyle, voxel size not positive and finite, iterations < 1),
+/// @brief The default finest voxel size of a hairstyle, from its own scale: three times the
+/// median distance between neighbouring roots (so that a voxel near the scalp holds about nine
+/// strands, enough for a robust direction and its spread), kept between 1/64 and 1/4 of the head
+/// radius (the radius of the sphere fitted to the roots, or half the hair's largest extent when
+/// that fit is implausible) so that the finest level resolves wisps whatever the strand count.
+/// Coarser levels double it, as Wang et al. halve their spacing from coarse to fine.
+/// (Defined in Refine.cc, with the root-sphere fit it shares with headFromRoots().)
+/// @throw ValueError for an empty hairstyle.
+double suggestVoxelSize(const StrandSet& strands);
+
+/// @brief The voxel size an estimate at @a params uses: params.voxelSize, or
+/// suggestVoxelSize(@a strands) when it is 0 (the one place that rule lives).
+double resolveVoxelSize(const StrandSet& strands, const FieldParams& params);
+
+/// @brief Estimate the field of @a strands at one voxel size (params.voxelSize, 0: resolveVoxelSize()).
+/// @throw ValueError (empty hairstyle, voxel size negative or not finite, iterations < 1),
 /// LimitError (the voxel bound exceeds params.maxVoxels; the message says the estimate and the
-/// cap), InterruptedError.
+/// cap and names maxVoxels), InterruptedError.
 /// @warning Thread-safe for concurrent calls on different outputs.
 TangentField estimateTangentField(const StrandSet& strands, const FieldParams& params,
                                   bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr);
@@ -83,6 +102,7 @@ TangentField estimateTangentField(const StrandSet& strands, const FieldParams& p
 /// @brief Multi-level fields: level l has voxel size params.voxelSize · 2^l (Wang et al. halve the
 /// spacing from level to level); element l of the result is level l (0 the finest). Grids are
 /// named with tangentGridName(l, levels) / densityGridName(l, levels).
+/// @throw as estimateTangentField(); ValueError for @a levels outside [1, FieldParams::kMaxLevels].
 std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, const FieldParams& params,
                                                      int levels, bool threaded = true,
                                                      openvdb::util::NullInterrupter* interrupter = nullptr);

@@ -160,7 +160,7 @@ void AtomicOutput::commit()
             const int err = errno;
             std::error_code ec;
             fs::remove(mTemp, ec);
-            if (err == EEXIST) throw IoError(mTarget + ": exists; --no-clobber refuses to replace it (nothing was written)");
+            if (err == EEXIST) throw IoError(mTarget + ": exists; OverwritePolicy::NoClobber refuses to replace it (nothing was written)");
             throw IoError(mTarget + ": cannot move the finished output into place: " + std::strerror(err));
         }
         std::error_code ec;

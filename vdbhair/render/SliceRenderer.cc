@@ -135,7 +135,7 @@ struct InPlaneSampler
 
 void parseSlice(const std::string& text, int& axis, double& world)
 {
-    const std::string rule = "--slice " + text + ": expected AXIS=WORLD with AXIS x, y or z and WORLD a finite number (e.g. z=1.5)";
+    const std::string rule = "slice " + text + ": expected AXIS=WORLD with AXIS x, y or z and WORLD a finite number (e.g. z=1.5)";
     if (text.size() < 3 || text[1] != '=' || (text[0] != 'x' && text[0] != 'y' && text[0] != 'z')) throw ValueError(rule);
     axis = text[0] - 'x';
     const std::string number = text.substr(2);
@@ -148,11 +148,13 @@ SliceResult renderSlice(const std::string& path, const std::string& gridName, co
 {
     const std::string where = "inspect(" + path + ")";
     if (params.axis < 0 || params.axis > 2) throw ValueError(where + ": slice axis " + std::to_string(params.axis) + " is not 0, 1 or 2");
-    if (params.width < 16 || params.width > 16384) {
-        throw ValueError(where + ": --width " + std::to_string(params.width) + ": must be between 16 and 16384 pixels");
+    if (params.width < SliceParams::kMinWidth || params.width > SliceParams::kMaxWidth) {
+        throw ValueError(where + ": width " + std::to_string(params.width) + " must be between " + std::to_string(SliceParams::kMinWidth) +
+                         " and " + std::to_string(SliceParams::kMaxWidth) + " pixels");
     }
-    if (params.streamlines < 0 || params.streamlines > 100000) {
-        throw ValueError(where + ": --streamlines " + std::to_string(params.streamlines) + ": must be between 0 and 100000");
+    if (params.streamlines < 0 || params.streamlines > SliceParams::kMaxStreamlines) {
+        throw ValueError(where + ": streamlines " + std::to_string(params.streamlines) + " must be between 0 and " +
+                         std::to_string(SliceParams::kMaxStreamlines));
     }
     const openvdb::GridBase::Ptr base = readVdbGrid(path, gridName, where);
     const std::string gw = where + ": grid '" + gridName + "'";

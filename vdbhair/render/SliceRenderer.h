@@ -26,11 +26,14 @@ enum class SliceColor { Rgb, Hsv };
 
 struct SliceParams
 {
+    static constexpr int kMinWidth = 16, kMaxWidth = 16384;  ///< pixels
+    static constexpr int kMaxStreamlines = 100000;
+
     int axis = 2;               ///< 0: x, 1: y, 2: z
     double world = 0.0;         ///< the plane's world coordinate along @a axis
-    int width = 1024;           ///< of the plot (height follows the grid's aspect)
+    int width = 1024;           ///< of the plot, kMinWidth to kMaxWidth (height follows the grid's aspect)
     SliceColor color = SliceColor::Rgb;
-    int streamlines = 0;
+    int streamlines = 0;        ///< 0 to kMaxStreamlines
 };
 
 struct SliceResult

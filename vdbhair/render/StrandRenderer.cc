@@ -40,6 +40,19 @@ const char* viewName(View v)
     }
 }
 
+const char* colorByName(ColorBy colorBy)
+{
+    switch (colorBy) {
+    case ColorBy::Shaded: return "shaded";
+    case ColorBy::Root: return "root";
+    case ColorBy::Tangent: return "tangent";
+    case ColorBy::Depth: return "depth";
+    case ColorBy::Curvature: return "curvature";
+    case ColorBy::Strand: return "strand";
+    }
+    return "shaded";
+}
+
 ColorBy colorByFromName(const std::string& name)
 {
     if (name == "shaded") return ColorBy::Shaded;
@@ -48,7 +61,7 @@ ColorBy colorByFromName(const std::string& name)
     if (name == "depth") return ColorBy::Depth;
     if (name == "curvature") return ColorBy::Curvature;
     if (name == "strand") return ColorBy::Strand;
-    throw ValueError("--color-by '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand");
+    throw ValueError("colorBy '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand");
 }
 
 namespace {
@@ -325,9 +338,10 @@ BBox renderFrame(const StrandSet& strands, const RenderParams& params)
 
 void checkSize(const RenderParams& p)
 {
-    if (p.width < 1 || p.height < 1 || p.width > 16384 || p.height > 16384) {
+    if (p.width < 1 || p.height < 1 || p.width > RenderParams::kMaxSize || p.height > RenderParams::kMaxSize) {
+        const std::string most = std::to_string(RenderParams::kMaxSize);
         throw ValueError("image size " + std::to_string(p.width) + "x" + std::to_string(p.height) +
-                         " must be between 1x1 and 16384x16384 pixels");
+                         " must be between 1x1 and " + most + "x" + most + " pixels");
     }
     if (p.supersample < 1 || p.supersample > 8) throw ValueError("supersampling " + std::to_string(p.supersample) + " must be 1 to 8");
 }

@@ -36,12 +36,16 @@ enum class ColorBy
     Curvature,  ///< 1 / world units, colour map with a legend (5th to 95th percentile)
     Strand      ///< a colour per strand, lit
 };
+/// @throw ValueError naming colorBy unless one of colorByName()'s names.
 ColorBy colorByFromName(const std::string& name);
+const char* colorByName(ColorBy colorBy);
 
 struct RenderParams
 {
+    static constexpr int kMaxSize = 16384;  ///< most pixels of width and of height
+
     View view = View::ThreeQuarter;
-    int width = 1024, height = 1024;
+    int width = 1024, height = 1024;  ///< pixels, 1 to kMaxSize
     ColorBy colorBy = ColorBy::Shaded;
     Vec3f hairColor{0.30f, 0.17f, 0.08f};
     Vec3f background{1.f, 1.f, 1.f};

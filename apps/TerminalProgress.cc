@@ -1,4 +1,4 @@
-#include "Progress.h"
+#include "TerminalProgress.h"
 
 #include <vdbhair/io/FileUtil.h>
 
@@ -23,8 +23,11 @@ bool commitRefused() { return sSignal != 0; }
 
 /// For tests of Ctrl-C that must not depend on the machine's speed: with
 /// VDBHAIR_TEST_INTERRUPT_AFTER=N in the environment, the first report of N or more items done
-/// raises SIGINT in the process itself, exactly as a Ctrl-C at that point would.
+/// raises SIGINT in the process itself, exactly as a Ctrl-C at that point would. With
+/// VDBHAIR_TEST_INTERRUPT_DRAWN=1, the first line drawn with a rate and a time left does (a test
+/// of the drawn bar then needs no timer that a fast machine could outrun or a slow one miss).
 std::uint64_t sInterruptAfter = 0;
+bool sInterruptDrawn = false;
 
 /// "12", "1.2k", "3.4M": three significant digits are all a progress line needs.
 std::string shortNumber(double v)
@@ -83,6 +86,7 @@ void installInterruptHandlers()
     setHandlers(SA_RESETHAND | SA_RESTART);
     setCommitInterruptCheck(commitRefused);
     if (const char* n = std::getenv("VDBHAIR_TEST_INTERRUPT_AFTER"); n && *n) sInterruptAfter = std::strtoull(n, nullptr, 10);
+    if (const char* d = std::getenv("VDBHAIR_TEST_INTERRUPT_DRAWN"); d && *d == '1') sInterruptDrawn = true;
 }
 
 bool interruptRequested() { return sSignal != 0; }
@@ -226,6 +230,7 @@ void TerminalProgress::draw()
     std::fprintf(stderr, "\r%s\033[K", line.c_str());
     std::fflush(stderr);
     mShown = true;
+    if (sInterruptDrawn && sSignal == 0 && mTotal > 0 && mDone.load() > 0 && mDone.load() < mTotal) std::raise(SIGINT);
 }
 
 void TerminalProgress::erase()

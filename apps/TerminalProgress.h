@@ -1,4 +1,4 @@
-/// @file Progress.h
+/// @file TerminalProgress.h
 /// @brief The command's progress bar and Ctrl-C handling.
 ///
 /// TerminalProgress is the interrupter (vdbhair/Progress.h, OpenVDB's pattern) every long command

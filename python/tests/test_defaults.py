@@ -1,0 +1,89 @@
+"""The Python keyword defaults and the command's defaults are the library's, so they agree:
+each keyword below against what `vdbhair <verb> --help` shows for the flag that sets the same
+parameter. Both come from the library's parameter structs (FieldParams, TraceParams,
+RefineParams, ...); a default restated in either front end fails here once it drifts."""
+import os
+import pathlib
+import re
+import subprocess
+
+import pytest
+
+import vdbhair
+
+# (function, keyword, verb, flag)
+PAIRS = [
+    ("estimate_tangent_field", "iterations", "field", "--iterations"),
+    ("estimate_tangent_field", "max_voxels", "field", "--max-voxels"),
+    ("retrace", "integrator", "retrace", "--integrator"),
+    ("retrace", "vanish", "retrace", "--vanish"),
+    ("retrace", "max_steps", "retrace", "--max-steps"),
+    ("retrace", "margin", "retrace", "--margin"),
+    ("retrace", "vertices", "retrace", "--vertices"),
+    ("refine", "levels", "refine", "--levels"),
+    ("refine", "mode", "refine", "--mode"),
+    ("refine", "iterations", "refine", "--iterations"),
+    ("refine", "outlier_start", "refine", "--outlier-start"),
+    ("refine", "outlier_full", "refine", "--outlier-full"),
+    ("refine", "min_spread", "refine", "--min-spread"),
+    ("refine", "head_policy", "refine", "--head-policy"),
+    ("refine", "integrator", "refine", "--integrator"),
+    ("refine", "margin", "refine", "--margin"),
+    ("refine", "max_voxels", "refine", "--max-voxels"),
+    ("grow", "max_vertices", "grow", "--max-vertices"),
+    ("fit", "max_error", "fit", "--max-error"),
+    ("fit", "max_pieces", "fit", "--max-pieces"),
+    ("fit", "max_evaluations", "fit", "--max-evaluations"),
+    ("interpolate", "power", "interpolate", "--power"),
+    ("interpolate", "max_vertices", "interpolate", "--max-vertices"),
+    ("render", "view", "render", "--view"),
+    ("render", "width", "render", "--width"),
+    ("render", "height", "render", "--height"),
+    ("render", "color_by", "render", "--color-by"),
+    ("synth", "levels", "synth", "--levels"),
+    ("synth", "vertices", "synth", "--vertices"),
+    ("synth", "threshold", "synth", "--threshold"),
+    ("synth", "components", "synth", "--components"),
+    ("synth", "map_spacing", "synth", "--map-spacing"),
+    ("transfer", "smoothing", "transfer", "--smoothing"),
+    ("comb", "smoothing", "comb", "--smoothing"),
+    ("comb", "levels", "comb", "--levels"),
+]
+
+
+def cli():
+    """The `vdbhair` command of the same build (VDBHAIR_CLI, else bin/ next to the module's python/)."""
+    path = os.environ.get("VDBHAIR_CLI") or str(pathlib.Path(vdbhair.__file__).resolve().parents[1] / "bin" / "vdbhair")
+    assert os.access(path, os.X_OK), f"no vdbhair command at {path} (set VDBHAIR_CLI)"
+    return path
+
+
+def keyword_defaults(name):
+    """The keyword defaults of a binding, from pybind11's signature line."""
+    signature = getattr(vdbhair, name).__doc__.splitlines()[0]
+    return dict(re.findall(r"(\w+): [\w.\[\], ]+? = ([^,()]+|\([^)]*\))", signature))
+
+
+def flag_defaults(verb, cache={}):
+    """The defaults `vdbhair VERB --help` shows (`--flag TYPE=default`)."""
+    if verb not in cache:
+        text = subprocess.run([cli(), verb, "--help"], capture_output=True, text=True, check=True).stdout
+        cache[verb] = dict(re.findall(r"^\s+(?:-\w,)?(--[\w-]+) [A-Z]+=(\S+)", text, re.M))
+    return cache[verb]
+
+
+def same(python_value, cli_value):
+    python_value = python_value.strip().strip("'")
+    try:
+        return float(python_value) == float(cli_value)
+    except ValueError:
+        return python_value == cli_value
+
+
+@pytest.mark.parametrize("function, keyword, verb, flag", PAIRS, ids=[f"{f}.{k}" for f, k, _, _ in PAIRS])
+def test_python_defaults_are_the_commands(function, keyword, verb, flag):
+    python = keyword_defaults(function)
+    shown = flag_defaults(verb)
+    assert keyword in python, f"{function}() has no keyword default for {keyword}: {sorted(python)}"
+    assert flag in shown, f"vdbhair {verb} --help shows no default for {flag}: {sorted(shown)}"
+    assert same(python[keyword], shown[flag]), f"{function}({keyword}={python[keyword]}) but vdbhair {verb} {flag} defaults to {shown[flag]}"

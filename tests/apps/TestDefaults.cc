@@ -1,0 +1,230 @@
+// The command's options against the library's parameter structs: every default `--help` shows
+// is the struct's, every range the command checks is the library's named limit, and the
+// library's parameter names in messages become the verb's flags. A default restated in a
+// command (a literal beside the struct's member initializer) fails here as soon as they differ.
+#include "../TestUtil.h"
+
+#include "Command.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/field/Streamline.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/HelicoidInterpolation.h>
+#include <vdbhair/helicoid/PointInterpolation.h>
+#include <vdbhair/helicoid/Reconstruction.h>
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/StrandIO.h>
+#include <vdbhair/render/SliceRenderer.h>
+#include <vdbhair/render/StrandRenderer.h>
+#include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/ScalpRegion.h>
+#include <vdbhair/scalp/ScalpSurface.h>
+#include <vdbhair/synth/Comb.h>
+#include <vdbhair/synth/HairTransfer.h>
+#include <vdbhair/synth/Synthesis.h>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+using namespace vdbhair;
+using namespace vdbhair::app;
+
+namespace {
+
+/// Every verb registered as `vdbhair` registers them.
+struct Verbs
+{
+    CLI::App app{"vdbhair"};
+    CommonOptions common;
+    std::vector<Command> commands = addCommands(app, common);
+
+    const Command& command(const std::string& verb) const
+    {
+        for (const Command& c : commands) if (c.sub->get_name() == verb) return c;
+        FAIL("no verb " << verb);
+        throw std::logic_error("unreachable");
+    }
+    /// What `vdbhair <verb> --help` shows as the default of @a flag ("" for none).
+    std::string shown(const std::string& verb, const std::string& flag) const
+    {
+        return command(verb).sub->get_option(flag)->get_default_str();
+    }
+    /// Parse `vdbhair <args...>` and run the verb.
+    int run(std::vector<std::string> args)
+    {
+        std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 parses a vector from the back
+        app.parse(reversed);
+        for (const Command& c : commands) if (c.sub->parsed()) return c.run();
+        FAIL("no verb parsed");
+        return -1;
+    }
+};
+
+/// A value as CLI11 shows a default (capture_default_str()).
+template<typename T>
+std::string shownAs(const T& value)
+{
+    return CLI::detail::to_string(value);
+}
+
+} // namespace
+
+TEST_CASE("vdbhair --help: every default is the library's", "[apps]")
+{
+    const Verbs v;
+    struct Row
+    {
+        std::string verb, flag, expected;
+    };
+    const FieldParams field;
+    const TraceParams trace;
+    const RefineParams refine;
+    const FitParams fit;
+    const HelicoidInterpolationParams interp;
+    const ReconstructParams rec;
+    const FollicleParams follicles;
+    const ScalpParams scalp;
+    const SliceParams slice;
+    const RenderParams render;
+    const SynthParams synth;
+    const TransferParams transfer;
+    const CombParams comb;
+    const std::vector<Row> rows = {
+        {"field", "--iterations", shownAs(field.iterations)},
+        {"field", "--max-voxels", shownAs(field.maxVoxels)},
+        {"retrace", "--integrator", integratorName(trace.integrator)},
+        {"retrace", "--vanish", shownAs(trace.vanishThreshold)},
+        {"retrace", "--max-steps", shownAs(trace.maxSteps)},
+        {"retrace", "--margin", shownAs(trace.margin)},
+        {"retrace", "--vertices", trace.vertices == RetraceVertices::Input ? "input" : "steps"},
+        {"refine", "--levels", shownAs(refine.levels)},
+        {"refine", "--mode", refineModeName(refine.mode)},
+        {"refine", "--iterations", shownAs(refine.field.iterations)},
+        {"refine", "--outlier-start", shownAs(refine.consistency.zStart)},
+        {"refine", "--outlier-full", shownAs(refine.consistency.zFull)},
+        {"refine", "--min-spread", shownAs(refine.consistency.minSpreadDeg)},
+        {"refine", "--integrator", integratorName(refine.trace.integrator)},
+        {"refine", "--margin", shownAs(refine.trace.margin)},
+        {"refine", "--max-voxels", shownAs(refine.field.maxVoxels)},
+        {"refine", "--head-policy", headPolicyName(kDefaultHeadPolicy)},
+        {"demo", "--levels", shownAs(refine.levels)},
+        {"grow", "--max-vertices", shownAs(GrowOptions().maxVertices)},
+        {"fit", "--max-error", shownAs(fit.maxError)},
+        {"fit", "--lambda", shownAs(fit.lambda)},
+        {"fit", "--max-pieces", shownAs(fit.maxPieces)},
+        {"fit", "--max-evaluations", shownAs(fit.maxEvaluations)},
+        {"interpolate", "--power", shownAs(interp.shepard.power)},
+        {"interpolate", "--max-vertices", shownAs(interp.maxVertices)},
+        {"interpolate", "--up", axisName(interp.up)},
+        {"reconstruct", "--guides", formatValue(100.0 * rec.guideFraction) + "%"},
+        {"reconstruct", "--seed", shownAs(rec.seed)},
+        {"reconstruct", "--power", shownAs(rec.helicoid.shepard.power)},
+        {"reconstruct", "--max-error", shownAs(rec.fit.maxError)},
+        {"roots", "--seed", shownAs(follicles.seed)},
+        {"roots", "--iterations", shownAs(follicles.maxIterations)},
+        {"roots", "--step-scale", shownAs(follicles.stepScale)},
+        {"roots", "--up", axisName(follicles.up)},
+        {"scalp", "--half-width", shownAs(scalp.halfWidth)},
+        {"scalp", "--max-voxels", shownAs(scalp.maxVoxels)},
+        {"scalp", "--max-constraints", shownAs(ScalpParams{}.maxConstraints)},
+        {"scalp", "--region-threshold", shownAs(kDefaultRegionThreshold)},
+        {"inspect", "--width", shownAs(slice.width)},
+        {"inspect", "--streamlines", shownAs(slice.streamlines)},
+        {"render", "--view", viewName(render.view)},
+        {"render", "--width", shownAs(render.width)},
+        {"render", "--height", shownAs(render.height)},
+        {"render", "--color-by", colorByName(render.colorBy)},
+        {"render", "--up", axisName(render.up)},
+        {"render", "--grid", ReadOptions().vdbGrid},
+        {"convert", "--grid", ReadOptions().vdbGrid},
+        {"convert", "--codec", positionCodecName(WriteOptions().vdb.codec)},
+        {"convert", "--meters-per-unit", shownAs(WriteOptions().usd.metersPerUnit)},
+        {"synth", "--levels", shownAs(synth.cluster.levels)},
+        {"synth", "--seed", shownAs(synth.seed)},
+        {"synth", "--vertices", shownAs(synth.vertices)},
+        {"synth", "--threshold", shownAs(synth.cluster.threshold)},
+        {"synth", "--initial-clusters", shownAs(synth.cluster.initialClusters)},
+        {"synth", "--components", shownAs(synth.components)},
+        {"synth", "--map-spacing", shownAs(synth.mapSpacing)},
+        {"synth", "--place-weight", shownAs(synth.placeWeight)},
+        {"synth", "--nearby", shownAs(synth.texture.nearbyRadius)},
+        {"synth", "--voxel-size", shownAs(synth.voxelSize)},
+        {"transfer", "--smoothing", shownAs(transfer.smoothing)},
+        {"transfer", "--levels", shownAs(transfer.synth.cluster.levels)},
+        {"comb", "--smoothing", shownAs(comb.smoothing)},
+        {"comb", "--levels", shownAs(comb.synth.cluster.levels)},
+    };
+    for (const Row& r : rows) {
+        CAPTURE(r.verb, r.flag);
+        CHECK(v.shown(r.verb, r.flag) == r.expected);
+    }
+    // The help of a default the library computes names the library's rule.
+    CHECK_THAT(v.command("retrace").sub->get_option("--step")->get_description(),
+               Catch::Contains(formatValue(kDefaultStepVoxels) + " of the field's voxel size"));
+}
+
+TEST_CASE("vdbhair: range checks are the library's limits", "[apps]")
+{
+    const std::string missing = test::tempPath("defaults_missing.hair");
+    const std::string out = test::tempPath("defaults_out.vdb");
+    // One past a limit is refused before any file is read; the limit itself passes the checks
+    // and fails only on the missing input.
+    {
+        Verbs v;
+        REQUIRE_THROWS_WITH(v.run({"field", missing, "-o", out, "--levels", std::to_string(FieldParams::kMaxLevels + 1)}),
+                            Catch::Contains("--levels " + std::to_string(FieldParams::kMaxLevels + 1) + ": must be between 1 and " +
+                                            std::to_string(FieldParams::kMaxLevels)));
+    }
+    {
+        Verbs v;
+        REQUIRE_THROWS_AS(v.run({"field", missing, "-o", out, "--levels", std::to_string(FieldParams::kMaxLevels)}), IoError);
+    }
+    const std::string field = test::tempPath("defaults_missing.vdb"), traced = test::tempPath("defaults_out.hair");
+    {
+        Verbs v;
+        REQUIRE_THROWS_WITH(v.run({"retrace", missing, "--field", field, "-o", traced, "--margin", std::to_string(TraceParams::kMaxMargin + 1)}),
+                            Catch::Contains("must be between 0 and " + std::to_string(TraceParams::kMaxMargin)));
+    }
+    {
+        Verbs v;
+        REQUIRE_THROWS_AS(v.run({"retrace", missing, "--field", field, "-o", traced, "--margin", std::to_string(TraceParams::kMaxMargin)}),
+                          IoError);
+    }
+}
+
+TEST_CASE("withFlagNames: the library's parameter names become the verb's flags", "[apps]")
+{
+    const FlagNames names = {{"maxVoxels", "--max-voxels"}, {"margin", "--margin"}, {"slice", "--slice"}};
+    // An identifier wherever it stands as a word.
+    CHECK(withFlagNames("estimateTangentField: ... more than the cap of 9 (raise maxVoxels or the voxel size)", names) ==
+          "estimateTangentField: ... more than the cap of 9 (raise --max-voxels or the voxel size)");
+    CHECK(withFlagNames("maxVoxelsX and xmaxVoxels stay", names) == "maxVoxelsX and xmaxVoxels stay");
+    // A plain word only where a message names its parameter: at the start or after ": ".
+    CHECK(withFlagNames("retrace: margin 20 voxels must be between 0 and 16", names) == "retrace: --margin 20 voxels must be between 0 and 16");
+    CHECK(withFlagNames("slice w=3: expected AXIS=WORLD", names) == "--slice w=3: expected AXIS=WORLD");
+    CHECK(withFlagNames("inspect(a.vdb): no voxel grid to slice (only points)", names) == "inspect(a.vdb): no voxel grid to slice (only points)");
+    // What the library throws, as the verbs print it.
+    SliceParams sp;
+    sp.width = SliceParams::kMaxWidth + 1;
+    const Verbs v;
+    try {
+        renderSlice("missing.vdb", "tangent", sp);
+        FAIL("renderSlice accepted a width beyond SliceParams::kMaxWidth");
+    } catch (const ValueError& e) {
+        CHECK_THAT(withFlagNames(e.what(), v.command("inspect").flags),
+                   Catch::Contains("--width " + std::to_string(sp.width) + " must be between"));
+    }
+    try {
+        colorByFromName("plaid");
+        FAIL("colorByFromName accepted plaid");
+    } catch (const ValueError& e) {
+        CHECK(withFlagNames(e.what(), v.command("render").flags) ==
+              "--color-by 'plaid' is not one of shaded, root, tangent, depth, curvature, strand");
+    }
+}
