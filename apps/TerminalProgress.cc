@@ -180,7 +180,7 @@ bool TerminalProgress::wasInterruptedAt(std::uint64_t done, int)
     // Keep the largest: threads report out of order.
     std::uint64_t seen = mDone.load(std::memory_order_relaxed);
     while (done > seen && !mDone.compare_exchange_weak(seen, done, std::memory_order_relaxed)) {}
-    if (sInterruptAfter != 0 && done >= sInterruptAfter && sSignal == 0) std::raise(SIGINT);
+    if (sInterruptAfter != 0 && done >= sInterruptAfter && sSignal == 0) ::kill(::getpid(), SIGINT);  // to the process, as a Ctrl-C: the ticker thread blocks SIGINT
     return sSignal != 0;
 }
 
@@ -230,7 +230,7 @@ void TerminalProgress::draw()
     std::fprintf(stderr, "\r%s\033[K", line.c_str());
     std::fflush(stderr);
     mShown = true;
-    if (sInterruptDrawn && sSignal == 0 && mTotal > 0 && mDone.load() > 0 && mDone.load() < mTotal) std::raise(SIGINT);
+    if (sInterruptDrawn && sSignal == 0 && mTotal > 0 && mDone.load() > 0 && mDone.load() < mTotal) ::kill(::getpid(), SIGINT);  // to the process, as a Ctrl-C: the ticker thread blocks SIGINT
 }
 
 void TerminalProgress::erase()

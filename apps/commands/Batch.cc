@@ -1,7 +1,7 @@
 // vdbhair batch JOB.json -o OUTDIR: one verb over a dataset, each input in a process of its own,
 // with records, resumption and shards for schedulers (Slurm arrays); vdbhair batch --merge OUTDIR.
 #include "../Command.h"
-#include "../Progress.h"
+#include "../TerminalProgress.h"
 #include "../batch/BatchJob.h"
 #include "../batch/BatchRecords.h"
 #include "../batch/BatchShard.h"
