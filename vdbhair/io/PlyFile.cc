@@ -200,6 +200,18 @@ int findProperty(const Element* e, const char* name, bool list = false)
     return -1;
 }
 
+/// The (last) element named `vertex` of @a hdr.
+/// @throw FormatError when there is none.
+const Element& vertexElement(const PlyHeader& hdr, const std::string& where)
+{
+    const Element* vertexEl = nullptr;
+    for (const Element& e : hdr.elements) {
+        if (e.name == "vertex") vertexEl = &e;
+    }
+    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    return *vertexEl;
+}
+
 /// @brief Read the body after @a hdr, element by element and item by item, bounds-checked before
 /// anything is allocated. @a onElement(e) runs before an element's items; @a onItem(e, n, values,
 /// list, src) after each item, with its scalar property values (by property index) and, for the
@@ -534,11 +546,7 @@ OrientedPoints readPlyPoints(const std::string& path)
     const std::string where = "readPlyPoints(" + path + ")";
     const MappedFile file(path, where);
     const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
-    const Element* vertexEl = nullptr;
-    for (const Element& e : hdr.elements) {
-        if (e.name == "vertex") vertexEl = &e;
-    }
-    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    const Element* vertexEl = &vertexElement(hdr, where);
     const int ix = findProperty(vertexEl, "x"), iy = findProperty(vertexEl, "y"), iz = findProperty(vertexEl, "z");
     if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
     const int inx = findProperty(vertexEl, "nx"), iny = findProperty(vertexEl, "ny"), inz = findProperty(vertexEl, "nz");
@@ -569,11 +577,7 @@ std::vector<float> readPlyVertexValues(const std::string& path, const std::strin
     const std::string where = "readPlyVertexValues(" + path + ")";
     const MappedFile file(path, where);
     const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
-    const Element* vertexEl = nullptr;
-    for (const Element& e : hdr.elements) {
-        if (e.name == "vertex") vertexEl = &e;
-    }
-    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    const Element* vertexEl = &vertexElement(hdr, where);
     const int ip = findProperty(vertexEl, property.c_str());
     if (ip < 0) {
         std::string names;
