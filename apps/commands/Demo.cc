@@ -105,7 +105,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
                   << ", " << rp.field.iterations << " iterations of Wang et al. Eq. 9) in " << seconds << " s\n";
         printRefineReport(r, rp);
         std::cout << "wrote " << refinedPath << " (refined strands)\n"
-                  << "wrote " << fieldPath << " (grids 'tangent', 'density', 'coherence' and 'spread')\n"
+                  << "wrote " << fieldPath << " (grids 'tangent', 'density', 'hair_length', 'coherence' and 'spread')\n"
                   << "wrote " << strandsPath << " (points grids 'strands' and 'strands_input', for Houdini or Blender)\n"
                   << "wrote " << previewPath << " (before and after)\n"
                   << "wrote " << reportPath << "\n";
