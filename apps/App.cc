@@ -13,6 +13,8 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <atomic>
+#include <new>
 #include <cctype>
 #include <limits>
 #include <memory>
@@ -184,6 +186,31 @@ std::vector<std::string> nearestVerbs(const std::string& word, const std::vector
     return out;
 }
 
+namespace {
+
+/// Memory kept for unwinding after an allocation fails. OpenVDB's Tree::clear() allocates while a
+/// grid is destroyed, so when a failed allocation left nothing, the unwinding itself ran out and
+/// ended in std::terminate (measured: `field` under `ulimit -v 250000` aborted with SIGABRT and
+/// "terminate called after throwing an instance of 'std::bad_alloc'"). The first allocation that
+/// fails frees this reserve and throws, so the grids are destroyed with its room and the verb ends
+/// with its one-line "out of memory". The block is never touched: it holds address space, not RAM.
+constexpr std::size_t kUnwindReserveBytes = std::size_t(64) << 20;
+std::atomic<void*> sUnwindReserve{nullptr};
+
+void releaseUnwindReserve()
+{
+    std::free(sUnwindReserve.exchange(nullptr));
+    throw std::bad_alloc();
+}
+
+void keepUnwindReserve()
+{
+    if (sUnwindReserve.load() == nullptr) sUnwindReserve.store(std::malloc(kUnwindReserveBytes));
+    std::set_new_handler(releaseUnwindReserve);
+}
+
+} // namespace
+
 std::vector<Command> addCommands(CLI::App& app, CommonOptions& common)
 {
     std::vector<Command> commands;
@@ -298,6 +325,7 @@ int run(int argc, char** argv)
                                                             std::size_t(common.threads));
         }
         installInterruptHandlers();
+        keepUnwindReserve();
         TerminalProgress progress(verb, common.quiet);
         common.interrupter = &progress;
         // Errors: one line, after the progress line is erased, with the library's parameter names

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Times a dataset through `vdbhair field` three ways (issue 21's measure): the shell loop a user
 # writes today (one process per file, one after another, each with every core), and
-# `vdbhair batch` with --jobs 1 and --jobs 2. Prints the wall time, the time per file and the
-# throughput of each, and the scaling of batch's throughput with jobs.
+# `vdbhair batch` with --jobs 1, 2, ... up to twice the cores (JOBS="1 2 4" to choose). Prints the
+# wall time, the time per file and the throughput of each, and the scaling of batch's throughput
+# with jobs: it should grow until the cores are used and then stay flat.
 #   scripts/bench_batch.sh [DATA_GLOB] [VDBHAIR]
 # DATA_GLOB defaults to the 343 five-guide USC-HairSalon styles in ../shared (absolute, quoted);
 # VDBHAIR to build/bin/vdbhair. Extra field options: FIELD_ARGS="--voxel-size 0.01" (the default).
@@ -36,12 +37,18 @@ done
 loop=$(echo "$(now) - $t0" | bc)
 report "shell loop (sequential)" "$loop"
 
-for jobs in 1 2; do
+cores=$(nproc)
+job_counts=${JOBS:-$(j=1; while [ "$j" -le $((2 * cores)) ]; do printf '%s ' "$j"; j=$((2 * j)); done)}
+case " $job_counts " in *" 1 "*) ;; *) job_counts="1 $job_counts";; esac
+case " $job_counts " in *" 2 "*) ;; *) job_counts="$job_counts 2";; esac
+for jobs in $job_counts; do
   t0=$(now)
   "$cli" batch "$work/job.json" -o "$work/batch$jobs" --jobs $jobs --quiet || true
   s=$(echo "$(now) - $t0" | bc)
   report "batch --jobs $jobs" "$s"
   eval "batch$jobs=$s"
+  [ "$jobs" = 1 ] || awk -v b1="$batch1" -v s="$s" -v j="$jobs" -v c="$cores" \
+    'BEGIN { printf "  --jobs %d vs --jobs 1: %.2fx the throughput (%d cores)\n", j, b1 / s, c }'
 done
 # Each batch's outputs equal the loop's (after the .vdb header's random UUID).
 for f in "$work"/loop/*.vdb; do

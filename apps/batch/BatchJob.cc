@@ -227,6 +227,9 @@ std::vector<BatchItem> planBatch(const BatchJob& job, const std::string& outDir)
             throw ValueError(job.path + ": \"output\" gives '" + name + "', the name of batch's own records; choose another rule");
         }
         item.output = (fs::path(outDir) / name).string();
+        for (const std::string& a : job.args) {
+            if (a.rfind("{outdir}/", 0) == 0) item.moreOutputs.push_back(expandPlaceholders(a, item, outDir, job.path + ": \"args\""));
+        }
         const auto [it, added] = byOutput.emplace(item.output, i);
         if (!added) {
             throw ValueError(job.path + ": \"output\" '" + job.outputRule + "' maps both " + job.inputs[it->second] + " and " + item.input + " to " +
@@ -235,6 +238,21 @@ std::vector<BatchItem> planBatch(const BatchJob& job, const std::string& outDir)
         items.push_back(std::move(item));
     }
     return items;
+}
+
+bool outputsExist(const BatchItem& item, std::string* missing)
+{
+    if (!fs::exists(item.output)) {
+        if (missing) *missing = item.output;
+        return false;
+    }
+    for (const std::string& f : item.moreOutputs) {
+        if (!fs::exists(f)) {
+            if (missing) *missing = f;
+            return false;
+        }
+    }
+    return true;
 }
 
 } // namespace vdbhair::app

@@ -15,7 +15,9 @@
 /// relative paths in `args` mean the same. Placeholders, in `output` and in `args`: `{stem}` (the
 /// input's file name without its last extension), `{name}` (with it), `{index}` (the input's
 /// position in the sorted input list, from 0; the same in every shard), and in `args` only
-/// `{outdir}` (the output folder, absolute).
+/// `{outdir}` (the output folder, absolute). An argument that starts with `{outdir}/` names a
+/// second output of the verb (e.g. `--dense {outdir}/{stem}.npy`): an input is done only when its
+/// output and every such file exist.
 #pragma once
 
 #include <cstddef>
@@ -44,7 +46,11 @@ struct BatchItem
     std::size_t index = 0;  ///< in BatchJob::inputs
     std::string input;      ///< absolute
     std::string output;     ///< absolute, in the output folder
+    std::vector<std::string> moreOutputs;  ///< the arguments that start with {outdir}/, expanded
 };
+
+/// @brief Whether the output and every second output of @a item exist; else the first missing.
+bool outputsExist(const BatchItem& item, std::string* missing = nullptr);
 
 /// @brief Read, check and expand the JOB file @a path.
 /// @throw ValueError, one line naming the JOB, the key and the rule: invalid JSON, an unknown

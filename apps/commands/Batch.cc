@@ -126,16 +126,17 @@ nlohmann::json makeRecord(const BatchJob& job, const Running& run, const ChildEx
     for (const std::string& line : err) {
         if (line.find(": warning: ") != std::string::npos && warnings.size() < 20) warnings.push_back(line);
     }
-    const bool wrote = fs::exists(run.item.output);
+    std::string missing;
+    const bool wrote = outputsExist(run.item, &missing);
     const bool ok = exit.exitCode == 0 && wrote;
     nlohmann::json error = nullptr;
     if (!ok) {
         if (!err.empty() && err.back().find(": warning: ") == std::string::npos) error = err.back();
         else if (exit.signal) error = "killed by " + signalName(exit.signal) + (exit.signal == SIGKILL ? " (out of memory?)" : "");
-        else if (exit.exitCode == 0) error = "exited with status 0 but wrote no " + run.item.output;
+        else if (exit.exitCode == 0) error = "exited with status 0 but wrote no " + missing;
         else error = "exited with status " + std::to_string(exit.exitCode) + " and no message";
     }
-    nlohmann::json r = {{"input", run.item.input}, {"output", run.item.output}, {"index", run.item.index}, {"job", job.hash},
+    nlohmann::json r = {{"input", run.item.input}, {"output", run.item.output}, {"more_outputs", run.item.moreOutputs}, {"index", run.item.index}, {"job", job.hash},
                         {"verb", job.verb},        {"status", ok ? "ok" : "failed"}, {"seconds", seconds},
                         {"cpu_seconds", exit.cpuSeconds}, {"peak_rss_kb", exit.peakRssKb}, {"report", report},
                         {"error", error},          {"warnings", warnings}, {"finished", utcNow()}};
@@ -294,7 +295,7 @@ int runBatch(const BatchCmdParams& p, const CommonOptions& common)
         if (!shard.holds(item.index)) continue;
         ++s.inputs;
         const auto it = latest.find({item.input, job.hash});
-        const bool done = it != latest.end() && it->second["status"] == "ok" && fs::exists(item.output);
+        const bool done = it != latest.end() && it->second["status"] == "ok" && outputsExist(item);
         const bool failed = it != latest.end() && it->second["status"] == "failed";
         if (done) ++s.skipped;
         else if (p.retryFailed && !failed) ++s.notRun;
@@ -385,7 +386,8 @@ Command addBatchCommand(CLI::App& app, CommonOptions& common)
         "   \"verb\": \"field\",  \"args\": [\"--voxel-size\", \"0.005\"],  \"output\": \"{stem}.vdb\"}\n"
         "Verbs: convert field refine retrace fit render grow reconstruct interpolate synth comb scalp roots.\n"
         "Placeholders in output and args: {stem} {name} {index} (sorted position); in args also {outdir}.\n"
-        "A rerun skips inputs recorded ok (for the same verb, args and output rule) whose output exists.\n"
+        "An arg that starts with {outdir}/ is a second output (e.g. --dense {outdir}/{stem}.npy).\n"
+        "A rerun skips inputs recorded ok (for the same verb, args and output rule) whose outputs exist.\n"
         "Exit status: 0 every input ok, 1 an input failed (see the records), 2 a bad command line or JOB,\n"
         "130/143 interrupted by SIGINT/SIGTERM (finished inputs are recorded; the rest run on the next run).\n"
         "Example: vdbhair batch scenes/batch/field.json -o out --jobs 2; vdbhair batch --merge out");

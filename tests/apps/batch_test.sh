@@ -2,7 +2,7 @@
 # `vdbhair batch` for real: a generated dataset, runs killed halfway and resumed, a corrupt input,
 # shards and their merge, and a one-node Slurm cluster when Debian's slurm-wlm is installed.
 #   batch_test.sh CLI SOURCE_DIR WORK_DIR CASE
-# CASE: resume-term | resume-kill | corrupt | shard | slurm
+# CASE: resume-term | resume-kill | corrupt | crash | more-outputs | shard | slurm
 # Each case works in WORK_DIR/CASE (removed first) and prints "ok: ..." when it passes.
 set -u
 cli=$1; src=$2; work=$3/$4; case=$4
@@ -103,6 +103,75 @@ corrupt)
   "$cli" batch job.json -o out --jobs 2 --json > run3.json 2>/dev/null
   grep -q '"skipped":0,' run3.json && grep -q '"ok":4,' run3.json || fail "a changed job must run again: $(cat run3.json)"
   echo "ok: the corrupt and the missing input are recorded with their errors, the others written; --retry-failed reruns the failures only"
+  ;;
+crash)
+  # Children that crash (SIGSEGV), that are killed as the kernel's OOM killer kills (SIGKILL), and
+  # that run out of memory (an address-space limit): each is recorded with its cause, the batch
+  # goes on with the others, and --retry-failed completes the set as an uninterrupted run does.
+  ulimit -c 0
+  make_data 4
+  echo '{"inputs": "data/*.hair", "verb": "field", "args": ["--voxel-size", "0.5"], "output": "{stem}.vdb"}' > job.json
+  "$cli" batch job.json -o ref --jobs 2 --quiet || fail "the clean run failed"
+  "$cli" batch job.json -o run --jobs 1 2> run.err &
+  pid=$!; killed=" "
+  for sig in SEGV KILL; do  # the first child, then the second (--jobs 1: one at a time)
+    c=""
+    for t in $(seq 3000); do
+      c=$(pgrep -P $pid | head -n 1)
+      [ -n "$c" ] && [ "${killed#* $c }" = "$killed" ] && break
+      c=""; sleep 0.01
+    done
+    [ -n "$c" ] || fail "no new child of the batch to send SIG$sig to"
+    kill -"$sig" "$c"; killed="$killed$c "
+  done
+  wait $pid; status=$?
+  [ $status -eq 1 ] || fail "expected exit status 1 with two children killed, got $status: $(cat run.err)"
+  /usr/bin/python3 - run/batch.jsonl <<'PY' || fail "the records do not say what happened: $(cat run/batch.jsonl)"
+import json, sys
+rs = [json.loads(l) for l in open(sys.argv[1])]
+by = sorted((r["index"], r["status"], r.get("signal_name"), r["error"]) for r in rs)
+assert [b[1] for b in by] == ["failed", "failed", "ok", "ok"], by
+assert by[0][2] == "SIGSEGV" and by[0][3] == "killed by SIGSEGV", by[0]
+assert by[1][2] == "SIGKILL" and by[1][3] == "killed by SIGKILL (out of memory?)", by[1]
+PY
+  grep -q "killed by SIGSEGV" run.err && grep -q "killed by SIGKILL (out of memory?)" run.err || fail "the summary does not name the signals: $(cat run.err)"
+  [ ! -e run/style00.vdb ] && [ ! -e run/style01.vdb ] || fail "a killed child left an output: $(ls run)"
+  # Out of memory: the same job at a voxel size that needs several GB, under a 400 MB address-space
+  # limit that the batch and its children inherit. Each child says so in one line and exits 1.
+  echo '{"inputs": "data/*.hair", "verb": "field", "args": ["--voxel-size", "0.1"], "output": "{stem}.vdb"}' > oom.json
+  (ulimit -v 400000; "$cli" batch oom.json -o oom --jobs 2 --json > oom.out 2> oom.err); status=$?
+  [ $status -eq 1 ] || fail "expected exit status 1 when every child runs out of memory, got $status: $(cat oom.err)"
+  grep -q '"ok":0,' oom.out && grep -q '"failed":4,' oom.out || fail "expected 4 failures: $(cat oom.out)"
+  [ "$(grep -c '"error":"vdbhair field: out of memory"' oom/batch.jsonl)" -eq 4 ] || fail "the records lack 'out of memory': $(cat oom/batch.jsonl)"
+  ! grep -q "terminate called" oom.err || fail "a child aborted instead of reporting: $(cat oom.err)"
+  ! ls -a run oom | grep -q "vdbhair-tmp" || fail "a temporary output was left: $(ls -a run oom)"
+  # The same for a verb run alone, at limits around where its field stops fitting: OpenVDB frees a
+  # grid with a vector it allocates, so without vdbhair's unwind reserve a child ended in
+  # "terminate called after throwing an instance of 'std::bad_alloc'" (SIGABRT) at 250 MB.
+  for lim in 150000 200000 250000 300000 350000; do
+    (ulimit -v $lim; "$cli" field data/style00.hair -o alone.vdb --voxel-size 0.5 --threads 2 --quiet) > alone.out 2>&1; status=$?
+    [ $status -eq 0 ] || { [ $status -eq 1 ] && [ "$(cat alone.out)" = "vdbhair field: out of memory" ]; } ||
+      fail "field under ulimit -v $lim: exit $status, $(head -c 300 alone.out)"
+  done
+  # Retrying the killed two completes the set.
+  "$cli" batch job.json -o run --jobs 2 --retry-failed --json > retry.json 2> retry.err || fail "--retry-failed: $(cat retry.err)"
+  grep -q '"ok":2,' retry.json && grep -q '"skipped":2,' retry.json || fail "--retry-failed should run the 2 killed inputs: $(cat retry.json)"
+  m=$(same_outputs ref run)
+  echo "ok: a child killed by SIGSEGV and one by SIGKILL recorded as such, 4 out-of-memory children reported in one line each; retried: $m outputs identical to a clean run"
+  ;;
+more-outputs)
+  # A second output named in args ({outdir}/...) counts: a rerun after it is deleted runs that input again.
+  make_data 2
+  echo '{"inputs": "data/*.hair", "verb": "field", "args": ["--voxel-size", "2", "--dense", "{outdir}/{stem}.npy", "--dense-box", "-40,-10,-45,40,130,85", "--dense-size", "8,8,8"], "output": "{stem}.vdb"}' > job.json
+  "$cli" batch job.json -o out --jobs 2 --quiet || fail "the first run failed"
+  [ -f out/style00.npy ] && [ -f out/style01.npy ] || fail "no .npy written: $(ls out)"
+  grep -q '"more_outputs":\["[^"]*/out/style00.npy"\]' out/batch.jsonl || fail "the record does not list the second output: $(cat out/batch.jsonl)"
+  cp out/style01.npy style01.npy.first
+  rm out/style01.npy
+  "$cli" batch job.json -o out --jobs 2 --json > rerun.json 2> rerun.err || fail "the rerun failed: $(cat rerun.err)"
+  grep -q '"ok":1,' rerun.json && grep -q '"skipped":1,' rerun.json || fail "the rerun should redo only the input whose .npy is gone: $(cat rerun.json)"
+  cmp -s out/style01.npy style01.npy.first || fail "the rewritten .npy differs from the first"
+  echo "ok: an input whose second output (.npy) was deleted runs again; the other is skipped"
   ;;
 shard)
   make_data 7; write_job
