@@ -54,6 +54,10 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     const Follicles f = sampleFollicles(surface, region, fp, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const FollicleStats stats = measureFollicles(f.positions, surface);
+    if (f.areaWithoutZero > 0.01 * (f.area + f.areaWithoutZero) && !common.quiet) {
+        std::cerr << "vdbhair roots: warning: " << p.input << ": " << formatValue(100.0 * f.areaWithoutZero / (f.area + f.areaWithoutZero))
+                  << " % of the surface's band never crosses zero (an open or inside-out part of the mesh that has no inside); no roots there\n";
+    }
 
     OrientedPoints out;
     out.positions = f.positions;
@@ -66,7 +70,7 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     }
     if (common.json) {
         printJson({{"output", p.output}, {"count", f.positions.size()}, {"region", bool(region)}, {"area", f.area},
-                   {"target_spacing", f.targetSpacing}, {"iterations", f.iterations}, {"last_move", f.lastMove}, {"removed", f.removed},
+                   {"area_without_zero", f.areaWithoutZero}, {"target_spacing", f.targetSpacing}, {"iterations", f.iterations}, {"last_move", f.lastMove}, {"removed", f.removed},
                    {"spacing", {{"mean", stats.nnMean}, {"cv", stats.nnCV}, {"min", stats.nnMin}, {"max", stats.nnMax}}},
                    {"max_surface_distance_voxels", stats.maxSurfaceDistanceVoxels}, {"seconds", seconds}});
     } else if (!common.quiet) {

@@ -219,6 +219,7 @@ Returns:
             d["tangents"] = pointsArray(out.f.tangents);
             d["region"] = out.region;
             d["area"] = out.f.area;
+            d["area_without_zero"] = out.f.areaWithoutZero;
             d["target_spacing"] = out.f.targetSpacing;
             d["iterations"] = out.f.iterations;
             d["last_move"] = out.f.lastMove;

@@ -64,6 +64,34 @@ TEST_CASE("sampleFollicles: a sphere gets evenly spread roots on it", "[scalp]")
     CHECK(worstTangent < 1e-5);
 }
 
+TEST_CASE("sampleFollicles: a band that never crosses zero gets no roots and no share of the count", "[scalp]")
+{
+    // A proper sphere and, beside it, a second sphere's band made unsigned (|phi|): what an open
+    // part of a mesh that capping did not close looks like (head_max4's torso). The roots owed to
+    // the unsigned part used to be redrawn onto the proper sphere, at half the spacing.
+    const double r = 1.0, h = 0.05;
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), r, h);
+    const openvdb::FloatGrid::Ptr other = unitSphere(Vec3d(3.0, 0.0, 0.0), r, h);
+    {
+        auto acc = g->getAccessor();
+        for (auto it = other->cbeginValueOn(); it; ++it) acc.setValue(it.getCoord(), std::abs(*it));
+    }
+    FollicleParams fp;
+    fp.count = 1500;
+    const Follicles f = sampleFollicles(g, nullptr, fp);
+    const FollicleStats st = measureFollicles(f.positions, g);
+    std::cout << "sphere beside an unsigned band: " << f.positions.size() << " roots, area " << f.area << ", without a zero "
+              << f.areaWithoutZero << " (each sphere " << 4 * M_PI * r * r << "), NN mean " << st.nnMean << ", CV " << st.nnCV << "\n";
+    CHECK(f.area == Approx(4 * M_PI * r * r).epsilon(0.03));
+    CHECK(f.areaWithoutZero > 0.5 * 4 * M_PI * r * r);
+    CHECK(std::abs(double(f.positions.size()) - 1500.0) <= 0.02 * 1500.0);
+    double farthest = 0.0;
+    for (const Vec3f& p : f.positions) farthest = std::max(farthest, std::abs(Vec3d(p).length() - r) / h);
+    CHECK(farthest < 0.05);  // every root on the proper sphere
+    CHECK(st.nnCV < 0.1);
+    CHECK(st.nnMean == Approx(f.targetSpacing * 0.93).epsilon(0.05));
+}
+
 TEST_CASE("sampleFollicles: a cap region holds every root", "[scalp]")
 {
     const Vec3d c(0.0);

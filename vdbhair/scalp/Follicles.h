@@ -5,7 +5,9 @@
 ///
 /// Algorithm (each step labelled in Follicles.cc):
 /// 1. Area A of the surface (in the region): sum over band voxels of a smoothed delta of the
-///    distance, delta(phi) = (1 + cos(pi phi / eps)) / (2 eps), eps = 1.5 voxels.
+///    distance, delta(phi) = (1 + cos(pi phi / eps)) / (2 eps), eps = 1.5 voxels, over the voxels
+///    within two voxels of a sign change only (a band that never crosses zero, as around an open
+///    part of a mesh, has no surface; its area is reported as Follicles::areaWithoutZero).
 /// 2. Target: a count N gives the spacing of a hexagonal packing, d = sqrt(2 A / (sqrt(3) N));
 ///    a nearest-neighbour spacing s gives d = s / 0.93 (relaxed roots sit 7 % closer than the
 ///    ideal lattice, measured on spheres) and N = 2 A / (sqrt(3) d^2).
@@ -17,9 +19,11 @@
 ///    tangent plane, capped at d / 4, then reprojected onto the surface; a move that leaves the
 ///    region, or whose projection fails (|phi| above 0.01 voxel, or landing more than 2 voxels
 ///    beyond the aimed step: thin or folded parts of a mesh's band), is halved up to three times,
-///    else not taken. Neighbours within 4 sigma come from a nanoflann k-d tree rebuilt each
-///    iteration. All particles move at once from the previous positions (Jacobi), each summing its
-///    neighbours in index order, so the result is the same bit for bit for any thread count.
+///    else not taken. Neighbours within 4 sigma come from neighbour lists (4 sigma plus a skin of
+///    d / 2, from a nanoflann k-d tree, rebuilt when 1/20 of the particles have moved more than
+///    half the skin; those that have are searched for each iteration). All particles move at once
+///    from the previous positions (Jacobi), each summing its neighbours in index order, so the
+///    result is the same bit for bit for any thread count, and as with a search per iteration.
 ///    Equilibrium: the largest move is below @c tolerance d, or @c maxIterations.
 /// 5. Death: a particle within 0.1 d of an earlier one is removed (coincident particles exert no
 ///    force on each other; projection onto thin or folded parts of a mesh's band can make them).
@@ -61,10 +65,13 @@ struct Follicles
 {
     std::vector<Vec3f> positions, normals, tangents;  ///< #N each, world units / unit vectors
     double area = 0.0;           ///< estimated surface area in the region
+    /// Area of band (in the region) with no sign change within two voxels: no surface to put a
+    /// root on (an open or inside-out part of a mesh), left out of @c area and of the count.
+    double areaWithoutZero = 0.0;
     double targetSpacing = 0.0;  ///< d of step 2
     int iterations = 0;          ///< relaxation iterations run
     double lastMove = 0.0;       ///< largest move of the last iteration, in units of d
-    std::size_t removed = 0;     ///< particles removed by step 6 (within 0.1 d of another)
+    std::size_t removed = 0;     ///< particles removed by step 5 (within 0.1 d of another)
 };
 
 /// @brief Spread follicles over @a surface (in @a region when given).
