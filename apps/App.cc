@@ -19,6 +19,7 @@
 #include <limits>
 #include <memory>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 
@@ -339,8 +340,8 @@ int run(int argc, char** argv)
         };
         try {
             return c.run();
-        } catch (const InterruptedError&) {
-            return fail(130, "interrupted; no partial output was written");
+        } catch (const InterruptedError&) {  // 128 + the signal, as a shell reports it: 130 for Ctrl-C, 143 for SIGTERM
+            return fail(128 + (interruptSignal() ? interruptSignal() : SIGINT), "interrupted; no partial output was written");
         } catch (const ValueError& e) {
             return fail(2, e.what());
         } catch (const Error& e) {

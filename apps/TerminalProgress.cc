@@ -26,8 +26,10 @@ bool commitRefused() { return sSignal != 0; }
 /// raises SIGINT in the process itself, exactly as a Ctrl-C at that point would. With
 /// VDBHAIR_TEST_INTERRUPT_DRAWN=1, the first line drawn with a rate and a time left does (a test
 /// of the drawn bar then needs no timer that a fast machine could outrun or a slow one miss).
+/// VDBHAIR_TEST_INTERRUPT_SIGNAL=TERM sends SIGTERM instead (as `timeout` and Slurm do).
 std::uint64_t sInterruptAfter = 0;
 bool sInterruptDrawn = false;
+int sTestSignal = SIGINT;
 
 /// "12", "1.2k", "3.4M": three significant digits are all a progress line needs.
 std::string shortNumber(double v)
@@ -87,6 +89,7 @@ void installInterruptHandlers()
     setCommitInterruptCheck(commitRefused);
     if (const char* n = std::getenv("VDBHAIR_TEST_INTERRUPT_AFTER"); n && *n) sInterruptAfter = std::strtoull(n, nullptr, 10);
     if (const char* d = std::getenv("VDBHAIR_TEST_INTERRUPT_DRAWN"); d && *d == '1') sInterruptDrawn = true;
+    if (const char* t = std::getenv("VDBHAIR_TEST_INTERRUPT_SIGNAL"); t && std::string(t) == "TERM") sTestSignal = SIGTERM;
 }
 
 bool interruptRequested() { return sSignal != 0; }
@@ -180,7 +183,7 @@ bool TerminalProgress::wasInterruptedAt(std::uint64_t done, int)
     // Keep the largest: threads report out of order.
     std::uint64_t seen = mDone.load(std::memory_order_relaxed);
     while (done > seen && !mDone.compare_exchange_weak(seen, done, std::memory_order_relaxed)) {}
-    if (sInterruptAfter != 0 && done >= sInterruptAfter && sSignal == 0) ::kill(::getpid(), SIGINT);  // to the process, as a Ctrl-C: the ticker thread blocks SIGINT
+    if (sInterruptAfter != 0 && done >= sInterruptAfter && sSignal == 0) ::kill(::getpid(), sTestSignal);  // to the process, as a Ctrl-C: the ticker thread blocks SIGINT
     return sSignal != 0;
 }
 
@@ -230,7 +233,7 @@ void TerminalProgress::draw()
     std::fprintf(stderr, "\r%s\033[K", line.c_str());
     std::fflush(stderr);
     mShown = true;
-    if (sInterruptDrawn && sSignal == 0 && mTotal > 0 && mDone.load() > 0 && mDone.load() < mTotal) ::kill(::getpid(), SIGINT);  // to the process, as a Ctrl-C: the ticker thread blocks SIGINT
+    if (sInterruptDrawn && sSignal == 0 && mTotal > 0 && mDone.load() > 0 && mDone.load() < mTotal) ::kill(::getpid(), sTestSignal);  // to the process, as a Ctrl-C: the ticker thread blocks SIGINT
 }
 
 void TerminalProgress::erase()

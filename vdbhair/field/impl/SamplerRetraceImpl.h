@@ -2,6 +2,7 @@
 /// @brief Template body of SamplerRetrace.h.
 #pragma once
 
+#include <vdbhair/field/SamplerRetrace.h>  // when included on its own (it is included at that header's end)
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
 

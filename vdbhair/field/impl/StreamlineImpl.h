@@ -2,7 +2,8 @@
 /// @brief Template bodies of Streamline.h (the integrator and the streamline loop).
 #pragma once
 
-// Included at the end of Streamline.h.
+// Included at the end of Streamline.h; on its own, it includes Streamline.h first.
+#include <vdbhair/field/Streamline.h>
 
 namespace vdbhair {
 
