@@ -12,6 +12,8 @@
 //   end to end (--sections e2e, opt-in): the         vs  vdbhair_peer (Peer.cc): the same jobs
 //   `vdbhair` verbs info, field, retrace, refine,        with stock OpenVDB and an ifstream
 //   --help as processes, as a user times them            reader, as processes on the same files
+//   scale (--sections scale, opt-in): `vdbhair refine` of 1,000,000 strands x 32 vertices grown by
+//   `vdbhair grow`: time, peak memory and refine's own memory estimate
 //
 // Inputs: a real hairstyle from ../shared/data and a 100,000-strand, 64-vertex hairstyle made
 // deterministically from the bundled one (jittered copies), and, for reference, as many strands
@@ -25,6 +27,8 @@
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
 #include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/JsonFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbFile.h>
@@ -519,8 +523,9 @@ struct ProcessRun
 };
 
 /// @brief Run @a args (a program and its arguments) as a process with stdout and stderr sent to
-/// /dev/null, and measure it from the outside (wait4's rusage: the child's own CPU and peak RSS).
-ProcessRun runProcess(const std::vector<std::string>& args)
+/// /dev/null (stdout to @a stdoutPath if given), and measure it from the outside (wait4's rusage:
+/// the child's own CPU and peak RSS).
+ProcessRun runProcess(const std::vector<std::string>& args, const std::string& stdoutPath = std::string())
 {
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -529,7 +534,8 @@ ProcessRun runProcess(const std::vector<std::string>& args)
     const pid_t pid = fork();
     if (pid == 0) {
         const int devNull = open("/dev/null", O_WRONLY);
-        dup2(devNull, 1);
+        const int out = stdoutPath.empty() ? devNull : open(stdoutPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(out, 1);
         dup2(devNull, 2);
         execv(argv[0], argv.data());
         _exit(127);
@@ -624,6 +630,62 @@ void benchmarkEndToEnd(const std::string& source, std::size_t strands, std::size
     std::filesystem::remove_all(dir, ec);
 }
 
+/// @brief The scale section (issue 22, item 7): `vdbhair refine` at its defaults on hairstyles of
+/// @a sizes strands x 32 vertices, made by vdbhair itself at benchmark time (the default head
+/// scene's 400 guides, each grown into a wisp of size / 400 strands at step 1 by `vdbhair grow`,
+/// resampled to 32 vertices by `vdbhair convert`) in a scratch folder removed afterwards: wall
+/// and CPU time and peak resident memory from the outside (wait4), against the memory estimate
+/// refine checks before it allocates (its --json report).
+void benchmarkScale(const std::string& source, const std::vector<std::size_t>& sizes, std::string ours)
+{
+    const std::filesystem::path bin = std::filesystem::read_symlink("/proc/self/exe").parent_path();
+    if (ours.empty()) ours = (bin / "vdbhair").string();
+    if (!std::filesystem::exists(ours)) {
+        std::printf("\n(skipped the scale section: %s not found)\n", ours.c_str());
+        return;
+    }
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("vdbhair_scale_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    nlohmann::json scene = readJsonFile(source + "/scenes/default/head.json", 64, "a scene");
+    const std::size_t guides = scene["guides"].size();
+    std::printf("\n== scale: vdbhair refine at its defaults, N strands x 32 vertices grown from the default head scene ==\n");
+    std::printf("%9s %10s %7s | %9s %9s %9s | %10s %7s\n", "strands", "vertices", "leaves", "wall", "CPU", "peak", "estimate", "est/peak");
+    for (std::size_t n : sizes) {
+        const std::size_t perGuide = std::max<std::size_t>(1, (n + guides - 1) / guides);
+        scene["step"] = 1.0;
+        for (auto& g : scene["guides"]) g["wisp"]["count"] = perGuide - 1;  // the guide and its wisp
+        const std::string sceneFile = (dir / "scene.json").string(), grown = (dir / "grown.data").string(),
+                          hair = (dir / "hair.data").string(), refined = (dir / "refined.data").string(),
+                          report = (dir / "report.json").string();
+        writeFileAtomic(sceneFile, scene.dump(), "benchmark");
+        if (runProcess({ours, "grow", sceneFile, "-o", grown, "-q"}).status != 0 ||
+            runProcess({ours, "convert", grown, hair, "--resample", "32", "-q"}).status != 0) {
+            std::printf("%9zu (skipped: grow or convert failed)\n", n);
+            continue;
+        }
+        std::filesystem::remove(grown);
+        const ProcessRun r = runProcess({ours, "refine", hair, "-o", refined, "--json"}, report);
+        nlohmann::json j;
+        try {
+            j = readJsonFile(report, 64, "a report");
+        } catch (const std::exception&) {
+        }
+        if (r.status != 0 || !j.contains("memory")) {
+            std::printf("%9zu (refine failed: exit status %d, %.1f s, peak %.0f MiB)\n", perGuide * guides, r.status, r.wall, r.peakMiB);
+            continue;
+        }
+        const double estimate = double(j["memory"]["estimate_bytes"].get<std::uint64_t>()) / double(1 << 20);
+        const std::size_t strands = j["strands"].get<std::size_t>();
+        std::printf("%9zu %10zu %7llu | %7.1f s %7.1f s %5.0f MiB | %6.0f MiB %7.2f\n", strands, strands * 32,
+                    static_cast<unsigned long long>(j["memory"]["leaves"][0].get<std::uint64_t>()), r.wall, r.cpu, r.peakMiB, estimate,
+                    estimate / r.peakMiB);
+        std::fflush(stdout);
+        for (const std::string& f : {hair, refined}) std::filesystem::remove(f);
+    }
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -640,6 +702,7 @@ int main(int argc, char** argv)
     std::size_t fitStrands = 2000;
     std::vector<std::size_t> rootCounts{10000, 100000};
     std::string rootHeads;
+    std::vector<std::size_t> scaleStrands{1000000};
     app.add_option("--data", data, "The shared data folder (real hairstyles)")->capture_default_str();
     app.add_option("--scene", source, "The vdbhair checkout (for scenes/default)")->capture_default_str();
     app.add_option("--strands", strands, "Strands of the synthetic hairstyle")->capture_default_str();
@@ -648,13 +711,15 @@ int main(int argc, char** argv)
     app.add_option("--threads", threads, "Threads (0: all cores)")->capture_default_str();
     app.add_option("--voxel-size", voxelSize, "Voxel size (0: vdbhair's suggestion for each input)");
     app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots, interpolate, synth, "
-                                           "and e2e (the command and a stock-OpenVDB peer as processes; not run by default) (comma-separated)")->capture_default_str();
+                                           "and e2e (the command and a stock-OpenVDB peer as processes) and scale (refine of 1,000,000 strands x 32 vertices: "
+                                           "time, peak memory, the memory estimate), both opt-in (comma-separated)")->capture_default_str();
     app.add_option("--e2e-runs", e2eRuns, "Counted runs of each command in the e2e section (after one warm-up)")->capture_default_str();
     app.add_option("--e2e-command", e2eCommand, "The vdbhair command the e2e section runs (default: the one built next to this program; "
                                                 "another build's, for before and after)");
     app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
     app.add_option("--root-counts", rootCounts, "Root counts of the follicle rows")->delimiter(',')->capture_default_str();
     app.add_option("--root-heads", rootHeads, "Only the shared heads whose path contains this");
+    app.add_option("--scale-strands", scaleStrands, "Strand counts of the scale section (32 vertices each)")->delimiter(',')->capture_default_str();
     CLI11_PARSE(app, argc, argv);
     auto wants = [&](const char* s) { return ("," + sections + ",").find("," + std::string(s) + ",") != std::string::npos; };
     std::unique_ptr<tbb::global_control> control;
@@ -684,5 +749,6 @@ int main(int argc, char** argv)
     if (wants("interpolate")) benchmarkInterpolation(reps);
     if (wants("synth")) benchmarkSynthesis(data, source, strands, vertices);
     if (wants("e2e")) benchmarkEndToEnd(source, strands, vertices, std::max(1, e2eRuns), e2eCommand);
+    if (wants("scale")) benchmarkScale(source, scaleStrands, e2eCommand);
     return 0;
 }

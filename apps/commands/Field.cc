@@ -28,6 +28,7 @@ struct FieldCmdParams
     int iterations = FieldParams{}.iterations;
     int levels = 1;
     std::uint64_t maxVoxels = FieldParams{}.maxVoxels;
+    std::uint64_t maxMemory = FieldParams{}.maxMemory;
     bool withStrands = false;
     bool helicoid = false;
     bool strict = false;
@@ -94,6 +95,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     fp.voxelSize = resolveVoxelSize(strands, fp);  // 0: the library's suggestion (reported below)
     fp.iterations = p.iterations;
     fp.maxVoxels = p.maxVoxels;
+    fp.maxMemory = p.maxMemory;
     fp.densityReference = p.densityReference;
     applyScalpOptions(p.scalp, strands, fp);
 
@@ -173,6 +175,8 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--iterations", params->iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
     sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
     sub->add_option("--max-voxels", params->maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
+    sub->add_option("--max-memory", params->maxMemory, "Refuse work whose memory estimate exceeds this many bytes (suffixes k, M, G: 16G); 0: the memory available (MemAvailable)")
+        ->transform(CLI::AsSizeValue(false))->capture_default_str();
     sub->add_option("--density-reference", params->densityReference,
                     "Hair length per unit volume (world units^-2) that 'density' maps to 1 (default: the 95th percentile of the hairstyle's)");
     sub->add_option("--vector-name", params->vectorName,
@@ -193,7 +197,7 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair field hair.hair -o field.vdb --voxel-size 0.5 --levels 3\n"
                 "Orientation volume: vdbhair field hair.data -o f.vdb --dense f.npy --dense-box -0.32,-0.32,-0.24,0.32,0.32,0.24");
-    return {sub, [params, &common] { return runField(*params, common); }, {{"maxVoxels", "--max-voxels"}}};
+    return {sub, [params, &common] { return runField(*params, common); }, {{"maxVoxels", "--max-voxels"}, {"maxMemory", "--max-memory"}}};
 }
 
 } // namespace vdbhair::app

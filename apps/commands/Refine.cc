@@ -88,6 +88,9 @@ nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp)
     j["iterations"] = rp.field.iterations;
     j["space"] = fieldSpaceName(rp.field.space);
     j["head"] = r.head.describe();
+    nlohmann::json leaves = nlohmann::json::array();
+    for (const FieldFootprint& f : r.memory.footprints) leaves.push_back(f.leaves);
+    j["memory"] = {{"estimate_bytes", r.memory.bytes}, {"available_bytes", r.memory.available}, {"leaves", leaves}};
     nlohmann::json per = nlohmann::json::array();
     for (std::size_t l = 0; l < r.levels.size(); ++l) {
         const RefineLevel& lv = r.levels[l];
@@ -192,6 +195,8 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
     sub->add_option("--integrator", p.integrator, "field mode: euler (the papers' choice), rk2 or rk4")->capture_default_str();
     sub->add_option("--margin", rp.trace.margin, "field mode: voxels a strand may continue straight past the field's active region")->capture_default_str();
     sub->add_option("--max-voxels", rp.field.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
+    sub->add_option("--max-memory", rp.field.maxMemory, "Refuse work whose memory estimate exceeds this many bytes (suffixes k, M, G: 16G); 0: the memory available (MemAvailable)")
+        ->transform(CLI::AsSizeValue(false))->capture_default_str();
     sub->add_flag("--strict", p.strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addScalpOptions(sub, p.scalp);
 }
@@ -206,7 +211,7 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
     addRefineOptions(sub, *params);
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --json");
-    return {sub, [params, &common] { return runRefine(*params, common); }, {{"maxVoxels", "--max-voxels"}}};
+    return {sub, [params, &common] { return runRefine(*params, common); }, {{"maxVoxels", "--max-voxels"}, {"maxMemory", "--max-memory"}}};
 }
 
 } // namespace vdbhair::app

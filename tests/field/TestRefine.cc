@@ -296,3 +296,28 @@ TEST_CASE("refineStrands: the shared hairstyles keep their shape at the defaults
         REQUIRE(r.strands.offsets == s.offsets);
     }
 }
+
+TEST_CASE("refineStrands: a refinement whose memory estimate exceeds maxMemory is refused up front", "[field]")
+{
+    const StrandSet s = bundle(6, 2.f, 10.f, 21);
+    RefineParams p;
+    p.field.voxelSize = 0.5;
+    p.levels = 2;
+    const RefineMemory m = estimateRefineMemory(s, p);
+    REQUIRE(m.footprints.size() == 2);
+    // Each level's leaves are the leaves of the field refineStrands() estimates at that level.
+    const RefineResult r = refineStrands(s, p);
+    for (std::size_t l = 0; l < 2; ++l) {
+        CAPTURE(l);
+        CHECK(m.footprints[l].leaves == r.fields[l].tangent->tree().leafCount());
+    }
+    CHECK(r.memory.bytes == m.bytes);
+    CHECK(m.bytes > estimatePeakBytes(m.footprints, MemoryUse::Field));  // a refinement holds more than its fields
+    p.field.maxMemory = m.bytes - 1;
+    REQUIRE_THROWS_AS(refineStrands(s, p), LimitError);
+    REQUIRE_THROWS_WITH(refineStrands(s, p), Contains("refineStrands: needs about ") && Contains("(36 strands, 756 vertices, ") &&
+                                                 Contains(" leaves in 2 level(s) from voxel size 0.500000), more than the ") &&
+                                                 Contains("of maxMemory; a request whose estimate exceeds the memory it may use is refused"));
+    p.field.maxMemory = m.bytes;
+    CHECK_NOTHROW(refineStrands(s, p));
+}

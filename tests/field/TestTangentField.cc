@@ -242,3 +242,51 @@ TEST_CASE("estimateTangentField: density is a fog volume in [0, 1], the same at 
     p.densityReference = -1.0;
     REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("density reference"));
 }
+
+TEST_CASE("estimateFieldFootprint: the leaves counted before the estimate are the field's leaves", "[field]")
+{
+    // Random walks of random step lengths (some segments cross several blocks, some stay in one
+    // voxel, some have zero length), at voxel sizes from far below to above a step.
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    for (int trial = 0; trial < 9; ++trial) {
+        StrandSet s;
+        const float stepLength = trial % 3 == 0 ? 0.05f : trial % 3 == 1 ? 0.5f : 3.f;
+        for (int i = 0; i < 40; ++i) {
+            std::vector<Vec3f> pts{Vec3f(5.f * u(rng), 5.f * u(rng), 5.f * u(rng))};
+            for (int j = 0; j < 30; ++j) pts.push_back(j == 7 ? pts.back() : pts.back() + stepLength * Vec3f(u(rng), u(rng), u(rng)));
+            s.addStrand(pts);
+        }
+        FieldParams p;
+        p.voxelSize = trial < 3 ? 0.03 : trial < 6 ? 0.2 : 1.1;
+        CAPTURE(trial, stepLength, p.voxelSize);
+        const FieldFootprint f = estimateFieldFootprint(s, p);
+        const TangentField field = estimateTangentField(s, p);
+        CHECK(f.leaves == field.tangent->tree().leafCount());
+        CHECK(f.strands == s.numStrands());
+        CHECK(f.vertices == s.numVertices());
+        CHECK(f.visits >= field.tangent->activeVoxelCount());
+        // The bytes grow with every term.
+        FieldFootprint more = f;
+        more.leaves += 1;
+        CHECK(estimatePeakBytes({more}, MemoryUse::Field) > estimatePeakBytes({f}, MemoryUse::Field));
+    }
+}
+
+TEST_CASE("estimateTangentField: an estimate above maxMemory is refused before any work", "[field]")
+{
+    const StrandSet s = parallelStrands(Vec3f(1, 0, 0), 3, 0.5f, 10.f, 20);
+    FieldParams p;
+    p.voxelSize = 0.25;
+    p.maxMemory = 1000;
+    REQUIRE_THROWS_AS(estimateTangentField(s, p), LimitError);
+    // The estimate, its terms, what is available and the rule, naming the library's parameter.
+    REQUIRE_THROWS_WITH(estimateTangentFieldLevels(s, p, 2),
+                        Contains("estimateTangentField: needs about ") && Contains(" MiB (9 strands, 180 vertices, ") &&
+                            Contains("more than the 1000 B of maxMemory; a request whose estimate exceeds the memory it may use is refused"));
+    p.maxMemory = estimatePeakBytes({estimateFieldFootprint(s, p)}, MemoryUse::Field);  // exactly enough
+    CHECK(estimateTangentField(s, p).tangent->activeVoxelCount() > 0);
+    p.maxMemory = 0;  // the memory available now: ample for nine strands
+    CHECK(availableMemoryBytes(p) > (std::uint64_t(64) << 20));
+    CHECK_NOTHROW(estimateTangentField(s, p));
+}

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vdbhair {
 
@@ -124,6 +125,23 @@ HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up)
     return head;
 }
 
+RefineMemory estimateRefineMemory(const StrandSet& strands, const RefineParams& params)
+{
+    params.validate("refineStrands");
+    if (strands.empty()) throw ValueError("refineStrands: the hairstyle has no strands");
+    FieldParams lp = params.field;
+    lp.voxelSize = resolveVoxelSize(strands, params.field);
+    RefineMemory m;
+    for (int level = 0; level < params.levels; ++level) {
+        FieldParams l = lp;
+        l.voxelSize = lp.voxelSize * double(1 << level);
+        m.footprints.push_back(estimateFieldFootprint(strands, l));
+    }
+    m.bytes = estimatePeakBytes(m.footprints, MemoryUse::Refine);
+    m.available = availableMemoryBytes(params.field);
+    return m;
+}
+
 RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded,
                            openvdb::util::NullInterrupter* interrupter)
 {
@@ -132,7 +150,22 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
     FieldParams fp = params.field;
     if (fp.voxelSize == 0.0) fp.voxelSize = suggestVoxelSize(strands);
 
+    // Memory, before anything is allocated: the whole refinement's estimate, checked once (the
+    // estimates below are part of it and skip their own check).
     RefineResult result;
+    {
+        RefineParams rp = params;
+        rp.field.voxelSize = fp.voxelSize;
+        result.memory = estimateRefineMemory(strands, rp);
+        std::uint64_t leaves = 0;
+        for (const FieldFootprint& f : result.memory.footprints) leaves += f.leaves;
+        checkMemoryEstimate("refineStrands", result.memory.bytes,
+                            std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) +
+                                " vertices, " + std::to_string(leaves) + " leaves in " + std::to_string(params.levels) +
+                                " level(s) from voxel size " + std::to_string(fp.voxelSize),
+                            fp);
+        fp.maxMemory = std::numeric_limits<std::uint64_t>::max();
+    }
     result.voxelSize = fp.voxelSize;
     result.head = params.head.unset() ? headFromRoots(strands, fp.scalp.up) : params.head;
     result.fields.resize(std::size_t(params.levels));

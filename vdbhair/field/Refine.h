@@ -68,6 +68,20 @@ struct RefineLevel
     RefineMeasures measures;       ///< this level's output against the *input*, at the finest voxel size
 };
 
+/// @brief The memory estimate of a refinement (estimateRefineMemory()).
+struct RefineMemory
+{
+    std::uint64_t bytes = 0;                 ///< the estimated peak
+    std::uint64_t available = 0;             ///< what it was checked against (availableMemoryBytes())
+    std::vector<FieldFootprint> footprints;  ///< element l: level l (0 the finest)
+};
+
+/// @brief The peak bytes of refineStrands(@a strands, @a params), before anything is allocated:
+/// each level's footprint (estimateFieldFootprint()) and estimatePeakBytes(MemoryUse::Refine)
+/// over them. The voxel size is resolved as refineStrands() does.
+/// @throw ValueError as refineStrands(); LimitError above FieldParams::maxVoxels.
+RefineMemory estimateRefineMemory(const StrandSet& strands, const RefineParams& params);
+
 struct RefineResult
 {
     StrandSet strands;                 ///< the refined hairstyle (input vertex counts)
@@ -75,13 +89,16 @@ struct RefineResult
     std::vector<RefineLevel> levels;   ///< element l: level l
     double voxelSize = 0.0;            ///< the finest voxel size used
     HeadObstacle head;                 ///< the obstacle used
+    RefineMemory memory;               ///< the estimate checked before anything was allocated
 };
 
 /// @brief The fallback head: the sphere fitted to the roots (fitScalpSphere()) with the up axis @a up.
 HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up = Vec3d(0.0, 1.0, 0.0));
 
+/// Refuses up front (LimitError naming the estimate, the memory available and the rule) when
+/// estimateRefineMemory() exceeds availableMemoryBytes(params.field).
 /// @throw as estimateTangentField(), retraceStrands() and retraceConsistent(); ValueError for
-/// parameters out of range.
+/// parameters out of range; LimitError (memory, above).
 RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded = true,
                            openvdb::util::NullInterrupter* interrupter = nullptr);
 

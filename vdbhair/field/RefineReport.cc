@@ -108,7 +108,8 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
     {
         std::size_t left = 0, headBefore = 0, headAfter = 0, tipsIn = 0, full = 0, vertices = 0;
         double displacement = 0.0;
-        std::vector<double> curvV, curvVIn, curv8, curv8In, disp;
+        std::vector<double> curvV, curvVIn, curv8, curv8In;
+        std::vector<float> disp;  // a float a vertex: the largest array of the report (its 95th percentile only)
         std::vector<std::size_t> leftIds;
     };
     std::vector<Part> parts(chunks);
@@ -146,7 +147,7 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
             for (std::size_t j = 0; j < std::min(na, nb); ++j) {
                 const double d = double((b[j] - a[j]).length()) / voxel;
                 part.displacement += d;
-                part.disp.push_back(d);
+                part.disp.push_back(float(d));
             }
             part.vertices += std::min(na, nb);
         }
@@ -154,7 +155,11 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
 
     std::size_t tipsIn = 0, vertices = 0;
     double displacement = 0.0;
-    std::vector<double> curvV, curvVIn, curv8, curv8In, disp;
+    std::vector<double> curvV, curvVIn, curv8, curv8In;
+    std::vector<float> disp;
+    std::size_t dispCount = 0;
+    for (const Part& p : parts) dispCount += p.disp.size();
+    disp.reserve(dispCount);
     for (Part& p : parts) {  // in chunk order
         m.leftVolume += p.left;
         for (std::size_t id : p.leftIds) {
@@ -171,6 +176,7 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
         curv8.insert(curv8.end(), p.curv8.begin(), p.curv8.end());
         curv8In.insert(curv8In.end(), p.curv8In.begin(), p.curv8In.end());
         disp.insert(disp.end(), p.disp.begin(), p.disp.end());
+        std::vector<float>().swap(p.disp);  // one copy at a time
     }
     m.tipOccupancy = double(tipsIn) / double(nS);
     m.displacementMean = vertices ? displacement / double(vertices) : 0.0;

@@ -17,6 +17,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <limits>
 #include <unordered_map>
 
@@ -366,6 +368,109 @@ Extent measure(const StrandSet& strands, const FieldMapping& map, bool threaded)
     return result;
 }
 
+/// Index coordinates must fit OpenVDB's int32 Coord (and the block count's arithmetic).
+void checkIndexRange(Extent extent, const FieldMapping& map, double voxelSize)
+{
+    if (extent.nan) extent.box.min = Vec3f(std::numeric_limits<float>::quiet_NaN());  // fails below
+    for (const Vec3f& corner : {extent.box.min, extent.box.max}) {
+        const Vec3d ip = map.worldToIndex(Vec3d(corner));
+        for (int k = 0; k < 3; ++k) {
+            if (!(std::abs(ip[k]) < double(1 << 30))) {
+                throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) +
+                                 " puts the hairstyle at index " + std::to_string(ip[k]) +
+                                 ", beyond the grid's index range of ±2^30");
+            }
+        }
+    }
+}
+
+/// The maxVoxels rule: LimitError above the cap.
+void checkVisits(std::uint64_t bound, const FieldParams& p, double voxelSize)
+{
+    if (bound > p.maxVoxels) {
+        throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) + " needs up to " +
+                         std::to_string(bound) + " voxel visits, more than the cap of " +
+                         std::to_string(p.maxVoxels) + " (raise maxVoxels or the voxel size)");
+    }
+}
+
+/// Bounding boxes of at most this many leaf blocks are counted block by block (a bit each).
+constexpr std::uint64_t kMaxCountedBlocks = std::uint64_t(1) << 27;
+
+/// @brief The 8^3 leaf blocks the segments of @a strands pass through (what the accumulation
+/// touches: the leaves of every grid), counted with a bit per block of the index bounding box;
+/// min(@a visits, blocks of the box) when the box has more than kMaxCountedBlocks blocks.
+std::uint64_t countLeaves(const StrandSet& strands, const FieldMapping& map, std::uint64_t visits)
+{
+    const std::size_t nS = strands.numStrands();
+    struct Box
+    {
+        Coord lo{std::numeric_limits<int>::max()}, hi{std::numeric_limits<int>::min()};
+    };
+    Box box;
+    withToIndex(map, [&](const auto& toIndex) {
+        box = tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(0, nS, 256), Box(),
+            [&](const tbb::blocked_range<std::size_t>& r, Box b) {
+                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                    const Vec3f* v = strands.data(i);
+                    for (std::size_t j = 0, n = strands.size(i); j < n; ++j) {
+                        const Coord c = voxelOf(toIndex(v[j]));
+                        const Coord blk(c.x() >> 3, c.y() >> 3, c.z() >> 3);
+                        b.lo.minComponent(blk);
+                        b.hi.maxComponent(blk);
+                    }
+                }
+                return b;
+            },
+            [](Box a, const Box& b) {
+                a.lo.minComponent(b.lo);
+                a.hi.maxComponent(b.hi);
+                return a;
+            });
+    });
+    if (box.lo.x() > box.hi.x()) return 0;
+    const std::uint64_t nx = std::uint64_t(box.hi.x() - box.lo.x()) + 1, ny = std::uint64_t(box.hi.y() - box.lo.y()) + 1,
+                        nz = std::uint64_t(box.hi.z() - box.lo.z()) + 1;
+    const double boxBlocks = double(nx) * double(ny) * double(nz);
+    if (boxBlocks > double(kMaxCountedBlocks)) return std::min<std::uint64_t>(visits, std::uint64_t(std::min(boxBlocks, 1e18)));
+    std::vector<std::uint64_t> bits((nx * ny * nz + 63) / 64, 0);
+    withToIndex(map, [&](const auto& toIndex) {
+        // Walk each segment through the blocks: block b spans index [8b - 0.5, 8b + 7.5), so the
+        // affine map x -> (x + 0.5) / 8 - 0.5 turns blocks into the unit cells of walkSegment().
+        const auto toBlock = [](const Vec3d& x) { return (x + Vec3d(0.5)) * 0.125 - Vec3d(0.5); };
+        const auto mark = [&](const Coord& b) {
+            const std::uint64_t k = (std::uint64_t(b.x() - box.lo.x()) * ny + std::uint64_t(b.y() - box.lo.y())) * nz +
+                                    std::uint64_t(b.z() - box.lo.z());
+            std::uint64_t& word = bits[k >> 6];
+            const std::uint64_t bit = std::uint64_t(1) << (k & 63);
+            if (!(__atomic_load_n(&word, __ATOMIC_RELAXED) & bit)) __atomic_fetch_or(&word, bit, __ATOMIC_RELAXED);
+        };
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const Vec3f* v = strands.data(i);
+                const std::size_t n = strands.size(i);
+                if (n == 0) continue;
+                Vec3d a = toBlock(toIndex(v[0]));
+                Coord ca = voxelOf(a);
+                for (std::size_t j = 1; j < n; ++j) {
+                    const Vec3d b = toBlock(toIndex(v[j]));
+                    const Coord cb = voxelOf(b);
+                    if (v[j] != v[j - 1]) {  // zero-length segments add nothing (SegmentAccumulator)
+                        if (ChunkWriter::sameCoord(ca, cb)) mark(ca);
+                        else walkSegment(a, b, ca, cb, [&](const Coord& c, double, double) { mark(c); });
+                    }
+                    a = b;
+                    ca = cb;
+                }
+            }
+        });
+    });
+    std::uint64_t count = 0;
+    for (std::uint64_t w : bits) count += std::uint64_t(__builtin_popcountll(w));
+    return count;
+}
+
 std::uint64_t visitBound(const StrandSet& strands, const FieldMapping& map)
 {
     return std::min(measure(strands, map, true).visits, kSaturated);
@@ -388,23 +493,8 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
         extent = measure(strands, map, false);
         order = spatialOrder(strands);
     }
-    if (extent.nan) extent.box.min = Vec3f(std::numeric_limits<float>::quiet_NaN());  // fails below
-    for (const Vec3f& corner : {extent.box.min, extent.box.max}) {
-        const Vec3d ip = map.worldToIndex(Vec3d(corner));
-        for (int k = 0; k < 3; ++k) {
-            if (!(std::abs(ip[k]) < double(1 << 30))) {
-                throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) +
-                                 " puts the hairstyle at index " + std::to_string(ip[k]) +
-                                 ", beyond the grid's index range of ±2^30");
-            }
-        }
-    }
-    const std::uint64_t bound = std::min(extent.visits, kSaturated);
-    if (bound > p.maxVoxels) {
-        throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) + " needs up to " +
-                         std::to_string(bound) + " voxel visits, more than the cap of " +
-                         std::to_string(p.maxVoxels) + " (raise maxVoxels or the voxel size)");
-    }
+    checkIndexRange(extent, map, voxelSize);
+    checkVisits(std::min(extent.visits, kSaturated), p, voxelSize);
 
     // Accumulate the moments, chunk by chunk (each chunk in strand order).
     const std::string stage = levels > 1 ? "estimating level " + std::to_string(level) + " of " + std::to_string(levels)
@@ -570,7 +660,121 @@ FieldParams resolvedParams(const StrandSet& strands, const FieldParams& params, 
     return p;
 }
 
+/// Refuse a field of @a levels levels at @a p (voxel size resolved) whose estimate exceeds the
+/// memory it may use; nothing is counted when there is no limit (maxMemory at its largest).
+void checkFieldMemory(const StrandSet& strands, const FieldParams& p, int levels)
+{
+    if (p.maxMemory == std::numeric_limits<std::uint64_t>::max()) return;
+    std::vector<FieldFootprint> footprints;
+    FieldParams lp = p;
+    std::uint64_t leaves = 0;
+    for (int l = 0; l < levels; ++l) {
+        lp.voxelSize = p.voxelSize * double(1 << l);
+        footprints.push_back(estimateFieldFootprint(strands, lp));
+        leaves += footprints.back().leaves;
+    }
+    checkMemoryEstimate("estimateTangentField", estimatePeakBytes(footprints, MemoryUse::Field),
+                        std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) + " vertices, " +
+                            std::to_string(leaves) + " leaves at voxel size " + std::to_string(p.voxelSize),
+                        p);
+}
+
 } // namespace
+
+FieldFootprint estimateFieldFootprint(const StrandSet& strands, const FieldParams& params)
+{
+    const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
+    const FieldMapping map = mappingFor(p, p.voxelSize);
+    FieldFootprint f;
+    f.strands = strands.numStrands();
+    f.vertices = strands.numVertices();
+    const Extent extent = measure(strands, map, true);
+    checkIndexRange(extent, map, p.voxelSize);  // as estimateTangentField() does, before counting
+    f.visits = std::min(extent.visits, kSaturated);
+    checkVisits(f.visits, p, p.voxelSize);  // also bounds the walk of countLeaves()
+    f.leaves = countLeaves(strands, map, f.visits);
+    return f;
+}
+
+namespace {
+
+/// The memory model's terms (bytes), fitted to the peak resident memory of `vdbhair field` and
+/// `vdbhair refine` (README, "Memory at scale": 100,000 strands at three voxel sizes and with 3
+/// levels, 250,000 and 500,000 strands, x 32 vertices) so that the estimate stays above every
+/// measured peak, by 4-19 %. Per leaf: a leaf's cost depends on how many of its 512 voxels the
+/// hair fills, which is not known before the estimate, so the fit takes the larger of the
+/// measured slopes.
+namespace memory {
+constexpr std::uint64_t kBase = std::uint64_t(48) << 20;  ///< the process: libraries, allocator arenas, threads
+constexpr std::uint64_t kStrand = 8;                      ///< a strand's offset and its place in the spatial order
+constexpr std::uint64_t kStrandVertex = 12;               ///< one copy of the positions
+/// field, per vertex: the strands (12) and what reading them leaves behind
+constexpr std::uint64_t kFieldVertex = 18;
+constexpr std::uint64_t kFieldLeaf = 15 << 10;  ///< a kept level's five grids: 512 x (12 + 4 x 4) bytes and masks
+constexpr std::uint64_t kChunkLeaf = 25 << 10;  ///< the chunks (slots and moments) of the level being estimated
+/// refine, the rest of the process: the head's fit, the report's k-d tree and scratch
+constexpr std::uint64_t kRefineBase = std::uint64_t(32) << 20;
+/// refine, per vertex: the input and output strands (24), the report's displacements (4), the
+/// writer's bytes (12) while both sets are alive, and the report's per-strand curvatures
+constexpr std::uint64_t kRefineVertex = 44;
+/// refine, per leaf of every level: the level's grids, the input's field, the chunks, the
+/// retrace's bricks and the report's field of the output
+constexpr std::uint64_t kRefineLeaf = 83 << 10;
+} // namespace memory
+
+} // namespace
+
+std::uint64_t estimatePeakBytes(const std::vector<FieldFootprint>& footprints, MemoryUse use)
+{
+    if (footprints.empty()) return memory::kBase;
+    const FieldFootprint& f0 = footprints.front();
+    std::uint64_t leaves = 0, maxLeaves = 0;
+    for (const FieldFootprint& f : footprints) {
+        leaves += f.leaves;
+        maxLeaves = std::max(maxLeaves, f.leaves);
+    }
+    const std::uint64_t strands = memory::kBase + memory::kStrand * f0.strands;
+    if (use == MemoryUse::Field) {
+        // Every level's grids are kept; the chunks of one level at a time.
+        return strands + memory::kFieldVertex * f0.vertices + memory::kFieldLeaf * leaves + memory::kChunkLeaf * maxLeaves;
+    }
+    // With more than one level, a level's strands are made while the last level's are alive.
+    const std::uint64_t copies = footprints.size() > 1 ? memory::kStrandVertex * f0.vertices : 0;
+    return strands + memory::kRefineBase + memory::kRefineVertex * f0.vertices + copies + memory::kRefineLeaf * leaves;
+}
+
+std::uint64_t availableMemoryBytes(const FieldParams& params)
+{
+    if (params.maxMemory > 0) return params.maxMemory;
+    std::ifstream in("/proc/meminfo");
+    std::string key, unit;
+    std::uint64_t kib = 0;
+    while (in >> key >> kib) {
+        std::getline(in, unit);
+        if (key == "MemAvailable:") return kib * 1024;
+    }
+    return std::numeric_limits<std::uint64_t>::max();
+}
+
+std::string formatBytes(std::uint64_t bytes)
+{
+    char buf[64];
+    if (bytes >= (std::uint64_t(1) << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(1 << 30));
+    else if (bytes >= (std::uint64_t(1) << 20)) std::snprintf(buf, sizeof buf, "%.0f MiB", double(bytes) / double(1 << 20));
+    else if (bytes >= 1024) std::snprintf(buf, sizeof buf, "%.0f KiB", double(bytes) / 1024.0);
+    else std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
+    return buf;
+}
+
+void checkMemoryEstimate(const char* where, std::uint64_t estimate, const std::string& how, const FieldParams& params)
+{
+    const std::uint64_t available = availableMemoryBytes(params);
+    if (estimate <= available) return;
+    throw LimitError(std::string(where) + ": needs about " + formatBytes(estimate) + " (" + how + "), more than the " +
+                     formatBytes(available) + (params.maxMemory > 0 ? " of maxMemory" : " available (MemAvailable)") +
+                     "; a request whose estimate exceeds the memory it may use is refused before it allocates "
+                     "(raise maxMemory or the voxel size, or split the hairstyle)");
+}
 
 std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params)
 {
@@ -582,6 +786,7 @@ TangentField estimateTangentField(const StrandSet& strands, const FieldParams& p
                                   openvdb::util::NullInterrupter* interrupter)
 {
     const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
+    checkFieldMemory(strands, p, 1);
     return estimateLevel(strands, p, p.voxelSize, 0, 1, threaded, interrupter);
 }
 
@@ -593,6 +798,7 @@ std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, c
                          std::to_string(FieldParams::kMaxLevels));
     }
     FieldParams lp = resolvedParams(strands, params, "estimateTangentField");
+    checkFieldMemory(strands, lp, levels);
     const double voxelSize = lp.voxelSize;
     std::vector<TangentField> out;
     for (int l = 0; l < levels; ++l) {

@@ -27,6 +27,7 @@
 #include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace vdbhair {
@@ -43,13 +44,62 @@ struct FieldParams
     FieldSpace space = FieldSpace::World;
     ScalpSphere scalp;        ///< used in scalp space
     /// Cap on the voxel visits the segments could need (an upper bound computed before any
-    /// allocation); about 40 bytes each at most. A voxel size too small for the hairstyle fails
-    /// with LimitError (naming maxVoxels) instead of exhausting memory.
-    std::uint64_t maxVoxels = std::uint64_t(1) << 26;
+    /// allocation): a bound on the work, about a minute on two cores at the cap. A voxel size far
+    /// too small for the hairstyle fails with LimitError (naming maxVoxels). Memory is bounded by
+    /// maxMemory: visits revisit voxels, so they say little about it (a 1,000,000-strand head at
+    /// its default voxel size makes 370 million visits into 2 million voxels).
+    std::uint64_t maxVoxels = std::uint64_t(1) << 32;
     /// The hair length per unit volume (world units^-2) that `density` maps to 1; 0 chooses it
     /// (see TangentField::density).
     double densityReference = 0.0;
+    /// Bytes the work may hold at its peak; 0: the memory the system has available when it starts
+    /// (availableMemoryBytes()). A request whose estimate (estimatePeakBytes()) is larger fails
+    /// with LimitError before allocating; no limit (the largest value) skips the estimate.
+    std::uint64_t maxMemory = 0;
 };
+
+/// @brief What estimating a field at one voxel size will allocate, counted before it allocates
+/// (estimateFieldFootprint()): the terms of the memory estimate.
+struct FieldFootprint
+{
+    std::uint64_t strands = 0, vertices = 0;
+    std::uint64_t visits = 0;  ///< an upper bound on the voxel visits (what FieldParams::maxVoxels caps)
+    /// The 8^3 leaf blocks the segments pass through: every grid of the field has these leaves.
+    /// Exact when the bounding box has at most 2^27 blocks (a byte each while counting), otherwise
+    /// the upper bound min(visits, blocks of the bounding box).
+    std::uint64_t leaves = 0;
+};
+
+/// @brief The footprint of estimating the field of @a strands at @a params (voxel size 0:
+/// resolveVoxelSize()): one pass over the vertices for the bounds, one for the leaves.
+/// @throw ValueError as estimateTangentField().
+FieldFootprint estimateFieldFootprint(const StrandSet& strands, const FieldParams& params);
+
+/// What a computation over the footprints holds at its peak (estimatePeakBytes()).
+enum class MemoryUse
+{
+    Field,   ///< estimateTangentFieldLevels(): the strands, every level's grids, one level's chunks
+    Refine,  ///< refineStrands() (Refine.h): also the output strands, the input's field, the retrace's bricks, the report
+};
+
+/// @brief The memory estimate: peak bytes of @a use over @a footprints (one per level, level 0
+/// first), the sum of per-vertex, per-strand and per-leaf terms. The one home of the memory
+/// model (its constants, in TangentField.cc, say what each term holds); fitted to the peak
+/// resident memory of `vdbhair field` and `vdbhair refine` from 100,000 to 1,000,000 strands
+/// (README, "Memory at scale"), which it stays a little above.
+std::uint64_t estimatePeakBytes(const std::vector<FieldFootprint>& footprints, MemoryUse use);
+
+/// @brief params.maxMemory if set, else MemAvailable of /proc/meminfo (the memory the kernel can
+/// give without swapping), else (no such file) the largest value: no limit.
+std::uint64_t availableMemoryBytes(const FieldParams& params);
+
+/// @brief Refuse up front: LimitError "<where>: needs about <estimate> (<how>), more than the
+/// <available> <source>; ..." when @a estimate exceeds availableMemoryBytes(@a params).
+/// @param how the terms of the estimate, for the message
+void checkMemoryEstimate(const char* where, std::uint64_t estimate, const std::string& how, const FieldParams& params);
+
+/// @brief Bytes as a person reads them: "1.37 GiB", "512 MiB", "900 B".
+std::string formatBytes(std::uint64_t bytes);
 
 /// @brief The grids of one level.
 struct TangentField
