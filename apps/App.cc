@@ -37,7 +37,9 @@ void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson)
 void printWarnings(const std::string& verb, const ReadReport& report, const CommonOptions& common)
 {
     if (common.quiet) return;
-    for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << w << "\n";
+    // Readers name library parameters; a verb that reads strands may render them (`render --up`).
+    static const FlagNames readerFlags = {{"RenderParams::up", "--up"}};
+    for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << withFlagNames(w, readerFlags) << "\n";
 }
 
 std::string formatValue(double v)

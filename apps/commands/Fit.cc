@@ -29,7 +29,6 @@ int runFit(FitCmdParams p, const CommonOptions& common)
     if (!(p.fit.lambda >= 0.0) || !std::isfinite(p.fit.lambda)) throw ValueError("--lambda " + formatValue(p.fit.lambda) + ": must be zero or positive");
     if (p.fit.maxEvaluations < 10) throw ValueError("--max-evaluations " + std::to_string(p.fit.maxEvaluations) + ": must be at least 10");
     if (p.fit.step != 0.0 && !(p.fit.step > 0.0 && std::isfinite(p.fit.step))) throw ValueError("--step " + formatValue(p.fit.step) + ": must be a positive finite length");
-    if (p.fit.maxPieces < 1 || p.fit.maxPieces > 64) throw ValueError("--max-pieces " + std::to_string(p.fit.maxPieces) + ": must be between 1 and 64");
     const StrandSet strands = loadStrands("fit", p.input, common, p.strict);
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -92,7 +91,7 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "Scene file (.json): one guide per input strand, in input order")->required();
     sub->add_option("--max-error", params->fit.maxError, "Accept a piece within this discrete Frechet distance, as a fraction of the strand length")->capture_default_str();
     sub->add_option("--lambda", params->fit.lambda, "Regularization weight of Eq. 5 (dimensionless: per turn of the piece)")->capture_default_str();
-    sub->add_option("--max-pieces", params->fit.maxPieces, "Most pieces per strand (and at most (3 n - 10) / 6 for n vertices: a fit is never larger than its points)")->capture_default_str();
+    sub->add_option("--max-pieces", params->fit.maxPieces, "Most pieces per strand, 1 to " + std::to_string(FitParams::kMaxPieces) + " (and at most (3 n - 10) / 6 for n vertices: a fit is never larger than its points)")->capture_default_str();
     sub->add_option("--max-evaluations", params->fit.maxEvaluations, "Nelder-Mead evaluations per piece and start")->capture_default_str();
     sub->add_option("--step", params->fit.step, "Tracing step of the fits in world units (default: a quarter of each strand's mean segment length)");
     sub->add_option("--roll", params->fit.optimizeRoll, "Also fit a roll angle of each piece's frame about its tangent (true/false)")->capture_default_str();
@@ -100,7 +99,7 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair fit hair.hair -o fits.json --json && vdbhair grow fits.json -o regrown.hair");
-    return {sub, [params, &common] { return runFit(*params, common); }};
+    return {sub, [params, &common] { return runFit(*params, common); }, {{"maxPieces", "--max-pieces"}}};
 }
 
 } // namespace vdbhair::app

@@ -164,7 +164,8 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --json");
     return {sub, [params, &common] { return runRetrace(*params, common); },
-            {{"step", "--step"}, {"margin", "--margin"}, {"vanishThreshold", "--vanish"}, {"maxSteps", "--max-steps"}}};
+            {{"step", "--step"}, {"margin", "--margin"}, {"vanishThreshold", "--vanish"}, {"maxSteps", "--max-steps"},
+             {"estimateHelicoidField", "'vdbhair field --helicoid'"}}};
 }
 
 } // namespace vdbhair::app

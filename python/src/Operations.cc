@@ -386,7 +386,9 @@ Returns:
             if (!(lambda >= 0.0) || !std::isfinite(lambda)) throw ValueError("fit: lambda_=" + std::to_string(lambda) + ": must be zero or positive");
             if (maxEvaluations < 10) throw ValueError("fit: max_evaluations=" + std::to_string(maxEvaluations) + ": must be at least 10");
             if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) throw ValueError("fit: step=" + std::to_string(step) + ": must be a positive finite length (0: automatic)");
-            if (maxPieces < 1 || maxPieces > 64) throw ValueError("fit: max_pieces=" + std::to_string(maxPieces) + ": must be between 1 and 64");
+            if (maxPieces < 1 || maxPieces > FitParams::kMaxPieces) {
+                throw ValueError("fit: max_pieces=" + std::to_string(maxPieces) + ": must be between 1 and " + std::to_string(FitParams::kMaxPieces));
+            }
             fp.maxError = maxError;
             fp.lambda = lambda;
             fp.maxPieces = maxPieces;

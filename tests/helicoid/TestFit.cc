@@ -237,6 +237,21 @@ TEST_CASE("fitStrands: identical with 1 and 2 threads, and regrown through a sce
     }
 }
 
+TEST_CASE("fitStrands: maxPieces outside 1..kMaxPieces is refused before any work, by name", "[helicoid]")
+{
+    StrandSet s;
+    s.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(1.f, 0.f, 0.f), Vec3f(2.f, 1.f, 0.f)});
+    FitParams params;
+    for (const int bad : {0, -3, FitParams::kMaxPieces + 1}) {
+        params.maxPieces = bad;
+        CAPTURE(bad);
+        REQUIRE_THROWS_WITH(fitStrands(s, params), Contains("fitStrands: maxPieces " + std::to_string(bad) + " must be between 1 and 64"));
+        REQUIRE_THROWS_AS(fitStrand(s.data(0), s.size(0), params), ValueError);
+    }
+    params.maxPieces = FitParams::kMaxPieces;
+    REQUIRE(fitStrands(s, params).size() == 1);
+}
+
 TEST_CASE("fitStrand: a p-helicoid of several pieces is fitted back by both split searches", "[helicoid]")
 {
     // Three C¹ pieces (§3.4) of known parameters, with a roll at each joint, sampled at 40
@@ -249,11 +264,11 @@ TEST_CASE("fitStrand: a p-helicoid of several pieces is fitted back by both spli
     const std::size_t stride = (t.points.size() - 1) / 39;
     for (std::size_t i = 0; i < t.points.size(); i += stride) target.push_back(t.points[i]);
     const std::vector<Vec3f> pts = toF(target);
-    const bool forward = GENERATE(true, false);
+    const SplitSearch search = GENERATE(SplitSearch::Forward, SplitSearch::TopDown);
     FitParams params;
-    params.forwardSearch = forward;
+    params.splitSearch = search;
     const StrandFit fit = fitStrand(pts.data(), pts.size(), params);
-    CAPTURE(forward, fit.frechet / fit.length, fit.pieces.size(), fit.evaluations);
+    CAPTURE(search == SplitSearch::Forward, fit.frechet / fit.length, fit.pieces.size(), fit.evaluations);
     REQUIRE(fit.frechet <= params.maxError * fit.length);
     REQUIRE(fit.pieces.size() >= 2);  // one helicoid cannot hold three
     REQUIRE(fit.pieces.size() <= 6);

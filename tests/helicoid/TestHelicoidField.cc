@@ -112,7 +112,7 @@ TEST_CASE("estimateHelicoidField / readHelicoidField: from strands, through a fi
     sameValues(*f.frameN, *r.frameN);
     const std::string plain = test::tempPath("plain.vdb");
     writeVdbGrids(plain, {t.tangent}, "test");
-    REQUIRE_THROWS_WITH(readHelicoidField(plain), Contains("no grid named 'helicoid_k'") && Contains("vdbhair field --helicoid"));
+    REQUIRE_THROWS_WITH(readHelicoidField(plain), Contains("no grid named 'helicoid_k'") && Contains("estimateHelicoidField"));
 }
 
 TEST_CASE("retraceHelicoidField: the engine's rules: a negative step is an error naming it, every step on request, attributes kept", "[helicoid]")

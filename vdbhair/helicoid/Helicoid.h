@@ -79,7 +79,7 @@ struct Helicoid
 /// nearer the axis the trace depends on the step (issue 19: traces that passed within one step
 /// of it changed by up to 100 % of their length at a finer step). Measured for fitting: 2 steps
 /// fit as closely as 1 and 4 at 30 vertices and better than 4 at the stored resolutions
-/// (HelicoidFit.h). At a piece's root the axis is 1/sqrt(kT² + kN²) away, at least 4 steps by
+/// (docs/fitting.md). At a piece's root the axis is 1/sqrt(kT² + kN²) away, at least 4 steps by
 /// the fit's bounds on k.
 constexpr double kAxisClearanceSteps = 2.0;
 

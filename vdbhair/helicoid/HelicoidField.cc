@@ -154,7 +154,7 @@ HelicoidFieldGrids readHelicoidField(const std::string& path)
         try {
             g = readVdbGrid(path, name, where);
         } catch (const LookupError& e) {
-            throw LookupError(std::string(e.what()) + " (write a helicoid field with 'vdbhair field --helicoid')");
+            throw LookupError(std::string(e.what()) + " (a helicoid field holds the grids estimateHelicoidField makes)");
         }
         return g;
     };

@@ -45,7 +45,7 @@ HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool
                                          openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// @brief Read `helicoid_k`, `helicoid_alpha`, `frame_T`, `frame_N` from a .vdb file.
-/// @throw LookupError naming the missing grid (and suggesting `vdbhair field --helicoid`).
+/// @throw LookupError naming the missing grid (and estimateHelicoidField(), which makes them).
 HelicoidFieldGrids readHelicoidField(const std::string& path);
 
 /// @brief Retrace strands through a helicoid field: at a point, each active corner of the

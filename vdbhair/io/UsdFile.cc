@@ -368,7 +368,7 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         throw FormatError(where + ": no strands: the file has no 'def BasisCurves' prim");
     }
     auto warn = [&](const std::string& w) { if (report) report->warnings.push_back(where + ": " + w); };
-    if (doc.upAxis == "Z") warn("the stage's upAxis is Z; coordinates are kept as they are (render with --up z)");
+    if (doc.upAxis == "Z") warn("the stage's upAxis is Z; coordinates are kept as they are (render with RenderParams::up set to z)");
     if (doc.xformOps) warn(std::to_string(doc.xformOps) + " xformOp(s) of BasisCurves prims were not applied: points are read in the prim's own space");
     if (doc.timeSamples) warn(std::to_string(doc.timeSamples) + " time-sampled attribute(s) were ignored; only default values are read");
 
