@@ -691,7 +691,7 @@ void benchmarkScale(const std::string& source, const std::vector<std::size_t>& s
 int main(int argc, char** argv)
 {
     CLI::App app{"vdbhair_benchmark: vdbhair against OpenVDB's nearest peers on the same input, in one run"};
-    std::string source = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path().string();
+    std::string source = VDBHAIR_SOURCE_DIR;
     std::string data = source + "/../shared/data";
     std::size_t strands = 100000, vertices = 64;
     int reps = 3, threads = 0;
