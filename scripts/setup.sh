@@ -5,7 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake pkg-config ccache
-  libopenvdb-dev libboost-iostreams-dev libtbb-dev libeigen3-dev libopenimageio-dev
+  libopenvdb-dev libboost-iostreams-dev libtbb-dev libeigen3-dev libopenimageio-dev libpng-dev libfreetype-dev
   catch2 libcli11-dev nlohmann-json3-dev libnanoflann-dev libnlopt-dev libnlopt-cxx-dev
   libopenvdb-tools python3-openvdb python3-numpy fonts-dejavu-core
   pybind11-dev python3-pybind11 python3-dev python3-pytest

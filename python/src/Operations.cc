@@ -659,16 +659,13 @@ Returns:
                 writeImage(*path, image);
                 return pyb::none();
             }
-            // Linear to sRGB, 8 bits, opaque: what writeImage stores in a .png.
+            // What writeImage stores in a .png, made opaque.
+            const std::vector<std::uint8_t> srgb = toSrgb8(image);
             pyb::array_t<std::uint8_t> out({pyb::ssize_t(image.height), pyb::ssize_t(image.width), pyb::ssize_t(4)});
             std::uint8_t* o = out.mutable_data();
             const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
             for (std::size_t i = 0; i < n; ++i) {
-                for (int c = 0; c < 3; ++c) {
-                    float v = std::min(1.f, std::max(0.f, image.rgb[3 * i + c]));
-                    v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
-                    o[4 * i + c] = std::uint8_t(std::lround(v * 255.f));
-                }
+                for (int c = 0; c < 3; ++c) o[4 * i + c] = srgb[3 * i + c];
                 o[4 * i + 3] = 255;
             }
             return std::move(out);

@@ -1,6 +1,9 @@
 """grow, fit, render, inspect, and the module's documentation."""
 import inspect as pyinspect
 import json
+import os
+import struct
+import zlib
 
 import numpy as np
 import pytest
@@ -39,8 +42,58 @@ def test_render_returns_rgba_or_writes_a_file(tmp_path):
     hair = (image[:, :, :3] < 250).any(axis=-1)
     assert not hair[0, 0] and hair.sum() > 20
     path = tmp_path / "hair.png"
-    assert vdbhair.render(s, str(path), width=64, height=48) is None
+    assert vdbhair.render(s, str(path), width=64, height=48, view="front") is None
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    np.testing.assert_array_equal(read_png_rgb(path), image[:, :, :3])
+
+
+def read_png_rgb(path):
+    """An 8-bit RGB, non-interlaced PNG's pixels (the filters of the PNG specification, section 9)."""
+    data = path.read_bytes()
+    pos, idat = 8, b""
+    while pos < len(data):
+        (length,) = struct.unpack(">I", data[pos:pos + 4])
+        kind, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+        if kind == b"IHDR":
+            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            assert (depth, colour, interlace) == (8, 2, 0)
+        elif kind == b"IDAT":
+            idat += body
+    raw, stride = zlib.decompress(idat), width * 3
+    rows, prev = [], np.zeros(stride, dtype=np.int64)
+    for y in range(height):
+        kind, line = raw[y * (stride + 1)], np.frombuffer(raw, np.uint8, stride, y * (stride + 1) + 1).astype(np.int64)
+        out = np.zeros(stride, dtype=np.int64)
+        for i in range(stride):
+            a = out[i - 3] if i >= 3 else 0
+            b, c = prev[i], prev[i - 3] if i >= 3 else 0
+            if kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                predictor = a if pa <= pb and pa <= pc else b if pb <= pc else c
+            else:
+                predictor = [0, a, b, (a + b) // 2][kind]
+            out[i] = (line[i] + predictor) & 255
+        rows.append(out)
+        prev = out
+    return np.array(rows, dtype=np.uint8).reshape(height, width, 3)
+
+
+@pytest.mark.skipif(not os.path.exists("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"),
+                    reason="DejaVu Sans (fonts-dejavu-core) is not installed: titles are not drawn")
+def test_render_draws_its_title_in_the_written_png(tmp_path):
+    s = straight_bundle(count=3)
+    bare = vdbhair.render(s, width=96, height=64, view="front")
+    titled = vdbhair.render(s, width=96, height=64, view="front", title="Hair 42")
+    # The title is drawn in the top-left corner, dark on the white background, and nowhere else.
+    changed = (bare != titled).any(axis=-1)
+    rows, cols = np.nonzero(changed)
+    assert changed.sum() > 30 and rows.max() < 32 and cols.min() < 16
+    assert titled[:, :, :3].min() < 100
+    path = tmp_path / "titled.png"
+    vdbhair.render(s, str(path), width=96, height=64, view="front", title="Hair 42")
+    np.testing.assert_array_equal(read_png_rgb(path), titled[:, :, :3])
     with pytest.raises(ValueError, match="view"):
         vdbhair.render(s, view="sideways")
 

@@ -9,11 +9,19 @@
 #include <dlfcn.h>
 #include <unistd.h>
 
+#include <ft2build.h>
+#include FT_FREETYPE_H
+#include <png.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cctype>
+#include <csetjmp>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 
 namespace vdbhair {
@@ -32,6 +40,19 @@ void Image::paste(const Image& o, int x0, int y0)
             if (x0 + x >= 0 && x0 + x < width && y0 + y >= 0 && y0 + y < height) set(x0 + x, y0 + y, o.at(x, y));
         }
     }
+}
+
+float linearToSrgb(float v)
+{
+    v = std::min(1.f, std::max(0.f, v));
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+}
+
+std::vector<std::uint8_t> toSrgb8(const Image& image)
+{
+    std::vector<std::uint8_t> bytes(image.rgb.size());
+    for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<std::uint8_t>(std::lround(linearToSrgb(image.rgb[i]) * 255.f));
+    return bytes;
 }
 
 Vec3f fromSrgb(const Vec3f& c)
@@ -138,12 +159,70 @@ const VdbhairImageModule& imageModule()
 
 } // namespace
 
+namespace {
+
+/// The font, opened once with FreeType (what OpenImageIO's render_text uses: the same glyphs
+/// without loading OpenImageIO). Null when the font or FreeType cannot be opened.
+struct Font
+{
+    FT_Library library = nullptr;
+    FT_Face face = nullptr;
+    std::mutex mutex;  // a face is not thread-safe
+    Font()
+    {
+        const char* path = fontPath();
+        if (!path || FT_Init_FreeType(&library) != 0) return;
+        if (FT_New_Face(library, path, 0, &face) != 0) face = nullptr;
+    }
+    ~Font()
+    {
+        if (face) FT_Done_Face(face);
+        if (library) FT_Done_FreeType(library);
+    }
+};
+
+/// The next code point of UTF-8 @a s at @a i (advancing @a i); U+FFFD for a malformed sequence.
+unsigned long nextCodePoint(const std::string& s, std::size_t& i)
+{
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+    const unsigned char b = byte(i++);
+    if (b < 0x80) return b;
+    const int more = b >= 0xF0 ? 3 : b >= 0xE0 ? 2 : b >= 0xC0 ? 1 : -1;
+    if (more < 0) return 0xFFFD;
+    unsigned long cp = b & (0x3F >> more);
+    for (int k = 0; k < more; ++k, ++i) {
+        if (i >= s.size() || (byte(i) & 0xC0) != 0x80) return 0xFFFD;
+        cp = (cp << 6) | (byte(i) & 0x3F);
+    }
+    return cp;
+}
+
+} // namespace
+
 void drawText(Image& image, int x, int y, const std::string& text, int size, const Vec3f& color)
 {
-    const char* font = fontPath();
-    if (!font || image.width == 0) return;
-    const float c[3] = {color.x(), color.y(), color.z()};
-    imageModule().drawText(image.rgb.data(), image.width, image.height, x, y, text.c_str(), size, font, c);
+    static Font font;
+    if (!font.face || image.width == 0 || size < 1) return;
+    const std::lock_guard<std::mutex> lock(font.mutex);
+    if (FT_Set_Pixel_Sizes(font.face, 0, FT_UInt(size)) != 0) return;
+    // Each glyph's coverage blends the colour over the pixels (as OpenImageIO's render_text).
+    int penX = x;
+    for (std::size_t i = 0; i < text.size();) {
+        if (FT_Load_Char(font.face, nextCodePoint(text, i), FT_LOAD_RENDER) != 0) continue;
+        const FT_GlyphSlot g = font.face->glyph;
+        const FT_Bitmap& bm = g->bitmap;
+        const int left = penX + g->bitmap_left, top = y - g->bitmap_top;
+        for (int row = 0; row < int(bm.rows); ++row) {
+            for (int col = 0; col < int(bm.width); ++col) {
+                const int px = left + col, py = top + row;
+                if (px < 0 || px >= image.width || py < 0 || py >= image.height) continue;
+                const float a = float(bm.buffer[std::ptrdiff_t(row) * bm.pitch + col]) / 255.f;
+                if (a <= 0.f) continue;
+                image.set(px, py, color * a + image.at(px, py) * (1.f - a));
+            }
+        }
+        penX += int(g->advance.x >> 6);
+    }
 }
 
 void drawColorBar(Image& image, int x, int y, int w, int h, double lo, double hi, const std::string& label)
@@ -163,10 +242,58 @@ void drawColorBar(Image& image, int x, int y, int w, int h, double lo, double hi
     drawText(image, x, y - 6, label, size, Vec3f(0.f));
 }
 
+namespace {
+
+bool isPng(const std::string& path)
+{
+    std::string ext = fileExtension(path);
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".png";
+}
+
+/// Write 8-bit RGB @a bytes (top row first) as a PNG with libpng: the common case, without
+/// loading OpenImageIO (Image.h: the image module costs a process about half a second).
+void writePng(const std::string& path, const std::string& where, int width, int height, const std::vector<std::uint8_t>& bytes)
+{
+    struct File { std::FILE* f; ~File() { if (f) std::fclose(f); } } file{std::fopen(path.c_str(), "wb")};
+    if (!file.f) throw IoError(where + ": cannot open " + path + " for writing: " + std::strerror(errno));
+    struct Failure { char message[256] = "libpng failed"; } failure;
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &failure,
+        [](png_structp p, png_const_charp msg) {
+            std::snprintf(static_cast<Failure*>(png_get_error_ptr(p))->message, sizeof(Failure::message), "%s", msg);
+            png_longjmp(p, 1);
+        }, nullptr);
+    if (!png) throw IoError(where + ": libpng could not start");
+    png_infop info = png_create_info_struct(png);
+    std::vector<png_const_bytep> rows(static_cast<std::size_t>(height));
+    for (int y = 0; y < height; ++y) rows[std::size_t(y)] = bytes.data() + std::size_t(y) * std::size_t(width) * 3;
+    // Nothing with a destructor is made between setjmp and the longjmp that may return to it.
+    if (!info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        throw IoError(where + ": " + failure.message);
+    }
+    png_init_io(png, file.f);
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_text software{};
+    software.compression = PNG_TEXT_COMPRESSION_NONE;
+    software.key = const_cast<png_charp>("Software");
+    software.text = const_cast<png_charp>("vdbhair");
+    png_set_text(png, info, &software, 1);
+    png_write_info(png, info);
+    png_write_rows(png, const_cast<png_bytepp>(rows.data()), png_uint_32(height));
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    if (std::fflush(file.f) != 0 || std::ferror(file.f)) throw IoError(where + ": writing " + path + " failed: " + std::strerror(errno));
+}
+
+} // namespace
+
 bool isImagePath(const std::string& path)
 {
     const std::string ext = fileExtension(path);
     if (ext.empty()) return false;
+    if (isPng(path)) return true;
     return imageModule().canWrite(path.c_str()) != 0;
 }
 
@@ -179,13 +306,14 @@ void writeImage(const std::string& path, const Image& image)
     const std::string ext = fileExtension(path);
     const bool floatOut = ext == ".exr" || ext == ".hdr";
     AtomicOutput atomic(path);
+    if (isPng(path)) {
+        writePng(atomic.tempPath(), where, image.width, image.height, toSrgb8(image));
+        atomic.commit();
+        return;
+    }
     std::vector<float> pixels = image.rgb;
     if (!floatOut) {
-        // Linear to sRGB for 8-bit formats.
-        for (float& v : pixels) {
-            v = std::min(1.f, std::max(0.f, v));
-            v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
-        }
+        for (float& v : pixels) v = linearToSrgb(v);  // 8-bit formats: OpenImageIO rounds to nearest
     }
     char err[1024] = {0};
     if (imageModule().write(atomic.tempPath().c_str(), image.width, image.height, floatOut ? 1 : 0, pixels.data(), err, sizeof err) != 0) {

@@ -1,11 +1,12 @@
 /// @file Image.h
-/// @brief A linear RGB float image, colour maps, text (OpenImageIO, through the image module
-/// loaded on first use: ImageModule.h, with a DejaVu font) and
-/// atomic writing by extension (PNG, EXR, JPEG, ... whatever OpenImageIO writes).
+/// @brief A linear RGB float image, colour maps, text (FreeType, with a DejaVu font) and atomic
+/// writing by extension: PNG with libpng, every other format OpenImageIO writes (EXR, JPEG, ...)
+/// through the image module loaded on first use (ImageModule.h).
 #pragma once
 
 #include <vdbhair/Types.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,13 @@ struct Image
 /// @brief A display (sRGB-encoded) colour as the linear colour the image stores, so that it is
 /// written back as itself.
 Vec3f fromSrgb(const Vec3f& c);
+
+/// @brief A linear value clamped to [0, 1] and sRGB-encoded (what 8-bit images store).
+float linearToSrgb(float v);
+
+/// @brief The image as 8-bit sRGB, #width·#height·3 bytes rounded to nearest: the bytes of a
+/// written PNG (and of the arrays the Python module returns).
+std::vector<std::uint8_t> toSrgb8(const Image& image);
 
 /// @brief A perceptually ordered colour map (viridis-like) at t in [0, 1], linear.
 Vec3f colorMap(float t);
@@ -50,7 +58,8 @@ void drawColorBar(Image& image, int x, int y, int w, int h, double lo, double hi
 /// @throw ValueError (unknown extension), IoError.
 void writeImage(const std::string& path, const Image& image);
 
-/// @brief Whether OpenImageIO can write @a path's extension.
+/// @brief Whether @a path's extension is PNG or a format OpenImageIO can write (the latter loads
+/// the image module).
 bool isImagePath(const std::string& path);
 
 } // namespace vdbhair

@@ -1,8 +1,6 @@
 // The image module (ImageModule.h): OpenImageIO behind a C interface, loaded on first use.
 #include "ImageModule.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cstdio>
@@ -30,14 +28,7 @@ int write(const char* path, int width, int height, int asFloat, const float* rgb
     return 0;
 }
 
-void drawText(float* rgb, int width, int height, int x, int y, const char* text, int size, const char* font, const float* color)
-{
-    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::FLOAT);
-    OIIO::ImageBuf buf(spec, rgb);  // wraps the caller's pixels
-    OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font, OIIO::cspan<float>(color, 3));
-}
-
-const VdbhairImageModule kModule{kVdbhairImageModuleVersion, canWrite, write, drawText};
+const VdbhairImageModule kModule{kVdbhairImageModuleVersion, canWrite, write};
 
 } // namespace
 
