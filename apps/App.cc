@@ -327,7 +327,7 @@ int run(int argc, char** argv)
             threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                             std::size_t(common.threads));
         }
-        installInterruptHandlers();
+        installInterruptHandlers(verb);
         keepUnwindReserve();
         TerminalProgress progress(verb, common.quiet);
         common.interrupter = &progress;

@@ -27,6 +27,9 @@ bool commitRefused() { return sSignal != 0; }
 /// VDBHAIR_TEST_INTERRUPT_DRAWN=1, the first line drawn with a rate and a time left does (a test
 /// of the drawn bar then needs no timer that a fast machine could outrun or a slow one miss).
 /// VDBHAIR_TEST_INTERRUPT_SIGNAL=TERM sends SIGTERM instead (as `timeout` and Slurm do).
+/// With VDBHAIR_TEST_STOP_AT_START=VERB, a process running VERB stops itself (SIGSTOP) once its
+/// handlers are installed, before its work: a test of `batch` then signals a child that is certainly
+/// still running, or lets it go on (SIGCONT), in an order of its choosing.
 std::uint64_t sInterruptAfter = 0;
 bool sInterruptDrawn = false;
 int sTestSignal = SIGINT;
@@ -81,7 +84,7 @@ constexpr double kRedrawEvery = 0.1;  ///< seconds between redraws
 
 } // namespace
 
-void installInterruptHandlers()
+void installInterruptHandlers(const std::string& verb)
 {
     // One-shot (a second Ctrl-C terminates at once); system calls restart rather than fail
     // with EINTR (a read in progress would otherwise report an I/O error, not the interruption).
@@ -90,6 +93,7 @@ void installInterruptHandlers()
     if (const char* n = std::getenv("VDBHAIR_TEST_INTERRUPT_AFTER"); n && *n) sInterruptAfter = std::strtoull(n, nullptr, 10);
     if (const char* d = std::getenv("VDBHAIR_TEST_INTERRUPT_DRAWN"); d && *d == '1') sInterruptDrawn = true;
     if (const char* t = std::getenv("VDBHAIR_TEST_INTERRUPT_SIGNAL"); t && std::string(t) == "TERM") sTestSignal = SIGTERM;
+    if (const char* v = std::getenv("VDBHAIR_TEST_STOP_AT_START"); v && verb == v) ::raise(SIGSTOP);
 }
 
 bool interruptRequested() { return sSignal != 0; }

@@ -28,8 +28,8 @@
 namespace vdbhair::app {
 
 /// @brief Install the SIGINT/SIGTERM handlers and make AtomicOutput::commit() refuse to rename
-/// once a signal has arrived.
-void installInterruptHandlers();
+/// once a signal has arrived. @a verb is the verb about to run (for the test hooks, see the .cc).
+void installInterruptHandlers(const std::string& verb);
 
 /// @brief Whether Ctrl-C (or SIGTERM) has arrived.
 bool interruptRequested();

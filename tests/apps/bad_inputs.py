@@ -3,9 +3,13 @@
 twice - with a fresh output path and with an existing output. Each run must exit non-zero, print
 exactly one line on stderr that names the file (or the verb or option at fault) and the rule
 broken, leave no output and no temporary file, and leave an existing output byte-identical.
+The cases run two at a time (a process start is most of a case's time); each has a folder of its
+own for its output, so that what one case leaves is checked after each of its runs, and the input
+folder and the whole output folder are checked again once every case has run.
 
 Usage: bad_inputs.py VDBHAIR WORKDIR   (inputs are made here, small and synthetic)
 """
+import concurrent.futures
 import math
 import os
 import shutil
@@ -74,8 +78,10 @@ good_hair = write("good.hair", hair(GOOD))
 write("zero.hair", hair(ZERO))
 write("somezero.hair", hair(GOOD + [[(7, 7, 7)] * 3]))
 write("short1.hair", hair(GOOD + [[(1, 1, 1)]]))
-subprocess.run([CLI, "convert", good_hair, path("good.vdb"), "-q"], check=True)
-subprocess.run([CLI, "field", good_hair, "-o", path("field.vdb"), "-q"], check=True)
+setup = [subprocess.Popen([CLI, "convert", good_hair, path("good.vdb"), "-q"]),
+         subprocess.Popen([CLI, "field", good_hair, "-o", path("field.vdb"), "-q"])]
+if any(p.wait() != 0 for p in setup):
+    sys.exit("the inputs good.vdb and field.vdb could not be made")
 vdb = open(path("good.vdb"), "rb").read()
 
 
@@ -173,13 +179,17 @@ CASES = [
 ]
 
 
-def temporaries():
-    return [f for d in (IN, OUT) for f in os.listdir(d) if ".vdbhair-tmp-" in f]
+def temporaries(folder):
+    return [os.path.join(d, f) for d, dirs, files in os.walk(folder) for f in dirs + files if ".vdbhair-tmp-" in f]
 
 
-failures = []
-for i, (name, argv, words) in enumerate(CASES):
-    out = os.path.join(OUT, "case%02d" % i)
+def run_case(i):
+    """Both runs of case i; returns its failures."""
+    name, argv, words = CASES[i]
+    folder = os.path.join(OUT, "case%02d" % i)
+    os.makedirs(folder)
+    out = os.path.join(folder, "out")
+    failures = []
     for existing in (False, True):
         args = [a.replace("{out}", out) for a in argv]
         outputs = [a for a in args if a.startswith(out)]
@@ -215,9 +225,20 @@ for i, (name, argv, words) in enumerate(CASES):
                     failures.append("%s: the existing output %s was changed" % (what, o))
             elif os.path.exists(o):
                 failures.append("%s: an output %s was written" % (what, o))
-        if temporaries():
-            failures.append("%s: temporary files left: %s" % (what, temporaries()))
-    print("ok " if not [f for f in failures if f.startswith(name)] else "BAD", name)
+        if temporaries(folder):
+            failures.append("%s: temporary files left: %s" % (what, temporaries(folder)))
+    return failures
+
+
+failures = []
+with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
+    for (name, _, _), fs in zip(CASES, pool.map(run_case, range(len(CASES)))):
+        print("ok " if not fs else "BAD", name)
+        failures += fs
+# Every run has ended: nothing of theirs may be left anywhere (a case's own folder was checked
+# after each of its runs; this covers the inputs' folder and the rest).
+for f in temporaries(IN) + temporaries(OUT):
+    failures.append("temporary file left after all cases: %s" % f)
 
 print("%d cases, %d runs, %d failures" % (len(CASES), 2 * len(CASES), len(failures)))
 for f in failures:

@@ -12,11 +12,13 @@ stop() {
     [ -f "$f" ] && pids="$pids $(cat "$f")"
   done
   [ -n "$pids" ] && kill $pids 2>/dev/null
-  for t in $(seq 50); do  # gone within 5 s
-    alive=0
-    for p in $pids; do kill -0 "$p" 2>/dev/null && alive=1; done
+  for t in $(seq 100); do  # gone within 5 s; an exited daemon may stay a zombie (state Z) until
+    alive=0                # the container's init reaps it, up to a second later: that counts as gone
+    for p in $pids; do
+      [ -e "/proc/$p" ] && [ "$(cut -d' ' -f3 "/proc/$p/stat" 2>/dev/null)" != Z ] && alive=1
+    done
     [ $alive = 0 ] && break
-    sleep 0.1
+    sleep 0.05
   done
   return 0
 }
@@ -57,12 +59,18 @@ TaskPlugin=task/none
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 SchedulerType=sched/builtin
+# Schedule on the next pass after a submission or a job's end (Slurm's default batch_sched_delay
+# waits 3 s between passes). The first pass still comes 3 s after slurmctld starts.
+SchedulerParameters=batch_sched_delay=0
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
 ReturnToService=2
 MpiDefault=none
+# The node claims at least 4 CPUs (config_overrides: slurmd takes the configured count over the
+# hardware's), so that a test's 4-task array starts in one scheduling pass on a 2-core machine.
+SlurmdParameters=config_overrides
 SwitchType=switch/none
-NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) RealMemory=$(( $(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 * 9 / 10 )) State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$(( $(nproc) > 4 ? $(nproc) : 4 )) RealMemory=$(( $(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 * 9 / 10 )) State=UNKNOWN
 PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP OverSubscribe=YES
 CONF
 export SLURM_CONF=$dir/slurm.conf
