@@ -25,10 +25,7 @@ struct FitCmdParams
 int runFit(FitCmdParams p, const CommonOptions& common)
 {
     if (fileExtension(p.output) != ".json") throw ValueError(p.output + ": fits are written as a scene file; the output must end in .json");
-    if (!(p.fit.maxError > 0.0) || !std::isfinite(p.fit.maxError)) throw ValueError("--max-error " + formatValue(p.fit.maxError) + ": must be a positive fraction of the strand length");
-    if (!(p.fit.lambda >= 0.0) || !std::isfinite(p.fit.lambda)) throw ValueError("--lambda " + formatValue(p.fit.lambda) + ": must be zero or positive");
-    if (p.fit.maxEvaluations < 10) throw ValueError("--max-evaluations " + std::to_string(p.fit.maxEvaluations) + ": must be at least 10");
-    if (p.fit.step != 0.0 && !(p.fit.step > 0.0 && std::isfinite(p.fit.step))) throw ValueError("--step " + formatValue(p.fit.step) + ": must be a positive finite length");
+    p.fit.validate("option");  // the library's ranges, its field names spelled as flags (addFitCommand)
     const StrandSet strands = loadStrands("fit", p.input, common, p.strict);
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -66,6 +63,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
     if (common.json) {
         printJson({{"output", p.output}, {"strands", s.strands}, {"fitted", s.fitted}, {"skipped", s.skipped}, {"over_max_error", s.overMaxError},
                    {"frechet_relative", {{"mean", s.meanRelative}, {"p95", s.p95Relative}}}, {"pieces_per_strand", s.piecesPerStrand},
+                   {"evaluations_per_strand", s.evaluationsPerStrand},
                    {"step_convergence", {{"mean", s.stepDeviationMean}, {"max", s.stepDeviationMax}, {"unconverged", s.unconverged}}},
                    {"bytes", {{"fit", s.fitBytes}, {"points", s.pointBytes}}}, {"compression", s.pointBytes / s.fitBytes},
                    {"strands_per_second", double(s.fitted) / seconds}});
@@ -92,14 +90,16 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--max-error", params->fit.maxError, "Accept a piece within this discrete Frechet distance, as a fraction of the strand length")->capture_default_str();
     sub->add_option("--lambda", params->fit.lambda, "Regularization weight of Eq. 5 (dimensionless: per turn of the piece)")->capture_default_str();
     sub->add_option("--max-pieces", params->fit.maxPieces, "Most pieces per strand, 1 to " + std::to_string(FitParams::kMaxPieces) + " (and at most (3 n - 10) / 6 for n vertices: a fit is never larger than its points)")->capture_default_str();
-    sub->add_option("--max-evaluations", params->fit.maxEvaluations, "Nelder-Mead evaluations per piece and start")->capture_default_str();
+    sub->add_option("--prefit-iterations", params->fit.prefitIterations, "Levenberg-Marquardt pre-fit iterations per piece and start (0: none, Nelder-Mead alone from the raw starts, the paper's method)")->capture_default_str();
+    sub->add_option("--max-evaluations", params->fit.maxEvaluations, "Nelder-Mead evaluations per piece with --prefit-iterations 0, at least " + std::to_string(FitParams::kMinEvaluations) + " (the pre-fit needs none)")->capture_default_str();
     sub->add_option("--step", params->fit.step, "Tracing step of the fits in world units (default: a quarter of each strand's mean segment length)");
     sub->add_option("--roll", params->fit.optimizeRoll, "Also fit a roll angle of each piece's frame about its tangent (true/false)")->capture_default_str();
     sub->add_flag("--skip-degenerate", params->skipDegenerate, "Leave out strands of zero length instead of failing");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair fit hair.hair -o fits.json --json && vdbhair grow fits.json -o regrown.hair");
-    return {sub, [params, &common] { return runFit(*params, common); }, {{"maxPieces", "--max-pieces"}}};
+    return {sub, [params, &common] { return runFit(*params, common); }, {{"maxError", "--max-error"}, {"lambda", "--lambda"}, {"maxPieces", "--max-pieces"}, {"maxEvaluations", "--max-evaluations"},
+                                                                 {"prefitIterations", "--prefit-iterations"}, {"step", "--step"}}};
 }
 
 } // namespace vdbhair::app

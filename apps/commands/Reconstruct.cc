@@ -47,7 +47,7 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
     if (!(p.rec.helicoid.shepard.power > 0.0) || !std::isfinite(p.rec.helicoid.shepard.power)) {
         throw ValueError("--power " + formatValue(p.rec.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
     }
-    if (!(p.rec.fit.maxError > 0.0) || !std::isfinite(p.rec.fit.maxError)) throw ValueError("--max-error " + formatValue(p.rec.fit.maxError) + ": must be a positive fraction of the strand length");
+    p.rec.fit.validate("option");  // the fits' ranges, FitParams's, spelled as flags (addReconstructCommand)
     if (p.neighborsOpt && p.neighborsOpt->count() > 0) {
         if (p.neighbors < 1) throw ValueError("--neighbors " + std::to_string(p.neighbors) + ": must be at least 1 (omit it for each method's default)");
         p.rec.helicoid.shepard.neighbors = p.neighbors;
@@ -119,7 +119,7 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--errors", params->errors, "Also write every strand's relative error, both methods, as CSV");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair reconstruct straight.hair -o rebuilt.hair --guides 10% --json");
-    return {sub, [params, &common] { return runReconstruct(*params, common); }};
+    return {sub, [params, &common] { return runReconstruct(*params, common); }, {{"maxError", "--max-error"}}};
 }
 
 } // namespace vdbhair::app

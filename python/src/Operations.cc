@@ -57,11 +57,24 @@ Scene sceneArgument(const pyb::handle& scene, const std::string& where = "grow")
                     std::string(pyb::str(scene.get_type().attr("__name__"))));
 }
 
-/// The max_error= keyword of fit and reconstruct.
-void checkMaxError(double maxError, const char* where)
+/// FitParams::validate with its field names spelled as fit's and reconstruct's keywords.
+void validateFitKeywords(const FitParams& fp, const char* where)
 {
-    if (!(maxError > 0.0) || !std::isfinite(maxError))
-        throw ValueError(std::string(where) + ": max_error=" + std::to_string(maxError) + ": must be a positive fraction of the strand length");
+    try {
+        fp.validate(where);
+    } catch (const ValueError& e) {
+        std::string message = e.what();
+        for (const auto& [field, keyword] : {std::pair<const char*, const char*>{"maxError ", "max_error="}, {"lambda ", "lambda_="},
+                                            {"maxPieces ", "max_pieces="}, {"maxEvaluations ", "max_evaluations="},
+                                            {"prefitIterations ", "prefit_iterations="}, {"step ", "step="}}) {
+            const std::string named = std::string(where) + ": " + field;
+            if (message.compare(0, named.size(), named) == 0) {
+                message = std::string(where) + ": " + keyword + message.substr(named.size());
+                break;
+            }
+        }
+        throw ValueError(message);
+    }
 }
 
 Vec3d unitAxis(const std::array<double, 3>& a, const char* name)
@@ -379,22 +392,17 @@ Returns:
     const FitParams fitDefaults;
     m.def(
         "fit",
-        [](const StrandsPtr& strands, double maxError, double lambda, int maxPieces, int maxEvaluations, double step, bool roll,
+        [](const StrandsPtr& strands, double maxError, double lambda, int maxPieces, int prefitIterations, int maxEvaluations, double step, bool roll,
            bool skipDegenerate, bool returnSummary, int threads, const pyb::object& progress) -> pyb::object {
             FitParams fp;
-            checkMaxError(maxError, "fit");
-            if (!(lambda >= 0.0) || !std::isfinite(lambda)) throw ValueError("fit: lambda_=" + std::to_string(lambda) + ": must be zero or positive");
-            if (maxEvaluations < 10) throw ValueError("fit: max_evaluations=" + std::to_string(maxEvaluations) + ": must be at least 10");
-            if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) throw ValueError("fit: step=" + std::to_string(step) + ": must be a positive finite length (0: automatic)");
-            if (maxPieces < 1 || maxPieces > FitParams::kMaxPieces) {
-                throw ValueError("fit: max_pieces=" + std::to_string(maxPieces) + ": must be between 1 and " + std::to_string(FitParams::kMaxPieces));
-            }
             fp.maxError = maxError;
             fp.lambda = lambda;
             fp.maxPieces = maxPieces;
+            fp.prefitIterations = prefitIterations;
             fp.maxEvaluations = maxEvaluations;
             fp.step = step;
             fp.optimizeRoll = roll;
+            validateFitKeywords(fp, "fit");
             std::vector<std::string> errors;
             const std::vector<StrandFit> fits = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 return fitStrands(*strands, fp, true, &errors, interrupter);
@@ -430,7 +438,8 @@ Returns:
             return pyb::make_tuple(sceneObj, d);
         },
         pyb::arg("strands"), pyb::kw_only(), pyb::arg("max_error") = fitDefaults.maxError, pyb::arg("lambda_") = fitDefaults.lambda,
-        pyb::arg("max_pieces") = fitDefaults.maxPieces, pyb::arg("max_evaluations") = fitDefaults.maxEvaluations,
+        pyb::arg("max_pieces") = fitDefaults.maxPieces, pyb::arg("prefit_iterations") = fitDefaults.prefitIterations,
+        pyb::arg("max_evaluations") = fitDefaults.maxEvaluations,
         pyb::arg("step") = fitDefaults.step, pyb::arg("roll") = fitDefaults.optimizeRoll, pyb::arg("skip_degenerate") = false,
         pyb::arg("return_summary") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``.
@@ -442,7 +451,10 @@ Args:
     lambda_: regularization weight of Eq. 5 (dimensionless, per turn of the piece); the CLI's
         ``--lambda`` (``lambda`` is a Python keyword).
     max_pieces: most pieces per strand (1-64).
-    max_evaluations: Nelder-Mead evaluations per piece and start (at least 10).
+    prefit_iterations: Levenberg-Marquardt pre-fit iterations per piece and start (0: none,
+        Nelder-Mead alone from the raw starts, the paper's method).
+    max_evaluations: Nelder-Mead evaluations per piece with prefit_iterations=0 (at least 10;
+        the pre-fit needs none).
     step: tracing step of the fits in world units; 0 is a quarter of each strand's mean
         segment length.
     roll: also fit a roll angle of each piece's frame about its tangent.
@@ -568,8 +580,8 @@ Returns:
                 p.helicoid.shepard.neighbors = *neighbors;
                 p.points.neighbors = *neighbors;
             }
-            checkMaxError(maxError, "reconstruct");
             p.fit.maxError = maxError;
+            validateFitKeywords(p.fit, "reconstruct");
             ReconstructResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 return reconstructHairstyle(*strands, p, true, interrupter);
             });

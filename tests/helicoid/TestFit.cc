@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <random>
 
 using namespace vdbhair;
@@ -237,7 +238,7 @@ TEST_CASE("fitStrands: identical with 1 and 2 threads, and regrown through a sce
     }
 }
 
-TEST_CASE("fitStrands: maxPieces outside 1..kMaxPieces is refused before any work, by name", "[helicoid]")
+TEST_CASE("fitStrands: parameters outside their ranges are refused before any work, by name", "[helicoid]")
 {
     StrandSet s;
     s.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(1.f, 0.f, 0.f), Vec3f(2.f, 1.f, 0.f)});
@@ -245,11 +246,39 @@ TEST_CASE("fitStrands: maxPieces outside 1..kMaxPieces is refused before any wor
     for (const int bad : {0, -3, FitParams::kMaxPieces + 1}) {
         params.maxPieces = bad;
         CAPTURE(bad);
-        REQUIRE_THROWS_WITH(fitStrands(s, params), Contains("fitStrands: maxPieces " + std::to_string(bad) + " must be between 1 and 64"));
+        REQUIRE_THROWS_WITH(fitStrands(s, params), Contains("fitStrands: maxPieces " + std::to_string(bad) + ": must be between 1 and 64"));
         REQUIRE_THROWS_AS(fitStrand(s.data(0), s.size(0), params), ValueError);
     }
     params.maxPieces = FitParams::kMaxPieces;
     REQUIRE(fitStrands(s, params).size() == 1);
+    // Each other field at a value its rule refuses, and the message naming it.
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const std::vector<std::pair<std::function<void(FitParams&)>, std::string>> cases = {
+        {[](FitParams& p) { p.maxError = 0.0; }, "maxError 0: must be a positive fraction"},
+        {[&](FitParams& p) { p.maxError = nan; }, "maxError nan: must be a positive fraction"},
+        {[](FitParams& p) { p.lambda = -1e-3; }, "lambda -0.001: must be zero or positive"},
+        {[](FitParams& p) { p.relaxRetries = -1; }, "relaxRetries -1: must be 0 or more"},
+        {[](FitParams& p) { p.maxEvaluations = FitParams::kMinEvaluations - 1; }, "maxEvaluations 9: must be at least 10"},
+        {[](FitParams& p) { p.prefitIterations = -1; }, "prefitIterations -1: must be 0"},
+        {[](FitParams& p) { p.step = -0.5; }, "step -0.5: must be a positive finite length"},
+        {[](FitParams& p) { p.axisClearance = -1.0; }, "axisClearance -1: must be zero or positive"},
+        {[](FitParams& p) { p.stepDeviationLimit = 0.0; }, "stepDeviationLimit 0: must be a positive fraction"},
+    };
+    for (const auto& [set, message] : cases) {
+        FitParams p;
+        REQUIRE_NOTHROW(p.validate("here"));
+        set(p);
+        CAPTURE(message);
+        REQUIRE_THROWS_WITH(fitStrands(s, p), Contains("fitStrands: " + message));
+    }
+    // The limits themselves are accepted.
+    FitParams edge;
+    edge.lambda = 0.0;
+    edge.relaxRetries = 0;
+    edge.maxEvaluations = FitParams::kMinEvaluations;
+    edge.prefitIterations = 0;
+    edge.axisClearance = 0.0;
+    REQUIRE(fitStrands(s, edge).size() == 1);
 }
 
 TEST_CASE("fitStrand: a p-helicoid of several pieces is fitted back by both split searches", "[helicoid]")

@@ -22,13 +22,11 @@ namespace {
 /// pieces, so the budget reaches the tip): wavy at its stored 21 vertices 4.21 % -> 2.80 %.
 constexpr double kRelaxFactor = 1.4;
 
-/// @throw ValueError for parameters outside their ranges, naming them as FitParams does.
-void checkFitParams(const FitParams& params, const char* where)
+std::string formatParam(double v)
 {
-    if (params.maxPieces < 1 || params.maxPieces > FitParams::kMaxPieces) {
-        throw ValueError(std::string(where) + ": maxPieces " + std::to_string(params.maxPieces) + " must be between 1 and " +
-                         std::to_string(FitParams::kMaxPieces));
-    }
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
 }
 
 /// Make every kT >= 0 by the half-turn symmetry: a piece traced from its frame rolled by π with
@@ -117,6 +115,22 @@ StrandFit fitTarget(const fit::FitTarget& target, std::size_t n, const FitParams
 
 } // namespace
 
+void FitParams::validate(const char* where) const
+{
+    const auto fail = [&](const char* field, const std::string& value, const std::string& rule) {
+        throw ValueError(std::string(where) + ": " + field + " " + value + ": " + rule);
+    };
+    if (!(maxError > 0.0) || !std::isfinite(maxError)) fail("maxError", formatParam(maxError), "must be a positive fraction of the strand length");
+    if (!(lambda >= 0.0) || !std::isfinite(lambda)) fail("lambda", formatParam(lambda), "must be zero or positive");
+    if (maxPieces < 1 || maxPieces > kMaxPieces) fail("maxPieces", std::to_string(maxPieces), "must be between 1 and " + std::to_string(kMaxPieces));
+    if (relaxRetries < 0) fail("relaxRetries", std::to_string(relaxRetries), "must be 0 or more");
+    if (maxEvaluations < kMinEvaluations) fail("maxEvaluations", std::to_string(maxEvaluations), "must be at least " + std::to_string(kMinEvaluations));
+    if (prefitIterations < 0) fail("prefitIterations", std::to_string(prefitIterations), "must be 0 (none: Nelder-Mead alone, the paper's) or more");
+    if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) fail("step", formatParam(step), "must be a positive finite length (0: a quarter of the mean segment length)");
+    if (!(axisClearance >= 0.0) || !std::isfinite(axisClearance)) fail("axisClearance", formatParam(axisClearance), "must be zero or positive (steps)");
+    if (!(stepDeviationLimit > 0.0) || !std::isfinite(stepDeviationLimit)) fail("stepDeviationLimit", formatParam(stepDeviationLimit), "must be a positive fraction of the tolerance");
+}
+
 void traceFit(const StrandFit& fit, HelicoidTrace& out)
 {
     tracePHelicoid(fit.root, fit.frame, fit.pieces, fit.step, HelicoidIntegrator::RK4, out);
@@ -147,7 +161,7 @@ double fitStepDeviation(const StrandFit& fit, int refinement, double* clearance)
 
 StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
 {
-    checkFitParams(params, "fitStrand");
+    params.validate("fitStrand");
     const fit::FitTarget target = fit::makeFitTarget(points, n);
     if (target.pts.size() < 2 || !(target.length > 0.0)) {
         throw ValueError("fitStrand: the strand has zero length (" + std::to_string(n) + " points, " +
@@ -159,7 +173,7 @@ StrandFit fitStrand(const Vec3f* points, std::size_t n, const FitParams& params)
 std::vector<StrandFit> fitStrands(const StrandSet& strands, const FitParams& params, bool threaded,
                                   std::vector<std::string>* errors, openvdb::util::NullInterrupter* interrupter)
 {
-    checkFitParams(params, "fitStrands");
+    params.validate("fitStrands");
     const std::size_t nS = strands.numStrands();
     std::vector<StrandFit> fits(nS);
     std::vector<std::string> messages(nS);
