@@ -34,6 +34,7 @@ PAIRS = [
     ("fit", "max_error", "fit", "--max-error"),
     ("fit", "max_pieces", "fit", "--max-pieces"),
     ("fit", "max_evaluations", "fit", "--max-evaluations"),
+    ("fit", "prefit_iterations", "fit", "--prefit-iterations"),
     ("interpolate", "power", "interpolate", "--power"),
     ("interpolate", "max_vertices", "interpolate", "--max-vertices"),
     ("render", "view", "render", "--view"),
