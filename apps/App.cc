@@ -52,7 +52,11 @@ std::string formatValue(double v)
     return buf;
 }
 
-void printJson(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
+void printJson(const nlohmann::json& j)
+{
+    // A file name need not be UTF-8: invalid bytes print as U+FFFD instead of ending the run.
+    std::cout << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+}
 
 StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict,
                       const std::string& vdbGrid)

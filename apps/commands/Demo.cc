@@ -94,7 +94,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     report["vertices"] = s.vertices;
     report["seconds"] = seconds;
     report["outputs"] = {refinedPath, fieldPath, strandsPath, previewPath, reportPath};
-    writeFileAtomic(reportPath, report.dump(2) + "\n", "demo(" + reportPath + ")");
+    writeFileAtomic(reportPath, report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", "demo(" + reportPath + ")");
 
     if (common.json) {
         printJson(report);

@@ -10,6 +10,8 @@ rm -rf "$dir"; mkdir -p "$dir"; cd "$dir"
 "$bin" convert good.hair good.obj --quiet
 "$bin" field good.hair -o field.vdb --voxel-size 2 --quiet
 cp good.hair existing.hair
+# A file name that is not UTF-8 (byte 0xFF): JSON reports must still print.
+cp good.hair "$(printf 'latin1_\377.hair')"
 cp "$src/scenes/figures/fig2_waviness.json" existing_fit.json
 # The default head scene with 16 strands a wisp instead of 124 (6,800 strands instead of 50,000): its
 # shape and guides at an eighth of the work, for the tests that need a head of hair, not its count.
