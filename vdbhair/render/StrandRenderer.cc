@@ -1,6 +1,7 @@
 #include "StrandRenderer.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Memory.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/strands/Measures.h>
 
@@ -385,13 +386,18 @@ Image renderStrands(const StrandSet& strands, const RenderParams& params)
     const Camera cam = makeCamera(params.view, box, params.width * S, params.height * S, params);
 
     Raster r{params.width * S, params.height * S, {}, {}};
-    r.depth.assign(std::size_t(r.w) * std::size_t(r.h), std::numeric_limits<float>::max());
-    r.color.assign(r.depth.size(), params.background);
+    const std::size_t pixels = std::size_t(r.w) * std::size_t(r.h);
+    reserveHugePages(r.depth, pixels);
+    reserveHugePages(r.color, pixels);
+    r.depth.assign(pixels, std::numeric_limits<float>::max());
+    r.color.assign(pixels, params.background);
 
     auto drawSet = [&](const StrandSet& s, const std::optional<Vec3f>& fixed, bool onTop, int thickness, double& lo, double& hi) {
         // Per-vertex arrays left uninitialized (Vec3's default constructor writes nothing) and
         // first written in parallel: zero-filling them serially cost more than drawing.
+        // Fresh pages cost a fault each (Memory.h): ask for huge ones.
         const std::unique_ptr<Vec3d[]> proj(new Vec3d[s.numVertices()]);
+        adviseHugePages(proj.get(), s.numVertices() * sizeof(Vec3d));
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.numVertices(), 4096), [&](const tbb::blocked_range<std::size_t>& br) {
             for (std::size_t v = br.begin(); v != br.end(); ++v) proj[v] = cam.project(Vec3d(s.positions[v]));
         });
@@ -404,6 +410,7 @@ Image renderStrands(const StrandSet& strands, const RenderParams& params)
         else vcolor = (colors = baseColors(s, params, cam, lo, hi, lit)).data();
         // Segment directions in view space for the fibre shading.
         const std::unique_ptr<Vec3f[]> dirs(new Vec3f[s.numVertices()]);
+        adviseHugePages(dirs.get(), s.numVertices() * sizeof(Vec3f));
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.numStrands(), 256), [&](const tbb::blocked_range<std::size_t>& br) {
             for (std::size_t i = br.begin(); i != br.end(); ++i) {
                 for (std::size_t v = s.begin(i); v < s.end(i); ++v) {
