@@ -52,6 +52,14 @@ std::string formatValue(double v)
     return buf;
 }
 
+void warnBandWithoutZero(const std::string& verb, const std::string& input, double area, double areaWithoutZero,
+                         const CommonOptions& common)
+{
+    if (!(areaWithoutZero > 0.01 * (area + areaWithoutZero)) || common.quiet) return;
+    std::cerr << "vdbhair " << verb << ": warning: " << input << ": " << formatValue(std::round(1000.0 * areaWithoutZero / (area + areaWithoutZero)) / 10.0)
+              << " % of the surface's band never crosses zero (an open or inside-out part of the mesh that has no inside); no roots there\n";
+}
+
 void printJson(const nlohmann::json& j)
 {
     // A file name need not be UTF-8: invalid bytes print as U+FFFD instead of ending the run.

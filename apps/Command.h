@@ -99,6 +99,11 @@ nlohmann::json gridInfoJson(const GridInfo& g);
 /// @brief Print @a j on stdout as one line.
 void printJson(const nlohmann::json& j);
 
+/// @brief The warning of `scalp` and `roots` when more than 1 % of a scalp's band (@a input's)
+/// never crosses zero (ScalpArea): an open or inside-out part of a mesh, where no root can grow.
+void warnBandWithoutZero(const std::string& verb, const std::string& input, double area, double areaWithoutZero,
+                         const CommonOptions& common);
+
 /// @brief Read strands from any supported file, printing the reader's warnings for @a verb.
 /// @param strict reject strands of fewer than two vertices instead of dropping them
 /// @param vdbGrid for a .vdb file, the points grid holding the strands (`--grid`)

@@ -55,10 +55,7 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     const Follicles f = sampleFollicles(surface, region, fp, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const FollicleStats stats = measureFollicles(f.positions, surface);
-    if (f.areaWithoutZero > 0.01 * (f.area + f.areaWithoutZero) && !common.quiet) {
-        std::cerr << "vdbhair roots: warning: " << p.input << ": " << formatValue(std::round(1000.0 * f.areaWithoutZero / (f.area + f.areaWithoutZero)) / 10.0)
-                  << " % of the surface's band never crosses zero (an open or inside-out part of the mesh that has no inside); no roots there\n";
-    }
+    warnBandWithoutZero("roots", p.input, f.area, f.areaWithoutZero, common);
 
     OrientedPoints out;
     out.positions = f.positions;

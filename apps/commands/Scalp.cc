@@ -8,6 +8,7 @@
 #include <vdbhair/io/PointFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/scalp/ScalpRegion.h>
 #include <vdbhair/scalp/ScalpSurface.h>
@@ -114,9 +115,13 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         writeVdbGrids(p.output, grids, "scalp(" + p.output + ")");
     }
     const double h = surface->voxelSize().x();
+    // The area roots can grow on, as `roots` counts it, and the band that has no surface in it.
+    const ScalpArea areas = measureScalpArea(surface, region);
+    warnBandWithoutZero("scalp", kind == "sphere" ? std::string("the sphere") : p.input, areas.area, areas.areaWithoutZero, common);
     if (common.json) {
         nlohmann::json j = {{"output", p.output}, {"kind", kind}, {"voxel_size", h}, {"half_width", sp.halfWidth},
-                            {"active_voxels", surface->activeVoxelCount()}, {"seconds", seconds}};
+                            {"active_voxels", surface->activeVoxelCount()}, {"area", areas.area},
+                            {"area_without_zero", areas.areaWithoutZero}, {"seconds", seconds}};
         j.update(detail);
         printJson(j);
     } else if (!common.quiet) {
@@ -126,7 +131,7 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
             std::cout << " (" << detail["capped_loops"].get<std::size_t>() << " boundary loop(s) capped, "
                       << detail["welded_vertices"].get<std::size_t>() << " vertices welded)";
         }
-        std::cout << "\n";
+        std::cout << "; surface area " << formatValue(std::round(areas.area * 10.0) / 10.0) << (region ? " in the region" : "") << "\n";
         if (region && !p.region.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels within " << formatValue(detail["region"]["radius"].get<double>())
                       << " of the roots of " << p.region << "\n";

@@ -84,6 +84,10 @@ TEST_CASE("sampleFollicles: a band that never crosses zero gets no roots and no 
               << f.areaWithoutZero << " (each sphere " << 4 * M_PI * r * r << "), NN mean " << st.nnMean << ", CV " << st.nnCV << "\n";
     CHECK(f.area == Approx(4 * M_PI * r * r).epsilon(0.03));
     CHECK(f.areaWithoutZero > 0.5 * 4 * M_PI * r * r);
+    // measureScalpArea (what `scalp` reports) counts as the sampler does.
+    const ScalpArea measured = measureScalpArea(g, nullptr);
+    CHECK(measured.area == f.area);
+    CHECK(measured.areaWithoutZero == f.areaWithoutZero);
     CHECK(std::abs(double(f.positions.size()) - 1500.0) <= 0.02 * 1500.0);
     double farthest = 0.0;
     for (const Vec3f& p : f.positions) farthest = std::max(farthest, std::abs(Vec3d(p).length() - r) / h);

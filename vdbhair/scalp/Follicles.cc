@@ -47,7 +47,64 @@ Vec3d tangentFrom(const Vec3d& n, const Vec3d& up)
 /// Mean nearest-neighbour distance of relaxed roots over the hexagonal spacing d (measured).
 constexpr double kNearestPerHexSpacing = 0.93;
 
+/// A band voxel of the zero level set and its share of the area.
+struct SurfaceCell { openvdb::Coord ijk; double weight; };
+
+/// The area of the zero level set in the sampler's region, and its band voxels with their weights
+/// (@a cells, when given): only voxels within two voxels of a sign change. A band with no zero in
+/// it (both sides positive: an open part of a mesh that capping did not close, e.g. head_max4's
+/// torso) has no surface to project onto; counting its area put the roots it was owed on the rest,
+/// at half the spacing (measured: CV 0.52, median spacing 0.51 of the target, on head_max4 at
+/// 0.5-unit voxels). Its area is returned apart, as areaWithoutZero.
+ScalpArea surfaceCells(const openvdb::FloatGrid& surface, const ScalpSampler& sampler, std::vector<SurfaceCell>* cells)
+{
+    const double h = sampler.voxelSize();
+    openvdb::BoolGrid::Ptr nearZero = openvdb::BoolGrid::create(false);
+    {
+        auto acc = surface.getConstAccessor();
+        auto mark = nearZero->getAccessor();
+        for (auto it = surface.cbeginValueOn(); it; ++it) {
+            if (!it.isVoxelValue()) continue;
+            const float phi = *it;
+            const openvdb::Coord ijk = it.getCoord();
+            for (int a = 0; a < 3; ++a) {
+                openvdb::Coord n = ijk;
+                n[a] += 1;
+                const float q = acc.getValue(n);
+                if ((phi < 0.f) != (q < 0.f)) {  // zeros count with the outside: an unsigned band has exact zeros too
+                    mark.setValueOn(ijk);
+                    mark.setValueOn(n);
+                }
+            }
+        }
+        openvdb::tools::dilateActiveValues(nearZero->tree(), 2, openvdb::tools::NN_FACE_EDGE_VERTEX, openvdb::tools::IGNORE_TILES);
+    }
+    const double eps = 1.5 * h;
+    ScalpArea out;
+    auto nearAcc = nearZero->getConstAccessor();
+    for (auto it = surface.cbeginValueOn(); it; ++it) {
+        const double phi = double(*it);
+        if (!(std::abs(phi) < eps)) continue;
+        if (!it.isVoxelValue()) continue;
+        const openvdb::Coord ijk = it.getCoord();
+        if (!sampler.inRegion(surface.transform().indexToWorld(ijk))) continue;
+        const double w = (1.0 + std::cos(M_PI * phi / eps)) / (2.0 * eps) * h * h * h;
+        if (!nearAcc.isValueOn(ijk)) {
+            out.areaWithoutZero += w;
+            continue;
+        }
+        if (cells) cells->push_back({ijk, w});
+        out.area += w;
+    }
+    return out;
+}
+
 } // namespace
+
+ScalpArea measureScalpArea(const openvdb::FloatGrid::ConstPtr& surface, const openvdb::BoolGrid::ConstPtr& region)
+{
+    return surfaceCells(*surface, ScalpSampler(surface, region), nullptr);
+}
 
 Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const openvdb::BoolGrid::ConstPtr& region,
                           const FollicleParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter)
@@ -66,52 +123,10 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     const ScalpSampler sampler(surface, region);
     const double h = sampler.voxelSize();
 
-    // 1. Area of the surface in the region, and the band voxels to draw from: only voxels within
-    // two voxels of a sign change. A band with no zero in it (both sides positive: an open part of
-    // a mesh that capping did not close, e.g. head_max4's torso) has no surface to project onto;
-    // counting its area put the roots it was owed on the rest, at half the spacing (measured: CV
-    // 0.52, median spacing 0.51 of the target, on head_max4 at 0.5-unit voxels).
-    openvdb::BoolGrid::Ptr nearZero = openvdb::BoolGrid::create(false);
-    {
-        auto acc = surface->getConstAccessor();
-        auto mark = nearZero->getAccessor();
-        for (auto it = surface->cbeginValueOn(); it; ++it) {
-            if (!it.isVoxelValue()) continue;
-            const float phi = *it;
-            const openvdb::Coord ijk = it.getCoord();
-            for (int a = 0; a < 3; ++a) {
-                openvdb::Coord n = ijk;
-                n[a] += 1;
-                const float q = acc.getValue(n);
-                if ((phi < 0.f) != (q < 0.f)) {  // zeros count with the outside: an unsigned band has exact zeros too
-                    mark.setValueOn(ijk);
-                    mark.setValueOn(n);
-                }
-            }
-        }
-        openvdb::tools::dilateActiveValues(nearZero->tree(), 2, openvdb::tools::NN_FACE_EDGE_VERTEX, openvdb::tools::IGNORE_TILES);
-    }
-    struct Cell { openvdb::Coord ijk; double weight; };
-    std::vector<Cell> cells;
-    const double eps = 1.5 * h;
-    double area = 0.0, areaWithoutZero = 0.0;
-    {
-        auto nearAcc = nearZero->getConstAccessor();
-        for (auto it = surface->cbeginValueOn(); it; ++it) {
-            const double phi = double(*it);
-            if (!(std::abs(phi) < eps)) continue;
-            if (!it.isVoxelValue()) continue;
-            const openvdb::Coord ijk = it.getCoord();
-            if (!sampler.inRegion(surface->transform().indexToWorld(ijk))) continue;
-            const double w = (1.0 + std::cos(M_PI * phi / eps)) / (2.0 * eps) * h * h * h;
-            if (!nearAcc.isValueOn(ijk)) {
-                areaWithoutZero += w;
-                continue;
-            }
-            cells.push_back({ijk, w});
-            area += w;
-        }
-    }
+    // 1. Area of the surface in the region, and the band voxels to draw from (surfaceCells).
+    std::vector<SurfaceCell> cells;
+    const ScalpArea measured = surfaceCells(*surface, sampler, &cells);
+    const double area = measured.area, areaWithoutZero = measured.areaWithoutZero;
     if (cells.empty() || !(area > 0.0)) {
         throw LookupError(where + ": the " + std::string(region ? "region holds" : "surface has") + " no voxel of the zero level set" +
                           (areaWithoutZero > 0.0 ? " (its band never changes sign: an open or unsigned surface)" : "") + "; there is nowhere to put roots");

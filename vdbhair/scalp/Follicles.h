@@ -74,6 +74,16 @@ struct Follicles
     std::size_t removed = 0;     ///< particles removed by step 5 (within 0.1 d of another)
 };
 
+/// @brief The area of a scalp's surface (its zero level set, within a region).
+struct ScalpArea
+{
+    double area = 0.0;             ///< where the band changes sign within two voxels: where roots can grow
+    double areaWithoutZero = 0.0;  ///< band that never changes sign (an open or unsigned part of a mesh): no surface
+};
+
+/// @brief Measure @a surface's area in @a region (null: everywhere), as sampleFollicles counts it.
+ScalpArea measureScalpArea(const openvdb::FloatGrid::ConstPtr& surface, const openvdb::BoolGrid::ConstPtr& region);
+
 /// @brief Spread follicles over @a surface (in @a region when given).
 /// @throw ValueError (neither or both of count and spacing, a count of 0), LimitError (over
 /// maxCount), LookupError (the region holds no surface), InterruptedError.
