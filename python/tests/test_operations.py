@@ -1,9 +1,8 @@
 """grow, fit, render, inspect, and the module's documentation."""
 import inspect as pyinspect
+import importlib.util
 import json
 import os
-import struct
-import zlib
 
 import numpy as np
 import pytest
@@ -60,35 +59,11 @@ def test_render_returns_rgba_or_writes_a_file(tmp_path):
 
 
 def read_png_rgb(path):
-    """An 8-bit RGB, non-interlaced PNG's pixels (the filters of the PNG specification, section 9)."""
-    data = path.read_bytes()
-    pos, idat = 8, b""
-    while pos < len(data):
-        (length,) = struct.unpack(">I", data[pos:pos + 4])
-        kind, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + length]
-        pos += 12 + length
-        if kind == b"IHDR":
-            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            assert (depth, colour, interlace) == (8, 2, 0)
-        elif kind == b"IDAT":
-            idat += body
-    raw, stride = zlib.decompress(idat), width * 3
-    rows, prev = [], np.zeros(stride, dtype=np.int64)
-    for y in range(height):
-        kind, line = raw[y * (stride + 1)], np.frombuffer(raw, np.uint8, stride, y * (stride + 1) + 1).astype(np.int64)
-        out = np.zeros(stride, dtype=np.int64)
-        for i in range(stride):
-            a = out[i - 3] if i >= 3 else 0
-            b, c = prev[i], prev[i - 3] if i >= 3 else 0
-            if kind == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                predictor = a if pa <= pb and pa <= pc else b if pb <= pc else c
-            else:
-                predictor = [0, a, b, (a + b) // 2][kind]
-            out[i] = (line[i] + predictor) & 255
-        rows.append(out)
-        prev = out
+    """An 8-bit RGB PNG's pixels, decoded by the command-line tests' own reader (tests/apps/check_legend.py)."""
+    spec = importlib.util.spec_from_file_location("check_legend", SOURCE_DIR / "tests" / "apps" / "check_legend.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    width, height, rows = module.read_png(str(path))
     return np.array(rows, dtype=np.uint8).reshape(height, width, 3)
 
 
