@@ -340,7 +340,7 @@ void benchmarkHelicoidFields(const std::string& data, const std::string& source)
             const TangentField tf = estimateTangentField(s, fp);
             TraceParams tp;
             const StrandSet viaTangent = retraceStrands(s, *tf.tangent, tp);
-            const HelicoidFieldGrids hf = estimateHelicoidField(*tf.tangent);
+            const HelicoidFieldGrids hf = estimateHelicoidField(s, *tf.tangent);
             const StrandSet viaHelicoid = retraceHelicoidField(s, hf, tp);
             const double eT = meanVertexDisplacement(s, viaTangent) / meanLength;
             const double eH = meanVertexDisplacement(s, viaHelicoid) / meanLength;

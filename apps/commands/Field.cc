@@ -117,7 +117,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         }
     }
     if (p.helicoid) {
-        const HelicoidFieldGrids h = estimateHelicoidField(*fields[0].tangent, true, common.interrupter);
+        const HelicoidFieldGrids h = estimateHelicoidField(strands, *fields[0].tangent, true, common.interrupter);
         for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(h.k), openvdb::GridBase::Ptr(h.alpha),
                                                 openvdb::GridBase::Ptr(h.frameT), openvdb::GridBase::Ptr(h.frameN)}) {
             grids.push_back(g);

@@ -155,3 +155,62 @@ TEST_CASE("retraceHelicoidField: the engine's rules: a negative step is an error
     // Its vertices lie on the steps' polyline: the tip is the last step point exactly.
     REQUIRE(kept.positions.back() == steps.positions.back());
 }
+
+namespace {
+/// Sixteen strands on the same helix (radius r, pitch 2πc: z = c a) with phases 2πi/16: the
+/// curvature everywhere on the cylinder is r / (r² + c²), the curvature vector points at the axis.
+StrandSet phasedHelices(double r, double c)
+{
+    StrandSet s;
+    for (int i = 0; i < 16; ++i) {
+        const double phase = 2.0 * M_PI * i / 16.0;
+        std::vector<Vec3f> pts;
+        for (int j = 0; j <= 120; ++j) {
+            const double a = 0.1 * j;
+            pts.emplace_back(float(r * std::cos(a + phase)), float(r * std::sin(a + phase)), float(c * a));
+        }
+        s.addStrand(pts);
+    }
+    return s;
+}
+} // namespace
+
+TEST_CASE("estimateHelicoidField(strands): helices with different phases give the helix curvature, N towards the axis", "[helicoid]")
+{
+    initializeOpenVdb();
+    const double r = 5.0, c = 2.0, curvature = r / (r * r + c * c);
+    const StrandSet s = phasedHelices(r, c);
+    for (double h : {0.5, 1.0}) {
+        FieldParams p;
+        p.voxelSize = h;
+        const TangentField t = estimateTangentField(s, p);
+        const HelicoidFieldGrids f = estimateHelicoidField(s, *t.tangent);
+        const HelicoidFieldGrids serial = estimateHelicoidField(s, *t.tangent, false);
+        REQUIRE(f.k->activeVoxelCount() == t.tangent->activeVoxelCount());
+        REQUIRE(f.k->metaValue<std::string>("vdbhair_helicoid_fit").find("strand pieces") != std::string::npos);
+        // Voxels whose centre lies on the cylinder, away from the strands' ends.
+        auto ka = f.k->getConstAccessor();
+        auto na = f.frameN->getConstAccessor();
+        auto ks = serial.k->getConstAccessor();
+        std::size_t checked = 0, differ = 0;
+        std::vector<double> kT;
+        for (auto it = t.tangent->cbeginValueOn(); it; ++it) {
+            const Vec3d x = t.tangent->transform().indexToWorld(it.getCoord());
+            differ += !(ks.getValue(it.getCoord()) == ka.getValue(it.getCoord()));
+            if (std::abs(std::hypot(x.x(), x.y()) - r) > 0.1 * h || x.z() < 3.0 || x.z() > 20.0) continue;
+            const openvdb::Vec3f k = ka.getValue(it.getCoord()), n = na.getValue(it.getCoord());
+            const Vec3d inward = Vec3d(-x.x(), -x.y(), 0.0).unit();
+            CAPTURE(h, x, k, n, curvature);
+            REQUIRE(Vec3d(n).dot(inward) > 0.95);
+            kT.push_back(k.x());
+            ++checked;
+        }
+        REQUIRE(differ == 0);  // independent of the thread count
+        REQUIRE(checked >= 10);
+        std::sort(kT.begin(), kT.end());
+        CAPTURE(h, checked, kT.front(), kT[kT.size() / 2], kT.back());
+        REQUIRE(kT[kT.size() / 2] == Approx(curvature).epsilon(0.05));
+        REQUIRE(kT.front() > 0.8 * curvature);
+        REQUIRE(kT.back() < 1.2 * curvature);
+    }
+}
