@@ -256,26 +256,64 @@ PieceFit fitPieces(const std::vector<const SegmentPiece*>& near, const std::vect
 
 } // namespace
 
-HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool threaded, openvdb::util::NullInterrupter* interrupter)
+namespace {
+
+using TangentAccessor = openvdb::tree::ValueAccessor<const openvdb::Vec3STree>;
+
+/// A voxel's helicoid: k = (kT, kN, kB), alpha, and its frame (T, N).
+struct VoxelHelicoid
+{
+    Eigen::Vector3d k;
+    double alpha;
+    Vec3d t, n;
+};
+
+/// @throw ValueError unless @a tangent is an axis-aligned world-space field (both estimators).
+void checkHelicoidTangent(const openvdb::Vec3SGrid& tangent)
 {
     if (FieldMapping::fromGrid(tangent).space() != FieldSpace::World || !FieldMapping(tangent.constTransformPtr()).isAxisAlignedWorld()) {
         throw ValueError("estimateHelicoidField: grid '" + tangent.getName() + "' is not an axis-aligned world-space field");
     }
-    const double h = tangent.voxelSize().x();
-    HelicoidFieldGrids out = createHelicoidGrids(tangent);
+}
 
+/// Fill @a out at every voxel where @a tangent has a direction, leaves in parallel: @a makeFit()
+/// gives each leaf its own fitting function, (ijk, T, accessor) -> VoxelHelicoid.
+template<typename MakeFit>
+void fillPerVoxel(const openvdb::Vec3SGrid& tangent, HelicoidFieldGrids& out, bool threaded,
+                  openvdb::util::NullInterrupter* interrupter, const MakeFit& makeFit)
+{
     openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(out.k->tree());
     ProgressCounter progress(interrupter, "estimating the helicoid field", leaves.leafCount(), "blocks");
     leaves.foreach([&](openvdb::Vec3STree::LeafNodeType& kLeaf, std::size_t) {
         if (progress.active() && (progress.stopped() || progress.add(1))) return;
-        openvdb::tree::ValueAccessor<const openvdb::Vec3STree> acc(tangent.tree());
+        TangentAccessor acc(tangent.tree());
         auto* aLeaf = out.alpha->tree().probeLeaf(kLeaf.origin());
         auto* tLeaf = out.frameT->tree().probeLeaf(kLeaf.origin());
         auto* nLeaf = out.frameN->tree().probeLeaf(kLeaf.origin());
+        auto fit = makeFit();
         for (auto it = kLeaf.beginValueOn(); it; ++it) {
             const Coord ijk = it.getCoord();
             const Vec3d T = Vec3d(acc.getValue(ijk));
             if (!(T.lengthSqr() > 0.0)) continue;
+            const VoxelHelicoid v = fit(ijk, T, acc);
+            it.setValue(openvdb::Vec3f(float(v.k(0)), float(v.k(1)), float(v.k(2))));
+            aLeaf->setValueOnly(it.pos(), float(v.alpha));
+            tLeaf->setValueOnly(it.pos(), toF(v.t));
+            nLeaf->setValueOnly(it.pos(), toF(v.n));
+        }
+    }, threaded);
+    if (progress.stopped()) throw InterruptedError("estimateHelicoidField: interrupted");
+}
+
+} // namespace
+
+HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    checkHelicoidTangent(tangent);
+    const double h = tangent.voxelSize().x();
+    HelicoidFieldGrids out = createHelicoidGrids(tangent);
+    fillPerVoxel(tangent, out, threaded, interrupter, [&] {
+        return [&](const Coord& ijk, const Vec3d& T, TangentAccessor& acc) {
             const Vec3d t = T.unit();
             // Curvature vector (T·∇)T by central differences one voxel along T (index units).
             const Vec3d ip = ijk.asVec3d();
@@ -327,14 +365,9 @@ HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool
                 if (!k.allFinite()) k.setZero();
                 if (!std::isfinite(alpha)) alpha = 0.0;
             }
-            it.setValue(openvdb::Vec3f(float(k(0)), float(k(1)), float(k(2))));
-            aLeaf->setValueOnly(it.pos(), float(alpha));
-            tLeaf->setValueOnly(it.pos(), toF(t));
-            nLeaf->setValueOnly(it.pos(), toF(n));
-        }
-    }, threaded);
-    if (progress.stopped()) throw InterruptedError("estimateHelicoidField: interrupted");
-
+            return VoxelHelicoid{k, alpha, t, n};
+        };
+    });
     finishHelicoidGrids(tangent, out, "Eq. 1 to first order, least squares over the 26 neighbours' field directions");
     return out;
 }
@@ -342,9 +375,7 @@ HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool
 HelicoidFieldGrids estimateHelicoidField(const StrandSet& strands, const openvdb::Vec3SGrid& tangent, bool threaded,
                                          openvdb::util::NullInterrupter* interrupter)
 {
-    if (FieldMapping::fromGrid(tangent).space() != FieldSpace::World || !FieldMapping(tangent.constTransformPtr()).isAxisAlignedWorld()) {
-        throw ValueError("estimateHelicoidField: grid '" + tangent.getName() + "' is not an axis-aligned world-space field");
-    }
+    checkHelicoidTangent(tangent);
     const double h = tangent.voxelSize().x();
     HelicoidFieldGrids out = createHelicoidGrids(tangent);
 
@@ -359,20 +390,9 @@ HelicoidFieldGrids estimateHelicoidField(const StrandSet& strands, const openvdb
         i = j;
     }
 
-    openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(out.k->tree());
-    ProgressCounter progress(interrupter, "estimating the helicoid field", leaves.leafCount(), "blocks");
-    leaves.foreach([&](openvdb::Vec3STree::LeafNodeType& kLeaf, std::size_t) {
-        if (progress.active() && (progress.stopped() || progress.add(1))) return;
-        openvdb::tree::ValueAccessor<const openvdb::Vec3STree> acc(tangent.tree());
-        auto* aLeaf = out.alpha->tree().probeLeaf(kLeaf.origin());
-        auto* tLeaf = out.frameT->tree().probeLeaf(kLeaf.origin());
-        auto* nLeaf = out.frameN->tree().probeLeaf(kLeaf.origin());
-        std::vector<const SegmentPiece*> near;
-        std::vector<Vec3d> rel;
-        for (auto it = kLeaf.beginValueOn(); it; ++it) {
-            const Coord ijk = it.getCoord();
-            const Vec3d T = Vec3d(acc.getValue(ijk));
-            if (!(T.lengthSqr() > 0.0)) continue;
+    // Each leaf gathers the nearby pieces into scratch of its own.
+    fillPerVoxel(tangent, out, threaded, interrupter, [&] {
+        return [&, near = std::vector<const SegmentPiece*>(), rel = std::vector<Vec3d>()](const Coord& ijk, const Vec3d& T, TangentAccessor&) mutable {
             const Vec3d centre = tangent.transform().indexToWorld(ijk);
             near.clear();
             rel.clear();
@@ -389,13 +409,9 @@ HelicoidFieldGrids estimateHelicoidField(const StrandSet& strands, const openvdb
                 }
             }
             const PieceFit fit = fitPieces(near, rel, T.unit(), h);
-            it.setValue(openvdb::Vec3f(float(fit.k(0)), float(fit.k(1)), float(fit.k(2))));
-            aLeaf->setValueOnly(it.pos(), 0.f);
-            tLeaf->setValueOnly(it.pos(), toF(fit.t));
-            nLeaf->setValueOnly(it.pos(), toF(fit.n));
-        }
-    }, threaded);
-    if (progress.stopped()) throw InterruptedError("estimateHelicoidField: interrupted");
+            return VoxelHelicoid{fit.k, 0.0, fit.t, fit.n};
+        };
+    });
     finishHelicoidGrids(tangent, out, "Eq. 1 to first order, weighted least squares over the strand pieces within a voxel (Eq. 9 weights)");
     return out;
 }
