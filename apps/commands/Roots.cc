@@ -69,11 +69,13 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     if (common.json) {
         printJson({{"output", p.output}, {"count", f.positions.size()}, {"region", bool(region)}, {"area", f.area},
                    {"area_without_zero", f.areaWithoutZero}, {"target_spacing", f.targetSpacing}, {"iterations", f.iterations}, {"last_move", f.lastMove}, {"removed", f.removed},
+                   {"contour", f.contour}, {"initial", f.initial}, {"fissions", f.fissions}, {"deaths", f.deaths}, {"last_population_change", f.lastPopulationChange},
                    {"spacing", {{"mean", stats.nnMean}, {"cv", stats.nnCV}, {"min", stats.nnMin}, {"max", stats.nnMax}}},
                    {"max_surface_distance_voxels", stats.maxSurfaceDistanceVoxels}, {"seconds", seconds}});
     } else if (!common.quiet) {
         std::cout << "roots: " << f.positions.size() << " on " << (region ? "the region" : "the surface") << " (area " << formatValue(f.area)
                   << "), target spacing " << formatValue(f.targetSpacing) << ", " << f.iterations << " iterations in " << seconds << " s\n"
+                  << (f.contour > 0 ? std::to_string(f.contour) + " fixed on the region's rim; " : std::string()) << f.fissions << " fissions, " << f.deaths << " deaths\n"
                   << "nearest-neighbour spacing: mean " << stats.nnMean << ", coefficient of variation " << stats.nnCV
                   << "; largest distance from the surface " << stats.maxSurfaceDistanceVoxels << " voxels\n"
                   << "wrote " << p.output << "\n";
@@ -96,6 +98,8 @@ Command addRootsCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--step-scale", params->follicle.stepScale, "Relaxation step as a multiple of sigma^2 times the energy gradient")->capture_default_str();
     sub->add_option("--up", params->up, "Reference axis of the tangent frame: x, y, z, -x, -y or -z")->capture_default_str();
     sub->add_flag("--no-region", params->noRegion, "Ignore the file's 'region' grid: roots over the whole surface");
+    sub->add_flag("--no-contour", [params](std::int64_t) { params->follicle.contour = false; }, "No fixed roots on the region's rim (they line the hairline by default)");
+    sub->add_option("--initial-fraction", params->follicle.initialFraction, "Share of the roots placed at the start, in (0, 4]; fission and death make the count")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair roots scalp.vdb -o roots.ply --count 10000 --json");
     return {sub, [params, &common] { return runRoots(*params, common); }};

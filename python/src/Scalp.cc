@@ -170,7 +170,8 @@ Returns:
     m.def(
         "roots",
         [](const pyb::object& scalp, std::optional<std::size_t> count, std::optional<double> spacing, const pyb::object& regionArg,
-           std::uint64_t seed, int iterations, double stepScale, std::array<double, 3> up, int threads, const pyb::object& progress) {
+           std::uint64_t seed, int iterations, double stepScale, std::array<double, 3> up, bool contour, double initialFraction, int threads,
+           const pyb::object& progress) {
             if (bool(count) == bool(spacing)) throw ValueError("roots: give one of count= and spacing=");
             if (iterations < 0) throw ValueError("roots: iterations=" + std::to_string(iterations) + ": must be at least 0");
             FollicleParams fp;
@@ -182,6 +183,8 @@ Returns:
             fp.seed = seed;
             fp.maxIterations = iterations;
             fp.stepScale = stepScale;
+            fp.contour = contour;
+            fp.initialFraction = initialFraction;
             const Vec3d u(up[0], up[1], up[2]);
             if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("roots: up must be a non-zero finite vector");
             fp.up = u / u.length();
@@ -224,6 +227,10 @@ Returns:
             d["iterations"] = out.f.iterations;
             d["last_move"] = out.f.lastMove;
             d["removed"] = out.f.removed;
+            d["contour"] = out.f.contour;
+            d["initial"] = out.f.initial;
+            d["fissions"] = out.f.fissions;
+            d["deaths"] = out.f.deaths;
             pyb::dict sp;
             sp["mean"] = out.stats.nnMean;
             sp["cv"] = out.stats.nnCV;
@@ -237,6 +244,7 @@ Returns:
         pyb::arg("region") = pyb::none(), pyb::arg("seed") = follicleDefaults.seed, pyb::arg("iterations") = follicleDefaults.maxIterations,
         pyb::arg("step_scale") = follicleDefaults.stepScale,
         pyb::arg("up") = std::array<double, 3>{follicleDefaults.up.x(), follicleDefaults.up.y(), follicleDefaults.up.z()},
+        pyb::arg("contour") = follicleDefaults.contour, pyb::arg("initial_fraction") = follicleDefaults.initialFraction,
         pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(Follicles spread evenly over a scalp (Witkin & Heckbert 1994 repulsion on the zero level
 set, as Piuze et al. 2011 place roots): ``vdbhair roots``. Identical for any thread count.
@@ -252,6 +260,9 @@ Args:
     iterations: most relaxation iterations.
     step_scale: relaxation step as a multiple of sigma^2 times the energy gradient.
     up: reference axis of the tangents.
+    contour: with a region, fixed roots along its rim (the first ``contour`` of the result).
+    initial_fraction: share of the roots placed at the start, in (0, 4]; fission and death
+        (Witkin & Heckbert) make the count.
     threads: worker threads, 0 for all cores.
     progress: optional callable ``progress(stage, done, total, unit)``.
 
@@ -259,8 +270,8 @@ Returns:
     A dict: ``positions``, ``normals`` (outward), ``tangents``: (N, 3) float32 arrays (the
     roots and their frames, ready for interpolate(guides, r["positions"], normals=r["normals"]));
     ``region`` (whether one confined them), ``area``, ``target_spacing``, ``iterations``,
-    ``last_move``, ``removed``, ``spacing`` (nearest-neighbour mean, cv, min, max) and
-    ``max_surface_distance_voxels``.)doc");
+    ``last_move``, ``removed``, ``contour``, ``initial``, ``fissions``, ``deaths``, ``spacing``
+    (nearest-neighbour mean, cv, min, max) and ``max_surface_distance_voxels``.)doc");
 }
 
 } // namespace vdbhair::py

@@ -117,6 +117,13 @@ def test_roots_over_a_whole_sphere():
     assert np.array_equal(vdbhair.roots(surface, count=300, threads=2)["positions"], r["positions"])
     # A spacing instead of a count; the errors.
     assert vdbhair.roots(surface, spacing=0.3)["spacing"]["mean"] == pytest.approx(0.3, rel=0.15)
+    # Fission from a quarter of the count reaches it.
+    grown = vdbhair.roots(surface, count=300, initial_fraction=0.25)
+    assert grown["initial"] == 75 and grown["fissions"] >= 200
+    assert abs(len(grown["positions"]) - 300) <= 6 and grown["spacing"]["cv"] < 0.1
+    assert grown["contour"] == 0  # no region, no rim
+    with pytest.raises(ValueError, match="initialFraction 0 must be in"):
+        vdbhair.roots(surface, count=10, initial_fraction=0.0)
     with pytest.raises(ValueError, match="give one of count= and spacing="):
         vdbhair.roots(surface)
     with pytest.raises(ValueError, match="spacing=-1"):

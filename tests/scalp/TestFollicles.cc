@@ -123,7 +123,7 @@ TEST_CASE("sampleFollicles: a cap region holds every root", "[scalp]")
     CHECK(farthest <= capRadius + 0.5 * std::sqrt(3.0) * h);
     CHECK(st.nnMean == Approx(fp.spacing).epsilon(0.1));
     CHECK(st.nnCV < 0.1);
-    // The free roots reach the rim by themselves (the region's hard edge lines them up).
+    // Roots reach the rim (the contour's are on it; tested below).
     double outermost = 0.0;
     for (const Vec3f& p : f.positions) outermost = std::max(outermost, (Vec3d(p) - pole).length());
     std::cout << "cap: outermost root " << outermost << " (rim " << capRadius << ")\n";
@@ -319,4 +319,153 @@ TEST_CASE("sampleFollicles: roots on the shared heads, in the region of a hairst
         CHECK(f.positions.size() >= 2900);
         CHECK(st.maxSurfaceDistanceVoxels < 0.1);
     }
+}
+
+TEST_CASE("sampleFollicles: fission from a quarter of the count and death from twice it reach the target", "[scalp]")
+{
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.05);
+    for (const double fraction : {0.25, 2.0}) {
+        FollicleParams fp;
+        fp.count = 1500;
+        fp.initialFraction = fraction;
+        const Follicles f = sampleFollicles(g, nullptr, fp);
+        const FollicleStats st = measureFollicles(f.positions, g);
+        std::cout << "sphere from " << f.initial << " particles: " << f.positions.size() << " roots, " << f.fissions << " fissions, " << f.deaths
+                  << " deaths, last change at iteration " << f.lastPopulationChange << ", NN mean " << st.nnMean << ", CV " << st.nnCV
+                  << ", radius spread " << f.radiusSpread << " sigma_hat\n";
+        CHECK(f.initial == std::size_t(std::llround(fraction * 1500)));
+        if (fraction < 1.0) CHECK(f.fissions >= 1100);
+        else CHECK(f.deaths >= 1500);
+        CHECK(std::abs(double(f.positions.size()) - 1500.0) <= 0.02 * 1500.0);
+        CHECK(st.nnCV < 0.1);
+        CHECK(st.nnMean == Approx(f.targetSpacing * 0.93).epsilon(0.05));
+        CHECK(st.maxSurfaceDistanceVoxels < 0.05);
+        CHECK(f.lastPopulationChange > 0);
+        CHECK(f.lastPopulationChange + fp.settleIterations <= fp.maxIterations);
+    }
+    // Without population control the count stays where it started.
+    FollicleParams fp;
+    fp.count = 1500;
+    fp.initialFraction = 0.25;
+    fp.controlInterval = 0;
+    const Follicles f = sampleFollicles(g, nullptr, fp);
+    CHECK(f.positions.size() == 375);
+    CHECK(f.fissions == 0);
+}
+
+TEST_CASE("sampleFollicles: a radius left large splits, a squeezed one dies (Witkin & Heckbert's rules)", "[scalp]")
+{
+    // Half the count, and no count rule at work until the radii have grown: the sphere's
+    // particles grow their radii until they split on their own (sigma > 1.5 sigma_hat).
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.05);
+    FollicleParams fp;
+    fp.count = 1000;
+    fp.initialFraction = 0.2;  // radii start at sigma_hat / sqrt(0.2) = 2.24 sigma_hat: all above the fission threshold
+    fp.maxIterations = 40;
+    fp.settleIterations = 29;  // one control step, at iteration 10
+    const Follicles f = sampleFollicles(g, nullptr, fp);
+    std::cout << "one control step from 200 particles of radius 2.24 sigma_hat: " << f.positions.size() << " roots, " << f.fissions << " fissions\n";
+    // The count rule alone would split at most half of the 200; the radius rule splits every calm one.
+    CHECK(f.fissions > 100);
+    CHECK(f.positions.size() == 200 + f.fissions - f.deaths);
+}
+
+TEST_CASE("sampleFollicles: the region's contour holds fixed roots on the cap's rim", "[scalp]")
+{
+    const Vec3d pole(0.0, 1.0, 0.0);
+    const double h = 0.05, capRadius = 0.8;
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, h);
+    const openvdb::BoolGrid::Ptr region = regionFromRoots(*g, {Vec3f(0.f, 1.1f, 0.f)}, capRadius, "pole");
+    FollicleParams fp;
+    fp.spacing = 0.08;
+    const Follicles f = sampleFollicles(g, region, fp);
+    const FollicleStats st = measureFollicles(f.positions, g);
+    REQUIRE(f.contour > 10);
+    const double s = 0.93 * f.targetSpacing;  // the contour's spacing
+    // The rim: chord capRadius from the pole, a circle of radius rr at height yr.
+    const double yr = 1.0 - capRadius * capRadius / 2.0, rr = std::sqrt(1.0 - yr * yr);
+    double worstOff = 0.0, closestContour = 1e9, closestFree = 1e9;
+    for (std::size_t i = 0; i < f.contour; ++i) {
+        worstOff = std::max(worstOff, std::abs((Vec3d(f.positions[i]) - pole).length() - capRadius));
+        for (std::size_t j = 0; j < f.positions.size(); ++j) {
+            if (j == i) continue;
+            const double dij = (Vec3d(f.positions[i]) - Vec3d(f.positions[j])).length();
+            if (j < f.contour) closestContour = std::min(closestContour, dij);
+            else closestFree = std::min(closestFree, dij);
+        }
+    }
+    // Every point of the rim has a contour root near it.
+    double worstGap = 0.0;
+    for (int k = 0; k < 720; ++k) {
+        const double a = 2.0 * M_PI * k / 720.0;
+        const Vec3d q(rr * std::cos(a), yr, rr * std::sin(a));
+        double nearest = 1e9;
+        for (std::size_t i = 0; i < f.contour; ++i) nearest = std::min(nearest, (Vec3d(f.positions[i]) - q).length());
+        worstGap = std::max(worstGap, nearest);
+    }
+    std::cout << "cap contour: " << f.contour << " fixed of " << f.positions.size() << " (rim length " << 2 * M_PI * rr << " at spacing " << s
+              << "), farthest from the rim " << worstOff / h << " voxels, rim point farthest from a contour root " << worstGap
+              << ", contour-contour " << closestContour << ", contour-free " << closestFree << ", CV " << st.nnCV << "\n";
+    CHECK(worstOff < 2.0 * h);  // the region is voxelized: its rim is within a voxel or so of the true one
+    CHECK(worstGap < 0.75 * s + 2.0 * h);
+    CHECK(double(f.contour) == Approx(2 * M_PI * rr / s).epsilon(0.25));
+    CHECK(closestContour >= s * (1.0 - 1e-9));
+    CHECK(closestFree >= 0.8 * s * (1.0 - 1e-9));
+    CHECK(st.nnCV < 0.1);
+    const ScalpSampler sampler(g, region);
+    for (const Vec3f& p : f.positions) CHECK(sampler.inRegion(Vec3d(p)));
+    // Without the contour: no fixed roots, and the rim less evenly lined.
+    fp.contour = false;
+    const Follicles free = sampleFollicles(g, region, fp);
+    CHECK(free.contour == 0);
+}
+
+TEST_CASE("sampleFollicles: contour, fission and death give the same roots with 1 and 2 threads", "[scalp]")
+{
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.05);
+    const openvdb::BoolGrid::Ptr region = regionFromRoots(*g, {Vec3f(0.f, 1.1f, 0.f)}, 1.2, "pole");
+    FollicleParams fp;
+    fp.count = 500;
+    fp.initialFraction = 0.4;
+    fp.seed = 3;
+    Follicles one, two;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = sampleFollicles(g, region, fp);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        two = sampleFollicles(g, region, fp);
+    }
+    REQUIRE(one.fissions > 0);
+    REQUIRE(one.contour > 0);
+    REQUIRE(one.positions.size() == two.positions.size());
+    CHECK(one.fissions == two.fissions);
+    CHECK(one.deaths == two.deaths);
+    CHECK(std::memcmp(one.positions.data(), two.positions.data(), one.positions.size() * sizeof(Vec3f)) == 0);
+}
+
+TEST_CASE("sampleFollicles: Witkin & Heckbert parameters out of range", "[scalp]")
+{
+    const openvdb::FloatGrid::Ptr g = unitSphere(Vec3d(0.0), 1.0, 0.1);
+    FollicleParams fp;
+    fp.count = 10;
+    fp.initialFraction = 0.0;
+    CHECK_THROWS_WITH(sampleFollicles(g, nullptr, fp), Contains("initialFraction 0 must be in (0, 4]"));
+    fp = FollicleParams{};
+    fp.count = 10;
+    fp.deathRatio = 1.0;
+    CHECK_THROWS_WITH(sampleFollicles(g, nullptr, fp), Contains("deathRatio 1 must be in (0, 1)"));
+    fp = FollicleParams{};
+    fp.count = 10;
+    fp.fissionRatio = 0.9;
+    CHECK_THROWS_WITH(sampleFollicles(g, nullptr, fp), Contains("fissionRatio 0.9 must be above 1"));
+    fp = FollicleParams{};
+    fp.count = 10;
+    fp.radiusStep = 0.5;
+    CHECK_THROWS_AS(sampleFollicles(g, nullptr, fp), ValueError);
+    fp = FollicleParams{};
+    fp.count = 10;
+    fp.alpha = std::nan("");
+    CHECK_THROWS_AS(sampleFollicles(g, nullptr, fp), ValueError);
 }

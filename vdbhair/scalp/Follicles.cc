@@ -18,6 +18,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <unordered_map>
 
 namespace vdbhair {
 
@@ -99,6 +100,204 @@ ScalpArea surfaceCells(const openvdb::FloatGrid& surface, const ScalpSampler& sa
     return out;
 }
 
+/// Radii stay within these multiples of the desired radius sigma_hat (a particle alone on a
+/// surface grows until it fissions; one squeezed shrinks until it dies).
+constexpr double kMinRadius = 0.05, kMaxRadius = 4.0;
+
+/// Free particles keep this share of the contour's spacing from every contour particle: the
+/// others' pressure pushed them into the gaps of the contour line (measured on a cap of the unit
+/// sphere: NN CV 0.12 without, 0.05 at 0.65-0.8; on woman_head in straight.hair's region at 3,000
+/// roots 0.10 without, 0.056 at 0.8). A particle of the next row, at the hexagonal place, is a
+/// full spacing from them.
+constexpr double kContourClearance = 0.8;
+
+/// The region's contour on the surface, as fixed particles about @a spacing apart. Every pair of
+/// face neighbours (a in the region, b out of it, both on the surface's band near zero) gives a
+/// rim point: the segment between their projections onto the zero level set is bisected (12
+/// times, each midpoint projected) to where the region ends, keeping the last point inside. The
+/// points are walked as nearest-neighbour chains (next: the nearest unvisited point within two
+/// voxels) and a point is kept when it is at least @a spacing from every point kept before, so
+/// along a rim the kept points are @a spacing to @a spacing plus a voxel apart. Serial order
+/// throughout: the same points for any thread count.
+std::vector<Vec3d> contourParticles(const openvdb::FloatGrid& surface, const ScalpSampler& sampler, const std::vector<SurfaceCell>& cells,
+                                    double spacing, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    const double h = sampler.voxelSize();
+    constexpr std::size_t kChunk = 1024;
+    const std::size_t chunks = (cells.size() + kChunk - 1) / kChunk;
+    std::vector<std::vector<Vec3d>> found(chunks);
+    const openvdb::math::Transform& xf = surface.transform();
+    forRange(chunks, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
+        ScalpSampler::Local local(sampler);
+        const auto onSurface = [&](const Vec3d& q) { return std::abs(local.distance(q)) < 0.01 * h; };
+        for (std::size_t chunk = r.begin(); chunk != r.end(); ++chunk) {
+            if (interrupter && interrupter->wasInterrupted()) return;
+            for (std::size_t c = chunk * kChunk; c < std::min(cells.size(), (chunk + 1) * kChunk); ++c) {
+                const Vec3d pa = local.project(xf.indexToWorld(cells[c].ijk));
+                if (!onSurface(pa) || !local.inRegion(pa)) continue;
+                for (int axis = 0; axis < 3; ++axis) {
+                    for (int sgn = -1; sgn <= 1; sgn += 2) {
+                        Vec3d step(0.0);
+                        step[axis] = sgn * h;
+                        Vec3d lo = pa, hi = local.project(pa + step);
+                        if (!onSurface(hi) || local.inRegion(hi) || (hi - lo).length() > 3.0 * h) continue;
+                        for (int k = 0; k < 12; ++k) {
+                            const Vec3d mid = local.project(0.5 * (lo + hi));
+                            if (!onSurface(mid)) break;
+                            (local.inRegion(mid) ? lo : hi) = mid;
+                        }
+                        found[chunk].push_back(lo);
+                    }
+                }
+            }
+        }
+    });
+    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("sampleFollicles: interrupted");
+    std::vector<Vec3d> points;
+    for (const std::vector<Vec3d>& f : found) points.insert(points.end(), f.begin(), f.end());
+    std::vector<Vec3d> kept;
+    if (points.empty()) return kept;
+
+    const PointCloud cloud{&points};
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    std::vector<char> visited(points.size(), 0);
+    // Kept points in a hash of cells of side `spacing`: a new point is checked against 27 cells.
+    const auto key = [&](const Vec3d& p, int dx, int dy, int dz) {
+        const auto q = [&](double v, int o) { return std::uint64_t(std::int64_t(std::floor(v / spacing)) + o) & 0x1fffff; };
+        return (q(p.x(), dx) << 42) | (q(p.y(), dy) << 21) | q(p.z(), dz);
+    };
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;
+    const auto farFromKept = [&](const Vec3d& p) {
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    const auto cell = grid.find(key(p, dx, dy, dz));
+                    if (cell == grid.end()) continue;
+                    for (const std::uint32_t k : cell->second) if ((kept[k] - p).length() < spacing) return false;
+                }
+        return true;
+    };
+    std::vector<std::pair<std::uint32_t, double>> nb;
+    for (std::size_t start = 0; start < points.size(); ++start) {
+        for (std::size_t cur = start; !visited[cur];) {
+            visited[cur] = 1;
+            if (farFromKept(points[cur])) {
+                grid[key(points[cur], 0, 0, 0)].push_back(std::uint32_t(kept.size()));
+                kept.push_back(points[cur]);
+            }
+            nb.clear();
+            tree.radiusSearch(&points[cur][0], 4.0 * h * h, nb, nanoflann::SearchParams(32, 0.f, true));  // sorted by distance
+            for (const auto& m : nb) {
+                if (!visited[m.first]) { cur = m.first; break; }
+            }
+        }
+    }
+    return kept;
+}
+
+/// Births and deaths of one control step (populationControl).
+struct PopulationChange { std::size_t fissions = 0, deaths = 0; };
+
+/// Witkin & Heckbert's fission and death, then the count: among the free particles (from
+/// @a fixedCount on) near equilibrium (moved less than a quarter of their radius this iteration),
+/// one whose radius exceeds fissionRatio sigma_hat splits; one below deathRatio sigma_hat dies
+/// with probability 1 - sigma / (deathRatio sigma_hat). Then, if the population would still
+/// differ from @a target, the free particles with the largest radii (the sparsest places) split,
+/// at most half of them, or those with the smallest (the most crowded) die, at most a quarter.
+/// A split replaces the particle by two at +-sigma/2 along a random tangent direction, each of
+/// radius sigma / sqrt(2), the new one appended; random draws come from the stream (seed,
+/// particle id, iteration), so the result does not depend on the thread count.
+PopulationChange populationControl(const ScalpSampler& sampler, const FollicleParams& params, int iteration, std::size_t target, std::size_t fixedCount,
+                                   double sigmaHat, const std::vector<double>& moved, const std::vector<double>& fixedGap, double clearance2,
+                                   std::vector<Vec3d>& pos, std::vector<double>& sig,
+                                   std::vector<std::uint64_t>& ids, std::uint64_t& nextId)
+{
+    const std::size_t m = pos.size();
+    std::vector<char> split(m, 0), die(m, 0);
+    const double sigmaSplit = params.fissionRatio * sigmaHat, sigmaDie = params.deathRatio * sigmaHat;
+    std::size_t nSplit = 0, nDie = 0;
+    for (std::size_t i = fixedCount; i < m; ++i) {
+        if (fixedGap[i] < clearance2) {  // in a gap of the contour line: no room there
+            die[i] = 1;
+            ++nDie;
+            continue;
+        }
+        if (!(moved[i] < 0.25 * sig[i])) continue;
+        if (sig[i] > sigmaSplit) {
+            split[i] = 1;
+            ++nSplit;
+        } else if (sig[i] < sigmaDie && Rng(params.seed, ids[i], 0xdead0000ull + std::uint64_t(iteration)).uniform() > sig[i] / sigmaDie) {
+            die[i] = 1;
+            ++nDie;
+        }
+    }
+    const std::int64_t deficit = std::int64_t(target) - std::int64_t(m + nSplit - nDie);
+    if (deficit != 0 && m > fixedCount) {
+        std::vector<std::uint32_t> order;
+        for (std::size_t i = fixedCount; i < m; ++i) if (!split[i] && !die[i]) order.push_back(std::uint32_t(i));
+        const bool grow = deficit > 0;
+        std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return grow ? sig[a] > sig[b] : sig[a] < sig[b]; });
+        const std::size_t freeCount = m - fixedCount;
+        const std::size_t k = std::min<std::size_t>({std::size_t(grow ? deficit : -deficit), grow ? (freeCount + 1) / 2 : (freeCount + 3) / 4, order.size()});
+        for (std::size_t q = 0; q < k; ++q) {
+            if (grow) { split[order[q]] = 1; ++nSplit; }
+            else { die[order[q]] = 1; ++nDie; }
+        }
+    }
+    PopulationChange change;
+    if (nSplit + nDie == 0) return change;
+    ScalpSampler::Local local(sampler);
+    const double h = sampler.voxelSize();
+    const auto onSurface = [&](const Vec3d& q) { return local.inRegion(q) && std::abs(local.distance(q)) < 0.01 * h; };
+    std::vector<Vec3d> newPos, childPos;
+    std::vector<double> newSig, childSig;
+    std::vector<std::uint64_t> newIds, childIds;
+    newPos.reserve(m + nSplit);
+    for (std::size_t i = 0; i < m; ++i) {
+        if (die[i]) { ++change.deaths; continue; }
+        if (!split[i]) {
+            newPos.push_back(pos[i]);
+            newSig.push_back(sig[i]);
+            newIds.push_back(ids[i]);
+            continue;
+        }
+        const Vec3d n = local.normal(pos[i]);
+        Rng rng(params.seed, ids[i], 0xf1550000ull + std::uint64_t(iteration));
+        Vec3d a = pos[i], b = pos[i];
+        bool done = false;
+        for (int attempt = 0; attempt < 4 && !done; ++attempt) {
+            double x, y, z, w;
+            rng.normalPair(x, y);
+            rng.normalPair(z, w);
+            Vec3d t(x, y, z);
+            t -= n * t.dot(n);
+            if (!(t.length() > 1e-6)) continue;
+            t *= 0.5 * sig[i] / t.length();
+            const Vec3d pa = local.project(pos[i] + t), pb = local.project(pos[i] - t);
+            const bool okA = onSurface(pa), okB = onSurface(pb);
+            if (okA && okB) { a = pa; b = pb; done = true; }
+            else if (okA) { b = pa; done = true; }  // at the region's edge: one step inward only
+            else if (okB) { b = pb; done = true; }
+        }
+        const double s = done ? sig[i] / std::sqrt(2.0) : sig[i];
+        newPos.push_back(a);
+        newSig.push_back(s);
+        newIds.push_back(ids[i]);
+        if (!done) continue;
+        childPos.push_back(b);
+        childSig.push_back(s);
+        childIds.push_back(nextId++);
+        ++change.fissions;
+    }
+    newPos.insert(newPos.end(), childPos.begin(), childPos.end());
+    newSig.insert(newSig.end(), childSig.begin(), childSig.end());
+    newIds.insert(newIds.end(), childIds.begin(), childIds.end());
+    pos.swap(newPos);
+    sig.swap(newSig);
+    ids.swap(newIds);
+    return change;
+}
+
 } // namespace
 
 ScalpArea measureScalpArea(const openvdb::FloatGrid::ConstPtr& surface, const openvdb::BoolGrid::ConstPtr& region)
@@ -120,6 +319,18 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                          " (about " + std::to_string(params.count / 5000000 + 1) + " GB of particles and neighbour lists)");
     }
     if (params.maxIterations < 0) throw ValueError(where + ": maxIterations " + std::to_string(params.maxIterations) + " must be at least 0");
+    const auto positive = [&](const char* name, double v) {
+        if (!(v > 0.0) || !std::isfinite(v)) throw ValueError(where + ": " + name + " " + formatNumber(v) + " must be positive and finite");
+    };
+    positive("alpha", params.alpha);
+    positive("energyRatio", params.energyRatio);
+    positive("beta", params.beta);
+    if (!(params.feedback >= 0.0) || !std::isfinite(params.feedback)) throw ValueError(where + ": feedback " + formatNumber(params.feedback) + " must be at least 0");
+    if (!(params.radiusStep >= 0.0 && params.radiusStep <= 0.2)) throw ValueError(where + ": radiusStep " + formatNumber(params.radiusStep) + " must be in [0, 0.2] (the radius equation is unstable above)");
+    if (!(params.fissionRatio > 1.0) || !std::isfinite(params.fissionRatio)) throw ValueError(where + ": fissionRatio " + formatNumber(params.fissionRatio) + " must be above 1");
+    if (!(params.deathRatio > 0.0 && params.deathRatio < 1.0)) throw ValueError(where + ": deathRatio " + formatNumber(params.deathRatio) + " must be in (0, 1)");
+    if (params.controlInterval < 0 || params.settleIterations < 0) throw ValueError(where + ": controlInterval and settleIterations must be at least 0");
+    if (!(params.initialFraction > 0.0 && params.initialFraction <= 4.0)) throw ValueError(where + ": initialFraction " + formatNumber(params.initialFraction) + " must be in (0, 4]");
     const ScalpSampler sampler(surface, region);
     const double h = sampler.voxelSize();
 
@@ -148,22 +359,39 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
         }
         count = std::max<std::size_t>(1, std::size_t(std::llround(n)));
     }
+    const std::size_t targetCount = count;
     Follicles out;
     out.area = area;
     out.areaWithoutZero = areaWithoutZero;
     out.targetSpacing = d;
 
-    // 3. Initial particles: voxels drawn by weight, jittered, projected; region misses redrawn.
+    // 3. Fixed particles on the region's contour, at the relaxed spacing (contourParticles).
+    const double sigmaHat = 0.5 * d;
+    std::vector<Vec3d> pos;
+    if (region && params.contour) pos = contourParticles(*surface, sampler, cells, kNearestPerHexSpacing * d, threaded, interrupter);
+    const std::size_t fixedCount = pos.size();
+    const double clearance2 = std::pow(kContourClearance * kNearestPerHexSpacing * d, 2);
+    out.contour = fixedCount;
+
+    // 4. Initial free particles: voxels drawn by weight, jittered, projected; region misses
+    // redrawn. A share f of the free count starts, with radius sigma_hat / sqrt(f) (their density).
+    const std::size_t freeTarget = count > fixedCount ? count - fixedCount : 0;
+    const std::size_t initial = freeTarget == 0 ? 0 : std::max<std::size_t>(1, std::size_t(std::llround(params.initialFraction * double(freeTarget))));
+    if (initial > params.maxCount) throw LimitError(where + ": " + std::to_string(initial) + " initial particles (initialFraction " + formatNumber(params.initialFraction) + ") is more than the cap of " + std::to_string(params.maxCount));
     std::vector<double> cumulative(cells.size());
     {
         double s = 0.0;
         for (std::size_t i = 0; i < cells.size(); ++i) cumulative[i] = (s += cells[i].weight);
     }
-    std::vector<Vec3d> pos(count), next(count);
-    std::vector<char> placed(count, 0);
+    std::vector<Vec3d> fixedPos(pos.begin(), pos.end());
+    const PointCloud fixedCloud{&fixedPos};
+    std::unique_ptr<PointKdTree> fixedTree;
+    if (fixedCount > 0) fixedTree = std::make_unique<PointKdTree>(3, fixedCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     {
-        ProgressCounter progress(interrupter, "placing roots", count, "roots");
-        forRange(count, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<Vec3d> drawn(initial);
+        std::vector<char> placed(initial, 0);
+        ProgressCounter progress(interrupter, "placing roots", initial, "roots");
+        forRange(initial, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
             ScalpSampler::Local local(sampler);
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 Rng rng(params.seed, i, 0x5ca1b);
@@ -174,48 +402,66 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                     const Vec3d jitter(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
                     const Vec3d p = local.project(surface->transform().indexToWorld(cells[c].ijk.asVec3d() + jitter));
                     if (!local.inRegion(p) || !(std::abs(local.distance(p)) < 0.01 * h)) continue;
-                    pos[i] = p;
+                    if (fixedTree) {  // not in a gap of the contour line
+                        std::uint32_t idx;
+                        double d2;
+                        const double q[3] = {p.x(), p.y(), p.z()};
+                        fixedTree->knnSearch(q, 1, &idx, &d2);
+                        if (d2 < clearance2) continue;
+                    }
+                    drawn[i] = p;
                     placed[i] = 1;
                 }
             }
             if (progress.add(r.size())) return;
         });
         if (progress.stopped()) throw InterruptedError(where + ": interrupted");
+        for (std::size_t i = 0; i < initial; ++i) if (placed[i]) pos.push_back(drawn[i]);
     }
-    {
-        std::size_t k = 0;
-        for (std::size_t i = 0; i < count; ++i) if (placed[i]) pos[k++] = pos[i];
-        pos.resize(k);
-        next.resize(k);
-        count = k;
+    if (pos.empty()) throw LookupError(where + ": no root could be placed on the surface in the region");
+    out.initial = pos.size() - fixedCount;
+    std::vector<double> sig(pos.size(), sigmaHat);
+    if (params.initialFraction > 0.0 && params.initialFraction != 1.0) {
+        const double s0 = sigmaHat * std::sqrt(double(freeTarget) / double(std::max<std::size_t>(1, initial)));
+        std::fill(sig.begin() + std::ptrdiff_t(fixedCount), sig.end(), std::clamp(s0, kMinRadius * sigmaHat, kMaxRadius * sigmaHat));
     }
-    if (count == 0) throw LookupError(where + ": no root could be placed on the surface in the region");
+    std::vector<std::uint64_t> ids(pos.size());
+    for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = i;
+    std::uint64_t nextId = ids.size();
+    count = pos.size();
 
-    // 4. Relaxation: Witkin-Heckbert repulsion, all particles at once.
-    const double sigma = 0.5 * d, inv2s2 = 1.0 / (2.0 * sigma * sigma);
-    const double searchR2 = (4.0 * sigma) * (4.0 * sigma), maxMove = 0.25 * d;
-    std::vector<double> moved(count, 0.0);
+    // 5. Relaxation: Witkin-Heckbert repulsion and radius feedback, all particles at once, with
+    // fission and death every controlInterval iterations.
+    const double alpha = params.alpha, eHat = params.energyRatio * params.alpha;
+    const double moveScale = params.stepScale / (2.0 * alpha);  // uniform radii: stepScale sigma^2 grad E
+    std::vector<Vec3d> next(count);
+    std::vector<double> nextSig(count), moved(count, 0.0), fixedGap(count, std::numeric_limits<double>::max());
     ProgressCounter progress(interrupter, "relaxing roots", std::uint64_t(params.maxIterations), "iterations");
     int it = 0;
-    // Neighbour lists (Verlet lists): each particle's neighbours within 4 sigma plus a skin, in
+    // Neighbour lists (Verlet lists): each particle's neighbours within 4 sigma_max plus a skin, in
     // index order, from a k-d tree over the positions at the last build. A particle that has moved
     // more than half the skin since then is "fast": its neighbours come from a search around its
     // position in that tree, and every particle finds the fast ones in a small tree over their
-    // current positions. Any pair within 4 sigma is found (a pair of slow particles moved less
+    // current positions. Any pair within 4 sigma_max is found (a pair of slow particles moved less
     // than the skin together), so the forces are those of a full search per iteration, summed in
     // the same index order, bit for bit. The lists are rebuilt when more than 1/20 of the
-    // particles are fast. The searches and their sort were 45 % of the time (perf, 20,000 roots on
-    // head_max4); a few particles that keep jumping (thin or folded parts of a band) made a global
-    // skin test rebuild every iteration on woman_head and ruby_head.
-    const double skin = 0.5 * d, listR = 4.0 * sigma + skin, fastR = 4.0 * sigma + 0.5 * skin;
-    std::vector<std::vector<std::uint32_t>> lists(count);
+    // particles are fast, when the largest radius outgrows the lists' and when particles are born
+    // or die. The searches and their sort were 45 % of the time (perf, 20,000 roots on head_max4);
+    // a few particles that keep jumping (thin or folded parts of a band) made a global skin test
+    // rebuild every iteration on woman_head and ruby_head.
+    const double skin = 0.5 * d;
+    double listSigma = 0.0;  // the largest radius when the lists were built
+    std::vector<std::vector<std::uint32_t>> lists;
     std::vector<Vec3d> builtAt, fastPos;
     std::vector<std::uint32_t> fastIds;
-    std::vector<char> fast(count, 0);
+    std::vector<char> fast;
     const PointCloud builtCloud{&builtAt}, fastCloud{&fastPos};
     std::unique_ptr<PointKdTree> builtTree, fastTree;
-    auto buildLists = [&] {
+    auto buildLists = [&](double sigmaMax) {
         builtAt = pos;
+        listSigma = sigmaMax;
+        lists.assign(count, {});
+        const double listR = 4.0 * sigmaMax + skin;
         builtTree = std::make_unique<PointKdTree>(3, builtCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         forRange(count, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
             std::vector<std::pair<std::uint32_t, double>> nb;
@@ -223,22 +469,25 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                 nb.clear();
                 builtTree->radiusSearch(&pos[i][0], listR * listR, nb, nanoflann::SearchParams(32, 0.f, false));
                 std::vector<std::uint32_t>& list = lists[i];
-                list.clear();
                 for (const auto& m : nb) if (m.first != i) list.push_back(m.first);
                 std::sort(list.begin(), list.end());
             }
         });
     };
+    std::size_t lastControlChange = 0;
     for (; it < params.maxIterations; ++it) {
+        const double sigmaMax = *std::max_element(sig.begin(), sig.end());
+        const double searchR2 = (4.0 * sigmaMax) * (4.0 * sigmaMax), fastR = 4.0 * sigmaMax + 0.5 * skin;
         std::size_t fastCount = 0;
+        fast.assign(count, 0);
         if (builtAt.size() == count) {
             for (std::size_t i = 0; i < count; ++i) {
                 fast[i] = (pos[i] - builtAt[i]).length() > 0.5 * skin;
                 fastCount += std::size_t(fast[i]);
             }
         }
-        if (builtAt.size() != count || fastCount > count / 20) {
-            buildLists();
+        if (builtAt.size() != count || fastCount > count / 20 || sigmaMax > listSigma) {
+            buildLists(sigmaMax);
             std::fill(fast.begin(), fast.end(), 0);
             fastCount = 0;
         }
@@ -257,6 +506,12 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
             std::vector<std::pair<std::uint32_t, double>> nb;
             std::vector<std::uint32_t> found;
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                if (i < fixedCount) {
+                    next[i] = pos[i];
+                    nextSig[i] = sig[i];
+                    moved[i] = 0.0;
+                    continue;
+                }
                 const std::vector<std::uint32_t>* candidates = &lists[i];
                 if (fastCount > 0) {
                     found.clear();
@@ -273,22 +528,54 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                     if (fast[i] || !nb.empty()) std::sort(found.begin(), found.end());
                     candidates = &found;
                 }
-                Vec3d f(0.0);
+                // Witkin & Heckbert: E_i = sum_j alpha exp(-r^2 / 2 sigma_i^2) (cut at 4 sigma_i),
+                // the move sigma_i^2 sum_j r_ij (E_ij / sigma_i^2 + E_ji / sigma_j^2), and
+                // dE_i / dsigma_i for the radius feedback.
+                const double si = sig[i], si2 = si * si;
+                Vec3d force(0.0);
+                double energy = 0.0, dEnergy = 0.0;
                 for (const std::uint32_t j : *candidates) {
                     const Vec3d e = pos[i] - pos[j];
-                    const double r2 = e.lengthSqr();
-                    if (r2 < searchR2) f += e * std::exp(-r2 * inv2s2);  // sigma^2 * grad E
+                    const double r2 = e.lengthSqr(), sj2 = sig[j] * sig[j];
+                    double w = 0.0;
+                    if (r2 < 16.0 * si2) {
+                        const double eij = alpha * std::exp(-r2 / (2.0 * si2));
+                        energy += eij;
+                        dEnergy += r2 * eij;
+                        w += eij;
+                    }
+                    if (r2 < 16.0 * sj2) w += si2 / sj2 * alpha * std::exp(-r2 / (2.0 * sj2));
+                    force += e * w;
                 }
-                f *= params.stepScale;
+                dEnergy /= si2 * si;
+                Vec3d f = force * moveScale;
                 const Vec3d n = local.normal(pos[i]);
                 f -= n * f.dot(n);
+                const double maxMove = 0.5 * si;  // d / 4 at the desired radius
                 const double len = f.length();
                 if (len > maxMove) f *= maxMove / len;
                 // A move must stay in the region and land on the zero level set near where it was
                 // aimed (projection can run off where the band is thin or folded): else it is
                 // halved, up to three times, or not taken.
+                // Nor may it come closer to a contour particle than kContourClearance of the
+                // contour's spacing, unless it was closer already and moves away.
+                double nearFixed = std::numeric_limits<double>::max();
+                for (const std::uint32_t j : *candidates) {
+                    if (j >= fixedCount) break;  // index order: the fixed come first
+                    nearFixed = std::min(nearFixed, (pos[i] - pos[j]).lengthSqr());
+                }
+                fixedGap[i] = nearFixed;
+                auto clearOfContour = [&](const Vec3d& q) {
+                    if (nearFixed >= clearance2 * 16.0) return true;
+                    double m = std::numeric_limits<double>::max();
+                    for (const std::uint32_t j : *candidates) {
+                        if (j >= fixedCount) break;
+                        m = std::min(m, (q - pos[j]).lengthSqr());
+                    }
+                    return m >= clearance2 || m >= nearFixed;
+                };
                 auto acceptable = [&](const Vec3d& q) {
-                    return local.inRegion(q) && std::abs(local.distance(q)) < 0.01 * h && (q - pos[i]).length() < maxMove + 2.0 * h;
+                    return local.inRegion(q) && std::abs(local.distance(q)) < 0.01 * h && (q - pos[i]).length() < maxMove + 2.0 * h && clearOfContour(q);
                 };
                 Vec3d p = local.project(pos[i] + f);
                 for (int k = 0; k < 3 && !acceptable(p); ++k) {
@@ -298,19 +585,48 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                 if (!acceptable(p)) p = pos[i];
                 next[i] = p;
                 moved[i] = (p - pos[i]).length();
+                // Radius feedback: dsigma/dt = -rho (E_i - E_hat) / (dE_i/dsigma_i + beta / sigma_hat).
+                double ds = params.radiusStep * -params.feedback * (energy - eHat) / (dEnergy + params.beta / sigmaHat);
+                ds = std::clamp(ds, -0.1 * si, 0.1 * si);
+                nextSig[i] = std::clamp(si + ds, kMinRadius * sigmaHat, kMaxRadius * sigmaHat);
             }
         });
         pos.swap(next);
+        sig.swap(nextSig);
         double worst = 0.0;
         for (double m : moved) worst = std::max(worst, m);
         out.lastMove = worst / d;
         if (progress.add(1)) throw InterruptedError(where + ": interrupted");
-        if (worst < params.tolerance * d) { ++it; break; }
+        const bool settled = worst < params.tolerance * d;
+        // Fission and death (populationControl), not in the last settleIterations.
+        const bool mayControl = params.controlInterval > 0 && it + 1 + params.settleIterations <= params.maxIterations;
+        if (mayControl && (settled || (it + 1) % params.controlInterval == 0)) {
+            const PopulationChange change = populationControl(sampler, params, it, targetCount, fixedCount, sigmaHat, moved, fixedGap, clearance2, pos, sig, ids, nextId);
+            out.fissions += change.fissions;
+            out.deaths += change.deaths;
+            if (change.fissions + change.deaths > 0) {
+                count = pos.size();
+                next.resize(count);
+                nextSig.resize(count);
+                moved.assign(count, 0.0);
+                fixedGap.assign(count, std::numeric_limits<double>::max());
+                builtAt.clear();  // rebuild the lists
+                lastControlChange = std::size_t(it + 1);
+                continue;
+            }
+        }
+        if (settled) { ++it; break; }
     }
     progress.finish();
     out.iterations = it;
+    out.lastPopulationChange = int(lastControlChange);
+    out.radiusSpread = 0.0;
+    if (count > fixedCount) {
+        const auto [lo, hi] = std::minmax_element(sig.begin() + std::ptrdiff_t(fixedCount), sig.end());
+        out.radiusSpread = (*hi - *lo) / sigmaHat;
+    }
 
-    // 5. Death: a particle within 0.1 d of an earlier one is removed (they have no force between
+    // 6. Death: a particle within 0.1 d of an earlier one is removed (they have no force between
     // them once they coincide, which projection onto thin or folded parts of a band can cause).
     {
         const PointCloud cloud{&pos};
@@ -318,7 +634,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
         std::vector<char> alive(count, 1);
         std::vector<std::pair<std::uint32_t, double>> nb;
         const double r2 = (0.1 * d) * (0.1 * d);
-        for (std::size_t i = 0; i < count; ++i) {
+        for (std::size_t i = fixedCount; i < count; ++i) {
             nb.clear();
             tree.radiusSearch(&pos[i][0], r2, nb, nanoflann::SearchParams(32, 0.f, false));
             for (const auto& m : nb) {
@@ -332,7 +648,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
         count = k;
     }
 
-    // 6. Frames.
+    // 7. Frames.
     out.positions.resize(count);
     out.normals.resize(count);
     out.tangents.resize(count);
