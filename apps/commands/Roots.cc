@@ -69,7 +69,7 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     if (common.json) {
         printJson({{"output", p.output}, {"count", f.positions.size()}, {"region", bool(region)}, {"area", f.area},
                    {"area_without_zero", f.areaWithoutZero}, {"target_spacing", f.targetSpacing}, {"iterations", f.iterations}, {"last_move", f.lastMove}, {"removed", f.removed},
-                   {"contour", f.contour}, {"initial", f.initial}, {"fissions", f.fissions}, {"deaths", f.deaths}, {"last_population_change", f.lastPopulationChange},
+                   {"contour", f.contour}, {"initial", f.initial}, {"fissions", f.fissions}, {"deaths", f.deaths}, {"last_population_change", f.lastPopulationChange}, {"radius_spread", f.radiusSpread},
                    {"spacing", {{"mean", stats.nnMean}, {"cv", stats.nnCV}, {"min", stats.nnMin}, {"max", stats.nnMax}}},
                    {"max_surface_distance_voxels", stats.maxSurfaceDistanceVoxels}, {"seconds", seconds}});
     } else if (!common.quiet) {

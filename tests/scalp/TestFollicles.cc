@@ -93,7 +93,7 @@ TEST_CASE("sampleFollicles: a band that never crosses zero gets no roots and no 
     for (const Vec3f& p : f.positions) farthest = std::max(farthest, std::abs(Vec3d(p).length() - r) / h);
     CHECK(farthest < 0.05);  // every root on the proper sphere
     CHECK(st.nnCV < 0.1);
-    CHECK(st.nnMean == Approx(f.targetSpacing * 0.93).epsilon(0.05));
+    CHECK(st.nnMean == Approx(f.targetSpacing * kRelaxedNearestPerSpacing).epsilon(0.05));
 }
 
 TEST_CASE("sampleFollicles: a cap region holds every root", "[scalp]")
@@ -338,7 +338,7 @@ TEST_CASE("sampleFollicles: fission from a quarter of the count and death from t
         else CHECK(f.deaths >= 1500);
         CHECK(std::abs(double(f.positions.size()) - 1500.0) <= 0.02 * 1500.0);
         CHECK(st.nnCV < 0.1);
-        CHECK(st.nnMean == Approx(f.targetSpacing * 0.93).epsilon(0.05));
+        CHECK(st.nnMean == Approx(f.targetSpacing * kRelaxedNearestPerSpacing).epsilon(0.05));
         CHECK(st.maxSurfaceDistanceVoxels < 0.05);
         CHECK(f.lastPopulationChange > 0);
         CHECK(f.lastPopulationChange + fp.settleIterations <= fp.maxIterations);
@@ -381,7 +381,7 @@ TEST_CASE("sampleFollicles: the region's contour holds fixed roots on the cap's 
     const Follicles f = sampleFollicles(g, region, fp);
     const FollicleStats st = measureFollicles(f.positions, g);
     REQUIRE(f.contour > 10);
-    const double s = 0.93 * f.targetSpacing;  // the contour's spacing
+    const double s = kRelaxedNearestPerSpacing * f.targetSpacing;  // the contour's spacing
     // The rim: chord capRadius from the pole, a circle of radius rr at height yr.
     const double yr = 1.0 - capRadius * capRadius / 2.0, rr = std::sqrt(1.0 - yr * yr);
     double worstOff = 0.0, closestContour = 1e9, closestFree = 1e9;

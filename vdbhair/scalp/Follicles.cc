@@ -45,8 +45,6 @@ Vec3d tangentFrom(const Vec3d& n, const Vec3d& up)
     return Vec3d(1, 0, 0);
 }
 
-/// Mean nearest-neighbour distance of relaxed roots over the hexagonal spacing d (measured).
-constexpr double kNearestPerHexSpacing = 0.93;
 
 /// A band voxel of the zero level set and its share of the area.
 struct SurfaceCell { openvdb::Coord ijk; double weight; };
@@ -103,6 +101,11 @@ ScalpArea surfaceCells(const openvdb::FloatGrid& surface, const ScalpSampler& sa
 /// Radii stay within these multiples of the desired radius sigma_hat (a particle alone on a
 /// surface grows until it fissions; one squeezed shrinks until it dies).
 constexpr double kMinRadius = 0.05, kMaxRadius = 4.0;
+
+/// Pairs interact within kCut radii (exp(-kCut^2 / 2) = 0.011 of the energy at contact). 4 took
+/// 1.4 times as long for the same spread (woman_head, 30,000 roots: CV 0.0572 at 4, 0.0576 at 3;
+/// 10.0 s against 7.2 s).
+constexpr double kCut = 3.0, kCut2 = kCut * kCut;
 
 /// Free particles keep this share of the contour's spacing from every contour particle: the
 /// others' pressure pushed them into the gaps of the contour line (measured on a cap of the unit
@@ -350,8 +353,8 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
         d = std::sqrt(2.0 * area / (std::sqrt(3.0) * double(count)));
     } else {
         // A relaxed set's nearest-neighbour distance is below the hexagonal spacing (defects,
-        // curvature): 0.93 d on spheres of 2000 roots after 200 to 700 iterations (README).
-        d = params.spacing / kNearestPerHexSpacing;
+        // curvature): kRelaxedNearestPerSpacing d (Follicles.h).
+        d = params.spacing / kRelaxedNearestPerSpacing;
         const double n = 2.0 * area / (std::sqrt(3.0) * d * d);
         if (!(n <= double(params.maxCount))) {
             throw LimitError(where + ": spacing " + formatNumber(params.spacing) + " over an area of " + formatNumber(area) + " makes about " + formatNumber(std::round(n)) +
@@ -368,9 +371,9 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     // 3. Fixed particles on the region's contour, at the relaxed spacing (contourParticles).
     const double sigmaHat = 0.5 * d;
     std::vector<Vec3d> pos;
-    if (region && params.contour) pos = contourParticles(*surface, sampler, cells, kNearestPerHexSpacing * d, threaded, interrupter);
+    if (region && params.contour) pos = contourParticles(*surface, sampler, cells, kRelaxedNearestPerSpacing * d, threaded, interrupter);
     const std::size_t fixedCount = pos.size();
-    const double clearance2 = std::pow(kContourClearance * kNearestPerHexSpacing * d, 2);
+    const double clearance2 = std::pow(kContourClearance * kRelaxedNearestPerSpacing * d, 2);
     out.contour = fixedCount;
 
     // 4. Initial free particles: voxels drawn by weight, jittered, projected; region misses
@@ -434,34 +437,36 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     // fission and death every controlInterval iterations.
     const double alpha = params.alpha, eHat = params.energyRatio * params.alpha;
     const double moveScale = params.stepScale / (2.0 * alpha);  // uniform radii: stepScale sigma^2 grad E
+    // Interactions use radii of at most sigmaCap (the fission threshold), so the neighbour lists
+    // have one radius for the whole run: a particle beyond it splits at its next control step,
+    // and one that cannot (alone on a scrap of surface too small for two) would otherwise widen
+    // every particle's search.
+    const double sigmaCap = params.fissionRatio * sigmaHat;
     std::vector<Vec3d> next(count);
     std::vector<double> nextSig(count), moved(count, 0.0), fixedGap(count, std::numeric_limits<double>::max());
     ProgressCounter progress(interrupter, "relaxing roots", std::uint64_t(params.maxIterations), "iterations");
     int it = 0;
-    // Neighbour lists (Verlet lists): each particle's neighbours within 4 sigma_max plus a skin, in
+    // Neighbour lists (Verlet lists): each particle's neighbours within kCut sigmaCap plus a skin, in
     // index order, from a k-d tree over the positions at the last build. A particle that has moved
     // more than half the skin since then is "fast": its neighbours come from a search around its
     // position in that tree, and every particle finds the fast ones in a small tree over their
-    // current positions. Any pair within 4 sigma_max is found (a pair of slow particles moved less
+    // current positions. Any pair within kCut sigmaCap is found (a pair of slow particles moved less
     // than the skin together), so the forces are those of a full search per iteration, summed in
     // the same index order, bit for bit. The lists are rebuilt when more than 1/20 of the
-    // particles are fast, when the largest radius outgrows the lists' and when particles are born
-    // or die. The searches and their sort were 45 % of the time (perf, 20,000 roots on head_max4);
+    // particles are fast and when particles are born or die. The searches and their sort were 45 % of the time (perf, 20,000 roots on head_max4);
     // a few particles that keep jumping (thin or folded parts of a band) made a global skin test
     // rebuild every iteration on woman_head and ruby_head.
     const double skin = 0.5 * d;
-    double listSigma = 0.0;  // the largest radius when the lists were built
     std::vector<std::vector<std::uint32_t>> lists;
     std::vector<Vec3d> builtAt, fastPos;
     std::vector<std::uint32_t> fastIds;
     std::vector<char> fast;
     const PointCloud builtCloud{&builtAt}, fastCloud{&fastPos};
     std::unique_ptr<PointKdTree> builtTree, fastTree;
-    auto buildLists = [&](double sigmaMax) {
+    auto buildLists = [&] {
         builtAt = pos;
-        listSigma = sigmaMax;
         lists.assign(count, {});
-        const double listR = 4.0 * sigmaMax + skin;
+        const double listR = kCut * sigmaCap + skin;
         builtTree = std::make_unique<PointKdTree>(3, builtCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         forRange(count, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
             std::vector<std::pair<std::uint32_t, double>> nb;
@@ -476,8 +481,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
     };
     std::size_t lastControlChange = 0;
     for (; it < params.maxIterations; ++it) {
-        const double sigmaMax = *std::max_element(sig.begin(), sig.end());
-        const double searchR2 = (4.0 * sigmaMax) * (4.0 * sigmaMax), fastR = 4.0 * sigmaMax + 0.5 * skin;
+        const double searchR2 = (kCut * sigmaCap) * (kCut * sigmaCap), fastR = kCut * sigmaCap + 0.5 * skin;
         std::size_t fastCount = 0;
         fast.assign(count, 0);
         if (builtAt.size() == count) {
@@ -486,8 +490,8 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                 fastCount += std::size_t(fast[i]);
             }
         }
-        if (builtAt.size() != count || fastCount > count / 20 || sigmaMax > listSigma) {
-            buildLists(sigmaMax);
+        if (builtAt.size() != count || fastCount > count / 20) {
+            buildLists();
             std::fill(fast.begin(), fast.end(), 0);
             fastCount = 0;
         }
@@ -528,23 +532,24 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                     if (fast[i] || !nb.empty()) std::sort(found.begin(), found.end());
                     candidates = &found;
                 }
-                // Witkin & Heckbert: E_i = sum_j alpha exp(-r^2 / 2 sigma_i^2) (cut at 4 sigma_i),
+                // Witkin & Heckbert: E_i = sum_j alpha exp(-r^2 / 2 sigma_i^2) (cut at kCut sigma_i),
                 // the move sigma_i^2 sum_j r_ij (E_ij / sigma_i^2 + E_ji / sigma_j^2), and
                 // dE_i / dsigma_i for the radius feedback.
-                const double si = sig[i], si2 = si * si;
+                const double si = std::min(sig[i], sigmaCap), si2 = si * si;
                 Vec3d force(0.0);
                 double energy = 0.0, dEnergy = 0.0;
                 for (const std::uint32_t j : *candidates) {
                     const Vec3d e = pos[i] - pos[j];
-                    const double r2 = e.lengthSqr(), sj2 = sig[j] * sig[j];
+                    const double sjc = std::min(sig[j], sigmaCap);
+                    const double r2 = e.lengthSqr(), sj2 = sjc * sjc;
                     double w = 0.0;
-                    if (r2 < 16.0 * si2) {
+                    if (r2 < kCut2 * si2) {
                         const double eij = alpha * std::exp(-r2 / (2.0 * si2));
                         energy += eij;
                         dEnergy += r2 * eij;
                         w += eij;
                     }
-                    if (r2 < 16.0 * sj2) w += si2 / sj2 * alpha * std::exp(-r2 / (2.0 * sj2));
+                    if (r2 < kCut2 * sj2) w += si2 / sj2 * alpha * std::exp(-r2 / (2.0 * sj2));
                     force += e * w;
                 }
                 dEnergy /= si2 * si;
@@ -588,7 +593,7 @@ Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const ope
                 // Radius feedback: dsigma/dt = -rho (E_i - E_hat) / (dE_i/dsigma_i + beta / sigma_hat).
                 double ds = params.radiusStep * -params.feedback * (energy - eHat) / (dEnergy + params.beta / sigmaHat);
                 ds = std::clamp(ds, -0.1 * si, 0.1 * si);
-                nextSig[i] = std::clamp(si + ds, kMinRadius * sigmaHat, kMaxRadius * sigmaHat);
+                nextSig[i] = std::clamp(sig[i] + ds, kMinRadius * sigmaHat, kMaxRadius * sigmaHat);
             }
         });
         pos.swap(next);
