@@ -8,10 +8,12 @@
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/MeshFile.h>
+#include <vdbhair/io/PointFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrands.h>
 #include <vdbhair/render/StrandRenderer.h>
+#include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/HairTransfer.h>
@@ -28,7 +30,7 @@ namespace {
 
 struct SynthCmdParams
 {
-    std::string input, output, scalp, saveMaps, layout = synthLayoutName(SynthParams{}.layout);
+    std::string input, output, scalp, saveMaps, region, layout = synthLayoutName(SynthParams{}.layout);
     SynthOptionText text;
     std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;
@@ -110,6 +112,36 @@ nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, double 
     return j;
 }
 
+/// The points of an output region: a .vdb's bool grid 'region' (its active voxels' centres), a
+/// PLY of points (no 'strand' element), or the roots of a hairstyle.
+std::vector<Vec3d> readRegionPoints(const std::string& path, const CommonOptions& common)
+{
+    std::vector<Vec3d> out;
+    const std::string ext = fileExtension(path);
+    if (ext == ".vdb") {
+        if (const openvdb::BoolGrid::Ptr region = readScalpRegion(path)) {
+            const openvdb::Index64 n = region->activeVoxelCount();
+            if (n > (openvdb::Index64(1) << 27)) throw LimitError(path + ": region of " + std::to_string(n) + " voxels, more than the cap of 2^27");
+            out.reserve(std::size_t(n));
+            for (auto it = region->cbeginValueOn(); it; ++it) {
+                if (it.isVoxelValue()) out.push_back(region->transform().indexToWorld(it.getCoord()));
+                else throw FormatError(path + ": grid 'region' has active tiles; a region is a set of voxels");
+            }
+            if (out.empty()) throw ValueError(path + ": grid 'region' is empty: no place for the hair to grow");
+            return out;
+        }
+    }
+    if (ext == ".ply" && plyElementCount(path, "vertex") > 0 && plyElementCount(path, "strand") == 0) {
+        const OrientedPoints op = readPlyPoints(path);
+        for (const Vec3f& v : op.positions) out.emplace_back(v.x(), v.y(), v.z());
+    } else {
+        const StrandSet s = loadStrandsOrScene("synth", path, common);
+        for (std::size_t i = 0; i < s.numStrands(); ++i) out.emplace_back(s.root(i).x(), s.root(i).y(), s.root(i).z());
+    }
+    if (out.empty()) throw ValueError(path + ": no points: no place for the hair to grow");
+    return out;
+}
+
 int runSynth(SynthCmdParams p, const CommonOptions& common)
 {
     strandFormatFromPath(p.output, /*forWriting=*/true);
@@ -135,15 +167,20 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     const StrandSet example = loadStrands("synth", p.input, common);
     if (example.numStrands() < 2) throw ValueError(p.input + ": " + std::to_string(example.numStrands()) + " strand: synthesis needs an example of many strands");
     if (p.strands > 0) {
-        p.synth.strandScale = double(p.strands) / double(example.numStrands());
+        p.synth.strands = std::size_t(p.strands);
         const double estimate = double(p.strands) * p.synth.vertices;
         if (estimate > double(p.synth.maxVertices))
             throw LimitError("--strands " + std::to_string(p.strands) + ": " + formatValue(estimate) + " vertices exceed the cap of " +
                              std::to_string(p.synth.maxVertices));
     }
     const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
+    std::vector<Vec3d> region;
+    if (!p.region.empty()) {
+        const Stage stage(common, "reading " + p.region);
+        region = readRegionPoints(p.region, common);
+    }
     const auto t0 = std::chrono::steady_clock::now();
-    const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter);
+    const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter, p.region.empty() ? nullptr : &region);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     {
         const Stage stage(common, "writing " + p.output);
@@ -191,7 +228,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
                    {"map", {{"width", r.grid.width}, {"height", r.grid.height}, {"components", r.pca.components},
                             {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
                    {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
-                   {"head_radius", r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)},
+                   {"head_radius", r.map->radius()}, {"region", p.region.empty() ? "the example's" : p.region}, {"output_area", r.outputArea}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)},
                    {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}});
     } else if (!common.quiet) {
         std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
@@ -268,7 +305,8 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", params->scalp, "The scalp: a .vdb with a level set 'surface' (vdbhair scalp) or a head mesh (.ply, .obj); default: the sphere fitted to the roots");
     addSynthHierarchyOptions(sub, s, params->text);
-    sub->add_option("--strands", params->strands, "Strands in the output (default: as many as the example; every level scales alike)");
+    sub->add_option("--region", params->region, "Where the new hair grows (default: the example's region): a scalp .vdb's 'region' grid (vdbhair scalp --region...), roots (.ply points, as vdbhair roots writes) or the roots of a hairstyle; the strand count scales with the area");
+    sub->add_option("--strands", params->strands, "Strands in the output (default: the example's density over the region; every level scales alike)");
     sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();
     sub->add_option("--layout", params->layout, "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: a variation that keeps its global flow exactly)")->capture_default_str();
     sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();

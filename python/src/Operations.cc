@@ -164,9 +164,17 @@ Returns:
         [](const StrandsPtr& example, int levels, std::optional<std::size_t> strands, std::uint64_t seed, int vertices,
            double threshold, int initialClusters, int components, double mapSpacing, const std::string& layout,
            const std::string& detail, double placeWeight, double nearby, bool refine, std::optional<std::string> refineMode,
-           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp, bool returnReport,
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp,
+           std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region, bool returnReport,
            int threads, const pyb::object& progress) -> pyb::object {
             SynthParams p;
+            std::vector<Vec3d> regionPoints;
+            if (region) {
+                if (region->ndim() != 2 || region->shape(1) != 3) throw ValueError("synth: region must be an (N, 3) array of points");
+                const auto r = region->unchecked<2>();
+                regionPoints.reserve(std::size_t(r.shape(0)));
+                for (pyb::ssize_t i = 0; i < r.shape(0); ++i) regionPoints.emplace_back(r(i, 0), r(i, 1), r(i, 2));
+            }
             setHierarchy(p, levels, seed, vertices, threshold, initialClusters, up);
             p.components = components;
             p.mapSpacing = mapSpacing;
@@ -180,12 +188,12 @@ Returns:
             if (strands) {
                 if (*strands == 0) throw ValueError("synth: strands=0: must be at least 1");
                 if (example->empty()) throw ValueError("synth: the example has no strands");
-                p.strandScale = double(*strands) / double(example->numStrands());
+                p.strands = *strands;
             }
             p.validate("synth");
             SynthResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
-                return synthesizeHair(*example, p, grid, true, interrupter);
+                return synthesizeHair(*example, p, grid, true, interrupter, region ? &regionPoints : nullptr);
             });
             auto out = std::make_shared<StrandSet>(std::move(r.strands));
             if (!returnReport) return pyb::cast(out);
@@ -206,6 +214,7 @@ Returns:
             report["cluster_of"] = clusters;
             report["head_radius"] = r.map->radius();
             report["up"] = pyb::make_tuple(r.up.x(), r.up.y(), r.up.z());
+            report["output_area"] = r.outputArea;
             return pyb::make_tuple(out, report);
         },
         pyb::arg("example"), pyb::kw_only(), pyb::arg("levels") = synthDefaults.cluster.levels, pyb::arg("strands") = pyb::none(),
@@ -215,7 +224,8 @@ Returns:
         pyb::arg("layout") = synthLayoutName(synthDefaults.layout), pyb::arg("detail") = detailBlendName(synthDefaults.detailBlend), pyb::arg("place_weight") = synthDefaults.placeWeight,
         pyb::arg("nearby") = synthDefaults.texture.nearbyRadius, pyb::arg("refine") = synthDefaults.refine,
         pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(),
-        pyb::arg("scalp") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        pyb::arg("scalp") = pyb::none(), pyb::arg("region") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0,
+        pyb::arg("progress") = pyb::none(),
         R"doc(A new hairstyle in the style of an example (Wang et al. 2009, §3-5): ``vdbhair synth``.
 
 Hierarchical clustering, PCA feature maps and texture optimization, cluster-oriented detail
@@ -225,7 +235,7 @@ thread count. README, "Example-based synthesis", explains every option and its m
 Args:
     example: Strands (many: at least 4^(levels-1)).
     levels: levels of the hierarchy, the strands included (2 to 5).
-    strands: strands in the output (None: as many as the example).
+    strands: strands in the output (None: the example's density over the region).
     seed: random seed.
     vertices: vertices per strand, n_s.
     threshold: adaptive clustering threshold epsilon (L2 over n_s vertices, head radii squared).
@@ -241,7 +251,9 @@ Args:
     voxel_size: refinement voxel of the finest level, world units (0: refine's suggestion).
     up: the scalp's up axis (None: the roots' mean direction from the head's centre).
     scalp: a path to a scalp: .vdb with a level set 'surface', or a head mesh (.ply, .obj).
-    return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up).
+    region: where the new hair grows, an (N, 3) array of points on the scalp (roots() positions,
+        another hairstyle's roots); None: the example's region. The count scales with the area.
+    return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up, output_area).
     threads: worker threads, 0 for all cores.
     progress: optional callable ``progress(stage, done, total, unit)``.
 

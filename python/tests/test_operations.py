@@ -117,6 +117,16 @@ def test_synth(tmp_path):
     assert np.array_equal(again.positions, out.positions)
     other = vdbhair.synth(example, strands=800, seed=4)
     assert not np.array_equal(other.positions, out.positions)
+    # An output region: the roots of the example's half with x above the middle give about half
+    # the strands (the example's density), all on that side; strands= still sets the count.
+    roots = example.positions[example.offsets[:-1]]
+    half = roots[roots[:, 0] > np.median(roots[:, 0])]
+    part, rep = vdbhair.synth(example, layout="example", region=half, seed=3, return_report=True)
+    assert 0.4 * len(example) < len(part) < 0.65 * len(example) and rep["output_area"] > 0
+    assert part.positions[part.offsets[:-1]][:, 0].min() > np.median(roots[:, 0]) - 5.0
+    assert len(vdbhair.synth(example, layout="example", region=half, strands=300)) == 300
+    with pytest.raises(ValueError, match=r"region must be an \(N, 3\) array"):
+        vdbhair.synth(example, region=np.zeros((4, 2)))
     with pytest.raises(ValueError, match="layout 'tiled' is not one of example, synthesize"):
         vdbhair.synth(example, layout="tiled")
     with pytest.raises(ValueError, match="strands=0"):

@@ -40,6 +40,7 @@ printf 'some text\n' > unknown.abc
 : > empty.obj
 # A .vdb written by another OpenVDB client (pyopenvdb) without a strands grid.
 /usr/bin/python3 -c "import pyopenvdb as vdb; g = vdb.FloatGrid(); g.name = 'density'; g.fill((0, 0, 0), (3, 3, 3), 1.0); vdb.write('density.vdb', grids=[g])"
+/usr/bin/python3 -c "import pyopenvdb as vdb; g = vdb.BoolGrid(); g.name = 'region'; vdb.write('empty_region.vdb', grids=[g])"
 # Strands of one vertex only: all dropped, leaving an empty hairstyle.
 printf 'v 0 0 0\nv 1 1 1\nl 1\nl 2\n' > only_short.obj
 # A strand of zero length (one point repeated) after a good one.

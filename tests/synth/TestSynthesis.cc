@@ -82,6 +82,45 @@ TEST_CASE("synthesizeHair: deterministic for a seed and independent of the threa
     CHECK(c.strands.positions != a.strands.positions);
 }
 
+TEST_CASE("synthesizeHair: an output region of its own", "[synth]")
+{
+    const StrandSet example = test::wispHairstyle(1200, 8, nullptr, 16, 0.02);
+    SynthParams params = smallParams();
+    params.layout = SynthLayout::Example;  // quick; the region applies alike to both layouts
+    const SynthResult own = synthesizeHair(example, params);
+    // The example's own roots as the region: the same hairstyle, bit for bit.
+    std::vector<Vec3d> roots;
+    for (std::size_t s = 0; s < example.numStrands(); ++s) roots.emplace_back(Vec3d(example.root(s)));
+    const SynthResult same = synthesizeHair(example, params, nullptr, true, nullptr, &roots);
+    CHECK(same.strands.positions == own.strands.positions);
+    CHECK(same.outputArea > 0.0);
+    // Half of them (x > 0): about half the strands, all of them on that half.
+    std::vector<Vec3d> half;
+    for (const Vec3d& r : roots) if (r.x() > 0.0) half.push_back(r);
+    const SynthResult h = synthesizeHair(example, params, nullptr, true, nullptr, &half);
+    const double ratio = double(h.strands.numStrands()) / double(own.strands.numStrands());
+    double lowestX = 1.0;
+    for (std::size_t s = 0; s < h.strands.numStrands(); ++s) lowestX = std::min(lowestX, double(h.strands.root(s).x()));
+    std::cout << "synth region: half the example's roots -> " << h.strands.numStrands() << " strands of " << own.strands.numStrands()
+              << " (area " << h.outputArea << " of " << same.outputArea << "), lowest root x " << lowestX << "\n";
+    CHECK(ratio == Approx(0.5).epsilon(0.15));
+    CHECK(h.outputArea == Approx(0.5 * same.outputArea).epsilon(0.15));
+    CHECK(lowestX > -0.1);  // the mask reaches two root spacings past the region's points
+    // A band below the example (y 0.05-0.25 on the sphere): hair grows there too.
+    std::vector<Vec3d> band;
+    for (int i = 0; i < 400; ++i) {
+        const double y = 0.05 + 0.2 * (i % 20) / 19.0, a = 2 * M_PI * (i / 20) / 20.0, rho = std::sqrt(1 - y * y);
+        band.emplace_back(rho * std::cos(a), y, rho * std::sin(a));
+    }
+    const SynthResult low = synthesizeHair(example, params, nullptr, true, nullptr, &band);
+    REQUIRE(low.strands.numStrands() > 0);
+    double highest = -1.0;
+    for (std::size_t s = 0; s < low.strands.numStrands(); ++s) highest = std::max(highest, double(low.strands.root(s).y()));
+    CHECK(highest < 0.35);
+    const std::vector<Vec3d> none;
+    CHECK_THROWS_WITH(synthesizeHair(example, params, nullptr, true, nullptr, &none), Catch::Contains("the output region has no points"));
+}
+
 TEST_CASE("synthesizeHair: bad input is refused before work", "[synth]")
 {
     const StrandSet example = test::wispHairstyle(10, 2, nullptr, 8);

@@ -75,12 +75,10 @@ FeatureImage buildFeatureMap(const UvGrid& grid, const std::vector<Vec3d>& rootC
 {
     if (rootCoords.empty()) throw ValueError("feature map: no roots to interpolate from");
     FeatureImage map(grid.width, grid.height, channels);
-    const std::vector<Vec3d> roots = flatten(rootCoords), mask = flatten(maskCoords);
-    PointCloud rootCloud{&roots}, maskCloud{&mask};
+    const std::vector<Vec3d> roots = flatten(rootCoords);
+    PointCloud rootCloud{&roots};
     PointKdTree rootTree(3, rootCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     rootTree.buildIndex();
-    PointKdTree maskTree(3, maskCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    if (!mask.empty()) maskTree.buildIndex();
     const std::size_t k = std::min<std::size_t>(4, roots.size());
     for (int y = 0; y < grid.height; ++y) {
         for (int x = 0; x < grid.width; ++x) {
@@ -102,17 +100,29 @@ FeatureImage buildFeatureMap(const UvGrid& grid, const std::vector<Vec3d>& rootC
                 }
                 for (int c = 0; c < channels; ++c) px[c] = float(acc[std::size_t(c)] / wsum);
             }
-            bool valid = false;
-            if (!mask.empty()) {
-                std::uint32_t mi;
-                double md2;
-                maskTree.knnSearch(q, 1, &mi, &md2);
-                valid = md2 <= maskRadius * maskRadius;
-            }
-            map.valid[std::size_t(y) * grid.width + x] = valid ? 1 : 0;
         }
     }
+    map.valid = uvMask(grid, maskCoords, maskRadius);
     return map;
+}
+
+std::vector<std::uint8_t> uvMask(const UvGrid& grid, const std::vector<Vec3d>& coords, double radius)
+{
+    std::vector<std::uint8_t> valid(std::size_t(grid.width) * std::size_t(grid.height), 0);
+    if (coords.empty()) return valid;
+    const std::vector<Vec3d> pts = flatten(coords);
+    PointCloud cloud{&pts};
+    PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree.buildIndex();
+    for (int y = 0; y < grid.height; ++y)
+        for (int x = 0; x < grid.width; ++x) {
+            const double q[3] = {grid.u(x), grid.v(y), 0.0};
+            std::uint32_t i;
+            double d2;
+            tree.knnSearch(q, 1, &i, &d2);
+            valid[std::size_t(y) * grid.width + x] = d2 <= radius * radius ? 1 : 0;
+        }
+    return valid;
 }
 
 bool nearestFeature(const FeatureImage& map, const UvGrid& grid, double u, double v, float* out)

@@ -13,6 +13,7 @@
 #include <vdbhair/synth/FeatureImage.h>
 #include <vdbhair/synth/ScalpMap.h>
 
+#include <cstdint>
 #include <vector>
 
 namespace vdbhair {
@@ -41,6 +42,10 @@ double medianUvSpacing(const std::vector<Vec3d>& scalpCoords);
 /// valid within @a maskRadius (u, v units) of a coordinate of @a maskCoords.
 FeatureImage buildFeatureMap(const UvGrid& grid, const std::vector<Vec3d>& rootCoords, const float* features,
                              int channels, const std::vector<Vec3d>& maskCoords, double maskRadius);
+
+/// @brief Pixels of @a grid within @a radius (u, v units) of a coordinate of @a coords: 1, else 0
+/// (row-major, as FeatureImage::valid).
+std::vector<std::uint8_t> uvMask(const UvGrid& grid, const std::vector<Vec3d>& coords, double radius);
 
 /// @brief The feature vector of the valid pixel nearest to (u, v) (the paper's "spatially closest
 /// feature vector"), into @a out (channels floats). @return false if the map has no valid pixel.

@@ -36,6 +36,39 @@ void SynthParams::validate(const char* where) const
     texture.validate(where);
 }
 
+namespace {
+
+FeatureImage filledFeatureImage(const FeatureImage& in)
+{
+    // Breadth-first from the valid pixels, 4-neighbours, in index order: every invalid pixel takes
+    // the value of the nearest valid one (in steps) and counts as valid.
+    const int C = in.channels;
+    FeatureImage filled = in;
+    std::vector<std::size_t> queue;
+    std::vector<std::uint8_t> done(in.pixelCount(), 0);
+    for (std::size_t i = 0; i < in.pixelCount(); ++i)
+        if (in.isValid(int(i % std::size_t(in.width)), int(i / std::size_t(in.width)))) {
+            done[i] = 1;
+            queue.push_back(i);
+        }
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+        const int x = int(queue[head] % std::size_t(in.width)), y = int(queue[head] / std::size_t(in.width));
+        const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+        for (int k = 0; k < 4; ++k) {
+            if (nx[k] < 0 || ny[k] < 0 || nx[k] >= in.width || ny[k] >= in.height) continue;
+            const std::size_t j = std::size_t(ny[k]) * in.width + nx[k];
+            if (done[j]) continue;
+            done[j] = 1;
+            std::copy_n(filled.pixel(x, y), C, filled.pixel(nx[k], ny[k]));
+            queue.push_back(j);
+        }
+    }
+    std::fill(filled.valid.begin(), filled.valid.end(), std::uint8_t(1));
+    return filled;
+}
+
+} // namespace
+
 SynthStageTimer::~SynthStageTimer()
 {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -78,7 +111,7 @@ ClusterHierarchy hairHierarchy(const StrandSet& strands, const ScalpMap& map, co
 }
 
 SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, openvdb::FloatGrid::ConstPtr scalp,
-                           bool threaded, openvdb::util::NullInterrupter* interrupter)
+                           bool threaded, openvdb::util::NullInterrupter* interrupter, const std::vector<Vec3d>* outputRegion)
 {
     params.validate("synthesizeHair");
     const int L = params.cluster.levels;
@@ -97,28 +130,53 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     }
     const StrandSamples& finest = res.example.levels.front();
     const StrandSamples& coarsest = res.example.levels.back();
-    // Output counts per level and the memory estimate, before any output is made.
-    std::vector<std::size_t> counts(static_cast<std::size_t>(L));
-    for (int l = 0; l < L; ++l)
-        counts[std::size_t(l)] = std::max<std::size_t>(1, std::size_t(std::llround(double(res.example.levels[std::size_t(l)].count()) * params.strandScale)));
-    if (double(counts[0]) * params.vertices > double(params.maxVertices))
-        throw LimitError("synthesizeHair: " + std::to_string(counts[0]) + " strands of " + std::to_string(params.vertices) +
-                         " vertices exceed the cap of " + std::to_string(params.maxVertices) + " vertices");
+    // The output region in scalp space (the example's when none is given).
+    std::vector<Vec3d> regionUv;
+    if (outputRegion) {
+        if (outputRegion->empty()) throw ValueError("synthesizeHair: the output region has no points");
+        regionUv.reserve(outputRegion->size());
+        for (const Vec3d& p : *outputRegion) {
+            if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) throw ValueError("synthesizeHair: a point of the output region is not finite");
+            regionUv.push_back(map.toScalp(p));
+        }
+    }
     // 4. Feature maps.
+    std::vector<std::uint8_t> outputMask;
+    double areaRatio = 1.0;
     {
         SynthStageTimer t{res.stages, "feature maps"};
         res.pca = fitPca(coarsest.local.data(), coarsest.count(), coarsest.dim(), params.components);
         const int nf = res.pca.components;
         std::vector<float> features(coarsest.count() * std::size_t(nf));
         for (std::size_t s = 0; s < coarsest.count(); ++s) res.pca.project(coarsest.row(s), features.data() + s * std::size_t(nf));
-        res.grid = uvGridAround(finest.scalp, params.mapSpacing);
+        std::vector<Vec3d> covered = finest.scalp;
+        covered.insert(covered.end(), regionUv.begin(), regionUv.end());
+        res.grid = uvGridAround(covered, params.mapSpacing);
         const double maskRadius = std::max(params.mapSpacing, 2.0 * medianUvSpacing(finest.scalp));
         res.inputMap = buildFeatureMap(res.grid, coarsest.scalp, features.data(), nf, finest.scalp, maskRadius);
+        if (outputRegion) {
+            outputMask = uvMask(res.grid, regionUv, std::max(params.mapSpacing, 2.0 * medianUvSpacing(regionUv)));
+            FeatureImage mask(res.grid.width, res.grid.height, 1);
+            mask.valid = outputMask;
+            const double exampleArea = regionArea(map, res.grid, res.inputMap), outputArea = regionArea(map, res.grid, mask);
+            if (!(outputArea > 0.0)) throw ValueError("synthesizeHair: the output region covers no pixel of the feature map");
+            areaRatio = exampleArea > 0.0 ? outputArea / exampleArea : 1.0;
+            res.outputArea = outputArea;
+        }
     }
+    // Output counts per level (the example's density over the output region) and the memory
+    // estimate, before any output is made.
+    const double scale = params.strands > 0 ? double(params.strands) / double(finest.count()) : params.strandScale * areaRatio;
+    std::vector<std::size_t> counts(static_cast<std::size_t>(L));
+    for (int l = 0; l < L; ++l)
+        counts[std::size_t(l)] = std::max<std::size_t>(1, std::size_t(std::llround(double(res.example.levels[std::size_t(l)].count()) * scale)));
+    if (double(counts[0]) * params.vertices > double(params.maxVertices))
+        throw LimitError("synthesizeHair: " + std::to_string(counts[0]) + " strands of " + std::to_string(params.vertices) +
+                         " vertices exceed the cap of " + std::to_string(params.maxVertices) + " vertices");
     {
         SynthStageTimer t{res.stages, "texture optimization"};
         if (params.layout == SynthLayout::Example) {
-            res.outputMap = res.inputMap;
+            res.outputMap = outputRegion ? filledFeatureImage(res.inputMap) : res.inputMap;
         } else {
         TextureParams tp = params.texture;
         tp.seed = params.seed;
@@ -140,29 +198,7 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
         // from the valid pixels, 4-neighbours, in index order) and count as valid: output windows
         // at the region's edge then match windows that continue the edge outward instead of
         // windows from inside, which averaged the edge's extremes away.
-        FeatureImage filled = in;
-        {
-            std::vector<std::size_t> queue;
-            std::vector<std::uint8_t> done(in.pixelCount(), 0);
-            for (std::size_t i = 0; i < in.pixelCount(); ++i)
-                if (in.isValid(int(i % std::size_t(in.width)), int(i / std::size_t(in.width)))) {
-                    done[i] = 1;
-                    queue.push_back(i);
-                }
-            for (std::size_t head = 0; head < queue.size(); ++head) {
-                const int x = int(queue[head] % std::size_t(in.width)), y = int(queue[head] / std::size_t(in.width));
-                const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-                for (int k = 0; k < 4; ++k) {
-                    if (nx[k] < 0 || ny[k] < 0 || nx[k] >= in.width || ny[k] >= in.height) continue;
-                    const std::size_t j = std::size_t(ny[k]) * in.width + nx[k];
-                    if (done[j]) continue;
-                    done[j] = 1;
-                    std::copy_n(filled.pixel(x, y), C, filled.pixel(nx[k], ny[k]));
-                    queue.push_back(j);
-                }
-            }
-            std::fill(filled.valid.begin(), filled.valid.end(), std::uint8_t(1));
-        }
+        const FeatureImage filled = filledFeatureImage(in);
         FeatureImage guided(in.width, in.height, C + G);
         for (int y = 0; y < in.height; ++y)
             for (int x = 0; x < in.width; ++x) {
@@ -179,6 +215,7 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
         res.outputMap.valid = in.valid;  // the output region is the example's
         }
     }
+    if (outputRegion) res.outputMap.valid = outputMask;
     // 5. The coarsest level from the synthesized map.
     res.output.resize(std::size_t(L));
     const auto scatter = [&](int l) {

@@ -22,8 +22,8 @@
 ///    makes a finest voxel of 0.005 radii, ten times finer than the roots of a 10,000-strand head:
 ///    each voxel then holds one strand, the field returns every strand as it is, and refining
 ///    straight.hair took 120 s instead of a few.
-/// The output region is the example's (the valid pixels of its map). Deterministic for a seed and
-/// independent of the thread count.
+/// The output region is the example's (the valid pixels of its map) or one given as points.
+/// Deterministic for a seed and independent of the thread count.
 #pragma once
 
 #include <vdbhair/field/Refine.h>
@@ -91,6 +91,9 @@ struct SynthParams
     /// paper's stationary synthesis).
     double placeWeight = 1.0;
     double strandScale = 1.0;  ///< output strands per example strand, at every level
+    /// Output strands at the finest level, coarser levels alike (0: the example's density over the
+    /// output region, times @c strandScale)
+    std::size_t strands = 0;
     int rootIterations = 10;   ///< RootScatter.h relaxation rounds
     bool refine = true;        ///< §5.3 after every level
     double voxelSize = 0.0;    ///< the finest level's refinement voxel, world units (0: suggestVoxelSize(example))
@@ -130,6 +133,7 @@ struct SynthResult
     std::vector<std::size_t> refinedCorrected;  ///< per output level (0 the finest): strands refinement corrected
     std::vector<double> refineVoxelSizes;       ///< per output level (0 the finest), world units
     Vec3d up{0.0, 1.0, 0.0};                    ///< the up axis used
+    double outputArea = 0.0;                    ///< world area of a given output region (0: the example's)
 };
 
 /// @brief Stage 1: the scalp map of a hairstyle: the sphere fitted to its roots (Wang et al. §3),
@@ -178,10 +182,17 @@ struct SynthStageTimer
 
 /// @brief Synthesize a hairstyle from @a example.
 /// @param scalp the scalp level set (`surface`), or null for the sphere fitted to the roots
+/// @param outputRegion where the new hair grows, as world points on or near the scalp (the roots
+/// of another hairstyle, follicles, a region grid's voxels): the (u, v) pixels within two of their
+/// median spacings (at least a map pixel) of one of them; null: the example's own region. The
+/// map covers both regions; the example's features are extended into pixels it lacks by the
+/// nearest (Synthesis.cc), and the strand count of every level scales with the ratio of the
+/// regions' areas.
 /// @throw ValueError (bad parameters, too few strands, strands of fewer than 2 vertices, an empty
 /// region), LimitError (an output beyond maxVertices), InterruptedError.
 SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params,
                            openvdb::FloatGrid::ConstPtr scalp = nullptr, bool threaded = true,
-                           openvdb::util::NullInterrupter* interrupter = nullptr);
+                           openvdb::util::NullInterrupter* interrupter = nullptr,
+                           const std::vector<Vec3d>* outputRegion = nullptr);
 
 } // namespace vdbhair
