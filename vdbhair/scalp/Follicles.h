@@ -14,7 +14,8 @@
 /// 3. Contour: with a region, fixed particles on its rim (where the region ends on the surface),
 ///    about 0.90 d apart along it (contourParticles in Follicles.cc). They repel the others and
 ///    never move, so the region's edge is lined with roots (a hairline) instead of left to
-///    whichever free particles reach it.
+///    whichever free particles reach it. The rim is found at the level set's resolution: where the
+///    spacing is below a voxel, contour roots are about a voxel apart and free roots fill between.
 /// 4. Initial particles: band voxels drawn with probability delta(phi) (particle i from the
 ///    random stream (seed, i)), jittered in the voxel and projected onto the zero level set;
 ///    a draw that lands outside the region is redrawn. A share @c initialFraction of the free
