@@ -30,7 +30,8 @@ namespace {
 
 struct SynthCmdParams
 {
-    std::string input, output, scalp, saveMaps, region, layout = synthLayoutName(SynthParams{}.layout);
+    double outputTurnDeg = 0.0;
+    std::string input, output, scalp, saveMaps, region, outputScalp, layout = synthLayoutName(SynthParams{}.layout);
     SynthOptionText text;
     std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;
@@ -67,16 +68,16 @@ Image mapImage(const FeatureImage& map, const FeatureImage& ref, int zoom)
     return img;
 }
 
-nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, double voxelSize, nlohmann::json& checks)
+nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, const StrandSet& output, double voxelSize, nlohmann::json& checks)
 {
     const double radius = r.map->radius();
     nlohmann::json j;
     // Per-strand measures: distances between distributions (relative 1-Wasserstein).
     std::vector<double> le, lo;
     for (float x : strandLengths(example)) le.push_back(x);
-    for (float x : strandLengths(r.strands)) lo.push_back(x);
+    for (float x : strandLengths(output)) lo.push_back(x);
     j["length_distance"] = relativeWasserstein(le, lo);
-    j["turning_distance"] = relativeWasserstein(turningPerLength(example), turningPerLength(r.strands));
+    j["turning_distance"] = relativeWasserstein(turningPerLength(example), turningPerLength(output));
     // Wisp sizes per level.
     nlohmann::json wisps = nlohmann::json::array();
     for (std::size_t l = 0; l < r.clusterOf.size(); ++l) {
@@ -99,9 +100,9 @@ nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, double 
     // Tangent coherence of both at the finest refinement voxel.
     FieldParams fp;
     fp.voxelSize = voxelSize;
-    const double ce = meanCoherence(estimateTangentField(example, fp)), co = meanCoherence(estimateTangentField(r.strands, fp));
+    const double ce = meanCoherence(estimateTangentField(example, fp)), co = meanCoherence(estimateTangentField(output, fp));
     j["coherence"] = {{"example", ce}, {"output", co}, {"voxel_size", voxelSize}};
-    const NoveltyStats nov = measureNovelty(example, r.strands, radius);
+    const NoveltyStats nov = measureNovelty(example, output, radius);
     j["novelty"] = {{"output_to_example_median", nov.outputMedian}, {"example_to_example_median", nov.exampleMedian},
                     {"copies", nov.copies}};
     // The thresholds (README, "Synthesis", says why each).
@@ -175,12 +176,29 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     }
     const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
     std::vector<Vec3d> region;
-    if (!p.region.empty()) {
-        const Stage stage(common, "reading " + p.region);
-        region = readRegionPoints(p.region, common);
+    std::string regionFrom = p.region;
+    if (regionFrom.empty() && !p.outputScalp.empty()) {
+        if (!readScalpRegion(p.outputScalp))
+            throw ValueError("--output-scalp " + p.outputScalp + ": no grid 'region' in it: say where the hair grows on it with --region");
+        regionFrom = p.outputScalp;
+    }
+    if (!regionFrom.empty()) {
+        const Stage stage(common, "reading " + regionFrom);
+        region = readRegionPoints(regionFrom, common);
+    }
+    std::shared_ptr<const ScalpMap> outputMap;
+    if (p.outputTurnDeg != 0.0 && p.outputScalp.empty()) throw ValueError("--output-turn: needs --output-scalp (it turns the layout on the other head)");
+    if (!std::isfinite(p.outputTurnDeg)) throw ValueError("--output-turn " + formatValue(p.outputTurnDeg) + ": must be a finite angle in degrees");
+    p.synth.outputTurn = p.outputTurnDeg * M_PI / 180.0;
+    if (!p.outputScalp.empty()) {
+        const openvdb::FloatGrid::Ptr other = readScalpOption(p.outputScalp, common);
+        std::vector<Vec3f> pts;
+        pts.reserve(region.size());
+        for (const Vec3d& q : region) pts.emplace_back(q);
+        outputMap = scalpMapOfPoints(pts, p.synth.up, other);
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter, p.region.empty() ? nullptr : &region);
+    const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter, regionFrom.empty() ? nullptr : &region, outputMap);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     {
         const Stage stage(common, "writing " + p.output);
@@ -212,7 +230,11 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     }
     const double finestVoxel = r.refineVoxelSizes.front();
     nlohmann::json checks;
-    const nlohmann::json stats = statsJson(example, r, finestVoxel, checks);
+    // On another head the output is measured where it was made, on the example's scalp (moved
+    // back: the same (u, v), height and local offsets), so that its figures compare with the example's.
+    StrandSet movedBack;
+    if (outputMap) movedBack = moveToScalp(r.strands, *outputMap, *r.map, -p.synth.outputTurn);
+    const nlohmann::json stats = statsJson(example, r, outputMap ? movedBack : r.strands, finestVoxel, checks);
     if (common.json) {
         nlohmann::json levels = nlohmann::json::array();
         for (std::size_t l = 0; l < r.output.size(); ++l)
@@ -228,7 +250,8 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
                    {"map", {{"width", r.grid.width}, {"height", r.grid.height}, {"components", r.pca.components},
                             {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
                    {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
-                   {"head_radius", r.map->radius()}, {"region", p.region.empty() ? "the example's" : p.region}, {"output_area", r.outputArea}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)},
+                   {"head_radius", r.map->radius()}, {"region", regionFrom.empty() ? "the example's" : regionFrom}, {"output_area", r.outputArea},
+                   {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)},
                    {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}});
     } else if (!common.quiet) {
         std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
@@ -307,6 +330,8 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     addSynthHierarchyOptions(sub, s, params->text);
     sub->add_option("--region", params->region, "Where the new hair grows (default: the example's region): a scalp .vdb's 'region' grid (vdbhair scalp --region...), roots (.ply points, as vdbhair roots writes) or the roots of a hairstyle; the strand count scales with the area");
     sub->add_option("--strands", params->strands, "Strands in the output (default: the example's density over the region; every level scales alike)");
+    sub->add_option("--output-turn", params->outputTurnDeg, "With --output-scalp: degrees about the up axis that the layout turns on the other head (for heads that face different ways)")->capture_default_str();
+    sub->add_option("--output-scalp", params->outputScalp, "Grow the new hair on another head: a scalp .vdb (its 'region' grid is where the hair grows, unless --region says) or a head mesh with --region; the hairstyle moves there through scalp space");
     sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();
     sub->add_option("--layout", params->layout, "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: a variation that keeps its global flow exactly)")->capture_default_str();
     sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();

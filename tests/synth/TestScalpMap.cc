@@ -83,3 +83,55 @@ TEST_CASE("ScalpMap: a centre outside the scalp is refused", "[synth]")
     s.center = Vec3d(0.0);
     CHECK_THROWS_WITH(ScalpMap(s, *surface, 4), Catch::Contains("resolution 4"));
 }
+
+TEST_CASE("moveToScalp: the same head is the identity, a turn is a rigid rotation, a larger head scales", "[synth]")
+{
+    ScalpSphere s;
+    s.center = Vec3d(0.3, -0.2, 0.1);
+    s.radius = 2.0;
+    s.up = Vec3d(0.0, 1.0, 0.0);
+    const ScalpMap a(s);
+    // Strands on the upper half, bent in all directions.
+    StrandSet hair;
+    for (int i = 0; i < 60; ++i) {
+        const double az = 0.41 * i, el = 0.2 + 1.2 * double(i % 11) / 11.0;
+        const Vec3d n(std::cos(el) * std::cos(az), std::sin(el), std::cos(el) * std::sin(az));
+        std::vector<Vec3f> pts;
+        for (int k = 0; k < 12; ++k) {
+            const double t = 0.1 * k;
+            pts.emplace_back(s.center + n * s.radius * (1.0 + 0.02 + 0.3 * t) + Vec3d(0.2 * t * t, -0.5 * t, 0.1 * std::sin(3 * t)));
+        }
+        hair.addStrand(pts);
+    }
+    const auto maxDiff = [](const StrandSet& x, const std::vector<Vec3d>& y) {
+        double m = 0.0;
+        for (std::size_t k = 0; k < y.size(); ++k) m = std::max(m, (Vec3d(x.positions[k]) - y[k]).length());
+        return m;
+    };
+    std::vector<Vec3d> same, rotated, scaled;
+    const double turn = 0.7, c = std::cos(turn), sn = std::sin(turn);
+    for (const Vec3f& p : hair.positions) {
+        const Vec3d q = Vec3d(p) - s.center;
+        same.push_back(Vec3d(p));
+        rotated.push_back(s.center + Vec3d(c * q.x() + sn * q.z(), q.y(), -sn * q.x() + c * q.z()));
+        scaled.push_back(Vec3d(1, 2, 3) + q * 1.5);
+    }
+    CHECK(maxDiff(moveToScalp(hair, a, a), same) < 1e-5);
+    const StrandSet turned = moveToScalp(hair, a, a, turn);
+    CHECK(maxDiff(turned, rotated) < 1e-5);
+    CHECK(maxDiff(moveToScalp(turned, a, a, -turn), same) < 1e-5);
+    ScalpSphere big = s;
+    big.center = Vec3d(1, 2, 3);
+    big.radius = 3.0;
+    const StrandSet moved = moveToScalp(hair, a, ScalpMap(big));
+    CHECK(maxDiff(moved, scaled) < 1e-5);
+    CHECK(moved.offsets == hair.offsets);
+    // Onto a level-set scalp: roots land on it (w kept: 0.02 radii above it).
+    ScalpParams sp;
+    sp.voxelSize = 0.05;
+    const openvdb::FloatGrid::Ptr ball = scalpFromSphere(big.center, big.radius, sp);
+    const ScalpMap onBall(big, *ball);
+    const StrandSet landed = moveToScalp(hair, a, onBall);
+    for (std::size_t i = 0; i < landed.numStrands(); ++i)
+        CHECK((Vec3d(landed.root(i)) - big.center).length() == Approx(big.radius * 1.02).epsilon(0.01));
+}

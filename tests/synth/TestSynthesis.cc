@@ -121,6 +121,36 @@ TEST_CASE("synthesizeHair: an output region of its own", "[synth]")
     CHECK_THROWS_WITH(synthesizeHair(example, params, nullptr, true, nullptr, &none), Catch::Contains("the output region has no points"));
 }
 
+TEST_CASE("synthesizeHair: onto another head, through scalp space", "[synth]")
+{
+    const StrandSet example = test::wispHairstyle(1200, 8, nullptr, 16, 0.02);
+    SynthParams params = smallParams();
+    params.layout = SynthLayout::Example;
+    // The other head: a sphere of radius 2.5 at (10, 0, 0); the region: the example's roots put
+    // on it (the same (u, v)).
+    ScalpSphere other;
+    other.center = Vec3d(10.0, 0.0, 0.0);
+    other.radius = 2.5;
+    std::vector<Vec3d> region;
+    std::vector<Vec3f> regionF;
+    for (std::size_t s = 0; s < example.numStrands(); ++s) {
+        region.push_back(other.center + Vec3d(example.root(s)) * other.radius);
+        regionF.emplace_back(region.back());
+    }
+    const std::shared_ptr<ScalpMap> otherMap = scalpMapOfPoints(regionF, Vec3d(0.0), nullptr);
+    CHECK(otherMap->radius() == Approx(2.5).epsilon(1e-3));
+    const SynthResult here = synthesizeHair(example, params);
+    const SynthResult there = synthesizeHair(example, params, nullptr, true, nullptr, &region, otherMap);
+    // The same hairstyle, scaled 2.5 times about the new centre.
+    REQUIRE(there.strands.numVertices() == here.strands.numVertices());
+    double worst = 0.0;
+    for (std::size_t k = 0; k < here.strands.positions.size(); ++k)
+        worst = std::max(worst, (Vec3d(there.strands.positions[k]) - (other.center + Vec3d(here.strands.positions[k]) * 2.5)).length());
+    CAPTURE(worst);
+    CHECK(worst < 5e-3);
+    CHECK_THROWS_WITH(synthesizeHair(example, params, nullptr, true, nullptr, nullptr, otherMap), Catch::Contains("needs the region"));
+}
+
 TEST_CASE("synthesizeHair: bad input is refused before work", "[synth]")
 {
     const StrandSet example = test::wispHairstyle(10, 2, nullptr, 8);

@@ -1,6 +1,7 @@
 #include "ScalpMap.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parallel.h>
 
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/RayIntersector.h>
@@ -162,6 +163,31 @@ ScalpFrame ScalpMap::frame(double u, double v) const
     f.t = rotateShortest(mUp, n, mRight, mRight);
     f.b = rotateShortest(mUp, n, mForward, mRight);
     return f;
+}
+
+StrandSet moveToScalp(const StrandSet& strands, const ScalpMap& from, const ScalpMap& to, double turn, bool threaded)
+{
+    StrandSet out = strands;
+    const double scale = to.radius() / from.radius(), c = std::cos(turn), s = std::sin(turn);
+    // A turn about the sphere's up (+y in its frame): x' = c x + s z, z' = -s x + c z.
+    const auto turnY = [&](const Vec3d& v) { return Vec3d(c * v.x() + s * v.z(), v.y(), -s * v.x() + c * v.z()); };
+    const ScalpSphere unit;  // (u, v) <-> unit directions in a sphere's own frame
+    forEachIndex(strands.numStrands(), threaded, [&](std::size_t i) {
+        const std::size_t b = strands.begin(i), e = strands.end(i);
+        if (b == e) return;
+        const Vec3d root(strands.positions[b]);
+        const Vec3d uvw = from.toScalp(root);
+        Vec3d uv2 = uvw;
+        if (turn != 0.0) {
+            const Vec3d turned = worldToScalp(unit, turnY(scalpToWorld(unit, Vec3d(uvw.x(), uvw.y(), 0.0))));
+            uv2 = Vec3d(turned.x(), turned.y(), uvw.z());
+        }
+        const ScalpFrame f = from.frame(uvw.x(), uvw.y()), g = to.frame(uv2.x(), uv2.y());
+        const Vec3d newRoot = to.toWorld(uv2);
+        for (std::size_t k = b; k < e; ++k)
+            out.positions[k] = Vec3f(newRoot + g.toWorld(turnY(f.toLocal(Vec3d(strands.positions[k]) - root))) * scale);
+    });
+    return out;
 }
 
 } // namespace vdbhair

@@ -20,6 +20,7 @@
 
 #include <vdbhair/Types.h>
 #include <vdbhair/field/ScalpSpace.h>
+#include <vdbhair/strands/StrandSet.h>
 
 #include <openvdb/openvdb.h>
 
@@ -80,5 +81,17 @@ private:
     std::vector<Vec3f> mNormal;   ///< #res² unit normals in world space
     std::size_t mMisses = 0;
 };
+
+/// @brief @a strands moved from the scalp @a from onto the scalp @a to through scalp space (Wang
+/// et al. §3: the parameterization is the same for every head): each root keeps its (u, v) and
+/// its height w above the scalp, and every vertex its offset from the root in the root's local
+/// frame, in units of the head's radius. Hair made on one head so grows on another of any size or
+/// shape with the same (u, v) layout; the strand count, vertex counts and order are kept.
+/// Scalp space ties (u, v) to the world's axes (the shortest rotation taking +y to each sphere's
+/// up): heads that face different ways need @a turn, radians about the up axis, turning the layout
+/// (and every strand with it) on @a to. With @a from and @a to the same map, @a turn is the
+/// rigid rotation of the hairstyle about the up axis through the centre (tested).
+/// @warning Far from the root the other head's shape may differ: strands are not kept out of it.
+StrandSet moveToScalp(const StrandSet& strands, const ScalpMap& from, const ScalpMap& to, double turn = 0.0, bool threaded = true);
 
 } // namespace vdbhair

@@ -31,6 +31,7 @@ void SynthParams::validate(const char* where) const
     if (rootIterations < 0 || rootIterations > 1000) fail("root iterations " + std::to_string(rootIterations) + ": 0 to 1000");
     if (!(voxelSize >= 0.0) || !std::isfinite(voxelSize)) fail("voxel size " + std::to_string(voxelSize) + ": 0 (suggested) or a positive finite length");
     if (!std::isfinite(up.length())) fail("up axis: a finite vector (or 0 for the roots' mean direction)");
+    if (!std::isfinite(outputTurn)) fail("output turn: a finite angle");
     if (!(placeWeight >= 0.0) || !std::isfinite(placeWeight)) fail("place weight " + std::to_string(placeWeight) + ": 0 or a positive finite weight");
     cluster.validate(where);
     texture.validate(where);
@@ -84,6 +85,11 @@ std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up
 {
     std::vector<Vec3f> roots(strands.numStrands());
     for (std::size_t s = 0; s < roots.size(); ++s) roots[s] = strands.root(s);
+    return scalpMapOfPoints(roots, up, scalp, upUsed);
+}
+
+std::shared_ptr<ScalpMap> scalpMapOfPoints(const std::vector<Vec3f>& roots, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp, Vec3d* upUsed)
+{
     ScalpSphere sphere = fitScalpSphere(roots, up.length() > 0.0 ? up : Vec3d(0.0, 1.0, 0.0));
     if (up.length() == 0.0) {
         Vec3d mean(0.0);
@@ -111,9 +117,12 @@ ClusterHierarchy hairHierarchy(const StrandSet& strands, const ScalpMap& map, co
 }
 
 SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, openvdb::FloatGrid::ConstPtr scalp,
-                           bool threaded, openvdb::util::NullInterrupter* interrupter, const std::vector<Vec3d>* outputRegion)
+                           bool threaded, openvdb::util::NullInterrupter* interrupter, const std::vector<Vec3d>* outputRegion,
+                           std::shared_ptr<const ScalpMap> outputScalp)
 {
     params.validate("synthesizeHair");
+    if (outputRegion && outputRegion->empty()) throw ValueError("synthesizeHair: the output region has no points");
+    if (outputScalp && !outputRegion) throw ValueError("synthesizeHair: another scalp for the output needs the region the hair grows in on it");
     const int L = params.cluster.levels;
     SynthResult res;
     // 1. Scalp space.
@@ -133,11 +142,19 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     // The output region in scalp space (the example's when none is given).
     std::vector<Vec3d> regionUv;
     if (outputRegion) {
-        if (outputRegion->empty()) throw ValueError("synthesizeHair: the output region has no points");
         regionUv.reserve(outputRegion->size());
+        // On another scalp, each point's (u, v) turned back by outputTurn (moveToScalp turns the
+        // hairstyle forward at the end).
+        const double c = std::cos(params.outputTurn), sn = std::sin(params.outputTurn);
+        const ScalpSphere unit;
         for (const Vec3d& p : *outputRegion) {
             if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) throw ValueError("synthesizeHair: a point of the output region is not finite");
-            regionUv.push_back(map.toScalp(p));
+            Vec3d uvw = outputScalp ? outputScalp->toScalp(p) : map.toScalp(p);
+            if (outputScalp && params.outputTurn != 0.0) {
+                const Vec3d d = scalpToWorld(unit, Vec3d(uvw.x(), uvw.y(), 0.0));
+                uvw = worldToScalp(unit, Vec3d(c * d.x() - sn * d.z(), d.y(), sn * d.x() + c * d.z()));
+            }
+            regionUv.push_back(uvw);
         }
     }
     // 4. Feature maps.
@@ -250,6 +267,7 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     const double finestVoxel = params.voxelSize > 0.0 ? params.voxelSize : suggestVoxelSize(example);
     synthesizeFinerLevels(res, res.example, [&](int l) { return LevelRoots{scatter(l).positions, {}}; }, params, finestVoxel,
                           /*refineCoarsest=*/true, scalp, threaded, interrupter);
+    if (outputScalp) res.strands = moveToScalp(res.strands, map, *outputScalp, params.outputTurn, threaded);
     return res;
 }
 

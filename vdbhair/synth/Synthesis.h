@@ -94,6 +94,9 @@ struct SynthParams
     /// Output strands at the finest level, coarser levels alike (0: the example's density over the
     /// output region, times @c strandScale)
     std::size_t strands = 0;
+    /// With another scalp for the output: radians about its up axis that its layout is turned
+    /// by against the example's (moveToScalp()), for heads that face different ways
+    double outputTurn = 0.0;
     int rootIterations = 10;   ///< RootScatter.h relaxation rounds
     bool refine = true;        ///< §5.3 after every level
     double voxelSize = 0.0;    ///< the finest level's refinement voxel, world units (0: suggestVoxelSize(example))
@@ -133,7 +136,7 @@ struct SynthResult
     std::vector<std::size_t> refinedCorrected;  ///< per output level (0 the finest): strands refinement corrected
     std::vector<double> refineVoxelSizes;       ///< per output level (0 the finest), world units
     Vec3d up{0.0, 1.0, 0.0};                    ///< the up axis used
-    double outputArea = 0.0;                    ///< world area of a given output region (0: the example's)
+    double outputArea = 0.0;                    ///< area of a given output region on the example's scalp (0: the example's region)
 };
 
 /// @brief Stage 1: the scalp map of a hairstyle: the sphere fitted to its roots (Wang et al. §3),
@@ -141,6 +144,9 @@ struct SynthResult
 /// @param upUsed if given, receives the up axis used
 std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp,
                                        Vec3d* upUsed = nullptr);
+/// @brief The same for points on a scalp (roots, a region's voxels): the sphere fitted to them.
+std::shared_ptr<ScalpMap> scalpMapOfPoints(const std::vector<Vec3f>& points, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp,
+                                           Vec3d* upUsed = nullptr);
 
 /// @brief Stages 2-3: every strand sampled on @a map (in spatial order, Measures.h) and the
 /// hierarchy of @a params.cluster with seed @a params.seed.
@@ -187,12 +193,15 @@ struct SynthStageTimer
 /// median spacings (at least a map pixel) of one of them; null: the example's own region. The
 /// map covers both regions; the example's features are extended into pixels it lacks by the
 /// nearest (Synthesis.cc), and the strand count of every level scales with the ratio of the
-/// regions' areas.
+/// regions' areas (in scalp space).
+/// @param outputScalp another head for the output (scalpMapOfPoints() of its region): the
+/// region's points are on it, the hairstyle is synthesized on the example's scalp at their (u, v)
+/// and moved onto it at the end (moveToScalp()); the output's refinement is the example's scalp's.
 /// @throw ValueError (bad parameters, too few strands, strands of fewer than 2 vertices, an empty
 /// region), LimitError (an output beyond maxVertices), InterruptedError.
 SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params,
                            openvdb::FloatGrid::ConstPtr scalp = nullptr, bool threaded = true,
                            openvdb::util::NullInterrupter* interrupter = nullptr,
-                           const std::vector<Vec3d>* outputRegion = nullptr);
+                           const std::vector<Vec3d>* outputRegion = nullptr, std::shared_ptr<const ScalpMap> outputScalp = nullptr);
 
 } // namespace vdbhair
