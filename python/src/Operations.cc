@@ -165,8 +165,9 @@ Returns:
            double threshold, int initialClusters, int components, double mapSpacing, const std::string& layout,
            const std::string& detail, double placeWeight, double nearby, bool refine, std::optional<std::string> refineMode,
            double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp,
-           std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region, bool returnReport,
-           int threads, const pyb::object& progress) -> pyb::object {
+           std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region,
+           std::optional<std::string> outputScalp, double outputTurn, bool returnReport, int threads,
+           const pyb::object& progress) -> pyb::object {
             SynthParams p;
             std::vector<Vec3d> regionPoints;
             if (region) {
@@ -191,9 +192,18 @@ Returns:
                 p.strands = *strands;
             }
             p.validate("synth");
+            if (!std::isfinite(outputTurn)) throw ValueError("synth: output_turn must be a finite angle in degrees");
+            if (outputTurn != 0.0 && !outputScalp) throw ValueError("synth: output_turn needs output_scalp");
+            p.outputTurn = outputTurn * M_PI / 180.0;
+            if (outputScalp && !region) throw ValueError("synth: output_scalp needs region=, the points where the hair grows on that head");
             SynthResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
-                return synthesizeHair(*example, p, grid, true, interrupter, region ? &regionPoints : nullptr);
+                std::shared_ptr<const ScalpMap> other;
+                if (outputScalp) {
+                    std::vector<Vec3f> pts(regionPoints.begin(), regionPoints.end());
+                    other = scalpMapOfPoints(pts, p.up, readScalp(*outputScalp, interrupter));
+                }
+                return synthesizeHair(*example, p, grid, true, interrupter, region ? &regionPoints : nullptr, other);
             });
             auto out = std::make_shared<StrandSet>(std::move(r.strands));
             if (!returnReport) return pyb::cast(out);
@@ -224,7 +234,8 @@ Returns:
         pyb::arg("layout") = synthLayoutName(synthDefaults.layout), pyb::arg("detail") = detailBlendName(synthDefaults.detailBlend), pyb::arg("place_weight") = synthDefaults.placeWeight,
         pyb::arg("nearby") = synthDefaults.texture.nearbyRadius, pyb::arg("refine") = synthDefaults.refine,
         pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(),
-        pyb::arg("scalp") = pyb::none(), pyb::arg("region") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0,
+        pyb::arg("scalp") = pyb::none(), pyb::arg("region") = pyb::none(), pyb::arg("output_scalp") = pyb::none(),
+        pyb::arg("output_turn") = 0.0, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(A new hairstyle in the style of an example (Wang et al. 2009, §3-5): ``vdbhair synth``.
 
@@ -253,6 +264,9 @@ Args:
     scalp: a path to a scalp: .vdb with a level set 'surface', or a head mesh (.ply, .obj).
     region: where the new hair grows, an (N, 3) array of points on the scalp (roots() positions,
         another hairstyle's roots); None: the example's region. The count scales with the area.
+    output_scalp: a path to another head (scalp .vdb or mesh) that region= lies on: the hairstyle
+        is made at the region's (u, v) and moved onto it through scalp space.
+    output_turn: degrees about the up axis the layout turns on output_scalp (heads facing different ways).
     return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up, output_area).
     threads: worker threads, 0 for all cores.
     progress: optional callable ``progress(stage, done, total, unit)``.

@@ -125,6 +125,16 @@ def test_synth(tmp_path):
     assert 0.4 * len(example) < len(part) < 0.65 * len(example) and rep["output_area"] > 0
     assert part.positions[part.offsets[:-1]][:, 0].min() > np.median(roots[:, 0]) - 5.0
     assert len(vdbhair.synth(example, layout="example", region=half, strands=300)) == 300
+    # Onto another head: a sphere of radius 20 at (100, 0, 0), hair on its upper half.
+    surface, _ = vdbhair.scalp(sphere=(100.0, 0.0, 0.0, 20.0), voxel_size=1.0)
+    vdbhair.write_grids(str(tmp_path / "other.vdb"), [surface])
+    upper = vdbhair.roots(surface, count=400)["positions"]
+    upper = upper[upper[:, 1] > 2.0]
+    moved = vdbhair.synth(example, layout="example", region=upper, output_scalp=str(tmp_path / "other.vdb"), strands=300)
+    r = np.linalg.norm(moved.positions[moved.offsets[:-1]] - np.array([100.0, 0.0, 0.0]), axis=1)
+    assert len(moved) == 300 and np.all(np.abs(r - 20.0) < 2.0)
+    with pytest.raises(ValueError, match="output_scalp needs region="):
+        vdbhair.synth(example, output_scalp=str(tmp_path / "other.vdb"))
     with pytest.raises(ValueError, match=r"region must be an \(N, 3\) array"):
         vdbhair.synth(example, region=np.zeros((4, 2)))
     with pytest.raises(ValueError, match="layout 'tiled' is not one of example, synthesize"):
