@@ -4,6 +4,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/field/TangentField.h>
+#include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/helicoid/Scene.h>
@@ -13,6 +14,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <atomic>
 #include <new>
 #include <cctype>
@@ -121,8 +123,9 @@ void addScalpOptions(CLI::App* sub, ScalpOptions& opts)
 {
     sub->add_option("--space", opts.space, "Grid space: world (default; any hairstyle) or scalp (Wang et al.'s (u,v,w); hair over the scalp)")
         ->capture_default_str();
-    sub->add_option("--scalp", opts.sphere, "Scalp sphere for --space scalp: CX,CY,CZ,R in world units (default: fitted to the roots)")
-        ->delimiter(',')->expected(4);
+    sub->add_option("--scalp", opts.scalp, "The scalp for --space scalp: a sphere CX,CY,CZ,R in world units, or a .vdb with a level set "
+                    "'surface' (vdbhair scalp) or a head mesh (.ply, .obj), measured along rays from the sphere fitted to the roots "
+                    "(default: that sphere)");
     sub->add_option("--up", opts.up, "The scalp's up axis for --space scalp: x, y, z, -x, -y or -z")->capture_default_str();
 }
 
@@ -145,21 +148,58 @@ std::string axisName(const Vec3d& axis)
                      ") is not one of x, y, z, -x, -y, -z");
 }
 
-void applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params)
+std::vector<double> ScalpOptions::sphere() const
+{
+    // Four comma-separated numbers are a sphere; anything else names a file.
+    if (scalp.empty() || scalp.find(',') == std::string::npos || std::filesystem::exists(scalp)) return {};
+    std::vector<double> v;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = scalp.find(',', start);
+        const std::string item = scalp.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        char* end = nullptr;
+        const double x = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end || !std::isfinite(x))
+            throw ValueError("--scalp '" + scalp + "': '" + item + "' is not a number (a sphere is CX,CY,CZ,R; a scalp file must exist)");
+        v.push_back(x);
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    if (v.size() != 4 || !(v[3] > 0.0)) throw ValueError("--scalp '" + scalp + "': a sphere is CX,CY,CZ,R with R > 0");
+    return v;
+}
+
+openvdb::FloatGrid::Ptr applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params,
+                                          const CommonOptions& common)
 {
     params.space = fieldSpaceFromName(opts.space);
     const Vec3d up = axisFromName(opts.up, "--up");
-    if (params.space != FieldSpace::Scalp) return;
-    if (opts.sphere.empty()) {
-        std::vector<Vec3f> roots;
-        for (std::size_t i = 0; i < strands.numStrands(); ++i) roots.push_back(strands.root(i));
-        params.scalp = fitScalpSphere(roots, up);
-    } else {
-        if (opts.sphere.size() != 4 || !(opts.sphere[3] > 0.0)) throw ValueError("--scalp needs CX,CY,CZ,R with R > 0");
-        params.scalp.center = Vec3d(opts.sphere[0], opts.sphere[1], opts.sphere[2]);
-        params.scalp.radius = opts.sphere[3];
-        params.scalp.up = up;
+    const std::vector<double> sphere = opts.sphere();
+    if (params.space != FieldSpace::Scalp) {
+        if (!opts.scalp.empty()) throw ValueError("--scalp " + opts.scalp + ": needs --space scalp");
+        return nullptr;
     }
+    std::vector<Vec3f> roots;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) roots.push_back(strands.root(i));
+    ScalpSphere given;
+    if (!sphere.empty()) {
+        given.center = Vec3d(sphere[0], sphere[1], sphere[2]);
+        given.radius = sphere[3];
+    }
+    const openvdb::FloatGrid::Ptr surface = sphere.empty() ? readScalpOption(opts.scalp, common) : nullptr;
+    try {
+        useScalpSpace(params, roots, up, sphere.empty() ? nullptr : &given, surface);
+    } catch (const ValueError& e) {
+        throw ValueError((opts.scalp.empty() ? std::string("--space scalp") : "--scalp " + opts.scalp) + ": " + e.what());
+    }
+    return surface;
+}
+
+openvdb::FloatGrid::Ptr readScalpOption(const std::string& path, const CommonOptions& common)
+{
+    if (path.empty()) return nullptr;
+    const Stage stage(common, "reading " + path);
+    return readScalp(path, common.interrupter);
 }
 
 namespace {

@@ -131,17 +131,27 @@ Vec3d axisFromName(const std::string& name, const std::string& option);
 /// @throw ValueError for a vector that is not a unit axis.
 std::string axisName(const Vec3d& axis);
 
-/// @brief The scalp sphere options of `field` and `refine` (`--space scalp`).
+/// @brief The scalp options of `field` and `refine` (`--space scalp`).
 struct ScalpOptions
 {
     std::string space = "world";
-    std::vector<double> sphere;  ///< cx, cy, cz, r; empty: fit to the roots
+    /// `CX,CY,CZ,R` (a sphere), or a scalp: a .vdb with a level set `surface` or a head mesh;
+    /// empty: the sphere fitted to the roots
+    std::string scalp;
     std::string up = "y";
+
+    /// The sphere `--scalp` gives (cx, cy, cz, r), or empty when it names a file or is not given.
+    /// @throw ValueError for numbers that are not four, or a radius that is not positive.
+    std::vector<double> sphere() const;
 };
 void addScalpOptions(CLI::App* sub, ScalpOptions& opts);
-/// @brief Fill @a params' space and scalp from @a opts (fitting the sphere to the roots if needed).
-/// @throw ValueError for a bad space, sphere or up axis.
-void applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params);
+/// @brief Fill @a params' space and scalp from @a opts: the sphere given, or fitted to the roots;
+/// with a scalp file, the scalp measured on its level set (FieldParams::scalpSurface, on the
+/// sphere fitted to the roots).
+/// @return the scalp's level set when `--scalp` named a file (for `refine`'s head), else null.
+/// @throw ValueError for a bad space, sphere or up axis; what reading the scalp throws.
+openvdb::FloatGrid::Ptr applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params,
+                                          const CommonOptions& common);
 
 // One function per subcommand file, each returning the registered command.
 Command addInfoCommand(CLI::App& app, CommonOptions& common);

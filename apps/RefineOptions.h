@@ -29,7 +29,7 @@ struct RefineCmdParams
 
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p);
 /// @throw ValueError for out-of-range options, IoError/FormatError for an unreadable --head.
-RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands);
+RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands, const CommonOptions& common);
 /// The field grids of @a r, each tagged `vdbhair_source` = @a source (the input file).
 openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source);
 /// The refine report: settings, then what an artist sees (RefineMeasures), for the finest level

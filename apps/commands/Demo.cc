@@ -30,7 +30,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
     const auto t0 = std::chrono::steady_clock::now();
     TriangleMesh head;  // a scene's own head, drawn in the preview
     const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common, "strands", &head);
-    RefineParams rp = refineParamsFrom(p.refine, strands);
+    RefineParams rp = refineParamsFrom(p.refine, strands, common);
     // A scene's own head is the obstacle refinement keeps strands out of, unless --head says otherwise.
     if (p.refine.head.path.empty() && fileExtension(p.refine.input) == ".json") {
         const Scene scene = readScene(p.refine.input);

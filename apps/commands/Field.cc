@@ -11,6 +11,7 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrandGrid.h>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -97,7 +98,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     fp.maxVoxels = p.maxVoxels;
     fp.maxMemory = p.maxMemory;
     fp.densityReference = p.densityReference;
-    applyScalpOptions(p.scalp, strands, fp);
+    applyScalpOptions(p.scalp, strands, fp, common);
 
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<TangentField> fields = estimateTangentFieldLevels(strands, fp, p.levels, true, common.interrupter);
@@ -147,7 +148,17 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
                           {"box", p.denseBox}};
         }
         if (fp.space == FieldSpace::Scalp) {
-            j["scalp"] = {{"center", {fp.scalp.center.x(), fp.scalp.center.y(), fp.scalp.center.z()}}, {"radius", fp.scalp.radius}};
+            const ScalpSphere& sphere = fp.scalpSphere();
+            j["scalp"] = {{"center", {sphere.center.x(), sphere.center.y(), sphere.center.z()}}, {"radius", sphere.radius},
+                          {"up", {sphere.up.x(), sphere.up.y(), sphere.up.z()}}};
+            if (fp.scalpSurface) {
+                // The measured scalp: d(u, v) in radii over the table, and the rays that missed it.
+                const std::vector<float>& d = fp.scalpSurface->distances();
+                j["scalp"]["surface"] = p.scalp.scalp;
+                j["scalp"]["resolution"] = fp.scalpSurface->resolution();
+                j["scalp"]["distance_range"] = {*std::min_element(d.begin(), d.end()), *std::max_element(d.begin(), d.end())};
+                j["scalp"]["misses"] = fp.scalpSurface->misses();
+            }
         }
         printJson(j);
     } else if (!common.quiet) {

@@ -131,7 +131,7 @@ int infoVdb(const InfoParams& p, const CommonOptions& common)
             for (const std::string& name : g.groups) std::cout << " " << name;
             std::cout << "\n";
         }
-        for (const MetaValue& m : g.metadata) std::cout << "    " << m.name << " = " << metaValueString(m) << "\n";
+        for (const MetaValue& m : g.metadata) std::cout << "    " << m.name << " = " << metaValueString(m, kListedMetaChars) << "\n";
     }
     return 0;
 }

@@ -114,7 +114,7 @@ void printReport(const GridReport& r)
     if (!g.metadata.empty()) {
         std::cout << "  metadata ";
         for (std::size_t i = 0; i < g.metadata.size(); ++i) {
-            std::cout << (i ? "\n            " : " ") << g.metadata[i].name << " = " << metaValueString(g.metadata[i]);
+            std::cout << (i ? "\n            " : " ") << g.metadata[i].name << " = " << metaValueString(g.metadata[i], kListedMetaChars);
         }
         std::cout << "\n";
     }

@@ -11,7 +11,7 @@
 
 namespace vdbhair::app {
 
-RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands)
+RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands, const CommonOptions& common)
 {
     RefineParams rp = p.refine;
     const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0, stepGiven = p.stepOpt && p.stepOpt->count() > 0;
@@ -43,8 +43,12 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     }
     rp.mode = refineModeFromName(p.mode);
     rp.trace.integrator = integratorFromName(p.integrator);
-    applyScalpOptions(p.scalp, strands, rp.field);
-    rp.head = headFromOptions(p.head, p.scalp.sphere.empty() ? HeadObstacle()
+    // A scalp given as a sphere or a level set is also the head the strands keep out of, unless
+    // --head says otherwise.
+    const openvdb::FloatGrid::Ptr surface = applyScalpOptions(p.scalp, strands, rp.field, common);
+    const std::vector<double> sphere = p.scalp.sphere();
+    rp.head = headFromOptions(p.head, surface ? HeadObstacle::levelSet(surface, p.head.headPolicy())
+                                      : sphere.empty() ? HeadObstacle()
                                       : HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, p.head.headPolicy()));
     return rp;
 }
@@ -153,7 +157,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     }
     const StrandSet strands = loadStrands("refine", p.input, common, p.strict);
     checkStrandLengths("refine", p.input, strands, common, p.strict);
-    const RefineParams rp = refineParamsFrom(p, strands);
+    const RefineParams rp = refineParamsFrom(p, strands, common);
     const RefineResult r = refineStrands(strands, rp, true, common.interrupter);
     // Write the field first: if the strands' write fails, nothing half-done is claimed.
     {

@@ -299,13 +299,6 @@ void applySynthOptionText(const SynthOptionText& t, SynthParams& s)
     if (!t.detailScale.empty()) s.detailScale = detailScaleFromName(t.detailScale);
 }
 
-openvdb::FloatGrid::Ptr readScalpOption(const std::string& path, const CommonOptions& common)
-{
-    if (path.empty()) return nullptr;
-    const Stage stage(common, "reading " + path);
-    return readScalp(path, common.interrupter);
-}
-
 void writeSynthStrands(const std::string& path, const StrandSet& strands, const std::vector<std::vector<std::int32_t>>& clusterOf)
 {
     if (fileExtension(path) == ".vdb") {

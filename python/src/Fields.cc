@@ -9,6 +9,7 @@
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/scalp/ScalpSurface.h>
 
 #include <openvdb/openvdb.h>
 
@@ -20,6 +21,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <variant>
 
 namespace vdbhair::py {
 
@@ -481,28 +483,39 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
     m.def(
         "estimate_tangent_field",
         [](const StrandsPtr& strands, double voxelSize, int iterations, std::optional<int> levels, std::uint64_t maxVoxels,
-           double densityReference, const std::string& space, std::optional<std::array<double, 4>> scalp, std::array<double, 3> up,
+           double densityReference, const std::string& space, std::optional<std::variant<std::array<double, 4>, std::string>> scalp, std::array<double, 3> up,
            int threads, const pyb::object& progress) -> pyb::object {
             FieldParams fp;
             fp.voxelSize = voxelSize;
             fp.iterations = iterations;
             fp.maxVoxels = maxVoxels;
             fp.densityReference = densityReference;
-            // Scalp space (as `field --space scalp --scalp CX,CY,CZ,R --up`): the sphere given, or fitted to the roots.
+            // Scalp space (as `field --space scalp --scalp CX,CY,CZ,R|HEAD --up`): the sphere given,
+            // fitted to the roots, or the scalp measured on a head (a scalp .vdb or a mesh).
             fp.space = fieldSpaceFromName(space);
             const Vec3d upAxis(up[0], up[1], up[2]);
             if (!(upAxis.length() > 0.0) || !std::isfinite(upAxis.length())) throw ValueError("estimate_tangent_field: up must be a non-zero finite vector");
             if (fp.space == FieldSpace::Scalp) {
+                std::vector<Vec3f> roots;
+                for (std::size_t i = 0; i < strands->numStrands(); ++i) roots.push_back(strands->root(i));
+                ScalpSphere given;
+                openvdb::FloatGrid::Ptr surface;
                 if (scalp) {
-                    if (!((*scalp)[3] > 0.0) || !std::isfinite((*scalp)[3]))
-                        throw ValueError("estimate_tangent_field: scalp=(cx, cy, cz, r) needs r > 0");
-                    fp.scalp.center = Vec3d((*scalp)[0], (*scalp)[1], (*scalp)[2]);
-                    fp.scalp.radius = (*scalp)[3];
-                    fp.scalp.up = upAxis / upAxis.length();
-                } else {
-                    std::vector<Vec3f> roots;
-                    for (std::size_t i = 0; i < strands->numStrands(); ++i) roots.push_back(strands->root(i));
-                    fp.scalp = fitScalpSphere(roots, upAxis / upAxis.length());
+                    if (const auto* path = std::get_if<std::string>(&*scalp)) {
+                        surface = readScalp(*path);
+                    } else {
+                        const auto& v = std::get<std::array<double, 4>>(*scalp);
+                        if (!(v[3] > 0.0) || !std::isfinite(v[3]))
+                            throw ValueError("estimate_tangent_field: scalp=(cx, cy, cz, r) needs r > 0");
+                        given.center = Vec3d(v[0], v[1], v[2]);
+                        given.radius = v[3];
+                    }
+                }
+                const bool sphereGiven = scalp && !surface;
+                try {
+                    useScalpSpace(fp, roots, upAxis, sphereGiven ? &given : nullptr, surface);
+                } catch (const ValueError& e) {
+                    throw ValueError(std::string("estimate_tangent_field: ") + e.what());
                 }
             } else if (scalp) {
                 throw ValueError("estimate_tangent_field: scalp= is for space='scalp'");
@@ -543,7 +556,10 @@ Args:
         0 chooses the 95th percentile of the hairstyle's.
     space: "world" (any hairstyle) or "scalp" (Wang et al.'s (u, v, w) over a scalp sphere), as
         ``--space``.
-    scalp: with space="scalp", the sphere (cx, cy, cz, r) in world units; None fits it to the roots.
+    scalp: with space="scalp", the sphere (cx, cy, cz, r) in world units, or a head (the path of a
+        scalp .vdb with a level set 'surface', or of a mesh): w is then the height above that
+        head, measured along rays from the sphere fitted to the roots, and the grids carry the
+        measured table (vdbhair_scalp_distance); None fits a sphere to the roots.
     up: the scalp's up axis for space="scalp".
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``, called at each stage's

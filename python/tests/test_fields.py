@@ -237,3 +237,61 @@ def test_scalp_space_matches_the_command(wavy, tmp_path):
         vdbhair.estimate_tangent_field(wavy, scalp=(0.0, 0.0, 0.0, 1.0))
     with pytest.raises(ValueError, match="r > 0"):
         vdbhair.estimate_tangent_field(wavy, space="scalp", scalp=(0.0, 0.0, 0.0, 0.0))
+
+
+def test_scalp_space_over_a_measured_head(tmp_path):
+    # Hair standing on an ellipsoid head (semi-axes 1.3, 1, 1): over the head measured as a level
+    # set, every root is at w = 0; over the sphere fitted to the roots, w spreads with the shape.
+    rng = np.random.default_rng(4)
+    strands = []
+    for _ in range(400):
+        h = rng.uniform(0.2, 0.95)
+        a = rng.uniform(0.0, 2.0 * np.pi)
+        r = np.sqrt(1.0 - h * h)
+        root = np.array([1.3 * r * np.cos(a), h, r * np.sin(a)])
+        n = np.array([root[0] / 1.69, root[1], root[2]])
+        n /= np.linalg.norm(n)
+        strands.append(root + np.linspace(0.0, 0.4, 12)[:, None] * n)
+    hair = vdbhair.Strands(np.concatenate(strands).astype(np.float32), np.arange(0, 12 * 401, 12))
+    # The head: a mesh of the ellipsoid, written as PLY.
+    rings, segs = 40, 80
+    verts = []
+    for i in range(rings + 1):
+        t = np.pi * i / rings
+        for j in range(segs):
+            p = 2.0 * np.pi * j / segs
+            verts.append((1.3 * np.sin(t) * np.cos(p), np.cos(t), np.sin(t) * np.sin(p)))
+    faces = []
+    for i in range(rings):
+        for j in range(segs):
+            a, b = i * segs + j, i * segs + (j + 1) % segs
+            c, d = a + segs, b + segs
+            faces += [(a, c, b), (b, c, d)]
+    head = tmp_path / "ellipsoid.ply"
+    with open(head, "w") as f:
+        f.write(f"ply\nformat ascii 1.0\nelement vertex {len(verts)}\nproperty float x\nproperty float y\nproperty float z\n"
+                f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n")
+        f.writelines(f"{x} {y} {z}\n" for x, y, z in verts)
+        f.writelines(f"3 {a} {b} {c}\n" for a, b, c in faces)
+
+    measured = vdbhair.estimate_tangent_field(hair, 0.05, space="scalp", scalp=str(head))
+    meta = measured.metadata
+    assert meta["vdbhair_scalp_resolution"] == 64
+    table = np.array(meta["vdbhair_scalp_distance"].split(), dtype=np.float32)
+    assert table.shape == (64 * 64,)
+    # d, in radii of the sphere fitted to the roots, from the centre of that sphere: not constant
+    # (the head is not that sphere), every ray hit it.
+    assert np.all(np.isfinite(table)) and table.min() > 0.0 and table.max() / table.min() > 1.1
+    assert len(meta["vdbhair_scalp_distance"]) > 30000
+    # The grids' (u, v, w) lattice: the lowest active w layer holds the roots, at w = 0 over the
+    # measured head; over the sphere the roots reach several voxels below and above it.
+    sphere = vdbhair.estimate_tangent_field(hair, 0.05, space="scalp")
+    lowest = measured.active_coords()[:, 2].min()
+    assert lowest >= -1
+    assert sphere.active_coords()[:, 2].min() < lowest - 2
+    # Retraced, the strands stand along the normals they were made along.
+    out = vdbhair.retrace(hair, measured)
+    assert len(out) == 400
+    with pytest.raises(ValueError, match="not inside the scalp surface"):
+        far = vdbhair.Strands(hair.positions + np.float32([5.0, 0.0, 0.0]), hair.offsets)
+        vdbhair.estimate_tangent_field(far, 0.05, space="scalp", scalp=str(head))

@@ -2,11 +2,14 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/field/ScalpMap.h>
 #include <vdbhair/io/MetaKeys.h>
 
 #include <openvdb/Metadata.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace vdbhair {
 
@@ -66,9 +69,19 @@ FieldMapping::FieldMapping(openvdb::math::Transform::ConstPtr xform, const Scalp
     mScalp = scalp;
 }
 
+FieldMapping::FieldMapping(openvdb::math::Transform::ConstPtr xform, std::shared_ptr<const ScalpMap> surface)
+    : FieldMapping(std::move(xform))
+{
+    if (!surface) throw ValueError("FieldMapping: no scalp map");
+    mSpace = FieldSpace::Scalp;
+    mScalp = surface->sphere();
+    if (surface->hasSurface()) mSurface = std::move(surface);
+}
+
 openvdb::Vec3d FieldMapping::toScalp(const openvdb::Vec3d& world) const
 {
-    return worldToScalp(mScalp, Vec3d(world.x(), world.y(), world.z()));
+    const Vec3d p(world.x(), world.y(), world.z());
+    return mSurface ? mSurface->toScalp(p) : worldToScalp(mScalp, p);
 }
 
 double FieldMapping::worldVoxelSize() const
@@ -92,11 +105,38 @@ FieldMapping FieldMapping::fromGrid(const openvdb::GridBase& grid)
     s.center = Vec3d(center->value().x(), center->value().y(), center->value().z());
     s.radius = radius->value();
     s.up = Vec3d(up->value().x(), up->value().y(), up->value().z()).unitSafe();
-    return FieldMapping(grid.constTransformPtr(), s);
+    const auto table = findVdbhairMeta<openvdb::StringMetadata>(grid, "scalp_distance");
+    if (!table) return FieldMapping(grid.constTransformPtr(), s);
+    const auto resolution = findVdbhairMeta<openvdb::Int32Metadata>(grid, "scalp_resolution");
+    const std::string where = "grid '" + grid.getName() + "': vdbhair_scalp_distance";
+    if (!resolution || resolution->value() < ScalpMap::kMinResolution || resolution->value() > ScalpMap::kMaxResolution) {
+        throw FormatError(where + " needs vdbhair_scalp_resolution in [" + std::to_string(ScalpMap::kMinResolution) + ", " +
+                          std::to_string(ScalpMap::kMaxResolution) + "]");
+    }
+    // The count is bounded by the checked resolution before anything is allocated.
+    const std::size_t count = std::size_t(resolution->value()) * std::size_t(resolution->value());
+    std::vector<float> d;
+    d.reserve(count);
+    const char* c = table->value().c_str();
+    while (true) {
+        while (*c == ' ') ++c;
+        if (!*c) break;
+        char* end = nullptr;
+        const float value = std::strtof(c, &end);
+        if (end == c || (*end && *end != ' ')) throw FormatError(where + ": value " + std::to_string(d.size()) + " is not a number");
+        if (d.size() == count) throw FormatError(where + " has more than the " + std::to_string(count) + " values of its resolution");
+        d.push_back(value);
+        c = end;
+    }
+    try {
+        return FieldMapping(grid.constTransformPtr(), std::make_shared<const ScalpMap>(s, std::move(d), resolution->value()));
+    } catch (const ValueError& e) {
+        throw FormatError(where + ": " + e.what());
+    }
 }
 
 void setFieldMetadata(openvdb::GridBase& grid, double voxelSize, int iterations, FieldSpace space,
-                      const ScalpSphere& scalp, int level, int levels, std::size_t strandCount)
+                      const ScalpSphere& scalp, int level, int levels, std::size_t strandCount, const ScalpMap* surface)
 {
     grid.insertMeta("creator", openvdb::StringMetadata(creatorString()));
     grid.insertMeta("vdbhair_voxel_size", openvdb::DoubleMetadata(voxelSize));
@@ -109,6 +149,17 @@ void setFieldMetadata(openvdb::GridBase& grid, double voxelSize, int iterations,
         grid.insertMeta("vdbhair_scalp_center", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.center.x(), scalp.center.y(), scalp.center.z())));
         grid.insertMeta("vdbhair_scalp_radius", openvdb::DoubleMetadata(scalp.radius));
         grid.insertMeta("vdbhair_scalp_up", openvdb::Vec3DMetadata(openvdb::Vec3d(scalp.up.x(), scalp.up.y(), scalp.up.z())));
+        if (surface && surface->hasSurface()) {
+            std::string text;
+            text.reserve(surface->distances().size() * 12);
+            char buf[32];
+            for (float v : surface->distances()) {
+                std::snprintf(buf, sizeof buf, text.empty() ? "%.9g" : " %.9g", double(v));
+                text += buf;
+            }
+            grid.insertMeta("vdbhair_scalp_resolution", openvdb::Int32Metadata(surface->resolution()));
+            grid.insertMeta("vdbhair_scalp_distance", openvdb::StringMetadata(text));
+        }
     }
 }
 

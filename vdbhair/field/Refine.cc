@@ -167,7 +167,7 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
         fp.maxMemory = std::numeric_limits<std::uint64_t>::max();
     }
     result.voxelSize = fp.voxelSize;
-    result.head = params.head.unset() ? headFromRoots(strands, fp.scalp.up) : params.head;
+    result.head = params.head.unset() ? headFromRoots(strands, fp.scalpSphere().up) : params.head;
     result.fields.resize(std::size_t(params.levels));
     result.levels.resize(std::size_t(params.levels));
 

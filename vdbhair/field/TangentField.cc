@@ -273,7 +273,7 @@ void checkParams(const StrandSet& strands, const FieldParams& p, const char* whe
                          " must be a positive hair length per unit volume (0 chooses it)");
     }
     // OpenVDB refuses transforms whose scale determinant is within 1e-15 of zero.
-    const double lattice = p.space == FieldSpace::Scalp ? p.voxelSize / p.scalp.radius : p.voxelSize;
+    const double lattice = p.space == FieldSpace::Scalp ? p.voxelSize / p.scalpSphere().radius : p.voxelSize;
     if (lattice < 2e-5) {
         throw ValueError(std::string(where) + ": voxel size " + std::to_string(p.voxelSize) +
                          " is below OpenVDB's smallest voxel size (about 2e-5" +
@@ -281,8 +281,8 @@ void checkParams(const StrandSet& strands, const FieldParams& p, const char* whe
                          "); use a larger voxel or scale the hairstyle up");
     }
     if (p.iterations < 1) throw ValueError(std::string(where) + ": iterations " + std::to_string(p.iterations) + " must be at least 1");
-    if (p.space == FieldSpace::Scalp && !(p.scalp.radius > 0.0)) {
-        throw ValueError(std::string(where) + ": scalp radius " + std::to_string(p.scalp.radius) + " must be positive");
+    if (p.space == FieldSpace::Scalp && !(p.scalpSphere().radius > 0.0)) {
+        throw ValueError(std::string(where) + ": scalp radius " + std::to_string(p.scalpSphere().radius) + " must be positive");
     }
 }
 
@@ -291,7 +291,9 @@ FieldMapping mappingFor(const FieldParams& p, double voxelSize)
 {
     if (p.space == FieldSpace::Scalp) {
         // (u, v, w) voxel size: the world voxel size at the scalp, in units of the radius.
-        return FieldMapping(openvdb::math::Transform::createLinearTransform(voxelSize / p.scalp.radius), p.scalp);
+        const auto xform = openvdb::math::Transform::createLinearTransform(voxelSize / p.scalpSphere().radius);
+        if (p.scalpSurface) return FieldMapping(xform, p.scalpSurface);
+        return FieldMapping(xform, p.scalp);
     }
     return FieldMapping(openvdb::math::Transform::createLinearTransform(voxelSize));
 }
@@ -623,7 +625,7 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
                                  static_cast<openvdb::GridBase*>(out.hairLength.get()), static_cast<openvdb::GridBase*>(out.coherence.get()),
                                  static_cast<openvdb::GridBase*>(out.spread.get())}) {
         g->setTransform(map.transform().copy());
-        setFieldMetadata(*g, voxelSize, p.iterations, p.space, p.scalp, level, levels, strands.numStrands());
+        setFieldMetadata(*g, voxelSize, p.iterations, p.space, map.scalp(), level, levels, strands.numStrands(), map.scalpSurface().get());
     }
     out.density->insertMeta("vdbhair_density_reference", openvdb::DoubleMetadata(reference));
     out.density->insertMeta("vdbhair_density_rule", openvdb::StringMetadata(
@@ -780,6 +782,27 @@ std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& p
 {
     const FieldParams p = resolvedParams(strands, params, "estimateVoxelVisits");
     return visitBound(strands, mappingFor(p, p.voxelSize));
+}
+
+void useScalpSpace(FieldParams& params, const std::vector<Vec3f>& roots, const Vec3d& up, const ScalpSphere* sphere,
+                   openvdb::FloatGrid::ConstPtr surface)
+{
+    if (sphere && surface) throw ValueError("scalp space: a sphere and a scalp surface were both given; the surface's sphere is fitted to the roots");
+    if (sphere && (!(sphere->radius > 0.0) || !std::isfinite(sphere->radius)))
+        throw ValueError("scalp space: sphere radius " + std::to_string(sphere->radius) + " must be positive and finite");
+    const Vec3d upAxis = up.unitSafe();
+    if (upAxis.lengthSqr() == 0.0) throw ValueError("scalp space: the up axis must be a non-zero vector");
+    params.space = FieldSpace::Scalp;
+    params.scalpSurface.reset();
+    if (sphere) {
+        params.scalp = *sphere;
+        params.scalp.up = upAxis;
+    } else if (surface) {
+        params.scalpSurface = scalpMapOfPoints(roots, upAxis, surface, nullptr, ScalpMap::kFieldResolution);
+        params.scalp = params.scalpSurface->sphere();
+    } else {
+        params.scalp = fitScalpSphere(roots, upAxis);
+    }
 }
 
 TangentField estimateTangentField(const StrandSet& strands, const FieldParams& params, bool threaded,

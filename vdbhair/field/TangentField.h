@@ -20,6 +20,7 @@
 #pragma once
 
 #include <vdbhair/field/FieldTypes.h>
+#include <vdbhair/field/ScalpMap.h>
 #include <vdbhair/strands/StrandSet.h>
 
 #include <openvdb/Grid.h>
@@ -27,6 +28,7 @@
 #include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,7 +44,13 @@ struct FieldParams
     double voxelSize = 0.0;
     int iterations = 2;       ///< Eq. 9 iterations (>= 1)
     FieldSpace space = FieldSpace::World;
-    ScalpSphere scalp;        ///< used in scalp space
+    ScalpSphere scalp;        ///< used in scalp space (the sphere: d ≡ 1) unless scalpSurface is set
+    /// In scalp space, a scalp measured on a level set (ScalpMap.h, built at
+    /// ScalpMap::kFieldResolution): w is the height above it, and its sphere replaces `scalp`.
+    /// The grids carry its table, so readers rebuild the same mapping (FieldMapping.h).
+    std::shared_ptr<const ScalpMap> scalpSurface;
+    /// The parameterization's sphere: scalpSurface's when set, else `scalp`.
+    const ScalpSphere& scalpSphere() const { return scalpSurface ? scalpSurface->sphere() : scalp; }
     /// Cap on the voxel visits the segments could need (an upper bound computed before any
     /// allocation): a bound on the work, about a minute on two cores at the cap. A voxel size far
     /// too small for the hairstyle fails with LimitError (naming maxVoxels). Memory is bounded by
@@ -57,6 +65,14 @@ struct FieldParams
     /// with LimitError before allocating; no limit (the largest value) skips the estimate.
     std::uint64_t maxMemory = 0;
 };
+
+/// @brief Put @a params in scalp space for hair with @a roots: on @a sphere when given, else on
+/// the sphere fitted to the roots with @a up; with @a surface (a scalp level set), w measured
+/// above that surface (ScalpMap at ScalpMap::kFieldResolution, from the sphere fitted to the roots).
+/// @throw ValueError for a sphere whose radius is not positive and finite, a sphere and a surface
+/// both given, roots too few or too flat to fit a sphere, or a fitted centre outside the surface.
+void useScalpSpace(FieldParams& params, const std::vector<Vec3f>& roots, const Vec3d& up, const ScalpSphere* sphere,
+                   openvdb::FloatGrid::ConstPtr surface);
 
 /// @brief What estimating a field at one voxel size will allocate, counted before it allocates
 /// (estimateFieldFootprint()): the terms of the memory estimate.

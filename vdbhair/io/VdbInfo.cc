@@ -45,8 +45,12 @@ MetaValue toMetaValue(const std::string& name, const openvdb::Metadata& meta)
 
 } // namespace
 
-std::string metaValueString(const MetaValue& m)
+std::string metaValueString(const MetaValue& m, std::size_t maxChars)
 {
+    if (const auto* text = std::get_if<std::string>(&m.value); text && maxChars > 0 && text->size() > maxChars) {
+        const std::size_t keep = maxChars / 2;
+        return text->substr(0, keep) + "... (" + std::to_string(text->size()) + " characters)";
+    }
     std::ostringstream os;
     std::visit([&os](const auto& v) {
         using T = std::decay_t<decltype(v)>;

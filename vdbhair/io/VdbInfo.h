@@ -53,7 +53,11 @@ struct GridInfo
 /// @param where message prefix; empty: "info(PATH)"
 std::vector<GridInfo> describeVdbFile(const std::string& path, const std::string& where = "");
 
-/// @brief A metadata value as text ("0.5", "[1, 2, 3]", "vdbhair 0.1.0").
-std::string metaValueString(const MetaValue& m);
+/// @brief A metadata value as text ("0.5", "[1, 2, 3]", "vdbhair 0.1.0"). Text longer than
+/// @a maxChars (0: no limit) is cut to its start and "... (N characters)", for listings (a
+/// scalp-space field's vdbhair_scalp_distance is about 40,000 characters).
+std::string metaValueString(const MetaValue& m, std::size_t maxChars = 0);
+/// @brief The text length `info` and `inspect` list metadata values at.
+constexpr std::size_t kListedMetaChars = 120;
 
 } // namespace vdbhair

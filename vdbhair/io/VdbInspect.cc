@@ -238,6 +238,10 @@ std::string explainGrid(const GridInfo& info)
             const std::string c = text("vdbhair_scalp_center"), rad = text("vdbhair_scalp_radius");
             if (!c.empty()) os << " centred at " << c;
             if (!rad.empty()) os << " of radius " << rad;
+            const std::string res = text("vdbhair_scalp_resolution");
+            if (!res.empty() && findMeta(info, "vdbhair_scalp_distance"))
+                os << "; the height is measured above a head, its distance from the centre tabulated on " << res << " x " << res
+                   << " directions in vdbhair_scalp_distance";
             os << ")";
         }
         os << ".";

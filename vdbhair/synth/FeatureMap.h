@@ -11,7 +11,7 @@
 
 #include <vdbhair/Types.h>
 #include <vdbhair/synth/FeatureImage.h>
-#include <vdbhair/synth/ScalpMap.h>
+#include <vdbhair/field/ScalpMap.h>
 
 #include <cstdint>
 #include <vector>

@@ -7,7 +7,7 @@
 #pragma once
 
 #include <vdbhair/strands/StrandSet.h>
-#include <vdbhair/synth/ScalpMap.h>
+#include <vdbhair/field/ScalpMap.h>
 
 #include <cstddef>
 #include <vector>

@@ -81,25 +81,6 @@ SynthStageTimer::~SynthStageTimer()
     stages.push_back({name, s});
 }
 
-std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp, Vec3d* upUsed)
-{
-    std::vector<Vec3f> roots(strands.numStrands());
-    for (std::size_t s = 0; s < roots.size(); ++s) roots[s] = strands.root(s);
-    return scalpMapOfPoints(roots, up, scalp, upUsed);
-}
-
-std::shared_ptr<ScalpMap> scalpMapOfPoints(const std::vector<Vec3f>& roots, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp, Vec3d* upUsed)
-{
-    ScalpSphere sphere = fitScalpSphere(roots, up.length() > 0.0 ? up : Vec3d(0.0, 1.0, 0.0));
-    if (up.length() == 0.0) {
-        Vec3d mean(0.0);
-        for (const Vec3f& r : roots) mean += (Vec3d(r) - sphere.center).unitSafe();
-        if (mean.length() > 1e-9 * double(roots.size())) sphere.up = mean.unitSafe();
-    }
-    if (upUsed) *upUsed = sphere.up;
-    return scalp ? std::make_shared<ScalpMap>(sphere, *scalp) : std::make_shared<ScalpMap>(sphere);
-}
-
 ClusterHierarchy hairHierarchy(const StrandSet& strands, const ScalpMap& map, const SynthParams& params, bool threaded,
                                openvdb::util::NullInterrupter* interrupter, std::vector<std::uint32_t>* orderOut)
 {

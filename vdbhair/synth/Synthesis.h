@@ -139,14 +139,7 @@ struct SynthResult
     double outputArea = 0.0;                    ///< area of a given output region on the example's scalp (0: the example's region)
 };
 
-/// @brief Stage 1: the scalp map of a hairstyle: the sphere fitted to its roots (Wang et al. §3),
-/// measured on @a scalp when given; up @a up, or (0, 0, 0) for the mean root direction.
-/// @param upUsed if given, receives the up axis used
-std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp,
-                                       Vec3d* upUsed = nullptr);
-/// @brief The same for points on a scalp (roots, a region's voxels): the sphere fitted to them.
-std::shared_ptr<ScalpMap> scalpMapOfPoints(const std::vector<Vec3f>& points, const Vec3d& up, openvdb::FloatGrid::ConstPtr scalp,
-                                           Vec3d* upUsed = nullptr);
+/// Stage 1, the scalp map of a hairstyle (hairScalpMap(), scalpMapOfPoints()), is in field/ScalpMap.h.
 
 /// @brief Stages 2-3: every strand sampled on @a map (in spatial order, Measures.h) and the
 /// hierarchy of @a params.cluster with seed @a params.seed.

@@ -12,6 +12,11 @@
 ///   w = |p'| - d(u, v)   (units of the radius; 0 on the scalp, positive above it).
 /// The inverse (Eq. 2): p' = (w + d(u, v)) (h cot u, h - 1, h cot v), h = 2 / (cot²u + cot²v + 1).
 ///
+/// A scalp-space tangent field (`field --space scalp --scalp HEAD`) carries its map in its grids'
+/// metadata so that any reader rebuilds it exactly: `vdbhair_scalp_distance`, the table of d at
+/// kFieldResolution² nodes as text (FieldMapping.h), from which the map is restored with the
+/// table constructor below.
+///
 /// Local frame (§3): R is the shortest rotation taking +y onto the scalp's unit outward normal at
 /// (u, v) (the sphere's radial direction, or the level set's normalized gradient, tabulated with d);
 /// the frame is n = R y (normal), t = R x (tangent), b = R z (binormal), in world space. Points in
@@ -24,6 +29,7 @@
 
 #include <openvdb/openvdb.h>
 
+#include <memory>
 #include <vector>
 
 namespace vdbhair {
@@ -43,6 +49,12 @@ class ScalpMap
 {
 public:
     static constexpr int kDefaultResolution = 256;  ///< table nodes per (u, v) axis: 0.7° apart
+    /// Table nodes per axis of the map a scalp-space field carries (2.8° apart: 0.5 units on a
+    /// head of radius 10; d is bilinear between nodes, and the field only needs the map to be the
+    /// same wherever it is rebuilt, which the stored table guarantees).
+    static constexpr int kFieldResolution = 64;
+    static constexpr int kMinResolution = 8;
+    static constexpr int kMaxResolution = 4096;
 
     /// @brief The paper's scalp: the sphere itself (d ≡ 1).
     explicit ScalpMap(const ScalpSphere& sphere);
@@ -51,6 +63,14 @@ public:
     /// @throw TypeError if @a surface is not a level set; ValueError if the sphere's centre is not
     /// inside it (rays from outside cross the scalp twice) or @a resolution is below 8.
     ScalpMap(const ScalpSphere& sphere, const openvdb::FloatGrid& surface, int resolution = kDefaultResolution);
+
+    /// @brief A real scalp restored from its table: @a distances holds d at resolution² nodes (row
+    /// v, column u, as distances() returns them). Normals come from the tabulated surface by
+    /// central differences (within about a degree of the level set's on a smooth head); misses()
+    /// is 0.
+    /// @throw ValueError if @a resolution is outside [kMinResolution, kMaxResolution], the table
+    /// has another size, or a distance is not a positive finite number.
+    ScalpMap(const ScalpSphere& sphere, std::vector<float> distances, int resolution);
 
     /// (u, v, w) of a world point (Eq. 1; w in units of the radius).
     Vec3d toScalp(const Vec3d& worldPos) const;
@@ -67,12 +87,15 @@ public:
     double radius() const { return mSphere.radius; }
     bool hasSurface() const { return !mD.empty(); }
     int resolution() const { return mResolution; }
+    /// d at the table's nodes (row v, column u; empty for the sphere).
+    const std::vector<float>& distances() const { return mD; }
     /// Table directions whose ray missed the surface (they use the sphere).
     std::size_t misses() const { return mMisses; }
 
 private:
     Vec3d unitDirection(double u, double v) const;  ///< in the sphere's frame (y up), unit
     void lookup(double u, double v, double& d, Vec3d& normal) const;
+    void axesFromUp();
 
     ScalpSphere mSphere;
     Vec3d mRight{1.0, 0.0, 0.0}, mUp{0.0, 1.0, 0.0}, mForward{0.0, 0.0, 1.0};  ///< world axes of the sphere's x, y, z
@@ -81,6 +104,17 @@ private:
     std::vector<Vec3f> mNormal;   ///< #res² unit normals in world space
     std::size_t mMisses = 0;
 };
+
+/// @brief The scalp map of hair with these roots (Wang et al. §3): the sphere fitted to @a roots
+/// (fitScalpSphere()), up @a up or, when @a up is zero, the roots' mean direction from its centre
+/// (cyHair files are z-up, USC's y-up); measured on the level set @a surface when given.
+/// @param upUsed if given, receives the up axis used
+/// @throw ValueError as fitScalpSphere() and the ScalpMap constructors (a centre not inside the surface).
+std::shared_ptr<ScalpMap> scalpMapOfPoints(const std::vector<Vec3f>& roots, const Vec3d& up, openvdb::FloatGrid::ConstPtr surface,
+                                           Vec3d* upUsed = nullptr, int resolution = ScalpMap::kDefaultResolution);
+/// @brief The same for a hairstyle's roots.
+std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up, openvdb::FloatGrid::ConstPtr surface,
+                                       Vec3d* upUsed = nullptr, int resolution = ScalpMap::kDefaultResolution);
 
 /// @brief @a strands moved from the scalp @a from onto the scalp @a to through scalp space (Wang
 /// et al. §3: the parameterization is the same for every head): each root keeps its (u, v) and

@@ -33,10 +33,12 @@ Vec3d rotateShortest(const Vec3d& from, const Vec3d& to, const Vec3d& v, const V
 
 } // namespace
 
-ScalpMap::ScalpMap(const ScalpSphere& sphere) : mSphere(sphere)
+ScalpMap::ScalpMap(const ScalpSphere& sphere) : mSphere(sphere) { axesFromUp(); }
+
+void ScalpMap::axesFromUp()
 {
     // The sphere's own axes, as ScalpSpace.cc builds them (x kept near world x).
-    mUp = sphere.up.unitSafe();
+    mUp = mSphere.up.unitSafe();
     if (mUp.lengthSqr() == 0.0) mUp = Vec3d(0.0, 1.0, 0.0);
     mSphere.up = mUp;
     Vec3d x(1.0, 0.0, 0.0);
@@ -50,8 +52,9 @@ ScalpMap::ScalpMap(const ScalpSphere& sphere, const openvdb::FloatGrid& surface,
     if (surface.getGridClass() != openvdb::GRID_LEVEL_SET)
         throw TypeError("scalp map: grid '" + surface.getName() + "' is not a level set (class " +
                         openvdb::GridBase::gridClassToString(surface.getGridClass()) + ")");
-    if (resolution < 8)
-        throw ValueError("scalp map: resolution " + std::to_string(resolution) + " is below the minimum of 8");
+    if (resolution < kMinResolution || resolution > kMaxResolution)
+        throw ValueError("scalp map: resolution " + std::to_string(resolution) + " is outside [" + std::to_string(kMinResolution) +
+                         ", " + std::to_string(kMaxResolution) + "]");
     using Sampler = openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler>;
     {
         const openvdb::FloatGrid::ConstAccessor acc = surface.getConstAccessor();
@@ -98,6 +101,42 @@ ScalpMap::ScalpMap(const ScalpSphere& sphere, const openvdb::FloatGrid& surface,
         }
     });
     for (std::uint8_t m : missed) mMisses += m;
+}
+
+ScalpMap::ScalpMap(const ScalpSphere& sphere, std::vector<float> distances, int resolution) : ScalpMap(sphere)
+{
+    if (resolution < kMinResolution || resolution > kMaxResolution)
+        throw ValueError("scalp map: resolution " + std::to_string(resolution) + " is outside [" + std::to_string(kMinResolution) +
+                         ", " + std::to_string(kMaxResolution) + "]");
+    const std::size_t count = std::size_t(resolution) * resolution;
+    if (distances.size() != count)
+        throw ValueError("scalp map: " + std::to_string(distances.size()) + " distances for a table of " + std::to_string(resolution) +
+                         "² = " + std::to_string(count) + " nodes");
+    for (std::size_t k = 0; k < count; ++k) {
+        if (!(distances[k] > 0.0f) || !std::isfinite(distances[k]))
+            throw ValueError("scalp map: distance " + std::to_string(distances[k]) + " at node " + std::to_string(k) +
+                             " is not a positive finite number");
+    }
+    mResolution = resolution;
+    mD = std::move(distances);
+    mNormal.assign(count, Vec3f(0.0f));
+    // The tabulated surface's points, and each node's normal from central differences along u and
+    // v (one-sided at the table's edges), turned outward.
+    const auto point = [&](int i, int j) {
+        const Vec3d local = unitDirection(M_PI * (i + 0.5) / resolution, M_PI * (j + 0.5) / resolution);
+        return (mRight * local.x() + mUp * local.y() + mForward * local.z()).unitSafe() * double(mD[std::size_t(j) * resolution + i]);
+    };
+    for (int j = 0; j < resolution; ++j) {
+        for (int i = 0; i < resolution; ++i) {
+            const Vec3d du = point(std::min(i + 1, resolution - 1), j) - point(std::max(i - 1, 0), j);
+            const Vec3d dv = point(i, std::min(j + 1, resolution - 1)) - point(i, std::max(j - 1, 0));
+            const Vec3d radial = point(i, j).unitSafe();
+            Vec3d n = du.cross(dv).unitSafe();
+            if (n.lengthSqr() == 0.0) n = radial;
+            if (n.dot(radial) < 0.0) n = -n;
+            mNormal[std::size_t(j) * resolution + i] = Vec3f(n);
+        }
+    }
 }
 
 Vec3d ScalpMap::unitDirection(double u, double v) const
@@ -163,6 +202,27 @@ ScalpFrame ScalpMap::frame(double u, double v) const
     f.t = rotateShortest(mUp, n, mRight, mRight);
     f.b = rotateShortest(mUp, n, mForward, mRight);
     return f;
+}
+
+std::shared_ptr<ScalpMap> scalpMapOfPoints(const std::vector<Vec3f>& roots, const Vec3d& up, openvdb::FloatGrid::ConstPtr surface,
+                                           Vec3d* upUsed, int resolution)
+{
+    ScalpSphere sphere = fitScalpSphere(roots, up.length() > 0.0 ? up : Vec3d(0.0, 1.0, 0.0));
+    if (up.length() == 0.0) {
+        Vec3d mean(0.0);
+        for (const Vec3f& r : roots) mean += (Vec3d(r) - sphere.center).unitSafe();
+        if (mean.length() > 1e-9 * double(roots.size())) sphere.up = mean.unitSafe();
+    }
+    if (upUsed) *upUsed = sphere.up;
+    return surface ? std::make_shared<ScalpMap>(sphere, *surface, resolution) : std::make_shared<ScalpMap>(sphere);
+}
+
+std::shared_ptr<ScalpMap> hairScalpMap(const StrandSet& strands, const Vec3d& up, openvdb::FloatGrid::ConstPtr surface,
+                                       Vec3d* upUsed, int resolution)
+{
+    std::vector<Vec3f> roots(strands.numStrands());
+    for (std::size_t s = 0; s < roots.size(); ++s) roots[s] = strands.root(s);
+    return scalpMapOfPoints(roots, up, std::move(surface), upUsed, resolution);
 }
 
 StrandSet moveToScalp(const StrandSet& strands, const ScalpMap& from, const ScalpMap& to, double turn, bool threaded)

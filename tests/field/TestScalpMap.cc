@@ -1,5 +1,5 @@
 #include <vdbhair/scalp/ScalpSurface.h>
-#include <vdbhair/synth/ScalpMap.h>
+#include <vdbhair/field/ScalpMap.h>
 
 #include <catch2/catch.hpp>
 
@@ -17,7 +17,7 @@ void checkFrame(const ScalpFrame& f)
 }
 } // namespace
 
-TEST_CASE("ScalpMap: the sphere round-trips and its frames are radial", "[synth]")
+TEST_CASE("ScalpMap: the sphere round-trips and its frames are radial", "[field]")
 {
     ScalpSphere s;
     s.center = Vec3d(0.3, -0.2, 0.1);
@@ -42,7 +42,7 @@ TEST_CASE("ScalpMap: the sphere round-trips and its frames are radial", "[synth]
     CHECK((top.b - Vec3d(0, 0, 1)).length() < 1e-9);
 }
 
-TEST_CASE("ScalpMap: a level-set scalp is measured along the rays (d, w, normals)", "[synth]")
+TEST_CASE("ScalpMap: a level-set scalp is measured along the rays (d, w, normals)", "[field]")
 {
     // A scalp of radius 1.2 parameterized by the unit sphere at the same centre: d = 1.2 everywhere.
     ScalpParams params;
@@ -72,7 +72,7 @@ TEST_CASE("ScalpMap: a level-set scalp is measured along the rays (d, w, normals
     }
 }
 
-TEST_CASE("ScalpMap: a centre outside the scalp is refused", "[synth]")
+TEST_CASE("ScalpMap: a centre outside the scalp is refused", "[field]")
 {
     ScalpParams params;
     params.voxelSize = 0.05;
@@ -84,7 +84,7 @@ TEST_CASE("ScalpMap: a centre outside the scalp is refused", "[synth]")
     CHECK_THROWS_WITH(ScalpMap(s, *surface, 4), Catch::Contains("resolution 4"));
 }
 
-TEST_CASE("moveToScalp: the same head is the identity, a turn is a rigid rotation, a larger head scales", "[synth]")
+TEST_CASE("moveToScalp: the same head is the identity, a turn is a rigid rotation, a larger head scales", "[field]")
 {
     ScalpSphere s;
     s.center = Vec3d(0.3, -0.2, 0.1);
