@@ -354,6 +354,44 @@ void addArrayMethods(ClassT& cls, GetT get, const char* subject)
 
 } // namespace
 
+/// The scalp argument of estimate_tangent_field() and refine(), as `--space`, `--scalp` and `--up`:
+/// a sphere (cx, cy, cz, r), a head (the path of a scalp .vdb or a mesh) or None (the sphere
+/// fitted to the roots), for space="scalp" only.
+using ScalpArgument = std::optional<std::variant<std::array<double, 4>, std::string>>;
+
+/// @return the head's level set when @a scalp named one (refine's default head), else null
+openvdb::FloatGrid::Ptr applyScalpArgument(FieldParams& fp, const StrandSet& strands, const std::string& space,
+                                           const ScalpArgument& scalp, const std::array<double, 3>& up, const std::string& where)
+{
+    fp.space = fieldSpaceFromName(space);
+    const Vec3d upAxis(up[0], up[1], up[2]);
+    if (!(upAxis.length() > 0.0) || !std::isfinite(upAxis.length())) throw ValueError(where + ": up must be a non-zero finite vector");
+    if (fp.space != FieldSpace::Scalp) {
+        if (scalp) throw ValueError(where + ": scalp= is for space='scalp'");
+        return nullptr;
+    }
+    std::vector<Vec3f> roots;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) roots.push_back(strands.root(i));
+    ScalpSphere given;
+    openvdb::FloatGrid::Ptr surface;
+    if (scalp) {
+        if (const auto* path = std::get_if<std::string>(&*scalp)) {
+            surface = readScalp(*path);
+        } else {
+            const auto& v = std::get<std::array<double, 4>>(*scalp);
+            if (!(v[3] > 0.0) || !std::isfinite(v[3])) throw ValueError(where + ": scalp=(cx, cy, cz, r) needs r > 0");
+            given.center = Vec3d(v[0], v[1], v[2]);
+            given.radius = v[3];
+        }
+    }
+    try {
+        useScalpSpace(fp, roots, upAxis, scalp && !surface ? &given : nullptr, surface);
+    } catch (const ValueError& e) {
+        throw ValueError(where + ": " + e.what());
+    }
+    return surface;
+}
+
 void bindFields(pyb::module_& m)
 {
     // ---- Grid ----------------------------------------------------------------------------
@@ -483,43 +521,14 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
     m.def(
         "estimate_tangent_field",
         [](const StrandsPtr& strands, double voxelSize, int iterations, std::optional<int> levels, std::uint64_t maxVoxels,
-           double densityReference, const std::string& space, std::optional<std::variant<std::array<double, 4>, std::string>> scalp, std::array<double, 3> up,
+           double densityReference, const std::string& space, const ScalpArgument& scalp, std::array<double, 3> up,
            int threads, const pyb::object& progress) -> pyb::object {
             FieldParams fp;
             fp.voxelSize = voxelSize;
             fp.iterations = iterations;
             fp.maxVoxels = maxVoxels;
             fp.densityReference = densityReference;
-            // Scalp space (as `field --space scalp --scalp CX,CY,CZ,R|HEAD --up`): the sphere given,
-            // fitted to the roots, or the scalp measured on a head (a scalp .vdb or a mesh).
-            fp.space = fieldSpaceFromName(space);
-            const Vec3d upAxis(up[0], up[1], up[2]);
-            if (!(upAxis.length() > 0.0) || !std::isfinite(upAxis.length())) throw ValueError("estimate_tangent_field: up must be a non-zero finite vector");
-            if (fp.space == FieldSpace::Scalp) {
-                std::vector<Vec3f> roots;
-                for (std::size_t i = 0; i < strands->numStrands(); ++i) roots.push_back(strands->root(i));
-                ScalpSphere given;
-                openvdb::FloatGrid::Ptr surface;
-                if (scalp) {
-                    if (const auto* path = std::get_if<std::string>(&*scalp)) {
-                        surface = readScalp(*path);
-                    } else {
-                        const auto& v = std::get<std::array<double, 4>>(*scalp);
-                        if (!(v[3] > 0.0) || !std::isfinite(v[3]))
-                            throw ValueError("estimate_tangent_field: scalp=(cx, cy, cz, r) needs r > 0");
-                        given.center = Vec3d(v[0], v[1], v[2]);
-                        given.radius = v[3];
-                    }
-                }
-                const bool sphereGiven = scalp && !surface;
-                try {
-                    useScalpSpace(fp, roots, upAxis, sphereGiven ? &given : nullptr, surface);
-                } catch (const ValueError& e) {
-                    throw ValueError(std::string("estimate_tangent_field: ") + e.what());
-                }
-            } else if (scalp) {
-                throw ValueError("estimate_tangent_field: scalp= is for space='scalp'");
-            }
+            applyScalpArgument(fp, *strands, space, scalp, up, "estimate_tangent_field");
             if (levels && (*levels < 1 || *levels > FieldParams::kMaxLevels)) {
                 throw ValueError("estimate_tangent_field: levels=" + std::to_string(*levels) + ": must be between 1 and " +
                                  std::to_string(FieldParams::kMaxLevels));
@@ -632,8 +641,8 @@ Raises:
         "refine",
         [](const StrandsPtr& strands, double voxelSize, int levels, const std::string& mode, int iterations, double step,
            double outlierStart, double outlierFull, double minSpread, const pyb::object& head, const std::string& headPolicy,
-           const std::string& integrator, int margin, std::uint64_t maxVoxels, bool measure, bool returnReport, int threads,
-           const pyb::object& progress) -> pyb::object {
+           const std::string& integrator, int margin, std::uint64_t maxVoxels, bool measure, const std::string& space,
+           const ScalpArgument& scalp, std::array<double, 3> up, bool returnReport, int threads, const pyb::object& progress) -> pyb::object {
             RefineParams rp;
             rp.field.voxelSize = voxelSize;
             rp.levels = levels;
@@ -650,10 +659,17 @@ Raises:
             rp.measure = measure;
             const HeadArgument headArg(head, headPolicy);
             rp.head = headArg.head;
+            // A scalp given as a sphere or a head is also the head strands keep out of, unless head= says (as the CLI).
+            const openvdb::FloatGrid::Ptr scalpSurface = applyScalpArgument(rp.field, *strands, space, scalp, up, "refine");
+            const bool scalpHead = head.is_none() && scalp.has_value();
+            if (scalpHead) {
+                rp.head = scalpSurface ? HeadObstacle::levelSet(scalpSurface, headArg.policy)
+                                       : HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, headArg.policy);
+            }
             rp.validate("refine");
             RefineResult result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 RefineParams p = rp;
-                p.head = headArg.get("refine");
+                if (!scalpHead) p.head = headArg.get("refine");
                 return refineStrands(*strands, p, true, interrupter);
             });
             auto out = std::make_shared<StrandSet>(std::move(result.strands));
@@ -688,8 +704,10 @@ Raises:
         pyb::arg("min_spread") = refineDefaults.consistency.minSpreadDeg, pyb::arg("head") = pyb::none(),
         pyb::arg("head_policy") = headPolicyName(kDefaultHeadPolicy), pyb::arg("integrator") = integratorName(refineDefaults.trace.integrator),
         pyb::arg("margin") = refineDefaults.trace.margin, pyb::arg("max_voxels") = refineDefaults.field.maxVoxels,
-        pyb::arg("measure") = refineDefaults.measure, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
-        pyb::arg("progress") = pyb::none(),
+        pyb::arg("measure") = refineDefaults.measure, pyb::arg("space") = fieldSpaceName(refineDefaults.field.space),
+        pyb::arg("scalp") = pyb::none(),
+        pyb::arg("up") = std::array<double, 3>{refineDefaults.field.scalp.up.x(), refineDefaults.field.scalp.up.y(), refineDefaults.field.scalp.up.z()},
+        pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(Vector-field refinement (Wang et al. 2009, Sec. 5.3): estimate, retrace, repeat from the
 coarsest level to the finest: ``vdbhair refine``.
 
@@ -711,6 +729,9 @@ Args:
     margin: field mode: voxels a strand may continue past the field's active region.
     max_voxels: refuse voxel sizes whose voxel visits could exceed this.
     measure: measure each level against the input (the report's numbers; costs a field a level).
+    space, scalp, up: the fields' space, as estimate_tangent_field() (``--space``, ``--scalp``,
+        ``--up``); a scalp given (a sphere or a head) is also the head strands keep out of
+        unless head= says otherwise.
     return_report: also return a dict: the finest level's measures, mode, voxel_size, head,
         per_level (a dict a level) and fields (the TangentField of each level, 0 the finest).
     threads: worker threads, 0 for all cores (results do not depend on it).

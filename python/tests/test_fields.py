@@ -295,3 +295,26 @@ def test_scalp_space_over_a_measured_head(tmp_path):
     with pytest.raises(ValueError, match="not inside the scalp surface"):
         far = vdbhair.Strands(hair.positions + np.float32([5.0, 0.0, 0.0]), hair.offsets)
         vdbhair.estimate_tangent_field(far, 0.05, space="scalp", scalp=str(head))
+
+
+def test_refine_in_scalp_space_over_a_head(tmp_path):
+    # refine(space="scalp", scalp=HEAD) as `vdbhair refine --space scalp --scalp HEAD`: the fields
+    # carry the measured scalp and the head is the obstacle.
+    surface, _ = vdbhair.scalp(sphere=(0.0, 0.0, 0.0, 1.0), voxel_size=0.02)
+    head = str(tmp_path / "ball.vdb")
+    vdbhair.write_grids(head, [surface])
+    rng = np.random.default_rng(2)
+    strands = []
+    for _ in range(300):
+        d = rng.normal(size=3)
+        d[1] = abs(d[1]) + 0.3
+        d /= np.linalg.norm(d)
+        strands.append(d * 1.01 + np.linspace(0.0, 0.5, 10)[:, None] * d)
+    hair = vdbhair.Strands(np.concatenate(strands).astype(np.float32), np.arange(0, 10 * 301, 10))
+    out, report = vdbhair.refine(hair, voxel_size=0.05, space="scalp", scalp=head, return_report=True)
+    assert len(out) == 300
+    assert report["head"].startswith("level set")
+    meta = report["fields"][0].metadata
+    assert meta["vdbhair_space"] == "scalp" and meta["vdbhair_scalp_resolution"] == 64
+    with pytest.raises(ValueError, match="scalp= is for space='scalp'"):
+        vdbhair.refine(hair, scalp=head)
