@@ -280,3 +280,61 @@ TEST_CASE("tracePHelicoids: the wisps' SIMD Euler lanes hold to the engine's Eul
         REQUIRE(worst < 1e-9 * pieces[0].length);  // the lanes' own atan2 and sin/cos (FastMath.h)
     }
 }
+
+TEST_CASE("tracePHelicoidPointsEuler: every lane on its own p-helicoid holds to tracePHelicoid, and growScene uses it", "[helicoid]")
+{
+    // 21 strands (two full groups of eight lanes and one partly idle), each with its own root,
+    // frame, 1 to 5 pieces of lengths that are not multiples of the step (one of zero length),
+    // rolls, and its own step; the lanes finish at different times and take new strands.
+    Rng rng(11);
+    const auto u = [&](double a, double b) { return a + (b - a) * rng.uniform(); };
+    std::vector<std::vector<HelicoidPiece>> pieces(21);
+    std::vector<PHelicoidRequest> req(21);
+    for (std::size_t i = 0; i < req.size(); ++i) {
+        const int n = 1 + int(i % 5);
+        for (int p = 0; p < n; ++p) {
+            const double length = (i == 7 && p == 1) ? 0.0 : u(0.2, 1.3);
+            pieces[i].push_back({{u(-3.0, 3.0), u(-0.5, 0.5), u(-1.0, 1.0), u(-0.6, 0.6)}, length, u(-1.0, 1.0)});
+        }
+        req[i].root = Vec3d(u(-1, 1), u(-1, 1), u(-1, 1));
+        req[i].frame = FrameD::fromTangentNormal(Vec3d(u(-1, 1), u(-1, 1), 1.0), Vec3d(1.0, u(-0.3, 0.3), 0.0));
+        req[i].pieces = &pieces[i];
+        req[i].step = i % 3 == 0 ? 0.013 : 0.02;
+    }
+    std::vector<std::vector<Vec3f>> outs(req.size());
+    std::vector<Vec3f*> dst(req.size());
+    for (std::size_t i = 0; i < req.size(); ++i) {
+        std::size_t total = 1;
+        for (const HelicoidPiece& pc : pieces[i]) total += stepCount(pc.length, req[i].step);
+        outs[i].assign(total, Vec3f(std::numeric_limits<float>::quiet_NaN()));
+        dst[i] = outs[i].data();
+    }
+    tracePHelicoidPointsEuler(req.data(), req.size(), dst.data());
+
+    Scene scene;
+    scene.step = 0.02;
+    for (std::size_t i = 0; i < req.size(); ++i) {
+        HelicoidTrace t;
+        tracePHelicoid(req[i].root, req[i].frame, pieces[i], req[i].step, HelicoidIntegrator::Euler, t);
+        REQUIRE(t.points.size() == outs[i].size());
+        double worst = 0.0;
+        for (std::size_t k = 0; k < t.points.size(); ++k) worst = std::max(worst, (Vec3d(outs[i][k]) - t.points[k]).length());
+        CAPTURE(i, worst);
+        REQUIRE(worst < 1e-5);  // float output of the same steps (the lanes' branchless atan2 and sin/cos)
+        SceneGuide g;
+        g.root = req[i].root;
+        g.frame = req[i].frame;
+        g.pieces = pieces[i];
+        g.step = req[i].step;
+        scene.guides.push_back(g);
+    }
+    // A scene of such hairs grows through the lanes: the same points, with any thread count.
+    for (bool threaded : {false, true}) {
+        const StrandSet grown = growScene(scene, {}, threaded);
+        REQUIRE(grown.numStrands() == req.size());
+        for (std::size_t i = 0; i < req.size(); ++i) {
+            REQUIRE(grown.size(i) == outs[i].size());
+            for (std::size_t k = 0; k < outs[i].size(); ++k) REQUIRE(grown.data(i)[k] == outs[i][k]);
+        }
+    }
+}

@@ -76,7 +76,7 @@ struct EulerLanes
     double bx[kLanes], by[kLanes], bz[kLanes];
     double th[kLanes];
 
-    __attribute__((target_clones("avx2", "default")))
+    __attribute__((target_clones("avx2", "default"), flatten))  // flatten: see EulerLanesPerStrand
     void step(const Helicoid& h, double hstep)
     {
         const double qtx = h.q.t.x(), qty = h.q.t.y(), qtz = h.q.t.z();
@@ -124,6 +124,62 @@ struct EulerLanes
     {
         return FrameD{Vec3d(tx[l], ty[l], tz[l]), Vec3d(nx[l], ny[l], nz[l]), Vec3d(bx[l], by[l], bz[l])};
     }
+};
+
+/// @brief kLanes positions moved one forward-Euler step (Eq. 3), each through its own helicoid and
+/// by its own step: EulerLanes with per-lane helicoids, for hairs that share nothing (interpolated
+/// hair). The same operations in the same order as EulerLanes::step.
+struct EulerLanesPerStrand
+{
+    double px[kLanes], py[kLanes], pz[kLanes];
+    double tx[kLanes], ty[kLanes], tz[kLanes];
+    double th[kLanes];
+    double hstep[kLanes];
+    // Each lane's helicoid: Q's columns, p0, k.
+    double qtx[kLanes], qty[kLanes], qtz[kLanes], qnx[kLanes], qny[kLanes], qnz[kLanes], qbx[kLanes], qby[kLanes], qbz[kLanes];
+    double ox[kLanes], oy[kLanes], oz[kLanes];
+    double kT[kLanes], kN[kLanes], kB[kLanes], alpha[kLanes];
+
+    // flatten: the lane math must be inlined for the loop to vectorize (left to itself, the
+    // compiler called sinCosLane out of line: a third of the kernel's instructions).
+    __attribute__((target_clones("avx2", "default"), flatten))
+    void step()
+    {
+        constexpr double twoPi = 2.0 * M_PI, invTwoPi = 1.0 / (2.0 * M_PI);
+        for (int l = 0; l < kLanes; ++l) {
+            px[l] += hstep[l] * tx[l];
+            py[l] += hstep[l] * ty[l];
+            pz[l] += hstep[l] * tz[l];
+            const double dx = px[l] - ox[l], dy = py[l] - oy[l], dz = pz[l] - oz[l];
+            const double y1 = dx * qtx[l] + dy * qty[l] + dz * qtz[l];
+            const double y2 = dx * qnx[l] + dy * qny[l] + dz * qnz[l];
+            const double y3 = dx * qbx[l] + dy * qby[l] + dz * qbz[l];
+            double t = fastmath::atan2Lane(kT[l] * y1 + kN[l] * y2, 1.0 + kN[l] * y1 - kT[l] * y2) + kB[l] * y3;
+            t += twoPi * fastmath::roundLane((th[l] - t) * invTwoPi);
+            th[l] = t;
+            double st, ct, sp, cp;
+            fastmath::sinCosLane(t, st, ct);
+            fastmath::sinCosLane(alpha[l] * t, sp, cp);
+            const double a = cp * ct, b = cp * st;
+            tx[l] = a * qtx[l] + b * qnx[l] + sp * qbx[l];
+            ty[l] = a * qty[l] + b * qny[l] + sp * qby[l];
+            tz[l] = a * qtz[l] + b * qnz[l] + sp * qbz[l];
+        }
+    }
+    /// Lane @a l on helicoid @a h at @a p, with theta @a theta and E_T @a t there.
+    void set(int l, const Helicoid& h, const Vec3d& p, const Vec3d& t, double theta, double step)
+    {
+        px[l] = p.x(); py[l] = p.y(); pz[l] = p.z();
+        tx[l] = t.x(); ty[l] = t.y(); tz[l] = t.z();
+        th[l] = theta;
+        hstep[l] = step;
+        qtx[l] = h.q.t.x(); qty[l] = h.q.t.y(); qtz[l] = h.q.t.z();
+        qnx[l] = h.q.n.x(); qny[l] = h.q.n.y(); qnz[l] = h.q.n.z();
+        qbx[l] = h.q.b.x(); qby[l] = h.q.b.y(); qbz[l] = h.q.b.z();
+        ox[l] = h.p0.x(); oy[l] = h.p0.y(); oz[l] = h.p0.z();
+        kT[l] = h.k.kT; kN[l] = h.k.kN; kB[l] = h.k.kB; alpha[l] = h.k.alpha;
+    }
+    Vec3d point(int l) const { return Vec3d(px[l], py[l], pz[l]); }
 };
 
 /// Wisp strands through a shared helicoid field with forward Euler: tracePHelicoids' hot path.
@@ -268,6 +324,89 @@ void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame,
                 }
             }
             for (std::size_t l = 0; l < lanes; ++l) f[l] = fr[l];
+        }
+    }
+}
+
+void tracePHelicoidPointsEuler(const PHelicoidRequest* strands, std::size_t count, Vec3f* const* out)
+{
+    EulerLanesPerStrand L;
+    // Per lane: the strand, its piece, the steps left in it, the next point's index, and the
+    // frame the next piece starts from (Eq. 2 at the piece's end).
+    struct Lane
+    {
+        std::size_t strand = 0, piece = 0, stepsLeft = 0, steps = 0, at = 0;
+        bool active = false;
+        Helicoid h;
+        double theta = 0.0;
+    };
+    Lane lanes[kLanes];
+    // Start @a ln on piece @a i of its strand at point @a p with frame @a f (the previous piece's
+    // frame at its end, or the root frame); false once the strand has no pieces left.
+    const auto startPiece = [&](int ln, const Vec3d& p, FrameD f) {
+        Lane& lane = lanes[ln];
+        const PHelicoidRequest& r = strands[lane.strand];
+        while (lane.piece < r.pieces->size()) {
+            const HelicoidPiece& pc = (*r.pieces)[lane.piece];
+            lane.h.k = pc.k;
+            lane.h.q = f.rolled(pc.roll);
+            lane.h.p0 = p;
+            lane.theta = lane.h.theta(p, 0.0);
+            lane.steps = stepCount(pc.length, r.step);
+            lane.stepsLeft = lane.steps;
+            if (lane.steps > 0) {
+                L.set(ln, lane.h, p, lane.h.frameFromTheta(lane.theta).t, lane.theta, lane.steps == 1 ? pc.length : r.step);
+                return true;
+            }
+            // A piece of no length: the next starts here, from its (rolled) frame, as in tracePHelicoids().
+            f = lane.h.frameFromTheta(lane.theta);
+            ++lane.piece;
+        }
+        return false;
+    };
+    std::size_t next = 0;
+    const auto feed = [&](int ln) {
+        Lane& lane = lanes[ln];
+        lane.active = false;
+        while (next < count) {
+            lane.strand = next++;
+            lane.piece = 0;
+            lane.at = 1;
+            const PHelicoidRequest& r = strands[lane.strand];
+            out[lane.strand][0] = Vec3f(r.root);
+            if (startPiece(ln, r.root, r.frame)) {
+                lane.active = true;
+                return;
+            }
+        }
+        // Idle: keep stepping harmless values.
+        L.set(ln, Helicoid{}, Vec3d(0.0), Vec3d(1.0, 0.0, 0.0), 0.0, 0.0);
+    };
+    int activeLanes = 0;
+    for (int l = 0; l < kLanes; ++l) {
+        feed(l);
+        activeLanes += lanes[l].active;
+    }
+    while (activeLanes > 0) {
+        L.step();
+        for (int l = 0; l < kLanes; ++l) {
+            Lane& lane = lanes[l];
+            if (!lane.active) continue;
+            const PHelicoidRequest& r = strands[lane.strand];
+            const Vec3d p = L.point(l);
+            out[lane.strand][lane.at++] = Vec3f(float(p.x()), float(p.y()), float(p.z()));
+            if (--lane.stepsLeft > 0) {
+                // The last step of a piece lands on its length.
+                if (lane.stepsLeft == 1) L.hstep[l] = (*r.pieces)[lane.piece].length - double(lane.steps - 1) * r.step;
+                continue;
+            }
+            // The piece ends: the next starts here with the frame of Eq. 2 at this point.
+            const FrameD f = lane.h.frameFromTheta(L.th[l]);
+            ++lane.piece;
+            if (!startPiece(l, p, f)) {
+                feed(l);
+                if (!lane.active) --activeLanes;
+            }
         }
     }
 }

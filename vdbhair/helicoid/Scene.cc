@@ -1,6 +1,7 @@
 #include "Scene.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Memory.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/JsonFile.h>
@@ -276,6 +277,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
     }
     StrandSet out;
     out.offsets = offsets;
+    reserveHugePages(out.positions, offsets.back());  // fresh pages 2 MiB at a time (Memory.h)
     out.positions.resize(offsets.back());
 
     // Guides first (wisps need their traces), then all strands in parallel.
@@ -306,6 +308,28 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
             if (progress.stopped()) return;
             const Item& it = items[i];
             const SceneGuide& guide = scene.guides[it.guide];
+            // Hairs without wisps or waviness traced with forward Euler (interpolated hair) need
+            // their points only: a run of them goes through the lane kernel at once.
+            const auto pointsOnly = [&](const Item& x) {
+                const SceneGuide& g = scene.guides[x.guide];
+                return !g.wisp && !g.waviness && !report && integrator == HelicoidIntegrator::Euler;
+            };
+            if (pointsOnly(it)) {
+                constexpr std::size_t kRun = 64;
+                PHelicoidRequest run[kRun];
+                Vec3f* dst[kRun];
+                std::size_t count = 0;
+                while (count < kRun && i + count != r.end() && pointsOnly(items[i + count])) {
+                    const SceneGuide& g = scene.guides[items[i + count].guide];
+                    run[count] = PHelicoidRequest{g.root, g.frame, &g.pieces, stepOf(g)};
+                    dst[count] = out.positions.data() + out.offsets[i + count];
+                    ++count;
+                }
+                tracePHelicoidPointsEuler(run, count, dst);
+                i += count;
+                progress.add(count);
+                continue;
+            }
             std::size_t count = 1;
             rngs.assign(1, Rng(scene.seed, it.guide, it.wisp));
             const HelicoidTrace* batch[kBatch] = {&guideTraces[it.guide]};
