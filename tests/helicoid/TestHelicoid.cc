@@ -281,7 +281,7 @@ TEST_CASE("tracePHelicoids: the wisps' SIMD Euler lanes hold to the engine's Eul
     }
 }
 
-TEST_CASE("tracePHelicoidPointsEuler: every lane on its own p-helicoid holds to tracePHelicoid, and growScene uses it", "[helicoid]")
+TEST_CASE("tracePHelicoidPoints: every lane on its own p-helicoid holds to tracePHelicoid (Euler and RK4), and growScene uses it", "[helicoid]")
 {
     // 21 strands (two full groups of eight lanes and one partly idle), each with its own root,
     // frame, 1 to 5 pieces of lengths that are not multiples of the step (one of zero length),
@@ -301,40 +301,43 @@ TEST_CASE("tracePHelicoidPointsEuler: every lane on its own p-helicoid holds to 
         req[i].pieces = &pieces[i];
         req[i].step = i % 3 == 0 ? 0.013 : 0.02;
     }
-    std::vector<std::vector<Vec3f>> outs(req.size());
-    std::vector<Vec3f*> dst(req.size());
-    for (std::size_t i = 0; i < req.size(); ++i) {
-        std::size_t total = 1;
-        for (const HelicoidPiece& pc : pieces[i]) total += stepCount(pc.length, req[i].step);
-        outs[i].assign(total, Vec3f(std::numeric_limits<float>::quiet_NaN()));
-        dst[i] = outs[i].data();
-    }
-    tracePHelicoidPointsEuler(req.data(), req.size(), dst.data());
-
-    Scene scene;
-    scene.step = 0.02;
-    for (std::size_t i = 0; i < req.size(); ++i) {
-        HelicoidTrace t;
-        tracePHelicoid(req[i].root, req[i].frame, pieces[i], req[i].step, HelicoidIntegrator::Euler, t);
-        REQUIRE(t.points.size() == outs[i].size());
-        double worst = 0.0;
-        for (std::size_t k = 0; k < t.points.size(); ++k) worst = std::max(worst, (Vec3d(outs[i][k]) - t.points[k]).length());
-        CAPTURE(i, worst);
-        REQUIRE(worst < 1e-5);  // float output of the same steps (the lanes' branchless atan2 and sin/cos)
-        SceneGuide g;
-        g.root = req[i].root;
-        g.frame = req[i].frame;
-        g.pieces = pieces[i];
-        g.step = req[i].step;
-        scene.guides.push_back(g);
-    }
-    // A scene of such hairs grows through the lanes: the same points, with any thread count.
-    for (bool threaded : {false, true}) {
-        const StrandSet grown = growScene(scene, {}, threaded);
-        REQUIRE(grown.numStrands() == req.size());
+    for (const HelicoidIntegrator integrator : {HelicoidIntegrator::Euler, HelicoidIntegrator::RK4}) {
+        std::vector<std::vector<Vec3f>> outs(req.size());
+        std::vector<Vec3f*> dst(req.size());
         for (std::size_t i = 0; i < req.size(); ++i) {
-            REQUIRE(grown.size(i) == outs[i].size());
-            for (std::size_t k = 0; k < outs[i].size(); ++k) REQUIRE(grown.data(i)[k] == outs[i][k]);
+            std::size_t total = 1;
+            for (const HelicoidPiece& pc : pieces[i]) total += stepCount(pc.length, req[i].step);
+            outs[i].assign(total, Vec3f(std::numeric_limits<float>::quiet_NaN()));
+            dst[i] = outs[i].data();
+        }
+        tracePHelicoidPoints(req.data(), req.size(), integrator, dst.data());
+
+        Scene scene;
+        scene.step = 0.02;
+        scene.integrator = integrator;
+        for (std::size_t i = 0; i < req.size(); ++i) {
+            HelicoidTrace t;
+            tracePHelicoid(req[i].root, req[i].frame, pieces[i], req[i].step, integrator, t);
+            REQUIRE(t.points.size() == outs[i].size());
+            double worst = 0.0;
+            for (std::size_t k = 0; k < t.points.size(); ++k) worst = std::max(worst, (Vec3d(outs[i][k]) - t.points[k]).length());
+            CAPTURE(i, worst);
+            REQUIRE(worst < 1e-5);  // float output of the same steps (the lanes' branchless atan2 and sin/cos)
+            SceneGuide g;
+            g.root = req[i].root;
+            g.frame = req[i].frame;
+            g.pieces = pieces[i];
+            g.step = req[i].step;
+            scene.guides.push_back(g);
+        }
+        // A scene of such hairs grows through the lanes: the same points, with any thread count.
+        for (bool threaded : {false, true}) {
+            const StrandSet grown = growScene(scene, {}, threaded);
+            REQUIRE(grown.numStrands() == req.size());
+            for (std::size_t i = 0; i < req.size(); ++i) {
+                REQUIRE(grown.size(i) == outs[i].size());
+                for (std::size_t k = 0; k < outs[i].size(); ++k) REQUIRE(grown.data(i)[k] == outs[i][k]);
+            }
         }
     }
 }

@@ -76,7 +76,7 @@ struct EulerLanes
     double bx[kLanes], by[kLanes], bz[kLanes];
     double th[kLanes];
 
-    __attribute__((target_clones("avx2", "default"), flatten))  // flatten: see EulerLanesPerStrand
+    __attribute__((target_clones("avx2", "default"), flatten))  // flatten: see HelicoidLanes
     void step(const Helicoid& h, double hstep)
     {
         const double qtx = h.q.t.x(), qty = h.q.t.y(), qtz = h.q.t.z();
@@ -126,46 +126,73 @@ struct EulerLanes
     }
 };
 
-/// @brief kLanes positions moved one forward-Euler step (Eq. 3), each through its own helicoid and
-/// by its own step: EulerLanes with per-lane helicoids, for hairs that share nothing (interpolated
-/// hair). The same operations in the same order as EulerLanes::step.
-struct EulerLanesPerStrand
+/// @brief kLanes positions moved one step, each through its own helicoid and by its own step, with
+/// forward Euler (Eq. 3) or classical RK4: the lane kernel for hairs that share nothing
+/// (interpolated hair). Each stage is Helicoid::tangent() with the branchless forms of the same
+/// polynomials, unwrapped against theta at the step's start as AnalyticHelicoidSampler does, and
+/// the stages combine in StreamlineIntegrator's order (tests hold the lanes to tracePHelicoid()).
+struct HelicoidLanes
 {
     double px[kLanes], py[kLanes], pz[kLanes];
-    double tx[kLanes], ty[kLanes], tz[kLanes];
-    double th[kLanes];
+    double tx[kLanes], ty[kLanes], tz[kLanes];  // E_T at the current point
+    double th[kLanes];                          // theta there (unwrapped)
     double hstep[kLanes];
     // Each lane's helicoid: Q's columns, p0, k.
     double qtx[kLanes], qty[kLanes], qtz[kLanes], qnx[kLanes], qny[kLanes], qnz[kLanes], qbx[kLanes], qby[kLanes], qbz[kLanes];
     double ox[kLanes], oy[kLanes], oz[kLanes];
     double kT[kLanes], kN[kLanes], kB[kLanes], alpha[kLanes];
 
-    // flatten: the lane math must be inlined for the loop to vectorize (left to itself, the
-    // compiler called sinCosLane out of line: a third of the kernel's instructions).
-    __attribute__((target_clones("avx2", "default"), flatten))
-    void step()
+    /// E_T of lane @a l's helicoid at (x, y, z); @a t is unwrapped against its value on entry.
+    inline void tangent(int l, double x, double y, double z, double& t, double& ex, double& ey, double& ez) const
     {
         constexpr double twoPi = 2.0 * M_PI, invTwoPi = 1.0 / (2.0 * M_PI);
+        const double dx = x - ox[l], dy = y - oy[l], dz = z - oz[l];
+        const double y1 = dx * qtx[l] + dy * qty[l] + dz * qtz[l];
+        const double y2 = dx * qnx[l] + dy * qny[l] + dz * qnz[l];
+        const double y3 = dx * qbx[l] + dy * qby[l] + dz * qbz[l];
+        double a = fastmath::atan2Lane(kT[l] * y1 + kN[l] * y2, 1.0 + kN[l] * y1 - kT[l] * y2) + kB[l] * y3;
+        a += twoPi * fastmath::roundLane((t - a) * invTwoPi);
+        t = a;
+        double st, ct, sp, cp;
+        fastmath::sinCosLane(a, st, ct);
+        fastmath::sinCosLane(alpha[l] * a, sp, cp);
+        const double u = cp * ct, v = cp * st;
+        ex = u * qtx[l] + v * qnx[l] + sp * qbx[l];
+        ey = u * qty[l] + v * qny[l] + sp * qby[l];
+        ez = u * qtz[l] + v * qnz[l] + sp * qbz[l];
+    }
+
+    // flatten: the lane math must be inlined for the loops to vectorize (left to itself, the
+    // compiler called sinCosLane out of line: a third of the kernel's instructions).
+    __attribute__((target_clones("avx2", "default"), flatten))
+    void stepEuler()
+    {
         for (int l = 0; l < kLanes; ++l) {
             px[l] += hstep[l] * tx[l];
             py[l] += hstep[l] * ty[l];
             pz[l] += hstep[l] * tz[l];
-            const double dx = px[l] - ox[l], dy = py[l] - oy[l], dz = pz[l] - oz[l];
-            const double y1 = dx * qtx[l] + dy * qty[l] + dz * qtz[l];
-            const double y2 = dx * qnx[l] + dy * qny[l] + dz * qnz[l];
-            const double y3 = dx * qbx[l] + dy * qby[l] + dz * qbz[l];
-            double t = fastmath::atan2Lane(kT[l] * y1 + kN[l] * y2, 1.0 + kN[l] * y1 - kT[l] * y2) + kB[l] * y3;
-            t += twoPi * fastmath::roundLane((th[l] - t) * invTwoPi);
-            th[l] = t;
-            double st, ct, sp, cp;
-            fastmath::sinCosLane(t, st, ct);
-            fastmath::sinCosLane(alpha[l] * t, sp, cp);
-            const double a = cp * ct, b = cp * st;
-            tx[l] = a * qtx[l] + b * qnx[l] + sp * qbx[l];
-            ty[l] = a * qty[l] + b * qny[l] + sp * qby[l];
-            tz[l] = a * qtz[l] + b * qnz[l] + sp * qbz[l];
+            tangent(l, px[l], py[l], pz[l], th[l], tx[l], ty[l], tz[l]);
         }
     }
+
+    __attribute__((target_clones("avx2", "default"), flatten))
+    void stepRk4()
+    {
+        for (int l = 0; l < kLanes; ++l) {
+            const double h = hstep[l], hh = 0.5 * h;
+            double t2 = th[l], t3 = th[l], t4 = th[l];
+            double k2x, k2y, k2z, k3x, k3y, k3z, k4x, k4y, k4z;
+            tangent(l, px[l] + hh * tx[l], py[l] + hh * ty[l], pz[l] + hh * tz[l], t2, k2x, k2y, k2z);
+            tangent(l, px[l] + hh * k2x, py[l] + hh * k2y, pz[l] + hh * k2z, t3, k3x, k3y, k3z);
+            tangent(l, px[l] + h * k3x, py[l] + h * k3y, pz[l] + h * k3z, t4, k4x, k4y, k4z);
+            const double h6 = h / 6.0;
+            px[l] += h6 * (((tx[l] + 2.0 * k2x) + 2.0 * k3x) + k4x);
+            py[l] += h6 * (((ty[l] + 2.0 * k2y) + 2.0 * k3y) + k4y);
+            pz[l] += h6 * (((tz[l] + 2.0 * k2z) + 2.0 * k3z) + k4z);
+            tangent(l, px[l], py[l], pz[l], th[l], tx[l], ty[l], tz[l]);
+        }
+    }
+
     /// Lane @a l on helicoid @a h at @a p, with theta @a theta and E_T @a t there.
     void set(int l, const Helicoid& h, const Vec3d& p, const Vec3d& t, double theta, double step)
     {
@@ -328,9 +355,10 @@ void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame,
     }
 }
 
-void tracePHelicoidPointsEuler(const PHelicoidRequest* strands, std::size_t count, Vec3f* const* out)
+void tracePHelicoidPoints(const PHelicoidRequest* strands, std::size_t count, HelicoidIntegrator integrator, Vec3f* const* out)
 {
-    EulerLanesPerStrand L;
+    HelicoidLanes L;
+    const bool rk4 = integrator == HelicoidIntegrator::RK4;
     // Per lane: the strand, its piece, the steps left in it, the next point's index, and the
     // frame the next piece starts from (Eq. 2 at the piece's end).
     struct Lane
@@ -388,7 +416,8 @@ void tracePHelicoidPointsEuler(const PHelicoidRequest* strands, std::size_t coun
         activeLanes += lanes[l].active;
     }
     while (activeLanes > 0) {
-        L.step();
+        if (rk4) L.stepRk4();
+        else L.stepEuler();
         for (int l = 0; l < kLanes; ++l) {
             Lane& lane = lanes[l];
             if (!lane.active) continue;

@@ -169,7 +169,7 @@ double traceClearance(const HelicoidTrace& trace, double step);
 void tracePHelicoids(const Vec3d* roots, std::size_t count, const FrameD& frame, const std::vector<HelicoidPiece>& pieces,
                      double step, HelicoidIntegrator integrator, HelicoidTrace* outs, const std::vector<Helicoid>* field = nullptr);
 
-/// @brief One p-helicoid to trace: root, frame, pieces and step (tracePHelicoidPointsEuler()).
+/// @brief One p-helicoid to trace: root, frame, pieces and step (tracePHelicoidPoints()).
 struct PHelicoidRequest
 {
     Vec3d root{0.0};
@@ -179,11 +179,10 @@ struct PHelicoidRequest
 };
 
 /// @brief The points only of @a count p-helicoids, each with its own root, frame, pieces and step,
-/// traced with forward Euler (Eq. 3) eight at a time through the lane kernel of wisps, each lane
-/// on its own strand's helicoid (interpolated hair: growScene()'s hot path). Strand i's points go
-/// to @a out[i], which holds 1 + Σ stepCount(length, step) points. The same steps as
-/// tracePHelicoid() with HelicoidIntegrator::Euler (the branchless forms of the same
-/// polynomials; tests hold them together).
-void tracePHelicoidPointsEuler(const PHelicoidRequest* strands, std::size_t count, Vec3f* const* out);
+/// traced with forward Euler (Eq. 3) or RK4 eight at a time in a lane kernel, each lane on its
+/// own strand's helicoids (interpolated hair: growScene()'s hot path). Strand i's points go to
+/// @a out[i], which holds 1 + Σ stepCount(length, step) points. The same steps as
+/// tracePHelicoid() (the branchless forms of the same polynomials; tests hold them together).
+void tracePHelicoidPoints(const PHelicoidRequest* strands, std::size_t count, HelicoidIntegrator integrator, Vec3f* const* out);
 
 } // namespace vdbhair

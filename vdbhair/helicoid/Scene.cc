@@ -308,11 +308,11 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
             if (progress.stopped()) return;
             const Item& it = items[i];
             const SceneGuide& guide = scene.guides[it.guide];
-            // Hairs without wisps or waviness traced with forward Euler (interpolated hair) need
-            // their points only: a run of them goes through the lane kernel at once.
+            // Hairs without wisps or waviness (interpolated hair) need their points only: a run of
+            // them goes through the lane kernel at once.
             const auto pointsOnly = [&](const Item& x) {
                 const SceneGuide& g = scene.guides[x.guide];
-                return !g.wisp && !g.waviness && !report && integrator == HelicoidIntegrator::Euler;
+                return !g.wisp && !g.waviness && !report;
             };
             if (pointsOnly(it)) {
                 constexpr std::size_t kRun = 64;
@@ -325,7 +325,7 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
                     dst[count] = out.positions.data() + out.offsets[i + count];
                     ++count;
                 }
-                tracePHelicoidPointsEuler(run, count, dst);
+                tracePHelicoidPoints(run, count, integrator, dst);
                 i += count;
                 progress.add(count);
                 continue;
