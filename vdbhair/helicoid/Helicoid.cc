@@ -64,6 +64,21 @@ namespace {
 
 constexpr int kLanes = 8;
 
+/// @brief Eq. 1 in a lane: theta at local coordinates (y1, y2, y3) of a helicoid with curvatures
+/// (kT, kN, kB), unwrapped against @a t (which receives it), and the sines and cosines of theta and
+/// of phi = alpha theta that Eq. 2's frame is made of. Branchless (FastMath.h), for the lane
+/// kernels below.
+inline void laneAngles(double y1, double y2, double y3, double kT, double kN, double kB, double alpha, double& t,
+                       double& st, double& ct, double& sp, double& cp)
+{
+    constexpr double twoPi = 2.0 * M_PI, invTwoPi = 1.0 / (2.0 * M_PI);
+    double a = fastmath::atan2Lane(kT * y1 + kN * y2, 1.0 + kN * y1 - kT * y2) + kB * y3;
+    a += twoPi * fastmath::roundLane((t - a) * invTwoPi);
+    t = a;
+    fastmath::sinCosLane(a, st, ct);
+    fastmath::sinCosLane(alpha * a, sp, cp);
+}
+
 /// @brief kLanes positions moved one forward-Euler step (Eq. 3) through one helicoid, then theta
 /// (unwrapped), the frame of Eq. 2 and the next tangent there. Structure of arrays with a fixed
 /// trip count and branchless math, so the compiler vectorizes it (with AVX2 where the processor
@@ -84,7 +99,6 @@ struct EulerLanes
         const double qbx = h.q.b.x(), qby = h.q.b.y(), qbz = h.q.b.z();
         const double ox = h.p0.x(), oy = h.p0.y(), oz = h.p0.z();
         const double kT = h.k.kT, kN = h.k.kN, kB = h.k.kB, alpha = h.k.alpha;
-        constexpr double twoPi = 2.0 * M_PI, invTwoPi = 1.0 / (2.0 * M_PI);
         for (int l = 0; l < kLanes; ++l) {
             px[l] += hstep * tx[l];
             py[l] += hstep * ty[l];
@@ -93,12 +107,8 @@ struct EulerLanes
             const double y1 = dx * qtx + dy * qty + dz * qtz;
             const double y2 = dx * qnx + dy * qny + dz * qnz;
             const double y3 = dx * qbx + dy * qby + dz * qbz;
-            double t = fastmath::atan2Lane(kT * y1 + kN * y2, 1.0 + kN * y1 - kT * y2) + kB * y3;
-            t += twoPi * fastmath::roundLane((th[l] - t) * invTwoPi);
-            th[l] = t;
             double st, ct, sp, cp;
-            fastmath::sinCosLane(t, st, ct);
-            fastmath::sinCosLane(alpha * t, sp, cp);
+            laneAngles(y1, y2, y3, kT, kN, kB, alpha, th[l], st, ct, sp, cp);
             const double a = cp * ct, b = cp * st, e = -sp * ct, f = -sp * st;
             tx[l] = a * qtx + b * qnx + sp * qbx;
             ty[l] = a * qty + b * qny + sp * qby;
@@ -145,17 +155,12 @@ struct HelicoidLanes
     /// E_T of lane @a l's helicoid at (x, y, z); @a t is unwrapped against its value on entry.
     inline void tangent(int l, double x, double y, double z, double& t, double& ex, double& ey, double& ez) const
     {
-        constexpr double twoPi = 2.0 * M_PI, invTwoPi = 1.0 / (2.0 * M_PI);
         const double dx = x - ox[l], dy = y - oy[l], dz = z - oz[l];
         const double y1 = dx * qtx[l] + dy * qty[l] + dz * qtz[l];
         const double y2 = dx * qnx[l] + dy * qny[l] + dz * qnz[l];
         const double y3 = dx * qbx[l] + dy * qby[l] + dz * qbz[l];
-        double a = fastmath::atan2Lane(kT[l] * y1 + kN[l] * y2, 1.0 + kN[l] * y1 - kT[l] * y2) + kB[l] * y3;
-        a += twoPi * fastmath::roundLane((t - a) * invTwoPi);
-        t = a;
         double st, ct, sp, cp;
-        fastmath::sinCosLane(a, st, ct);
-        fastmath::sinCosLane(alpha[l] * a, sp, cp);
+        laneAngles(y1, y2, y3, kT[l], kN[l], kB[l], alpha[l], t, st, ct, sp, cp);
         const double u = cp * ct, v = cp * st;
         ex = u * qtx[l] + v * qnx[l] + sp * qbx[l];
         ey = u * qty[l] + v * qny[l] + sp * qby[l];
