@@ -6,6 +6,7 @@
 #include <vdbhair/field/FieldSampler.h>
 #include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/Streamline.h>
+#include <vdbhair/strands/Measures.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 
 namespace vdbhair {
 
@@ -278,12 +280,19 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
     const TreeT::Ptr spreadTree = spreadAsVectors(field);
     const BrickedField<TreeT> spreads(*spreadTree);
     const openvdb::Vec3SGrid& volumeGrid = hairVolume ? *hairVolume : *field.tangent;
-    const BrickedField<TreeT> volume(volumeGrid.tree());
+    // The field's own bricks when the hair volume is its grid (one-level refinement).
+    std::unique_ptr<const BrickedField<TreeT>> ownVolume;
+    if (&volumeGrid != field.tangent.get()) ownVolume.reset(new BrickedField<TreeT>(volumeGrid.tree()));
+    const BrickedField<TreeT>& volume = ownVolume ? *ownVolume : tangents;
     const HairVolume dilated(volumeGrid);
     const Shared shared{strands, map, FieldMapping::fromGrid(volumeGrid), tangents, spreads, volume, dilated, head, params, step,
                         std::sin(params.minSpreadDeg * M_PI / 180.0), 1.0 / (params.returnVoxels * map.worldVoxelSize()), out};
 
     const std::size_t nS = strands.numStrands();
+    // Strands in spatial order (Measures.h): neighbouring strands sample the same bricks, which
+    // then stay in cache (synthesized roots come in random order). Each strand is traced on its
+    // own and the counts are integers, so the order changes nothing in the result.
+    const std::vector<std::uint32_t> order = spatialOrder(strands);
     constexpr std::size_t kChunk = 256;
     const std::size_t nChunks = (nS + kChunk - 1) / kChunk;
     std::vector<Counts> counts(nChunks);
@@ -292,7 +301,7 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
         if (progress.stopped()) return;
         StrandTracer tracer(shared);
         const std::size_t first = c * kChunk, last = std::min(nS, first + kChunk);
-        for (std::size_t i = first; i < last; ++i) tracer.trace(i, counts[c]);
+        for (std::size_t o = first; o < last; ++o) tracer.trace(order[o], counts[c]);
         progress.add(last - first);
     };
     if (threaded) {

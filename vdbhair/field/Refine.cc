@@ -180,7 +180,9 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
         FieldParams lp = fp;
         lp.voxelSize = fp.voxelSize * double(1 << level);
         const StrandSet& from = level == params.levels - 1 ? strands : current;
-        TangentField f = estimateTangentField(from, lp, threaded, interrupter);
+        // With one level, the level's field is the input's (the same strands at the same voxel
+        // size): estimated once, shared.
+        TangentField f = params.levels == 1 ? inputField : estimateTangentField(from, lp, threaded, interrupter);
         f.tangent->setName(tangentGridName(level, params.levels));
         f.density->setName(densityGridName(level, params.levels));
         f.hairLength->setName(hairLengthGridName(level, params.levels));

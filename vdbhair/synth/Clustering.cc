@@ -86,6 +86,7 @@ struct Lloyd
     std::size_t islands = 0;
     std::vector<std::uint32_t> memoCluster;
     std::vector<double> memoDistance;
+    std::vector<double> own;  ///< after fit(): each strand's distance to its cluster's centre
 
     std::size_t k() const { return seeds.size(); }
     double dist(std::size_t s, std::size_t c) const
@@ -146,21 +147,36 @@ struct Lloyd
     double fit()
     {
         const std::size_t n = samples.count(), kk = k();
-        std::vector<double> sum(kk * dim, 0.0);
-        std::vector<std::size_t> count(kk, 0);
-        for (std::size_t s = 0; s < n; ++s) {
-            const float* r = samples.row(s);
-            double* acc = sum.data() + label[s] * dim;
-            for (std::size_t i = 0; i < dim; ++i) acc[i] += r[i];
-            ++count[label[s]];
+        // Each cluster's members in strand order (a counting sort), so that each centre sums its
+        // members in strand order on any thread: the same sums as one pass in strand order.
+        std::vector<std::uint32_t> start(kk + 1, 0), members(n);
+        for (std::size_t s = 0; s < n; ++s) ++start[label[s] + 1];
+        for (std::size_t c = 0; c < kk; ++c) start[c + 1] += start[c];
+        {
+            std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+            for (std::uint32_t s = 0; s < n; ++s) members[at[label[s]]++] = s;
         }
-        for (std::size_t c = 0; c < kk; ++c)
-            for (std::size_t i = 0; i < dim; ++i)
-                centers[c * dim + i] = float(sum[c * dim + i] / double(std::max<std::size_t>(count[c], 1)));
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kk, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+            std::vector<double> sum(dim);
+            for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                std::fill(sum.begin(), sum.end(), 0.0);
+                for (std::uint32_t m = start[c]; m < start[c + 1]; ++m) {
+                    const float* row = samples.row(members[m]);
+                    for (std::size_t i = 0; i < dim; ++i) sum[i] += row[i];
+                }
+                const double count = double(std::max<std::uint32_t>(start[c + 1] - start[c], 1));
+                for (std::size_t i = 0; i < dim; ++i) centers[c * dim + i] = float(sum[i] / count);
+            }
+        });
+        // Each strand's distance to its centre (in parallel), then E and the seeds in strand order.
+        own.resize(n);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t s = r.begin(); s != r.end(); ++s) own[s] = dist(s, label[s]);
+        });
         double energy = 0.0;
         std::vector<double> best(kk, std::numeric_limits<double>::max());
         for (std::uint32_t s = 0; s < n; ++s) {
-            const double d = dist(s, label[s]);
+            const double d = own[s];
             energy += d;
             if (d < best[label[s]]) {
                 best[label[s]] = d;
@@ -237,7 +253,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
         throw ValueError("clusterSamples: " + std::to_string(k) + " clusters of " + std::to_string(n) +
                          " strands: between 1 and the strand count");
     const Graph graph(neighbourGraph(samples.roots, params.neighbours));
-    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}};
+    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}, {}};
     lloyd.seeds = initialSeeds(samples, k, Rng(params.seed, 0x5eedc1u, stream));
     for (std::uint32_t s : lloyd.seeds) lloyd.centers.insert(lloyd.centers.end(), samples.row(s), samples.row(s) + lloyd.dim);
     Clustering out;
@@ -259,7 +275,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
         std::vector<double> far(lloyd.k(), -1.0);
         std::vector<std::uint32_t> farthest(lloyd.k(), 0);
         for (std::uint32_t s = 0; s < n; ++s) {
-            const double d = lloyd.dist(s, lloyd.label[s]);
+            const double d = lloyd.own[s];
             if (d > far[lloyd.label[s]]) {
                 far[lloyd.label[s]] = d;
                 farthest[lloyd.label[s]] = s;
@@ -283,7 +299,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
     std::vector<double> lengthSum(kk, 0.0);
     std::vector<std::size_t> count(kk, 0);
     for (std::uint32_t s = 0; s < n; ++s) {
-        out.largestDistance = std::max(out.largestDistance, lloyd.dist(s, lloyd.label[s]));
+        out.largestDistance = std::max(out.largestDistance, lloyd.own[s]);
         rootSum[lloyd.label[s]] += samples.roots[s];
         lengthSum[lloyd.label[s]] += samples.lengths[s];
         ++count[lloyd.label[s]];

@@ -93,7 +93,7 @@ void sampleToWorld(const float* localRow, int vertices, const Vec3d& root, const
     }
 }
 
-StrandSet samplesToStrands(const StrandSamples& samples, double radius)
+StrandSet samplesToStrands(const StrandSamples& samples, double radius, bool threaded)
 {
     StrandSet out;
     const std::size_t n = samples.count(), ns = std::size_t(samples.vertices);
@@ -103,9 +103,14 @@ StrandSet samplesToStrands(const StrandSamples& samples, double radius)
     out.positions.resize(n * ns);
     out.offsets.resize(n + 1);
     for (std::size_t s = 0; s <= n; ++s) out.offsets[s] = std::uint32_t(s * ns);
-    for (std::size_t s = 0; s < n; ++s)
-        sampleToWorld(samples.row(s), samples.vertices, samples.roots[s], samples.frames[s], radius,
-                      out.positions.data() + s * ns);
+    // Each strand writes only its own vertices: the same on any thread count.
+    const auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t s = r.begin(); s != r.end(); ++s)
+            sampleToWorld(samples.row(s), samples.vertices, samples.roots[s], samples.frames[s], radius,
+                          out.positions.data() + s * ns);
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), body);
+    else body(tbb::blocked_range<std::size_t>(0, n));
     return out;
 }
 

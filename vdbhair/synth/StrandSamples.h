@@ -56,6 +56,6 @@ void sampleToWorld(const float* localRow, int vertices, const Vec3d& root, const
                    Vec3f* out);
 
 /// @brief All samples as world strands of n_s vertices each.
-StrandSet samplesToStrands(const StrandSamples& samples, double radius);
+StrandSet samplesToStrands(const StrandSamples& samples, double radius, bool threaded = true);
 
 } // namespace vdbhair

@@ -270,7 +270,7 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
     StrandSet finestStrands;
     const auto refineLevel = [&](int l, bool refine) {
         StrandSamples& level = res.output[std::size_t(l)];
-        StrandSet strands = samplesToStrands(level, radius);
+        StrandSet strands = samplesToStrands(level, radius, threaded);
         if (refine && params.refine) {
             SynthStageTimer t{res.stages, "refinement"};
             RefineParams rp;
