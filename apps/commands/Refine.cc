@@ -23,26 +23,13 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     if (stepGiven && (!(rp.trace.step > 0.0) || !std::isfinite(rp.trace.step))) {
         throw ValueError("--step " + formatValue(rp.trace.step) + ": must be a positive finite length");
     }
-    rp.consistency.step = rp.trace.step;  // one --step for both modes
+    rp.setStep(rp.trace.step, integratorFromName(p.integrator));  // one --step and --integrator for both modes
     if (rp.field.iterations < 1) throw ValueError("--iterations " + std::to_string(rp.field.iterations) + ": must be at least 1");
-    if (rp.levels < 1 || rp.levels > RefineParams::kMaxLevels) {
-        throw ValueError("--levels " + std::to_string(rp.levels) + ": must be between 1 and " + std::to_string(RefineParams::kMaxLevels));
-    }
     if (rp.trace.margin < 0 || rp.trace.margin > TraceParams::kMaxMargin) {
         throw ValueError("--margin " + std::to_string(rp.trace.margin) + ": must be between 0 and " + std::to_string(TraceParams::kMaxMargin) + " voxels");
     }
-    if (!(rp.consistency.zStart >= 0.0) || !std::isfinite(rp.consistency.zStart)) {
-        throw ValueError("--outlier-start " + formatValue(rp.consistency.zStart) + ": must be finite and at least 0");
-    }
-    if (!(rp.consistency.zFull > rp.consistency.zStart) || !std::isfinite(rp.consistency.zFull)) {
-        throw ValueError("--outlier-full " + formatValue(rp.consistency.zFull) + ": must be finite and above --outlier-start " +
-                         formatValue(rp.consistency.zStart));
-    }
-    if (!(rp.consistency.minSpreadDeg >= 0.0 && rp.consistency.minSpreadDeg < 90.0)) {
-        throw ValueError("--min-spread " + formatValue(rp.consistency.minSpreadDeg) + ": must be in [0, 90) degrees");
-    }
+    rp.validate("option");  // the library's ranges, its field names spelled as flags (addRefineCommand)
     rp.mode = refineModeFromName(p.mode);
-    rp.trace.integrator = integratorFromName(p.integrator);
     // A scalp given as a sphere or a level set is also the head the strands keep out of, unless
     // --head says otherwise.
     const openvdb::FloatGrid::Ptr surface = applyScalpOptions(p.scalp, strands, rp.field, common);
@@ -196,7 +183,7 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
     sub->add_option("--min-spread", rp.consistency.minSpreadDeg,
                     "consistent mode: deviations below this many degrees are never outliers")->capture_default_str();
     addHeadOptions(sub, p.head, "--scalp's sphere if given, else a sphere fitted to the roots");
-    sub->add_option("--integrator", p.integrator, "field mode: euler (the papers' choice), rk2 or rk4")->capture_default_str();
+    sub->add_option("--integrator", p.integrator, "euler (the papers' choice), rk2, rk3 or rk4: each step of either mode")->capture_default_str();
     sub->add_option("--margin", rp.trace.margin, "field mode: voxels a strand may continue straight past the field's active region")->capture_default_str();
     sub->add_option("--max-voxels", rp.field.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
     sub->add_option("--max-memory", rp.field.maxMemory, "Refuse work whose memory estimate exceeds this many bytes (suffixes k, M, G: 16G); 0: the memory available (MemAvailable)")
@@ -215,7 +202,8 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
     addRefineOptions(sub, *params);
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --json");
-    return {sub, [params, &common] { return runRefine(*params, common); }, {{"maxVoxels", "--max-voxels"}, {"maxMemory", "--max-memory"}}};
+    return {sub, [params, &common] { return runRefine(*params, common); }, {{"maxVoxels", "--max-voxels"}, {"maxMemory", "--max-memory"}, {"zStart", "--outlier-start"}, {"zFull", "--outlier-full"},
+                                                                       {"minSpreadDeg", "--min-spread"}, {"levels", "--levels"}}};
 }
 
 } // namespace vdbhair::app

@@ -154,7 +154,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
     params->stepOpt = sub->add_option("--step", params->trace.step, "Integration step in world units (default: " + formatValue(kDefaultStepVoxels) + " of the field's voxel size)");
-    sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2 or rk4")->capture_default_str();
+    sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2, rk3 or rk4")->capture_default_str();
     sub->add_option("--vanish", params->trace.vanishThreshold, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
     sub->add_option("--max-steps", params->trace.maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
     sub->add_option("--margin", params->trace.margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();

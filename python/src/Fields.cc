@@ -618,7 +618,7 @@ Args:
     field: a TangentField (its tangent grid is followed) or a vector Grid (vec3s), e.g. read with
         read_grid from any OpenVDB writer.
     step: integration step in world units; 0 picks half the field's voxel size.
-    integrator: "euler" (the papers' choice), "rk2" or "rk4".
+    integrator: "euler" (the papers' choice), "rk2", "rk3" or "rk4".
     vanish: stop where the blended direction's length falls below this fraction, in [0, 1).
     max_steps: stop a strand after this many steps (0: no limit).
     margin: voxels (0-16) a strand may continue straight past the field's active region
@@ -648,12 +648,10 @@ Raises:
             rp.levels = levels;
             rp.mode = refineModeFromName(mode);
             rp.field.iterations = iterations;
-            rp.trace.step = step;
-            rp.consistency.step = step;  // one step for both modes, as the CLI's --step
+            rp.setStep(step, integratorFromName(integrator));  // one step and integrator for both modes, as the CLI's
             rp.consistency.zStart = outlierStart;
             rp.consistency.zFull = outlierFull;
             rp.consistency.minSpreadDeg = minSpread;
-            rp.trace.integrator = integratorFromName(integrator);
             rp.trace.margin = margin;
             rp.field.maxVoxels = maxVoxels;
             rp.measure = measure;
@@ -725,7 +723,7 @@ Args:
     head: None (a sphere fitted to the roots), "none" (no head), a path to a mesh (.ply, .obj)
         or a .vdb level set, or a sphere (cx, cy, cz, r) in world units.
     head_policy: "no-deeper" (no vertex enters the head that was outside it) or "outside".
-    integrator: field mode: "euler", "rk2" or "rk4".
+    integrator: "euler", "rk2", "rk3" or "rk4", for each step of either mode.
     margin: field mode: voxels a strand may continue past the field's active region.
     max_voxels: refuse voxel sizes whose voxel visits could exceed this.
     measure: measure each level against the input (the report's numbers; costs a field a level).

@@ -114,7 +114,7 @@ def test_argument_errors(bundle, tmp_path):
     with pytest.raises(vdbhair.ArgumentError, match="voxel size"):
         vdbhair.estimate_tangent_field(bundle, voxel_size=-1.0)
     with pytest.raises(ValueError, match="integrator"):
-        vdbhair.retrace(bundle, field, integrator="rk3")
+        vdbhair.retrace(bundle, field, integrator="rk5")
     with pytest.raises(vdbhair.LimitError):
         vdbhair.estimate_tangent_field(bundle, voxel_size=1e-4, max_voxels=1000)
     with pytest.raises(ValueError, match=r"threads=-1: must be 0 \(all cores\) or more"):

@@ -54,7 +54,7 @@ Vec3f unitDir(const StrandSet& s, std::size_t i, std::size_t j)
 
 } // namespace
 
-TEST_CASE("refineStrands: outliers crossing a coherent bundle are pulled into its flow, inliers stay", "[field]")
+TEST_CASE("refineStrands: outliers crossing a coherent bundle are pulled into its flow, inliers stay, with every integrator", "[field]")
 {
     StrandSet s = bundle(20, 2.f, 10.f, 41);
     const std::size_t inliers = s.numStrands();
@@ -64,9 +64,14 @@ TEST_CASE("refineStrands: outliers crossing a coherent bundle are pulled into it
         const float a = angles[k] * float(M_PI) / 180.f;
         s.addStrand(line(Vec3f(0.f, 0.35f + 0.5f * float(k), 1.05f), Vec3f(std::cos(a), k == 1 ? -std::sin(a) : std::sin(a), 0.f), 10.f, 41));
     }
+    // The consistent retrace steps through the engine (Streamline.h): every integrator keeps the
+    // inliers and corrects the outliers.
+    const Integrator integ = GENERATE(Integrator::Euler, Integrator::RK2, Integrator::RK3, Integrator::RK4);
+    CAPTURE(integratorName(integ));
     RefineParams rp;
     rp.field.voxelSize = 0.5;
     rp.head = HeadObstacle::none();
+    rp.setStep(0.0, integ);
     const RefineResult r = refineStrands(s, rp);
     const double voxel = 0.5;
     double worstInlier = 0.0;
@@ -262,7 +267,7 @@ TEST_CASE("refineStrands: bad parameters are refused, naming them", "[field]")
     const StrandSet s = bundle(3, 1.f, 2.f, 5);
     RefineParams rp;
     rp.levels = 0;
-    REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("levels 0 must be between 1 and 8"));
+    REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("levels 0: must be between 1 and 8"));
     rp.levels = 1;
     rp.consistency.zFull = 1.0;
     REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("zFull"));

@@ -64,7 +64,7 @@ TEST_CASE("retraceStrands: a uniform field retraces straight strands exactly", "
     FieldParams p;
     p.voxelSize = 0.4;
     const TangentField f = estimateTangentField(s, p);
-    for (Integrator integ : {Integrator::Euler, Integrator::RK2, Integrator::RK4}) {
+    for (Integrator integ : {Integrator::Euler, Integrator::RK2, Integrator::RK3, Integrator::RK4}) {
         TraceParams tp;
         tp.integrator = integ;
         TraceStats stats;
@@ -389,7 +389,7 @@ TEST_CASE("retraceStrands: the lane kernel holds to the general engine, its two 
         const openvdb::Vec3SGrid::Ptr field = swirlField(rng, h, offset, R);
         const StrandSet in = randomRoots(rng, h, offset, R, 60);
         TraceParams tp;
-        tp.integrator = seed % 4 == 3 ? Integrator::RK4 : seed % 4 == 2 ? Integrator::RK2 : Integrator::Euler;
+        tp.integrator = seed % 5 == 4 ? Integrator::RK3 : seed % 4 == 3 ? Integrator::RK4 : seed % 4 == 2 ? Integrator::RK2 : Integrator::Euler;
         tp.margin = int(seed % 3);
         tp.vertices = seed % 5 == 4 ? RetraceVertices::Steps : RetraceVertices::Input;
         tp.step = seed % 2 ? 0.0 : (0.2 + 0.6 * rng.uniform()) * h;

@@ -1,6 +1,7 @@
 #include "ConsistentRetrace.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
@@ -20,13 +21,15 @@ namespace vdbhair {
 
 void ConsistencyParams::validate(const char* where) const
 {
-    auto fail = [&](const std::string& what) { throw ValueError(std::string(where) + ": " + what); };
+    auto fail = [&](const char* field, double value, const std::string& rule) {
+        throw ValueError(std::string(where) + ": " + field + " " + formatNumber(value) + ": " + rule);
+    };
     resolveStepLength(step, 1.0, where);  // the engine's rule for a step (Streamline.h)
-    if (!(zStart >= 0.0) || !std::isfinite(zStart)) fail("outlier score zStart " + std::to_string(zStart) + " must be finite and at least 0");
-    if (!(zFull > zStart) || !std::isfinite(zFull)) fail("outlier score zFull " + std::to_string(zFull) + " must be finite and above zStart " + std::to_string(zStart));
-    if (!(minSpreadDeg >= 0.0 && minSpreadDeg < 90.0)) fail("minimum spread " + std::to_string(minSpreadDeg) + " degrees must be in [0, 90)");
-    if (!(returnVoxels > 0.0) || !std::isfinite(returnVoxels)) fail("return length " + std::to_string(returnVoxels) + " voxels must be positive and finite");
-    if (!(vanishThreshold >= 0.0 && vanishThreshold < 1.0)) fail("vanishThreshold " + std::to_string(vanishThreshold) + " must be in [0, 1)");
+    if (!(zStart >= 0.0) || !std::isfinite(zStart)) fail("zStart", zStart, "must be finite and at least 0");
+    if (!(zFull > zStart) || !std::isfinite(zFull)) fail("zFull", zFull, "must be finite and above zStart " + formatNumber(zStart));
+    if (!(minSpreadDeg >= 0.0 && minSpreadDeg < 90.0)) fail("minSpreadDeg", minSpreadDeg, "must be in [0, 90) degrees");
+    if (!(returnVoxels > 0.0) || !std::isfinite(returnVoxels)) fail("returnVoxels", returnVoxels, "must be positive and finite");
+    if (!(vanishThreshold >= 0.0 && vanishThreshold < 1.0)) fail("vanishThreshold", vanishThreshold, "must be in [0, 1)");
 }
 
 namespace {
@@ -93,6 +96,21 @@ public:
 
     void trace(std::size_t i, Counts& counts)
     {
+        switch (mS.params.integrator) {
+        case Integrator::Euler: return trace<Integrator::Euler>(i, counts);
+        case Integrator::RK2: return trace<Integrator::RK2>(i, counts);
+        case Integrator::RK3: return trace<Integrator::RK3>(i, counts);
+        case Integrator::RK4: return trace<Integrator::RK4>(i, counts);
+        }
+    }
+
+private:
+    template<Integrator I>
+    void trace(std::size_t i, Counts& counts)
+    {
+        BlendSampler blend{*this, &counts};
+        StreamlineIntegrator<BlendSampler> integrator(blend, I);
+        constexpr bool euler = I == Integrator::Euler;
         const std::size_t n = mS.in.size(i);
         const Vec3f* c = mS.in.data(i);
         Vec3f* o = mS.out.data(i);
@@ -121,10 +139,19 @@ public:
                     Vec3d own = t + off * mS.invReturn;
                     const double ol = own.length();
                     own = ol > 1e-12 ? own / ol : t;
-                    double w = 0.0;
-                    Vec3d d = direction(p, own, w, counts);
-                    if (w >= 0.5) corrected = true;
-                    Vec3d q = p + h * d;
+                    // A step of the engine through the blended direction (with Euler, the default,
+                    // q = p + h d); d is the step's direction for the constraints below.
+                    blend.own = own;
+                    Vec3d q, k1;
+                    blend.startDirection(p, k1);
+                    integrator.template advanceFrom<I>(p, k1, h, q);  // never fails: without a field the strand keeps its own direction
+                    if (blend.w >= 0.5) corrected = true;
+                    Vec3d d = k1;
+                    if constexpr (!euler) {
+                        const Vec3d e = q - p;
+                        const double el = e.length();
+                        if (el > 1e-12) d = e / el;
+                    }
                     if (!insideField(q)) {
                         // The step would leave the hair: head for the input strand's own point
                         // at the step's end instead (the input lies inside the hair by definition).
@@ -204,7 +231,31 @@ public:
         if (corrected) ++counts.corrected;
     }
 
-private:
+    /// The streamline engine's sampler for one sub-step (Streamline.h): the blended direction for
+    /// a strand heading `own`. A step's first stage records the field's weight and counts the
+    /// sub-step; the later stages of RK2/RK3/RK4 only blend.
+    struct BlendSampler
+    {
+        StrandTracer& tracer;
+        Counts* counts;
+        Vec3d own = Vec3d(0.0);
+        double w = 0.0;  ///< the field's weight at the step's first stage
+
+        SampleStatus startDirection(const Vec3d& p, Vec3d& d)
+        {
+            w = 0.0;
+            d = tracer.direction(p, own, w, *counts);
+            return SampleStatus::Ok;
+        }
+        SampleStatus direction(const Vec3d& p, Vec3d& d)
+        {
+            double stageW = 0.0;
+            Counts stage;
+            d = tracer.direction(p, own, stageW, stage);
+            return SampleStatus::Ok;
+        }
+    };
+
     /// How deep (a negative distance) a retraced vertex may be inside a NoDeeper head where the
     /// input vertex at the same arc length is at @a input: on or outside the surface where the
     /// input was outside it; where the input was inside, as deep plus half a sub-step, so that

@@ -2,7 +2,8 @@
 /// @brief Retracing that fixes only a hairstyle's inconsistencies: every strand is retraced from
 /// its root through the robust tangent field (Wang et al. 2009, §5.3), but at each step the
 /// direction blends the strand's own direction with the field's by how much of an *outlier* the
-/// strand is there. This goes beyond the paper (see below and README, "Refinement").
+/// strand is there. Each sub-step is a step of the streamline engine (Streamline.h) through that
+/// blended direction: forward Euler by default, RK2/RK3/RK4 with ConsistencyParams::integrator. This goes beyond the paper (see below and README, "Refinement").
 ///
 /// Wang et al. replace every strand by a streamline of the field. On real hair that combs waves
 /// and curls straight (the field averages strands of different phase), swaps crossing wisps (a
@@ -59,6 +60,9 @@ struct ConsistencyParams
     /// (the own direction t becomes t + offset / (returnVoxels · voxel size), renormalized)
     double returnVoxels = 4.0;
     double vanishThreshold = kDefaultVanishThreshold;  ///< as TraceParams::vanishThreshold
+    /// the engine's step through the blended direction (Streamline.h); each stage blends the
+    /// strand's own direction of the sub-step with the field's at the stage's point
+    Integrator integrator = Integrator::Euler;
 
     /// @throw ValueError (parameter @a where names the offender) for values out of range.
     void validate(const char* where) const;

@@ -26,10 +26,16 @@ const char* refineModeName(RefineMode mode)
 void RefineParams::validate(const char* where) const
 {
     if (levels < 1 || levels > kMaxLevels) {
-        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + " must be between 1 and " +
+        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + ": must be between 1 and " +
                          std::to_string(kMaxLevels));
     }
     consistency.validate(where);
+}
+
+void RefineParams::setStep(double step, Integrator integrator)
+{
+    trace.step = consistency.step = step;
+    trace.integrator = consistency.integrator = integrator;
 }
 
 namespace {

@@ -55,6 +55,10 @@ struct RefineParams
     HeadObstacle head;
     bool measure = true;  ///< fill RefineLevel::measures (costs a field estimate per level)
 
+    /// @brief One step rule for both modes (the CLI's --step and --integrator): the step (world
+    /// units; 0: half of each level's voxel) and the integrator of trace and consistency.
+    void setStep(double step, Integrator integrator);
+
     /// @throw ValueError naming the parameter for values out of range.
     void validate(const char* where) const;
 };

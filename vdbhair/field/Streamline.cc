@@ -11,14 +11,16 @@ Integrator integratorFromName(const std::string& name)
 {
     if (name == "euler") return Integrator::Euler;
     if (name == "rk2") return Integrator::RK2;
+    if (name == "rk3") return Integrator::RK3;
     if (name == "rk4") return Integrator::RK4;
-    throw ValueError("integrator '" + name + "' is not one of euler, rk2, rk4");
+    throw ValueError("integrator '" + name + "' is not one of euler, rk2, rk3, rk4");
 }
 
 const char* integratorName(Integrator integrator)
 {
     switch (integrator) {
     case Integrator::RK2: return "rk2";
+    case Integrator::RK3: return "rk3";
     case Integrator::RK4: return "rk4";
     default: return "euler";
     }

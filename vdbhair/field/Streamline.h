@@ -27,8 +27,10 @@
 /// - `ReversedSampler` (below): any sampler traced backwards.
 ///
 /// Integrators (StreamlineIntegrator::advance()): forward Euler (Eq. 3 of Piuze et al., the
-/// papers' choice), midpoint RK2 and classical RK4, each stage's direction a unit vector, so a
-/// step of length h advances arc length h and step m of a streamline lies at arc length m·step.
+/// papers' choice), midpoint RK2, Kutta's third-order rule (RK3: three stages, the fit's pre-fit
+/// traces with it, sharing each step's last point's direction as the next step's first) and
+/// classical RK4, each stage's direction a unit vector, so a step of length h advances arc length
+/// h and step m of a streamline lies at arc length m·step.
 ///
 /// A streamline (traceStreamline()) stops when
 /// - it reaches the requested length (the last step is shortened to land on it exactly);
@@ -59,9 +61,9 @@
 
 namespace vdbhair {
 
-enum class Integrator { Euler, RK2, RK4 };
+enum class Integrator { Euler, RK2, RK3, RK4 };
 
-/// @throw ValueError unless "euler", "rk2" or "rk4".
+/// @throw ValueError unless "euler", "rk2", "rk3" or "rk4".
 Integrator integratorFromName(const std::string& name);
 const char* integratorName(Integrator integrator);
 
@@ -193,6 +195,12 @@ public:
 
     /// @brief advance() with the first stage's unit direction @a k1 at @a p already known (a
     /// helicoid trace has it from the frame at p); Euler then samples nothing.
+    SampleStatus advanceFrom(const Vec3d& p, const Vec3d& k1, double h, Vec3d& q);
+
+    /// @brief advanceFrom() with the integrator @a I fixed at compile time (the integrator given
+    /// to the constructor is ignored): for a hot loop that always takes the same kind of step
+    /// (the fit's pre-fit).
+    template<Integrator I>
     SampleStatus advanceFrom(const Vec3d& p, const Vec3d& k1, double h, Vec3d& q);
 
     SamplerT& sampler() { return mSampler; }

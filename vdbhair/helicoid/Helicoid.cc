@@ -64,21 +64,6 @@ namespace {
 
 constexpr int kLanes = 8;
 
-/// @brief Eq. 1 in a lane: theta at local coordinates (y1, y2, y3) of a helicoid with curvatures
-/// (kT, kN, kB), unwrapped against @a t (which receives it), and the sines and cosines of theta and
-/// of phi = alpha theta that Eq. 2's frame is made of. Branchless (FastMath.h), for the lane
-/// kernels below.
-inline void laneAngles(double y1, double y2, double y3, double kT, double kN, double kB, double alpha, double& t,
-                       double& st, double& ct, double& sp, double& cp)
-{
-    constexpr double twoPi = 2.0 * M_PI, invTwoPi = 1.0 / (2.0 * M_PI);
-    double a = fastmath::atan2Lane(kT * y1 + kN * y2, 1.0 + kN * y1 - kT * y2) + kB * y3;
-    a += twoPi * fastmath::roundLane((t - a) * invTwoPi);
-    t = a;
-    fastmath::sinCosLane(a, st, ct);
-    fastmath::sinCosLane(alpha * a, sp, cp);
-}
-
 /// @brief kLanes positions moved one forward-Euler step (Eq. 3) through one helicoid, then theta
 /// (unwrapped), the frame of Eq. 2 and the next tangent there. Structure of arrays with a fixed
 /// trip count and branchless math, so the compiler vectorizes it (with AVX2 where the processor

@@ -64,6 +64,10 @@ struct Helicoid
 
     /// @brief Unit tangent E_T at @a world; updates @a thetaRef to the unwrapped theta there.
     Vec3d tangent(const Vec3d& world, double& thetaRef) const;
+    /// @brief tangent() through the branchless forms of FastMath.h (the same polynomials; theta
+    /// unwrapped to even at exact halves): for the fit's pre-fit, whose traces call it millions
+    /// of times and whose branches would follow the data.
+    Vec3d tangentLane(const Vec3d& world, double& thetaRef) const;
 
     /// @brief Distance (world units) from @a world to the helicoid's singular axis, where both
     /// arguments of Eq. 1's atan2, kT y1 + kN y2 and 1 + kN y1 - kT y2, vanish: the line through
@@ -113,6 +117,29 @@ inline Vec3d Helicoid::tangent(const Vec3d& world, double& thetaRef) const
     double ct, st, cp = 1.0, sp = 0.0;
     fastmath::sinCos(thetaRef, st, ct);
     if (phi != 0.0) fastmath::sinCos(phi, sp, cp);
+    return (cp * ct) * q.t + (cp * st) * q.n + sp * q.b;
+}
+
+/// @brief Eq. 1 in a lane: theta at local coordinates (y1, y2, y3) of a helicoid with curvatures
+/// (kT, kN, kB), unwrapped against @a t (which receives it), and the sines and cosines of theta and
+/// of phi = alpha theta that Eq. 2's frame is made of. Branchless (FastMath.h), for the lane
+/// kernels (Helicoid.cc) and tangentLane().
+inline void laneAngles(double y1, double y2, double y3, double kT, double kN, double kB, double alpha, double& t,
+                       double& st, double& ct, double& sp, double& cp)
+{
+    constexpr double twoPi = 2.0 * M_PI, invTwoPi = 1.0 / (2.0 * M_PI);
+    double a = fastmath::atan2Lane(kT * y1 + kN * y2, 1.0 + kN * y1 - kT * y2) + kB * y3;
+    a += twoPi * fastmath::roundLane((t - a) * invTwoPi);
+    t = a;
+    fastmath::sinCosLane(a, st, ct);
+    fastmath::sinCosLane(alpha * a, sp, cp);
+}
+
+inline Vec3d Helicoid::tangentLane(const Vec3d& world, double& thetaRef) const
+{
+    const Vec3d d = world - p0;
+    double st, ct, sp, cp;
+    laneAngles(d.dot(q.t), d.dot(q.n), d.dot(q.b), k.kT, k.kN, k.kB, k.alpha, thetaRef, st, ct, sp, cp);
     return (cp * ct) * q.t + (cp * st) * q.n + sp * q.b;
 }
 

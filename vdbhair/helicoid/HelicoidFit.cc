@@ -1,6 +1,7 @@
 #include "HelicoidFit.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/helicoid/Frechet.h>
 #include <vdbhair/helicoid/impl/FitTarget.h>
@@ -21,13 +22,6 @@ namespace {
 /// Each refit of a strand that used every piece allowed multiplies the tolerance by this (longer
 /// pieces, so the budget reaches the tip): wavy at its stored 21 vertices 4.21 % -> 2.80 %.
 constexpr double kRelaxFactor = 1.4;
-
-std::string formatParam(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
 
 /// Make every kT >= 0 by the half-turn symmetry: a piece traced from its frame rolled by π with
 /// kT negated is the same curve, and ends in its end frame rolled by π. The roll therefore
@@ -120,15 +114,15 @@ void FitParams::validate(const char* where) const
     const auto fail = [&](const char* field, const std::string& value, const std::string& rule) {
         throw ValueError(std::string(where) + ": " + field + " " + value + ": " + rule);
     };
-    if (!(maxError > 0.0) || !std::isfinite(maxError)) fail("maxError", formatParam(maxError), "must be a positive fraction of the strand length");
-    if (!(lambda >= 0.0) || !std::isfinite(lambda)) fail("lambda", formatParam(lambda), "must be zero or positive");
+    if (!(maxError > 0.0) || !std::isfinite(maxError)) fail("maxError", formatNumber(maxError), "must be a positive fraction of the strand length");
+    if (!(lambda >= 0.0) || !std::isfinite(lambda)) fail("lambda", formatNumber(lambda), "must be zero or positive");
     if (maxPieces < 1 || maxPieces > kMaxPieces) fail("maxPieces", std::to_string(maxPieces), "must be between 1 and " + std::to_string(kMaxPieces));
     if (relaxRetries < 0) fail("relaxRetries", std::to_string(relaxRetries), "must be 0 or more");
     if (maxEvaluations < kMinEvaluations) fail("maxEvaluations", std::to_string(maxEvaluations), "must be at least " + std::to_string(kMinEvaluations));
     if (prefitIterations < 0) fail("prefitIterations", std::to_string(prefitIterations), "must be 0 (none: Nelder-Mead alone, the paper's) or more");
-    if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) fail("step", formatParam(step), "must be a positive finite length (0: a quarter of the mean segment length)");
-    if (!(axisClearance >= 0.0) || !std::isfinite(axisClearance)) fail("axisClearance", formatParam(axisClearance), "must be zero or positive (steps)");
-    if (!(stepDeviationLimit > 0.0) || !std::isfinite(stepDeviationLimit)) fail("stepDeviationLimit", formatParam(stepDeviationLimit), "must be a positive fraction of the tolerance");
+    if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) fail("step", formatNumber(step), "must be a positive finite length (0: a quarter of the mean segment length)");
+    if (!(axisClearance >= 0.0) || !std::isfinite(axisClearance)) fail("axisClearance", formatNumber(axisClearance), "must be zero or positive (steps)");
+    if (!(stepDeviationLimit > 0.0) || !std::isfinite(stepDeviationLimit)) fail("stepDeviationLimit", formatNumber(stepDeviationLimit), "must be a positive fraction of the tolerance");
 }
 
 void traceFit(const StrandFit& fit, HelicoidTrace& out)

@@ -32,26 +32,41 @@ inline SampleStatus StreamlineIntegrator<SamplerT>::advance(const Vec3d& p, doub
 template<typename SamplerT>
 inline SampleStatus StreamlineIntegrator<SamplerT>::advanceFrom(const Vec3d& p, const Vec3d& k1, double h, Vec3d& q)
 {
+    switch (mIntegrator) {
+    case Integrator::Euler: return advanceFrom<Integrator::Euler>(p, k1, h, q);
+    case Integrator::RK2: return advanceFrom<Integrator::RK2>(p, k1, h, q);
+    case Integrator::RK3: return advanceFrom<Integrator::RK3>(p, k1, h, q);
+    case Integrator::RK4: return advanceFrom<Integrator::RK4>(p, k1, h, q);
+    }
+    return SampleStatus::Left;
+}
+
+template<typename SamplerT>
+template<Integrator I>
+inline SampleStatus StreamlineIntegrator<SamplerT>::advanceFrom(const Vec3d& p, const Vec3d& k1, double h, Vec3d& q)
+{
     Vec3d k2, k3, k4;
     SampleStatus s = SampleStatus::Ok;
-    switch (mIntegrator) {
-    case Integrator::Euler:
+    if constexpr (I == Integrator::Euler) {
         q = p + h * k1;  // Piuze et al. 2011, Eq. 3: p_{i+1} = p_i + h E_T(p_i)
-        return s;
-    case Integrator::RK2:  // the midpoint rule
+    } else if constexpr (I == Integrator::RK2) {  // the midpoint rule
         if ((s = mSampler.direction(p + 0.5 * h * k1, k2)) != SampleStatus::Ok) return s;
         if (reversed(k1, k2)) return SampleStatus::Vanished;
         q = p + h * k2;
-        return s;
-    case Integrator::RK4:
+    } else if constexpr (I == Integrator::RK3) {  // Kutta's third-order rule
+        if ((s = mSampler.direction(p + 0.5 * h * k1, k2)) != SampleStatus::Ok) return s;
+        if ((s = mSampler.direction(p + h * (2.0 * k2 - k1), k3)) != SampleStatus::Ok) return s;
+        if (reversed(k1, k2) || reversed(k1, k3)) return SampleStatus::Vanished;
+        q = p + (h / 6.0) * (k1 + 4.0 * k2 + k3);
+    } else {
+        static_assert(I == Integrator::RK4);
         if ((s = mSampler.direction(p + 0.5 * h * k1, k2)) != SampleStatus::Ok) return s;
         if ((s = mSampler.direction(p + 0.5 * h * k2, k3)) != SampleStatus::Ok) return s;
         if ((s = mSampler.direction(p + h * k3, k4)) != SampleStatus::Ok) return s;
         if (reversed(k1, k2) || reversed(k1, k3) || reversed(k1, k4)) return SampleStatus::Vanished;
         q = p + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-        return s;
     }
-    return SampleStatus::Left;
+    return s;
 }
 
 template<typename SamplerT>
