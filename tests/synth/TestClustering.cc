@@ -173,7 +173,7 @@ TEST_CASE("clusterSamples: adaptive clustering splits until every strand is with
     const Clustering d = clusterSamples(samples, unitMap(), 2, true, params);
     CHECK(d.centers.count() == std::size_t(800 * params.maxClusterFraction));
     params.threshold = -1.0;
-    CHECK_THROWS_WITH(clusterSamples(samples, unitMap(), 2, true, params), Catch::Contains("cluster threshold"));
+    CHECK_THROWS_WITH(clusterSamples(samples, unitMap(), 2, true, params), Catch::Contains("threshold -1: must be a positive finite"));
 }
 
 TEST_CASE("buildHierarchy: each level has about a quarter of the clusters of the one below", "[synth]")

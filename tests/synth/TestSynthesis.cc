@@ -157,7 +157,7 @@ TEST_CASE("synthesizeHair: bad input is refused before work", "[synth]")
     SynthParams params = smallParams();
     CHECK_THROWS_WITH(synthesizeHair(example, params), Catch::Contains("10 strands for 3 levels"));
     params.strandScale = std::nan("");
-    CHECK_THROWS_WITH(synthesizeHair(example, params), Catch::Contains("strand scale"));
+    CHECK_THROWS_WITH(synthesizeHair(example, params), Catch::Contains("strandScale"));
     params = smallParams();
     params.strandScale = 1e9;
     const StrandSet big = test::wispHairstyle(400, 4, nullptr, 8);

@@ -1,6 +1,7 @@
 #include "Clustering.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
 #include <vdbhair/Random.h>
 #include <vdbhair/scalp/PointCloud.h>
 #include <vdbhair/synth/Pca.h>
@@ -18,17 +19,19 @@ namespace vdbhair {
 
 void ClusterParams::validate(const char* where) const
 {
-    const auto fail = [&](const std::string& what) { throw ValueError(std::string(where) + ": " + what); };
-    if (initialClusters < 1) fail("initial clusters " + std::to_string(initialClusters) + ": at least 1");
+    const auto fail = [&](const char* field, const std::string& value, const std::string& rule) {
+        throw ValueError(std::string(where) + ": " + field + " " + value + ": " + rule);
+    };
+    if (initialClusters < 1) fail("initialClusters", std::to_string(initialClusters), "must be at least 1");
     if (!(threshold > 0.0) || !std::isfinite(threshold))
-        fail("cluster threshold " + std::to_string(threshold) + ": a positive finite L² distance (radius units²)");
-    if (neighbours < 1 || neighbours > 64) fail("neighbours " + std::to_string(neighbours) + ": 1 to 64");
-    if (maxIterations < 1) fail("iterations " + std::to_string(maxIterations) + ": at least 1");
-    if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) fail("tolerance " + std::to_string(tolerance) + ": 0 or more");
-    if (maxSplitRounds < 0) fail("split rounds " + std::to_string(maxSplitRounds) + ": 0 or more");
+        fail("threshold", formatNumber(threshold), "must be a positive finite L2 distance (head radii squared)");
+    if (neighbours < 1 || neighbours > 64) fail("neighbours", std::to_string(neighbours), "must be between 1 and 64");
+    if (maxIterations < 1) fail("maxIterations", std::to_string(maxIterations), "must be at least 1");
+    if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) fail("tolerance", formatNumber(tolerance), "must be 0 or more");
+    if (maxSplitRounds < 0) fail("maxSplitRounds", std::to_string(maxSplitRounds), "must be 0 or more");
     if (!(maxClusterFraction > 0.0 && maxClusterFraction <= 1.0))
-        fail("cluster fraction " + std::to_string(maxClusterFraction) + ": in (0, 1]");
-    if (levels < 2 || levels > 5) fail("levels " + std::to_string(levels) + ": 2 to 5");
+        fail("maxClusterFraction", formatNumber(maxClusterFraction), "must be in (0, 1]");
+    if (levels < 2 || levels > 5) fail("levels", std::to_string(levels), "must be between 2 and 5");
 }
 
 std::vector<std::vector<std::uint32_t>> neighbourGraph(const std::vector<Vec3d>& points, int k)

@@ -1,6 +1,7 @@
 #include "Synthesis.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
 #include <vdbhair/synth/DetailTransfer.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/RootScatter.h>
@@ -23,16 +24,18 @@ const char* synthLayoutName(SynthLayout layout) { return layout == SynthLayout::
 
 void SynthParams::validate(const char* where) const
 {
-    const auto fail = [&](const std::string& what) { throw ValueError(std::string(where) + ": " + what); };
-    if (vertices < 4 || vertices > 4096) fail("vertices per strand " + std::to_string(vertices) + ": 4 to 4096");
-    if (components < 1) fail("PCA components " + std::to_string(components) + ": at least 1");
-    if (!(mapSpacing >= 1e-3 && mapSpacing <= 0.5)) fail("map spacing " + std::to_string(mapSpacing) + ": 0.001 to 0.5 radians");
-    if (!(strandScale > 0.0) || !std::isfinite(strandScale)) fail("strand scale " + std::to_string(strandScale) + ": a positive finite factor");
-    if (rootIterations < 0 || rootIterations > 1000) fail("root iterations " + std::to_string(rootIterations) + ": 0 to 1000");
-    if (!(voxelSize >= 0.0) || !std::isfinite(voxelSize)) fail("voxel size " + std::to_string(voxelSize) + ": 0 (suggested) or a positive finite length");
-    if (!std::isfinite(up.length())) fail("up axis: a finite vector (or 0 for the roots' mean direction)");
-    if (!std::isfinite(outputTurn)) fail("output turn: a finite angle");
-    if (!(placeWeight >= 0.0) || !std::isfinite(placeWeight)) fail("place weight " + std::to_string(placeWeight) + ": 0 or a positive finite weight");
+    const auto fail = [&](const char* field, const std::string& value, const std::string& rule) {
+        throw ValueError(std::string(where) + ": " + field + (value.empty() ? "" : " " + value) + ": " + rule);
+    };
+    if (vertices < 4 || vertices > 4096) fail("vertices", std::to_string(vertices), "must be between 4 and 4096");
+    if (components < 1) fail("components", std::to_string(components), "must be at least 1");
+    if (!(mapSpacing >= 1e-3 && mapSpacing <= 0.5)) fail("mapSpacing", formatNumber(mapSpacing), "must be between 0.001 and 0.5 radians");
+    if (!(strandScale > 0.0) || !std::isfinite(strandScale)) fail("strandScale", formatNumber(strandScale), "must be a positive finite factor");
+    if (rootIterations < 0 || rootIterations > 1000) fail("rootIterations", std::to_string(rootIterations), "must be between 0 and 1000");
+    if (!(voxelSize >= 0.0) || !std::isfinite(voxelSize)) fail("voxelSize", formatNumber(voxelSize), "must be 0 (suggested) or a positive finite length");
+    if (!std::isfinite(up.length())) fail("up", "", "must be a finite vector (or 0 for the roots' mean direction)");
+    if (!std::isfinite(outputTurn)) fail("outputTurn", formatNumber(outputTurn), "must be a finite angle");
+    if (!(placeWeight >= 0.0) || !std::isfinite(placeWeight)) fail("placeWeight", formatNumber(placeWeight), "must be 0 or a positive finite weight");
     cluster.validate(where);
     texture.validate(where);
 }

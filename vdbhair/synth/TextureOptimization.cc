@@ -49,7 +49,7 @@ void TextureParams::validate(const char* where) const
         fail("robustExponent " + formatNumber(robustExponent) + " must be finite and in (0, 2] (Kwatra et al. use 0.8)");
     }
     if (pcaDims < 1 || pcaDims > 1024) fail("pcaDims " + std::to_string(pcaDims) + " must be between 1 and 1024");
-    if (!(nearbyRadius >= 0.0 && nearbyRadius <= 1.0)) fail("nearbyRadius " + std::to_string(nearbyRadius) + " must be between 0 and 1");
+    if (!(nearbyRadius >= 0.0 && nearbyRadius <= 1.0)) fail("nearbyRadius " + formatNumber(nearbyRadius) + ": must be between 0 and 1");
     if (keyTaps < 1 || keyTaps > 64) fail("keyTaps " + std::to_string(keyTaps) + " must be between 1 and 64");
     if (candidates < 1 || candidates > 256) fail("candidates " + std::to_string(candidates) + " must be between 1 and 256");
     if (!(searchEpsilon >= 0.0 && searchEpsilon <= 1e6)) fail("searchEpsilon " + formatNumber(searchEpsilon) + " must be finite and at least 0");
