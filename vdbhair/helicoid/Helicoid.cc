@@ -62,6 +62,15 @@ double traceClearance(const HelicoidTrace& trace, double step)
 
 namespace {
 
+// The lane kernels come in an AVX2 and a baseline clone. GCC inlines the lane math into them only
+// when told to (flatten; see HelicoidLanes); clang does it by itself and refuses flatten with
+// target_clones.
+#if defined(__clang__)
+#define VDBHAIR_LANE_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define VDBHAIR_LANE_KERNEL __attribute__((target_clones("avx2", "default"), flatten))
+#endif
+
 constexpr int kLanes = 8;
 
 /// @brief kLanes positions moved one forward-Euler step (Eq. 3) through one helicoid, then theta
@@ -76,7 +85,7 @@ struct EulerLanes
     double bx[kLanes], by[kLanes], bz[kLanes];
     double th[kLanes];
 
-    __attribute__((target_clones("avx2", "default"), flatten))  // flatten: see HelicoidLanes
+    VDBHAIR_LANE_KERNEL  // flatten: see HelicoidLanes
     void step(const Helicoid& h, double hstep)
     {
         const double qtx = h.q.t.x(), qty = h.q.t.y(), qtz = h.q.t.z();
@@ -154,7 +163,7 @@ struct HelicoidLanes
 
     // flatten: the lane math must be inlined for the loops to vectorize (left to itself, the
     // compiler called sinCosLane out of line: a third of the kernel's instructions).
-    __attribute__((target_clones("avx2", "default"), flatten))
+    VDBHAIR_LANE_KERNEL
     void stepEuler()
     {
         for (int l = 0; l < kLanes; ++l) {
@@ -165,7 +174,7 @@ struct HelicoidLanes
         }
     }
 
-    __attribute__((target_clones("avx2", "default"), flatten))
+    VDBHAIR_LANE_KERNEL
     void stepRk4()
     {
         for (int l = 0; l < kLanes; ++l) {
