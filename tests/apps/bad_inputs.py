@@ -3,7 +3,7 @@
 twice - with a fresh output path and with an existing output. Each run must exit non-zero, print
 exactly one line on stderr that names the file (or the verb or option at fault) and the rule
 broken, leave no output and no temporary file, and leave an existing output byte-identical.
-The cases run two at a time (a process start is most of a case's time); each has a folder of its
+The cases run two at a time, through forkrun.py (a process start is most of a case's time); each has a folder of its
 own for its output, so that what one case leaves is checked after each of its runs, and the input
 folder and the whole output folder are checked again once every case has run.
 
@@ -17,6 +17,8 @@ import stat
 import struct
 import subprocess
 import sys
+
+import forkrun
 
 CLI, WORK = sys.argv[1], sys.argv[2]
 shutil.rmtree(WORK, ignore_errors=True)
@@ -201,17 +203,17 @@ def run_case(i):
                 with open(o, "wb") as f:
                     f.write(sentinel)
         try:
-            r = subprocess.run([CLI] + args, capture_output=True, timeout=60)
+            returncode, _, stderr = forkrun.run([CLI] + args, timeout=60)
         except subprocess.TimeoutExpired:
             failures.append("%s: still running after 60 s" % name)
             continue
-        err = r.stderr.decode(errors="replace")
+        err = stderr.decode(errors="replace")
         lines = err.splitlines()
         what = "%s (%s output)" % (name, "existing" if existing else "no")
-        if r.returncode == 0:
+        if returncode == 0:
             failures.append("%s: exit status 0" % what)
-        if r.returncode < 0:
-            failures.append("%s: killed by signal %d" % (what, -r.returncode))
+        if returncode < 0:
+            failures.append("%s: killed by signal %d" % (what, -returncode))
         if len(lines) != 1:
             failures.append("%s: %d stderr lines: %r" % (what, len(lines), err[:600]))
         elif not lines[0].startswith("vdbhair"):

@@ -23,6 +23,9 @@ and no temporary output (".STEM.vdbhair-tmp-*") may be left next to any PATH nam
 Every case runs, in the order of the file, whatever the others do; the group fails if one does,
 and the report names each failed case with its command, stdout and stderr. The environment variable
 VDBHAIR_CLI_CASES=RE runs only the cases whose name matches RE (e.g. to rerun one failure).
+Commands of `vdbhair` itself run through forkrun.py (forked from a parent that has loaded the
+program, when CTest says where vdbhair_forkserver is); VDBHAIR_CLI_EXEC=1 starts every command as a
+process of its own.
 """
 import hashlib
 import os
@@ -30,6 +33,8 @@ import re
 import subprocess
 import sys
 import time
+
+import forkrun
 
 OPTIONS_WITH_VALUE = {"--exit", "--stdout", "--no-stdout", "--stderr", "--stderr-lines", "--absent", "--exists", "--keep"}
 
@@ -105,10 +110,10 @@ def run_case(args):
             subprocess.run(["rm", "-rf", path], check=True)
         elif os.path.lexists(path):
             os.remove(path)
-    done = subprocess.run(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    out = done.stdout.decode("utf-8", "replace")
-    err = done.stderr.decode("utf-8", "replace")
-    status = done.returncode if done.returncode >= 0 else 128 - done.returncode
+    code, out, err = forkrun.run(command)
+    status = code if code >= 0 else 128 - code
+    out = out.decode("utf-8", "replace")
+    err = err.decode("utf-8", "replace")
     if spec["exit"] == "nonzero":
         if status == 0:
             failures.append("expected a non-zero exit status, got 0")
