@@ -56,6 +56,14 @@ inline const std::filesystem::path& tempDir()
 
 inline std::string tempPath(const std::string& name) { return (tempDir() / name).string(); }
 
+/// A committed input of tests/io/data (the fuzzers' findings, issue 22), checked to be there.
+inline std::string regressionInput(const std::string& name)
+{
+    const std::filesystem::path path = std::filesystem::path(VDBHAIR_TEST_INPUTS_DIR) / name;
+    REQUIRE(std::filesystem::is_regular_file(path));
+    return path.string();
+}
+
 /// Write raw bytes to a file in the temporary folder and return its path.
 inline std::string writeBytes(const std::string& name, const std::string& bytes)
 {

@@ -56,3 +56,14 @@ TEST_CASE("readConvdata: shapes whose product wraps 2^64 or beyond 2^64 are refu
     REQUIRE_THROWS_WITH(readConvdata(test::writeBytes("huge.convdata", huge)),
                         Contains("has dimension 99999999999999999999999, beyond 2^64-1"));
 }
+
+TEST_CASE("readConvdata: fuzz_convdata's finding, a shape with no strand slots allocates nothing (issue 22)", "[io][fuzz]")
+{
+    // Shape (8888888888888, 3, 0): no floats, so the file's size bounds nothing, and the reader
+    // allocated 2.2e12 points for a strand before it looked at the slots (106 TB requested).
+    ReadReport report;
+    const StrandSet s = readConvdata(test::regressionInput("fuzz_convdata_zero_slots.convdata"), {}, &report);
+    REQUIRE(s.numStrands() == 0);
+    REQUIRE(report.warnings.size() == 1);
+    REQUIRE_THAT(report.warnings[0], Contains("shape (8888888888888, 3, 0) has no strand slots (rows x columns = 0)"));
+}

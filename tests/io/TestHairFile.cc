@@ -160,3 +160,15 @@ TEST_CASE("readHair: strand counts beyond the point count are refused before all
     REQUIRE_THROWS_WITH(readHair(test::writeBytes("nS_default.hair", hairHeader(2, 2, 2, 1) + pts)),
                         Contains("at byte 8: the strands' point counts add up to 4 but the header declares 2 points (no segments array"));
 }
+
+TEST_CASE("readHair: fuzz_hair's finding, an absent array copied into an empty set (issue 22)", "[io][fuzz]")
+{
+    // Zero strands with a thickness array: the copy of 0 values passed a null pointer to memcpy
+    // (undefined behaviour under UBSan, HairFile.cc:128). The file reads as an empty set.
+    ReadReport report;
+    const StrandSet s = readHair(test::regressionInput("fuzz_hair_empty_array.hair"), {}, &report);
+    REQUIRE(s.numStrands() == 0);
+    REQUIRE(s.positions.empty());
+    REQUIRE(report.warnings.size() == 1);
+    REQUIRE_THAT(report.warnings[0], Contains("bytes after the arrays the header describes were ignored"));
+}

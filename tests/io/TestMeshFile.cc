@@ -127,3 +127,19 @@ TEST_CASE("renderStrands --head: the head hides hair behind it and not hair in f
     rp.head = nullptr;
     CHECK(changed(behind, rp) > 0.1f);   // without the head it shows
 }
+
+TEST_CASE("readPlyMesh: list counts are whole numbers within what is left of the file (fuzz_mesh, issue 22)", "[io][mesh][fuzz]")
+{
+    // An ascii face whose count is 3.9e85: converting it to an integer was undefined behaviour.
+    REQUIRE_THROWS_WITH(readTriangleMesh(test::regressionInput("fuzz_mesh_list_count.ply")),
+                        Contains("line 15: list 'vertex_indices' declares 3.88889e+85 items but fewer remain in the file"));
+    const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    REQUIRE(readTriangleMesh(test::writeBytes("tri.ply", head + "3 0 1 2\n")).triangles.size() == 1);
+    REQUIRE_THROWS_WITH(readTriangleMesh(test::writeBytes("tri4.ply", head + "4 0 1 2\n")),
+                        Contains("line 13: list 'vertex_indices' declares 4 items but fewer remain in the file"));
+    REQUIRE_THROWS_WITH(readTriangleMesh(test::writeBytes("tri_frac.ply", head + "2.5 0 1 2\n")),
+                        Contains("line 13: list 'vertex_indices' has count 2.5; a list count is a whole number, 0 or more"));
+    REQUIRE_THROWS_WITH(readTriangleMesh(test::writeBytes("tri_nan.ply", head + "nan 0 1 2\n")),
+                        Contains("list 'vertex_indices' has count nan"));
+}

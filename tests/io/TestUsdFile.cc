@@ -116,3 +116,24 @@ TEST_CASE("readUsda: each kind of bad input has its own error", "[io][usd]")
     REQUIRE_THROWS_WITH(readUsda(test::writeBytes("b6.usda", usda("int[] curveVertexCounts = [2]\npoint3f[] points = [(0,0,0), (1,nan,1)]\n"))),
                         Contains("non-finite coordinate"));
 }
+
+TEST_CASE("readUsda: values and prims nest at most 128 deep, so no file runs the parser out of stack (fuzz_usda, issue 22)", "[io][usd][fuzz]")
+{
+    // fuzz_usda's finding: metadata opening 7,000 '{' overflowed the stack of the recursive parser.
+    REQUIRE_THROWS_WITH(readUsda(test::regressionInput("fuzz_usda_nested.usda")),
+                        Contains("line 5: values nested more than 128 deep; USD text here nests at most 128 levels"));
+    const auto nestedValue = [](int n) {
+        return "#usda 1.0\ndef BasisCurves \"c\" {\n    int[] curveVertexCounts = " + std::string(std::size_t(n), '[') + "2" +
+               std::string(std::size_t(n), ']') + "\n}\n";
+    };
+    REQUIRE_THROWS_WITH(readUsda(test::writeBytes("deep_value.usda", nestedValue(129))), Contains("values nested more than 128 deep"));
+    // 128 levels parse (and fail later, for what the value is, not for its depth).
+    REQUIRE_THROWS_WITH(readUsda(test::writeBytes("ok_value.usda", nestedValue(128))), !Contains("nested"));
+    const auto nestedPrims = [](int n) {
+        std::string s = "#usda 1.0\n";
+        for (int i = 0; i < n; ++i) s += "def Xform \"x\" {\n";
+        return s + std::string(std::size_t(n), '}') + "\n";
+    };
+    REQUIRE_THROWS_WITH(readUsda(test::writeBytes("deep_prims.usda", nestedPrims(129))), Contains("line 130: prims nested more than 128 deep"));
+    REQUIRE_THROWS_WITH(readUsda(test::writeBytes("ok_prims.usda", nestedPrims(128))), !Contains("nested"));
+}

@@ -334,7 +334,7 @@ TEST_CASE("checkVdbFileLayout: what OpenVDB reads differently by version, type a
         // A points tree whose first leaf's chunk is cut short: OpenVDB's RootNode::readTopology
         // throws and leaks the child it was reading (tests/sanitizers/lsan.supp says why that
         // leak is OpenVDB's); vdbhair turns the throw into its one-line error.
-        const std::string path = (std::filesystem::path(__FILE__).parent_path() / "data" / "fuzz_vdb_rootnode_leak.vdb").string();
+        const std::string path = test::regressionInput("fuzz_vdb_rootnode_leak.vdb");
         REQUIRE(std::filesystem::file_size(path) == 10822);
         REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("cannot read grid 'strands' (RuntimeError: Expected to read a 480-byte uncompressed chunk"));
     }

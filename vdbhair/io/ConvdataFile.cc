@@ -82,8 +82,15 @@ StrandSet readConvdata(const std::string& path, const ReadOptions& opts, ReadRep
 
     StrandSet out;
     ShortStrandFilter filter(opts, report, where);
+    if (slots == 0) {
+        // No strand slots: the array holds no floats, so nothing bounds the point count by the
+        // file's size; nothing is allocated from it.
+        if (report) report->warnings.push_back(where + ": shape " + shapeStr + " has no strand slots (rows x columns = 0)");
+        filter.finish();
+        return out;
+    }
     std::size_t empty = 0;
-    std::vector<Vec3f> pts(nP);
+    std::vector<Vec3f> pts(nP);  // nP x slots floats were read above, so nP is bounded by the file
     InterruptPoll poll(opts.interrupter, where);
     for (std::uint64_t s = 0; s < slots; ++s) {
         poll();

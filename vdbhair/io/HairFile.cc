@@ -122,7 +122,7 @@ StrandSet readHair(const std::string& path, const ReadOptions& opts, ReadReport*
     ShortStrandFilter filter(opts, report, where);
     const bool anyShort = std::any_of(counts.begin(), counts.end(), [](std::uint32_t c) { return c < 2; });
     auto copyRange = [&](auto& dst, const char* src, std::size_t bytesPerPoint, std::size_t v, std::size_t n) {
-        if (!src) return;
+        if (!src || n == 0) return;  // (memcpy to an empty vector's null data is undefined, even of 0 bytes)
         const std::size_t old = dst.size();
         dst.resize(old + n);
         std::memcpy(reinterpret_cast<char*>(dst.data() + old), src + bytesPerPoint * v, bytesPerPoint * n);

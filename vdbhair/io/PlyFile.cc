@@ -113,6 +113,12 @@ public:
         return mBin ? "at byte " + std::to_string(mBin->offset()) : "line " + std::to_string(mText->line());
     }
     std::uint64_t remainingBytes() const { return mBin ? mBin->remaining() : mText->remainingBytes(); }
+    /// At most how many more values of type @a t there can be: binary values take their size,
+    /// ascii ones at least a byte each (the tokens left on the current line, then the rest).
+    std::uint64_t valuesLeftAtMost(PlyType t) const
+    {
+        return mBin ? mBin->remaining() / plySize(t) : mText->remainingBytes() + (mTokens.size() - mTok);
+    }
     [[noreturn]] void fail(const std::string& msg) const
     {
         if (mBin) mBin->fail(msg);
@@ -250,13 +256,15 @@ void readPlyBody(const char* data, std::size_t size, const PlyHeader& hdr, const
                     continue;
                 }
                 const double c = src.read(p.countType, "list count");
-                if (c < 0) src.fail("list '" + p.name + "' has a negative count");
-                const std::uint64_t cnt = std::uint64_t(c);
-                // Binary lists are checked against the bytes left; ascii items fail one by one at
-                // the end of the file (and only the kept list grows, item by item).
-                if (hdr.binary && cnt > src.remainingBytes() / plySize(p.type)) {
-                    src.fail("list '" + p.name + "' declares " + std::to_string(cnt) + " items but fewer bytes remain");
+                if (!(c >= 0) || c != std::floor(c)) {
+                    src.fail("list '" + p.name + "' has count " + formatNumber(c) + "; a list count is a whole number, 0 or more");
                 }
+                // The count is checked against what is left before it is converted or looped
+                // over (only the kept list grows, item by item).
+                if (c > double(src.valuesLeftAtMost(p.type))) {
+                    src.fail("list '" + p.name + "' declares " + formatNumber(c) + " items but fewer remain in the file");
+                }
+                const std::uint64_t cnt = std::uint64_t(c);
                 const bool keep = &e == listElement && int(k) == listProp;
                 if (keep) list.clear();
                 for (std::uint64_t j = 0; j < cnt; ++j) {

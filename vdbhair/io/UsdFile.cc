@@ -177,6 +177,18 @@ private:
 // ---------------------------------------------------------------------------------------------
 // Values, flattened: every number in order, every string or word, how many top-level elements.
 
+/// Values and prims nest at most this deep: the parser recurses once per level, so a file
+/// cannot run it out of stack (real files nest values 2-3 deep and prims a few tens).
+constexpr int kMaxNesting = 128;
+
+void checkNesting(const UsdLexer& lex, int depth, const char* what)
+{
+    if (depth > kMaxNesting) {
+        lex.fail(std::string(what) + " nested more than " + std::to_string(kMaxNesting) + " deep; USD text here nests at most " +
+                 std::to_string(kMaxNesting) + " levels");
+    }
+}
+
 struct FlatValue
 {
     std::vector<double> numbers;
@@ -188,6 +200,7 @@ struct FlatValue
 
 void parseValueInto(UsdLexer& lex, FlatValue& v, int depth)
 {
+    checkNesting(lex, depth, "values");
     const Token& t = lex.peek();
     if (t.kind == Tok::Number) { v.numbers.push_back(lex.next().number); return; }
     if (t.kind == Tok::String || t.kind == Tok::Word || t.kind == Tok::Path) { v.words.emplace_back(lex.next().text); return; }
@@ -267,10 +280,11 @@ struct UsdDocument
     std::size_t xformOps = 0, timeSamples = 0;
 };
 
-void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves);
+void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, int depth);
 
-void parsePrim(UsdLexer& lex, UsdDocument& doc)
+void parsePrim(UsdLexer& lex, UsdDocument& doc, int depth)
 {
+    checkNesting(lex, depth, "prims");
     const Token spec = lex.next();  // def, over, class
     std::string type;
     if (lex.peek().kind == Tok::Word) type = std::string(lex.next().text);
@@ -282,20 +296,20 @@ void parsePrim(UsdLexer& lex, UsdDocument& doc)
         CurvesPrim prim;
         prim.name = std::string(name.text);
         prim.line = name.line;
-        parsePrimBody(lex, doc, &prim);
+        parsePrimBody(lex, doc, &prim, depth);
         doc.curves.push_back(std::move(prim));
     } else {
-        parsePrimBody(lex, doc, nullptr);
+        parsePrimBody(lex, doc, nullptr, depth);
     }
 }
 
-void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves)
+void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, int depth)
 {
     while (!lex.isPunct('}')) {
         const Token& t = lex.peek();
         if (t.kind == Tok::End) lex.fail("a prim's body is not closed with '}'");
         if (t.kind == Tok::Punct && t.text[0] == ';') { lex.next(); continue; }
-        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) { parsePrim(lex, doc); continue; }
+        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) { parsePrim(lex, doc, depth + 1); continue; }
         if (lex.isWord("variantSet")) {  // variantSet "name" = { "a" { ... } }
             lex.next();
             lex.next();
@@ -306,7 +320,8 @@ void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves)
                 lex.next();
                 if (lex.isPunct('(')) parseMetadata(lex);
                 lex.expect('{', "to open a variant");
-                parsePrimBody(lex, doc, nullptr);
+                checkNesting(lex, depth + 1, "prims");
+                parsePrimBody(lex, doc, nullptr, depth + 1);
             }
             lex.next();
             continue;
@@ -351,7 +366,7 @@ UsdDocument parseUsda(const std::vector<char>& bytes, const std::string& where)
         if (const auto it = meta.find("upAxis"); it != meta.end() && !it->second.words.empty()) doc.upAxis = it->second.words[0];
     }
     while (lex.peek().kind != Tok::End) {
-        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) parsePrim(lex, doc);
+        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) parsePrim(lex, doc, 1);
         else lex.fail("expected a prim (def, over or class), found " + UsdLexer::describe(lex.peek()));
     }
     return doc;
