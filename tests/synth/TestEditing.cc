@@ -361,8 +361,9 @@ TEST_CASE("transferHairstyle: short curls onto a base four times as long keep th
     CHECK(tr.detailsSmoothing == Approx(std::min(1.0, p.smoothing * tr.lengthRatio)));
     // Turning per length at the curls' own sample spacing. Laid vertex by vertex (the paper's rule)
     // the curls stretch four times and keep a tenth of it; laid by arc length they keep two thirds
-    // (measured 0.66; onto a base of their own length 0.99: the third lost here is not understood,
-    // README "Editing hairstyles"). Below half, or below four times the paper's rule, is a fault.
+    // (measured 0.66; onto a base of their own length 0.99: the third is lost to the matching of
+    // centres by size, README "Editing hairstyles"). Below half, or below four times the paper's
+    // rule, is a fault.
     const double spacing = polylineLength(curly.data(0), curly.size(0)) / 63.0;
     const double tc = meanTurningPerLengthAtSpacing(curly, spacing), to = meanTurningPerLengthAtSpacing(tr.result.strands, spacing);
     TransferParams index = p;
