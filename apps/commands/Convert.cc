@@ -131,7 +131,10 @@ int runConvert(ConvertParams p, const CommonOptions& common)
         strands.append(readStrands(in, ropts, &report));
     }
     printWarnings("convert", report, common);
-    if (strands.empty()) throw FormatError("the input has no strands; nothing to write to " + p.output);
+    if (strands.empty()) {
+        std::string what = inputs.size() == 1 ? inputs[0] + ": the file has no strands" : "the " + std::to_string(inputs.size()) + " inputs have no strands";
+        throw FormatError(what + "; nothing to write to " + p.output);
+    }
     if (p.scale != 1.0) scaleStrands(strands, float(p.scale));
     rotateUpToY(strands, axisFromName(p.up, "--up"));
     if (p.resample >= 2) {

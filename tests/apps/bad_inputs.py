@@ -87,6 +87,12 @@ if any(p.wait() != 0 for p in setup):
 vdb = open(path("good.vdb"), "rb").read()
 
 
+def fuzz_input(name):
+    """A committed fuzzer finding, as bytes."""
+    with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "io", "data", name), "rb") as f:
+        return f.read()
+
+
 def patched(b, at, fmt, value):
     b = bytearray(b)
     struct.pack_into(fmt, b, at, value)
@@ -147,6 +153,10 @@ CASES = [
     # OBJ
     ("obj: index beyond the vertices", ["convert", write("idx.obj", "v 0 0 0\nv 1 1 1\nl 1 5\n"), "{out}.hair"], ["idx.obj", "5"]),
     ("obj: NaN vertex", ["convert", write("nan.obj", "v 0 0 0\nv nan 1 1\nl 1 2\n"), "{out}.hair"], ["nan.obj", "non-finite"]),
+    # The long fuzz run's findings (tests/io/data, issue 22)
+    ("usda: values nested 7,000 deep (fuzz_usda)", ["convert", write("nested.usda", fuzz_input("fuzz_usda_nested.usda")), "{out}.obj"], ["nested.usda", "line 5: values nested more than 128 deep"]),
+    ("mesh: an ascii list count of 3.9e85 (fuzz_mesh)", ["scalp", write("listcount.ply", fuzz_input("fuzz_mesh_list_count.ply")), "-o", "{out}.vdb"], ["listcount.ply", "declares 3.88889e+85 items but fewer remain"]),
+    ("usda: prims nested 200 deep", ["convert", write("prims.usda", "#usda 1.0\n" + 'def Xform "x" {\n' * 200 + "}" * 200 + "\n"), "{out}.obj"], ["prims.usda", "line 130: prims nested more than 128 deep"]),
     # VDB
     ("vdb: not a VDB file", ["convert", write("junk.vdb", "this is not a vdb file"), "{out}.obj"], ["junk.vdb", "not a readable VDB file"]),
     ("vdb: file metadata count beyond the file", ["convert", write("meta.vdb", patched(vdb, 57, "<I", 0xffffffff)), "{out}.obj"], ["meta.vdb", "metadata declares 4294967295 entries"]),
