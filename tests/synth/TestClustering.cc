@@ -4,6 +4,10 @@
 #include <vdbhair/synth/Pca.h>
 
 #include <catch2/catch.hpp>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include <queue>
 #include <set>
@@ -32,8 +36,8 @@ bool clustersConnected(const StrandSamples& s, const std::vector<std::uint32_t>&
         while (!q.empty()) {
             const std::uint32_t a = q.front();
             q.pop();
-            for (std::uint32_t b : graph[a])
-                if (!seen[b] && label[b] == label[a]) {
+            for (const std::uint32_t* it = graph.begin(a); it != graph.end(a); ++it)
+                if (const std::uint32_t b = *it; !seen[b] && label[b] == label[a]) {
                     seen[b] = 1;
                     q.push(b);
                 }
@@ -65,6 +69,63 @@ TEST_CASE("sampleStrands: rows are root-relative in the root frame, in radius un
     bad.addStrand({Vec3f(0, 2, 0)});
     CHECK_THROWS_WITH(sampleStrands(bad, map, 5), Catch::Contains("strand 0 has 1 vertex"));
     CHECK_THROWS_WITH(sampleStrands(s, map, 1), Catch::Contains("1 vertices per strand"));
+}
+
+TEST_CASE("sampleStrands: an order picks the strand each row takes", "[synth]")
+{
+    const ScalpMap& map = unitMap();
+    StrandSet s;
+    for (int i = 0; i < 5; ++i) {
+        const float a = 0.3f * float(i);
+        const Vec3f root(std::sin(a), std::cos(a), 0.f);
+        s.addStrand({root, root * 1.2f + Vec3f(0.f, 0.f, 0.1f * float(i)), root * 1.5f});
+    }
+    const StrandSamples all = sampleStrands(s, map, 4);
+    const std::vector<std::uint32_t> order{3, 0, 4, 4, 1};
+    const StrandSamples picked = sampleStrands(s, map, 4, true, &order);
+    REQUIRE(picked.count() == order.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        CHECK(picked.roots[i] == all.roots[order[i]]);
+        CHECK(picked.lengths[i] == all.lengths[order[i]]);
+        for (std::size_t k = 0; k < picked.dim(); ++k) CHECK(picked.row(i)[k] == all.row(order[i])[k]);
+    }
+    const std::vector<std::uint32_t> bad{0, 5};
+    CHECK_THROWS_WITH(sampleStrands(s, map, 4, true, &bad), Catch::Contains("order names strand 5 of 5"));
+}
+
+TEST_CASE("neighbourGraph: the symmetric k-nearest-neighbour graph, sorted rows, any thread count", "[synth]")
+{
+    // Seeded points in a box; the graph against a brute-force one.
+    std::vector<Vec3d> pts;
+    std::uint64_t x = 12345;
+    const auto next = [&] { x = x * 6364136223846793005ull + 1442695040888963407ull; return double(x >> 11) / double(1ull << 53); };
+    for (int i = 0; i < 3000; ++i) pts.emplace_back(next(), next(), 0.2 * next());
+    const int k = 6;
+    std::vector<std::set<std::uint32_t>> expect(pts.size());
+    for (std::uint32_t i = 0; i < pts.size(); ++i) {
+        std::vector<std::pair<double, std::uint32_t>> d;
+        for (std::uint32_t j = 0; j < pts.size(); ++j) d.emplace_back((pts[i] - pts[j]).lengthSqr(), j);
+        std::partial_sort(d.begin(), d.begin() + k + 1, d.end());
+        for (int m = 0; m <= k; ++m) {
+            if (d[std::size_t(m)].second == i) continue;
+            expect[i].insert(d[std::size_t(m)].second);
+            expect[d[std::size_t(m)].second].insert(i);
+        }
+    }
+    const NeighbourGraph g = neighbourGraph(pts, k);
+    REQUIRE(g.offsets.size() == pts.size() + 1);
+    std::size_t mismatched = 0;
+    for (std::uint32_t i = 0; i < pts.size(); ++i) {
+        const std::vector<std::uint32_t> row(g.begin(i), g.end(i));
+        if (row != std::vector<std::uint32_t>(expect[i].begin(), expect[i].end())) ++mismatched;  // sorted, unique, symmetric
+    }
+    CHECK(mismatched == 0);
+    tbb::task_arena one(1);
+    NeighbourGraph serial;
+    one.execute([&] { serial = neighbourGraph(pts, k); });
+    CHECK(serial.offsets == g.offsets);
+    CHECK(serial.indices == g.indices);
+    CHECK(neighbourGraph({Vec3d(0.0)}, k).indices.empty());
 }
 
 TEST_CASE("fitPca: rows spanning a plane have two components", "[synth]")

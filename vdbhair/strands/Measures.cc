@@ -200,26 +200,40 @@ std::uint32_t spreadBits(std::uint32_t v)
 }
 } // namespace
 
-std::vector<std::uint32_t> spatialOrder(const StrandSet& strands)
+namespace {
+/// The Morton order of @a n points given by @a point(i) (see spatialOrder()).
+template<typename PointFn>
+std::vector<std::uint32_t> mortonOrder(std::size_t n, PointFn&& point)
 {
-    const std::size_t nS = strands.numStrands();
     BBox box;
-    for (std::size_t i = 0; i < nS; ++i) box.expand(strands.root(i));
+    for (std::size_t i = 0; i < n; ++i) box.expand(point(i));
     const Vec3f e = box.extent();
-    std::vector<std::uint64_t> keys(nS);
-    for (std::size_t i = 0; i < nS; ++i) {
+    std::vector<std::uint64_t> keys(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3f p = point(i);
         std::uint32_t code = 0;
         for (int k = 0; k < 3; ++k) {
-            const float f = e[k] > 0.f ? (strands.root(i)[k] - box.min[k]) / e[k] : 0.f;
+            const float f = e[k] > 0.f ? (p[k] - box.min[k]) / e[k] : 0.f;
             const std::uint32_t q = std::uint32_t(std::min(1023.f, std::max(0.f, f * 1024.f)));
             code |= spreadBits(q) << k;
         }
         keys[i] = (std::uint64_t(code) << 32) | std::uint64_t(i);
     }
     std::sort(keys.begin(), keys.end());
-    std::vector<std::uint32_t> order(nS);
-    for (std::size_t i = 0; i < nS; ++i) order[i] = std::uint32_t(keys[i] & 0xffffffffu);
+    std::vector<std::uint32_t> order(n);
+    for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(keys[i] & 0xffffffffu);
     return order;
+}
+} // namespace
+
+std::vector<std::uint32_t> spatialOrder(const StrandSet& strands)
+{
+    return mortonOrder(strands.numStrands(), [&](std::size_t i) { return strands.root(i); });
+}
+
+std::vector<std::uint32_t> spatialOrder(const std::vector<Vec3d>& points)
+{
+    return mortonOrder(points.size(), [&](std::size_t i) { return Vec3f(points[i]); });
 }
 
 double meanVertexDisplacement(const StrandSet& a, const StrandSet& b, bool threaded)

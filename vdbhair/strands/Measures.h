@@ -74,6 +74,9 @@ namespace vdbhair {
 /// A deterministic function of the roots only.
 std::vector<std::uint32_t> spatialOrder(const StrandSet& strands);
 
+/// @brief The same order of points (quantized in single precision): for work on neighbouring points.
+std::vector<std::uint32_t> spatialOrder(const std::vector<Vec3d>& points);
+
 /// @brief Mean distance between corresponding vertices of @a a and @a b: each vertex of a
 /// strand of @a a against the point of the same strand of @a b at the same arc length (up to
 /// the shorter of the two strands). Both sets must have the same strand count.

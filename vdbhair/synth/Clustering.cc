@@ -14,6 +14,7 @@
 #include <queue>
 #include <string>
 #include <tuple>
+#include <utility>
 
 namespace vdbhair {
 
@@ -34,54 +35,69 @@ void ClusterParams::validate(const char* where) const
     if (levels < 2 || levels > 5) fail("levels", std::to_string(levels), "must be between 2 and 5");
 }
 
-std::vector<std::vector<std::uint32_t>> neighbourGraph(const std::vector<Vec3d>& points, int k)
+NeighbourGraph neighbourGraph(const std::vector<Vec3d>& points, int k)
 {
     const std::size_t n = points.size();
-    std::vector<std::vector<std::uint32_t>> adj(n);
-    if (n < 2) return adj;
+    NeighbourGraph g;
+    g.offsets.assign(n + 1, 0);
+    if (n < 2) return g;
     PointCloud cloud{&points};
     PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree.buildIndex();
-    const std::size_t want = std::min<std::size_t>(std::size_t(k) + 1, n);
-    std::vector<std::uint32_t> idx(want);
-    std::vector<double> d2(want);
-    for (std::size_t i = 0; i < n; ++i) {
-        const double q[3] = {points[i].x(), points[i].y(), points[i].z()};
-        const std::size_t got = tree.knnSearch(q, want, idx.data(), d2.data());
-        for (std::size_t j = 0; j < got; ++j) {
-            if (idx[j] == i) continue;
-            adj[i].push_back(idx[j]);
-            adj[idx[j]].push_back(std::uint32_t(i));
+    const std::size_t want = std::min<std::size_t>(std::size_t(std::max(k, 0)) + 1, n);
+    // The searches in parallel; then each point's edges out and in, counted, placed, sorted and
+    // made unique row by row (the same graph on any thread count).
+    std::vector<std::uint32_t> idx(n * want);
+    std::vector<std::uint32_t> got(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<double> d2(want);
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const double q[3] = {points[i].x(), points[i].y(), points[i].z()};
+            got[i] = std::uint32_t(tree.knnSearch(q, want, idx.data() + i * want, d2.data()));
         }
+    });
+    std::vector<std::uint32_t> start(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < got[i]; ++j) {
+            const std::uint32_t o = idx[i * want + j];
+            if (o == i) continue;
+            ++start[i + 1];
+            ++start[std::size_t(o) + 1];
+        }
+    for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+    std::vector<std::uint32_t> all(start[n]);
+    {
+        std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t j = 0; j < got[i]; ++j) {
+                const std::uint32_t o = idx[i * want + j];
+                if (o == i) continue;
+                all[at[i]++] = o;
+                all[at[o]++] = std::uint32_t(i);
+            }
     }
-    for (auto& a : adj) {
-        std::sort(a.begin(), a.end());
-        a.erase(std::unique(a.begin(), a.end()), a.end());
-    }
-    return adj;
+    std::vector<std::uint32_t> unique(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::uint32_t* b = all.data() + start[i];
+            std::uint32_t* e = all.data() + start[i + 1];
+            std::sort(b, e);
+            unique[i] = std::uint32_t(std::unique(b, e) - b);
+        }
+    });
+    for (std::size_t i = 0; i < n; ++i) g.offsets[i + 1] = g.offsets[i] + unique[i];
+    g.indices.resize(g.offsets[n]);
+    for (std::size_t i = 0; i < n; ++i)
+        std::copy(all.data() + start[i], all.data() + start[i] + unique[i], g.indices.data() + g.offsets[i]);
+    return g;
 }
 
 namespace {
 
-/// The root graph in compressed rows (one allocation: the region growing's neighbour loads are
-/// its hottest memory accesses).
-struct Graph
-{
-    std::vector<std::uint32_t> offsets, indices;
-    explicit Graph(const std::vector<std::vector<std::uint32_t>>& adj) : offsets(adj.size() + 1, 0)
-    {
-        for (std::size_t i = 0; i < adj.size(); ++i) offsets[i + 1] = offsets[i] + std::uint32_t(adj[i].size());
-        indices.reserve(offsets.back());
-        for (const auto& a : adj) indices.insert(indices.end(), a.begin(), a.end());
-    }
-    const std::uint32_t* begin(std::uint32_t s) const { return indices.data() + offsets[s]; }
-    const std::uint32_t* end(std::uint32_t s) const { return indices.data() + offsets[s + 1]; }
-};
-
 struct Lloyd
 {
     const StrandSamples& samples;
-    const Graph& graph;
+    const NeighbourGraph& graph;
     std::size_t dim;
     std::vector<float> centers;          // k × dim
     std::vector<std::uint32_t> seeds;    // k
@@ -90,11 +106,53 @@ struct Lloyd
     std::vector<std::uint32_t> memoCluster;
     std::vector<double> memoDistance;
     std::vector<double> own;  ///< after fit(): each strand's distance to its cluster's centre
+    /// After fit(): each strand's distances to the clusters it will most likely be offered to by the
+    /// next partition (its own and its neighbours' current clusters, at most kCached), computed in
+    /// parallel; the region growing then reads them instead of computing them in its serial loop
+    /// (the same values: only where they are computed changes).
+    static constexpr std::size_t kCached = 4;
+    std::vector<std::uint32_t> cachedCluster;  // N × kCached, kNoCluster where unused
+    std::vector<double> cachedDistance;        // N × kCached
+    static constexpr std::uint32_t kNoCluster = ~0u;
 
     std::size_t k() const { return seeds.size(); }
     double dist(std::size_t s, std::size_t c) const
     {
         return sampleDistance2(samples.row(s), centers.data() + c * dim, dim);
+    }
+
+    double cachedDist(std::uint32_t s, std::uint32_t c) const
+    {
+        if (!cachedCluster.empty()) {
+            const std::uint32_t* cc = cachedCluster.data() + std::size_t(s) * kCached;
+            for (std::size_t j = 0; j < kCached; ++j)
+                if (cc[j] == c) return cachedDistance[std::size_t(s) * kCached + j];
+        }
+        return dist(s, c);
+    }
+
+    /// The distances the next partition will most likely ask for (see cachedCluster).
+    void cacheDistances()
+    {
+        const std::size_t n = samples.count();
+        cachedCluster.assign(n * kCached, kNoCluster);
+        cachedDistance.resize(n * kCached);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t s = r.begin(); s != r.end(); ++s) {
+                std::uint32_t* cc = cachedCluster.data() + s * kCached;
+                double* cd = cachedDistance.data() + s * kCached;
+                std::size_t used = 0;
+                const auto add = [&](std::uint32_t c) {
+                    for (std::size_t j = 0; j < used; ++j) if (cc[j] == c) return;
+                    if (used == kCached) return;
+                    cc[used] = c;
+                    cd[used] = c == label[s] ? own[s] : dist(s, c);
+                    ++used;
+                };
+                add(label[s]);
+                for (const std::uint32_t* it = graph.begin(std::uint32_t(s)); it != graph.end(std::uint32_t(s)); ++it) add(label[*it]);
+            }
+        });
     }
 
     /// §4.2: grow every cluster from its seed through one global priority queue.
@@ -115,7 +173,7 @@ struct Lloyd
                 if (label[nb] != kNone) continue;
                 if (memoCluster[nb] == c) continue;  // already queued with this tag: the same entry
                 memoCluster[nb] = c;
-                memoDistance[nb] = dist(nb, c);
+                memoDistance[nb] = cachedDist(nb, c);
                 queue.emplace(memoDistance[nb], nb, c);
             }
         };
@@ -255,7 +313,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
     if (k == 0 || k > n)
         throw ValueError("clusterSamples: " + std::to_string(k) + " clusters of " + std::to_string(n) +
                          " strands: between 1 and the strand count");
-    const Graph graph(neighbourGraph(samples.roots, params.neighbours));
+    const NeighbourGraph graph = neighbourGraph(samples.roots, params.neighbours);
     Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}, {}};
     lloyd.seeds = initialSeeds(samples, k, Rng(params.seed, 0x5eedc1u, stream));
     for (std::uint32_t s : lloyd.seeds) lloyd.centers.insert(lloyd.centers.end(), samples.row(s), samples.row(s) + lloyd.dim);
@@ -268,6 +326,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
             if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("clustering interrupted");
             lloyd.partition();
             const double energy = lloyd.fit();
+            lloyd.cacheDistances();
             out.energy.push_back(energy);
             out.clusters.push_back(lloyd.k());
             if (previous - energy <= params.tolerance * energy) break;
@@ -317,7 +376,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
     return out;
 }
 
-ClusterHierarchy buildHierarchy(const StrandSamples& strands, const ScalpMap& map, const ClusterParams& params,
+ClusterHierarchy buildHierarchy(StrandSamples strands, const ScalpMap& map, const ClusterParams& params,
                                 openvdb::util::NullInterrupter* interrupter)
 {
     params.validate("buildHierarchy");
@@ -328,7 +387,7 @@ ClusterHierarchy buildHierarchy(const StrandSamples& strands, const ScalpMap& ma
         throw ValueError("buildHierarchy: " + std::to_string(n) + " strands for " + std::to_string(params.levels) +
                          " levels: at least " + std::to_string(needed) + " (a quarter as many clusters per level)");
     ClusterHierarchy h;
-    h.levels.push_back(strands);
+    h.levels.push_back(std::move(strands));
     for (int l = 0; l + 1 < params.levels; ++l) {
         const StrandSamples& level = h.levels.back();
         const bool adaptive = l == 0;

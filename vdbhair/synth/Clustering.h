@@ -88,10 +88,22 @@ struct ClusterHierarchy
 
 /// @throw ValueError for fewer strands than the hierarchy needs (4 per cluster at the coarsest
 /// level); InterruptedError.
-ClusterHierarchy buildHierarchy(const StrandSamples& strands, const ScalpMap& map, const ClusterParams& params,
+/// @param strands level 0, taken by value (pass an rvalue: 100,000 strands are 77 MB to copy).
+ClusterHierarchy buildHierarchy(StrandSamples strands, const ScalpMap& map, const ClusterParams& params,
                                 openvdb::util::NullInterrupter* interrupter = nullptr);
 
-/// @brief The symmetric k-nearest-neighbour graph of @a points (adjacency lists, sorted).
-std::vector<std::vector<std::uint32_t>> neighbourGraph(const std::vector<Vec3d>& points, int k);
+/// @brief A graph in compressed rows: the neighbours of point i are indices[offsets[i] ..
+/// offsets[i + 1]), sorted (one allocation: the region growing's neighbour loads are its hottest
+/// memory accesses).
+struct NeighbourGraph
+{
+    std::vector<std::uint32_t> offsets, indices;
+    const std::uint32_t* begin(std::uint32_t i) const { return indices.data() + offsets[i]; }
+    const std::uint32_t* end(std::uint32_t i) const { return indices.data() + offsets[i + 1]; }
+};
+
+/// @brief The symmetric k-nearest-neighbour graph of @a points. Searched in parallel; the same
+/// graph on any thread count.
+NeighbourGraph neighbourGraph(const std::vector<Vec3d>& points, int k);
 
 } // namespace vdbhair

@@ -1,5 +1,7 @@
 #include "DetailTransfer.h"
 
+#include <vdbhair/Memory.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/scalp/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
@@ -187,6 +189,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
     // 4-5. Every new strand.
     StrandSamples out;
     out.vertices = no;
+    reserveHugePages(out.local, n * out.dim());  // fresh pages 2 MiB at a time (Memory.h)
     out.local.assign(n * out.dim(), 0.0f);
     out.roots = roots;
     out.scalp.resize(n);

@@ -1,5 +1,7 @@
 #include "StrandSamples.h"
 
+#include <vdbhair/Memory.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/strands/Resample.h>
 
@@ -19,17 +21,24 @@ void StrandSamples::push(const float* localRow, const Vec3d& root, const Vec3d& 
     lengths.push_back(length);
 }
 
-StrandSamples sampleStrands(const StrandSet& strands, const ScalpMap& map, int vertices, bool threaded)
+StrandSamples sampleStrands(const StrandSet& strands, const ScalpMap& map, int vertices, bool threaded,
+                            const std::vector<std::uint32_t>* order)
 {
     if (vertices < 2)
         throw ValueError("sampleStrands: " + std::to_string(vertices) + " vertices per strand: at least 2 are needed");
-    const std::size_t n = strands.numStrands();
-    for (std::size_t s = 0; s < n; ++s)
+    const std::size_t n = order ? order->size() : strands.numStrands();
+    if (order)
+        for (std::uint32_t s : *order)
+            if (s >= strands.numStrands())
+                throw ValueError("sampleStrands: order names strand " + std::to_string(s) + " of " +
+                                 std::to_string(strands.numStrands()) + ": each must be less than the strand count");
+    for (std::size_t s = 0; s < strands.numStrands(); ++s)
         if (strands.size(s) < 2)
             throw ValueError("sampleStrands: strand " + std::to_string(s) + " has " + std::to_string(strands.size(s)) +
                              " vertex: at least 2 are needed to resample it");
     StrandSamples out;
     out.vertices = vertices;
+    reserveHugePages(out.local, n * out.dim());  // fresh pages 2 MiB at a time (Memory.h)
     out.local.assign(n * out.dim(), 0.0f);
     out.roots.resize(n);
     out.scalp.resize(n);
@@ -39,8 +48,9 @@ StrandSamples sampleStrands(const StrandSet& strands, const ScalpMap& map, int v
     const auto body = [&](const tbb::blocked_range<std::size_t>& r) {
         std::vector<Vec3f> pts(vertices);
         for (std::size_t s = r.begin(); s != r.end(); ++s) {
-            const Vec3f* p = strands.data(s);
-            const std::size_t m = strands.size(s);
+            const std::size_t from = order ? std::size_t((*order)[s]) : s;
+            const Vec3f* p = strands.data(from);
+            const std::size_t m = strands.size(from);
             double len = 0.0;
             for (std::size_t i = 1; i < m; ++i) len += (p[i] - p[i - 1]).length();
             resamplePolyline(p, m, std::size_t(vertices), pts.data());
@@ -100,6 +110,7 @@ StrandSet samplesToStrands(const StrandSamples& samples, double radius, bool thr
     if (n * ns >= (std::size_t(1) << 32))
         throw LimitError("samplesToStrands: " + std::to_string(n) + " strands of " + std::to_string(ns) +
                          " vertices exceed the 2^32 vertices a strand set holds");
+    reserveHugePages(out.positions, n * ns);  // fresh pages 2 MiB at a time (Memory.h)
     out.positions.resize(n * ns);
     out.offsets.resize(n + 1);
     for (std::size_t s = 0; s <= n; ++s) out.offsets[s] = std::uint32_t(s * ns);

@@ -10,6 +10,7 @@
 #include <vdbhair/field/ScalpMap.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace vdbhair {
@@ -44,9 +45,11 @@ struct StrandSamples
 
 /// @brief Resample and express every strand of @a strands in its root frame on @a map.
 /// @param vertices n_s, at least 2
+/// @param order null, or the strand each sample takes (sample i is strand (*order)[i]: a
+/// permutation or any selection of strand indices, each less than the strand count)
 /// @throw ValueError for fewer than 2 vertices, or a strand of fewer than two vertices (named).
 StrandSamples sampleStrands(const StrandSet& strands, const ScalpMap& map, int vertices = StrandSamples::kDefaultVertices,
-                            bool threaded = true);
+                            bool threaded = true, const std::vector<std::uint32_t>* order = nullptr);
 
 /// @brief The L² distance of Wang et al. §4.1 between two sample rows of @a dim floats.
 double sampleDistance2(const float* a, const float* b, std::size_t dim);
