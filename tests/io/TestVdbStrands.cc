@@ -13,6 +13,8 @@
 
 #include <vdbhair/io/StrandIO.h>
 
+#include <tbb/task_arena.h>
+
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -240,6 +242,58 @@ TEST_CASE("strandsFromGrid: leaf offsets and attribute arrays are checked before
         auto leaf = g->tree().beginLeaf();
         leaf->setOffsetOnly(511, leaf->getValue(511) + 7);
         REQUIRE_THROWS_WITH(strandsFromGrid(*g, "test"), Contains("points but its 'P' array holds") && Contains("one value per point"));
+    }
+}
+
+TEST_CASE("strandsFromGrid: leaves read in parallel give the error a pass in leaf order meets first, and the same strands on one thread", "[io][vdb][fuzz]")
+{
+    initializeOpenVdb();
+    // Strands spread over many leaves.
+    StrandSet s;
+    for (int i = 0; i < 400; ++i) {
+        const float x = float(i % 20) * 3.f, z = float(i / 20) * 3.f;
+        s.addStrand({Vec3f(x, 0.f, z), Vec3f(x + 0.3f, 1.f, z), Vec3f(x + 0.5f, 2.f, z + 0.2f), Vec3f(x + 0.4f, 3.f, z + 0.6f)});
+    }
+    VdbPointsOptions opts;
+    opts.voxelSize = 0.25;
+    const auto leafAt = [](openvdb::points::PointDataGrid& g, int n) {
+        auto leaf = g.tree().beginLeaf();
+        for (int i = 0; i < n && leaf; ++i) ++leaf;
+        REQUIRE(leaf);
+        return leaf.getLeaf();
+    };
+    const auto breakVertex = [](openvdb::points::PointDataTree::LeafNodeType* leaf) {
+        const std::size_t iV = leaf->attributeSet().descriptor().find("vertex");
+        openvdb::points::AttributeWriteHandle<std::int32_t> h(leaf->attributeArray(iV));
+        h.set(0, -5);
+    };
+    {
+        auto g = createStrandGrid(s, opts);
+        REQUIRE(g->tree().leafCount() > 50);
+        // Equal on one thread and on all, and to what was written.
+        StrandSet serial;
+        tbb::task_arena one(1);
+        one.execute([&] { serial = strandsFromGrid(*g, "test"); });
+        const StrandSet parallel = strandsFromGrid(*g, "test");
+        CHECK(serial.offsets == parallel.offsets);
+        CHECK(serial.positions == parallel.positions);
+        test::requireSameStrands(s, parallel, 1e-5f);
+    }
+    SECTION("a point's error in an early leaf comes before a later leaf's offsets")
+    {
+        auto g = createStrandGrid(s, opts);
+        breakVertex(leafAt(*g, 3));
+        auto late = leafAt(*g, 40);
+        late->setOffsetOnly(0, late->getValue(511) + 1000);
+        REQUIRE_THROWS_WITH(strandsFromGrid(*g, "test"), Contains("and vertex -5; strand must be in"));
+    }
+    SECTION("an early leaf's offsets come before a later leaf's point")
+    {
+        auto g = createStrandGrid(s, opts);
+        breakVertex(leafAt(*g, 40));
+        auto early = leafAt(*g, 3);
+        early->setOffsetOnly(0, early->getValue(511) + 1000);
+        REQUIRE_THROWS_WITH(strandsFromGrid(*g, "test"), Contains("a leaf's point offsets never decrease"));
     }
 }
 

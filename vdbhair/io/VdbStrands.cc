@@ -11,7 +11,10 @@
 #include <openvdb/points/PointGroup.h>
 #include <openvdb/tools/PointIndexGrid.h>
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <limits>
@@ -215,85 +218,140 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
         }
     }
 
-    // Gather every point (the tree already holds them: sizes come from real data).
+    if (nPoints > std::numeric_limits<std::uint32_t>::max())
+        throw LimitError(where + ": grid '" + grid.getName() + "' has " + std::to_string(nPoints) +
+                         " points, more than the 2^32-1 vertices a strand set holds");
+    // Gather every point (the tree already holds them: sizes come from real data), leaves in
+    // parallel. A leaf's offsets and arrays come from the file as they are: OpenVDB's handles index
+    // the arrays without bounds checks, so what they will index is checked first (one flipped bit
+    // in an offset otherwise reads and writes past the arrays). Errors are those a pass over the
+    // leaves in order would meet first: each leaf's checks, then its points, leaf by leaf.
+    std::vector<const pts::PointDataTree::LeafNodeType*> leaves;
+    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
+    const std::size_t nL = leaves.size();
+    std::vector<openvdb::Index32> last(nL, 0);    // each leaf's point count (its last offset)
+    std::vector<std::uint64_t> visited(nL, 0);    // the points of its active voxels (what is gathered)
+    std::vector<std::string> leafError(nL);       // its first check that fails (layout, offsets)
+    std::vector<std::string> arrayError(nL);      // its first array too short for its points
+    const std::pair<const char*, std::size_t> used[] = {{"P", iP}, {"strand", iS}, {"vertex", iV},
+                                                       {"Cd", iCd}, {"width", iW}, {"Alpha", iA}};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nL, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const auto& leaf = *leaves[l];
+            if (!(leaf.attributeSet().descriptor() == desc)) {
+                leafError[l] = where + ": the leaf at voxel " + toString(leaf.origin()) +
+                               " has other attributes than the first leaf; every leaf of a points grid shares one layout";
+                continue;
+            }
+            openvdb::Index32 previous = 0;
+            std::uint64_t onPoints = 0;
+            for (openvdb::Index i = 0; i < pts::PointDataTree::LeafNodeType::SIZE; ++i) {
+                const openvdb::Index32 offset = leaf.getValue(i);
+                if (offset < previous) {
+                    leafError[l] = where + ": the leaf at voxel " + toString(leaf.origin()) + " has point offset " +
+                                   std::to_string(offset) + " after " + std::to_string(previous) + " (voxel " + std::to_string(i) +
+                                   "); a leaf's point offsets never decrease";
+                    break;
+                }
+                if (leaf.isValueOn(i)) onPoints += offset - previous;
+                previous = offset;
+            }
+            if (!leafError[l].empty()) continue;
+            last[l] = previous;
+            visited[l] = onPoints;
+            for (const auto& [name, index] : used) {
+                if (index == pts::AttributeSet::INVALID_POS) continue;
+                const pts::AttributeArray& array = leaf.constAttributeArray(index);
+                if (!array.isUniform() && array.size() < previous) {
+                    arrayError[l] = where + ": the leaf at voxel " + toString(leaf.origin()) + " has " + std::to_string(previous) +
+                                    " points but its '" + std::string(name) + "' array holds " + std::to_string(array.size()) +
+                                    "; each array holds one value per point";
+                    break;
+                }
+            }
+        }
+    });
+    // The leaves before the first one that fails its checks are gathered; their points come first.
+    std::vector<std::uint64_t> base(nL + 1, 0);
+    std::size_t good = nL;
+    std::string firstLeafError;
+    for (std::size_t l = 0; l < nL; ++l) {
+        if (!leafError[l].empty()) {
+            firstLeafError = leafError[l];
+        } else if (std::uint64_t(last[l]) > nPoints - base[l]) {
+            firstLeafError = where + ": the leaf at voxel " + toString(leaves[l]->origin()) + " holds " + std::to_string(last[l]) +
+                             " points, more than the " + std::to_string(nPoints) + " the tree counts";
+        } else if (!arrayError[l].empty()) {
+            firstLeafError = arrayError[l];
+        }
+        if (!firstLeafError.empty()) {
+            good = l;
+            break;
+        }
+        base[l + 1] = base[l] + visited[l];
+    }
     std::vector<Vec3f> pos(nPoints), cd(hasCd ? nPoints : 0);
     std::vector<float> width(hasW ? nPoints : 0), alpha(hasA ? nPoints : 0);
     std::vector<std::int32_t> sid(nPoints), vid(nPoints);
-    std::size_t k = 0;
-    std::int64_t maxStrand = -1;
-    InterruptPoll poll(opts.interrupter, where);
-    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
-        // A leaf's offsets and arrays come from the file as they are: OpenVDB's handles index the
-        // arrays without bounds checks, so what they will index is checked first (one flipped
-        // bit in an offset otherwise reads and writes past the arrays).
-        if (!(leaf->attributeSet().descriptor() == desc)) {
-            throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) +
-                              " has other attributes than the first leaf; every leaf of a points grid shares one layout");
+    std::vector<std::string> pointError(good);
+    std::vector<std::int64_t> leafMaxStrand(good, -1);
+    const std::int64_t strandLimit = declared >= 0 ? declared : std::int64_t(nPoints);
+    std::atomic<bool> interrupted{false};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, good, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        if (opts.interrupter && opts.interrupter->wasInterrupted()) {
+            interrupted = true;
+            return;
         }
-        openvdb::Index32 last = 0;
-        for (openvdb::Index i = 0; i < pts::PointDataTree::LeafNodeType::SIZE; ++i) {
-            const openvdb::Index32 offset = leaf->getValue(i);
-            if (offset < last) {
-                throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) + " has point offset " +
-                                  std::to_string(offset) + " after " + std::to_string(last) + " (voxel " + std::to_string(i) +
-                                  "); a leaf's point offsets never decrease");
-            }
-            last = offset;
-        }
-        if (std::uint64_t(last) > nPoints - k) {
-            throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) + " holds " + std::to_string(last) +
-                              " points, more than the " + std::to_string(nPoints) + " the tree counts");
-        }
-        const std::pair<const char*, std::size_t> used[] = {{"P", iP}, {"strand", iS}, {"vertex", iV},
-                                                           {"Cd", iCd}, {"width", iW}, {"Alpha", iA}};
-        for (const auto& [name, index] : used) {
-            if (index == pts::AttributeSet::INVALID_POS) continue;
-            const pts::AttributeArray& array = leaf->constAttributeArray(index);
-            if (!array.isUniform() && array.size() < last) {
-                throw FormatError(where + ": the leaf at voxel " + toString(leaf->origin()) + " has " + std::to_string(last) +
-                                  " points but its '" + std::string(name) + "' array holds " + std::to_string(array.size()) + "; each array holds one value per point");
-            }
-        }
-        pts::AttributeHandle<openvdb::Vec3f> hP(leaf->constAttributeArray(iP));
-        const WholeNumberAttribute hS(leaf->constAttributeArray(iS), typeS), hV(leaf->constAttributeArray(iV), typeV);
-        std::unique_ptr<pts::AttributeHandle<openvdb::Vec3f>> hCd;
-        std::unique_ptr<pts::AttributeHandle<float>> hW, hA;
-        if (hasCd) hCd.reset(new pts::AttributeHandle<openvdb::Vec3f>(leaf->constAttributeArray(iCd)));
-        if (hasW) hW.reset(new pts::AttributeHandle<float>(leaf->constAttributeArray(iW)));
-        if (hasA) hA.reset(new pts::AttributeHandle<float>(leaf->constAttributeArray(iA)));
-        for (auto it = leaf->beginIndexOn(); it; ++it) {
-            poll();
-            const openvdb::Vec3d ijk = it.getCoord().asVec3d();
-            const openvdb::Vec3d world = grid.transform().indexToWorld(ijk + hP.get(*it));
-            pos[k] = Vec3f(float(world.x()), float(world.y()), float(world.z()));
-            const double sv = hS.get(*it), vv = hV.get(*it);
-            const std::pair<const char*, double> checks[] = {{"strand", sv}, {"vertex", vv}};
-            for (const auto& [name, value] : checks) {
-                if (!std::isfinite(value) || value != std::floor(value)) {
-                    std::ostringstream v;
-                    v.precision(9);
-                    v << value;
-                    throw FormatError(where + ": a point in voxel " + toString(it.getCoord()) + " has " + name + " " + v.str() +
-                                      "; strand and vertex must hold whole numbers");
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const auto& leaf = *leaves[l];
+            pts::AttributeHandle<openvdb::Vec3f> hP(leaf.constAttributeArray(iP));
+            const WholeNumberAttribute hS(leaf.constAttributeArray(iS), typeS), hV(leaf.constAttributeArray(iV), typeV);
+            std::optional<pts::AttributeHandle<openvdb::Vec3f>> hCd;
+            std::optional<pts::AttributeHandle<float>> hW, hA;
+            if (hasCd) hCd.emplace(leaf.constAttributeArray(iCd));
+            if (hasW) hW.emplace(leaf.constAttributeArray(iW));
+            if (hasA) hA.emplace(leaf.constAttributeArray(iA));
+            std::size_t k = std::size_t(base[l]);
+            for (auto it = leaf.beginIndexOn(); it; ++it, ++k) {
+                const openvdb::Vec3d ijk = it.getCoord().asVec3d();
+                const openvdb::Vec3d world = grid.transform().indexToWorld(ijk + hP.get(*it));
+                pos[k] = Vec3f(float(world.x()), float(world.y()), float(world.z()));
+                const double sv = hS.get(*it), vv = hV.get(*it);
+                const std::pair<const char*, double> checks[] = {{"strand", sv}, {"vertex", vv}};
+                for (const auto& [name, value] : checks) {
+                    if (!std::isfinite(value) || value != std::floor(value)) {
+                        std::ostringstream v;
+                        v.precision(9);
+                        v << value;
+                        pointError[l] = where + ": a point in voxel " + toString(it.getCoord()) + " has " + name + " " + v.str() +
+                                        "; strand and vertex must hold whole numbers";
+                        break;
+                    }
                 }
+                if (!pointError[l].empty()) break;
+                sid[k] = (sv >= 0.0 && sv < double(strandLimit)) ? std::int32_t(sv) : -1;
+                vid[k] = (vv >= 0.0 && vv < double(nPoints)) ? std::int32_t(vv) : -1;
+                if (hasCd) cd[k] = hCd->get(*it);
+                if (hasW) width[k] = hW->get(*it);
+                if (hasA) alpha[k] = hA->get(*it);
+                if (sid[k] < 0 || sid[k] >= strandLimit || vid[k] < 0 || std::uint64_t(vid[k]) >= nPoints) {
+                    pointError[l] = where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + std::to_string(std::int64_t(sv)) +
+                                    " and vertex " + std::to_string(std::int64_t(vv)) + "; strand must be in [0, " +
+                                    std::to_string(strandLimit) + ") and vertex in [0, " + std::to_string(nPoints) + ")";
+                    break;
+                }
+                leafMaxStrand[l] = std::max<std::int64_t>(leafMaxStrand[l], sid[k]);
             }
-            const double limit = double(declared >= 0 ? declared : std::int64_t(nPoints));
-            sid[k] = (sv >= 0.0 && sv < limit) ? std::int32_t(sv) : -1;
-            vid[k] = (vv >= 0.0 && vv < double(nPoints)) ? std::int32_t(vv) : -1;
-            if (hasCd) cd[k] = hCd->get(*it);
-            if (hasW) width[k] = hW->get(*it);
-            if (hasA) alpha[k] = hA->get(*it);
-            if (sid[k] < 0 || sid[k] >= (declared >= 0 ? declared : std::int64_t(nPoints)) || vid[k] < 0 || std::uint64_t(vid[k]) >= nPoints) {
-                throw FormatError(where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + std::to_string(std::int64_t(sv)) +
-                                  " and vertex " + std::to_string(std::int64_t(vv)) + "; strand must be in [0, " +
-                                  std::to_string(declared >= 0 ? declared : std::int64_t(nPoints)) +
-                                  ") and vertex in [0, " + std::to_string(nPoints) + ")");
-            }
-            maxStrand = std::max<std::int64_t>(maxStrand, sid[k]);
-            ++k;
         }
-    }
+    });
+    if (interrupted) throw InterruptedError(where + ": interrupted while reading");
+    for (const std::string& e : pointError)
+        if (!e.empty()) throw FormatError(e);
+    if (!firstLeafError.empty()) throw FormatError(firstLeafError);
+    const std::uint64_t k = base[nL];
     if (k != nPoints) throw FormatError(where + ": counted " + std::to_string(k) + " points, expected " + std::to_string(nPoints));
+    std::int64_t maxStrand = -1;
+    for (std::int64_t m : leafMaxStrand) maxStrand = std::max(maxStrand, m);
     const std::size_t nS = std::size_t(declared >= 0 ? declared : maxStrand + 1);
 
     // Vertices per strand = 1 + highest vertex index; every index below must appear exactly once.
@@ -314,24 +372,38 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
         slot[at] = std::uint32_t(p);
     }
 
+    // The strands kept (in order, for the short-strand policy's messages), then their vertices in parallel.
     StrandSet out;
-    out.reserve(nS, nPoints);
     if (const auto m = findVdbhairMeta<openvdb::FloatMetadata>(grid, "default_thickness")) out.defaults.thickness = m->value();
     if (const auto m = findVdbhairMeta<openvdb::FloatMetadata>(grid, "default_transparency")) out.defaults.transparency = m->value();
     if (const auto m = findVdbhairMeta<openvdb::Vec3SMetadata>(grid, "default_color")) out.defaults.color = m->value();
     ShortStrandFilter filter(opts, report, where);
+    std::vector<std::uint32_t> kept;
+    std::uint64_t keptVertices = 0;
     for (std::size_t s = 0; s < nS; ++s) {
         if (!filter.keep(s, count[s], "grid '" + grid.getName() + "'")) continue;
-        for (std::uint64_t a = start[s]; a < start[s + 1]; ++a) {
-            const std::uint32_t p = slot[a];
-            out.positions.push_back(pos[p]);
-            if (hasCd) out.color.push_back(cd[p]);
-            if (hasW) out.thickness.push_back(width[p]);
-            if (hasA) out.transparency.push_back(1.f - alpha[p]);
-        }
-        out.offsets.push_back(std::uint32_t(out.positions.size()));
+        kept.push_back(std::uint32_t(s));
+        keptVertices += count[s];
     }
     filter.finish();
+    out.reserve(kept.size(), keptVertices);
+    for (std::uint32_t s : kept) out.offsets.push_back(out.offsets.back() + count[s]);
+    out.positions.resize(keptVertices);
+    if (hasCd) out.color.resize(keptVertices);
+    if (hasW) out.thickness.resize(keptVertices);
+    if (hasA) out.transparency.resize(keptVertices);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kept.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::size_t o = out.offsets[i];
+            for (std::uint64_t a = start[kept[i]]; a < start[kept[i] + 1]; ++a, ++o) {
+                const std::uint32_t p = slot[a];
+                out.positions[o] = pos[p];
+                if (hasCd) out.color[o] = cd[p];
+                if (hasW) out.thickness[o] = width[p];
+                if (hasA) out.transparency[o] = 1.f - alpha[p];
+            }
+        }
+    });
     return out;
 }
 
