@@ -40,14 +40,22 @@ void RefineParams::setStep(double step, Integrator integrator)
 
 namespace {
 
-/// The roots as a nanoflann point cloud.
+/// The roots as a nanoflann point cloud, copied together: a strand's root is a strand's length away
+/// from the next one in the positions, and the tree's build reads every root many times.
 struct RootCloud
 {
-    const StrandSet& s;
-    std::size_t kdtree_get_point_count() const { return s.numStrands(); }
-    float kdtree_get_pt(std::size_t i, std::size_t d) const { return s.root(i)[int(d)]; }
+    std::vector<Vec3f> roots;
+    std::size_t kdtree_get_point_count() const { return roots.size(); }
+    float kdtree_get_pt(std::size_t i, std::size_t d) const { return roots[i][int(d)]; }
     template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
 };
+
+std::vector<Vec3f> rootsOf(const StrandSet& strands)
+{
+    std::vector<Vec3f> roots(strands.numStrands());
+    for (std::size_t i = 0; i < roots.size(); ++i) roots[i] = strands.root(i);
+    return roots;
+}
 
 /// Median distance from a root to its nearest other root (0 for fewer than two distinct roots).
 double medianRootSpacing(const StrandSet& strands)
@@ -55,7 +63,7 @@ double medianRootSpacing(const StrandSet& strands)
     const std::size_t n = strands.numStrands();
     if (n < 2) return 0.0;
     using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, RootCloud>, RootCloud, 3>;
-    const RootCloud cloud{strands};
+    const RootCloud cloud{rootsOf(strands)};
     Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree.buildIndex();
     // At most 4096 roots, evenly spaced in index order: the median is stable long before that.
@@ -78,13 +86,6 @@ double medianRootSpacing(const StrandSet& strands)
     if (d.empty()) return 0.0;
     std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
     return d[d.size() / 2];
-}
-
-std::vector<Vec3f> rootsOf(const StrandSet& strands)
-{
-    std::vector<Vec3f> roots(strands.numStrands());
-    for (std::size_t i = 0; i < roots.size(); ++i) roots[i] = strands.root(i);
-    return roots;
 }
 
 /// Half the largest extent of the hair: the head radius when the roots do not fit a sphere.
