@@ -106,9 +106,9 @@ struct Lloyd
     std::vector<std::uint32_t> memoCluster;
     std::vector<double> memoDistance;
     std::vector<double> own;  ///< after fit(): each strand's distance to its cluster's centre
-    /// After fit(): each strand's distances to the clusters it will most likely be offered to by the
-    /// next partition (its own and its neighbours' current clusters, at most kCached), computed in
-    /// parallel; the region growing then reads them instead of computing them in its serial loop
+    /// Before a partition that follows a fit: each strand's distances to the clusters it will most
+    /// likely be offered to (its own and its neighbours' current clusters, at most kCached), computed
+    /// in parallel; the region growing then reads them instead of computing them in its serial loop
     /// (the same values: only where they are computed changes).
     static constexpr std::size_t kCached = 4;
     std::vector<std::uint32_t> cachedCluster;  // N × kCached, kNoCluster where unused
@@ -131,7 +131,8 @@ struct Lloyd
         return dist(s, c);
     }
 
-    /// The distances the next partition will most likely ask for (see cachedCluster).
+    /// The distances this partition will most likely ask for (see cachedCluster), from the last
+    /// fit's labels, centres and own distances.
     void cacheDistances()
     {
         const std::size_t n = samples.count();
@@ -160,6 +161,7 @@ struct Lloyd
     {
         constexpr std::uint32_t kNone = ~0u;
         const std::size_t n = samples.count();
+        if (!own.empty()) cacheDistances();
         label.assign(n, kNone);
         using Item = std::tuple<double, std::uint32_t, std::uint32_t>;  // L², strand, cluster
         std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
@@ -314,7 +316,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
         throw ValueError("clusterSamples: " + std::to_string(k) + " clusters of " + std::to_string(n) +
                          " strands: between 1 and the strand count");
     const NeighbourGraph graph = neighbourGraph(samples.roots, params.neighbours);
-    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}, {}};
+    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}, {}, {}, {}};
     lloyd.seeds = initialSeeds(samples, k, Rng(params.seed, 0x5eedc1u, stream));
     for (std::uint32_t s : lloyd.seeds) lloyd.centers.insert(lloyd.centers.end(), samples.row(s), samples.row(s) + lloyd.dim);
     Clustering out;
@@ -326,7 +328,6 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
             if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("clustering interrupted");
             lloyd.partition();
             const double energy = lloyd.fit();
-            lloyd.cacheDistances();
             out.energy.push_back(energy);
             out.clusters.push_back(lloyd.k());
             if (previous - energy <= params.tolerance * energy) break;
