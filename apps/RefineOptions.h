@@ -7,8 +7,11 @@
 #include "HeadOptions.h"
 
 #include <vdbhair/field/Refine.h>
+#include <vdbhair/field/TangentAngles.h>
 
 #include <openvdb/Grid.h>
+
+#include <optional>
 
 namespace vdbhair::app {
 
@@ -37,8 +40,9 @@ openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source
 nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp);
 void printRefineReport(const RefineResult& r, const RefineParams& rp);
 
-/// The report of retrace: {"strands","full_length","stopped":{...},"tangent_angle_deg":{...},"mean_displacement"}.
-nlohmann::json traceReportJson(const TraceStats& s, double before, double after, double displacement);
-void printTraceReport(const TraceStats& s, double before, double after, double displacement);
+/// The report of retrace: {"strands","full_length","stopped":{...},"mean_displacement"}, and
+/// "tangent_angle_deg":{"before","after"} when @a angles is given (--measure).
+nlohmann::json traceReportJson(const TraceStats& s, const std::optional<TangentAngles>& angles, double displacement);
+void printTraceReport(const TraceStats& s, const std::optional<TangentAngles>& angles, double displacement);
 
 } // namespace vdbhair::app

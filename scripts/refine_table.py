@@ -50,7 +50,7 @@ def main():
     for name, hair, head, ropts in STYLES:
         path = os.path.join(DATA, hair)
         out = os.path.join(tmp, os.path.basename(hair) + ".hair")
-        cmd = [args.vdbhair, "refine", path, "-o", out, "--json", "--quiet", "--levels", str(args.levels), "--mode", args.mode]
+        cmd = [args.vdbhair, "refine", path, "-o", out, "--measure", "--json", "--quiet", "--levels", str(args.levels), "--mode", args.mode]
         if head:
             headvdb = os.path.join(tmp, os.path.basename(head) + ".vdb")
             if not os.path.exists(headvdb):

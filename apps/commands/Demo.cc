@@ -36,6 +36,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
         const Scene scene = readScene(p.refine.input);
         if (scene.head) rp.head = HeadObstacle::sphere(scene.head->center, scene.head->radius, p.refine.head.headPolicy());
     }
+    rp.measure = true;  // the demo's report is what an artist checks the refinement by
     std::error_code ec;
     fs::create_directories(p.outDir, ec);
     if (ec) throw IoError(p.outDir + ": cannot create the output folder: " + ec.message());

@@ -13,52 +13,50 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace vdbhair::app {
 
 /// The JSON report of retrace and refine (the schema).
-nlohmann::json traceReportJson(const TraceStats& s, double before, double after, double displacement)
+nlohmann::json traceReportJson(const TraceStats& s, const std::optional<TangentAngles>& angles, double displacement)
 {
-    return {{"strands", s.strands},
-            {"full_length", s.fullLength},
-            {"stopped", {{"vanished", s.vanished}, {"left_field", s.leftField}, {"max_steps", s.maxSteps}}},
-            // NaN: no vertex lay inside the field (every strand left it), so there is no angle.
-            {"tangent_angle_deg", {{"before", std::isnan(before) ? nlohmann::json(nullptr) : nlohmann::json(before)},
-                                   {"after", std::isnan(after) ? nlohmann::json(nullptr) : nlohmann::json(after)}}},
-            {"mean_displacement", displacement}};
+    nlohmann::json j = {{"strands", s.strands},
+                        {"full_length", s.fullLength},
+                        {"stopped", {{"vanished", s.vanished}, {"left_field", s.leftField}, {"max_steps", s.maxSteps}}},
+                        {"mean_displacement", displacement}};
+    if (angles) {
+        // null: no vertex lay inside the field (every strand left it), so there is no angle.
+        auto angle = [](double deg, std::size_t counted) { return counted ? nlohmann::json(deg) : nlohmann::json(nullptr); };
+        j["tangent_angle_deg"] = {{"before", angle(angles->beforeDeg, angles->countedBefore)},
+                                  {"after", angle(angles->afterDeg, angles->countedAfter)}};
+    }
+    return j;
 }
 
 namespace {
-std::string angleText(double deg)
+std::string angleText(double deg, std::size_t counted)
 {
-    if (std::isnan(deg)) return "none (no vertex inside the field)";
+    if (!counted) return "none (no vertex inside the field)";
     std::ostringstream os;
     os << deg << " deg";
     return os.str();
 }
 } // namespace
 
-void printTraceReport(const TraceStats& s, double before, double after, double displacement)
+void printTraceReport(const TraceStats& s, const std::optional<TangentAngles>& angles, double displacement)
 {
     std::cout << "retraced " << s.strands << " strands: " << s.fullLength << " full length, " << s.vanished
               << " stopped where the field vanished, " << s.leftField << " left the field, " << s.maxSteps
-              << " hit the step limit (" << s.steps << " steps)\n"
-              << "mean angle between strand tangents and the field: "
-              << angleText(before) << " before, " << angleText(after) << " after\n"
-              << "mean vertex displacement: " << displacement << "\n";
+              << " hit the step limit (" << s.steps << " steps)\n";
+    if (angles) {
+        std::cout << "mean angle between strand tangents and the field: " << angleText(angles->beforeDeg, angles->countedBefore)
+                  << " before, " << angleText(angles->afterDeg, angles->countedAfter) << " after\n";
+    }
+    std::cout << "mean vertex displacement: " << displacement << "\n";
 }
 
 namespace {
-
-/// The mean angles between the input and output strands and @a field, NaN for a set with no
-/// vertex inside the field.
-void anglesOrNan(const StrandSet& input, const StrandSet& output, const openvdb::GridBase& field, double& before, double& after)
-{
-    const TangentAngles a = meanTangentAnglesDeg(input, output, field);
-    before = a.countedBefore ? a.beforeDeg : std::nan("");
-    after = a.countedAfter ? a.afterDeg : std::nan("");
-}
 
 /// The command line of retrace: the numeric options bind to the library's TraceParams fields,
 /// the named ones start from its defaults, so `--help` shows the library's defaults.
@@ -71,6 +69,7 @@ struct RetraceParams
     std::string vertices = TraceParams{}.vertices == RetraceVertices::Input ? "input" : "steps";
     bool helicoid = false;
     bool strict = false;
+    bool measure = false;  ///< the tangent angles: the field sampled at every input and output vertex
 };
 
 int runRetrace(const RetraceParams& p, const CommonOptions& common)
@@ -96,22 +95,24 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         checkStrandLengths("retrace", p.input, strands, common, p.strict);
         TraceStats stats;
         const StrandSet out = retraceHelicoidField(strands, field, tp, &stats, true, common.interrupter);
-        // Coherence is measured against the tangent field when the file has one.
-        double before = std::nan(""), after = std::nan("");
-        const std::vector<std::string> names = vdbGridNames(p.field, "retrace(" + p.field + ")");
-        if (std::find(names.begin(), names.end(), p.grid) != names.end()) {
-            const openvdb::GridBase::Ptr tangent = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
-            anglesOrNan(strands, out, *tangent, before, after);
+        // The angles are measured against the tangent field when the file has one.
+        std::optional<TangentAngles> angles;
+        if (p.measure) {
+            const std::vector<std::string> names = vdbGridNames(p.field, "retrace(" + p.field + ")");
+            if (std::find(names.begin(), names.end(), p.grid) != names.end()) {
+                const openvdb::GridBase::Ptr tangent = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
+                angles = meanTangentAnglesDeg(strands, out, *tangent);
+            }
         }
         const double disp = meanVertexDisplacement(strands, out);
         writeStrands(p.output, out);
         if (common.json) {
-            nlohmann::json j = traceReportJson(stats, before, after, disp);
+            nlohmann::json j = traceReportJson(stats, angles, disp);
             j["output"] = p.output;
             j["field"] = "helicoid";
             printJson(j);
         } else if (!common.quiet) {
-            printTraceReport(stats, before, after, disp);
+            printTraceReport(stats, angles, disp);
             std::cout << "wrote " << p.output << " (traced through the helicoid field)\n";
         }
         return 0;
@@ -126,18 +127,18 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 
     TraceStats stats;
     const StrandSet out = retraceStrands(strands, *grid, tp, &stats, nullptr, true, common.interrupter);
-    double before = 0.0, after = 0.0;
-    anglesOrNan(strands, out, *grid, before, after);
+    std::optional<TangentAngles> angles;
+    if (p.measure) angles = meanTangentAnglesDeg(strands, out, *grid);
     const double disp = meanVertexDisplacement(strands, out);
     writeStrands(p.output, out);
     if (common.json) {
-        nlohmann::json j = traceReportJson(stats, before, after, disp);
+        nlohmann::json j = traceReportJson(stats, angles, disp);
         j["output"] = p.output;
         j["step"] = resolveStep(*grid, tp);
         j["integrator"] = integratorName(tp.integrator);
         printJson(j);
     } else if (!common.quiet) {
-        printTraceReport(stats, before, after, disp);
+        printTraceReport(stats, angles, disp);
         std::cout << "wrote " << p.output << "\n";
     }
     return 0;
@@ -161,8 +162,11 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--vertices", params->vertices, "input: the input's vertex count and arc lengths; steps: every step")->capture_default_str();
     sub->add_flag("--helicoid", params->helicoid, "Trace through the file's helicoid field (vdbhair field --helicoid) instead of the tangent grid");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    sub->add_flag("--measure", params->measure,
+                  "Also report the mean angle between strand tangents and the field before and after "
+                  "(samples the field at every input and output vertex: about a third of the run)");
     addCommonOptions(sub, common);
-    sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --json");
+    sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --measure --json");
     return {sub, [params, &common] { return runRetrace(*params, common); },
             {{"step", "--step"}, {"margin", "--margin"}, {"vanishThreshold", "--vanish"}, {"maxSteps", "--max-steps"},
              {"estimateHelicoidField", "'vdbhair field --helicoid'"}}};

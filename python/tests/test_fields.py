@@ -98,11 +98,14 @@ def test_levels_and_defaults(wavy):
 
 
 def test_refine_report(wavy):
-    out, report = vdbhair.refine(wavy, voxel_size=0.15, levels=2, return_report=True)
+    out, report = vdbhair.refine(wavy, voxel_size=0.15, levels=2, return_report=True, measure=True)
     assert len(out) == len(wavy) and out.num_vertices == wavy.num_vertices
     assert report["mode"] == "consistent" and len(report["per_level"]) == 2
     assert [f.voxel_size for f in report["fields"]] == pytest.approx([0.15, 0.3])
     assert 0.0 <= report["coherence_after"] <= 1.0
+    # The measures are opt-in (as `refine --measure`): without them the report has none.
+    _, plain = vdbhair.refine(wavy, voxel_size=0.15, levels=2, return_report=True)
+    assert "coherence_after" not in plain and plain["mode"] == "consistent"
     field_mode = vdbhair.refine(wavy, voxel_size=0.15, mode="field", head="none")
     assert not np.array_equal(field_mode.positions, out.positions)
     with pytest.raises(ValueError, match="mode"):

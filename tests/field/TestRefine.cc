@@ -72,6 +72,7 @@ TEST_CASE("refineStrands: outliers crossing a coherent bundle are pulled into it
     rp.field.voxelSize = 0.5;
     rp.head = HeadObstacle::none();
     rp.setStep(0.0, integ);
+    rp.measure = true;
     const RefineResult r = refineStrands(s, rp);
     const double voxel = 0.5;
     double worstInlier = 0.0;
@@ -195,6 +196,7 @@ TEST_CASE("refineStrands: a strand pointed into a sphere head is kept outside it
     RefineParams rp;
     rp.field.voxelSize = 0.1;
     rp.head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    rp.measure = true;
     const RefineResult r = refineStrands(s, rp);
     for (std::size_t i = 0; i < r.strands.numStrands(); ++i) {
         for (std::size_t j = 0; j < r.strands.size(i); ++j) {
@@ -229,6 +231,7 @@ TEST_CASE("refineStrands: a helix bundle keeps its helix through 3 levels", "[fi
     rp.levels = 3;
     rp.head = HeadObstacle::none();
     rp.field.voxelSize = 0.15;
+    rp.measure = true;
     const RefineResult r = refineStrands(s, rp);
     std::vector<float> curv;
     double mean = 0.0;
@@ -255,6 +258,7 @@ TEST_CASE("refineStrands: identical for 1 and 2 threads", "[field]")
         rp.mode = mode;
         rp.levels = 2;
         rp.field.voxelSize = 0.3;
+        rp.measure = true;
         const RefineResult one = refineStrands(s, rp, /*threaded=*/false);
         const RefineResult two = refineStrands(s, rp, /*threaded=*/true);
         REQUIRE(one.strands.positions == two.strands.positions);
@@ -289,7 +293,9 @@ TEST_CASE("refineStrands: the shared hairstyles keep their shape at the defaults
     for (const char* file : {"usc_data/harolongo.data", "tressfx/ascii_v2/hair_tail_16_guide.tfx", "ply/Curly_100.ply"}) {
         CAPTURE(file);
         const StrandSet s = readStrands(dir + file);
-        const RefineResult r = refineStrands(s, RefineParams{});
+        RefineParams rp;
+        rp.measure = true;
+        const RefineResult r = refineStrands(s, rp);
         const RefineMeasures& m = r.levels.front().measures;
         CAPTURE(r.voxelSize, m.leftVolume, m.curvatureKept8, m.displacementMean, m.coherenceBefore, m.coherenceAfter);
         REQUIRE(double(m.fullLength) >= 0.99 * double(s.numStrands()));

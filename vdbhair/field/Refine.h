@@ -53,7 +53,9 @@ struct RefineParams
     /// The head retraced strands may not enter. Unset: a sphere fitted to the roots (headFromRoots());
     /// HeadObstacle::none(): no head.
     HeadObstacle head;
-    bool measure = true;  ///< fill RefineLevel::measures (costs a field estimate per level)
+    /// Fill RefineLevel::measures: the output against the input (costs a field estimate per level,
+    /// a fifth of the run; `refine --measure`).
+    bool measure = false;
 
     /// @brief One step rule for both modes (the CLI's --step and --integrator): the step (world
     /// units; 0: half of each level's voxel) and the integrator of trace and consistency.

@@ -1,6 +1,5 @@
 #include "DataFile.h"
 
-#include <vdbhair/Memory.h>
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/MappedFile.h>
@@ -68,16 +67,13 @@ void writeData(const std::string& path, const StrandSet& strands)
     if (strands.numStrands() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
         throw ValueError(where + ": " + std::to_string(strands.numStrands()) + " strands exceed the format's int32 count");
     }
-    std::string out;
-    reserveHugePages(out, 4 + 4 * strands.numStrands() + 12 * strands.numVertices());
-    const std::int32_t nS = std::int32_t(strands.numStrands());
-    out.append(reinterpret_cast<const char*>(&nS), 4);
+    AtomicFileWriter out(path, where);
+    out.appendValue(std::int32_t(strands.numStrands()));
     for (std::size_t i = 0; i < strands.numStrands(); ++i) {
-        const std::int32_t nV = std::int32_t(strands.size(i));
-        out.append(reinterpret_cast<const char*>(&nV), 4);
-        out.append(reinterpret_cast<const char*>(strands.data(i)), 12 * strands.size(i));
+        out.appendValue(std::int32_t(strands.size(i)));
+        out.append(strands.data(i), 12 * strands.size(i));
     }
-    writeFileAtomic(path, out, where);
+    out.commit();
 }
 
 } // namespace vdbhair

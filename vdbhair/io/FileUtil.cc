@@ -177,16 +177,65 @@ void AtomicOutput::commit()
     mCommitted = true;
 }
 
+namespace {
+constexpr std::size_t kWriteBuffer = std::size_t(1) << 20;
+}
+
+AtomicFileWriter::AtomicFileWriter(const std::string& path, std::string where) : mOut(path), mWhere(std::move(where))
+{
+    mFd = ::open(mOut.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (mFd < 0) throw IoError(mWhere + ": cannot open '" + mOut.tempPath() + "' for writing: " + std::strerror(errno));
+}
+
+AtomicFileWriter::~AtomicFileWriter()
+{
+    if (mFd >= 0) ::close(mFd);  // not committed: AtomicOutput's destructor removes the temporary
+}
+
+void AtomicFileWriter::writeAll(const char* data, std::size_t n)
+{
+    while (n > 0) {
+        const ssize_t w = ::write(mFd, data, std::min<std::size_t>(n, std::size_t(1) << 30));
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) throw IoError(mWhere + ": write failed (disk full?): " + std::strerror(w < 0 ? errno : ENOSPC));
+        data += w;
+        n -= std::size_t(w);
+    }
+}
+
+void AtomicFileWriter::flush()
+{
+    writeAll(mBuffer.data(), mUsed);
+    mUsed = 0;
+}
+
+void AtomicFileWriter::append(const void* data, std::size_t n)
+{
+    const char* p = static_cast<const char*>(data);
+    if (n >= kWriteBuffer) {
+        flush();
+        writeAll(p, n);
+        return;
+    }
+    if (mBuffer.empty()) mBuffer.resize(kWriteBuffer);
+    if (mUsed + n > kWriteBuffer) flush();
+    std::memcpy(mBuffer.data() + mUsed, p, n);
+    mUsed += n;
+}
+
+void AtomicFileWriter::commit()
+{
+    flush();
+    const int fd = mFd;
+    mFd = -1;
+    if (::close(fd) != 0) throw IoError(mWhere + ": write failed (disk full?): " + std::strerror(errno));
+    mOut.commit();
+}
+
 void writeFileAtomic(const std::string& path, const std::string& bytes, const std::string& where)
 {
-    AtomicOutput out(path);
-    {
-        std::ofstream f(out.tempPath(), std::ios::binary | std::ios::trunc);
-        if (!f) throw IoError(where + ": cannot open '" + out.tempPath() + "' for writing: " + std::strerror(errno));
-        f.write(bytes.data(), std::streamsize(bytes.size()));
-        f.flush();
-        if (!f) throw IoError(where + ": write failed (disk full?): " + std::strerror(errno));
-    }
+    AtomicFileWriter out(path, where);
+    out.append(bytes.data(), bytes.size());
     out.commit();
 }
 

@@ -73,6 +73,38 @@ enum class OverwritePolicy
 void setOverwritePolicy(OverwritePolicy policy);
 OverwritePolicy overwritePolicy();
 
+/// @brief An output file written as a stream of pieces into an AtomicOutput's temporary and
+/// renamed into place by commit(). Small pieces gather in a buffer of 1 MiB; a piece as large as
+/// the buffer goes to write(2) straight from the caller's memory. So a writer need not assemble
+/// the whole file first: a 77 MB strand file then costs no fresh memory (whose pages the kernel
+/// must clear) and one copy fewer.
+class AtomicFileWriter
+{
+public:
+    /// @throw IoError if the temporary cannot be created (see AtomicOutput).
+    AtomicFileWriter(const std::string& path, std::string where);
+    ~AtomicFileWriter();
+    AtomicFileWriter(const AtomicFileWriter&) = delete;
+    AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+
+    /// @throw IoError when a write fails (disk full, ...).
+    void append(const void* data, std::size_t n);
+    template<typename T>
+    void appendValue(const T& v) { append(&v, sizeof(T)); }
+    /// Flush, close and rename onto the target (AtomicOutput::commit()).
+    void commit();
+
+private:
+    void flush();
+    void writeAll(const char* data, std::size_t n);
+
+    AtomicOutput mOut;
+    std::string mWhere;
+    int mFd = -1;
+    std::vector<char> mBuffer;
+    std::size_t mUsed = 0;
+};
+
 /// @brief Write @a bytes to @a path atomically (see AtomicOutput).
 void writeFileAtomic(const std::string& path, const std::string& bytes, const std::string& where);
 

@@ -1,6 +1,5 @@
 #include "HairFile.h"
 
-#include <vdbhair/Memory.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
@@ -190,10 +189,9 @@ void writeHair(const std::string& path, const StrandSet& strands)
     if (!strands.transparency.empty()) arrays |= kTransparency;
     if (!strands.color.empty()) arrays |= kColors;
 
-    std::string out;
-    auto put = [&out](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+    AtomicFileWriter out(path, where);
+    auto put = [&out](const void* p, std::size_t n) { out.append(p, n); };
     auto putU32 = [&](std::uint32_t v) { put(&v, 4); };
-    reserveHugePages(out, 128 + 2 * nS + 28 * nP);
     put("HAIR", 4);
     putU32(std::uint32_t(nS));
     putU32(std::uint32_t(nP));
@@ -215,7 +213,7 @@ void writeHair(const std::string& path, const StrandSet& strands)
     if (arrays & kThickness) put(strands.thickness.data(), 4 * nP);
     if (arrays & kTransparency) put(strands.transparency.data(), 4 * nP);
     if (arrays & kColors) put(strands.color.data(), 12 * nP);
-    writeFileAtomic(path, out, where);
+    out.commit();
 }
 
 } // namespace vdbhair
