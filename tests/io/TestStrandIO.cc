@@ -45,6 +45,42 @@ TEST_CASE("writeStrands: a failed write leaves an existing file untouched and no
     REQUIRE_THROWS_AS(writeStrands(test::tempPath("no/such/folder/x.hair"), test::sampleStrands()), IoError);
 }
 
+TEST_CASE("AtomicFileWriter: small and large pieces in order; nothing without commit", "[io]")
+{
+    // Pieces around the 1 MiB buffer: small ones gather, one of a buffer's size or more goes
+    // straight to write(2) after what was gathered before it.
+    std::string expected;
+    const std::string path = test::tempPath("pieces.bin");
+    {
+        AtomicFileWriter out(path, "test");
+        std::size_t k = 0;
+        for (std::size_t n : {std::size_t(3), std::size_t(1) << 20, std::size_t(7), (std::size_t(1) << 20) - 1, std::size_t(2),
+                              (std::size_t(3) << 20) + 5, std::size_t(1)}) {
+            std::string piece(n, '\0');
+            for (char& c : piece) c = char('a' + (k++ % 23));
+            expected += piece;
+            out.append(piece.data(), piece.size());
+        }
+        out.appendValue(std::int32_t(-2));
+        const std::int32_t v = -2;
+        expected.append(reinterpret_cast<const char*>(&v), 4);
+        REQUIRE_FALSE(std::filesystem::exists(path));  // nothing at the target before commit()
+        out.commit();
+    }
+    REQUIRE(test::readBytes(path) == expected);
+
+    // Not committed (an exception in the writer's caller): the target keeps its old content and
+    // no temporary is left.
+    {
+        AtomicFileWriter out(path, "test");
+        out.append("abc", 3);
+    }
+    REQUIRE(test::readBytes(path) == expected);
+    for (const auto& e : std::filesystem::directory_iterator(test::tempDir())) {
+        REQUIRE(e.path().filename().string().find(".vdbhair-tmp-") == std::string::npos);
+    }
+}
+
 TEST_CASE("readStrands: the same hairstyle in five formats reads to the same strands", "[io][data]")
 {
     VDBHAIR_REQUIRE_SHARED_DATA();
