@@ -25,6 +25,7 @@ struct InterpolateCmdParams
 {
     std::string guides, output, roots, scalp, method = "helicoid", frames = "auto";
     std::string up = axisName(HelicoidInterpolationParams{}.up);
+    std::string blend = helicoidBlendName(HelicoidInterpolationParams{}.blend);
     std::int64_t count = -1;  ///< -1: not given
     std::uint64_t seed = 0;
     HelicoidInterpolationParams helicoid;
@@ -58,6 +59,7 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
     if (p.roots.empty() == p.scalp.empty()) throw ValueError("needs --roots ROOTS or --scalp SCALP.vdb --count N (one of them)");
     if (!p.scalp.empty() && p.count < 0) throw ValueError("--scalp needs --count N");
     if (p.count == 0) throw ValueError("--count 0: must be at least 1");
+    p.helicoid.blend = helicoidBlendFromName(p.blend);
     if (!(p.helicoid.shepard.power > 0.0) || !std::isfinite(p.helicoid.shepard.power)) {
         throw ValueError("--power " + formatValue(p.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
     }
@@ -145,7 +147,8 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
     }
     const std::size_t count = roots.positions.size();
     if (common.json) {
-        printJson({{"output", p.output}, {"method", p.method}, {"guides", guides.guides.size()}, {"strands", count},
+        printJson({{"output", p.output}, {"method", p.method}, {"blend", points ? nlohmann::json(nullptr) : nlohmann::json(p.blend)},
+                   {"guides", guides.guides.size()}, {"strands", count},
                    {"vertices", sceneOut ? nlohmann::json(nullptr) : nlohmann::json(strands.numVertices())},
                    {"frames", roots.normals.empty() ? "world" : "surface"}, {"seconds", seconds},
                    {"strands_per_second", double(count) / seconds}, {"fit_seconds", fitSeconds}});
@@ -169,6 +172,9 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--scalp", params->scalp, "Scalp .vdb (vdbhair scalp): spread --count roots over it (and its region)");
     sub->add_option("--count", params->count, "Number of roots on --scalp");
     sub->add_option("--method", params->method, "helicoid (Piuze et al.) or points (Blender's Interpolate Curves)")->capture_default_str();
+    sub->add_option("--blend", params->blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "
+                                              "so guides blend alike) or fitted (the fits' own pieces, as the paper prints it)")->capture_default_str();
+    sub->add_option("--arcs", params->helicoid.arcs, "--blend arcs: arcs per hair (0: one per 0.2 radian of the most-turning guide, 16 to 512)")->capture_default_str();
     sub->add_option("--power", params->helicoid.shepard.power, "Shepard exponent p: weights |x - x_i|^-p")->capture_default_str();
     params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair, nearest by root (default: every guide for helicoid, " +
                                            std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
@@ -181,7 +187,8 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     return {sub, [params, &common] {
                 params->points.maxVertices = params->helicoid.maxVertices;
                 return runInterpolate(*params, common);
-            }};
+            },
+            {{"blend", "--blend"}}};
 }
 
 } // namespace vdbhair::app

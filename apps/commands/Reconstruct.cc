@@ -18,6 +18,7 @@ namespace {
 struct ReconstructCmdParams
 {
     std::string input, output, method = "helicoid", select = "random", errors;
+    std::string blend = helicoidBlendName(ReconstructParams{}.helicoid.blend);
     std::string guides = formatValue(100.0 * ReconstructParams{}.guideFraction) + "%";
     ReconstructParams rec;
     int neighbors = 0;
@@ -43,6 +44,7 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
     else if (p.select == "cluster") p.rec.selection = GuideSelection::Cluster;
     else throw ValueError("--select '" + p.select + "' is not one of random, cluster");
     p.rec.guideFraction = parsePercent(p.guides);
+    p.rec.helicoid.blend = helicoidBlendFromName(p.blend);
     strandFormatFromPath(p.output, /*forWriting=*/true);
     if (!(p.rec.helicoid.shepard.power > 0.0) || !std::isfinite(p.rec.helicoid.shepard.power)) {
         throw ValueError("--power " + formatValue(p.rec.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
@@ -78,7 +80,7 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
     const std::size_t S = strands.numStrands();
     if (common.json) {
         printJson({{"output", p.output}, {"method", p.method}, {"strands", S}, {"guides", r.guides.size()}, {"unfitted", r.unfitted},
-                   {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", p.select},
+                   {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", p.select}, {"blend", p.blend},
                    {"fit", {{"mean", r.fitSummary.meanRelative}, {"p95", r.fitSummary.p95Relative}, {"pieces_per_strand", r.fitSummary.piecesPerStrand}, {"seconds", r.fitSeconds}}},
                    {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}}}});
     } else if (!common.quiet) {
@@ -87,11 +89,11 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
                   << " %, " << p.select << "); fits: mean " << formatValue(100.0 * r.fitSummary.meanRelative) << " %, "
                   << formatValue(r.fitSummary.piecesPerStrand) << " pieces, " << formatValue(r.fitSeconds) << " s\n"
                   << "discrete Frechet distance / strand length:\n";
-        std::snprintf(buf, sizeof buf, "%-9s %10s %10s %14s %14s %9s\n", "method", "mean", "p95", "mean interp.", "p95 interp.", "time s");
+        std::snprintf(buf, sizeof buf, "%-17s %10s %10s %14s %14s %9s\n", "method", "mean", "p95", "mean interp.", "p95 interp.", "time s");
         std::cout << buf;
         for (int m = 0; m < 2; ++m) {
             const ReconstructErrors& e = m == 0 ? r.helicoidErrors : r.pointErrors;
-            std::snprintf(buf, sizeof buf, "%-9s %9.3f%% %9.3f%% %13.3f%% %13.3f%% %9.3f\n", m == 0 ? "helicoid" : "points", 100.0 * e.mean, 100.0 * e.p95,
+            std::snprintf(buf, sizeof buf, "%-17s %9.3f%% %9.3f%% %13.3f%% %13.3f%% %9.3f\n", m == 0 ? ("helicoid (" + p.blend + ")").c_str() : "points", 100.0 * e.mean, 100.0 * e.p95,
                           100.0 * e.meanInterpolated, 100.0 * e.p95Interpolated, e.seconds);
             std::cout << buf;
         }
@@ -112,6 +114,9 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--method", params->method, "Which reconstruction to write: helicoid or points (both are measured)")->capture_default_str();
     sub->add_option("--select", params->select, "Guide choice: random, or cluster (k-means of the roots)")->capture_default_str();
     sub->add_option("--seed", params->rec.seed, "Seed of the guide choice")->capture_default_str();
+    sub->add_option("--blend", params->blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "
+                                              "so guides blend alike) or fitted (the fits' own pieces, as the paper prints it)")->capture_default_str();
+    sub->add_option("--arcs", params->rec.helicoid.arcs, "--blend arcs: arcs per hair (0: one per 0.2 radian of the most-turning guide, 16 to 512)")->capture_default_str();
     sub->add_option("--power", params->rec.helicoid.shepard.power, "Shepard exponent p of helicoid interpolation")->capture_default_str();
     params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair (default: every guide for helicoid, " +
                                            std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
@@ -119,7 +124,7 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--errors", params->errors, "Also write every strand's relative error, both methods, as CSV");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair reconstruct straight.hair -o rebuilt.hair --guides 10% --json");
-    return {sub, [params, &common] { return runReconstruct(*params, common); }, {{"maxError", "--max-error"}}};
+    return {sub, [params, &common] { return runReconstruct(*params, common); }, {{"maxError", "--max-error"}, {"blend", "--blend"}}};
 }
 
 } // namespace vdbhair::app

@@ -500,7 +500,7 @@ Returns:
     m.def(
         "interpolate",
         [](const pyb::object& guidesArg, const pyb::object& rootsArg, const pyb::object& normalsArg, const std::string& method,
-           double power, std::optional<int> neighbors, const std::string& frames, std::array<double, 3> up, std::uint64_t seed,
+           double power, std::optional<int> neighbors, const std::string& blend, const std::string& frames, std::array<double, 3> up, std::uint64_t seed,
            std::size_t maxVertices, bool returnScene, int threads, const pyb::object& progress) -> pyb::object {
             // Arguments first, as the command checks them.
             const bool points = method == "points";
@@ -510,6 +510,8 @@ Returns:
             if (returnScene && points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
             HelicoidInterpolationParams hp;
             PointInterpolationParams pp;
+            if (blend != "arcs" && blend != "fitted") throw ValueError("interpolate: blend '" + blend + "' is not one of arcs, fitted");
+            hp.blend = helicoidBlendFromName(blend);
             if (!(power > 0.0) || !std::isfinite(power))
                 throw ValueError("interpolate: power=" + std::to_string(power) + ": must be a positive finite exponent (the paper uses 3)");
             hp.shepard.power = power;
@@ -563,7 +565,8 @@ Returns:
             return pyb::cast(std::make_shared<StrandSet>(std::move(result.second)));
         },
         pyb::arg("guides"), pyb::arg("roots"), pyb::kw_only(), pyb::arg("normals") = pyb::none(), pyb::arg("method") = "helicoid",
-        pyb::arg("power") = interpDefaults.shepard.power, pyb::arg("neighbors") = pyb::none(), pyb::arg("frames") = "auto",
+        pyb::arg("power") = interpDefaults.shepard.power, pyb::arg("neighbors") = pyb::none(),
+        pyb::arg("blend") = helicoidBlendName(interpDefaults.blend), pyb::arg("frames") = "auto",
         pyb::arg("up") = std::array<double, 3>{interpDefaults.up.x(), interpDefaults.up.y(), interpDefaults.up.z()},
         pyb::arg("seed") = 0, pyb::arg("max_vertices") = interpDefaults.maxVertices, pyb::arg("return_scene") = false,
         pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
@@ -578,6 +581,9 @@ Args:
         their points, as Blender's and Houdini's interpolation do).
     power: Shepard exponent p of the weights |x - x_i|^-p (the paper: 3).
     neighbors: blend only the K nearest guides by root; None: every guide (helicoid), 4 (points).
+    blend: "fitted" (the fits' own pieces, as the paper prints it) or "arcs" (each guide
+        re-described as equal circular arcs in its rotation-minimizing frame, so guides blend
+        alike; reconstruct's default).
     frames: "auto" (surface frames when normals are given), "world" or "surface".
     up: reference axis of the surface frames.
     seed: the scene's seed (recorded; the new hairs have no wisps).
@@ -593,8 +599,10 @@ Returns:
     m.def(
         "reconstruct",
         [](const StrandsPtr& strands, double guides, const std::string& select, std::uint64_t seed, double power,
-           std::optional<int> neighbors, double maxError, int threads, const pyb::object& progress) {
+           std::optional<int> neighbors, const std::string& blend, double maxError, int threads, const pyb::object& progress) {
             ReconstructParams p;
+            if (blend != "arcs" && blend != "fitted") throw ValueError("reconstruct: blend '" + blend + "' is not one of arcs, fitted");
+            p.helicoid.blend = helicoidBlendFromName(blend);
             p.guideFraction = guides;
             if (select == "random") p.selection = GuideSelection::Random;
             else if (select == "cluster") p.selection = GuideSelection::Cluster;
@@ -632,7 +640,8 @@ Returns:
         },
         pyb::arg("strands"), pyb::kw_only(), pyb::arg("guides") = reconstructDefaults.guideFraction, pyb::arg("select") = "random",
         pyb::arg("seed") = reconstructDefaults.seed, pyb::arg("power") = reconstructDefaults.helicoid.shepard.power,
-        pyb::arg("neighbors") = pyb::none(), pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("threads") = 0,
+        pyb::arg("neighbors") = pyb::none(), pyb::arg("blend") = helicoidBlendName(reconstructDefaults.helicoid.blend),
+        pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(Rebuild a hairstyle from a share of its strands (Piuze et al. 2011, Sec. 5.4):
 ``vdbhair reconstruct``. The guides are fitted with p-helicoids and new hairs interpolated at every
@@ -648,6 +657,9 @@ Args:
     seed: seed of the guide choice.
     power: Shepard exponent p of the helicoid interpolation (the paper: 3).
     neighbors: guides per new hair; None: every guide (helicoid), 4 (points).
+    blend: "arcs" (each guide re-described as equal circular arcs in its rotation-minimizing
+        frame, so guides blend alike; only guides shaped like the heaviest take part) or "fitted"
+        (the fits' own pieces, as the paper prints it).
     max_error: the fits' accepted discrete Frechet distance, a fraction of the strand length.
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``.

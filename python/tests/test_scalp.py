@@ -140,9 +140,16 @@ def test_reconstruct_straight_hair():
     for method, out in (("helicoid", helicoid), ("points", points)):
         e = report[method]
         assert e["relative"].shape == (36,)
-        assert e["mean"] < 0.01, method  # straight parallel hair is rebuilt straight
+        # Straight parallel hair is rebuilt straight: the fits are within 0.9 % of these strands,
+        # and the arcs reconstruction blends them (1.1 %).
+        assert e["mean"] < 0.015, method
         for i in range(len(out)):
             assert np.allclose(out[i][0], hair[i][0], atol=1e-4), method  # every root kept
+    # The paper's blend of the fits' own pieces, on request; a blend that does not exist is refused.
+    fitted = vdbhair.reconstruct(hair, guides=0.25, seed=1, blend="fitted")[2]
+    assert fitted["helicoid"]["mean"] < 0.015 and fitted["points"]["mean"] == report["points"]["mean"]
+    with pytest.raises(ValueError, match="blend 'sideways' is not one of arcs, fitted"):
+        vdbhair.reconstruct(hair, blend="sideways")
     # Every strand a guide: the points way returns the strands themselves.
     _, same, everything = vdbhair.reconstruct(hair, guides=1.0)
     assert everything["points"]["mean"] == 0.0

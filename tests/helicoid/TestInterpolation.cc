@@ -74,6 +74,19 @@ InterpolationRoots rootsOnLine(const Vec3d& a, const Vec3d& b, int n)
 
 const FrameD kUp = FrameD::fromTangentNormal(Vec3d(0, 0, 1), Vec3d(1, 0, 0));
 
+/// Two p-helicoid guides a unit apart with alpha, kN, kB and rolls (curves in space, of 2.5
+/// units), traced with RK4 at @a step.
+Scene twoSpatialGuides(double step)
+{
+    Scene scene;
+    scene.step = step;
+    scene.integrator = HelicoidIntegrator::RK4;
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp.rolled(0.7),
+                                     {piece(1.0, 0.2, 0.3, 0.5, 1.0, 0.2), piece(2.0, 0.1, -0.4, 0.2, 0.6, 1.3), piece(0.5, -0.3, 0.0, 0.1, 0.9, -2.0)}));
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(-0.4), {piece(0.3, 0.0, 0.2, 0.0, 1.5), piece(1.0, 0.5, 0.0, 0.0, 1.0, 0.5)}));
+    return scene;
+}
+
 } // namespace
 
 TEST_CASE("GuideLocator: Shepard and faded weights sum to 1; a coincident root takes its guide alone", "[helicoid][interp]")
@@ -337,12 +350,7 @@ TEST_CASE("interpolation: bad input is refused before any work, naming the value
 
 TEST_CASE("interpolateHelicoids: next to a guide's root the blend approaches that guide (the general path)", "[helicoid][interp]")
 {
-    Scene scene;
-    scene.step = 0.01;
-    scene.integrator = HelicoidIntegrator::RK4;
-    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), kUp.rolled(0.7),
-                                     {piece(1.0, 0.2, 0.3, 0.5, 1.0, 0.2), piece(2.0, 0.1, -0.4, 0.2, 0.6, 1.3), piece(0.5, -0.3, 0.0, 0.1, 0.9, -2.0)}));
-    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), kUp.rolled(-0.4), {piece(0.3, 0.0, 0.2, 0.0, 1.5), piece(1.0, 0.5, 0.0, 0.0, 1.0, 0.5)}));
+    const Scene scene = twoSpatialGuides(0.01);
     const StrandSet guides = growScene(scene);
     InterpolationRoots near;
     near.positions.push_back(Vec3d(1e-4, 0, 0));  // weight of the other guide ~1e-12
@@ -351,4 +359,101 @@ TEST_CASE("interpolateHelicoids: next to a guide's root the blend approaches tha
     float worst = 0.f;
     for (std::size_t v = 0; v < s.size(0); ++v) worst = std::max(worst, (s.positions[v] - Vec3f(1e-4f, 0.f, 0.f) - guides.positions[v]).length());
     REQUIRE(worst < 1e-5f);
+}
+
+namespace {
+
+/// The largest distance between strand @a i of @a a and strand @a j of @a b (moved by @a shift),
+/// both resampled to 201 points by arc length.
+double curveDistance(const StrandSet& a, std::size_t i, const StrandSet& b, std::size_t j, const Vec3f& shift = Vec3f(0.f))
+{
+    std::vector<Vec3f> ra(201), rb(201);
+    resamplePolyline(a.positions.data() + a.begin(i), a.size(i), ra.size(), ra.data());
+    resamplePolyline(b.positions.data() + b.begin(j), b.size(j), rb.size(), rb.data());
+    double worst = 0.0;
+    for (std::size_t k = 0; k < ra.size(); ++k) worst = std::max(worst, double((ra[k] - rb[k] - shift).length()));
+    return worst;
+}
+
+HelicoidInterpolationParams arcsParams()
+{
+    HelicoidInterpolationParams p;
+    p.blend = HelicoidBlend::Arcs;
+    return p;
+}
+
+} // namespace
+
+TEST_CASE("interpolateHelicoids, arcs: next to a guide's root the blend follows that guide's curve", "[helicoid][interp]")
+{
+    // Three-dimensional p-helicoids (alpha, kN, kB and rolls): the arcs describe the curve, not its pieces.
+    const Scene scene = twoSpatialGuides(0.005);
+    const StrandSet guides = growScene(scene);
+    InterpolationRoots near;
+    near.positions.push_back(Vec3d(1e-4, 0, 0));  // weight of the other guide ~1e-12: the general path
+    const Scene out = interpolateHelicoids(scene, near, arcsParams());
+    REQUIRE(out.guides[0].pieces.size() >= 16);  // one arc per 0.2 radian of the most-turning guide, at least 16
+    for (const HelicoidPiece& p : out.guides[0].pieces) {
+        REQUIRE(p.k.kT >= 0.0);
+        REQUIRE(p.k.kN == 0.0);
+        REQUIRE(p.k.kB == 0.0);
+        REQUIRE(p.k.alpha == 0.0);
+    }
+    const StrandSet s = growScene(out);
+    const double d = curveDistance(s, 0, guides, 0, Vec3f(1e-4f, 0.f, 0.f));
+    CAPTURE(d, out.guides[0].pieces.size());
+    REQUIRE(d < 5e-3 * 2.5);  // within 0.5 % of the guide's length of 2.5 (0.22 % measured, 16 arcs)
+    // More arcs follow it more closely.
+    HelicoidInterpolationParams fine = arcsParams();
+    fine.arcs = 4 * out.guides[0].pieces.size();
+    const double dFine = curveDistance(growScene(interpolateHelicoids(scene, near, fine)), 0, guides, 0, Vec3f(1e-4f, 0.f, 0.f));
+    CAPTURE(dFine);
+    REQUIRE(dFine < 0.25 * d);
+}
+
+TEST_CASE("interpolateHelicoids, arcs: guides of one curve described unlike each other blend into that curve", "[helicoid][interp]")
+{
+    // Three guides with the same curve: one piece; the kT sign flipped with its frame turned by π;
+    // and three pieces of the same k (each restarts the helicoid at its joint, so it is another
+    // curve unless k is a pure circle: kT only). Fitted pieces of different counts do not blend
+    // (PieceCountRule); their arcs are alike, so every blend is the curve itself.
+    Scene scene;
+    scene.step = 0.005;
+    scene.integrator = HelicoidIntegrator::RK4;
+    const FrameD q = FrameD::fromTangentNormal(Vec3d(0.2, 0.1, 1.0), Vec3d(1, 0, 0));
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), q, {piece(1.2, 0, 0, 0, 2.4)}));
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), q.rolled(M_PI), {piece(-1.2, 0, 0, 0, 2.4)}));
+    scene.guides.push_back(makeGuide(Vec3d(0, 1, 0), q, {piece(1.2, 0, 0, 0, 0.8), piece(1.2, 0, 0, 0, 0.8), piece(1.2, 0, 0, 0, 0.8)}));
+    const StrandSet guides = growScene(scene);
+    REQUIRE(curveDistance(guides, 1, guides, 0, Vec3f(1.f, 0.f, 0.f)) < 1e-5);
+    REQUIRE(curveDistance(guides, 2, guides, 0, Vec3f(0.f, 1.f, 0.f)) < 1e-5);
+    InterpolationRoots roots;
+    for (const Vec3d& r : {Vec3d(0.4, 0.3, 0), Vec3d(0.5, 0.5, 0), Vec3d(0.2, 0.7, 0)}) roots.positions.push_back(r);
+    const StrandSet s = growScene(interpolateHelicoids(scene, roots, arcsParams()));
+    for (std::size_t i = 0; i < 3; ++i) {
+        const double d = curveDistance(s, i, guides, 0, Vec3f(roots.positions[i]));
+        CAPTURE(i, d);
+        REQUIRE(d < 2e-3 * 2.4);
+    }
+}
+
+TEST_CASE("interpolateHelicoids, arcs: hair does not blend across a parting", "[helicoid][interp]")
+{
+    // Two guides leaving the scalp 40° apart and bending to opposite sides (a parting between
+    // them): blended, their bends would cancel into a hair that sticks out. Shaped unlike each
+    // other (mean distance far above a quarter of the length), only the heaviest takes part.
+    Scene scene;
+    scene.step = 0.01;
+    scene.integrator = HelicoidIntegrator::RK4;
+    const FrameD left = FrameD::fromTangentNormal(Vec3d(-0.34, 0, 0.94), Vec3d(-1, 0, 0));
+    const FrameD right = FrameD::fromTangentNormal(Vec3d(0.34, 0, 0.94), Vec3d(1, 0, 0));
+    scene.guides.push_back(makeGuide(Vec3d(0, 0, 0), left, {piece(1.0, 0, 0, 0, 3.0)}));
+    scene.guides.push_back(makeGuide(Vec3d(1, 0, 0), right, {piece(1.0, 0, 0, 0, 3.0)}));
+    const StrandSet guides = growScene(scene);
+    InterpolationRoots roots;
+    roots.positions = {Vec3d(0.4, 0, 0), Vec3d(0.6, 0, 0)};
+    const StrandSet s = growScene(interpolateHelicoids(scene, roots, arcsParams()));
+    CAPTURE(curveDistance(s, 0, guides, 0, Vec3f(0.4f, 0.f, 0.f)), curveDistance(s, 1, guides, 1, Vec3f(-0.4f, 0.f, 0.f)));
+    REQUIRE(curveDistance(s, 0, guides, 0, Vec3f(0.4f, 0.f, 0.f)) < 0.01 * 3.0);
+    REQUIRE(curveDistance(s, 1, guides, 1, Vec3f(-0.4f, 0.f, 0.f)) < 0.01 * 3.0);
 }

@@ -116,4 +116,12 @@ TEST_CASE("reconstructHairstyle: real straight hair at 10 % guides", "[helicoid]
     for (double e : r.helicoidErrors.relative) REQUIRE(std::isfinite(e));
     for (double e : r.pointErrors.relative) REQUIRE(std::isfinite(e));
     REQUIRE(r.pointErrors.meanInterpolated < 0.1);  // neighbouring straight strands are alike
+    // The fits' own pieces blended (the paper's rule, interpolation's default) against the arcs
+    // reconstruction chooses: arcs follow the captured strands more closely.
+    ReconstructParams fitted;
+    fitted.helicoid.blend = HelicoidBlend::Fitted;
+    const ReconstructResult f = reconstructHairstyle(some, fitted);
+    std::cout << "  the same with --blend fitted: helicoid mean " << f.helicoidErrors.meanInterpolated << " p95 "
+              << f.helicoidErrors.p95Interpolated << "\n";
+    REQUIRE(r.helicoidErrors.meanInterpolated < f.helicoidErrors.meanInterpolated);
 }

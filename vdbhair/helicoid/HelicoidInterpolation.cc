@@ -18,7 +18,53 @@ namespace {
 
 bool finite3(const Vec3d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
+constexpr double kArcTurn = 0.2;  ///< radians of the most-turning guide per arc (automatic count)
+constexpr std::size_t kMinArcs = 16, kMaxArcs = 512;
+/// HelicoidBlend::Arcs blends only guides shaped like the heaviest: root-relative points at
+/// kShapeSamples equal fractions of the length, a mean distance below kUnlike of the length.
+constexpr std::size_t kShapeSamples = 16;
+constexpr double kUnlike = 0.25;
+
+/// @a v turned about the unit @a axis by the angle whose cosine and sine are @a c, @a s (Rodrigues).
+Vec3d rotateAbout(const Vec3d& v, const Vec3d& axis, double c, double s)
+{
+    return v * c + axis.cross(v) * s + axis * (axis.dot(v) * (1.0 - c));
+}
+
+/// @a ref turned by the least rotation that takes ref.t onto the unit @a t (a half turn about ref.n
+/// when @a t is opposite).
+FrameD leastRotationOnto(const FrameD& ref, const Vec3d& t)
+{
+    const Vec3d axis = ref.t.cross(t);
+    const double s = axis.length(), c = ref.t.dot(t);
+    if (s < 1e-12) return FrameD::fromTangentNormal(t, ref.n);  // t along ref.t or opposite it
+    return FrameD::fromTangentNormal(t, rotateAbout(ref.n, axis / s, c, s));
+}
+
+/// The unit tangent at arc length @a s of @a tr (its frames' tangents, linear between points),
+/// @a k the point to search from (advanced: calls come in increasing s).
+Vec3d tangentAt(const HelicoidTrace& tr, double s, std::size_t& k)
+{
+    const std::size_t n = tr.arc.size();
+    while (k + 2 < n && tr.arc[k + 1] < s) ++k;
+    if (n < 2) return tr.frames.front().t;
+    const double len = tr.arc[k + 1] - tr.arc[k];
+    const double f = len > 0.0 ? std::min(1.0, std::max(0.0, (s - tr.arc[k]) / len)) : 0.0;
+    Vec3d t = tr.frames[k].t * (1.0 - f) + tr.frames[k + 1].t * f;
+    const double l = t.length();
+    return l > 0.0 ? t / l : tr.frames[k].t;
+}
+
 } // namespace
+
+const char* helicoidBlendName(HelicoidBlend blend) { return blend == HelicoidBlend::Arcs ? "arcs" : "fitted"; }
+
+HelicoidBlend helicoidBlendFromName(const std::string& name)
+{
+    if (name == "arcs") return HelicoidBlend::Arcs;
+    if (name == "fitted") return HelicoidBlend::Fitted;
+    throw ValueError("blend '" + name + "' is not one of arcs, fitted");
+}
 
 FrameD surfaceFrame(const Vec3d& normal, const Vec3d& up)
 {
@@ -67,6 +113,14 @@ struct HelicoidInterpolator::Prepared
     std::vector<HelicoidParams> k;  ///< per piece, kT >= 0 under the sign rule
     std::vector<double> entryRoll;  ///< per piece: its roll about E_T where it begins (index 0 unused)
     std::vector<double> c;          ///< normalized arc length of each breakpoint, #P + 1
+};
+
+/// One guide described as equal circular arcs (HelicoidBlend::Arcs).
+struct HelicoidInterpolator::ArcGuide
+{
+    double length = 0.0, step = 0.0;
+    std::vector<double> c;  ///< 2 per arc: the curvature vector in the carried frame's (E_N, E_B)
+    std::vector<Vec3d> shape;  ///< kShapeSamples points at equal arc lengths, root to tip, less the root (in W's axes with surface frames)
 };
 
 HelicoidInterpolator::HelicoidInterpolator(const Scene& guides, const HelicoidInterpolationParams& params,
@@ -118,10 +172,78 @@ HelicoidInterpolator::HelicoidInterpolator(const Scene& guides, const HelicoidIn
         maxLength = std::max(maxLength, p.length);
         maxPieces = std::max(maxPieces, P);
     }
+    mNormals = guideNormals;
+    if (params.blend == HelicoidBlend::Arcs) {
+        prepareArcs(guideNormals);
+        maxPieces = std::max(maxPieces, mArcCount);
+    }
     const double perHair = maxLength / minStep + double(maxPieces) + 1.0;
     mMaxVertices = perHair < 1e18 ? std::size_t(std::ceil(perHair)) : std::numeric_limits<std::size_t>::max();
-    mNormals = guideNormals;
     mLocator = std::make_unique<GuideLocator>(std::move(roots));
+}
+
+void HelicoidInterpolator::prepareArcs(const std::vector<Vec3d>& guideNormals)
+{
+    const std::size_t G = mScene.guides.size();
+    std::vector<HelicoidTrace> traces(G);
+    double maxTurn = 0.0;
+    Vec3d meanTangent(0.0);
+    for (std::size_t g = 0; g < G; ++g) {
+        const SceneGuide& sg = mScene.guides[g];
+        tracePHelicoid(sg.root, sg.frame, sg.pieces, mGuides[g].step, mScene.integrator, traces[g]);
+        const HelicoidTrace& tr = traces[g];
+        double turn = 0.0;
+        for (std::size_t k = 1; k < tr.frames.size(); ++k) {
+            turn += std::atan2(tr.frames[k - 1].t.cross(tr.frames[k].t).length(), tr.frames[k - 1].t.dot(tr.frames[k].t));
+        }
+        maxTurn = std::max(maxTurn, turn);
+        meanTangent += tr.frames.front().t;
+    }
+    mArcCount = mParams.arcs ? mParams.arcs
+                             : std::min(kMaxArcs, std::max(kMinArcs, std::size_t(std::ceil(maxTurn / kArcTurn))));
+    // Without surface normals, one reference frame for every guide.
+    const double ml = meanTangent.length();
+    const FrameD shared = surfaceFrame(ml > 1e-9 ? meanTangent / ml : mParams.up, mParams.up);
+    mArcs.resize(G);
+    mArcFrames.resize(G);
+    const std::size_t A = mArcCount;
+    for (std::size_t g = 0; g < G; ++g) {
+        const HelicoidTrace& tr = traces[g];
+        ArcGuide& a = mArcs[g];
+        a.step = mGuides[g].step;
+        a.length = mGuides[g].length;
+        const FrameD W = mSurface ? surfaceFrame(guideNormals[g], mParams.up) : shared;
+        FrameD R = leastRotationOnto(W, tr.frames.front().t);
+        mArcFrames[g] = mSurface ? relativeFrame(R, W) : R;
+        a.shape.resize(kShapeSamples);
+        std::size_t m = 0;
+        for (std::size_t q = 0; q < kShapeSamples; ++q) {
+            const double sq = tr.arc.back() * double(q + 1) / double(kShapeSamples);
+            while (m + 2 < tr.arc.size() && tr.arc[m + 1] < sq) ++m;
+            const double len = tr.arc[m + 1] - tr.arc[m];
+            const double f = len > 0.0 ? std::min(1.0, std::max(0.0, (sq - tr.arc[m]) / len)) : 0.0;
+            const Vec3d d = tr.points[m] * (1.0 - f) + tr.points[m + 1] * f - tr.points.front();
+            a.shape[q] = mSurface ? Vec3d(d.dot(W.t), d.dot(W.n), d.dot(W.b)) : d;
+        }
+        a.c.assign(2 * A, 0.0);
+        const double ds = tr.arc.back() / double(A);
+        std::size_t k = 0;
+        for (std::size_t j = 0; j < A; ++j) {
+            const Vec3d t0 = R.t, t1 = tangentAt(tr, ds * double(j + 1), k);
+            const Vec3d axis = t0.cross(t1);
+            const double sn = axis.length(), cs = t0.dot(t1);
+            if (!(sn > 1e-12) || !(ds > 0.0)) {
+                R = FrameD::fromTangentNormal(t1, R.n);
+                continue;
+            }
+            const double theta = std::atan2(sn, cs), kappa = theta / ds;
+            const Vec3d bend = (t1 - t0 * cs) / sn;  // unit, across t0 towards t1
+            a.c[2 * j] = kappa * bend.dot(R.n);
+            a.c[2 * j + 1] = kappa * bend.dot(R.b);
+            // Carry the frame along the arc: the rotation about its axis that takes t0 onto t1.
+            R = FrameD::fromTangentNormal(t1, rotateAbout(R.n, axis / sn, cs, sn));
+        }
+    }
 }
 
 HelicoidInterpolator::~HelicoidInterpolator() = default;
@@ -131,10 +253,120 @@ void HelicoidInterpolator::weights(const Vec3d& root, std::vector<GuideWeight>& 
     mLocator->shepardWeights(root, mParams.shepard, out);
 }
 
+FrameD HelicoidInterpolator::placeFirstFrame(const FrameD& avg, const std::vector<GuideWeight>& ws, const Vec3d* normal) const
+{
+    if (!mSurface) return avg;
+    if (normal) return composeFrames(surfaceFrame(*normal, mParams.up), avg);
+    // Guide frames are relative to their surface frames; without a normal here, use the heaviest's.
+    std::size_t h = 0;
+    for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h].weight) h = i;
+    return composeFrames(surfaceFrame(mNormals[ws[h].guide], mParams.up), avg);
+}
+
+void HelicoidInterpolator::blendWaviness(const std::vector<GuideWeight>& ws, SceneGuide& out) const
+{
+    // Waviness (Eq. 4) by the same weights.
+    double wavyWeight = 0.0;
+    for (const GuideWeight& gw : ws) if (mScene.guides[gw.guide].waviness) wavyWeight += gw.weight;
+    if (!(wavyWeight > 0.0)) return;
+    WavinessParams wp;
+    double s = 0.0, c = 0.0;
+    for (const GuideWeight& gw : ws) {
+        const auto& w = mScene.guides[gw.guide].waviness;
+        if (!w) continue;
+        wp.amplitude += gw.weight * w->amplitude;
+        wp.noise += gw.weight * w->noise;
+        wp.frequency += gw.weight / wavyWeight * w->frequency;
+        s += gw.weight * std::sin(w->phase);
+        c += gw.weight * std::cos(w->phase);
+    }
+    wp.phase = std::atan2(s, c);
+    out.waviness = wp;
+}
+
+SceneGuide HelicoidInterpolator::interpolateArcs(const std::vector<GuideWeight>& wsIn, const Vec3d& root, const Vec3d* normal) const
+{
+    // Only guides shaped like the heaviest take part: blending the bends of hair that goes another
+    // way (across a parting, a whorl) sends the new hair sideways or straight out. A guide's
+    // unlikeness is the mean distance between its shape and the heaviest's (root-relative points
+    // at equal fractions of the length) over the longer length; its weight is multiplied by
+    // (1 - (u / kUnlike)²)², zero from kUnlike on.
+    thread_local std::vector<GuideWeight> ws;
+    ws = wsIn;
+    {
+        std::size_t h0 = 0;
+        for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h0].weight) h0 = i;
+        const ArcGuide& ref = mArcs[ws[h0].guide];
+        double sum = 0.0;
+        std::size_t kept = 0;
+        for (const GuideWeight& gw : ws) {
+            const ArcGuide& g = mArcs[gw.guide];
+            double d = 0.0;
+            for (std::size_t q = 0; q < kShapeSamples; ++q) d += (g.shape[q] - ref.shape[q]).length();
+            const double u = d / double(kShapeSamples) / std::max(g.length, ref.length) / kUnlike;
+            if (!(u < 1.0)) continue;
+            ws[kept] = gw;
+            ws[kept].weight *= (1.0 - u * u) * (1.0 - u * u);
+            sum += ws[kept++].weight;
+        }
+        ws.resize(kept);
+        for (GuideWeight& gw : ws) gw.weight /= sum;
+    }
+    SceneGuide out;
+    out.root = root;
+    const std::size_t A = mArcCount;
+    // The new hair's first frame: the weighted mean root tangent, with the heaviest guide's frame
+    // carried onto it by the least rotation. Each guide's arcs are turned into that frame's axes
+    // (its own first frame carried onto the same tangent differs from it by a roll about it), so
+    // curvature vectors of neighbouring guides blend in one gauge whatever their frames' rolls.
+    std::size_t h = 0;
+    Vec3d tangent(0.0);
+    for (std::size_t i = 0; i < ws.size(); ++i) {
+        if (ws[i].weight > ws[h].weight) h = i;
+        tangent += ws[i].weight * mArcFrames[ws[i].guide].t;
+    }
+    const double tl = tangent.length();
+    tangent = tl > 1e-9 ? tangent / tl : mArcFrames[ws[h].guide].t;
+    const FrameD F = leastRotationOnto(mArcFrames[ws[h].guide], tangent);
+    double length = 0.0, step = 0.0;
+    thread_local std::vector<double> c;
+    c.assign(2 * A, 0.0);
+    for (const GuideWeight& gw : ws) {
+        const ArcGuide& g = mArcs[gw.guide];
+        length += gw.weight * g.length;
+        step += gw.weight * g.step;
+        const Vec3d n = leastRotationOnto(mArcFrames[gw.guide], tangent).n;
+        const double cd = n.dot(F.n), sd = n.dot(F.b);  // the roll between the two, as cosine and sine
+        for (std::size_t j = 0; j < A; ++j) {
+            const double x = g.c[2 * j], y = g.c[2 * j + 1];
+            c[2 * j] += gw.weight * (x * cd - y * sd);
+            c[2 * j + 1] += gw.weight * (x * sd + y * cd);
+        }
+    }
+    out.step = step;
+    out.pieces.resize(A);
+    double psiPrev = 0.0, psi0 = 0.0;
+    for (std::size_t j = 0; j < A; ++j) {
+        const double kappa = std::hypot(c[2 * j], c[2 * j + 1]);
+        // A straight arc keeps the previous bending plane (its roll is 0).
+        const double psi = kappa > 0.0 ? std::atan2(c[2 * j + 1], c[2 * j]) : psiPrev;
+        HelicoidPiece& pc = out.pieces[j];
+        pc.k.kT = kappa;
+        pc.length = length / double(A);
+        if (j == 0) psi0 = psi;
+        else pc.roll = std::remainder(psi - psiPrev, 2.0 * M_PI);
+        psiPrev = psi;
+    }
+    out.frame = placeFirstFrame(F, ws, normal).rolled(psi0);
+    blendWaviness(ws, out);
+    return out;
+}
+
 SceneGuide HelicoidInterpolator::interpolate(const Vec3d& root, const Vec3d* normal) const
 {
     thread_local std::vector<GuideWeight> ws;
     weights(root, ws);
+    if (mParams.blend == HelicoidBlend::Arcs && ws.size() > 1) return interpolateArcs(ws, root, normal);
     if (mParams.pieceCount == PieceCountRule::Heaviest && ws.size() > 1) {
         // Only guides with the heaviest's piece count take part (weights renormalized over them).
         std::size_t h = 0;
@@ -166,14 +398,7 @@ SceneGuide HelicoidInterpolator::interpolate(const Vec3d& root, const Vec3d* nor
     SceneGuide out;
     out.root = root;
     // Frame of the first piece (§4.1, §4.3).
-    const FrameD avg = averageFrames(mFirstFrames, ws);
-    out.frame = surface ? composeFrames(W, avg) : avg;
-    if (mSurface && !normal) {
-        // Guide frames are relative to their surface frames; without a normal here, use the heaviest's.
-        std::size_t h = 0;
-        for (std::size_t i = 1; i < ws.size(); ++i) if (ws[i].weight > ws[h].weight) h = i;
-        out.frame = composeFrames(surfaceFrame(mNormals[ws[h].guide], mParams.up), avg);
-    }
+    out.frame = placeFirstFrame(averageFrames(mFirstFrames, ws), ws, normal);
 
     // Length, step and the piece count.
     double length = 0.0, step = 0.0;
@@ -225,24 +450,7 @@ SceneGuide HelicoidInterpolator::interpolate(const Vec3d& root, const Vec3d* nor
         bPrev = bNext;
     }
 
-    // Waviness (Eq. 4) by the same weights.
-    double wavyWeight = 0.0;
-    for (const GuideWeight& gw : ws) if (mScene.guides[gw.guide].waviness) wavyWeight += gw.weight;
-    if (wavyWeight > 0.0) {
-        WavinessParams wp;
-        double s = 0.0, c = 0.0;
-        for (const GuideWeight& gw : ws) {
-            const auto& w = mScene.guides[gw.guide].waviness;
-            if (!w) continue;
-            wp.amplitude += gw.weight * w->amplitude;
-            wp.noise += gw.weight * w->noise;
-            wp.frequency += gw.weight / wavyWeight * w->frequency;
-            s += gw.weight * std::sin(w->phase);
-            c += gw.weight * std::cos(w->phase);
-        }
-        wp.phase = std::atan2(s, c);
-        out.waviness = wp;
-    }
+    blendWaviness(ws, out);
     return out;
 }
 

@@ -38,7 +38,13 @@ struct ReconstructParams
     GuideSelection selection = GuideSelection::Random;
     std::uint64_t seed = 0;
     FitParams fit;
-    HelicoidInterpolationParams helicoid;
+    /// Arcs, not interpolation's Fitted: a reconstruction is judged against the captured strands,
+    /// which arcs follow far more closely (README, "Interpolation").
+    HelicoidInterpolationParams helicoid = [] {
+        HelicoidInterpolationParams p;
+        p.blend = HelicoidBlend::Arcs;
+        return p;
+    }();
     PointInterpolationParams points;
 };
 
