@@ -108,6 +108,16 @@ pyb::object metaValue(const MetaValue& m)
 
 namespace {
 
+/// The blend= keyword of @a function: the library's names, its message with the function's name.
+HelicoidBlend blendArgument(const char* function, const std::string& blend)
+{
+    try {
+        return helicoidBlendFromName(blend);
+    } catch (const ValueError& e) {
+        throw ValueError(std::string(function) + ": " + e.what());
+    }
+}
+
 /// The hierarchy's keywords (as the commands' addSynthHierarchyOptions()), shared by synth,
 /// transfer and comb.
 void setHierarchy(SynthParams& p, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters,
@@ -510,8 +520,7 @@ Returns:
             if (returnScene && points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
             HelicoidInterpolationParams hp;
             PointInterpolationParams pp;
-            if (blend != "arcs" && blend != "fitted") throw ValueError("interpolate: blend '" + blend + "' is not one of arcs, fitted");
-            hp.blend = helicoidBlendFromName(blend);
+            hp.blend = blendArgument("interpolate", blend);
             if (!(power > 0.0) || !std::isfinite(power))
                 throw ValueError("interpolate: power=" + std::to_string(power) + ": must be a positive finite exponent (the paper uses 3)");
             hp.shepard.power = power;
@@ -601,8 +610,7 @@ Returns:
         [](const StrandsPtr& strands, double guides, const std::string& select, std::uint64_t seed, double power,
            std::optional<int> neighbors, const std::string& blend, double maxError, int threads, const pyb::object& progress) {
             ReconstructParams p;
-            if (blend != "arcs" && blend != "fitted") throw ValueError("reconstruct: blend '" + blend + "' is not one of arcs, fitted");
-            p.helicoid.blend = helicoidBlendFromName(blend);
+            p.helicoid.blend = blendArgument("reconstruct", blend);
             p.guideFraction = guides;
             if (select == "random") p.selection = GuideSelection::Random;
             else if (select == "cluster") p.selection = GuideSelection::Cluster;

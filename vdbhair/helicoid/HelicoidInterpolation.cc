@@ -4,6 +4,7 @@
 #include <vdbhair/Format.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/helicoid/FrameAverage.h>
+#include <vdbhair/strands/Resample.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -118,7 +119,6 @@ struct HelicoidInterpolator::Prepared
 /// One guide described as equal circular arcs (HelicoidBlend::Arcs).
 struct HelicoidInterpolator::ArcGuide
 {
-    double length = 0.0, step = 0.0;
     std::vector<double> c;  ///< 2 per arc: the curvature vector in the carried frame's (E_N, E_B)
     std::vector<Vec3d> shape;  ///< kShapeSamples points at equal arc lengths, root to tip, less the root (in W's axes with surface frames)
 };
@@ -210,19 +210,15 @@ void HelicoidInterpolator::prepareArcs(const std::vector<Vec3d>& guideNormals)
     for (std::size_t g = 0; g < G; ++g) {
         const HelicoidTrace& tr = traces[g];
         ArcGuide& a = mArcs[g];
-        a.step = mGuides[g].step;
-        a.length = mGuides[g].length;
         const FrameD W = mSurface ? surfaceFrame(guideNormals[g], mParams.up) : shared;
         FrameD R = leastRotationOnto(W, tr.frames.front().t);
         mArcFrames[g] = mSurface ? relativeFrame(R, W) : R;
+        // The trace at kShapeSamples + 1 equal arc lengths (the root first), less the root.
+        std::vector<Vec3f> traced(tr.points.begin(), tr.points.end()), sampled(kShapeSamples + 1);
+        resamplePolyline(traced.data(), traced.size(), sampled.size(), sampled.data());
         a.shape.resize(kShapeSamples);
-        std::size_t m = 0;
         for (std::size_t q = 0; q < kShapeSamples; ++q) {
-            const double sq = tr.arc.back() * double(q + 1) / double(kShapeSamples);
-            while (m + 2 < tr.arc.size() && tr.arc[m + 1] < sq) ++m;
-            const double len = tr.arc[m + 1] - tr.arc[m];
-            const double f = len > 0.0 ? std::min(1.0, std::max(0.0, (sq - tr.arc[m]) / len)) : 0.0;
-            const Vec3d d = tr.points[m] * (1.0 - f) + tr.points[m + 1] * f - tr.points.front();
+            const Vec3d d = Vec3d(sampled[q + 1]) - Vec3d(sampled[0]);
             a.shape[q] = mSurface ? Vec3d(d.dot(W.t), d.dot(W.n), d.dot(W.b)) : d;
         }
         a.c.assign(2 * A, 0.0);
@@ -303,7 +299,7 @@ SceneGuide HelicoidInterpolator::interpolateArcs(const std::vector<GuideWeight>&
             const ArcGuide& g = mArcs[gw.guide];
             double d = 0.0;
             for (std::size_t q = 0; q < kShapeSamples; ++q) d += (g.shape[q] - ref.shape[q]).length();
-            const double u = d / double(kShapeSamples) / std::max(g.length, ref.length) / kUnlike;
+            const double u = d / double(kShapeSamples) / std::max(mGuides[gw.guide].length, mGuides[ws[h0].guide].length) / kUnlike;
             if (!(u < 1.0)) continue;
             ws[kept] = gw;
             ws[kept].weight *= (1.0 - u * u) * (1.0 - u * u);
@@ -333,8 +329,8 @@ SceneGuide HelicoidInterpolator::interpolateArcs(const std::vector<GuideWeight>&
     c.assign(2 * A, 0.0);
     for (const GuideWeight& gw : ws) {
         const ArcGuide& g = mArcs[gw.guide];
-        length += gw.weight * g.length;
-        step += gw.weight * g.step;
+        length += gw.weight * mGuides[gw.guide].length;
+        step += gw.weight * mGuides[gw.guide].step;
         const Vec3d n = leastRotationOnto(mArcFrames[gw.guide], tangent).n;
         const double cd = n.dot(F.n), sd = n.dot(F.b);  // the roll between the two, as cosine and sine
         for (std::size_t j = 0; j < A; ++j) {
