@@ -164,7 +164,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_flag("--measure", params->measure,
                   "Also report the mean angle between strand tangents and the field before and after "
-                  "(samples the field at every input and output vertex: about a third of the run)");
+                  "(samples the field at every input and output vertex: about half of the run)");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --measure --json");
     return {sub, [params, &common] { return runRetrace(*params, common); },
