@@ -228,6 +228,9 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
         rp.title = "synth: coarsest clusters";
         writeImage(p.saveMaps + "/clusters.png", renderStrands(coloured, rp));
     }
+    // The statistics (two tangent fields and a nearest-strand search: a sixth of a large synthesis)
+    // are only what the report prints; --quiet without --json prints nothing.
+    if (common.quiet && !common.json) return 0;
     const double finestVoxel = r.refineVoxelSizes.front();
     nlohmann::json checks;
     // On another head the output is measured where it was made, on the example's scalp (moved

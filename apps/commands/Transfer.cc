@@ -70,7 +70,9 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
         const Stage stage(common, "writing " + job.output);
         writeSynthStrands(job.output, r.strands, r.clusterOf);
     }
-    // What the transfer did (README, "Detail transfer and combing", says why each check).
+    // What the transfer did (README, "Detail transfer and combing", says why each check): only
+    // measured to be printed.
+    if (common.quiet && !common.json) return 0;
     const int ns = params.synth.vertices;
     // Turning compared at one sample spacing in head radii, DETAILS' own: its median strand
     // length over n_s - 1 (a fixed vertex count would undersample the longer hairstyle's curls).

@@ -252,7 +252,7 @@ TEST_CASE("estimateFieldFootprint: the leaves counted before the estimate are th
     for (int trial = 0; trial < 9; ++trial) {
         StrandSet s;
         const float stepLength = trial % 3 == 0 ? 0.05f : trial % 3 == 1 ? 0.5f : 3.f;
-        for (int i = 0; i < 40; ++i) {
+        for (int i = 0; i < 16; ++i) {
             std::vector<Vec3f> pts{Vec3f(5.f * u(rng), 5.f * u(rng), 5.f * u(rng))};
             for (int j = 0; j < 30; ++j) pts.push_back(j == 7 ? pts.back() : pts.back() + stepLength * Vec3f(u(rng), u(rng), u(rng)));
             s.addStrand(pts);
