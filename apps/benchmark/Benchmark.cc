@@ -313,14 +313,18 @@ void benchmarkInterpolation(int reps)
     }
 }
 
-/// What a helicoid field buys over a plain tangent field (issue 4): curly and wavy strands
-/// retraced from their roots through each, at vdbhair's suggested voxel size and coarser, and the
-/// mean vertex error against the input (same arc lengths), relative to the mean strand length.
+/// What a helicoid field buys over a plain tangent field (issues 4 and 19): curly and wavy
+/// strands retraced from their roots through each, at vdbhair's suggested voxel size and coarser,
+/// with forward Euler (TraceParams' default) and with RK4 (retrace --helicoid's default,
+/// kHelicoidRetraceIntegrator) for both fields, and the mean vertex error against the input (same
+/// arc lengths), relative to the mean strand length.
 void benchmarkHelicoidFields(const std::string& data, const std::string& source)
 {
-    std::printf("\n== helicoid fields vs tangent fields: retrace every strand from its root (Euler, half-voxel step) ==\n"
-                "error: mean distance between input and retraced vertices at the same arc length, relative to the mean strand length\n");
-    std::printf("%-34s %8s %7s  %14s %14s  %7s\n", "hairstyle", "voxel", "voxels", "tangent field", "helicoid field", "ratio");
+    std::printf("\n== helicoid fields vs tangent fields: retrace every strand from its root (half-voxel step) ==\n"
+                "error: mean distance between input and retraced vertices at the same arc length, relative to the mean strand length;\n"
+                "ratio: tangent field's error / helicoid field's, with the same integrator for both\n");
+    std::printf("%-34s %8s %7s  %9s %9s %6s  %9s %9s %6s\n", "hairstyle", "voxel", "voxels", "tan euler", "hel euler", "ratio",
+                "tan rk4", "hel rk4", "ratio");
     struct Set { std::string name; std::string path; };
     const Set sets[] = {{"Fig. 5 curly four-piece (scene)", source + "/scenes/figures/fig5_curly_four_piece.json"},
                         {"Fig. 2 waviness (scene)", source + "/scenes/figures/fig2_waviness.json"},
@@ -341,14 +345,17 @@ void benchmarkHelicoidFields(const std::string& data, const std::string& source)
             FieldParams fp;
             fp.voxelSize = h0 * f;
             const TangentField tf = estimateTangentField(s, fp);
-            TraceParams tp;
-            const StrandSet viaTangent = retraceStrands(s, *tf.tangent, tp);
             const HelicoidFieldGrids hf = estimateHelicoidField(s, *tf.tangent);
-            const StrandSet viaHelicoid = retraceHelicoidField(s, hf, tp);
-            const double eT = meanVertexDisplacement(s, viaTangent) / meanLength;
-            const double eH = meanVertexDisplacement(s, viaHelicoid) / meanLength;
-            std::printf("%-34s %8.4g %7zu  %13.2f%% %13.2f%%  %6.2fx\n", f == 1.0 ? set.name.c_str() : "", fp.voxelSize,
-                        std::size_t(tf.tangent->activeVoxelCount()), 100.0 * eT, 100.0 * eH, eT / eH);
+            double e[2][2];  // [integrator][tangent, helicoid]
+            for (int i = 0; i < 2; ++i) {
+                TraceParams tp;
+                tp.integrator = i == 0 ? Integrator::Euler : kHelicoidRetraceIntegrator;
+                e[i][0] = meanVertexDisplacement(s, retraceStrands(s, *tf.tangent, tp)) / meanLength;
+                e[i][1] = meanVertexDisplacement(s, retraceHelicoidField(s, hf, tp)) / meanLength;
+            }
+            std::printf("%-34s %8.4g %7zu  %8.2f%% %8.2f%% %5.2fx  %8.2f%% %8.2f%% %5.2fx\n", f == 1.0 ? set.name.c_str() : "",
+                        fp.voxelSize, std::size_t(tf.tangent->activeVoxelCount()), 100.0 * e[0][0], 100.0 * e[0][1],
+                        e[0][0] / e[0][1], 100.0 * e[1][0], 100.0 * e[1][1], e[1][0] / e[1][1]);
             std::fflush(stdout);
         }
     }

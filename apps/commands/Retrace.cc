@@ -65,6 +65,7 @@ struct RetraceParams
     std::string input, output, field, grid = "tangent";
     TraceParams trace;
     CLI::Option* stepOpt = nullptr;
+    CLI::Option* integratorOpt = nullptr;
     std::string integrator = integratorName(TraceParams{}.integrator);
     std::string vertices = TraceParams{}.vertices == RetraceVertices::Input ? "input" : "steps";
     bool helicoid = false;
@@ -76,6 +77,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 {
     TraceParams tp = p.trace;
     tp.integrator = integratorFromName(p.integrator);
+    if (p.helicoid && !(p.integratorOpt && p.integratorOpt->count() > 0)) tp.integrator = kHelicoidRetraceIntegrator;
     const bool stepGiven = p.stepOpt && p.stepOpt->count() > 0;
     if (stepGiven && (!(tp.step > 0.0) || !std::isfinite(tp.step))) {
         throw ValueError("--step " + formatValue(tp.step) + ": must be a positive finite length");
@@ -110,6 +112,8 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
             nlohmann::json j = traceReportJson(stats, angles, disp);
             j["output"] = p.output;
             j["field"] = "helicoid";
+            j["step"] = resolveStepLength(tp.step, field.k->voxelSize().x(), "retrace");
+            j["integrator"] = integratorName(tp.integrator);
             printJson(j);
         } else if (!common.quiet) {
             printTraceReport(stats, angles, disp);
@@ -155,7 +159,9 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
     params->stepOpt = sub->add_option("--step", params->trace.step, "Integration step in world units (default: " + formatValue(kDefaultStepVoxels) + " of the field's voxel size)");
-    sub->add_option("--integrator", params->integrator, "euler (the papers' choice), rk2, rk3 or rk4")->capture_default_str();
+    params->integratorOpt = sub->add_option("--integrator", params->integrator,
+                                            std::string("euler (the papers' choice), rk2, rk3 or rk4; with --helicoid the default is ") +
+                                                integratorName(kHelicoidRetraceIntegrator))->capture_default_str();
     sub->add_option("--vanish", params->trace.vanishThreshold, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
     sub->add_option("--max-steps", params->trace.maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
     sub->add_option("--margin", params->trace.margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();

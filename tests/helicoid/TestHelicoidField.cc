@@ -214,3 +214,44 @@ TEST_CASE("estimateHelicoidField(strands): helices with different phases give th
         REQUIRE(kT.back() < 1.2 * curvature);
     }
 }
+
+TEST_CASE("retraceHelicoidField: curls of unlike phases that share voxels retrace closer than through the tangent field", "[helicoid]")
+{
+    // 25 helices of radius 1 and pitch 2 pi * 0.6 along z, axes 2 apart on a 5 x 5 grid, each at its
+    // own phase, traced at a voxel of 0.8: each voxel near a curl holds pieces of 1-3 curls in
+    // different phases. Both fields are retraced with the same integrator.
+    initializeOpenVdb();
+    const double r = 1.0, c = 0.6;
+    StrandSet s;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 2.0 * M_PI);
+    for (int i = 0; i < 25; ++i) {
+        const double cx = 2.0 * (i % 5), cy = 2.0 * (i / 5), phase = u(rng);
+        std::vector<Vec3f> pts;
+        for (int j = 0; j <= 400; ++j) {
+            const double a = 0.05 * j;
+            pts.emplace_back(float(cx + r * std::cos(a + phase)), float(cy + r * std::sin(a + phase)), float(c * a));
+        }
+        s.addStrand(pts);
+    }
+    double length = 0.0;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) length += polylineLength(s.data(i), s.size(i));
+    length /= double(s.numStrands());
+    FieldParams p;
+    p.voxelSize = 0.8;
+    const TangentField t = estimateTangentField(s, p);
+    const HelicoidFieldGrids f = estimateHelicoidField(s, *t.tangent);
+    TraceParams tp;
+    tp.integrator = kHelicoidRetraceIntegrator;
+    const double eT = meanVertexDisplacement(s, retraceStrands(s, *t.tangent, tp)) / length;
+    const double eH = meanVertexDisplacement(s, retraceHelicoidField(s, f, tp)) / length;
+    tp.integrator = Integrator::Euler;
+    const double eTe = meanVertexDisplacement(s, retraceStrands(s, *t.tangent, tp)) / length;
+    const double eHe = meanVertexDisplacement(s, retraceHelicoidField(s, f, tp)) / length;
+    std::cout << "25 curls of unlike phases, voxel 0.8: RK4 tangent " << 100.0 * eT << " %, helicoid " << 100.0 * eH << " %; Euler tangent "
+              << 100.0 * eTe << " %, helicoid " << 100.0 * eHe << " %\n";
+    // Measured: RK4 9.67 % against 11.43 % (0.85); with plain trilinear corner weights (power 1
+    // instead of HelicoidFieldSampler::kCornerSharpness) the helicoid field gave 10.52 % (0.92).
+    CHECK(eH < 0.9 * eT);
+    CHECK(eHe < eTe);
+}

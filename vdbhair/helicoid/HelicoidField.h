@@ -79,10 +79,20 @@ HelicoidFieldGrids estimateHelicoidField(const openvdb::Vec3SGrid& tangent, bool
 /// @throw LookupError naming the missing grid (and estimateHelicoidField(), which makes them).
 HelicoidFieldGrids readHelicoidField(const std::string& path);
 
+/// The integrator `vdbhair retrace --helicoid` uses unless told otherwise (the tangent field's
+/// default stays TraceParams' Euler). A helicoid field is for accuracy on curls, and forward Euler
+/// at half a voxel is not: its own error on a curl (the same through either field) hid the
+/// helicoid field's gain, 0.86-0.99x the tangent field's accuracy on Fig. 5's curls at Euler
+/// against 1.25-1.73x with RK4 for both (benchmark, helicoid-field section; README "Helicoid
+/// fields in VDB"). RK4 costs `retrace --helicoid` about 1.7 times Euler's time end to end
+/// (4,933 strands: 0.22 s against 0.13 s).
+inline constexpr Integrator kHelicoidRetraceIntegrator = Integrator::RK4;
+
 /// @brief Retrace strands through a helicoid field: at a point, each active corner of the
 /// sampling cell predicts a direction by evaluating its own helicoid (the exact Eq. 1, origin at
-/// the voxel centre) at that point, and the predictions are blended with trilinear weights and
-/// normalized (HelicoidFieldSampler). The streamline engine's general path (SamplerRetrace.h):
+/// the voxel centre) at that point, and the predictions are blended with the trilinear weights to
+/// the 8th power and normalized (HelicoidFieldSampler). params.integrator is used as given (the
+/// command's default for this retrace is kHelicoidRetraceIntegrator). The streamline engine's general path (SamplerRetrace.h):
 /// same parameters, stop rules, write-out and statistics as retraceStrands() (params.kernel is
 /// ignored: there is no lane kernel for helicoid fields).
 /// @param interrupter optional progress and Ctrl-C (Progress.h).
