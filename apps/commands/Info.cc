@@ -2,6 +2,7 @@
 #include "../Command.h"
 
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/StrandFileSummary.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbInfo.h>
 #include <vdbhair/strands/Measures.h>
@@ -42,9 +43,8 @@ int infoStrands(const InfoParams& p, const CommonOptions& common)
     if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
     if (!p.grid.empty()) ropts.vdbGrid = p.grid;
     ReadReport report;
-    const StrandSet strands = readStrands(p.input, ropts, &report);
+    const StrandSummary s = summarizeStrandFile(p.input, ropts, &report);
     printWarnings("info", report, common);
-    const StrandSummary s = summarizeStrands(strands);
     const Vec3d bmin = s.bbox.empty() ? Vec3d(0.0) : Vec3d(s.bbox.min.x(), s.bbox.min.y(), s.bbox.min.z());
     const Vec3d bmax = s.bbox.empty() ? Vec3d(0.0) : Vec3d(s.bbox.max.x(), s.bbox.max.y(), s.bbox.max.z());
     if (common.json) {

@@ -5,8 +5,12 @@
 #include <vdbhair/io/DataFile.h>
 #include <vdbhair/io/HairFile.h>
 
+#include <tbb/task_arena.h>
+
 #include <cstring>
 #include <limits>
+#include <string>
+#include <vector>
 
 using namespace vdbhair;
 using Catch::Matchers::Contains;
@@ -124,5 +128,103 @@ TEST_CASE("readData / readBin: each kind of bad input has its own error", "[io]"
             for (int i = 0; i < 7; ++i) test::put(b, v == 1 && i == 2 ? std::numeric_limits<float>::quiet_NaN() : float(v));
         }
         REQUIRE_THROWS_WITH(readBin(test::writeBytes("nan.bin", b)), Contains("at byte 36: vertex 1 has a non-finite coordinate"));
+    }
+}
+
+namespace {
+
+/// A .data file of @a counts strands: strand i's vertex j at (i, j, i * j), with a NaN at vertex
+/// @a nanVertex of strand @a nanStrand (-1: none); a count of @a lie replaces strand @a lieStrand's
+/// (-1: none) without changing what follows.
+std::string dataBytes(const std::vector<int>& counts, int nanStrand = -1, int nanVertex = 0, int lieStrand = -1, int lie = 0)
+{
+    std::string b;
+    test::put(b, std::int32_t(counts.size()));
+    for (int i = 0; i < int(counts.size()); ++i) {
+        test::put(b, std::int32_t(i == lieStrand ? lie : counts[std::size_t(i)]));
+        for (int j = 0; j < counts[std::size_t(i)]; ++j) {
+            test::put(b, float(i));
+            test::put(b, i == nanStrand && j == nanVertex ? std::numeric_limits<float>::quiet_NaN() : float(j));
+            test::put(b, float(i * j) * 0.5f);
+        }
+    }
+    return b;
+}
+
+/// The message of what @a fn throws ("" if nothing).
+template<typename Fn>
+std::string thrown(Fn&& fn)
+{
+    try {
+        fn();
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+    return "";
+}
+
+void requireSameSummary(const StrandSummary& a, const StrandSummary& b)
+{
+    REQUIRE(a.strands == b.strands);
+    REQUIRE(a.vertices == b.vertices);
+    REQUIRE(a.bbox.min == b.bbox.min);
+    REQUIRE(a.bbox.max == b.bbox.max);
+    REQUIRE(a.length.min == b.length.min);
+    REQUIRE(a.length.mean == b.length.mean);
+    REQUIRE(a.length.max == b.length.max);
+    REQUIRE(a.verticesPerStrand.min == b.verticesPerStrand.min);
+    REQUIRE(a.verticesPerStrand.mean == b.verticesPerStrand.mean);
+    REQUIRE(a.verticesPerStrand.max == b.verticesPerStrand.max);
+}
+
+} // namespace
+
+TEST_CASE("summarizeData: the summary, warnings and first error of reading the file, without its strands", "[io]")
+{
+    // 700 strands of 0 to 9 vertices (the 140 short ones dropped, with a warning), and 5 bytes more.
+    std::vector<int> counts;
+    for (int i = 0; i < 700; ++i) counts.push_back((i * 7 + 1) % 10);
+    const std::string path = test::writeBytes("summary.data", dataBytes(counts) + "extra");
+    ReadReport r1, r2;
+    const StrandSummary read = summarizeStrands(readData(path, {}, &r1));
+    const StrandSummary measured = summarizeData(path, {}, &r2);
+    requireSameSummary(read, measured);
+    REQUIRE(read.strands == 560);
+    REQUIRE(r1.warnings == r2.warnings);
+    REQUIRE(r1.warnings.size() == 2);
+    REQUIRE(r1.droppedStrands == r2.droppedStrands);
+    // The same on one thread.
+    tbb::task_arena one(1);
+    one.execute([&] { requireSameSummary(read, summarizeData(path)); });
+
+    // Whichever fault comes first in the file is the one reported, by both.
+    ReadOptions strict;
+    strict.shortStrands = ShortStrandPolicy::Reject;
+    struct Fault { const char* what; std::string bytes; ReadOptions opts; const char* expect; };
+    const std::vector<Fault> faults = {
+        {"a NaN before a lying count", dataBytes(counts, 12, 3, 40, 1 << 30), {}, "vertex"},
+        {"a lying count before a NaN", dataBytes(counts, 41, 3, 12, 1 << 30), {}, "declares 1073741824 vertices"},
+        {"a NaN in a strand dropped as short", dataBytes(counts, 0, 0), {}, "non-finite"},
+        {"a short strand refused before a NaN", dataBytes(counts, 12, 3), strict, "has 1 vertices"},
+        {"a NaN in the strand refused as short", dataBytes(counts, 0, 0), strict, "non-finite"},
+        {"a negative count", dataBytes(counts, -1, 0, 5, -2), {}, "counts must not be negative"},
+    };
+    for (const Fault& f : faults) {
+        const std::string p = test::writeBytes("fault.data", f.bytes);
+        const std::string a = thrown([&] { readData(p, f.opts); }), b = thrown([&] { summarizeData(p, f.opts); });
+        CAPTURE(f.what, a, b);
+        REQUIRE(!a.empty());
+        REQUIRE(a.find(f.expect) != std::string::npos);
+        REQUIRE(a == b);
+    }
+}
+
+TEST_CASE("summarizeData: real files give the summary of reading them", "[io][data]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    for (const char* name : {"harolongo.data", "Bangs_100.data", "hairnet_cstrands/cstrands00001.data"}) {
+        const std::string path = test::sharedData() + "/hair/usc_data/" + name;
+        CAPTURE(path);
+        requireSameSummary(summarizeStrands(readData(path)), summarizeData(path));
     }
 }

@@ -1,4 +1,5 @@
 #include "Measures.h"
+#include "Summary.h"
 
 #include <vdbhair/Exceptions.h>
 
@@ -161,17 +162,24 @@ void torsionProfile(const Vec3f* points, std::size_t n, float* out)
 
 StrandSummary summarizeStrands(const StrandSet& strands)
 {
+    std::vector<std::uint32_t> counts(strands.numStrands());
+    for (std::size_t i = 0; i < counts.size(); ++i) counts[i] = std::uint32_t(strands.size(i));
+    return summarizeStrands(strands.numVertices(), computeBBox(strands), strandLengths(strands), counts);
+}
+
+StrandSummary summarizeStrands(std::size_t vertices, const BBox& bbox, const std::vector<float>& lengths,
+                               const std::vector<std::uint32_t>& vertexCounts)
+{
     StrandSummary s;
-    s.strands = strands.numStrands();
-    s.vertices = strands.numVertices();
-    s.bbox = computeBBox(strands);
+    s.strands = lengths.size();
+    s.vertices = vertices;
+    s.bbox = bbox;
     if (s.strands == 0) return s;
-    const std::vector<float> lengths = strandLengths(strands);
     s.length.min = s.verticesPerStrand.min = std::numeric_limits<double>::max();
     s.length.max = s.verticesPerStrand.max = -std::numeric_limits<double>::max();
     double lenSum = 0.0;
     for (std::size_t i = 0; i < s.strands; ++i) {  // fixed order: deterministic sums
-        const double len = lengths[i], nv = double(strands.size(i));
+        const double len = lengths[i], nv = double(vertexCounts[i]);
         lenSum += len;
         s.length.min = std::min(s.length.min, len);
         s.length.max = std::max(s.length.max, len);
