@@ -263,7 +263,8 @@ std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<doubl
         Vec3d e = local * lambda;
         step *= lambda;
         bool last = false;
-        if (progress + step >= target && step > 0.0) {
+        // (Within rounding of the target: a strand laid to its own length ends on its last edge.)
+        if (progress + step >= target * (1.0 - 1e-9) && step > 0.0) {
             e *= (target - progress) / step;
             step = target - progress;
             last = true;
@@ -276,7 +277,7 @@ std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<doubl
     };
     for (std::size_t k = 0; k < d.size(); ++k)
         if (lay(d[k], advance[k])) return out;
-    if (progress >= target) return out;
+    if (progress >= target * (1.0 - 1e-9)) return out;
     double twist = 0.0;
     std::vector<Vec3d> loop = strandLoop(d, twist);
     const auto stepOf = [](const std::vector<Vec3d>& l, double& arc) {
@@ -417,11 +418,16 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             if (load[c])
                 for (std::size_t k = 0; k < K; ++k) pairs.emplace_back(nearest[c * K + k].first, std::uint32_t(c), nearest[c * K + k].second);
         std::sort(pairs.begin(), pairs.end());
-        const double share = matching.balance * double(n) / double(nIn);
+        // An input wisp's share is its own part of the input's strands, so that the output's
+        // wisps take detail in the proportions the input has it (and a hairstyle onto itself
+        // takes every wisp from itself: an even share turned wisps larger than the mean away
+        // from their own detail).
+        std::vector<double> share(nIn, 0.0);
+        for (std::uint32_t c : *source.label) share[c] += matching.balance * double(n) / double(inS.count());
         std::vector<double> used(nIn, 0.0);
         std::vector<std::uint8_t> done(nOut, 0);
         for (const auto& [d, c, j] : pairs) {
-            if (done[c] || used[j] + double(load[c]) > share) continue;
+            if (done[c] || used[j] + double(load[c]) > share[j]) continue;
             done[c] = 1;
             used[j] += double(load[c]);
             match[c] = j;
@@ -431,6 +437,52 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
     // Members of each input cluster.
     std::vector<std::vector<std::uint32_t>> members(nIn);
     for (std::uint32_t s = 0; s < inS.count(); ++s) members[(*source.label)[s]].push_back(s);
+    // 4. Matching strands: each output strand takes a member of its matched input wisp by root
+    // offset from the centre (aligned frames). Balanced, pairs are taken by increasing offset
+    // distance and a member serves at most balance × its even share of the output wisp's strands
+    // (so the output's strands take the input wisp's lengths and curls in its proportions: picked
+    // by nearest offset alone, 100 strands of Curly_100 took a few members many times); the
+    // paper's rule (balance 0) takes the nearest.
+    std::vector<std::vector<std::uint32_t>> strandsOf(nOut);
+    for (std::size_t i = 0; i < n; ++i) strandsOf[label[i]].push_back(std::uint32_t(i));
+    std::vector<std::uint32_t> pickOf(n, 0);
+    forEach(nOut, [&](std::size_t oc) {
+        const std::vector<std::uint32_t>& mine = strandsOf[oc];
+        const std::uint32_t ic = match[oc];
+        const std::vector<std::uint32_t>& mem = members[ic];
+        if (mine.empty() || mem.empty()) return;
+        const ScalpFrame& mo = outAligned[oc];
+        const ScalpFrame& mi = inAligned[ic];
+        std::vector<Vec3d> offIn(mem.size());
+        for (std::size_t k = 0; k < mem.size(); ++k) offIn[k] = mi.toLocal(inS.roots[mem[k]] - inC.roots[ic]);
+        std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> pairs;  // (distance², strand, member), positions in mine and mem
+        pairs.reserve(mine.size() * (balanced ? mem.size() : 1));
+        for (std::size_t a = 0; a < mine.size(); ++a) {
+            const Vec3d offOut = mo.toLocal(roots[mine[a]] - outCenters.roots[oc]);
+            std::size_t nearestK = 0;
+            double best = std::numeric_limits<double>::max();
+            for (std::size_t k = 0; k < mem.size(); ++k) {
+                const double d = (offIn[k] - offOut).lengthSqr();
+                if (balanced) pairs.emplace_back(d, std::uint32_t(a), std::uint32_t(k));
+                if (d < best) {
+                    best = d;
+                    nearestK = k;
+                }
+            }
+            pickOf[mine[a]] = mem[nearestK];
+        }
+        if (!balanced) return;
+        std::sort(pairs.begin(), pairs.end());
+        const double cap = std::ceil(matching.balance * double(mine.size()) / double(mem.size()));
+        std::vector<double> used(mem.size(), 0.0);
+        std::vector<std::uint8_t> done(mine.size(), 0);
+        for (const auto& [d, a, k] : pairs) {
+            if (done[a] || used[k] + 1.0 > cap) continue;
+            done[a] = 1;
+            used[k] += 1.0;
+            pickOf[mine[a]] = mem[k];
+        }
+    });
     // World geometry and rotation-minimizing frames of the centres used, computed once each.
     std::vector<std::vector<Vec3f>> outWorld(nOut), inWorld(nIn);
     std::vector<std::vector<Frame>> outRmf(nOut), inRmf(nIn);
@@ -490,17 +542,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         const std::uint32_t oc = label[i], ic = match[oc];
         const ScalpFrame& mo = outAligned[oc];
         const ScalpFrame& mi = inAligned[ic];
-        // 4. The input member whose root offset (aligned frame) is nearest to ours.
-        const Vec3d offOut = mo.toLocal(roots[i] - outCenters.roots[oc]);
-        std::uint32_t pick = 0;
-        double best = std::numeric_limits<double>::max();
-        for (std::uint32_t m : members[ic]) {
-            const double d = (mi.toLocal(inS.roots[m] - inC.roots[ic]) - offOut).lengthSqr();
-            if (d < best) {
-                best = d;
-                pick = m;
-            }
-        }
+        const std::uint32_t pick = pickOf[i];  // step 4
         const std::vector<Vec3f> gin = worldOf(inS, pick, radius);
         const Vec3d sc = map.toScalp(roots[i]);
         const ScalpFrame rf = map.frame(sc.x(), sc.y());
@@ -567,7 +609,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
                 // The output centre's length, as the other blends (each strand's own share of it,
                 // its length over its input centre's, moved the ponytail's wisps onto the default
                 // head 0.27 of their length from BASE's, against 0.08).
-                target = lo;
+                target = std::max(progress + lo - li, progress * std::min(1.0, li > 0.0 ? lo / li : 1.0));
             }
             const std::vector<Vec3d> laid = layEdges(d, advance, lambda, carrier, roots[i], target);
             std::vector<Vec3f> lf(laid.size()), rs(static_cast<std::size_t>(no));
