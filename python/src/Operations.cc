@@ -272,7 +272,7 @@ Args:
     layout: "synthesize" (texture optimization) or "example" (the example's own map).
     detail: "edges" (each strand's own edges re-laid along the output centre), "root-frame" or "paper" (Eq. 7).
     detail_scale: "strand" (each strand at its own length and pitch), "index" (vertex by vertex) or "arc-length".
-    match_balance: each example wisp serves at most this times its even share of the output (0: nearest wisp).
+    match_balance: each example wisp serves at most this times its own share of the output (its part of the example's strands), each of its strands at most this times its even share of an output wisp (0: nearest wisp and strand).
     match_candidates: example wisps considered per output wisp in balanced matching.
     place_weight: texture synthesis place guidance (0: none).
     nearby: reach of place guidance and initial patch offsets, a fraction of the map.

@@ -56,6 +56,32 @@ TEST_CASE("transferDetail: a cluster transferred onto its own centre is the clus
     }
 }
 
+TEST_CASE("transferDetail: edges give wisps transferred onto their own centres back", "[synth]")
+{
+    // Several wisps of different sizes (balanced matching must still pair each with itself), every
+    // strand laid onto its own centre: the same carriers, frames and arcs, so the strand itself.
+    const StrandSet hair = test::wispHairstyle(600, 6, nullptr, 32, 0.05);
+    const StrandSamples strands = sampleStrands(hair, unitMap(), 32);
+    ClusterParams params;
+    const Clustering c = clusterSamples(strands, unitMap(), 6, false, params);
+    REQUIRE(c.centers.count() == 6);
+    const TransferSource src{&strands, &c.centers, &c.label};
+    for (bool threaded : {true, false})
+        for (DetailScale scale : {DetailScale::ArcLength, DetailScale::Strand, DetailScale::Index}) {
+            TransferStats stats;
+            const StrandSamples out = transferDetail(src, c.centers, strands.roots, unitMap(), 16, nullptr, &stats, DetailBlend::Edges,
+                                                     threaded, nullptr, &c.label, scale);
+            REQUIRE(out.count() == strands.count());
+            CHECK(stats.distinctSources == 6);
+            double worst = 0.0;  // of the strand's length (head radii: the unit sphere)
+            for (std::size_t s = 0; s < out.count(); ++s)
+                for (std::size_t k = 0; k < strands.dim(); ++k)
+                    worst = std::max(worst, double(std::abs(out.row(s)[k] - strands.row(s)[k])) / double(strands.lengths[s]));
+            CAPTURE(detailScaleName(scale), threaded);
+            CHECK(worst < 1e-4);
+        }
+}
+
 TEST_CASE("transferDetail: detail follows a turned centre and new roots keep their root", "[synth]")
 {
     // Input: one wavy wisp. Output: the same wisp's centre at the other side of the head (turned

@@ -123,6 +123,21 @@ double polylineLengthOf(const std::vector<Vec3d>& p)
     return len;
 }
 
+/// Carrier smoothing (DetailBlend::Edges), σ as a fraction of a strand's vertices n_s.
+/// A laid strand turns as its edges do plus as its output carrier turns against its own carrier,
+/// and turning adds up in absolute value: so a carrier that keeps part of the curl gives that part
+/// to the output centre's carrier, which replaces it (Curly_100 onto straight.hair kept 6.3-6.8 of
+/// its 7.9 turning per head radius with strands and centres both at StrandSamples::kDetailSmoothing
+/// of n_s), while an output centre that is itself a laid strand (a level below the coarsest) keeps
+/// curl that a centre of the input, a mean of strands, does not have (Curly_100 synthesized came out
+/// with about a quarter more turning per strand than the strands it copied). Hence strands' carriers
+/// a little smoother than kDetailSmoothing (more of a strand is detail, carried whole) and centres'
+/// much smoother (their curl is not added twice). Measured at seeds 0-6: Curly_100 onto
+/// straight.hair 7.40-8.13 turning per head radius, onto harolongo 7.97-8.74 (its own 7.90);
+/// synthesized, its turning distance 0.08-0.12 but 0.257 at seed 6 (was 0.15-0.30).
+constexpr double kStrandCarrierSmoothing = 5.0 / 32.0;
+constexpr double kCentreCarrierSmoothing = 0.5;
+
 /// A polyline's low-passed self (smoothPolyline(), σ in vertices) with its rotation-minimizing
 /// frames (started from @a reference) and arc lengths: what detail is laid along.
 struct Carrier
@@ -502,11 +517,12 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
     };
     forEach(nIn, [&](std::size_t c) { if (inUsed[c]) prepare(inC, c, inAligned[c], ns, inWorld[c], inRmf[c]); });
     forEach(nOut, [&](std::size_t c) { if (outUsed[c]) prepare(outCenters, c, outAligned[c], no, outWorld[c], outRmf[c]); });
-    // DetailBlend::Edges: each used input centre's carrier length, and each used output centre's
-    // carrier, smoothed at the same σ in world units as the strands laid along it (σ =
-    // kDetailSmoothing of the matched input centre's length: StrandSamples.h says why).
+    // DetailBlend::Edges: each used input centre's carrier and each used output centre's, at one
+    // σ in world units (kCentreCarrierSmoothing of the matched input centre's vertices) so that a
+    // centre onto itself gives its own carrier; strands' carriers at kStrandCarrierSmoothing of
+    // their vertices (below, "Carrier smoothing").
     const bool edges = blend == DetailBlend::Edges;
-    const double sigmaIn = StrandSamples::kDetailSmoothing * double(ns);  // vertices of an input strand
+    const double sigmaCentre = kCentreCarrierSmoothing * double(ns), sigmaStrand = kStrandCarrierSmoothing * double(ns);
     std::vector<double> inCarrierLength(nIn, 0.0);
     std::vector<Carrier> inCarrier(edges ? nIn : 0), outCarrier(edges ? nOut : 0);
     if (edges) {
@@ -517,7 +533,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         };
         forEach(nIn, [&](std::size_t c) {
             if (!inUsed[c]) return;
-            inCarrier[c] = Carrier(toD(inWorld[c]), sigmaIn, Vec3f(inAligned[c].t));
+            inCarrier[c] = Carrier(toD(inWorld[c]), sigmaCentre, Vec3f(inAligned[c].t));
             inCarrierLength[c] = inCarrier[c].length();
         });
         forEach(nOut, [&](std::size_t c) {
@@ -525,7 +541,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             const std::vector<Vec3d> p = toD(outWorld[c]);
             const double spacingIn = polylineLengthOf(toD(inWorld[match[c]])) / double(ns - 1);
             const double spacingOut = polylineLengthOf(p) / double(no - 1);
-            outCarrier[c] = Carrier(p, spacingOut > 0.0 ? sigmaIn * spacingIn / spacingOut : sigmaIn, Vec3f(outAligned[c].t));
+            outCarrier[c] = Carrier(p, spacingOut > 0.0 ? sigmaCentre * spacingIn / spacingOut : sigmaCentre, Vec3f(outAligned[c].t));
         });
     }
 
@@ -582,7 +598,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             for (std::size_t k = 0; k < gin.size(); ++k) strand[k] = Vec3d(gin[k]);
             std::vector<Vec3f> cg;
             std::vector<double> advance;
-            const std::vector<Vec3d> d = strandEdges(strand, sigmaIn, Vec3f(mi.t), &cg, &advance);
+            const std::vector<Vec3d> d = strandEdges(strand, sigmaStrand, Vec3f(mi.t), &cg, &advance);
             double progress = 0.0;
             for (std::size_t k = 0; k < d.size(); ++k) progress += advance[k];
             // The output carrier: the output centre's, plus the strand's smooth offset from its
@@ -615,7 +631,10 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             std::vector<Vec3f> lf(laid.size()), rs(static_cast<std::size_t>(no));
             for (std::size_t k = 0; k < laid.size(); ++k) lf[k] = Vec3f(laid[k]);
             if (lf.size() < 2) lf.push_back(lf.back());
-            resamplePolyline(lf.data(), lf.size(), std::size_t(no), rs.data());
+            // Laid whole at the output's vertex count, the strand's own vertices stay (resampling by
+            // arc would cut its corners: samples even along the input, not along their chords).
+            if (lf.size() == std::size_t(no)) rs = lf;
+            else resamplePolyline(lf.data(), lf.size(), std::size_t(no), rs.data());
             double len = 0.0;
             for (int l = 0; l < no; ++l) {
                 const Vec3d p = l == 0 ? roots[i] : Vec3d(rs[std::size_t(l)]);

@@ -11,8 +11,10 @@
 ///    in their aligned frames; each output centre takes the input centre nearest in feature space
 ///    (exact search; ties to the lower index), or by default the nearest with share left
 ///    (DetailMatchParams: balanced, each set at one scale).
-/// 4. **Matching strands**: each output strand takes the member of the matched input cluster whose
-///    root offset from its centre, in the centre's aligned frame, is nearest to its own.
+/// 4. **Matching strands**: each output strand takes a member of the matched input cluster by root
+///    offset from its centre, in the centre's aligned frame: the nearest, or by default
+///    (DetailMatchParams) pairs by increasing offset distance with each member serving at most
+///    balance × its even share of the output wisp's strands.
 /// 5. **Eq. 5-8**: D_α in the centre's aligned root frame, D_β in rotation-minimizing frames along
 ///    the centre (Frames.h, started from the aligned tangent in both hairstyles), blended with
 ///    weights (n_s − i)/(n_s − 1) and (i − 1)/(n_s − 1). The paper's γ_β is shifted by a constant
@@ -26,20 +28,23 @@
 /// centres their tangential drift, mirrored, compresses and stretches a curl's pitch (Curly_100's
 /// curls onto straight.hair came out with about 65 % too much turning under balanced matching),
 /// and held in a bending frame they loop (below). Instead a strand is split into a carrier, its
-/// low-pass (smoothPolyline(), σ = StrandSamples::kDetailSmoothing of its vertices), and its own
+/// low-pass (smoothPolyline(), σ = 5/32 of its vertices), and its own
 /// edges, each expressed in the carrier's rotation-minimizing frame at the edge's middle (started
 /// from the aligned tangent, as D_β's). The output strand starts at its root and lays the edges
-/// one after another in the frames of the output carrier (the output centre smoothed at the same
-/// σ in world units, plus the strand's smooth offset from its input centre's carrier held in the
-/// aligned root frames, as D_α) at the arc each edge reached along its own carrier; so edges keep their lengths and the
+/// one after another in the frames of the output carrier (the output centre smoothed at σ = half
+/// the input centre's vertices, in world units, plus the strand's smooth offset from its input
+/// centre's carrier, smoothed alike, held in the aligned root frames, as D_α) at the arc each edge
+/// reached along its own carrier (DetailTransfer.cc, "Carrier smoothing", says why the two σ);
+/// so edges keep their lengths and the
 /// angles between them, and a curl keeps its turning per length (tested on a helix laid onto a
 /// straight centre three times as long and onto a quarter circle). DetailScale decides how far
-/// the strand runs: its own length (Strand), its centre's with the edges scaled (Index), or the
-/// output centre's (ArcLength), where past the strand's end a loop of it repeats: the edges from
+/// the strand runs: its own length (Strand), its own scaled by the centres' carrier lengths with
+/// the edges (Index), or its own plus what the output centre's carrier has over the input centre's
+/// (ArcLength; at least its own times their ratio), where past the strand's end a loop of it repeats: the edges from
 /// the place most like the strand's end on, at least a quarter of the strand (a period of a
 /// curl), turned as a whole so that its net step points along the carrier and its start joins the
-/// strand's end. Not yet exact: a wisp transferred onto itself comes back within 0.06 of its
-/// length (median RMS) but not within Eq. 5-8's 1e-5 (README, "Editing hairstyles").
+/// strand's end. A wisp transferred onto its own centre comes back (tested to 1e-4 of the strand's
+/// length, with every DetailScale): the same carriers, frames and arcs, and its own length.
 ///
 /// **Matching** (DetailMatchParams): balanced by share, at one scale, by default.
 ///
@@ -99,8 +104,8 @@ enum class DetailScale
     Index,
     /// The displacement read at the same arc length along the input centre as along the output
     /// centre: curls keep their size and spacing whatever the lengths, and the output strand
-    /// runs the output centre's length (times its input strand's length over its input centre's,
-    /// with DetailBlend::Edges). Beyond the input's end, the root-frame and paper blends mirror
+    /// runs the output centre's length (with DetailBlend::Edges: its input strand's carrier length
+    /// plus what the output centre's carrier has over the input centre's). Beyond the input's end, the root-frame and paper blends mirror
     /// the displacement back and forth (a wisp's spread repeats too: strands gather and part
     /// again every two input lengths); DetailBlend::Edges repeats a loop of the strand (a period
     /// of its detail) instead, turned as a whole (DetailTransfer.h, "Edges").
@@ -119,17 +124,21 @@ const char* detailScaleName(DetailScale scale);
 struct DetailMatchParams
 {
     /// Balanced matching: pairs (output centre, input centre) are taken by increasing feature
-    /// distance, and an input centre serves output wisps of at most @c balance times its even
-    /// share of the output's strands (the output strands over the input centres); an output wisp
-    /// that fits no candidate's share takes its nearest. Without it a few input wisps, those that
+    /// distance, and an input centre serves output wisps of at most @c balance times its own
+    /// share of the output's strands (its members' part of the input's strands: an even share
+    /// kept wisps larger than the mean from their own detail, so a hairstyle onto itself did not
+    /// come back); an output wisp that fits no candidate's share takes its nearest. Within a
+    /// matched wisp, a member serves at most @c balance times its even share of the output wisp's
+    /// strands (step 4: by nearest offset alone 100 strands of Curly_100 took a few members many
+    /// times, and their lengths). Without it a few input wisps, those that
     /// match long straight centres best, lay their detail everywhere: Curly_100 onto
     /// straight.hair arrived at 4.5 to 9.9 turning per head radius with the seed (7.90 its own).
     /// Balanced matching compares centres at one scale (each set's rows divided by its median
     /// centre length), so that long output wisps match input wisps by shape rather than by size;
     /// at one scale alone, straight wisps chose the straightest input centres, whose strands
     /// are the tightest curls (Curly_100 onto straight.hair 8.8-17.5), which the balance evens out.
-    /// 0 turns both off (every output centre takes its nearest input centre at absolute size,
-    /// the paper's rule).
+    /// 0 turns all three off (every output centre takes its nearest input centre at absolute
+    /// size and every output strand its nearest member, the paper's rule).
     double balance = 1.1;
     /// Input centres considered per output centre, nearest first (balanced matching only;
     /// transfer between hairstyles, whose wisps differ more, considers more).
