@@ -131,12 +131,21 @@ double polylineLengthOf(const std::vector<Vec3d>& p)
 /// of n_s), while an output centre that is itself a laid strand (a level below the coarsest) keeps
 /// curl that a centre of the input, a mean of strands, does not have (Curly_100 synthesized came out
 /// with about a quarter more turning per strand than the strands it copied). Hence strands' carriers
-/// a little smoother than kDetailSmoothing (more of a strand is detail, carried whole) and centres'
-/// much smoother (their curl is not added twice). Measured at seeds 0-6: Curly_100 onto
-/// straight.hair 7.40-8.13 turning per head radius, onto harolongo 7.97-8.74 (its own 7.90);
-/// synthesized, its turning distance 0.08-0.12 but 0.257 at seed 6 (was 0.15-0.30).
-constexpr double kStrandCarrierSmoothing = 5.0 / 32.0;
+/// smoother than kDetailSmoothing (more of a strand is detail, carried whole) and centres' much
+/// smoother (their curl is not added twice). Chosen from a sweep over seeds 0-6 (strands 1/8 to
+/// 1/4, centres 1/8 to 2), with collinear runs (strandEdges()): Curly_100 onto straight.hair
+/// 7.32-8.08 turning per head radius, onto harolongo 7.76-8.49 (its own 7.90), synthesized its
+/// turning distance 0.04-0.19 (0.08-0.26 at 5/32 without collinear runs); a compromise between
+/// the three, not an optimum of any.
+constexpr double kStrandCarrierSmoothing = 3.0 / 16.0;
 constexpr double kCentreCarrierSmoothing = 0.5;
+/// Edges whose angle has a cosine within this of 1 (about 0.06 degrees) are collinear (strandEdges()):
+/// a coarse polyline resampled to n_s (Curly_100 has 15-19 vertices a strand) is a run of collinear
+/// edges between its corners. Each edge held in the carrier's frame at its own middle, a run came
+/// out bent wherever the output carrier turned otherwise than the strand's own, every edge by a
+/// little, and the bends added up: Curly_100 synthesized had strands with 2.6 times the turning of
+/// the strand they copied (7.2 rad against 2.7).
+constexpr double kCollinearCos = 5e-7;
 
 /// A polyline's low-passed self (smoothPolyline(), σ in vertices) with its rotation-minimizing
 /// frames (started from @a reference) and arc lengths: what detail is laid along.
@@ -206,7 +215,7 @@ Vec3d rotateOnto(const Vec3d& from, const Vec3d& to, const Vec3d& v)
 /// local mean points along the carrier was tried: the ponytail onto the default head drifted
 /// 0.082 of its length from BASE's wisps with it, 0.076 without.)
 std::vector<Vec3d> strandEdges(const std::vector<Vec3d>& strand, double sigma, const Vec3f& reference, std::vector<Vec3f>* carrierPoints,
-                               std::vector<double>* advance)
+                               std::vector<double>* advance, std::vector<double>* frameShift)
 {
     const Carrier c(strand, sigma, reference);
     if (carrierPoints) *carrierPoints = c.points;
@@ -215,13 +224,32 @@ std::vector<Vec3d> strandEdges(const std::vector<Vec3d>& strand, double sigma, c
         for (std::size_t k = 0; k + 1 < strand.size(); ++k) (*advance)[k] = c.arc[k + 1] - c.arc[k];
     }
     const std::size_t K = strand.size() - 1;
+    // Runs of collinear edges (a straight piece of a coarse polyline, resampled) share one frame,
+    // the carrier's at the run's middle, so that they stay collinear wherever the output carrier
+    // turns otherwise; every other edge takes the frame at its own middle (NaN in frameShift).
+    std::vector<double> shift(K, std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t a = 0; a < K;) {
+        std::size_t b = a + 1;
+        while (b < K) {
+            const Vec3d e0 = strand[b] - strand[b - 1], e1 = strand[b + 1] - strand[b];
+            const double l0 = e0.length(), l1 = e1.length();
+            if (!(l0 > 0.0 && l1 > 0.0) || e0.dot(e1) < (1.0 - kCollinearCos) * l0 * l1) break;
+            ++b;
+        }
+        if (b - a > 1) {
+            const double mid = 0.5 * (c.arc[a] + c.arc[b]);
+            for (std::size_t k = a; k < b; ++k) shift[k] = mid - c.arc[k];
+        }
+        a = b;
+    }
     std::vector<Vec3d> d(K);
     for (std::size_t k = 0; k < K; ++k) {
         Vec3d axes[3];
-        c.frameAt(0.5 * (c.arc[k] + c.arc[k + 1]), axes);
+        c.frameAt(std::isnan(shift[k]) ? 0.5 * (c.arc[k] + c.arc[k + 1]) : c.arc[k] + shift[k], axes);
         const Vec3d e = strand[k + 1] - strand[k];
         d[k] = Vec3d(axes[0].dot(e), axes[1].dot(e), axes[2].dot(e));
     }
+    if (frameShift) *frameShift = std::move(shift);
     return d;
 }
 
@@ -268,13 +296,13 @@ std::vector<Vec3d> strandLoop(const std::vector<Vec3d>& d, double& twist)
 /// @a root in the frames of @a carrier at the place each edge reaches along it (its running
 /// progress along x̂), until the progress reaches @a target: the strand's last edge is cut
 /// there, or the strand's loop (strandLoop()) repeats after it, turned by one more twist each time.
-std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<double>& advance, double lambda, const Carrier& carrier,
-                            const Vec3d& root, double target)
+std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<double>& advance, const std::vector<double>& frameShift,
+                            double lambda, const Carrier& carrier, const Vec3d& root, double target)
 {
     std::vector<Vec3d> out{root};
     out.reserve(d.size() + 1);
     double progress = 0.0;
-    const auto lay = [&](const Vec3d& local, double step) {
+    const auto lay = [&](const Vec3d& local, double step, double shift) {
         Vec3d e = local * lambda;
         step *= lambda;
         bool last = false;
@@ -285,13 +313,13 @@ std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<doubl
             last = true;
         }
         Vec3d axes[3];
-        carrier.frameAt(progress + 0.5 * step, axes);
+        carrier.frameAt(std::isnan(shift) ? progress + 0.5 * step : progress + shift * lambda, axes);
         out.push_back(out.back() + axes[0] * e.x() + axes[1] * e.y() + axes[2] * e.z());
         progress += step;
         return last;
     };
     for (std::size_t k = 0; k < d.size(); ++k)
-        if (lay(d[k], advance[k])) return out;
+        if (lay(d[k], advance[k], frameShift[k])) return out;
     if (progress >= target * (1.0 - 1e-9)) return out;
     double twist = 0.0;
     std::vector<Vec3d> loop = strandLoop(d, twist);
@@ -321,7 +349,7 @@ std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<doubl
     for (int r = 1; progress < target && out.size() < kMaxLaid; ++r) {
         const double c = std::cos(twist * r), sn = std::sin(twist * r);
         for (const Vec3d& e : loop)
-            if (lay(Vec3d(e.x(), c * e.y() - sn * e.z(), sn * e.y() + c * e.z()), std::max(0.0, e.x()))) return out;
+            if (lay(Vec3d(e.x(), c * e.y() - sn * e.z(), sn * e.y() + c * e.z()), std::max(0.0, e.x()), std::numeric_limits<double>::quiet_NaN())) return out;
     }
     return out;
 }
@@ -597,8 +625,8 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             std::vector<Vec3d> strand(gin.size());
             for (std::size_t k = 0; k < gin.size(); ++k) strand[k] = Vec3d(gin[k]);
             std::vector<Vec3f> cg;
-            std::vector<double> advance;
-            const std::vector<Vec3d> d = strandEdges(strand, sigmaStrand, Vec3f(mi.t), &cg, &advance);
+            std::vector<double> advance, frameShift;
+            const std::vector<Vec3d> d = strandEdges(strand, sigmaStrand, Vec3f(mi.t), &cg, &advance, &frameShift);
             double progress = 0.0;
             for (std::size_t k = 0; k < d.size(); ++k) progress += advance[k];
             // The output carrier: the output centre's, plus the strand's smooth offset from its
@@ -627,7 +655,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
                 // head 0.27 of their length from BASE's, against 0.08).
                 target = std::max(progress + lo - li, progress * std::min(1.0, li > 0.0 ? lo / li : 1.0));
             }
-            const std::vector<Vec3d> laid = layEdges(d, advance, lambda, carrier, roots[i], target);
+            const std::vector<Vec3d> laid = layEdges(d, advance, frameShift, lambda, carrier, roots[i], target);
             std::vector<Vec3f> lf(laid.size()), rs(static_cast<std::size_t>(no));
             for (std::size_t k = 0; k < laid.size(); ++k) lf[k] = Vec3f(laid[k]);
             if (lf.size() < 2) lf.push_back(lf.back());

@@ -28,9 +28,10 @@
 /// centres their tangential drift, mirrored, compresses and stretches a curl's pitch (Curly_100's
 /// curls onto straight.hair came out with about 65 % too much turning under balanced matching),
 /// and held in a bending frame they loop (below). Instead a strand is split into a carrier, its
-/// low-pass (smoothPolyline(), σ = 5/32 of its vertices), and its own
+/// low-pass (smoothPolyline(), σ = 3/16 of its vertices), and its own
 /// edges, each expressed in the carrier's rotation-minimizing frame at the edge's middle (started
-/// from the aligned tangent, as D_β's). The output strand starts at its root and lays the edges
+/// from the aligned tangent, as D_β's; a run of collinear edges, a straight piece of a coarse
+/// polyline, in the frame at the run's middle, so that it stays straight). The output strand starts at its root and lays the edges
 /// one after another in the frames of the output carrier (the output centre smoothed at σ = half
 /// the input centre's vertices, in world units, plus the strand's smooth offset from its input
 /// centre's carrier, smoothed alike, held in the aligned root frames, as D_α) at the arc each edge
