@@ -37,6 +37,8 @@ struct SynthCmdParams
     SynthParams synth;
     bool coarseGuides = false;
     std::string coarse;
+    const CLI::Option* detailScaleOption = nullptr;     ///< (given or not: --coarse takes transfer's defaults)
+    const CLI::Option* matchCandidatesOption = nullptr;
 };
 
 /// The first three channels of a feature map as an RGB picture (each channel scaled by the input
@@ -155,7 +157,10 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
         // An imposed coarsest level: the example's finer levels transferred onto it (HairTransfer.h).
         if (p.layout != synthLayoutName(SynthParams{}.layout)) throw ValueError("--layout: has no effect with --coarse (the coarsest level is imposed)");
         TransferParams tp;
-        if (p.text.detailScale.empty()) p.synth.detailScale = tp.synth.detailScale;  // transfer's default
+        // Transfer's defaults for what was not given.
+        if (p.detailScaleOption->count() == 0) p.synth.detailScale = tp.synth.detailScale;
+        if (p.matchCandidatesOption->count() == 0) p.synth.match.candidates = tp.synth.match.candidates;
+        p.synth.validate("option");
         tp.synth = p.synth;
         tp.guides = p.coarseGuides;
         if (p.strands > 0) {
@@ -254,7 +259,8 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
                             {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
                    {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
                    {"head_radius", r.map->radius()}, {"region", regionFrom.empty() ? "the example's" : regionFrom}, {"output_area", r.outputArea},
-                   {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)},
+                   {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)}, {"detail_scale", detailScaleName(p.synth.detailScale)},
+                   {"match", {{"balance", p.synth.match.balance}, {"candidates", p.synth.match.candidates}}},
                    {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}});
     } else if (!common.quiet) {
         std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
@@ -285,9 +291,13 @@ void addSynthTransferOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
 {
     t.detail = detailBlendName(s.detailBlend);
     sub->add_option("--components", s.components, "PCA components of the feature maps and of cluster matching, n_f")->capture_default_str();
-    sub->add_option("--detail", t.detail, "Detail transfer: root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
-    sub->add_option("--detail-scale", t.detailScale, std::string("How detail is laid along a longer or shorter centre: index (vertex by vertex, the paper's: curls stretch with the length) or arc-length (curls keep their size, mirrored along a longer strand); default: ") +
-                                                        detailScaleName(s.detailScale) + (s.detailScale == DetailScale::Index ? " (arc-length with --coarse, as transfer)" : ""));
+    sub->add_option("--detail", t.detail, "Detail transfer: edges (each strand's own edges re-laid along the output centre: curls keep their turning), root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
+    t.detailScale = detailScaleName(s.detailScale);
+    sub->add_option("--detail-scale", t.detailScale, std::string("How detail is laid along a longer or shorter centre: strand (each strand at its own length and pitch), index (vertex by vertex, the paper's: curls stretch with the length) or arc-length (curls keep their size, repeated along a longer wisp)") +
+                                                        (s.detailScale == DetailScale::Strand ? "; arc-length with --coarse, as transfer" : ""))->capture_default_str();
+    sub->add_option("--match-balance", s.match.balance, "Each example wisp serves output wisps of at most this times its own share of the output's strands (its part of the example's), and each example strand at most this times its even share of its output wisp's, pairs taken by increasing distance at one scale (0: every output wisp takes its nearest, the paper's rule)")->capture_default_str();
+    sub->add_option("--match-candidates", s.match.candidates, std::string("Example wisps considered per output wisp in balanced matching, nearest first") +
+                                                                (s.match.candidates == SynthParams{}.match.candidates && s.detailScale == DetailScale::Strand ? " (64 with --coarse, as transfer)" : ""))->capture_default_str();
     sub->add_option("--refine-mode", t.refineMode, "Refinement after each level: consistent (default, keeps detail) or field (the paper's retrace)");
     sub->add_flag("--no-refine", t.noRefine, "Skip the vector-field refinement of every level");
     sub->add_option("--voxel-size", s.voxelSize, "Refinement voxel of the finest level, world units (0: refine's suggestion for the hairstyle; doubled per coarser level)")->capture_default_str();
@@ -333,6 +343,8 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();
     sub->add_option("--nearby", s.texture.nearbyRadius, "Texture synthesis: the reach of place guidance and of the initial patches' offsets, as a fraction of the map")->capture_default_str();
     addSynthTransferOptions(sub, s, params->text);
+    params->detailScaleOption = sub->get_option("--detail-scale");
+    params->matchCandidatesOption = sub->get_option("--match-candidates");
     sub->add_option("--coarse", params->coarse, "Impose a coarsest level instead of synthesizing one (Wang et al. §6): BASE's own coarsest level (a hairstyle, or a scene grown first); the example's finer levels are transferred onto it, on BASE's scalp, with BASE's roots (as vdbhair transfer EXAMPLE BASE)");
     sub->add_flag("--coarse-guides", params->coarseGuides, "With --coarse: BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over the guides' region (--strands sets the output count)");
     sub->add_option("--save-maps", params->saveMaps, "Write input_map.png, output_map.png (first three PCA channels as RGB) and clusters.png to this folder");

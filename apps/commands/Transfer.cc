@@ -97,6 +97,8 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
         printJson({{"output", job.output}, {"details", job.details}, {"base", job.base}, {"strands", r.strands.numStrands()},
                    {"vertices", r.strands.numVertices()}, {"levels", levels}, {"guides", params.guides},
                    {"smoothing", params.smoothing}, {"smooth_base", params.smoothBase}, {"detail", detailBlendName(params.synth.detailBlend)},
+                   {"detail_laid_by", detailScaleName(params.synth.detailScale)},
+                   {"match", {{"balance", params.synth.match.balance}, {"candidates", params.synth.match.candidates}}},
                    {"head_radius", {{"details", tr.detailsMap->radius()}, {"base", r.map->radius()}}},
                    {"detail_scale", tr.detailScale}, {"length_ratio", tr.lengthRatio},
                    {"turning_per_length", {{"details", turnDetails}, {"base", turnBase}, {"output", turnOut}, {"spacing_head_radii", spacing}}},

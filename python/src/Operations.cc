@@ -173,7 +173,8 @@ Returns:
         "synth",
         [](const StrandsPtr& example, int levels, std::optional<std::size_t> strands, std::uint64_t seed, int vertices,
            double threshold, int initialClusters, int components, double mapSpacing, const std::string& layout,
-           const std::string& detail, double placeWeight, double nearby, bool refine, std::optional<std::string> refineMode,
+           const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, double placeWeight,
+           double nearby, bool refine, std::optional<std::string> refineMode,
            double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp,
            std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region,
            std::optional<std::string> outputScalp, double outputTurn, bool returnReport, int threads,
@@ -191,6 +192,9 @@ Returns:
             p.mapSpacing = mapSpacing;
             p.layout = synthLayoutFromName(layout);
             p.detailBlend = detailBlendFromName(detail);
+            p.detailScale = detailScaleFromName(detailScale);
+            p.match.balance = matchBalance;
+            p.match.candidates = matchCandidates;
             p.placeWeight = placeWeight;
             p.texture.nearbyRadius = nearby;
             p.refine = refine;
@@ -241,7 +245,9 @@ Returns:
         pyb::arg("seed") = synthDefaults.seed, pyb::arg("vertices") = synthDefaults.vertices,
         pyb::arg("threshold") = synthDefaults.cluster.threshold, pyb::arg("initial_clusters") = synthDefaults.cluster.initialClusters,
         pyb::arg("components") = synthDefaults.components, pyb::arg("map_spacing") = synthDefaults.mapSpacing,
-        pyb::arg("layout") = synthLayoutName(synthDefaults.layout), pyb::arg("detail") = detailBlendName(synthDefaults.detailBlend), pyb::arg("place_weight") = synthDefaults.placeWeight,
+        pyb::arg("layout") = synthLayoutName(synthDefaults.layout), pyb::arg("detail") = detailBlendName(synthDefaults.detailBlend),
+        pyb::arg("detail_scale") = detailScaleName(synthDefaults.detailScale), pyb::arg("match_balance") = synthDefaults.match.balance,
+        pyb::arg("match_candidates") = synthDefaults.match.candidates, pyb::arg("place_weight") = synthDefaults.placeWeight,
         pyb::arg("nearby") = synthDefaults.texture.nearbyRadius, pyb::arg("refine") = synthDefaults.refine,
         pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(),
         pyb::arg("scalp") = pyb::none(), pyb::arg("region") = pyb::none(), pyb::arg("output_scalp") = pyb::none(),
@@ -264,7 +270,10 @@ Args:
     components: PCA components of the feature maps, n_f.
     map_spacing: feature-map pixel spacing in scalp (u, v) radians.
     layout: "synthesize" (texture optimization) or "example" (the example's own map).
-    detail: "root-frame" or "paper" (Eq. 7).
+    detail: "edges" (each strand's own edges re-laid along the output centre), "root-frame" or "paper" (Eq. 7).
+    detail_scale: "strand" (each strand at its own length and pitch), "index" (vertex by vertex) or "arc-length".
+    match_balance: each example wisp serves at most this times its own share of the output (its part of the example's strands), each of its strands at most this times its even share of an output wisp (0: nearest wisp and strand).
+    match_candidates: example wisps considered per output wisp in balanced matching.
     place_weight: texture synthesis place guidance (0: none).
     nearby: reach of place guidance and initial patch offsets, a fraction of the map.
     refine: refine every level (Wang et al. §5.3).
@@ -289,7 +298,8 @@ Returns:
         "transfer",
         [](const StrandsPtr& details, const StrandsPtr& base, bool guides, std::optional<std::size_t> strands, double smoothing,
            bool smoothBase, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters, int components,
-           const std::string& detail, const std::string& detailScale, bool refine, std::optional<std::string> refineMode,
+           const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, bool refine,
+           std::optional<std::string> refineMode,
            double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp, bool returnReport,
            int threads, const pyb::object& progress) -> pyb::object {
             TransferParams p;
@@ -306,6 +316,8 @@ Returns:
             s.components = components;
             s.detailBlend = detailBlendFromName(detail);
             s.detailScale = detailScaleFromName(detailScale);
+            s.match.balance = matchBalance;
+            s.match.candidates = matchCandidates;
             s.refine = refine;
             if (refineMode) s.refineMode = refineModeFromName(*refineMode);
             s.voxelSize = voxelSize;
@@ -333,6 +345,7 @@ Returns:
         pyb::arg("vertices") = transferDefaults.synth.vertices, pyb::arg("threshold") = transferDefaults.synth.cluster.threshold,
         pyb::arg("initial_clusters") = transferDefaults.synth.cluster.initialClusters, pyb::arg("components") = transferDefaults.synth.components,
         pyb::arg("detail") = detailBlendName(transferDefaults.synth.detailBlend), pyb::arg("detail_scale") = detailScaleName(transferDefaults.synth.detailScale),
+        pyb::arg("match_balance") = transferDefaults.synth.match.balance, pyb::arg("match_candidates") = transferDefaults.synth.match.candidates,
         pyb::arg("refine") = transferDefaults.synth.refine, pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = transferDefaults.synth.voxelSize,
         pyb::arg("up") = pyb::none(), pyb::arg("scalp") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
@@ -347,7 +360,9 @@ Args:
     strands: with guides, strands in the output.
     smoothing: sigma of the coarsest levels' smoothing, a fraction of their vertices.
     smooth_base: smooth the base's coarsest level too (False: the paper's rule).
-    detail_scale: "arc-length" (curls keep their size) or "index" (the paper's, vertex by vertex).
+    detail_scale: "arc-length" (curls keep their size, the strand runs the base's wisp), "index"
+        (the paper's, vertex by vertex) or "strand".
+    match_candidates: as synth's, 64 here (the two hairstyles' wisps differ more).
     Other options as synth.
 
 Returns:

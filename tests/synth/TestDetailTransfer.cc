@@ -1,9 +1,13 @@
 #include "SynthTestUtil.h"
 
 #include <vdbhair/synth/Clustering.h>
+#include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/DetailTransfer.h>
 
 #include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 using namespace vdbhair;
 
@@ -52,6 +56,32 @@ TEST_CASE("transferDetail: a cluster transferred onto its own centre is the clus
     }
 }
 
+TEST_CASE("transferDetail: edges give wisps transferred onto their own centres back", "[synth]")
+{
+    // Several wisps of different sizes (balanced matching must still pair each with itself), every
+    // strand laid onto its own centre: the same carriers, frames and arcs, so the strand itself.
+    const StrandSet hair = test::wispHairstyle(600, 6, nullptr, 32, 0.05);
+    const StrandSamples strands = sampleStrands(hair, unitMap(), 32);
+    ClusterParams params;
+    const Clustering c = clusterSamples(strands, unitMap(), 6, false, params);
+    REQUIRE(c.centers.count() == 6);
+    const TransferSource src{&strands, &c.centers, &c.label};
+    for (bool threaded : {true, false})
+        for (DetailScale scale : {DetailScale::ArcLength, DetailScale::Strand, DetailScale::Index}) {
+            TransferStats stats;
+            const StrandSamples out = transferDetail(src, c.centers, strands.roots, unitMap(), 16, nullptr, &stats, DetailBlend::Edges,
+                                                     threaded, nullptr, &c.label, scale);
+            REQUIRE(out.count() == strands.count());
+            CHECK(stats.distinctSources == 6);
+            double worst = 0.0;  // of the strand's length (head radii: the unit sphere)
+            for (std::size_t s = 0; s < out.count(); ++s)
+                for (std::size_t k = 0; k < strands.dim(); ++k)
+                    worst = std::max(worst, double(std::abs(out.row(s)[k] - strands.row(s)[k])) / double(strands.lengths[s]));
+            CAPTURE(detailScaleName(scale), threaded);
+            CHECK(worst < 1e-4);
+        }
+}
+
 TEST_CASE("transferDetail: detail follows a turned centre and new roots keep their root", "[synth]")
 {
     // Input: one wavy wisp. Output: the same wisp's centre at the other side of the head (turned
@@ -83,7 +113,7 @@ TEST_CASE("transferDetail: detail follows a turned centre and new roots keep the
     std::vector<Vec3d> roots;
     for (const Vec3d& r : strands.roots) roots.push_back(turn(r));
     const TransferSource src{&strands, &c.centers, &c.label};
-    const StrandSamples out = transferDetail(src, outC, roots, unitMap(), 16);
+    const StrandSamples out = transferDetail(src, outC, roots, unitMap(), 16, nullptr, nullptr, DetailBlend::RootFrame);
     REQUIRE(out.count() == roots.size());
     double worst = 0.0;
     for (std::size_t i = 0; i < out.count(); ++i) {
@@ -96,4 +126,117 @@ TEST_CASE("transferDetail: detail follows a turned centre and new roots keep the
     // The scalp frames at turned roots are not exactly the turned frames (R takes +y to the
     // normal), so allow a small tolerance.
     CHECK(worst < 1e-3);
+}
+
+namespace {
+
+/// Turning per length of a polyline: the sum of the angles between successive edges over its length.
+double polylineTurningPerLength(const std::vector<Vec3f>& p)
+{
+    double turn = 0.0, len = 0.0;
+    for (std::size_t k = 1; k < p.size(); ++k) {
+        len += (Vec3d(p[k]) - Vec3d(p[k - 1])).length();
+        if (k + 1 < p.size()) {
+            const Vec3d a = (Vec3d(p[k]) - Vec3d(p[k - 1])).unitSafe(), b = (Vec3d(p[k + 1]) - Vec3d(p[k])).unitSafe();
+            turn += std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+        }
+    }
+    return turn / len;
+}
+
+/// One strand of @a n vertices at the top of the unit head (root (0, 1, 0), growing along +y),
+/// sampled on the unit map.
+StrandSamples oneStrand(const std::vector<Vec3f>& p, int n)
+{
+    StrandSet s;
+    s.addStrand(p);
+    return sampleStrands(s, unitMap(), n);
+}
+
+/// A helix of radius @a r about the y axis from the root (0, 1, 0), @a c of rise per radian, @a turns turns.
+std::vector<Vec3f> helix(double r, double c, double turns, int n)
+{
+    std::vector<Vec3f> p;
+    for (int k = 0; k < n; ++k) {
+        const double a = 2.0 * M_PI * turns * double(k) / double(n - 1);
+        p.emplace_back(float(r * (std::cos(a) - 1.0)), float(1.0 + c * a), float(r * std::sin(a)));
+    }
+    return p;
+}
+
+/// The output of laying the one-strand cluster (@a strand about @a centre) onto @a outCentre, in world units.
+std::vector<Vec3f> layOnto(const StrandSamples& strand, const StrandSamples& centre, const StrandSamples& outCentre, DetailScale scale,
+                           int outVertices, bool threaded = true)
+{
+    const std::vector<std::uint32_t> label{0};
+    const TransferSource src{&strand, &centre, &label};
+    const StrandSamples out = transferDetail(src, outCentre, outCentre.roots, unitMap(), 16, nullptr, nullptr, DetailBlend::Edges,
+                                             threaded, nullptr, nullptr, scale, outVertices);
+    std::vector<Vec3f> w(std::size_t(out.vertices));
+    sampleToWorld(out.row(0), out.vertices, out.roots[0], out.frames[0], 1.0, w.data());
+    return w;
+}
+
+} // namespace
+
+TEST_CASE("transferDetail: edges keep a helix's turning per length on a longer straight centre and on a quarter circle", "[synth]")
+{
+    // A helix of radius r = 0.02 and rise c = 0.01 per radian: curvature r / (r² + c²) = 40 per
+    // head radius (STYLE.md's oracle), six turns, 0.84 radii of strand along 0.38 of axis.
+    const double r = 0.02, c = 0.01, turns = 6.0, kappa = r / (r * r + c * c);
+    const int ns = 128;
+    const StrandSamples strand = oneStrand(helix(r, c, turns, 1024), ns);
+    const double axis = c * 2.0 * M_PI * turns;
+    const auto line = [](double length, int n) {
+        std::vector<Vec3f> p;
+        for (int k = 0; k < n; ++k) p.emplace_back(0.0f, float(1.0 + length * double(k) / double(n - 1)), 0.0f);
+        return p;
+    };
+    const StrandSamples centre = oneStrand(line(axis, 64), ns);
+    std::vector<Vec3f> in(ns);
+    sampleToWorld(strand.row(0), ns, strand.roots[0], strand.frames[0], 1.0, in.data());
+    const double tIn = polylineTurningPerLength(in);
+    INFO("the helix sampled: turning per length " << tIn << " against its curvature " << kappa);
+    REQUIRE(tIn == Approx(kappa).epsilon(0.03));
+
+    SECTION("three times as long, straight: the loop repeats, the strand stays on the centre")
+    {
+        const StrandSamples longCentre = oneStrand(line(3.0 * axis, 64), ns);
+        for (bool threaded : {true, false}) {
+            const std::vector<Vec3f> out = layOnto(strand, centre, longCentre, DetailScale::ArcLength, 3 * ns, threaded);
+            const double tOut = polylineTurningPerLength(out);
+            const Vec3d end(out.back());
+            INFO("turning per length " << tOut << "; end " << end);
+            CHECK(tOut == Approx(tIn).epsilon(0.03));
+            // Ending on the axis at three times the helix's height (within the helix's diameter).
+            CHECK(std::hypot(end.x() + r, end.z()) < 2.5 * r);
+            CHECK(end.y() == Approx(1.0 + 3.0 * axis).margin(2.5 * r));
+        }
+        // Laid vertex by vertex, the same edges stretch three times: a third of the turning.
+        const double tIndex = polylineTurningPerLength(layOnto(strand, centre, longCentre, DetailScale::Index, 3 * ns));
+        CHECK(tIndex == Approx(tIn / 3.0).epsilon(0.05));
+        // At the strand's own length: the helix as it was, up to where its carrier (its low-pass,
+        // both ends kept) leans off the axis near the ends, about a helix radius.
+        const std::vector<Vec3f> own = layOnto(strand, centre, longCentre, DetailScale::Strand, ns);
+        double worst = 0.0;
+        for (int k = 0; k < ns; ++k) worst = std::max(worst, (Vec3d(own[std::size_t(k)]) - Vec3d(in[std::size_t(k)])).length());
+        INFO("own length: worst " << worst);
+        CHECK(worst < 2.0 * r);
+    }
+    SECTION("a quarter circle twice as long: the helix winds round the bend and ends at its end")
+    {
+        const double length = 2.0 * axis, radius = length / (0.5 * M_PI);
+        std::vector<Vec3f> arc;
+        for (int k = 0; k < 256; ++k) {
+            const double a = 0.5 * M_PI * double(k) / 255.0;
+            arc.emplace_back(float(radius * (1.0 - std::cos(a))), float(1.0 + radius * std::sin(a)), 0.0f);
+        }
+        const StrandSamples bent = oneStrand(arc, ns);
+        const std::vector<Vec3f> out = layOnto(strand, centre, bent, DetailScale::ArcLength, 2 * ns);
+        const double tOut = polylineTurningPerLength(out);
+        const Vec3d end(out.back()), want(arc.back());
+        INFO("turning per length " << tOut << "; end " << end << " against the centre's " << want);
+        CHECK(tOut == Approx(tIn).epsilon(0.03));
+        CHECK((end - want).length() < 3.0 * r);
+    }
 }

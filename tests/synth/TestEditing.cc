@@ -368,6 +368,7 @@ TEST_CASE("transferHairstyle: short curls onto a base four times as long keep th
     const double tc = meanTurningPerLengthAtSpacing(curly, spacing), to = meanTurningPerLengthAtSpacing(tr.result.strands, spacing);
     TransferParams index = p;
     index.synth.detailScale = DetailScale::Index;
+    index.synth.detailBlend = DetailBlend::RootFrame;  // the paper's rule: Eq. 5-8 vertex by vertex
     const TransferResult ti = transferHairstyle(curly, longBase, index);
     const double tIndex = meanTurningPerLengthAtSpacing(ti.result.strands, spacing);
     INFO("turning: curly " << tc << ", output " << to << ", by index " << tIndex);

@@ -9,17 +9,47 @@
 ///    the tangent plane (unchanged where that projection vanishes).
 /// 3. **Matching clusters**: PCA (n_f components, Pca.h) of the input and output centres together,
 ///    in their aligned frames; each output centre takes the input centre nearest in feature space
-///    (exact search; ties to the lower index).
-/// 4. **Matching strands**: each output strand takes the member of the matched input cluster whose
-///    root offset from its centre, in the centre's aligned frame, is nearest to its own.
+///    (exact search; ties to the lower index), or by default the nearest with share left
+///    (DetailMatchParams: balanced, each set at one scale).
+/// 4. **Matching strands**: each output strand takes a member of the matched input cluster by root
+///    offset from its centre, in the centre's aligned frame: the nearest, or by default
+///    (DetailMatchParams) pairs by increasing offset distance with each member serving at most
+///    balance × its even share of the output wisp's strands.
 /// 5. **Eq. 5-8**: D_α in the centre's aligned root frame, D_β in rotation-minimizing frames along
 ///    the centre (Frames.h, started from the aligned tangent in both hairstyles), blended with
 ///    weights (n_s − i)/(n_s − 1) and (i − 1)/(n_s − 1). The paper's γ_β is shifted by a constant
 ///    so that both estimates, and so the strand, start at the prescribed output root (the paper's
 ///    text swaps γ_α(1) and γ_β(1) there; this is its stated intent).
-/// Transferring a cluster onto its own centre gives the cluster back (tested), with either blend.
+/// Transferring a cluster onto its own centre gives the cluster back (tested), with the root-frame
+/// and paper blends.
 ///
-/// DetailBlend::RootFrame (the default) uses γ_α alone, the detail in the centre's aligned root
+/// **Edges** (DetailBlend::Edges, the default). Displacements from a centre ("strand minus centre
+/// at the same vertex") do not survive a centre of another length or bend: laid onto longer
+/// centres their tangential drift, mirrored, compresses and stretches a curl's pitch (Curly_100's
+/// curls onto straight.hair came out with about 65 % too much turning under balanced matching),
+/// and held in a bending frame they loop (below). Instead a strand is split into a carrier, its
+/// low-pass (smoothPolyline(), σ = 3/16 of its vertices), and its own
+/// edges, each expressed in the carrier's rotation-minimizing frame at the edge's middle (started
+/// from the aligned tangent, as D_β's; a run of collinear edges, a straight piece of a coarse
+/// polyline, in the frame at the run's middle, so that it stays straight). The output strand starts at its root and lays the edges
+/// one after another in the frames of the output carrier (the output centre smoothed at σ = half
+/// the input centre's vertices, in world units, plus the strand's smooth offset from its input
+/// centre's carrier, smoothed alike, held in the aligned root frames, as D_α) at the arc each edge
+/// reached along its own carrier (DetailTransfer.cc, "Carrier smoothing", says why the two σ);
+/// so edges keep their lengths and the
+/// angles between them, and a curl keeps its turning per length (tested on a helix laid onto a
+/// straight centre three times as long and onto a quarter circle). DetailScale decides how far
+/// the strand runs: its own length (Strand), its own scaled by the centres' carrier lengths with
+/// the edges (Index), or its own plus what the output centre's carrier has over the input centre's
+/// (ArcLength; at least its own times their ratio), where past the strand's end a loop of it repeats: the edges from
+/// the place most like the strand's end on, at least a quarter of the strand (a period of a
+/// curl), turned as a whole so that its net step points along the carrier and its start joins the
+/// strand's end. A wisp transferred onto its own centre comes back (tested to 1e-4 of the strand's
+/// length, with every DetailScale): the same carriers, frames and arcs, and its own length.
+///
+/// **Matching** (DetailMatchParams): balanced by share, at one scale, by default.
+///
+/// DetailBlend::RootFrame uses γ_α alone, the detail in the centre's aligned root
 /// frame. Eq. 7's blend toward γ_β, as implemented here, adds a wiggle wherever the input and
 /// output centres bend differently (the displacement turns with the two curves' rotation-minimizing
 /// frames): measured end to end, the bundled ponytail's turning per length came out 6.0 times
@@ -55,9 +85,14 @@ struct TransferSource
 enum class DetailBlend
 {
     RootFrame,  ///< γ_α only: displacements in the centre's aligned root frame
-    Paper       ///< Eq. 7: γ_α at the root blended linearly to γ_β at the tip
+    Paper,      ///< Eq. 7: γ_α at the root blended linearly to γ_β at the tip
+    /// The strand's own edges (the default; DetailTransfer.h, "Edges"): each edge in the
+    /// rotation-minimizing frame of the strand's low-passed self (its carrier), re-laid in the
+    /// frame of the output centre's low-passed self at the same place along it. Edges keep their
+    /// lengths and the angles between them, so curls keep their turning per length.
+    Edges
 };
-/// @throw ValueError unless "root-frame" or "paper".
+/// @throw ValueError unless "root-frame", "paper" or "edges".
 DetailBlend detailBlendFromName(const std::string& name);
 const char* detailBlendName(DetailBlend blend);
 
@@ -65,20 +100,54 @@ const char* detailBlendName(DetailBlend blend);
 enum class DetailScale
 {
     /// Vertex by vertex (Eq. 5-8 as printed): detail stretches with the length ratio, so curls
-    /// onto a wisp k times as long come out k times as long (the paper's stated limitation).
+    /// onto a wisp k times as long come out k times as long (the paper's stated limitation). With
+    /// DetailBlend::Edges every edge is scaled by the ratio of the centres' carrier lengths.
     Index,
     /// The displacement read at the same arc length along the input centre as along the output
-    /// centre, and mirrored back and forth beyond the input centre's end: curls keep their size
-    /// and spacing whatever the lengths, repeated along a longer strand (its wisp's spread
-    /// repeats too: strands gather and part again every two input lengths). Measured against a
-    /// split that kept the slowly varying part per index: Curly_100's detail onto straight.hair
-    /// arrived with turning per head radius 4.36 against 1.00 (the example's 7.92, index 0.51),
-    /// harolongo's 3.40 against 2.85 (its own 3.83, index 2.00).
-    ArcLength
+    /// centre: curls keep their size and spacing whatever the lengths, and the output strand
+    /// runs the output centre's length (with DetailBlend::Edges: its input strand's carrier length
+    /// plus what the output centre's carrier has over the input centre's). Beyond the input's end, the root-frame and paper blends mirror
+    /// the displacement back and forth (a wisp's spread repeats too: strands gather and part
+    /// again every two input lengths); DetailBlend::Edges repeats a loop of the strand (a period
+    /// of its detail) instead, turned as a whole (DetailTransfer.h, "Edges").
+    ArcLength,
+    /// DetailBlend::Edges: the strand keeps its own length and pitch, laid along the output
+    /// centre at its own arc length (past the centre's end, straight on along its last tangent);
+    /// synthesis's default, where output centres come from the example and so are of its
+    /// lengths. The other blends read it as ArcLength.
+    Strand
 };
-/// @throw ValueError unless "index" or "arc-length".
+/// @throw ValueError unless "index", "arc-length" or "strand".
 DetailScale detailScaleFromName(const std::string& name);
 const char* detailScaleName(DetailScale scale);
+
+/// How output centres choose input centres (step 3).
+struct DetailMatchParams
+{
+    /// Balanced matching: pairs (output centre, input centre) are taken by increasing feature
+    /// distance, and an input centre serves output wisps of at most @c balance times its own
+    /// share of the output's strands (its members' part of the input's strands: an even share
+    /// kept wisps larger than the mean from their own detail, so a hairstyle onto itself did not
+    /// come back); an output wisp that fits no candidate's share takes its nearest. Within a
+    /// matched wisp, a member serves at most @c balance times its even share of the output wisp's
+    /// strands (step 4: by nearest offset alone 100 strands of Curly_100 took a few members many
+    /// times, and their lengths). Without it a few input wisps, those that
+    /// match long straight centres best, lay their detail everywhere: Curly_100 onto
+    /// straight.hair arrived at 4.5 to 9.9 turning per head radius with the seed (7.90 its own).
+    /// Balanced matching compares centres at one scale (each set's rows divided by its median
+    /// centre length), so that long output wisps match input wisps by shape rather than by size;
+    /// at one scale alone, straight wisps chose the straightest input centres, whose strands
+    /// are the tightest curls (Curly_100 onto straight.hair 8.8-17.5), which the balance evens out.
+    /// 0 turns all three off (every output centre takes its nearest input centre at absolute
+    /// size and every output strand its nearest member, the paper's rule).
+    double balance = 1.1;
+    /// Input centres considered per output centre, nearest first (balanced matching only;
+    /// transfer between hairstyles, whose wisps differ more, considers more).
+    int candidates = 16;
+
+    /// @throw ValueError naming the parameter, its value and the rule.
+    void validate(const char* where) const;
+};
 
 struct TransferStats
 {
@@ -100,6 +169,6 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
                              std::vector<std::uint32_t>* outLabel = nullptr, TransferStats* stats = nullptr,
                              DetailBlend blend = DetailBlend::RootFrame, bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr,
                              const std::vector<std::uint32_t>* givenLabel = nullptr, DetailScale scale = DetailScale::Index,
-                             int outVertices = 0);
+                             int outVertices = 0, const DetailMatchParams& match = DetailMatchParams{});
 
 } // namespace vdbhair

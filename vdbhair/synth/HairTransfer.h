@@ -55,6 +55,9 @@ struct TransferParams
     SynthParams synth = [] {
         SynthParams p;
         p.detailScale = DetailScale::ArcLength;
+        // DETAILS' wisps differ from BASE's in length and shape more than an example's from its
+        // synthesis: balanced matching looks further for a wisp with share left.
+        p.match.candidates = 64;
         return p;
     }();
     /// σ of the smoothing of the coarsest strands, as a fraction of BASE's vertices (DETAILS': of

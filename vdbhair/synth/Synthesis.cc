@@ -38,6 +38,7 @@ void SynthParams::validate(const char* where) const
     if (!(placeWeight >= 0.0) || !std::isfinite(placeWeight)) fail("placeWeight", formatNumber(placeWeight), "must be 0 or a positive finite weight");
     cluster.validate(where);
     texture.validate(where);
+    match.validate(where);
 }
 
 namespace {
@@ -302,7 +303,7 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
             res.output[std::size_t(l)] = transferDetail(src, res.output[std::size_t(l + 1)], roots.positions, map, params.components,
                                                         &parent[std::size_t(l)], nullptr, params.detailBlend, threaded, interrupter,
                                                         roots.parent.empty() ? nullptr : &roots.parent, params.detailScale,
-                                                        outputVertices);
+                                                        outputVertices, params.match);
         }
         refineLevel(l, true);
     }
