@@ -194,10 +194,7 @@ TEST_CASE("synthesizeHair: Curly_100's curls keep their length and turning", "[s
     // Issue 15: short, strongly curled strands. Laid as displacements from their centres
     // (DetailBlend::RootFrame, the default before DetailBlend::Edges), the output's turning
     // distribution was 0.43-0.89 away from the example's over seeds 0-6 and its lengths 0.09-0.25.
-    if (test::sharedData().empty()) {
-        WARN("skipped: ../shared/data not found");
-        return;
-    }
+    VDBHAIR_REQUIRE_SHARED_DATA();
     const std::string path = test::sharedData() + "/hair/ply/Curly_100.ply";
     const StrandSet example = readStrands(path);
     std::vector<double> le;
