@@ -185,6 +185,8 @@ void addSynthHierarchyOptions(CLI::App* sub, SynthParams& params, SynthOptionTex
 void addSynthTransferOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
 /// @throw ValueError for a bad --up, --refine-mode or --detail.
 void applySynthOptionText(const SynthOptionText& text, SynthParams& params);
+/// @brief The flags of the detail-transfer parameters the library's errors name (synth, transfer, comb).
+FlagNames synthTransferFlags();
 
 /// @brief The scalp named by a verb's --scalp option (ScalpSurface.h's readScalp(), shown as a
 /// stage), or null when @a path is empty.

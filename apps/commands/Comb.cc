@@ -93,7 +93,7 @@ Command addCombCommand(CLI::App& app, CommonOptions& common)
     addSynthHierarchyOptions(sub, p->params.synth, p->text);
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair comb scenes/default/head.json --stroke scenes/comb/sweep_ponytail.json -o combed.hair --json");
-    return {sub, [p, &common] { return runComb(*p, common); }};
+    return {sub, [p, &common] { return runComb(*p, common); }, synthTransferFlags()};
 }
 
 } // namespace vdbhair::app

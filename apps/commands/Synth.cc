@@ -350,10 +350,18 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--save-maps", params->saveMaps, "Write input_map.png, output_map.png (first three PCA channels as RGB) and clusters.png to this folder");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair synth example.hair -o new.hair --levels 3 --seed 1 --json");
-    return {sub, [params, &common] { return runSynth(*params, common); },
+    Command c{sub, [params, &common] { return runSynth(*params, common); },
             {{"initialClusters", "--initial-clusters"}, {"threshold", "--threshold"}, {"levels", "--levels"}, {"vertices", "--vertices"},
              {"components", "--components"}, {"mapSpacing", "--map-spacing"}, {"voxelSize", "--voxel-size"}, {"outputTurn", "--output-turn"},
              {"placeWeight", "--place-weight"}, {"nearbyRadius", "--nearby"}}};
+    for (auto& f : synthTransferFlags()) c.flags.push_back(std::move(f));
+    return c;
+}
+
+FlagNames synthTransferFlags()
+{
+    return {{"match balance", "--match-balance"}, {"match candidates", "--match-candidates"},
+            {"detail blend", "--detail"}, {"detail scale", "--detail-scale"}};
 }
 
 } // namespace vdbhair::app

@@ -143,7 +143,8 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
                     params.strands = std::size_t(p->strands);
                 }
                 return runTransferJob(p->job, params, common);
-            }};
+            },
+            synthTransferFlags()};
 }
 
 } // namespace vdbhair::app
