@@ -142,23 +142,23 @@ void smoothPolyline(const Vec3d* points, std::size_t n, double sigma, Vec3d* out
     const long radius = std::min(last, std::max(1L, long(std::ceil(3.0 * sigma))));
     std::vector<double> kernel(std::size_t(radius) + 1);
     for (long k = 0; k <= radius; ++k) kernel[std::size_t(k)] = std::exp(-0.5 * double(k * k) / (sigma * sigma));
-    // The point at index k (−last ≤ k ≤ 2 last) of the polyline extended by odd reflection.
-    const auto at = [&](long k) -> Vec3d {
-        if (k < 0) return points[0] * 2.0 - points[-k];
-        if (k > last) return points[last] * 2.0 - points[2 * last - k];
-        return points[k];
-    };
-    for (long i = 0; i <= last; ++i) {
-        if (i == 0 || i == last) {
-            out[i] = points[i];
-            continue;
-        }
-        Vec3d sum = points[i] * kernel[0];
-        double w = kernel[0];
-        for (long k = 1; k <= radius; ++k) {
-            sum += (at(i - k) + at(i + k)) * kernel[std::size_t(k)];
-            w += 2.0 * kernel[std::size_t(k)];
-        }
+    // The polyline extended by odd reflection, radius points each side: ext[k + radius] is the
+    // point at index k (−radius ≤ k ≤ last + radius), so that the taps below read without branches.
+    std::vector<Vec3d> ext(n + 2 * std::size_t(radius));
+    for (long k = -radius; k <= last + radius; ++k) {
+        Vec3d& e = ext[std::size_t(k + radius)];
+        if (k < 0) e = points[0] * 2.0 - points[-k];
+        else if (k > last) e = points[last] * 2.0 - points[2 * last - k];
+        else e = points[k];
+    }
+    double w = kernel[0];
+    for (long k = 1; k <= radius; ++k) w += 2.0 * kernel[std::size_t(k)];
+    out[0] = points[0];
+    out[last] = points[last];
+    for (long i = 1; i < last; ++i) {
+        const Vec3d* c = ext.data() + (i + radius);
+        Vec3d sum = c[0] * kernel[0];
+        for (long k = 1; k <= radius; ++k) sum += (c[-k] + c[k]) * kernel[std::size_t(k)];
         out[i] = sum / w;
     }
 }

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -498,32 +499,68 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         const ScalpFrame& mi = inAligned[ic];
         std::vector<Vec3d> offIn(mem.size());
         for (std::size_t k = 0; k < mem.size(); ++k) offIn[k] = mi.toLocal(inS.roots[mem[k]] - inC.roots[ic]);
-        std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> pairs;  // (distance², strand, member), positions in mine and mem
-        pairs.reserve(mine.size() * (balanced ? mem.size() : 1));
+        // Balanced: the greedy over all (distance², strand, member) pairs by increasing distance
+        // (ties by strand, then member), taken lazily (sorting every pair was 5 % of a 100,000-
+        // strand synthesis): each strand's pairs form a min-heap, and one global heap holds each
+        // unserved strand's nearest pair not yet refused. A member refused once stays full (uses
+        // only grow), so the global heap's top is always the sorted sequence's next pair that the
+        // scan would take or refuse: the same picks as the full sort, in the same order.
+        using Candidate = std::pair<double, std::uint32_t>;  // (distance², member)
+        std::vector<Candidate> cand;
+        using Pair = std::tuple<double, std::uint32_t, std::uint32_t>;  // (distance², strand, member)
+        std::vector<Pair> next;  // the global heap
+        if (balanced) {
+            cand.resize(mine.size() * mem.size());
+            next.reserve(mine.size());
+        }
         for (std::size_t a = 0; a < mine.size(); ++a) {
             const Vec3d offOut = mo.toLocal(roots[mine[a]] - outCenters.roots[oc]);
             std::size_t nearestK = 0;
             double best = std::numeric_limits<double>::max();
+            Candidate* row = balanced ? cand.data() + a * mem.size() : nullptr;
             for (std::size_t k = 0; k < mem.size(); ++k) {
                 const double d = (offIn[k] - offOut).lengthSqr();
-                if (balanced) pairs.emplace_back(d, std::uint32_t(a), std::uint32_t(k));
+                if (balanced) row[k] = {d, std::uint32_t(k)};
                 if (d < best) {
                     best = d;
                     nearestK = k;
                 }
             }
             pickOf[mine[a]] = mem[nearestK];
+            if (balanced) next.emplace_back(best, std::uint32_t(a), std::uint32_t(nearestK));
         }
         if (!balanced) return;
-        std::sort(pairs.begin(), pairs.end());
+        const std::size_t m = mem.size();
+        // Each strand's first pair is its nearest member (the first k of least distance: the
+        // least under (distance², member) as well); its pairs are made a heap only when that one
+        // is refused (with balance above 1 most strands take their nearest).
+        std::vector<std::size_t> left(mine.size(), 0);  // each strand's heap size, once made
+        std::make_heap(next.begin(), next.end(), std::greater<Pair>());
         const double cap = std::ceil(matching.balance * double(mine.size()) / double(mem.size()));
         std::vector<double> used(mem.size(), 0.0);
-        std::vector<std::uint8_t> done(mine.size(), 0);
-        for (const auto& [d, a, k] : pairs) {
-            if (done[a] || used[k] + 1.0 > cap) continue;
-            done[a] = 1;
-            used[k] += 1.0;
-            pickOf[mine[a]] = mem[k];
+        while (!next.empty()) {
+            std::pop_heap(next.begin(), next.end(), std::greater<Pair>());
+            const auto [d, a, k] = next.back();
+            next.pop_back();
+            if (used[k] + 1.0 <= cap) {
+                used[k] += 1.0;
+                pickOf[mine[a]] = mem[k];
+                continue;
+            }
+            // Refused: the strand's next nearest member, if any.
+            Candidate* row = cand.data() + std::size_t(a) * m;
+            if (left[a] == 0) {
+                // First refusal: the other members as a heap (the refused one is the least).
+                std::swap(row[k], row[m - 1]);
+                left[a] = m - 1;
+                std::make_heap(row, row + left[a], std::greater<Candidate>());
+            } else {
+                std::pop_heap(row, row + left[a], std::greater<Candidate>());
+                --left[a];
+            }
+            if (left[a] == 0) continue;  // no member left (balance below 1): keeps its nearest
+            next.emplace_back(row[0].first, a, row[0].second);
+            std::push_heap(next.begin(), next.end(), std::greater<Pair>());
         }
     });
     // World geometry and rotation-minimizing frames of the centres used, computed once each.
