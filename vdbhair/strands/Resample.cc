@@ -142,25 +142,39 @@ void smoothPolyline(const Vec3d* points, std::size_t n, double sigma, Vec3d* out
     const long radius = std::min(last, std::max(1L, long(std::ceil(3.0 * sigma))));
     std::vector<double> kernel(std::size_t(radius) + 1);
     for (long k = 0; k <= radius; ++k) kernel[std::size_t(k)] = std::exp(-0.5 * double(k * k) / (sigma * sigma));
-    // The polyline extended by odd reflection, radius points each side: ext[k + radius] is the
-    // point at index k (−radius ≤ k ≤ last + radius), so that the taps below read without branches.
-    std::vector<Vec3d> ext(n + 2 * std::size_t(radius));
+    // The polyline extended by odd reflection, radius points each side, one array per axis:
+    // ext[a][k + radius] is axis a of the point at index k (−radius ≤ k ≤ last + radius). Taps in
+    // the outer loop and points in the inner one: every output sums its taps in the same order as
+    // one point at a time (bit for bit), and the inner loop runs without branches over
+    // consecutive points, which the compiler vectorizes.
+    const std::size_t m = n + 2 * std::size_t(radius);
+    std::vector<double> buf(3 * m + 3 * n);
+    double* ext[3] = {buf.data(), buf.data() + m, buf.data() + 2 * m};
+    double* sum[3] = {buf.data() + 3 * m, buf.data() + 3 * m + n, buf.data() + 3 * m + 2 * n};
     for (long k = -radius; k <= last + radius; ++k) {
-        Vec3d& e = ext[std::size_t(k + radius)];
+        Vec3d e;
         if (k < 0) e = points[0] * 2.0 - points[-k];
         else if (k > last) e = points[last] * 2.0 - points[2 * last - k];
         else e = points[k];
+        for (int a = 0; a < 3; ++a) ext[a][std::size_t(k + radius)] = e[a];
     }
     double w = kernel[0];
     for (long k = 1; k <= radius; ++k) w += 2.0 * kernel[std::size_t(k)];
+    for (int a = 0; a < 3; ++a) {
+        const double* c = ext[a] + radius;  // c[i] is axis a of point i
+        double* s = sum[a];
+        const double k0 = kernel[0];
+        for (long i = 1; i < last; ++i) s[i] = c[i] * k0;
+        for (long k = 1; k <= radius; ++k) {
+            const double kk = kernel[std::size_t(k)];
+            const double* lo = c - k;
+            const double* hi = c + k;
+            for (long i = 1; i < last; ++i) s[i] += (lo[i] + hi[i]) * kk;
+        }
+    }
     out[0] = points[0];
     out[last] = points[last];
-    for (long i = 1; i < last; ++i) {
-        const Vec3d* c = ext.data() + (i + radius);
-        Vec3d sum = c[0] * kernel[0];
-        for (long k = 1; k <= radius; ++k) sum += (c[-k] + c[k]) * kernel[std::size_t(k)];
-        out[i] = sum / w;
-    }
+    for (long i = 1; i < last; ++i) out[i] = Vec3d(sum[0][i], sum[1][i], sum[2][i]) / w;
 }
 
 } // namespace vdbhair
