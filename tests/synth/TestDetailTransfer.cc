@@ -3,11 +3,14 @@
 #include <vdbhair/synth/Clustering.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/DetailTransfer.h>
+#include <vdbhair/synth/impl/BalancedMatch.h>
+#include <vdbhair/Random.h>
 
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 using namespace vdbhair;
 
@@ -31,6 +34,44 @@ TEST_CASE("alignedFrame: the tangent follows the strand's mean direction on the 
     CHECK((g.t - Vec3d(1, 0, -1).unitSafe()).length() < 1e-6);
     CHECK((g.n - f.n).length() < 1e-12);
     CHECK((g.t.cross(g.n) - g.b).length() < 1e-9);
+}
+
+TEST_CASE("balancedMatch: the same pairs, in the same order, as sorting every pair and scanning", "[synth]")
+{
+    // The oracle: every (distance², strand, member) pair sorted, then a strand not yet served
+    // takes a member with room. Distances from a few values (many ties), caps below, at and above
+    // the even share, one member and one strand.
+    Rng rng(7, 0xba1u, 0);
+    int refusals = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        const std::size_t strands = 1 + std::size_t(rng.uniform() * 12), members = 1 + std::size_t(rng.uniform() * 12);
+        const double cap = double(1 + int(rng.uniform() * 3));
+        std::vector<detail::MatchCandidate> cand(strands * members);
+        std::vector<std::uint32_t> nearest(strands, 0);
+        std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> pairs;
+        for (std::size_t a = 0; a < strands; ++a)
+            for (std::size_t k = 0; k < members; ++k) {
+                const double d = trial % 2 ? double(int(rng.uniform() * 4)) : rng.uniform();
+                cand[a * members + k] = {d, std::uint32_t(k)};
+                pairs.emplace_back(d, std::uint32_t(a), std::uint32_t(k));
+                if (d < cand[a * members + nearest[a]].first) nearest[a] = std::uint32_t(k);
+            }
+        std::sort(pairs.begin(), pairs.end());
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> expected, got;
+        std::vector<double> used(members, 0.0);
+        std::vector<std::uint8_t> done(strands, 0);
+        for (const auto& [d, a, k] : pairs) {
+            if (done[a] || used[k] + 1.0 > cap) continue;
+            done[a] = 1;
+            used[k] += 1.0;
+            expected.emplace_back(a, k);
+        }
+        detail::balancedMatch(cand, strands, members, nearest, cap, [&](std::uint32_t a, std::uint32_t k) { got.emplace_back(a, k); });
+        CAPTURE(trial, strands, members, cap);
+        REQUIRE(got == expected);
+        for (const auto& [a, k] : got) refusals += k != nearest[a];
+    }
+    CHECK(refusals > 100);  // the heaps were exercised, not only the nearest members
 }
 
 TEST_CASE("transferDetail: a cluster transferred onto its own centre is the cluster", "[synth]")

@@ -7,6 +7,7 @@
 #include <vdbhair/strands/Resample.h>
 #include <vdbhair/scalp/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
+#include <vdbhair/synth/impl/BalancedMatch.h>
 
 #include <vdbhair/Parallel.h>
 
@@ -499,25 +500,19 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         const ScalpFrame& mi = inAligned[ic];
         std::vector<Vec3d> offIn(mem.size());
         for (std::size_t k = 0; k < mem.size(); ++k) offIn[k] = mi.toLocal(inS.roots[mem[k]] - inC.roots[ic]);
-        // Balanced: the greedy over all (distance², strand, member) pairs by increasing distance
-        // (ties by strand, then member), taken lazily (sorting every pair was 5 % of a 100,000-
-        // strand synthesis): each strand's pairs form a min-heap, and one global heap holds each
-        // unserved strand's nearest pair not yet refused. A member refused once stays full (uses
-        // only grow), so the global heap's top is always the sorted sequence's next pair that the
-        // scan would take or refuse: the same picks as the full sort, in the same order.
-        using Candidate = std::pair<double, std::uint32_t>;  // (distance², member)
-        std::vector<Candidate> cand;
-        using Pair = std::tuple<double, std::uint32_t, std::uint32_t>;  // (distance², strand, member)
-        std::vector<Pair> next;  // the global heap
+        // Balanced: the greedy over every (distance², strand, member) pair by increasing distance
+        // (impl/BalancedMatch.h; sorting every pair was 5 % of a 100,000-strand synthesis).
+        std::vector<detail::MatchCandidate> cand;
+        std::vector<std::uint32_t> nearest;
         if (balanced) {
             cand.resize(mine.size() * mem.size());
-            next.reserve(mine.size());
+            nearest.resize(mine.size());
         }
         for (std::size_t a = 0; a < mine.size(); ++a) {
             const Vec3d offOut = mo.toLocal(roots[mine[a]] - outCenters.roots[oc]);
             std::size_t nearestK = 0;
             double best = std::numeric_limits<double>::max();
-            Candidate* row = balanced ? cand.data() + a * mem.size() : nullptr;
+            detail::MatchCandidate* row = balanced ? cand.data() + a * mem.size() : nullptr;
             for (std::size_t k = 0; k < mem.size(); ++k) {
                 const double d = (offIn[k] - offOut).lengthSqr();
                 if (balanced) row[k] = {d, std::uint32_t(k)};
@@ -526,42 +521,13 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
                     nearestK = k;
                 }
             }
-            pickOf[mine[a]] = mem[nearestK];
-            if (balanced) next.emplace_back(best, std::uint32_t(a), std::uint32_t(nearestK));
+            pickOf[mine[a]] = mem[nearestK];  // kept by a strand the balanced greedy leaves out
+            if (balanced) nearest[a] = std::uint32_t(nearestK);
         }
         if (!balanced) return;
-        const std::size_t m = mem.size();
-        // Each strand's first pair is its nearest member (the first k of least distance: the
-        // least under (distance², member) as well); its pairs are made a heap only when that one
-        // is refused (with balance above 1 most strands take their nearest).
-        std::vector<std::size_t> left(mine.size(), 0);  // each strand's heap size, once made
-        std::make_heap(next.begin(), next.end(), std::greater<Pair>());
         const double cap = std::ceil(matching.balance * double(mine.size()) / double(mem.size()));
-        std::vector<double> used(mem.size(), 0.0);
-        while (!next.empty()) {
-            std::pop_heap(next.begin(), next.end(), std::greater<Pair>());
-            const auto [d, a, k] = next.back();
-            next.pop_back();
-            if (used[k] + 1.0 <= cap) {
-                used[k] += 1.0;
-                pickOf[mine[a]] = mem[k];
-                continue;
-            }
-            // Refused: the strand's next nearest member, if any.
-            Candidate* row = cand.data() + std::size_t(a) * m;
-            if (left[a] == 0) {
-                // First refusal: the other members as a heap (the refused one is the least).
-                std::swap(row[k], row[m - 1]);
-                left[a] = m - 1;
-                std::make_heap(row, row + left[a], std::greater<Candidate>());
-            } else {
-                std::pop_heap(row, row + left[a], std::greater<Candidate>());
-                --left[a];
-            }
-            if (left[a] == 0) continue;  // no member left (balance below 1): keeps its nearest
-            next.emplace_back(row[0].first, a, row[0].second);
-            std::push_heap(next.begin(), next.end(), std::greater<Pair>());
-        }
+        detail::balancedMatch(cand, mine.size(), mem.size(), nearest, cap,
+                              [&](std::uint32_t a, std::uint32_t k) { pickOf[mine[a]] = mem[k]; });
     });
     // World geometry and rotation-minimizing frames of the centres used, computed once each.
     std::vector<std::vector<Vec3f>> outWorld(nOut), inWorld(nIn);
