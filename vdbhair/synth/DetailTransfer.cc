@@ -576,28 +576,15 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         });
     }
 
-    // 4-5. Every new strand.
-    StrandSamples out;
-    out.vertices = no;
-    reserveHugePages(out.local, n * out.dim());  // fresh pages 2 MiB at a time (Memory.h)
-    out.local.assign(n * out.dim(), 0.0f);
-    out.roots = roots;
-    out.scalp.resize(n);
-    out.frames.resize(n);
-    out.lengths.resize(n);
-    forEach(n, [&](std::size_t i) {
-        const std::uint32_t oc = label[i], ic = match[oc];
-        const ScalpFrame& mo = outAligned[oc];
-        const ScalpFrame& mi = inAligned[ic];
-        const std::uint32_t pick = pickOf[i];  // step 4
-        const std::vector<Vec3f> gin = worldOf(inS, pick, radius);
-        const Vec3d sc = map.toScalp(roots[i]);
-        const ScalpFrame rf = map.frame(sc.x(), sc.y());
-        float* row = out.row(i);
-        const std::vector<Vec3f>& cin = inWorld[ic];
+    // Where each output vertex reads the input's displacement, a fractional input vertex: the
+    // same for every strand of an output centre (computed once per centre used).
+    std::vector<std::vector<double>> atOf(nOut);
+    forEach(nOut, [&](std::size_t oc) {
+        if (!outUsed[oc]) return;
+        const std::vector<Vec3f>& cin = inWorld[match[oc]];
         const std::vector<Vec3f>& cout = outWorld[oc];
-        // Where each output vertex reads the input's displacement: a fractional input vertex.
-        std::vector<double> at(static_cast<std::size_t>(no));
+        std::vector<double>& at = atOf[oc];
+        at.resize(static_cast<std::size_t>(no));
         if (scale != DetailScale::Index) {  // (Strand reads as ArcLength here)
             // At the output centre's arc length along the input centre, mirrored back and forth
             // beyond the input centre's end (DetailTransfer.h; DetailBlend::Edges: held at the end).
@@ -623,6 +610,29 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             // Vertex by vertex (the same fraction of the vertices).
             for (std::size_t k = 0; k < at.size(); ++k) at[k] = double(k) * double(ns - 1) / double(no - 1);
         }
+    });
+
+    // 4-5. Every new strand.
+    StrandSamples out;
+    out.vertices = no;
+    reserveHugePages(out.local, n * out.dim());  // fresh pages 2 MiB at a time (Memory.h)
+    out.local.assign(n * out.dim(), 0.0f);
+    out.roots = roots;
+    out.scalp.resize(n);
+    out.frames.resize(n);
+    out.lengths.resize(n);
+    forEach(n, [&](std::size_t i) {
+        const std::uint32_t oc = label[i], ic = match[oc];
+        const ScalpFrame& mo = outAligned[oc];
+        const ScalpFrame& mi = inAligned[ic];
+        const std::uint32_t pick = pickOf[i];  // step 4
+        const std::vector<Vec3f> gin = worldOf(inS, pick, radius);
+        const Vec3d sc = map.toScalp(roots[i]);
+        const ScalpFrame rf = map.frame(sc.x(), sc.y());
+        float* row = out.row(i);
+        const std::vector<Vec3f>& cin = inWorld[ic];
+        const std::vector<Vec3f>& cout = outWorld[oc];
+        const std::vector<double>& at = atOf[oc];  // where each output vertex reads
         if (edges) {
             // The strand's own edges laid along the output centre's carrier (DetailTransfer.h, "Edges").
             std::vector<Vec3d> strand(gin.size());
