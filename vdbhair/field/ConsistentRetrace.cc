@@ -6,6 +6,7 @@
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
 #include <vdbhair/field/HairVolume.h>
+#include <vdbhair/field/Simd.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/strands/Measures.h>
 
@@ -381,7 +382,13 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
         if (progress.stopped()) return;
         StrandTracer tracer(shared);
         const std::size_t first = c * kChunk, last = std::min(nS, first + kChunk);
-        for (std::size_t o = first; o < last; ++o) tracer.trace(order[o], counts[c]);
+        for (std::size_t o = first; o < last; ++o) {
+            // The spatial order scatters strands over memory, and a strand's first read of its
+            // input vertices waited for memory (perf: a tenth of trace()'s time on that load):
+            // fetch a later strand's input meanwhile. A hint only.
+            if (o + 2 < last) prefetchBytes(strands.data(order[o + 2]), strands.size(order[o + 2]) * sizeof(Vec3f));
+            tracer.trace(order[o], counts[c]);
+        }
         progress.add(last - first);
     };
     if (threaded) {
