@@ -6,6 +6,7 @@
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
 #include <vdbhair/field/HairVolume.h>
+#include <vdbhair/field/Simd.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/strands/Measures.h>
 
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 namespace vdbhair {
@@ -64,6 +66,9 @@ struct Shared
     const BrickedField<TreeT>& tangents;
     const BrickedField<TreeT>& spreads;
     const BrickedField<TreeT>& volume;
+    /// Whether the hair volume is the tangent field's own grid (volume is tangents, volumeMap is
+    /// map): insideField() then samples the tangent field, and direction() reuses that sample.
+    bool volumeIsTangent;
     const HairVolume& dilated;
     const HeadObstacle& head;
     const ConsistencyParams& params;
@@ -267,13 +272,35 @@ private:
     }
 
     /// Whether any corner of the hair volume's cell around world point @a q is active.
-    bool insideField(const Vec3d& q) { return mVolume.sample(mS.volumeMap.worldToIndex(q))[3] > 0.f; }
+    bool insideField(const Vec3d& q)
+    {
+        const Vec3d iq = mS.volumeMap.worldToIndex(q);
+        if (!mS.volumeIsTangent) return mVolume.sample(iq)[3] > 0.f;
+        // The hair volume is the tangent field: keep the whole sample, since q is most often the
+        // next sub-step's start, where direction() samples the tangent field at the same index
+        // point (the same mapping of the same grid). Measured: sampling the spread here too, at
+        // the same cell, was slower (insideField() also tests chord ends that are never a
+        // sub-step's start, and those spread samples were wasted).
+        mLastTan = mTan.sample(iq);
+        mLastTanAt = iq;
+        mHaveLastTan = true;
+        return mLastTan[3] > 0.f;
+    }
+
+    /// The tangent field's sample at index point @a ip: insideField()'s last sample when it was
+    /// taken at the same point, bit for bit (then the value a new sample would give), else a
+    /// new one.
+    Float4 sampleTangent(const Vec3d& ip)
+    {
+        if (mHaveLastTan && std::memcmp(&ip, &mLastTanAt, sizeof ip) == 0) return mLastTan;
+        return mTan.sample(ip);
+    }
 
     /// The blended direction at @a p for a strand heading @a t; @a w receives the field's weight.
     Vec3d direction(const Vec3d& p, const Vec3d& t, double& w, Counts& counts)
     {
         const Vec3d ip = mS.map.worldToIndex(p);
-        const Float4 r = mTan.sample(ip);
+        const Float4 r = sampleTangent(ip);
         const double weight = r[3];
         if (!(weight > 0.0)) {
             ++counts.noFieldSteps;
@@ -303,6 +330,9 @@ private:
     FieldSampler<TreeT> mTan, mSpread, mVolume;
     HairVolume::Probe mDilated;
     HeadObstacle::Probe mHead;
+    Float4 mLastTan = {0.f, 0.f, 0.f, 0.f};  ///< insideField()'s last sample of the tangent field,
+    Vec3d mLastTanAt = Vec3d(0.0);            ///< at this index point
+    bool mHaveLastTan = false;
 };
 
 } // namespace
@@ -336,7 +366,7 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
     if (&volumeGrid != field.tangent.get()) ownVolume.reset(new BrickedField<TreeT>(volumeGrid.tree()));
     const BrickedField<TreeT>& volume = ownVolume ? *ownVolume : tangents;
     const HairVolume dilated(volumeGrid);
-    const Shared shared{strands, map, FieldMapping::fromGrid(volumeGrid), tangents, spreads, volume, dilated, head, params, step,
+    const Shared shared{strands, map, FieldMapping::fromGrid(volumeGrid), tangents, spreads, volume, !ownVolume, dilated, head, params, step,
                         std::sin(params.minSpreadDeg * M_PI / 180.0), 1.0 / (params.returnVoxels * map.worldVoxelSize()), out};
 
     const std::size_t nS = strands.numStrands();
@@ -352,7 +382,13 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
         if (progress.stopped()) return;
         StrandTracer tracer(shared);
         const std::size_t first = c * kChunk, last = std::min(nS, first + kChunk);
-        for (std::size_t o = first; o < last; ++o) tracer.trace(order[o], counts[c]);
+        for (std::size_t o = first; o < last; ++o) {
+            // The spatial order scatters strands over memory, and a strand's first read of its
+            // input vertices waited for memory (perf: a tenth of trace()'s time on that load):
+            // fetch a later strand's input meanwhile. A hint only.
+            if (o + 2 < last) prefetchBytes(strands.data(order[o + 2]), strands.size(order[o + 2]) * sizeof(Vec3f));
+            tracer.trace(order[o], counts[c]);
+        }
         progress.add(last - first);
     };
     if (threaded) {
