@@ -103,25 +103,16 @@ struct Lloyd
     std::vector<std::uint32_t> seeds;    // k
     std::vector<std::uint32_t> label;    // N
     std::size_t islands = 0;
-    /// partition()'s state of each strand, together so that the region growing's visit of a
-    /// neighbour touches one cache line (its label and the cluster it was last offered to).
-    struct Slot
-    {
-        std::uint32_t label, offered;
-    };
-    std::vector<Slot> slots;
+    std::vector<std::uint32_t> memoCluster;
+    std::vector<double> memoDistance;
     std::vector<double> own;  ///< after fit(): each strand's distance to its cluster's centre
     /// Before a partition that follows a fit: each strand's distances to the clusters it will most
     /// likely be offered to (its own and its neighbours' current clusters, at most kCached), computed
     /// in parallel; the region growing then reads them instead of computing them in its serial loop
     /// (the same values: only where they are computed changes).
     static constexpr std::size_t kCached = 4;
-    struct Cached
-    {
-        std::uint32_t cluster[kCached];  // kNoCluster where unused
-        double distance[kCached];
-    };
-    std::vector<Cached> cached;  // N (one record a strand: one cache line read in the serial loop)
+    std::vector<std::uint32_t> cachedCluster;  // N × kCached, kNoCluster where unused
+    std::vector<double> cachedDistance;        // N × kCached
     static constexpr std::uint32_t kNoCluster = ~0u;
 
     std::size_t k() const { return seeds.size(); }
@@ -132,27 +123,25 @@ struct Lloyd
 
     double cachedDist(std::uint32_t s, std::uint32_t c) const
     {
-        if (!cached.empty()) {
-            const Cached& e = cached[s];
+        if (!cachedCluster.empty()) {
+            const std::uint32_t* cc = cachedCluster.data() + std::size_t(s) * kCached;
             for (std::size_t j = 0; j < kCached; ++j)
-                if (e.cluster[j] == c) return e.distance[j];
+                if (cc[j] == c) return cachedDistance[std::size_t(s) * kCached + j];
         }
         return dist(s, c);
     }
 
-    /// The distances this partition will most likely ask for (see cached), from the last
+    /// The distances this partition will most likely ask for (see cachedCluster), from the last
     /// fit's labels, centres and own distances.
     void cacheDistances()
     {
         const std::size_t n = samples.count();
-        Cached none;
-        std::fill(std::begin(none.cluster), std::end(none.cluster), kNoCluster);
-        std::fill(std::begin(none.distance), std::end(none.distance), 0.0);
-        cached.assign(n, none);
+        cachedCluster.assign(n * kCached, kNoCluster);
+        cachedDistance.resize(n * kCached);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t s = r.begin(); s != r.end(); ++s) {
-                std::uint32_t* cc = cached[s].cluster;
-                double* cd = cached[s].distance;
+                std::uint32_t* cc = cachedCluster.data() + s * kCached;
+                double* cd = cachedDistance.data() + s * kCached;
                 std::size_t used = 0;
                 const auto add = [&](std::uint32_t c) {
                     for (std::size_t j = 0; j < used; ++j) if (cc[j] == c) return;
@@ -173,19 +162,21 @@ struct Lloyd
         constexpr std::uint32_t kNone = ~0u;
         const std::size_t n = samples.count();
         if (!own.empty()) cacheDistances();
-        slots.assign(n, Slot{kNone, kNone});
+        label.assign(n, kNone);
         using Item = std::tuple<double, std::uint32_t, std::uint32_t>;  // L², strand, cluster
         std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
         // A strand is offered to the same cluster by each assigned neighbour: an entry (distance,
         // strand, cluster) already queued is not queued again (the same partition, a fifth of the work).
+        memoCluster.assign(n, kNone);
+        memoDistance.resize(n);
         const auto grow = [&](std::uint32_t s, std::uint32_t c) {
             for (const std::uint32_t* it = graph.begin(s); it != graph.end(s); ++it) {
                 const std::uint32_t nb = *it;
-                Slot& slot = slots[nb];
-                if (slot.label != kNone) continue;
-                if (slot.offered == c) continue;  // already queued with this tag: the same entry
-                slot.offered = c;
-                queue.emplace(cachedDist(nb, c), nb, c);
+                if (label[nb] != kNone) continue;
+                if (memoCluster[nb] == c) continue;  // already queued with this tag: the same entry
+                memoCluster[nb] = c;
+                memoDistance[nb] = cachedDist(nb, c);
+                queue.emplace(memoDistance[nb], nb, c);
             }
         };
         const auto drain = [&] {
@@ -193,27 +184,25 @@ struct Lloyd
                 const auto [d, s, c] = queue.top();
                 queue.pop();
                 (void)d;
-                if (slots[s].label != kNone) continue;
-                slots[s].label = c;
+                if (label[s] != kNone) continue;
+                label[s] = c;
                 grow(s, c);
             }
         };
-        for (std::uint32_t c = 0; c < seeds.size(); ++c) slots[seeds[c]].label = c;
+        for (std::uint32_t c = 0; c < seeds.size(); ++c) label[seeds[c]] = c;
         for (std::uint32_t c = 0; c < seeds.size(); ++c) grow(seeds[c], c);
         drain();
         // Components no seed reached: the first unassigned strand of each seeds a new cluster.
         for (std::uint32_t s = 0; s < n; ++s) {
-            if (slots[s].label != kNone) continue;
+            if (label[s] != kNone) continue;
             const std::uint32_t c = std::uint32_t(seeds.size());
             seeds.push_back(s);
             centers.insert(centers.end(), samples.row(s), samples.row(s) + dim);
-            slots[s].label = c;
+            label[s] = c;
             ++islands;
             grow(s, c);
             drain();
         }
-        label.resize(n);
-        for (std::size_t s = 0; s < n; ++s) label[s] = slots[s].label;
     }
 
     /// §4.3: centres are the members' means; returns E (Eq. 3). Then each seed becomes the member
@@ -327,7 +316,7 @@ Clustering clusterSamples(const StrandSamples& samples, const ScalpMap& map, std
         throw ValueError("clusterSamples: " + std::to_string(k) + " clusters of " + std::to_string(n) +
                          " strands: between 1 and the strand count");
     const NeighbourGraph graph = neighbourGraph(samples.roots, params.neighbours);
-    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}, {}};
+    Lloyd lloyd{samples, graph, samples.dim(), {}, {}, {}, 0, {}, {}, {}, {}, {}};
     lloyd.seeds = initialSeeds(samples, k, Rng(params.seed, 0x5eedc1u, stream));
     for (std::uint32_t s : lloyd.seeds) lloyd.centers.insert(lloyd.centers.end(), samples.row(s), samples.row(s) + lloyd.dim);
     Clustering out;
