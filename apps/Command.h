@@ -153,6 +153,19 @@ void addScalpOptions(CLI::App* sub, ScalpOptions& opts);
 openvdb::FloatGrid::Ptr applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params,
                                           const CommonOptions& common);
 
+/// A verb as `vdbhair --help` lists it.
+struct Verb
+{
+    const char* name;
+    const char* description;
+};
+/// @brief Every verb, in the order `vdbhair --help` lists them (Cli.cc: the one list of names and
+/// descriptions, which both programs register).
+const std::vector<Verb>& verbs();
+/// @brief The subcommand @a name of @a app with its description from verbs().
+/// @throw std::logic_error when verbs() has no such verb.
+CLI::App* addVerb(CLI::App& app, const std::string& name);
+
 // One function per subcommand file, each returning the registered command.
 Command addInfoCommand(CLI::App& app, CommonOptions& common);
 Command addConvertCommand(CLI::App& app, CommonOptions& common);
@@ -204,8 +217,11 @@ struct TransferJob
 };
 int runTransferJob(const TransferJob& job, TransferParams params, const CommonOptions& common);
 
-/// @brief Every verb, registered on @a app in the order `vdbhair --help` lists them.
+/// @brief Every verb, registered on @a app in the order of verbs().
 std::vector<Command> addCommands(CLI::App& app, CommonOptions& common);
+
+/// Registers a program's verbs: addCommands() in the full program, lite/Lite.cc's in the light one.
+using AddCommands = std::function<std::vector<Command>(CLI::App&, CommonOptions&)>;
 
 /// @brief The verbs of @a verbs nearest to @a word (edit distance, a prefix counting as 1), for
 /// "did you mean"; empty when none is close.
@@ -213,7 +229,10 @@ std::vector<std::string> nearestVerbs(const std::string& word, const std::vector
 
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line, 130 interrupted
-/// (Ctrl-C: nothing written).
+/// (Ctrl-C: nothing written). The verbs are those @a addCommands registers.
+int runVerbs(int argc, char** argv, const AddCommands& addCommands);
+
+/// @brief runVerbs() with every verb: the full program's main.
 int run(int argc, char** argv);
 
 } // namespace vdbhair::app

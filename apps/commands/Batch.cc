@@ -369,8 +369,7 @@ int runBatch(const BatchCmdParams& p, const CommonOptions& common)
 Command addBatchCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<BatchCmdParams>();
-    CLI::App* sub = app.add_subcommand("batch", "Run one verb over a dataset: each input in its own process, records in OUTDIR/batch.jsonl, "
-                                                "resumable, sharded for schedulers (Slurm arrays)");
+    CLI::App* sub = addVerb(app, "batch");
     sub->add_option("job", params->job, "The JOB file (.json): inputs, verb, args, output; see below");
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing): the outputs and the records");
     sub->add_option("--jobs,-j", params->jobs, "Inputs run at once (default 0: one per core); each run gets --threads cores/jobs "

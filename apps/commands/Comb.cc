@@ -83,7 +83,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
 Command addCombCommand(CLI::App& app, CommonOptions& common)
 {
     auto p = std::make_shared<CombCmdParams>();
-    CLI::App* sub = app.add_subcommand("comb", "Detail-preserving combing (Wang et al. 2009, section 6): the coarsest wisps turn toward each stroke's direction, every strand follows its wisp with its own detail, lengths and roots kept");
+    CLI::App* sub = addVerb(app, "comb");
     sub->add_option("input", p->input, "The hairstyle (any strand format, or a scene)")->required();
     sub->add_option("--stroke", p->stroke, "Strokes, JSON: {\"strokes\": [{\"points\": [[x,y,z], ...], \"radius\": R, \"strength\": S}]} (world units; strength 0-1, default 1), applied in order")->required();
     sub->add_option("-o,--output", p->output, "The combed hairstyle (any strand format)")->required();

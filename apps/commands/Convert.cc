@@ -169,7 +169,7 @@ int runConvert(ConvertParams p, const CommonOptions& common)
 Command addConvertCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<ConvertParams>();
-    CLI::App* sub = app.add_subcommand("convert", "Convert strands between formats (several inputs are concatenated)");
+    CLI::App* sub = addVerb(app, "convert");
     sub->add_option("files", params->files, "IN [IN...] OUT, or IN [IN...] with -o OUT")->required();
     sub->add_option("-o,--output", params->output, "Output file; its extension picks the format (.hair .data .obj .ply .vdb .usda)");
     sub->add_option("--resample", params->resample, "Resample every strand to N vertices, equally spaced in arc length")->check(CLI::NonNegativeNumber);

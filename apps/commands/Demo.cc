@@ -119,7 +119,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
 Command addDemoCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<DemoParams>();
-    CLI::App* sub = app.add_subcommand("demo", "The main job: refine a hairstyle through its own tangent field, all results in one folder");
+    CLI::App* sub = addVerb(app, "demo");
     sub->add_option("scene", params->refine.input, "The hairstyle: strands, or a helicoid scene .json (the README passes the bundled default)")->required();
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing)")->capture_default_str();
     addRefineOptions(sub, params->refine);

@@ -179,7 +179,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
 Command addFieldCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<FieldCmdParams>();
-    CLI::App* sub = app.add_subcommand("field", "Estimate the robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9) as VDB grids");
+    CLI::App* sub = addVerb(app, "field");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent', 'density' (fog volume in [0,1]) and 'hair_length' (or *_level_<l>)")->required();
     params->voxelOpt = sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: " + kSuggestedVoxelSizeHelp + ")");

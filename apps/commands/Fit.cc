@@ -84,7 +84,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
 Command addFitCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<FitCmdParams>();
-    CLI::App* sub = app.add_subcommand("fit", "Fit p-helicoids to strands (Frechet measures, Nelder-Mead, piecewise); writes a scene");
+    CLI::App* sub = addVerb(app, "fit");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Scene file (.json): one guide per input strand, in input order")->required();
     sub->add_option("--max-error", params->fit.maxError, "Accept a piece within this discrete Frechet distance, as a fraction of the strand length")->capture_default_str();

@@ -60,7 +60,7 @@ int runGrow(const GrowParams& p, const CommonOptions& common)
 Command addGrowCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<GrowParams>();
-    CLI::App* sub = app.add_subcommand("grow", "Grow the strands of a helicoid scene (guides, p-helicoid pieces, waviness, wisps)");
+    CLI::App* sub = addVerb(app, "grow");
     sub->add_option("scene", params->scene, "Scene file (JSON, \"vdbhair\": \"scene/1\")")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--integrator", params->integrator, "euler (Eq. 3, the paper's) or rk4 (default: the scene's, else euler)");

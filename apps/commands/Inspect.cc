@@ -186,7 +186,7 @@ int runInspect(const InspectParams& p, const CommonOptions& common)
 Command addInspectCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<InspectParams>();
-    CLI::App* sub = app.add_subcommand("inspect", "Look into a .vdb file: value statistics, tiles, memory, bounds, leaf fill, metadata in words; slices as images");
+    CLI::App* sub = addVerb(app, "inspect");
     sub->add_option("file", params->input, "A .vdb file")->required();
     sub->add_option("--grid", params->grid, "Only this grid (and the one to slice; default: 'tangent', else the first voxel grid)");
     sub->add_option("--slice", params->slice, "Render the slice AXIS=WORLD (e.g. z=1.5: the plane z = 1.5 in world units)");

@@ -165,7 +165,7 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
 Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<InterpolateCmdParams>();
-    CLI::App* sub = app.add_subcommand("interpolate", "New hairs between guide hairs: helicoid parameters blended by inverse distance (Piuze et al. 2011, 4), or guide points (--method points)");
+    CLI::App* sub = addVerb(app, "interpolate");
     sub->add_option("guides", params->guides, "Guides: a helicoid scene (.json, e.g. from vdbhair fit) or any strand file (fitted first)")->required();
     sub->add_option("-o,--output", params->output, "Output: any strand format, or a scene (.json, --method helicoid)")->required();
     sub->add_option("--roots", params->roots, "Roots: PLY points (x y z, optional nx ny nz, as vdbhair roots writes) or the roots of any strand file");

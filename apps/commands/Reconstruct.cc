@@ -107,7 +107,7 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
 Command addReconstructCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<ReconstructCmdParams>();
-    CLI::App* sub = app.add_subcommand("reconstruct", "Rebuild a hairstyle from a share of its strands: fit them, interpolate the rest, measure both ways (Piuze et al. 2011, 5.4)");
+    CLI::App* sub = addVerb(app, "reconstruct");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "The reconstructed strands (any strand format), by --method")->required();
     sub->add_option("--guides", params->guides, "Share of the strands used as guides, in (0, 100] %")->capture_default_str();

@@ -195,7 +195,7 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
 Command addRefineCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<RefineCmdParams>();
-    CLI::App* sub = app.add_subcommand("refine", "Refine a hairstyle through its own tangent field: estimate, retrace, repeat from coarse to fine");
+    CLI::App* sub = addVerb(app, "refine");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
     sub->add_option("--save-field", params->saveField, "Also write the fields used (tangent[_level_l], density[_level_l]) to this .vdb");

@@ -94,7 +94,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
 Command addRenderCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<RenderCmdParams>();
-    CLI::App* sub = app.add_subcommand("render", "Preview strands as an image: lit fibres, depth-correct, anti-aliased");
+    CLI::App* sub = addVerb(app, "render");
     sub->add_option("input", params->input, "Strands (any format), .vdb points, a scene .json, or roots (.ply points with normals: drawn as dots)")->required();
     sub->add_option("-o,--output", params->output, "Image (.png, .exr, .jpg: by extension)")->required();
     sub->add_option("--view", params->view, "front, side, top, back or three-quarter (perspective)")->capture_default_str();

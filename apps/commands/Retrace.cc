@@ -153,7 +153,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 Command addRetraceCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<RetraceParams>();
-    CLI::App* sub = app.add_subcommand("retrace", "Retrace every strand through a vector field from its root, for its own length");
+    CLI::App* sub = addVerb(app, "retrace");
     sub->add_option("input", params->input, "Strand file (roots, lengths and vertex spacing to follow)")->required();
     sub->add_option("--field", params->field, "A .vdb file holding the field")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();

@@ -88,7 +88,7 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
 Command addRootsCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<RootsCmdParams>();
-    CLI::App* sub = app.add_subcommand("roots", "Spread follicles (roots) evenly over a scalp level set, in its region (Witkin & Heckbert 1994)");
+    CLI::App* sub = addVerb(app, "roots");
     sub->add_option("scalp", params->input, "Scalp .vdb with grid 'surface' (and 'region'), as vdbhair scalp writes; or a head mesh (.ply, .obj), made into one at 1/100 of its size")->required();
     sub->add_option("-o,--output", params->output, "Output roots: .ply (x y z nx ny nz tx ty tz) or .vdb (points P, N, tangent, group root)")->required();
     sub->add_option("--count", params->count, "Number of roots");

@@ -151,7 +151,7 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
 Command addScalpCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<ScalpCmdParams>();
-    CLI::App* sub = app.add_subcommand("scalp", "Make a scalp level set (grid 'surface') from a mesh, a sphere or oriented points, and a hair region (grid 'region')");
+    CLI::App* sub = addVerb(app, "scalp");
     sub->add_option("input", params->input,
                     "Mesh (.ply or .obj with faces: meshToLevelSet, open boundaries capped), points with normals (.ply nx ny nz, or the roots "
                     "of a strand file: Turk & O'Brien's variational implicit)");

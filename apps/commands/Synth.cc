@@ -329,7 +329,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<SynthCmdParams>();
     SynthParams& s = params->synth;
-    CLI::App* sub = app.add_subcommand("synth", "A new hairstyle in the style of an example (Wang et al. 2009: clustering, feature-map synthesis, detail transfer, refinement)");
+    CLI::App* sub = addVerb(app, "synth");
     sub->add_option("example", params->input, "The example hairstyle (any strand format)")->required();
     sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", params->scalp, "The scalp: a .vdb with a level set 'surface' (vdbhair scalp) or a head mesh (.ply, .obj); default: the sphere fitted to the roots");

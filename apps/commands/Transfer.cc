@@ -121,7 +121,7 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
 {
     auto p = std::make_shared<TransferCmdParams>();
     SynthParams& s = p->params.synth;
-    CLI::App* sub = app.add_subcommand("transfer", "BASE's global flow with DETAILS' wisps and curls (Wang et al. 2009, section 6): BASE keeps its coarsest level, the finer levels come from DETAILS by cluster-oriented detail transfer");
+    CLI::App* sub = addVerb(app, "transfer");
     sub->add_option("details", p->job.details, "The hairstyle whose detail is taken (any strand format, or a scene)")->required();
     sub->add_option("base", p->job.base, "The hairstyle whose coarsest level is kept (any strand format, or a scene)")->required();
     sub->add_option("-o,--output", p->job.output, "The result (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();

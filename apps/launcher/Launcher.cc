@@ -1,6 +1,11 @@
 // `vdbhair` as a user runs it: a launcher that starts the vdbhair program (installed as
 // libexec/vdbhair/vdbhair, next to bin/) with glibc's malloc asked for transparent huge pages.
 //
+// A command line whose first word is `info`, `help` or an option, or that has none, goes to the
+// light program next to it instead (libexec/vdbhair/vdbhair-lite, lite/Lite.cc): the verbs' list
+// and help and `info` of a strand file, without the 50 ms of loading OpenVDB. It hands on to the
+// full program whatever it does not serve.
+//
 // A page fault costs about 20 µs on the virtual machines vdbhair is measured on (vdbhair/Memory.h),
 // and glibc's malloc serves the many mid-sized blocks a verb allocates (OpenVDB's leaf buffers and
 // point attribute arrays, k-d tree nodes, per-leaf vectors) from 4 KiB pages: their first touch
@@ -25,8 +30,11 @@
 #ifndef VDBHAIR_PROGRAM_RELATIVE
 #error "VDBHAIR_PROGRAM_RELATIVE: the program's path relative to the launcher's folder"
 #endif
+#ifndef VDBHAIR_LITE_PROGRAM_RELATIVE
+#error "VDBHAIR_LITE_PROGRAM_RELATIVE: the light program's path relative to the launcher's folder"
+#endif
 
-int main(int, char** argv)
+int main(int argc, char** argv)
 {
     char self[PATH_MAX];
     const ssize_t n = ::readlink("/proc/self/exe", self, sizeof(self) - 1);
@@ -37,7 +45,8 @@ int main(int, char** argv)
     self[n] = '\0';
     std::string program(self);
     program.erase(program.rfind('/') + 1);
-    program += VDBHAIR_PROGRAM_RELATIVE;
+    const bool light = argc < 2 || argv[1][0] == '-' || std::strcmp(argv[1], "help") == 0 || std::strcmp(argv[1], "info") == 0;
+    program += light ? VDBHAIR_LITE_PROGRAM_RELATIVE : VDBHAIR_PROGRAM_RELATIVE;
     const char* tunables = std::getenv("GLIBC_TUNABLES");
     if (!tunables || !std::strstr(tunables, "glibc.malloc.hugetlb")) {
         const std::string value = tunables && *tunables ? std::string(tunables) + ":glibc.malloc.hugetlb=1" : "glibc.malloc.hugetlb=1";

@@ -10,9 +10,11 @@
 
 namespace vdbhair {
 
-/// @brief summarizeStrands(readStrands(@a path, @a opts, @a report)), the same figures, warnings
-/// and errors; a `.data` file is measured in place (summarizeData(), DataFile.h), any other format
-/// is read first.
+/// @brief summarizeStrands(readNonVdbStrands(@a path, @a opts, @a report)), the same figures,
+/// warnings and errors; a `.data` file is measured in place (summarizeData(), DataFile.h), any
+/// other format is read first. No OpenVDB library: the light program (apps/lite) runs it. The
+/// strands of a `.vdb` file are summarized with summarizeStrands(readStrands()).
+/// @throw ValueError for a `.vdb` file.
 StrandSummary summarizeStrandFile(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 
 } // namespace vdbhair

@@ -39,8 +39,18 @@ const char* formatName(StrandFormat format);
 /// @brief Whether @a path has an extension vdbhair reads as strands.
 bool isStrandFile(const std::string& path);
 
+/// @brief The format of the strand file @a path (strandFormatFromPath()), after checking that a
+/// path that exists is a regular file (a folder has no extension to go by).
+/// @throw ValueError (unknown extension), IoError (not a regular file).
+StrandFormat strandFileFormat(const std::string& path);
+
 /// @brief Read strands from any supported file.
 StrandSet readStrands(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
+
+/// @brief Read strands from a file of any supported format but .vdb: readStrands() without the
+/// OpenVDB library (StrandFormats.cc), for the light program (apps/lite).
+/// @throw ValueError for a .vdb file; what readStrands() throws otherwise.
+StrandSet readNonVdbStrands(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 
 struct WriteOptions
 {

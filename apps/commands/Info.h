@@ -1,0 +1,48 @@
+/// @file Info.h
+/// @brief `vdbhair info`, in two halves: Info.cc (registration and strand files, no OpenVDB
+/// library: the light program links it) and InfoVdb.cc (.vdb files).
+#pragma once
+
+#include "../Command.h"
+
+#include <vdbhair/io/ReadOptions.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <functional>
+#include <string>
+
+namespace vdbhair::app {
+
+struct InfoParams
+{
+    std::string input;
+    bool strict = false;
+    std::string grid;  ///< a .vdb's points grid to summarize as strands; empty: list every grid
+
+    /// The reader's options these ask for (--strict, --grid).
+    ReadOptions readOptions() const;
+};
+
+/// @brief Print the summary @a s of the strand file @a p.input (and the reader's warnings of
+/// @a report), as prose or JSON. @return 0
+int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadReport& report, const CommonOptions& common);
+
+/// Runs `info` on a .vdb file: InfoVdb.cc's infoVdbFile() in the full program.
+using InfoVdbRunner = std::function<int(const InfoParams&, const CommonOptions&)>;
+
+/// @brief `info` registered on @a app; a .vdb file goes to @a vdbFile.
+Command addInfoVerb(CLI::App& app, CommonOptions& common, const InfoVdbRunner& vdbFile);
+
+/// @brief `info` of a .vdb file: its grids, or with --grid the strands of that points grid.
+int infoVdbFile(const InfoParams& p, const CommonOptions& common);
+
+namespace info {
+nlohmann::json vec3Json(const Vec3d& v);
+nlohmann::json metaJson(const MetaValue& m);
+/// @a v in six significant digits.
+std::string fmt(double v);
+/// @a v as (x, y, z) in fmt().
+std::string fmtVec(const Vec3d& v);
+} // namespace info
+
+} // namespace vdbhair::app
