@@ -20,6 +20,9 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <memory>
+#include <new>
+#include <type_traits>
 #include <unordered_map>
 
 namespace vdbhair {
@@ -106,6 +109,40 @@ float spreadOf(const Moments& mo, const openvdb::Vec3f& v)
     return float(std::min(1.0, std::max(0.0, 1.0 - vmv / d)));
 }
 
+/// @brief An array that grows by whole pages and never moves what it holds: a chunk's moments and
+/// blocks. A std::vector that doubles copied its contents into fresh memory at every growth,
+/// which the kernel had to clear first (about a fifth of `field`'s CPU went to clearing pages);
+/// here each element is written once, into the page it stays in. For trivially copyable T.
+template<typename T, unsigned kPageBits>
+class PagedArray
+{
+    static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+    static constexpr std::size_t kPage = std::size_t(1) << kPageBits;
+
+    struct Free
+    {
+        void operator()(T* p) const { ::operator delete(p, std::align_val_t(alignof(T))); }
+    };
+
+public:
+    std::size_t size() const { return mSize; }
+    T& operator[](std::size_t i) { return mPages[i >> kPageBits].get()[i & (kPage - 1)]; }
+    const T& operator[](std::size_t i) const { return mPages[i >> kPageBits].get()[i & (kPage - 1)]; }
+
+    /// The new last element, uninitialized.
+    T& grow()
+    {
+        if ((mSize & (kPage - 1)) == 0) {
+            mPages.emplace_back(static_cast<T*>(::operator new(sizeof(T) * kPage, std::align_val_t(alignof(T)))));
+        }
+        return (*this)[mSize++];
+    }
+
+private:
+    std::vector<std::unique_ptr<T, Free>> mPages;
+    std::size_t mSize = 0;
+};
+
 /// The accumulation of one chunk of strands. Moments live in one array; each touched leaf-sized
 /// block (8³ voxels) maps its voxels to slots in it. Consecutive flushes of a strand mostly hit
 /// the same block, which is cached, so a flush costs a compare, an index and three SIMD adds.
@@ -117,9 +154,9 @@ struct Chunk
         std::uint32_t slot[512];
     };
     std::unordered_map<Coord, std::uint32_t> blockOf;  // block origin -> block index
-    std::vector<Block> blocks;
+    PagedArray<Block, 9> blocks;                       // 1 MiB pages
     std::vector<Coord> origins;
-    std::vector<Moments> moments;
+    PagedArray<Moments, 15> moments;                   // 1.5 MiB pages
 
     /// The block of @a origin, or nullptr.
     const Block* find(const Coord& origin) const
@@ -160,8 +197,8 @@ private:
         mOrigin = origin;
         const auto [it, inserted] = mChunk.blockOf.try_emplace(origin, std::uint32_t(mChunk.blocks.size()));
         if (inserted) {
-            mChunk.blocks.emplace_back();
-            std::fill(std::begin(mChunk.blocks.back().slot), std::end(mChunk.blocks.back().slot), Chunk::kEmpty);
+            Chunk::Block& block = mChunk.blocks.grow();
+            std::fill(std::begin(block.slot), std::end(block.slot), Chunk::kEmpty);
             mChunk.origins.push_back(origin);
         }
         mSlots = mChunk.blocks[it->second].slot;
@@ -170,13 +207,12 @@ private:
     __attribute__((noinline)) void newSlot(std::uint32_t& slot, const Moments& m)
     {
         slot = std::uint32_t(mChunk.moments.size());
-        mChunk.moments.push_back(m);
+        mChunk.moments.grow() = m;
     }
 
     Chunk& mChunk;
     Coord mOrigin;
-    /// The cached block's slots. Adding a block may move the blocks, and add() then re-points
-    /// this at once; a chunk has one writer.
+    /// The cached block's slots (blocks never move); a chunk has one writer.
     std::uint32_t* mSlots = nullptr;
 };
 
@@ -402,7 +438,8 @@ constexpr std::uint64_t kMaxCountedBlocks = std::uint64_t(1) << 27;
 /// @brief The 8^3 leaf blocks the segments of @a strands pass through (what the accumulation
 /// touches: the leaves of every grid), counted with a bit per block of the index bounding box;
 /// min(@a visits, blocks of the box) when the box has more than kMaxCountedBlocks blocks.
-std::uint64_t countLeaves(const StrandSet& strands, const FieldMapping& map, std::uint64_t visits)
+/// @a extent is measure()'s of the same strands and map.
+std::uint64_t countLeaves(const StrandSet& strands, const FieldMapping& map, std::uint64_t visits, const Extent& extent)
 {
     const std::size_t nS = strands.numStrands();
     struct Box
@@ -410,27 +447,37 @@ std::uint64_t countLeaves(const StrandSet& strands, const FieldMapping& map, std
         Coord lo{std::numeric_limits<int>::max()}, hi{std::numeric_limits<int>::min()};
     };
     Box box;
-    withToIndex(map, [&](const auto& toIndex) {
-        box = tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, nS, 256), Box(),
-            [&](const tbb::blocked_range<std::size_t>& r, Box b) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                    const Vec3f* v = strands.data(i);
-                    for (std::size_t j = 0, n = strands.size(i); j < n; ++j) {
-                        const Coord c = voxelOf(toIndex(v[j]));
-                        const Coord blk(c.x() >> 3, c.y() >> 3, c.z() >> 3);
-                        b.lo.minComponent(blk);
-                        b.hi.maxComponent(blk);
+    const auto blockOf = [](const Coord& c) { return Coord(c.x() >> 3, c.y() >> 3, c.z() >> 3); };
+    if (map.isAxisAlignedWorld() && map.invScale().x() > 0.0 && map.invScale().y() > 0.0 && map.invScale().z() > 0.0) {
+        // Each index coordinate grows with its world coordinate alone (a difference and a positive
+        // factor, then floor: every step rounds monotonically), so the blocks' box is that of the
+        // vertices' box corners: no pass over the vertices.
+        if (extent.box.empty()) return 0;
+        const AxisAlignedToIndex toIndex{map.offset(), map.invScale()};
+        box.lo = blockOf(voxelOf(toIndex(extent.box.min)));
+        box.hi = blockOf(voxelOf(toIndex(extent.box.max)));
+    } else {
+        withToIndex(map, [&](const auto& toIndex) {
+            box = tbb::parallel_reduce(
+                tbb::blocked_range<std::size_t>(0, nS, 256), Box(),
+                [&](const tbb::blocked_range<std::size_t>& r, Box b) {
+                    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const Vec3f* v = strands.data(i);
+                        for (std::size_t j = 0, n = strands.size(i); j < n; ++j) {
+                            const Coord blk = blockOf(voxelOf(toIndex(v[j])));
+                            b.lo.minComponent(blk);
+                            b.hi.maxComponent(blk);
+                        }
                     }
-                }
-                return b;
-            },
-            [](Box a, const Box& b) {
-                a.lo.minComponent(b.lo);
-                a.hi.maxComponent(b.hi);
-                return a;
-            });
-    });
+                    return b;
+                },
+                [](Box a, const Box& b) {
+                    a.lo.minComponent(b.lo);
+                    a.hi.maxComponent(b.hi);
+                    return a;
+                });
+        });
+    }
     if (box.lo.x() > box.hi.x()) return 0;
     const std::uint64_t nx = std::uint64_t(box.hi.x() - box.lo.x()) + 1, ny = std::uint64_t(box.hi.y() - box.lo.y()) + 1,
                         nz = std::uint64_t(box.hi.z() - box.lo.z()) + 1;
@@ -478,8 +525,10 @@ std::uint64_t visitBound(const StrandSet& strands, const FieldMapping& map)
     return std::min(measure(strands, map, true).visits, kSaturated);
 }
 
+/// @param measured measure()'s extent of @a strands at @a voxelSize when the memory check took it
+/// already (checkFieldMemory()), or null
 TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, double voxelSize, int level, int levels,
-                           bool threaded, openvdb::util::NullInterrupter* interrupter)
+                           bool threaded, openvdb::util::NullInterrupter* interrupter, const Extent* measured = nullptr)
 {
     const FieldMapping map = mappingFor(p, voxelSize);
     const std::size_t nS = strands.numStrands(), nChunks = chunkCount(nS);
@@ -489,7 +538,10 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     // strands share voxels, so a chunk's moments stay small and in cache.
     Extent extent;
     std::vector<std::uint32_t> order;
-    if (threaded) {
+    if (measured) {
+        extent = *measured;
+        order = spatialOrder(strands);
+    } else if (threaded) {
         tbb::parallel_invoke([&] { extent = measure(strands, map, true); }, [&] { order = spatialOrder(strands); });
     } else {
         extent = measure(strands, map, false);
@@ -533,17 +585,22 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     if (progress.stopped()) throw InterruptedError("estimateTangentField: interrupted");
 
     // Topology: every block any chunk touched, as leaves of the output trees.
+    // The other trees copy the tangent tree's topology, in parallel (OpenVDB's topology copy).
     openvdb::Vec3STree::Ptr tangentTree(new openvdb::Vec3STree(openvdb::Vec3f(0.f)));
-    openvdb::FloatTree::Ptr densityTree(new openvdb::FloatTree(0.f));
-    openvdb::FloatTree::Ptr coherenceTree(new openvdb::FloatTree(0.f));
-    openvdb::FloatTree::Ptr spreadTree(new openvdb::FloatTree(0.f));
     for (const Chunk& c : chunks) {
-        for (const Coord& origin : c.origins) {
-            tangentTree->touchLeaf(origin);
-            densityTree->touchLeaf(origin);
-            coherenceTree->touchLeaf(origin);
-            spreadTree->touchLeaf(origin);
-        }
+        for (const Coord& origin : c.origins) tangentTree->touchLeaf(origin);
+    }
+    openvdb::FloatTree::Ptr densityTree, coherenceTree, spreadTree;
+    const auto copyTopology = [&](openvdb::FloatTree::Ptr& tree) {
+        tree.reset(new openvdb::FloatTree(*tangentTree, 0.f, openvdb::TopologyCopy()));
+    };
+    if (threaded) {
+        tbb::parallel_invoke([&] { copyTopology(densityTree); }, [&] { copyTopology(coherenceTree); },
+                             [&] { copyTopology(spreadTree); });
+    } else {
+        copyTopology(densityTree);
+        copyTopology(coherenceTree);
+        copyTopology(spreadTree);
     }
 
     // Per leaf: merge the chunks in order, then Eq. 9 and the density.
@@ -662,40 +719,56 @@ FieldParams resolvedParams(const StrandSet& strands, const FieldParams& params, 
     return p;
 }
 
+FieldFootprint footprintOf(const StrandSet& strands, const FieldParams& params, Extent& extent);
+
 /// Refuse a field of @a levels levels at @a p (voxel size resolved) whose estimate exceeds the
 /// memory it may use; nothing is counted when there is no limit (maxMemory at its largest).
-void checkFieldMemory(const StrandSet& strands, const FieldParams& p, int levels)
+/// @return each level's extent, as estimateLevel() measures it, when they were measured; else empty
+std::vector<Extent> checkFieldMemory(const StrandSet& strands, const FieldParams& p, int levels)
 {
-    if (p.maxMemory == std::numeric_limits<std::uint64_t>::max()) return;
+    if (p.maxMemory == std::numeric_limits<std::uint64_t>::max()) return {};
     std::vector<FieldFootprint> footprints;
+    std::vector<Extent> extents(static_cast<std::size_t>(levels));
     FieldParams lp = p;
     std::uint64_t leaves = 0;
     for (int l = 0; l < levels; ++l) {
         lp.voxelSize = p.voxelSize * double(1 << l);
-        footprints.push_back(estimateFieldFootprint(strands, lp));
+        footprints.push_back(footprintOf(strands, lp, extents[std::size_t(l)]));
         leaves += footprints.back().leaves;
     }
     checkMemoryEstimate("estimateTangentField", estimatePeakBytes(footprints, MemoryUse::Field),
                         std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) + " vertices, " +
                             std::to_string(leaves) + " leaves at voxel size " + std::to_string(p.voxelSize),
                         p);
+    return extents;
 }
 
 } // namespace
 
-FieldFootprint estimateFieldFootprint(const StrandSet& strands, const FieldParams& params)
+namespace {
+
+/// estimateFieldFootprint(), and the extent it measured in @a extent.
+FieldFootprint footprintOf(const StrandSet& strands, const FieldParams& params, Extent& extent)
 {
     const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
     const FieldMapping map = mappingFor(p, p.voxelSize);
     FieldFootprint f;
     f.strands = strands.numStrands();
     f.vertices = strands.numVertices();
-    const Extent extent = measure(strands, map, true);
+    extent = measure(strands, map, true);
     checkIndexRange(extent, map, p.voxelSize);  // as estimateTangentField() does, before counting
     f.visits = std::min(extent.visits, kSaturated);
     checkVisits(f.visits, p, p.voxelSize);  // also bounds the walk of countLeaves()
-    f.leaves = countLeaves(strands, map, f.visits);
+    f.leaves = countLeaves(strands, map, f.visits, extent);
     return f;
+}
+
+} // namespace
+
+FieldFootprint estimateFieldFootprint(const StrandSet& strands, const FieldParams& params)
+{
+    Extent extent;
+    return footprintOf(strands, params, extent);
 }
 
 namespace {
@@ -809,8 +882,8 @@ TangentField estimateTangentField(const StrandSet& strands, const FieldParams& p
                                   openvdb::util::NullInterrupter* interrupter)
 {
     const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
-    checkFieldMemory(strands, p, 1);
-    return estimateLevel(strands, p, p.voxelSize, 0, 1, threaded, interrupter);
+    const std::vector<Extent> extents = checkFieldMemory(strands, p, 1);
+    return estimateLevel(strands, p, p.voxelSize, 0, 1, threaded, interrupter, extents.empty() ? nullptr : &extents[0]);
 }
 
 std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, const FieldParams& params, int levels,
@@ -821,11 +894,12 @@ std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, c
                          std::to_string(FieldParams::kMaxLevels));
     }
     FieldParams lp = resolvedParams(strands, params, "estimateTangentField");
-    checkFieldMemory(strands, lp, levels);
+    const std::vector<Extent> extents = checkFieldMemory(strands, lp, levels);
     const double voxelSize = lp.voxelSize;
     std::vector<TangentField> out;
     for (int l = 0; l < levels; ++l) {
-        out.push_back(estimateLevel(strands, lp, voxelSize * double(1 << l), l, levels, threaded, interrupter));
+        out.push_back(estimateLevel(strands, lp, voxelSize * double(1 << l), l, levels, threaded, interrupter,
+                                    extents.empty() ? nullptr : &extents[std::size_t(l)]));
         lp.densityReference = out.front().densityReference;  // one meaning for every level
     }
     return out;
