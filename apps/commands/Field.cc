@@ -98,6 +98,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     fp.maxVoxels = p.maxVoxels;
     fp.maxMemory = p.maxMemory;
     fp.densityReference = p.densityReference;
+    fp.coherenceAndSpread = false;  // not written (below)
     applyScalpOptions(p.scalp, strands, fp, common);
 
     const auto t0 = std::chrono::steady_clock::now();

@@ -7,6 +7,8 @@
 #include <openvdb/tools/Count.h>
 #include <tbb/global_control.h>
 
+#include <cstring>
+#include <limits>
 #include <random>
 
 using namespace vdbhair;
@@ -144,6 +146,53 @@ TEST_CASE("estimateTangentField: bitwise identical with 1 and 2 threads", "[fiel
         REQUIRE(std::memcmp(&(*it), &acc.getValue(it.getCoord()), sizeof(openvdb::Vec3f)) == 0);
         const float d1 = one.density->tree().getValue(it.getCoord()), d2 = dacc.getValue(it.getCoord());
         REQUIRE(std::memcmp(&d1, &d2, sizeof(float)) == 0);
+    }
+}
+
+TEST_CASE("estimateTangentField: the same grids with or without the memory check, and without coherence and spread", "[field]")
+{
+    // The memory check measures the vertices' extent and the estimate reuses it; with no memory
+    // limit the estimate measures it itself. coherenceAndSpread = false leaves out two grids only.
+    StrandSet s;
+    std::mt19937 rng(13);
+    std::normal_distribution<float> n(0.f, 1.f);
+    for (int i = 0; i < 2000; ++i) {
+        std::vector<Vec3f> pts{Vec3f(n(rng), n(rng), n(rng))};
+        for (int k = 0; k < 10; ++k) pts.push_back(pts.back() + Vec3f(0.3f + 0.1f * n(rng), 0.1f * n(rng), 0.1f * n(rng)));
+        s.addStrand(pts);
+    }
+    FieldParams checked;
+    checked.voxelSize = 0.2;
+    FieldParams unchecked = checked;
+    unchecked.maxMemory = std::numeric_limits<std::uint64_t>::max();
+    FieldParams lean = checked;
+    lean.coherenceAndSpread = false;
+    const std::vector<TangentField> a = estimateTangentFieldLevels(s, checked, 2), b = estimateTangentFieldLevels(s, unchecked, 2),
+                                    c = estimateTangentFieldLevels(s, lean, 2);
+    for (std::size_t l = 0; l < 2; ++l) {
+        CAPTURE(l);
+        REQUIRE(c[l].coherence == nullptr);
+        REQUIRE(c[l].spread == nullptr);
+        REQUIRE(c[l].grids().size() == 3);
+        REQUIRE(a[l].coherence != nullptr);
+        REQUIRE(a[l].tangent->activeVoxelCount() > 1000);
+        for (const TangentField* other : {&b[l], &c[l]}) {
+            REQUIRE(other->tangent->activeVoxelCount() == a[l].tangent->activeVoxelCount());
+            REQUIRE(other->tangent->tree().leafCount() == a[l].tangent->tree().leafCount());
+            auto acc = other->tangent->getConstAccessor();
+            auto dacc = other->density->getConstAccessor();
+            auto hacc = other->hairLength->getConstAccessor();
+            for (auto it = a[l].tangent->cbeginValueOn(); it; ++it) {
+                REQUIRE(acc.isValueOn(it.getCoord()));
+                REQUIRE(std::memcmp(&(*it), &acc.getValue(it.getCoord()), sizeof(openvdb::Vec3f)) == 0);
+                const float d1 = a[l].density->tree().getValue(it.getCoord()), d2 = dacc.getValue(it.getCoord());
+                REQUIRE(std::memcmp(&d1, &d2, sizeof(float)) == 0);
+                const float h1 = a[l].hairLength->tree().getValue(it.getCoord()), h2 = hacc.getValue(it.getCoord());
+                REQUIRE(std::memcmp(&h1, &h2, sizeof(float)) == 0);
+            }
+        }
+        const auto& bc = b[l].coherence->tree();
+        for (auto it = a[l].coherence->cbeginValueOn(); it; ++it) REQUIRE(bc.getValue(it.getCoord()) == *it);
     }
 }
 

@@ -594,13 +594,14 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     const auto copyTopology = [&](openvdb::FloatTree::Ptr& tree) {
         tree.reset(new openvdb::FloatTree(*tangentTree, 0.f, openvdb::TopologyCopy()));
     };
-    if (threaded) {
+    const bool extra = p.coherenceAndSpread;
+    if (threaded && extra) {
         tbb::parallel_invoke([&] { copyTopology(densityTree); }, [&] { copyTopology(coherenceTree); },
                              [&] { copyTopology(spreadTree); });
     } else {
         copyTopology(densityTree);
-        copyTopology(coherenceTree);
-        copyTopology(spreadTree);
+        if (extra) copyTopology(coherenceTree);
+        if (extra) copyTopology(spreadTree);
     }
 
     // Per leaf: merge the chunks in order, then Eq. 9 and the density.
@@ -624,14 +625,15 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
             }
         }
         auto* dl = densityTree->probeLeaf(leaf.origin());
-        auto* cl = coherenceTree->probeLeaf(leaf.origin());
-        auto* sl = spreadTree->probeLeaf(leaf.origin());
+        auto* cl = extra ? coherenceTree->probeLeaf(leaf.origin()) : nullptr;
+        auto* sl = extra ? spreadTree->probeLeaf(leaf.origin()) : nullptr;
         for (openvdb::Index k = 0; k < 512; ++k) {
             if (!hit[k]) continue;
             const Moments& mo = sum[k];
             const openvdb::Vec3f v = robustDirection(mo, p.iterations);
             leaf.setValueOn(k, v);
             dl->setValueOn(k, mo.density());
+            if (!extra) continue;
             cl->setValueOn(k, coherenceOf(mo));
             sl->setValueOn(k, spreadOf(mo, v));
         }
@@ -664,12 +666,14 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     }
     out.tangent = openvdb::Vec3SGrid::create(tangentTree);
     out.density = openvdb::FloatGrid::create(densityTree);
-    out.coherence = openvdb::FloatGrid::create(coherenceTree);
-    out.spread = openvdb::FloatGrid::create(spreadTree);
     out.tangent->setName(tangentGridName(level, levels));
     out.density->setName(densityGridName(level, levels));
-    out.coherence->setName(coherenceGridName(level, levels));
-    out.spread->setName(spreadGridName(level, levels));
+    if (extra) {
+        out.coherence = openvdb::FloatGrid::create(coherenceTree);
+        out.spread = openvdb::FloatGrid::create(spreadTree);
+        out.coherence->setName(coherenceGridName(level, levels));
+        out.spread->setName(spreadGridName(level, levels));
+    }
     out.tangent->setGridClass(openvdb::GRID_UNKNOWN);
     // World-space grids hold world directions that move with the transform's Jacobian
     // (contravariant relative, like velocity); scalp-space grids hold world directions on a
@@ -681,6 +685,7 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(out.tangent.get()), static_cast<openvdb::GridBase*>(out.density.get()),
                                  static_cast<openvdb::GridBase*>(out.hairLength.get()), static_cast<openvdb::GridBase*>(out.coherence.get()),
                                  static_cast<openvdb::GridBase*>(out.spread.get())}) {
+        if (!g) continue;  // coherence and spread when not asked for
         g->setTransform(map.transform().copy());
         setFieldMetadata(*g, voxelSize, p.iterations, p.space, map.scalp(), level, levels, strands.numStrands(), map.scalpSurface().get());
     }

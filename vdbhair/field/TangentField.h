@@ -64,6 +64,9 @@ struct FieldParams
     /// (availableMemoryBytes()). A request whose estimate (estimatePeakBytes()) is larger fails
     /// with LimitError before allocating; no limit (the largest value) skips the estimate.
     std::uint64_t maxMemory = 0;
+    /// Also estimate TangentField::coherence and TangentField::spread (two more grids, which
+    /// `refine` needs); false leaves them null (`vdbhair field`, which writes neither).
+    bool coherenceAndSpread = true;
 };
 
 /// @brief Put @a params in scalp space for hair with @a roots: on @a sphere when given, else on
