@@ -329,6 +329,10 @@ TEST_CASE("estimateTangentField: an estimate above maxMemory is refused before a
     p.voxelSize = 0.25;
     p.maxMemory = 1000;
     REQUIRE_THROWS_AS(estimateTangentField(s, p), LimitError);
+    // A refusal names the leaves counted exactly (the check bounds them by their box first).
+    const FieldFootprint exact = estimateFieldFootprint(s, p);
+    REQUIRE(exact.leaves > 0);
+    REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains(", " + std::to_string(exact.leaves) + " leaves at voxel size "));
     // The estimate, its terms, what is available and the rule, naming the library's parameter.
     REQUIRE_THROWS_WITH(estimateTangentFieldLevels(s, p, 2),
                         Contains("estimateTangentField: needs about ") && Contains(" MiB (9 strands, 180 vertices, ") &&
