@@ -47,6 +47,12 @@ constexpr Verb kVerbs[] = {
 };
 } // namespace
 
+void keepUntilExit(std::shared_ptr<const void> object)
+{
+    static std::vector<std::shared_ptr<const void>> kept;
+    kept.push_back(std::move(object));
+}
+
 const std::vector<Verb>& verbs()
 {
     static const std::vector<Verb> all(std::begin(kVerbs), std::end(kVerbs));
