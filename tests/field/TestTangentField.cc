@@ -32,6 +32,20 @@ StrandSet parallelStrands(const Vec3f& dir, int side, float spacing, float lengt
     return s;
 }
 
+/// @a count random walks of @a steps steps, mostly along +x, rooted around the origin.
+StrandSet randomWalks(unsigned seed, int count, int steps)
+{
+    StrandSet s;
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> n(0.f, 1.f);
+    for (int i = 0; i < count; ++i) {
+        std::vector<Vec3f> pts{Vec3f(n(rng), n(rng), n(rng))};
+        for (int k = 0; k < steps; ++k) pts.push_back(pts.back() + Vec3f(0.3f + 0.1f * n(rng), 0.1f * n(rng), 0.1f * n(rng)));
+        s.addStrand(pts);
+    }
+    return s;
+}
+
 } // namespace
 
 TEST_CASE("estimateTangentField: a straight parallel hairstyle gives a uniform field", "[field]")
@@ -119,14 +133,7 @@ TEST_CASE("estimateTangentField: opposing strands cancel to a zero vector in an 
 
 TEST_CASE("estimateTangentField: bitwise identical with 1 and 2 threads", "[field]")
 {
-    StrandSet s;
-    std::mt19937 rng(11);
-    std::normal_distribution<float> n(0.f, 1.f);
-    for (int i = 0; i < 3000; ++i) {
-        std::vector<Vec3f> pts{Vec3f(n(rng), n(rng), n(rng))};
-        for (int k = 0; k < 12; ++k) pts.push_back(pts.back() + Vec3f(0.3f + 0.1f * n(rng), 0.1f * n(rng), 0.1f * n(rng)));
-        s.addStrand(pts);
-    }
+    const StrandSet s = randomWalks(11, 3000, 12);
     FieldParams p;
     p.voxelSize = 0.25;
     TangentField one, two;
@@ -153,14 +160,7 @@ TEST_CASE("estimateTangentField: the same grids with or without the memory check
 {
     // The memory check measures the vertices' extent and the estimate reuses it; with no memory
     // limit the estimate measures it itself. coherenceAndSpread = false leaves out two grids only.
-    StrandSet s;
-    std::mt19937 rng(13);
-    std::normal_distribution<float> n(0.f, 1.f);
-    for (int i = 0; i < 2000; ++i) {
-        std::vector<Vec3f> pts{Vec3f(n(rng), n(rng), n(rng))};
-        for (int k = 0; k < 10; ++k) pts.push_back(pts.back() + Vec3f(0.3f + 0.1f * n(rng), 0.1f * n(rng), 0.1f * n(rng)));
-        s.addStrand(pts);
-    }
+    const StrandSet s = randomWalks(13, 2000, 10);
     FieldParams checked;
     checked.voxelSize = 0.2;
     FieldParams unchecked = checked;
