@@ -43,7 +43,7 @@ constexpr Verb kVerbs[] = {
     {"inspect", "Look into a .vdb file: value statistics, tiles, memory, bounds, leaf fill, metadata in words; slices as images"},
     {"render", "Preview strands as an image: lit fibres, depth-correct, anti-aliased"},
     {"demo", "The main job: refine a hairstyle through its own tangent field, all results in one folder"},
-    {"batch", "Run one verb over a dataset: each input in its own process, records in OUTDIR/batch.jsonl, " "resumable, sharded for schedulers (Slurm arrays)"},
+    {"batch", "Run one verb over a dataset: each input in its own process, records in OUTDIR/batch.jsonl, resumable, sharded for schedulers (Slurm arrays)"},
 };
 } // namespace
 

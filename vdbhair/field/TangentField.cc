@@ -111,8 +111,9 @@ float spreadOf(const Moments& mo, const openvdb::Vec3f& v)
 
 /// @brief An array that grows by whole pages and never moves what it holds: a chunk's moments and
 /// blocks. A std::vector that doubles copied its contents into fresh memory at every growth,
-/// which the kernel had to clear first (about a fifth of `field`'s CPU went to clearing pages);
-/// here each element is written once, into the page it stays in. For trivially copyable T.
+/// which the kernel had to clear first (clearing pages was a fifth of `field`'s CPU, these copies
+/// part of it); here each element is written once, into the page it stays in. For trivially
+/// copyable T.
 template<typename T, unsigned kPageBits>
 class PagedArray
 {
@@ -726,7 +727,22 @@ FieldParams resolvedParams(const StrandSet& strands, const FieldParams& params, 
     return p;
 }
 
-FieldFootprint footprintOf(const StrandSet& strands, const FieldParams& params, Extent& extent, bool exactLeaves);
+/// estimateFieldFootprint(), and the extent it measured in @a extent; unless @a exactLeaves, the
+/// leaves are countLeaves()'s bound.
+FieldFootprint footprintOf(const StrandSet& strands, const FieldParams& params, Extent& extent, bool exactLeaves)
+{
+    const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
+    const FieldMapping map = mappingFor(p, p.voxelSize);
+    FieldFootprint f;
+    f.strands = strands.numStrands();
+    f.vertices = strands.numVertices();
+    extent = measure(strands, map, true);
+    checkIndexRange(extent, map, p.voxelSize);  // as estimateTangentField() does, before counting
+    f.visits = std::min(extent.visits, kSaturated);
+    checkVisits(f.visits, p, p.voxelSize);  // also bounds the walk of countLeaves()
+    f.leaves = countLeaves(strands, map, f.visits, extent, exactLeaves);
+    return f;
+}
 
 /// Refuse a field of @a levels levels at @a p (voxel size resolved) whose estimate exceeds the
 /// memory it may use; nothing is counted when there is no limit (maxMemory at its largest).
@@ -758,27 +774,6 @@ std::vector<Extent> checkFieldMemory(const StrandSet& strands, const FieldParams
                             std::to_string(leaves) + " leaves at voxel size " + std::to_string(p.voxelSize),
                         p);
     return extents;
-}
-
-} // namespace
-
-namespace {
-
-/// estimateFieldFootprint(), and the extent it measured in @a extent; unless @a exactLeaves, the
-/// leaves are countLeaves()'s bound.
-FieldFootprint footprintOf(const StrandSet& strands, const FieldParams& params, Extent& extent, bool exactLeaves)
-{
-    const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
-    const FieldMapping map = mappingFor(p, p.voxelSize);
-    FieldFootprint f;
-    f.strands = strands.numStrands();
-    f.vertices = strands.numVertices();
-    extent = measure(strands, map, true);
-    checkIndexRange(extent, map, p.voxelSize);  // as estimateTangentField() does, before counting
-    f.visits = std::min(extent.visits, kSaturated);
-    checkVisits(f.visits, p, p.voxelSize);  // also bounds the walk of countLeaves()
-    f.leaves = countLeaves(strands, map, f.visits, extent, exactLeaves);
-    return f;
 }
 
 } // namespace

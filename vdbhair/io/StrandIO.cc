@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/DataFile.h>
+#include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/HairFile.h>
 #include <vdbhair/io/ObjFile.h>
 
@@ -9,8 +10,9 @@ namespace vdbhair {
 
 StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
-    if (strandFileFormat(path) == StrandFormat::Vdb) return readVdbStrands(path, opts, report, opts.vdbGrid);
-    return readNonVdbStrands(path, opts, report);
+    if (fileExtension(path) != ".vdb") return readNonVdbStrands(path, opts, report);  // checks the path itself
+    strandFileFormat(path);  // a folder named .vdb: the same message as any other format's
+    return readVdbStrands(path, opts, report, opts.vdbGrid);
 }
 
 void writeStrands(const std::string& path, const StrandSet& strands, const WriteOptions& opts)
