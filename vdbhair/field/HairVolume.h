@@ -10,6 +10,7 @@
 
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
 #include <cstddef>
 
 namespace vdbhair {
@@ -27,12 +28,25 @@ public:
     {
     public:
         explicit Probe(const HairVolume& v) : mV(v), mAcc(v.mTree) {}
-        bool contains(const Vec3d& world) { return mAcc.isValueOn(openvdb::Coord::round(mV.mMap.worldToIndex(world))); }
+        bool contains(const Vec3d& world) { return mAcc.isValueOn(nearestVoxel(mV.mMap.worldToIndex(world))); }
         /// @brief Whether the vertices of @a p (n of them) and points at most half a voxel apart
         /// between them are all inside.
         bool containsPolyline(const Vec3f* p, std::size_t n);
 
     private:
+        /// openvdb::Coord::round(@a p) (floor(x + 0.5) on each axis) without a call to floor()
+        /// per axis; positions beyond ±2^30 (or NaN), where no voxel of a field is, clamp there.
+        static openvdb::Coord nearestVoxel(const Vec3d& p)
+        {
+            auto round = [](double x) {
+                constexpr double kLimit = double(1 << 30);
+                x = std::min(kLimit, std::max(-kLimit, x + 0.5));  // this order maps NaN to -kLimit
+                const int i = int(x);
+                return i - int(x < double(i));
+            };
+            return openvdb::Coord(round(p.x()), round(p.y()), round(p.z()));
+        }
+
         const HairVolume& mV;
         openvdb::tree::ValueAccessor<const openvdb::BoolTree> mAcc;
     };

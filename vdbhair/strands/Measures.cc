@@ -261,18 +261,24 @@ double meanVertexDisplacement(const StrandSet& a, const StrandSet& b, bool threa
             sb.resize(nb);
             arcLengths(a.data(i), na, sa.data());
             arcLengths(b.data(i), nb, sb.data());
+            const Vec3f* pa = a.data(i);
             const Vec3f* pb = b.data(i);
-            std::size_t j = 0;
-            for (std::size_t k = 0; k < na; ++k) {
+            // The strand's sum in a register (the same additions in the same order): through
+            // sum[i], each addition waited for the last one's store.
+            double total = 0.0;
+            std::size_t k = 0, j = 0;
+            const double end = sb[nb - 1] + 1e-6 * std::max(1.0, sb[nb - 1]);
+            for (; k < na; ++k) {
                 const double s = sa[k];
-                if (s > sb[nb - 1] + 1e-6 * std::max(1.0, sb[nb - 1])) break;
+                if (s > end) break;
                 while (j + 2 < nb && sb[j + 1] < s) ++j;
                 const double len = sb[j + 1] - sb[j];
                 const double f = len > 0.0 ? std::min(1.0, std::max(0.0, (s - sb[j]) / len)) : 0.0;
                 const Vec3d q = toD(pb[j]) + f * (toD(pb[j + 1]) - toD(pb[j]));
-                sum[i] += (toD(a.positions[a.begin(i) + k]) - q).length();
-                ++count[i];
+                total += (toD(pa[k]) - q).length();
             }
+            sum[i] = total;
+            count[i] = k;
         }
     };
     if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nS, 64), body);
