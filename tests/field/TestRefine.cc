@@ -117,6 +117,30 @@ TEST_CASE("HairVolume: the strands' voxels dilated by one, tested every half vox
     const std::vector<Vec3f> chord{Vec3f(0.f), Vec3f(10.f, 0.f, 0.f)};
     REQUIRE_FALSE(probe.containsPolyline(arc.data(), arc.size()));
     REQUIRE(probe.containsPolyline(chord.data(), chord.size()));
+
+    // containsChanged(): only the first vertex and the segments that differ from the reference
+    // are tested. A path out of the volume that the reference shares is not the change's doing.
+    const std::vector<Vec3f> outAndBack{Vec3f(0.f), Vec3f(3.f, 0.f, 0.f), Vec3f(3.f, 4.f, 0.f), Vec3f(6.f, 0.f, 0.f), Vec3f(10.f, 0.f, 0.f)};
+    std::vector<Vec3f> tipMoved = outAndBack;
+    tipMoved.back() = Vec3f(10.f, 0.5f, 0.f);  // inside (the dilation)
+    REQUIRE_FALSE(probe.containsPolyline(tipMoved.data(), tipMoved.size()));
+    REQUIRE(probe.containsChanged(tipMoved.data(), outAndBack.data(), tipMoved.size()));
+    REQUIRE(probe.containsChanged(outAndBack.data(), outAndBack.data(), outAndBack.size()));
+    std::vector<Vec3f> tipOut = outAndBack;
+    tipOut.back() = Vec3f(10.f, 2.f, 0.f);  // the changed segment leaves the volume
+    REQUIRE_FALSE(probe.containsChanged(tipOut.data(), outAndBack.data(), tipOut.size()));
+    // Against a straight reference, every segment of the detour differs and is tested.
+    std::vector<Vec3f> straight{Vec3f(0.f), Vec3f(3.f, 0.f, 0.f), Vec3f(4.5f, 0.f, 0.f), Vec3f(6.f, 0.f, 0.f), Vec3f(10.f, 0.f, 0.f)};
+    REQUIRE_FALSE(probe.containsChanged(outAndBack.data(), straight.data(), outAndBack.size()));
+    REQUIRE(probe.containsChanged(straight.data(), outAndBack.data(), straight.size()));
+    // A first vertex that differs is tested on its own.
+    std::vector<Vec3f> rootOut = straight, rootIn = straight;
+    rootOut.front() = Vec3f(0.f, 2.f, 0.f);
+    rootIn.front() = Vec3f(0.f, 0.5f, 0.f);
+    const std::vector<Vec3f> root{Vec3f(0.f, 2.f, 0.f)};
+    REQUIRE_FALSE(probe.containsChanged(root.data(), straight.data(), 1));
+    REQUIRE(probe.containsChanged(rootIn.data(), straight.data(), 1));
+    REQUIRE_FALSE(probe.containsChanged(rootOut.data(), straight.data(), rootOut.size()));
 }
 
 TEST_CASE("retraceConsistent: a strand whose retrace would leave the hair volume is left as it was", "[field]")

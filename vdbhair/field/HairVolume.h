@@ -32,6 +32,12 @@ public:
         /// @brief Whether the vertices of @a p (n of them) and points at most half a voxel apart
         /// between them are all inside.
         bool containsPolyline(const Vec3f* p, std::size_t n);
+        /// @brief containsPolyline(@a p, @a n) over the parts of @a p that differ from @a ref
+        /// (also n vertices): its first vertex if that differs, and each segment one of whose
+        /// vertices differs. The segments @a p shares with @a ref are not tested, so when this
+        /// is true and @a p is not inside, neither is @a ref (a retraced strand that leaves the
+        /// volume only where its input does is not the retrace's doing).
+        bool containsChanged(const Vec3f* p, const Vec3f* ref, std::size_t n);
 
     private:
         /// openvdb::Coord::round(@a p) (floor(x + 0.5) on each axis) without a call to floor()
@@ -46,6 +52,9 @@ public:
             };
             return openvdb::Coord(round(p.x()), round(p.y()), round(p.z()));
         }
+
+        /// The points of segment (a, b) at most half a voxel apart, b included, a not.
+        bool containsSegment(const Vec3d& a, const Vec3d& b, double half);
 
         const HairVolume& mV;
         openvdb::tree::ValueAccessor<const openvdb::BoolTree> mAcc;
