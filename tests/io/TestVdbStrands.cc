@@ -546,3 +546,38 @@ TEST_CASE("writeVdbStrands: extra per-strand attributes reach every point of the
     opts.strandAttributes = {{"bad:name", ids}};
     CHECK_THROWS_WITH(writeVdbStrands(path, s, opts), Catch::Contains("attribute name 'bad:name'"));
 }
+
+TEST_CASE("pointsVoxelSize: OpenVDB's computeVoxelSize, bit for bit", "[vdb][io]")
+{
+    namespace pts = openvdb::points;
+    auto openvdbs = [](const std::vector<Vec3f>& p, unsigned perVoxel) {
+        return pts::computeVoxelSize(pts::PointAttributeVector<Vec3f>(p), perVoxel);
+    };
+    std::vector<std::pair<std::string, std::vector<Vec3f>>> sets;
+    sets.emplace_back("no point", std::vector<Vec3f>{});
+    sets.emplace_back("one point", std::vector<Vec3f>{Vec3f(1.f, 2.f, 3.f)});
+    sets.emplace_back("coincident points", std::vector<Vec3f>(50, Vec3f(1.f, 2.f, 3.f)));
+    std::vector<Vec3f> line, plane, cloud, far, tiny;
+    for (int i = 0; i < 5000; ++i) {
+        const float t = float(i) * 0.37f;
+        line.emplace_back(t, 2.f * t, -t);                                    // collinear
+        plane.emplace_back(std::sin(t) * 30.f, std::cos(0.7f * t) * 12.f, 4.f); // coplanar
+        cloud.emplace_back(std::sin(1.3f * t) * 40.f, std::cos(0.9f * t) * 25.f + t * 0.01f, std::sin(0.31f * t) * 9.f);
+        tiny.emplace_back(1e-6f * std::sin(t), 1e-6f * std::cos(t), 1e-6f * std::sin(2.f * t));
+    }
+    far = cloud;
+    far.emplace_back(1e6f, -1e6f, 1e6f);  // a box of far more than 2^30 voxels: OpenVDB's own mask
+    sets.emplace_back("collinear", line);
+    sets.emplace_back("coplanar", plane);
+    sets.emplace_back("a cloud", cloud);
+    sets.emplace_back("a cloud and a far point", far);
+    sets.emplace_back("a micrometre cloud", tiny);
+    if (!test::sharedData().empty()) sets.emplace_back("harolongo.data", readStrands(test::sharedData() + "/hair/usc_data/harolongo.data").positions);
+    for (const auto& [name, p] : sets) {
+        for (unsigned perVoxel : {1u, 8u, 100000u}) {
+            INFO(name << ", " << perVoxel << " points per voxel");
+            REQUIRE(pointsVoxelSize(p, perVoxel) == openvdbs(p, perVoxel));
+        }
+    }
+    REQUIRE_THROWS_AS(pointsVoxelSize(cloud, 0), ValueError);
+}

@@ -10,12 +10,15 @@
 #include <openvdb/points/PointCount.h>
 #include <openvdb/points/PointGroup.h>
 #include <openvdb/tools/PointIndexGrid.h>
+#include <openvdb/tools/PointsToMask.h>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -67,6 +70,155 @@ private:
 
 } // namespace
 
+namespace {
+
+/// The voxels of @a xform that hold a point of @a positions, as openvdb::tools::PointsToMask
+/// activates them (worldToIndexCellCentered() of each point); @a box is the points' box.
+std::uint64_t occupiedVoxels(const std::vector<Vec3f>& positions, const openvdb::math::Transform& xform, const openvdb::BBoxd& box)
+{
+    // The index coordinate grows with the world coordinate on each axis (a positive uniform
+    // scale, then rounding): the voxels' box is that of the box's corners.
+    const openvdb::Coord lo = xform.worldToIndexCellCentered(box.min()), hi = xform.worldToIndexCellCentered(box.max());
+    const double dx = double(hi.x()) - lo.x() + 1, dy = double(hi.y()) - lo.y() + 1, dz = double(hi.z()) - lo.z() + 1;
+    if (!(dx * dy * dz <= double(std::uint64_t(1) << 30))) {
+        openvdb::MaskGrid mask(false);
+        mask.setTransform(xform.copy());
+        openvdb::tools::PointsToMask<openvdb::MaskGrid> op(mask);
+        op.addPoints<pts::PointAttributeVector<openvdb::Vec3f>, openvdb::Vec3f>(pts::PointAttributeVector<openvdb::Vec3f>(positions));
+        return mask.activeVoxelCount();
+    }
+    const std::uint64_t ny = std::uint64_t(dy), nz = std::uint64_t(dz);
+    std::vector<std::uint64_t> bits((std::uint64_t(dx) * ny * nz + 63) / 64, 0);
+    auto set = [&](const openvdb::Coord& c) {
+        const std::uint64_t k = (std::uint64_t(c.x() - lo.x()) * ny + std::uint64_t(c.y() - lo.y())) * nz + std::uint64_t(c.z() - lo.z());
+        std::uint64_t& word = bits[k >> 6];
+        const std::uint64_t bit = std::uint64_t(1) << (k & 63);
+        if (!(__atomic_load_n(&word, __ATOMIC_RELAXED) & bit)) __atomic_fetch_or(&word, bit, __ATOMIC_RELAXED);
+    };
+    // A uniform scale maps a point to index space as p * (1 / voxel size) (ScaleMap's
+    // applyInverseMap(), whose factor is its map of (1, 1, 1)), and Coord::round() is
+    // floor(x + 0.5): the same arithmetic inline, instead of a virtual call and three calls to
+    // floor() a point, where every coordinate is well inside an int.
+    constexpr int kLimit = 1 << 30;
+    const bool inline_ = xform.mapType() == openvdb::math::UniformScaleMap::mapType() && std::abs(lo.x()) < kLimit &&
+                         std::abs(lo.y()) < kLimit && std::abs(lo.z()) < kLimit && std::abs(hi.x()) < kLimit &&
+                         std::abs(hi.y()) < kLimit && std::abs(hi.z()) < kLimit;
+    const openvdb::Vec3d inv = xform.worldToIndex(openvdb::Vec3d(1.0));
+    auto round = [](double x) {
+        x += 0.5;
+        const int i = int(x);
+        return i - int(x < double(i));
+    };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (inline_) {
+                const openvdb::Vec3d p(positions[i]);
+                set(openvdb::Coord(round(p.x() * inv.x()), round(p.y() * inv.y()), round(p.z() * inv.z())));
+            } else {
+                set(xform.worldToIndexCellCentered(positions[i]));
+            }
+        }
+    });
+    std::uint64_t count = 0;
+    for (const std::uint64_t w : bits) count += std::uint64_t(__builtin_popcountll(w));
+    return count;
+}
+
+/// populateAttribute(@a tree, @a index, @a name, values) for an attribute of type T with
+/// OpenVDB's default (null) codec, where point i's value is @a value(i): the same arrays,
+/// compacted as it leaves them, but each value stored directly instead of through a write
+/// handle's setter (an indirect call a value: half the time of writing a strands grid's strand
+/// and vertex attributes went there).
+template<typename T, typename ValueOf>
+void populateDirect(pts::PointDataTree& tree, const openvdb::tools::PointIndexTree& index, const std::string& name,
+                    const ValueOf& value)
+{
+    const auto first = tree.cbeginLeaf();
+    if (!first) return;
+    const std::size_t pos = first->attributeSet().find(name);
+    if (pos == pts::AttributeSet::INVALID_POS) throw ValueError("populateDirect: no attribute '" + name + "'");
+    openvdb::tree::LeafManager<pts::PointDataTree> leaves(tree);
+    tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<pts::PointDataTree>::LeafRange& range) {
+        for (auto leaf = range.begin(); leaf; ++leaf) {
+            const openvdb::tools::PointIndexTree::LeafNodeType* indexLeaf = index.probeConstLeaf(leaf->origin());
+            if (!indexLeaf) continue;
+            auto& array = pts::TypedAttributeArray<T>::cast(leaf->attributeArray(pos));
+            array.expand(/*fill=*/false);  // every value is set below
+            openvdb::Index n = 0;
+            for (const auto i : indexLeaf->indices()) array.setUnsafe(n++, value(std::size_t(i)));
+            array.compact();
+        }
+    });
+}
+
+} // namespace
+
+float pointsVoxelSize(const std::vector<Vec3f>& positions, unsigned pointsPerVoxel)
+{
+    // openvdb::points::computeVoxelSize() (OpenVDB 10, points/PointConversion.h) step for step,
+    // with its identity transform and 5 decimals; only the voxels are counted otherwise.
+    namespace math = openvdb::math;
+    if (pointsPerVoxel == 0) throw ValueError("pointsVoxelSize: points per voxel cannot be zero");
+    float voxelSize(0.1f);
+    const std::size_t numPoints = positions.size();
+    if (numPoints <= 1) return voxelSize;
+    std::size_t targetVoxelCount(numPoints / std::size_t(pointsPerVoxel));
+    if (targetVoxelCount == 0) targetVoxelCount++;
+    auto voxelSizeFromVolume = [](double volume, std::size_t estimatedVoxelCount, float& size) {
+        static const double minimumVoxelVolume(3e-15);
+        static const double maximumVoxelVolume(std::numeric_limits<float>::max());
+        double voxelVolume = volume / static_cast<double>(estimatedVoxelCount);
+        bool valid = true;
+        if (voxelVolume < minimumVoxelVolume) {
+            voxelVolume = minimumVoxelVolume;
+            valid = false;
+        } else if (voxelVolume > maximumVoxelVolume) {
+            voxelVolume = maximumVoxelVolume;
+            valid = false;
+        }
+        size = static_cast<float>(math::Pow(voxelVolume, 1.0 / 3.0));
+        return valid;
+    };
+    const pts::PointAttributeVector<openvdb::Vec3f> wrapper(positions);
+    math::Mat4d inverseTransform = math::Mat4d::identity().inverse();
+    inverseTransform = math::unit(inverseTransform);
+    pts::point_conversion_internal::CalculatePositionBounds<pts::PointAttributeVector<openvdb::Vec3f>, openvdb::Vec3f> bounds(wrapper, inverseTransform);
+    tbb::parallel_reduce(tbb::blocked_range<std::size_t>(0, numPoints), bounds);
+    const openvdb::BBoxd bbox = bounds.getBoundingBox();
+    if (bbox.min() == bbox.max()) return voxelSize;
+    double volume = bbox.volume();
+    if (math::isApproxZero(volume)) {
+        const openvdb::Vec3d extents = bbox.extents().sorted().reversed();
+        if (math::isApproxZero(extents[1])) volume = extents[0] * extents[0] * extents[0];
+        else volume = extents[0] * extents[1] * extents[1];
+    }
+    double previousVolume = volume;
+    if (!voxelSizeFromVolume(volume, targetVoxelCount, voxelSize)) return voxelSize;
+    std::size_t previousVoxelCount(0);
+    std::size_t voxelCount(1);
+    while (voxelCount > previousVoxelCount) {
+        const math::Transform::Ptr xform = math::Transform::createLinearTransform(voxelSize);
+        previousVoxelCount = voxelCount;
+        voxelCount = std::size_t(occupiedVoxels(positions, *xform, bbox));
+        volume = math::Pow3(voxelSize) * static_cast<float>(voxelCount);
+        if (volume >= previousVolume) break;
+        previousVolume = volume;
+        const float previousVoxelSize = voxelSize;
+        if (!voxelSizeFromVolume(volume, targetVoxelCount, voxelSize)) {
+            voxelSize = previousVoxelSize;
+            break;
+        }
+        if (voxelSize / previousVoxelSize > 0.9f) break;
+    }
+    // Truncated to 5 decimals for readability (more where that would give 0).
+    float truncated = voxelSize;
+    for (int i = 5; i < 11; i++) {
+        truncated = static_cast<float>(math::Truncate(double(voxelSize), i));
+        if (truncated != 0.0f) break;
+    }
+    return truncated;
+}
+
 PositionCodec positionCodecFromName(const std::string& name)
 {
     if (name == "float") return PositionCodec::Float;
@@ -95,7 +247,7 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
     const pts::PointAttributeVector<openvdb::Vec3f> positions(strands.positions);
     double voxelSize = opts.voxelSize;
     if (voxelSize == 0.0) {
-        voxelSize = pts::computeVoxelSize(positions, std::max(1u, opts.pointsPerVoxel));
+        voxelSize = pointsVoxelSize(strands.positions, std::max(1u, opts.pointsPerVoxel));
         voxelSize = std::max(voxelSize, 2e-5);  // OpenVDB's smallest (its transforms refuse less)
     }
     if (!(voxelSize >= 2e-5) || !std::isfinite(voxelSize)) {
@@ -121,35 +273,33 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
 
     // Topology: strand and vertex index of every point, and the root group.
     const std::size_t nV = strands.numVertices();
-    std::vector<std::int32_t> strandOf(nV), vertexOf(nV);
+    std::vector<std::int32_t> strandOf(nV);
     std::vector<short> isRoot(nV, 0);
-    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
-        for (std::size_t v = strands.begin(i); v < strands.end(i); ++v) {
-            strandOf[v] = std::int32_t(i);
-            vertexOf[v] = std::int32_t(v - strands.begin(i));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, strands.numStrands(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::fill(strandOf.begin() + std::ptrdiff_t(strands.begin(i)), strandOf.begin() + std::ptrdiff_t(strands.end(i)), std::int32_t(i));
+            isRoot[strands.begin(i)] = 1;
         }
-        isRoot[strands.begin(i)] = 1;
-    }
+    });
     pts::appendAttribute<std::int32_t>(tree, "strand");
-    pts::populateAttribute(tree, index->tree(), "strand", pts::PointAttributeVector<std::int32_t>(strandOf));
+    populateDirect<std::int32_t>(tree, index->tree(), "strand", [&](std::size_t v) { return strandOf[v]; });
     pts::appendAttribute<std::int32_t>(tree, "vertex");
-    pts::populateAttribute(tree, index->tree(), "vertex", pts::PointAttributeVector<std::int32_t>(vertexOf));
+    populateDirect<std::int32_t>(tree, index->tree(), "vertex",
+                                 [&](std::size_t v) { return std::int32_t(v - strands.begin(std::size_t(strandOf[v]))); });
     pts::appendGroup(tree, "root");
     pts::setGroup(tree, index->tree(), isRoot, "root");
 
     if (!strands.color.empty()) {
         pts::appendAttribute<openvdb::Vec3f>(tree, "Cd");
-        pts::populateAttribute(tree, index->tree(), "Cd", pts::PointAttributeVector<openvdb::Vec3f>(strands.color));
+        populateDirect<openvdb::Vec3f>(tree, index->tree(), "Cd", [&](std::size_t v) { return strands.color[v]; });
     }
     if (!strands.thickness.empty()) {
         pts::appendAttribute<float>(tree, "width");
-        pts::populateAttribute(tree, index->tree(), "width", pts::PointAttributeVector<float>(strands.thickness));
+        populateDirect<float>(tree, index->tree(), "width", [&](std::size_t v) { return strands.thickness[v]; });
     }
     if (!strands.transparency.empty()) {
-        std::vector<float> alpha(nV);
-        for (std::size_t v = 0; v < nV; ++v) alpha[v] = 1.f - strands.transparency[v];
         pts::appendAttribute<float>(tree, "Alpha");
-        pts::populateAttribute(tree, index->tree(), "Alpha", pts::PointAttributeVector<float>(alpha));
+        populateDirect<float>(tree, index->tree(), "Alpha", [&](std::size_t v) { return 1.f - strands.transparency[v]; });
     }
 
     for (const auto& [name, values] : opts.strandAttributes) {
@@ -160,10 +310,8 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
         if (values.size() != strands.numStrands())
             throw ValueError(where + ": attribute '" + name + "' has " + std::to_string(values.size()) + " values for " +
                              std::to_string(strands.numStrands()) + " strands");
-        std::vector<std::int32_t> perVertex(nV);
-        for (std::size_t v = 0; v < nV; ++v) perVertex[v] = values[std::size_t(strandOf[v])];
         pts::appendAttribute<std::int32_t>(tree, name);
-        pts::populateAttribute(tree, index->tree(), name, pts::PointAttributeVector<std::int32_t>(perVertex));
+        populateDirect<std::int32_t>(tree, index->tree(), name, [&](std::size_t v) { return values[std::size_t(strandOf[v])]; });
     }
 
     grid->setName("strands");

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbStrandGrid.h>
 
 #include <openvdb/points/PointAttribute.h>
 #include <openvdb/points/PointConversion.h>
@@ -26,7 +27,7 @@ openvdb::points::PointDataGrid::Ptr createRootGrid(const OrientedPoints& roots, 
                          " tangents for " + std::to_string(n) + " roots; roots need one normal each");
     }
     const pts::PointAttributeVector<openvdb::Vec3f> positions(roots.positions);
-    double voxelSize = n > 1 ? pts::computeVoxelSize(positions, std::max(1u, pointsPerVoxel)) : 1.0;
+    double voxelSize = n > 1 ? pointsVoxelSize(roots.positions, std::max(1u, pointsPerVoxel)) : 1.0;
     voxelSize = std::max(voxelSize, 2e-5);
     const openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(voxelSize);
     const openvdb::tools::PointIndexGrid::Ptr index =
