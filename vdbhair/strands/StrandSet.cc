@@ -110,6 +110,16 @@ void StrandSet::append(const StrandSet& other)
     }
 }
 
+void StrandSet::append(StrandSet&& other)
+{
+    if (empty() && offsets.size() == 1 && positions.empty()) {
+        // What append(other) builds from an empty set: other's strands, attributes and defaults.
+        *this = std::move(other);
+        return;
+    }
+    append(static_cast<const StrandSet&>(other));
+}
+
 BBox computeBBox(const StrandSet& strands)
 {
     BBox box;

@@ -71,6 +71,9 @@ struct StrandSet
     /// @brief Append all strands of @a other (attribute arrays are filled with defaults
     /// where only one side has them).
     void append(const StrandSet& other);
+    /// @brief As above; into an empty set, @a other's storage is taken instead of copied (the
+    /// same result: reading one file into a set no longer copies it).
+    void append(StrandSet&& other);
 
     /// Per-vertex attribute values with defaults applied.
     float thicknessAt(std::size_t v) const { return thickness.empty() ? defaults.thickness : thickness[v]; }
