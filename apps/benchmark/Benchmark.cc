@@ -11,7 +11,8 @@
 //   scalp level set, `vdbhair roots`)                    zero-crossing voxels + projection
 //   end to end (--sections e2e, opt-in): the         vs  vdbhair_peer (Peer.cc): the same jobs
 //   `vdbhair` verbs info, field, retrace, refine,        with stock OpenVDB and an ifstream
-//   --help as processes, as a user times them            reader, as processes on the same files
+//   refine --mode field, --help as processes, as a       reader, as processes on the same files
+//   user times them
 //   scale (--sections scale, opt-in): `vdbhair refine` of 1,000,000 strands x 32 vertices grown by
 //   `vdbhair grow`: time, peak memory and refine's own memory estimate
 //
