@@ -63,6 +63,30 @@ TEST_CASE("StrandSet: append keeps attributes, filling defaults for the side wit
     REQUIRE(c.color.size() == c.numVertices());
     REQUIRE(c.color[0] == c.defaults.color);
     REQUIRE_NOTHROW(c.validate("append"));
+
+    // Into an empty set, a temporary's storage is taken: the same set as a copying append gives.
+    StrandSet withIds = test::sampleStrands(true);
+    withIds.strandId = {7, 8, 9};
+    withIds.rootUV = {Vec2f(0.1f, 0.2f), Vec2f(0.3f, 0.4f), Vec2f(0.5f, 0.6f)};
+    withIds.defaults.thickness = 0.25f;
+    StrandSet copied, moved;
+    copied.append(withIds);
+    const Vec3f* storage = withIds.positions.data();
+    moved.append(std::move(withIds));
+    REQUIRE(moved.positions.data() == storage);
+    for (const StrandSet* x : {&copied, &moved}) REQUIRE(x->defaults.thickness == 0.25f);
+    REQUIRE(moved.positions == copied.positions);
+    REQUIRE(moved.offsets == copied.offsets);
+    REQUIRE(moved.thickness == copied.thickness);
+    REQUIRE(moved.transparency == copied.transparency);
+    REQUIRE(moved.color == copied.color);
+    REQUIRE(moved.rootUV == copied.rootUV);
+    REQUIRE(moved.strandId == copied.strandId);
+    // Into a set that has strands, a temporary is appended as any other set.
+    StrandSet d = test::sampleStrands(false);
+    d.append(test::sampleStrands(true));
+    REQUIRE(d.positions == c.positions);
+    REQUIRE(d.color == c.color);
 }
 
 TEST_CASE("StrandSet: selectStrands and scaleStrands", "[strands]")

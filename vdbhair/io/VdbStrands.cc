@@ -68,10 +68,6 @@ private:
     std::optional<pts::AttributeHandle<double>> mD;
 };
 
-} // namespace
-
-namespace {
-
 /// The voxels of @a xform that hold a point of @a positions, as openvdb::tools::PointsToMask
 /// activates them (worldToIndexCellCentered() of each point); @a box is the points' box.
 std::uint64_t occupiedVoxels(const std::vector<Vec3f>& positions, const openvdb::math::Transform& xform, const openvdb::BBoxd& box)
@@ -100,7 +96,7 @@ std::uint64_t occupiedVoxels(const std::vector<Vec3f>& positions, const openvdb:
     // floor(x + 0.5): the same arithmetic inline, instead of a virtual call and three calls to
     // floor() a point, where every coordinate is well inside an int.
     constexpr int kLimit = 1 << 30;
-    const bool inline_ = xform.mapType() == openvdb::math::UniformScaleMap::mapType() && std::abs(lo.x()) < kLimit &&
+    const bool inlineMap = xform.mapType() == openvdb::math::UniformScaleMap::mapType() && std::abs(lo.x()) < kLimit &&
                          std::abs(lo.y()) < kLimit && std::abs(lo.z()) < kLimit && std::abs(hi.x()) < kLimit &&
                          std::abs(hi.y()) < kLimit && std::abs(hi.z()) < kLimit;
     const openvdb::Vec3d inv = xform.worldToIndex(openvdb::Vec3d(1.0));
@@ -111,7 +107,7 @@ std::uint64_t occupiedVoxels(const std::vector<Vec3f>& positions, const openvdb:
     };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            if (inline_) {
+            if (inlineMap) {
                 const openvdb::Vec3d p(positions[i]);
                 set(openvdb::Coord(round(p.x() * inv.x()), round(p.y() * inv.y()), round(p.z() * inv.z())));
             } else {
