@@ -7,6 +7,7 @@
 
 #include <vdbhair/Types.h>
 #include <vdbhair/field/FieldMapping.h>
+#include <vdbhair/field/SegmentWalk.h>
 
 #include <openvdb/openvdb.h>
 
@@ -40,17 +41,15 @@ public:
         bool containsChanged(const Vec3f* p, const Vec3f* ref, std::size_t n);
 
     private:
-        /// openvdb::Coord::round(@a p) (floor(x + 0.5) on each axis) without a call to floor()
-        /// per axis; positions beyond ±2^30 (or NaN), where no voxel of a field is, clamp there.
+        /// openvdb::Coord::round(@a p) without a call to floor() per axis (voxelOf()); positions
+        /// beyond ±2^30 (or NaN), where no voxel of a field is, clamp there first.
         static openvdb::Coord nearestVoxel(const Vec3d& p)
         {
-            auto round = [](double x) {
+            auto clamp = [](double x) {
                 constexpr double kLimit = double(1 << 30);
-                x = std::min(kLimit, std::max(-kLimit, x + 0.5));  // this order maps NaN to -kLimit
-                const int i = int(x);
-                return i - int(x < double(i));
+                return std::min(kLimit, std::max(-kLimit, x));  // this order maps NaN to -kLimit
             };
-            return openvdb::Coord(round(p.x()), round(p.y()), round(p.z()));
+            return voxelOf(Vec3d(clamp(p.x()), clamp(p.y()), clamp(p.z())));
         }
 
         /// The points of segment (a, b) at most half a voxel apart, b included, a not.

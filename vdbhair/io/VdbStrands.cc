@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/io/VdbFile.h>
 
@@ -100,16 +101,11 @@ std::uint64_t occupiedVoxels(const std::vector<Vec3f>& positions, const openvdb:
                          std::abs(lo.y()) < kLimit && std::abs(lo.z()) < kLimit && std::abs(hi.x()) < kLimit &&
                          std::abs(hi.y()) < kLimit && std::abs(hi.z()) < kLimit;
     const openvdb::Vec3d inv = xform.worldToIndex(openvdb::Vec3d(1.0));
-    auto round = [](double x) {
-        x += 0.5;
-        const int i = int(x);
-        return i - int(x < double(i));
-    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             if (inlineMap) {
                 const openvdb::Vec3d p(positions[i]);
-                set(openvdb::Coord(round(p.x() * inv.x()), round(p.y() * inv.y()), round(p.z() * inv.z())));
+                set(voxelOf(openvdb::Vec3d(p.x() * inv.x(), p.y() * inv.y(), p.z() * inv.z())));
             } else {
                 set(xform.worldToIndexCellCentered(positions[i]));
             }
