@@ -169,6 +169,58 @@ TEST_CASE("retraceConsistent: a strand whose retrace would leave the hair volume
     }
 }
 
+TEST_CASE("retraceConsistent: where the strand's own direction wins, the retrace is the input to the last bit", "[field]")
+{
+    // A straight bundle and one strand in it that follows it for 5 units, then kinks
+    // off at 30 degrees: every sub-step of the bundle keeps its own direction, so the retrace,
+    // exact in exact arithmetic, must give the input bit for bit; so must the kinked strand up to
+    // its kink (its correction starts there). Sub-steps are counted as the trace takes them.
+    // The bundle runs obliquely, so that its points are not exact in binary and the sub-steps
+    // round differently from the input's vertices.
+    const Vec3f dir = Vec3f(1.f, 0.37f, 0.21f).unit();
+    const Vec3f u = dir.cross(Vec3f(0.f, 0.f, 1.f)).unit(), v = dir.cross(u);
+    const Vec3f origin(0.3f, -1.7f, 2.9f);
+    StrandSet s;
+    for (int j = 0; j < 12; ++j) {
+        for (int k = 0; k < 12; ++k) s.addStrand(line(origin + u * (0.17f * float(j)) + v * (0.17f * float(k)), dir, 10.f, 41));
+    }
+    const std::size_t inliers = s.numStrands();
+    const Vec3f axis = origin + (u + v) * (0.17f * 5.5f);  // the bundle's axis passes here, along dir
+    std::vector<Vec3f> kinked = line(axis + u * 0.03f, dir, 5.f, 21);
+    const float a = float(30.0 * M_PI / 180.0);
+    for (std::size_t j = 1; j <= 20; ++j) kinked.push_back(kinked[20] + (dir * std::cos(a) + u * std::sin(a)) * (0.25f * float(j)));
+    s.addStrand(kinked);
+    FieldParams fp;
+    fp.voxelSize = 0.5;
+    const TangentField f = estimateTangentField(s, fp);
+    ConsistencyParams cp;
+    ConsistencyStats stats;
+    const StrandSet out = retraceConsistent(s, f, cp, HeadObstacle::none(), &stats);
+    const double step = resolveStepLength(cp.step, fp.voxelSize, "test");  // the default: half a voxel
+    std::size_t steps = 0;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        for (std::size_t j = 0; j + 1 < s.size(i); ++j) {
+            const double len = (Vec3d(s.data(i)[j + 1]) - Vec3d(s.data(i)[j])).length();  // as the trace measures it
+            if (len > 0.0) steps += std::max<std::size_t>(1, std::size_t(std::ceil(len / step)));
+        }
+    }
+    REQUIRE(stats.steps == steps);
+    REQUIRE(stats.corrected == 1);
+    std::size_t exact = 0;
+    for (std::size_t i = 0; i < inliers; ++i) {
+        exact += std::equal(s.data(i), s.data(i) + s.size(i), out.data(i)) ? 1 : 0;
+    }
+    REQUIRE(exact == inliers);
+    const std::size_t k = inliers;
+    for (std::size_t j = 0; j <= 20; ++j) {
+        CAPTURE(j);
+        REQUIRE(out.data(k)[j] == s.data(k)[j]);
+    }
+    // ...and the kink is pulled back into the bundle's flow: the tip comes closer to the axis.
+    auto offAxis = [&](const Vec3f& p) { const Vec3f q = p - axis; return (q - dir * q.dot(dir)).length(); };
+    REQUIRE(offAxis(out.tip(k)) < 0.5f * offAxis(s.tip(k)));
+}
+
 TEST_CASE("refineStrands: two wisps crossing in an X stay an X", "[field]")
 {
     // Two wisps of 49 strands each, crossing at 60 degrees at the origin.

@@ -135,6 +135,13 @@ private:
                 const Vec3d t = seg / len;
                 const std::size_t m = std::max<std::size_t>(1, std::size_t(std::ceil(len / mS.step)));
                 const double h = len / double(m);
+                // On the input strand (a vertex that rounds to the input's is the input's, below), a
+                // segment whose retrace is the segment itself is not traced (keepsOwnDirection()).
+                if (euler && p.x() == a.x() && p.y() == a.y() && p.z() == a.z() && keepsOwnDirection(a, seg, b, t, m, haveHead && !relative, counts)) {
+                    o[j + 1] = c[j + 1];
+                    p = b;
+                    continue;
+                }
                 bool pushed = false;
                 const Vec3d start = p;
                 for (std::size_t k = 0; k < m; ++k) {
@@ -222,6 +229,7 @@ private:
                 if (pushed) ++counts.pushedOut;
             }
             o[j + 1] = Vec3f(float(p.x()), float(p.y()), float(p.z()));
+            if (o[j + 1] == c[j + 1]) p = b;  // back on the input strand, to the last bit
         }
         // Only where the output differs from the input can it have left the volume on its own
         // (containsChanged()): most strands come out unchanged, bit for bit (57-68 % of them on
@@ -300,21 +308,23 @@ private:
         return mTan.sample(ip);
     }
 
-    /// The blended direction at @a p for a strand heading @a t; @a w receives the field's weight.
-    Vec3d direction(const Vec3d& p, const Vec3d& t, double& w, Counts& counts)
+    /// The field's pull on a strand heading @a t at index point @a ip, where the tangent field's
+    /// sample is @a r: its unit direction @a v and weight @a w (0: the strand keeps its own
+    /// direction, and @a v may be unset). Counts the sub-step as outside the field, or as
+    /// following it (w >= 0.5).
+    void fieldPull(const Float4& r, const Vec3d& ip, const Vec3d& t, Vec3d& v, double& w, Counts& counts)
     {
-        const Vec3d ip = mS.map.worldToIndex(p);
-        const Float4 r = sampleTangent(ip);
+        w = 0.0;
         const double weight = r[3];
         if (!(weight > 0.0)) {
             ++counts.noFieldSteps;
-            return t;
+            return;
         }
-        Vec3d v(r[0], r[1], r[2]);
+        v = Vec3d(r[0], r[1], r[2]);
         const double len = v.length();
         if (!(len > mS.params.vanishThreshold * weight)) {
             ++counts.noFieldSteps;
-            return t;
+            return;
         }
         v /= len;
         const double cosA = t.dot(v);
@@ -323,16 +333,60 @@ private:
         // monotonically): a strand that strays less than zStart floors keeps its own direction
         // (w = 0) whatever the voxel's spread, which then need not be sampled (half the sub-steps
         // of the benchmark's jittered set, 8 % of a real hairstyle's).
-        if (mS.minSigma > 0.0 && delta / mS.minSigma < mS.params.zStart) return t;
+        if (mS.minSigma > 0.0 && delta / mS.minSigma < mS.params.zStart) return;
         const Float4 sp = mSpread.sample(ip);
         const double spread = std::max(0.0, double(sp[0]) / weight);  // the active corners' mean
         const double sigma = std::max(mS.minSigma, std::sqrt(spread));
         w = smoothstep(mS.params.zStart, mS.params.zFull, delta / sigma);
         if (w >= 0.5) ++counts.fieldSteps;
+    }
+
+    /// The blended direction at @a p for a strand heading @a t; @a w receives the field's weight.
+    Vec3d direction(const Vec3d& p, const Vec3d& t, double& w, Counts& counts)
+    {
+        const Vec3d ip = mS.map.worldToIndex(p);
+        Vec3d v;
+        fieldPull(sampleTangent(ip), ip, t, v, w, counts);
         if (w <= 0.0) return t;
         Vec3d d = (1.0 - w) * t + w * v;
         const double dl = d.length();
         return dl > 1e-12 ? d / dl : v;
+    }
+
+    /// Whether the retrace of input segment a -> b (unit direction @a t, @a m sub-steps, forward
+    /// Euler) from p = a is the segment itself, and then its sub-steps' counts go to @a counts.
+    /// It is where the strand's own direction wins at every sub-step's start on the segment
+    /// (the field's weight is 0) and, for a KeepOutside head, every sub-step ends outside the
+    /// head: in exact arithmetic each sub-step then moves h along t (the return pull aims at
+    /// the point it reaches, a step held in the hair heads for that same point, a NoDeeper head's
+    /// floor lies below it), and the chord is the segment. The samples of the segment's points
+    /// do not depend on each other, so they overlap where the trace waits for each sub-step's end
+    /// before the next: most sub-steps of real hair are of such segments.
+    bool keepsOwnDirection(const Vec3d& a, const Vec3d& seg, const Vec3d& b, const Vec3d& t, std::size_t m, bool keepOutside,
+                           Counts& counts)
+    {
+        Counts own;
+        const double step = seg.length() / double(m);
+        for (std::size_t k = 0; k <= m; ++k) {
+            const Vec3d x = k == m ? b : a + seg * (double(k) / double(m));  // the points of the trace's sub-steps
+            const Vec3d ip = mS.map.worldToIndex(x);
+            const Float4 r = mTan.sample(ip);
+            if (k > 0) {
+                // The end of sub-step k - 1, as insideField() and the head's test see it.
+                const bool inside = mS.volumeIsTangent ? r[3] > 0.f : mVolume.sample(mS.volumeMap.worldToIndex(x))[3] > 0.f;
+                if (!inside && step > 1e-12) ++own.heldIn;  // as the trace counts it
+                if (keepOutside && mHead.distance(x) < 0.0) return false;
+            }
+            if (k < m) {
+                Vec3d v;
+                double w;
+                fieldPull(r, ip, t, v, w, own);
+                if (w > 0.0) return false;
+            }
+        }
+        own.steps = m;
+        counts.add(own);
+        return true;
     }
 
     const Shared& mS;

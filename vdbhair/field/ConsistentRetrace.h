@@ -34,6 +34,13 @@
 /// strand that still leaves the hair volume dilated by a voxel (HairVolume.h: the output chords
 /// can cut across a gap, a slide along the head can carry it out) is left as it was.
 ///
+/// Where the strand's own direction wins at every sub-step of an input segment (and, for a
+/// KeepOutside head, every sub-step ends outside it), the retrace of that segment from its first
+/// vertex is, in exact arithmetic, the segment itself. With forward Euler such a segment, reached
+/// on the input strand, is taken from the input bit for bit rather than traced (its points'
+/// samples are independent, where the trace waits for each sub-step's end); a traced vertex that
+/// rounds to the input's puts the strand back on it. Most segments of real hair are such.
+///
 /// Output strands keep the input's vertex count and segment lengths (so every strand has its
 /// full length), and the head is an obstacle: its HeadPolicy says whether retraced vertices must
 /// stay outside it or only no deeper inside than the input's (HeadObstacle.h). Strands are independent: results do not depend on the thread count.
