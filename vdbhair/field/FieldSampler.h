@@ -26,6 +26,7 @@
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/Simd.h>
 
+#include <openvdb/openvdb.h>
 #include <openvdb/math/Coord.h>
 #include <openvdb/math/Vec3.h>
 #include <openvdb/tree/LeafManager.h>
@@ -65,7 +66,10 @@ public:
     /// whichever thread asks first: a retrace starts tracing at once instead of first mapping
     /// and filling every brick (about 10 MB for 100,000 strands, mostly page faults that do not
     /// get faster with more threads), and bricks no streamline enters cost nothing.
-    explicit BrickedField(const TreeT& tree) : mTree(tree)
+    /// @param scalar optional: a float tree sampled through the same cells (FieldSampler::
+    /// sampleScalar()), stored beside each brick as 9³ floats, its values at @a tree's active
+    /// voxels and 0 elsewhere: a quarter of the bytes of a vector brick holding it.
+    explicit BrickedField(const TreeT& tree, const openvdb::FloatTree* scalar = nullptr) : mTree(tree), mScalarTree(scalar)
     {
         openvdb::tree::LeafManager<const TreeT> leaves(tree);
         const std::size_t count = leaves.leafCount();
@@ -80,6 +84,11 @@ public:
         }
         mZero = &mBricks[count];
         std::fill(std::begin(mBricks[count].cell), std::end(mBricks[count].cell), Float4{0.f, 0.f, 0.f, 0.f});
+        if (scalar) {
+            mScalar.reset(new float[(count + 1) * kCells]);
+            adviseHugePages(mScalar.get(), (count + 1) * kCells * sizeof(float));
+            std::fill(mScalar.get() + count * kCells, mScalar.get() + (count + 1) * kCells, 0.f);
+        }
         mState[count].store(kReady, std::memory_order_release);
         buildIndex(leaves);
     }
@@ -107,6 +116,10 @@ public:
     }
 
     const TreeT& tree() const { return mTree; }
+    /// The scalar tree of the constructor, or nullptr.
+    const openvdb::FloatTree* scalarTree() const { return mScalarTree; }
+    /// The scalar cells beside brick @a b (a brick of this field; a scalar tree is given).
+    const float* scalarCells(const Brick* b) const { return mScalar.get() + std::size_t(b - mBricks.get()) * kCells; }
     /// The all-zero brick brickAt() returns where there is no leaf.
     const Brick* zeroBrick() const { return mZero; }
 
@@ -147,8 +160,22 @@ public:
         return z0 + (z1 - z0) * fz;
     }
 
+    /// @brief blend4() of one float per cell: the same operations in the same order, so a scalar
+    /// gives bit for bit the lane a vector brick holding it in that lane would give.
+    static float blend1(const float* c, float fx, float fy, float fz)
+    {
+        const float y0z0 = c[0] + (c[N * N] - c[0]) * fx;
+        const float y0z1 = c[1] + (c[N * N + 1] - c[1]) * fx;
+        const float y1z0 = c[N] + (c[N * N + N] - c[N]) * fx;
+        const float y1z1 = c[N + 1] + (c[N * N + N + 1] - c[N + 1]) * fx;
+        const float z0 = y0z0 + (y1z0 - y0z0) * fy;
+        const float z1 = y0z1 + (y1z1 - y0z1) * fy;
+        return z0 + (z1 - z0) * fz;
+    }
+
 private:
     enum : std::uint8_t { kEmpty, kFilling, kReady };
+    static constexpr std::size_t kCells = std::size_t(N) * N * N;
 
     /// @brief Brick @a i, filled first if nobody has yet (the first caller fills it, others
     /// wait for it: a brick is filled once, whoever asks).
@@ -172,6 +199,9 @@ private:
         openvdb::tree::ValueAccessor<const TreeT> acc(mTree);
         const LeafT& leaf = *mLeaves[i];
         Brick& b = mBricks[i];
+        float* scalar = mScalar ? mScalar.get() + std::size_t(i) * kCells : nullptr;
+        std::unique_ptr<openvdb::tree::ValueAccessor<const openvdb::FloatTree>> scalarAcc;
+        if (scalar) scalarAcc.reset(new openvdb::tree::ValueAccessor<const openvdb::FloatTree>(*mScalarTree));
         const openvdb::Coord o = leaf.origin();
         // The leaf and its +x, +y, +z neighbours (nullptr where there is no leaf: tiles or background).
         const LeafT* nb[8];
@@ -191,6 +221,7 @@ private:
                     }
                     const int k = (x * N + y) * N + z;
                     b.cell[k] = on ? Float4{float(v[0]), float(v[1]), float(v[2]), 1.f} : Float4{0.f, 0.f, 0.f, 0.f};
+                    if (scalar) scalar[k] = on ? scalarAcc->getValue(o.offsetBy(x, y, z)) : 0.f;
                 }
             }
         }
@@ -229,7 +260,9 @@ private:
     }
 
     const TreeT& mTree;
+    const openvdb::FloatTree* mScalarTree;
     std::unique_ptr<Brick[]> mBricks;                       ///< filled on first use (mState)
+    std::unique_ptr<float[]> mScalar;                       ///< kCells per brick, filled with it
     std::unique_ptr<std::atomic<std::uint8_t>[]> mState;    ///< per brick: kEmpty, kFilling, kReady
     std::vector<const LeafT*> mLeaves;
     const Brick* mZero = nullptr;
@@ -249,7 +282,10 @@ public:
     using Bricks = BrickedField<TreeT>;
     static constexpr int N = Bricks::N;
 
-    explicit FieldSampler(const Bricks& bricks) : mBricks(bricks), mAcc(bricks.tree()) {}
+    explicit FieldSampler(const Bricks& bricks) : mBricks(bricks), mAcc(bricks.tree())
+    {
+        if (bricks.scalarTree()) mScalarAcc.reset(new openvdb::tree::ValueAccessor<const openvdb::FloatTree>(*bricks.scalarTree()));
+    }
 
     /// @brief Sample at index-space position @a p: the trilinear blend of the corners' vectors in
     /// x, y, z, and in w the summed weight of the active corners (0: outside the field).
@@ -260,6 +296,16 @@ public:
         if (!mValid || bx != mBase[0] || by != mBase[1] || bz != mBase[2]) load(bx, by, bz);
         // Corners at +0, +1 (z), +N (y), +N*N (x): three nested lerps, four lanes at a time.
         return Bricks::blend4(mCell, float(p.x() - bx), float(p.y() - by), float(p.z() - bz));
+    }
+
+    /// @brief The bricks' scalar (BrickedField's @a scalar) at index-space position @a p, blended
+    /// with sample()'s corners and weights: bit for bit the lane a vector brick holding it there
+    /// would give (the active corners' values, weighted; inactive corners count 0).
+    float sampleScalar(const openvdb::Vec3d& p)
+    {
+        const int bx = floorIndex(p.x()), by = floorIndex(p.y()), bz = floorIndex(p.z());
+        if (!mValid || bx != mBase[0] || by != mBase[1] || bz != mBase[2]) load(bx, by, bz);
+        return Bricks::blend1(mScalarCell, float(p.x() - bx), float(p.y() - by), float(p.z() - bz));
     }
 
     /// @brief sample() at each of @a n scattered index-space points @a p (the vertices of a
@@ -322,7 +368,9 @@ private:
             mBrick = mBricks.find(origin);
         }
         if (mBrick) {
-            mCell = mBrick->cell + ((bx & 7) * N + (by & 7)) * N + (bz & 7);
+            const int offset = ((bx & 7) * N + (by & 7)) * N + (bz & 7);
+            mCell = mBrick->cell + offset;
+            if (mScalarAcc) mScalarCell = mBricks.scalarCells(mBrick) + offset;
             return;
         }
         // No leaf holds the lower corner: read the corners through the tree into a small
@@ -330,10 +378,13 @@ private:
         for (int i = 0; i < 8; ++i) {
             const int dx = i >> 2, dy = (i >> 1) & 1, dz = i & 1;
             ValueT val;
-            const bool on = mAcc.probeValue(openvdb::Coord(bx + dx, by + dy, bz + dz), val);
+            const openvdb::Coord ijk(bx + dx, by + dy, bz + dz);
+            const bool on = mAcc.probeValue(ijk, val);
             mScratch[(dx * N + dy) * N + dz] = on ? Float4{float(val[0]), float(val[1]), float(val[2]), 1.f} : Float4{0.f, 0.f, 0.f, 0.f};
+            if (mScalarAcc) mScalarScratch[(dx * N + dy) * N + dz] = on ? mScalarAcc->getValue(ijk) : 0.f;
         }
         mCell = mScratch;
+        mScalarCell = mScalarScratch;
     }
 
     const Bricks& mBricks;
@@ -345,6 +396,9 @@ private:
     const typename Bricks::Brick* mBrick = nullptr;
     const Float4* mCell = nullptr;
     Float4 mScratch[N * N + N + 2] = {};
+    std::unique_ptr<openvdb::tree::ValueAccessor<const openvdb::FloatTree>> mScalarAcc;  ///< with a scalar tree
+    const float* mScalarCell = nullptr;
+    float mScalarScratch[N * N + N + 2] = {};
     std::vector<const Float4*> mCells;  ///< sampleScattered()'s cells (nullptr: through the tree)
 };
 
