@@ -123,7 +123,7 @@ private:
                 const double h = len / double(m);
                 // On the input strand (a vertex that rounds to the input's is the input's, below), a
                 // segment whose retrace is the segment itself is not traced (keepsOwnDirection()).
-                if (euler && p.x() == a.x() && p.y() == a.y() && p.z() == a.z() && keepsOwnDirection(a, seg, b, t, m, haveHead && !relative, counts)) {
+                if (euler && p.x() == a.x() && p.y() == a.y() && p.z() == a.z() && keepsOwnDirection(a, seg, b, t, m, h, haveHead && !relative, counts)) {
                     o[j + 1] = c[j + 1];
                     p = b;
                     continue;
@@ -339,8 +339,8 @@ private:
         return dl > 1e-12 ? d / dl : v;
     }
 
-    /// Whether the retrace of input segment a -> b (unit direction @a t, @a m sub-steps, forward
-    /// Euler) from p = a is the segment itself, and then its sub-steps' counts go to @a counts.
+    /// Whether the retrace of input segment a -> b (unit direction @a t, @a m sub-steps of length
+    /// @a h, forward Euler) from p = a is the segment itself, and then its sub-steps' counts go to @a counts.
     /// It is where the strand's own direction wins at every sub-step's start on the segment
     /// (the field's weight is 0) and, for a KeepOutside head, every sub-step ends outside the
     /// head: in exact arithmetic each sub-step then moves h along t (the return pull aims at
@@ -348,11 +348,10 @@ private:
     /// floor lies below it), and the chord is the segment. The samples of the segment's points
     /// do not depend on each other, so they overlap where the trace waits for each sub-step's end
     /// before the next: most sub-steps of real hair are of such segments.
-    bool keepsOwnDirection(const Vec3d& a, const Vec3d& seg, const Vec3d& b, const Vec3d& t, std::size_t m, bool keepOutside,
-                           Counts& counts)
+    bool keepsOwnDirection(const Vec3d& a, const Vec3d& seg, const Vec3d& b, const Vec3d& t, std::size_t m, double h,
+                           bool keepOutside, Counts& counts)
     {
         Counts own;
-        const double step = seg.length() / double(m);
         for (std::size_t k = 0; k <= m; ++k) {
             const Vec3d x = k == m ? b : a + seg * (double(k) / double(m));  // the points of the trace's sub-steps
             const Vec3d ip = mS.map.worldToIndex(x);
@@ -360,7 +359,7 @@ private:
             if (k > 0) {
                 // The end of sub-step k - 1, as insideField() and the head's test see it.
                 const bool inside = mS.volumeIsTangent ? r[3] > 0.f : mVolume.sample(mS.volumeMap.worldToIndex(x))[3] > 0.f;
-                if (!inside && step > 1e-12) ++own.heldIn;  // as the trace counts it
+                if (!inside && h > 1e-12) ++own.heldIn;  // as the trace counts it
                 if (keepOutside && mHead.distance(x) < 0.0) return false;
             }
             if (k < m) {
