@@ -142,10 +142,11 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     if (!p.saveField.empty() && fileExtension(p.saveField) != ".vdb") {
         throw ValueError("--save-field " + p.saveField + ": must end in .vdb");
     }
-    const StrandSet strands = loadStrands("refine", p.input, common, p.strict);
+    StrandSet strands = loadStrands("refine", p.input, common, p.strict);
     checkStrandLengths("refine", p.input, strands, common, p.strict);
     const RefineParams rp = refineParamsFrom(p, strands, common);
-    const RefineResult r = refineStrands(strands, rp, true, common.interrupter);
+    // The input is not needed again: its storage may take the output (refineStrands(StrandSet&&)).
+    const RefineResult r = refineStrands(std::move(strands), rp, true, common.interrupter);
     // Write the field first: if the strands' write fails, nothing half-done is claimed.
     {
         const Stage stage(common, "writing " + p.output);

@@ -342,6 +342,68 @@ TEST_CASE("refineStrands: identical for 1 and 2 threads", "[field]")
     }
 }
 
+TEST_CASE("refineStrands: a hairstyle given up is refined in its own storage, bit for bit as a kept one", "[field]")
+{
+    // A noisy bundle, three strands heading off it (corrected), one into a sphere head (pushed out).
+    StrandSet s = bundle(12, 1.2f, 6.f, 25);
+    std::mt19937 rng(5);
+    std::normal_distribution<float> noise(0.f, 0.05f);
+    for (Vec3f& p : s.positions) p += Vec3f(0.f, noise(rng), noise(rng));
+    for (int k = 0; k < 3; ++k) {
+        const float a = (25.f + 5.f * float(k)) * float(M_PI) / 180.f;
+        s.addStrand(line(Vec3f(0.f, 0.3f + 0.3f * float(k), 0.6f), Vec3f(std::cos(a), std::sin(a), 0.f), 6.f, 25));
+    }
+    s.addStrand(line(Vec3f(0.f, 0.6f, 0.6f), Vec3f(1.f, -1.f, 0.f), 3.f, 13));
+    for (int levels : {1, 3}) {
+        for (Integrator integ : {Integrator::Euler, Integrator::RK2}) {
+            CAPTURE(levels, integratorName(integ));
+            RefineParams rp;
+            rp.levels = levels;
+            rp.field.voxelSize = 0.3;
+            rp.head = HeadObstacle::sphere(Vec3d(2.0, -2.5, 0.6), 2.6, HeadPolicy::KeepOutside);
+            rp.setStep(0.0, integ);
+            const RefineResult kept = refineStrands(s, rp);
+            StrandSet given = s;
+            const Vec3f* storage = given.positions.data();
+            const RefineResult r = refineStrands(std::move(given), rp);
+            REQUIRE(r.strands.positions.data() == storage);  // no second copy of the positions
+            REQUIRE(r.strands.offsets == kept.strands.offsets);
+            REQUIRE(r.strands.positions == kept.strands.positions);
+            REQUIRE(kept.strands.positions != s.positions);
+            std::size_t corrected = 0, pushed = 0;
+            for (std::size_t l = 0; l < std::size_t(levels); ++l) {
+                const ConsistencyStats& a = r.levels[l].consistency;
+                const ConsistencyStats& b = kept.levels[l].consistency;
+                REQUIRE((a.corrected == b.corrected && a.steps == b.steps && a.fieldSteps == b.fieldSteps && a.pushedOut == b.pushedOut &&
+                         a.heldIn == b.heldIn && a.reverted == b.reverted && a.noFieldSteps == b.noFieldSteps));
+                corrected += b.corrected;
+                pushed += b.pushedOut;
+            }
+            if (levels == 1) {  // the paths taken: corrections and pushes out of the head
+                REQUIRE(corrected > 0);
+                REQUIRE(pushed > 0);
+            }
+            // The report's estimate is estimateRefineMemory()'s: the leaves counted exactly (level 0's
+            // are the input field's own, the others walked).
+            const RefineMemory m = estimateRefineMemory(s, rp);
+            REQUIRE(r.memory.bytes == m.bytes);
+            REQUIRE(kept.memory.bytes == m.bytes);
+            REQUIRE(r.memory.footprints.size() == std::size_t(levels));
+            for (std::size_t l = 0; l < std::size_t(levels); ++l) REQUIRE(r.memory.footprints[l].leaves == m.footprints[l].leaves);
+        }
+    }
+    // With the measures, the input is needed to the end: refined from a copy, the same again.
+    RefineParams rp;
+    rp.field.voxelSize = 0.3;
+    rp.measure = true;
+    const RefineResult kept = refineStrands(s, rp);
+    StrandSet given = s;
+    const RefineResult r = refineStrands(std::move(given), rp);
+    REQUIRE(r.strands.positions == kept.strands.positions);
+    REQUIRE(r.levels.front().measures.displacementMean == kept.levels.front().measures.displacementMean);
+    REQUIRE(r.levels.front().measures.displacementMean > 0.0);
+}
+
 TEST_CASE("refineStrands: bad parameters are refused, naming them", "[field]")
 {
     const StrandSet s = bundle(3, 1.f, 2.f, 5);

@@ -62,7 +62,10 @@ struct Shared
     double step;
     double minSigma;
     double invReturn;  ///< 1 / the return length (world units)
+    /// where each strand's retrace goes: a copy of @a in, or @a in itself (then each strand is
+    /// traced into a buffer and written over its input once traced)
     StrandSet& out;
+    bool inPlace;
 };
 
 struct Counts
@@ -88,24 +91,28 @@ public:
 
     void trace(std::size_t i, Counts& counts)
     {
+        const std::size_t n = mS.in.size(i);
+        if (mS.inPlace && mBuffer.size() < n) mBuffer.resize(n);
+        Vec3f* o = mS.inPlace ? mBuffer.data() : mS.out.data(i);
         switch (mS.params.integrator) {
-        case Integrator::Euler: return trace<Integrator::Euler>(i, counts);
-        case Integrator::RK2: return trace<Integrator::RK2>(i, counts);
-        case Integrator::RK3: return trace<Integrator::RK3>(i, counts);
-        case Integrator::RK4: return trace<Integrator::RK4>(i, counts);
+        case Integrator::Euler: trace<Integrator::Euler>(i, o, counts); break;
+        case Integrator::RK2: trace<Integrator::RK2>(i, o, counts); break;
+        case Integrator::RK3: trace<Integrator::RK3>(i, o, counts); break;
+        case Integrator::RK4: trace<Integrator::RK4>(i, o, counts); break;
         }
+        if (mS.inPlace && n > 0) std::memcpy(mS.out.data(i), o, n * sizeof(Vec3f));
     }
 
 private:
+    /// Retrace strand @a i of the input into @a o (its vertex count).
     template<Integrator I>
-    void trace(std::size_t i, Counts& counts)
+    void trace(std::size_t i, Vec3f* o, Counts& counts)
     {
         BlendSampler blend{*this, &counts};
         StreamlineIntegrator<BlendSampler> integrator(blend, I);
         constexpr bool euler = I == Integrator::Euler;
         const std::size_t n = mS.in.size(i);
         const Vec3f* c = mS.in.data(i);
-        Vec3f* o = mS.out.data(i);
         const bool haveHead = !mS.head.empty();
         const bool relative = haveHead && mS.head.policy() == HeadPolicy::NoDeeper;
         Vec3d p(c[0]);
@@ -285,9 +292,9 @@ private:
         return mLastTan[3] > 0.f;
     }
 
-    /// The tangent field's sample at index point @a ip: insideField()'s last sample when it was
-    /// taken at the same point, bit for bit (then the value a new sample would give), else a
-    /// new one.
+    /// The tangent field's sample at index point @a ip: the last sample kept (insideField(),
+    /// keepsOwnDirection()) when it was taken at the same point, bit for bit (then the value a
+    /// new sample would give), else a new one.
     Float4 sampleTangent(const Vec3d& ip)
     {
         if (mHaveLastTan && std::memcmp(&ip, &mLastTanAt, sizeof ip) == 0) return mLastTan;
@@ -355,7 +362,14 @@ private:
         for (std::size_t k = 0; k <= m; ++k) {
             const Vec3d x = k == m ? b : a + seg * (double(k) / double(m));  // the points of the trace's sub-steps
             const Vec3d ip = mS.map.worldToIndex(x);
-            const Float4 r = mTan.sample(ip);
+            // A segment's start is the last one's end, sampled there already (a third of the
+            // samples of a segment of two sub-steps): reused, bit for bit, and the end kept for the next.
+            const Float4 r = k == 0 ? sampleTangent(ip) : mTan.sample(ip);
+            if (k == m) {
+                mLastTan = r;
+                mLastTanAt = ip;
+                mHaveLastTan = true;
+            }
             if (k > 0) {
                 // The end of sub-step k - 1, as insideField() and the head's test see it.
                 const bool inside = mS.volumeIsTangent ? r[3] > 0.f : mVolume.sample(mS.volumeMap.worldToIndex(x))[3] > 0.f;
@@ -375,19 +389,23 @@ private:
     }
 
     const Shared& mS;
+    std::vector<Vec3f> mBuffer;  ///< one strand's retrace when in place
     FieldSampler<TreeT> mTan, mVolume;
     HairVolume::Probe mDilated;
     HeadObstacle::Probe mHead;
-    Float4 mLastTan = {0.f, 0.f, 0.f, 0.f};  ///< insideField()'s last sample of the tangent field,
+    Float4 mLastTan = {0.f, 0.f, 0.f, 0.f};  ///< the last sample of the tangent field kept for reuse (insideField(), keepsOwnDirection()),
     Vec3d mLastTanAt = Vec3d(0.0);            ///< at this index point
     bool mHaveLastTan = false;
 };
 
 } // namespace
 
-StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field, const ConsistencyParams& params,
-                            const HeadObstacle& head, ConsistencyStats* stats, bool threaded,
-                            openvdb::util::NullInterrupter* interrupter, const openvdb::Vec3SGrid* hairVolume)
+namespace {
+
+/// retraceConsistent() of @a strands into @a out: a copy of them, or @a strands itself.
+void retraceInto(const StrandSet& strands, StrandSet& out, const TangentField& field, const ConsistencyParams& params,
+                 const HeadObstacle& head, ConsistencyStats* stats, bool threaded, openvdb::util::NullInterrupter* interrupter,
+                 const openvdb::Vec3SGrid* hairVolume)
 {
     params.validate("retraceConsistent");
     if (!field.tangent || !field.spread) throw ValueError("retraceConsistent: the field needs its tangent and spread grids");
@@ -404,13 +422,6 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
                          " sub-steps for a hairstyle of total length " + std::to_string(total) + " (at most 4e9)");
     }
 
-    // Topology and attributes; positions are overwritten. The positions' storage is reserved
-    // first, hinted for huge pages (Memory.h): copy-assignment keeps storage that is large enough,
-    // so the copy faults in 2 MiB pages instead of 4 KiB ones (a 77 MB set: 19,000 faults in a
-    // process without the launcher's malloc setting, such as the benchmark or Python).
-    StrandSet out;
-    reserveHugePages(out.positions, strands.numVertices());
-    out = strands;
     // The spread beside the tangent in each brick, a float per voxel: sampled at the tangent's
     // cell, without a second brick lookup, in a quarter of the bytes of a vector brick.
     const BrickedField<TreeT> tangents(field.tangent->tree(), &field.spread->tree());
@@ -421,7 +432,8 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
     const BrickedField<TreeT>& volume = ownVolume ? *ownVolume : tangents;
     const HairVolume dilated(volumeGrid);
     const Shared shared{strands, map, FieldMapping::fromGrid(volumeGrid), tangents, volume, !ownVolume, dilated, head, params, step,
-                        std::sin(params.minSpreadDeg * M_PI / 180.0), 1.0 / (params.returnVoxels * map.worldVoxelSize()), out};
+                        std::sin(params.minSpreadDeg * M_PI / 180.0), 1.0 / (params.returnVoxels * map.worldVoxelSize()), out,
+                        &out == &strands};
 
     const std::size_t nS = strands.numStrands();
     // Strands in spatial order (Measures.h): neighbouring strands sample the same bricks, which
@@ -459,6 +471,31 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
         for (const Counts& c : counts) all.add(c);  // in chunk order
         *stats = ConsistencyStats{nS, all.corrected, all.steps, all.fieldSteps, all.noFieldSteps, all.pushedOut, all.heldIn, all.reverted};
     }
+}
+
+} // namespace
+
+StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field, const ConsistencyParams& params,
+                            const HeadObstacle& head, ConsistencyStats* stats, bool threaded,
+                            openvdb::util::NullInterrupter* interrupter, const openvdb::Vec3SGrid* hairVolume)
+{
+    // Topology and attributes; positions are overwritten. The positions' storage is reserved
+    // first, hinted for huge pages (Memory.h): copy-assignment keeps storage that is large enough,
+    // so the copy faults in 2 MiB pages instead of 4 KiB ones (a 77 MB set: 19,000 faults in a
+    // process without the launcher's malloc setting, such as the benchmark or Python).
+    StrandSet out;
+    reserveHugePages(out.positions, strands.numVertices());
+    out = strands;
+    retraceInto(strands, out, field, params, head, stats, threaded, interrupter, hairVolume);
+    return out;
+}
+
+StrandSet retraceConsistent(StrandSet&& strands, const TangentField& field, const ConsistencyParams& params,
+                            const HeadObstacle& head, ConsistencyStats* stats, bool threaded,
+                            openvdb::util::NullInterrupter* interrupter, const openvdb::Vec3SGrid* hairVolume)
+{
+    StrandSet out = std::move(strands);
+    retraceInto(out, out, field, params, head, stats, threaded, interrupter, hairVolume);
     return out;
 }
 

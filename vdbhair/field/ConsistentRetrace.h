@@ -101,4 +101,12 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
                             bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr,
                             const openvdb::Vec3SGrid* hairVolume = nullptr);
 
+/// @brief retraceConsistent() of @a strands into their own storage: the same result, bit for bit,
+/// without a second copy of the positions (each strand is traced into a buffer of its own and
+/// then written over its input; no strand's trace reads another's vertices).
+StrandSet retraceConsistent(StrandSet&& strands, const TangentField& field, const ConsistencyParams& params,
+                            const HeadObstacle& head = HeadObstacle(), ConsistencyStats* stats = nullptr,
+                            bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr,
+                            const openvdb::Vec3SGrid* hairVolume = nullptr);
+
 } // namespace vdbhair

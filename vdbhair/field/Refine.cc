@@ -149,38 +149,32 @@ RefineMemory estimateRefineMemory(const StrandSet& strands, const RefineParams& 
     return m;
 }
 
-RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded,
-                           openvdb::util::NullInterrupter* interrupter)
+namespace {
+
+/// refineStrands() of @a strands; @a consumable is @a strands itself when the caller gives it up, else null.
+RefineResult refine(const StrandSet& strands, StrandSet* consumable, const RefineParams& params, bool threaded,
+                    openvdb::util::NullInterrupter* interrupter)
 {
     params.validate("refineStrands");
     if (strands.empty()) throw ValueError("refineStrands: the hairstyle has no strands");
     FieldParams fp = params.field;
     if (fp.voxelSize == 0.0) fp.voxelSize = suggestVoxelSize(strands);
 
-    // Memory, before anything is allocated: the whole refinement's estimate, checked once (the
-    // estimates below are part of it and skip their own check).
+    // Memory, before anything is allocated: the whole refinement's estimate (estimateRefineMemory()'s),
+    // checked once, in the same pass over the strands as the input's own field at the finest voxel
+    // size. That field's active voxels are the hair volume that every level keeps strands in, and
+    // the reference every level is measured against. The estimates below are part of the check
+    // and skip their own.
     RefineResult result;
-    {
-        RefineParams rp = params;
-        rp.field.voxelSize = fp.voxelSize;
-        result.memory = estimateRefineMemory(strands, rp);
-        std::uint64_t leaves = 0;
-        for (const FieldFootprint& f : result.memory.footprints) leaves += f.leaves;
-        checkMemoryEstimate("refineStrands", result.memory.bytes,
-                            std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) +
-                                " vertices, " + std::to_string(leaves) + " leaves in " + std::to_string(params.levels) +
-                                " level(s) from voxel size " + std::to_string(fp.voxelSize),
-                            fp);
-        fp.maxMemory = std::numeric_limits<std::uint64_t>::max();
-    }
+    const TangentField inputField = estimateTangentFieldAfterCheck(strands, fp, MemoryUse::Refine, params.levels, "refineStrands",
+                                                                   result.memory.footprints, threaded, interrupter);
+    result.memory.bytes = estimatePeakBytes(result.memory.footprints, MemoryUse::Refine);
+    result.memory.available = availableMemoryBytes(fp);
+    fp.maxMemory = std::numeric_limits<std::uint64_t>::max();
     result.voxelSize = fp.voxelSize;
     result.head = params.head.unset() ? headFromRoots(strands, fp.scalpSphere().up) : params.head;
     result.fields.resize(std::size_t(params.levels));
     result.levels.resize(std::size_t(params.levels));
-
-    // The input's own field at the finest voxel size: its active voxels are the hair volume that
-    // every level keeps strands in, and the reference every level is measured against.
-    const TangentField inputField = estimateTangentField(strands, fp, threaded, interrupter);
 
     StrandSet current;  // the last level's strands (the input's before the first level)
     for (int level = params.levels - 1; level >= 0; --level) {
@@ -205,9 +199,18 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
         RefineLevel& info = result.levels[std::size_t(level)];
         info.voxelSize = lp.voxelSize;
         if (params.mode == RefineMode::Consistent) {
-            // Each level starts from the last one's strands: detail that a level keeps is there for the next.
-            current = retraceConsistent(from, f, params.consistency, result.head, &info.consistency, threaded, interrupter,
-                                        inputField.tangent.get());
+            // Each level starts from the last one's strands: detail that a level keeps is there for
+            // the next. Strands nothing reads again are retraced in their own storage: the last
+            // level's always, the input's when the caller gave it up and no measure needs it.
+            const bool consume = &from == &current || (consumable && !params.measure);
+            if (consume) {
+                StrandSet& own = &from == &current ? current : *consumable;
+                current = retraceConsistent(std::move(own), f, params.consistency, result.head, &info.consistency, threaded,
+                                            interrupter, inputField.tangent.get());
+            } else {
+                current = retraceConsistent(from, f, params.consistency, result.head, &info.consistency, threaded, interrupter,
+                                            inputField.tangent.get());
+            }
         } else {
             // The paper: every level retraces the input's roots for the input's lengths and
             // vertex arc lengths, so that early stops at one level do not shorten the next. The
@@ -220,6 +223,20 @@ RefineResult refineStrands(const StrandSet& strands, const RefineParams& params,
     }
     result.strands = std::move(current);
     return result;
+}
+
+} // namespace
+
+RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded,
+                           openvdb::util::NullInterrupter* interrupter)
+{
+    return refine(strands, nullptr, params, threaded, interrupter);
+}
+
+RefineResult refineStrands(StrandSet&& strands, const RefineParams& params, bool threaded,
+                           openvdb::util::NullInterrupter* interrupter)
+{
+    return refine(strands, &strands, params, threaded, interrupter);
 }
 
 } // namespace vdbhair

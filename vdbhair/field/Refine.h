@@ -108,4 +108,11 @@ HeadObstacle headFromRoots(const StrandSet& strands, const Vec3d& up = Vec3d(0.0
 RefineResult refineStrands(const StrandSet& strands, const RefineParams& params, bool threaded = true,
                            openvdb::util::NullInterrupter* interrupter = nullptr);
 
+/// @brief refineStrands() of a hairstyle the caller no longer needs: the same result, bit for bit.
+/// Consistent mode without RefineParams::measure retraces into the input's own storage instead of a
+/// copy of it (a 100,000 x 64 set: 77 MB less, and no serial copy). @a strands is left in a valid
+/// but unspecified state, also when an exception is thrown.
+RefineResult refineStrands(StrandSet&& strands, const RefineParams& params, bool threaded = true,
+                           openvdb::util::NullInterrupter* interrupter = nullptr);
+
 } // namespace vdbhair

@@ -744,12 +744,17 @@ FieldFootprint footprintOf(const StrandSet& strands, const FieldParams& params, 
     return f;
 }
 
-/// Refuse a field of @a levels levels at @a p (voxel size resolved) whose estimate exceeds the
-/// memory it may use; nothing is counted when there is no limit (maxMemory at its largest).
+/// Refuse a @a use of @a levels levels at @a p (voxel size resolved) whose estimate exceeds the
+/// memory it may use (the message names @a where); nothing is counted when there is no limit
+/// (maxMemory at its largest) and @a footprintsOut is null.
+/// @param footprintsOut if not null, receives the footprints checked, and @a exactOut whether
+/// their leaves are exact (else countLeaves()'s bound, which was enough for the check)
 /// @return each level's extent, as estimateLevel() measures it, when they were measured; else empty
-std::vector<Extent> checkFieldMemory(const StrandSet& strands, const FieldParams& p, int levels)
+std::vector<Extent> checkFieldMemory(const StrandSet& strands, const FieldParams& p, int levels, MemoryUse use = MemoryUse::Field,
+                                     const char* where = "estimateTangentField",
+                                     std::vector<FieldFootprint>* footprintsOut = nullptr, bool* exactOut = nullptr)
 {
-    if (p.maxMemory == std::numeric_limits<std::uint64_t>::max()) return {};
+    if (!footprintsOut && p.maxMemory == std::numeric_limits<std::uint64_t>::max()) return {};
     std::vector<FieldFootprint> footprints;
     std::vector<Extent> extents(static_cast<std::size_t>(levels));
     FieldParams lp = p;
@@ -760,19 +765,26 @@ std::vector<Extent> checkFieldMemory(const StrandSet& strands, const FieldParams
     // The leaves bounded by their box first: the estimate grows with them, so when the bound fits,
     // so does the exact count, and the walk of every segment that counts them (7 % of `field`'s
     // CPU) is only taken for a request that may not fit, whose message names the exact count.
-    if (estimatePeakBytes(footprints, MemoryUse::Field) > availableMemoryBytes(p)) {
+    bool exact = false;
+    if (estimatePeakBytes(footprints, use) > availableMemoryBytes(p)) {
         for (int l = 0; l < levels; ++l) {
             FieldFootprint& f = footprints[std::size_t(l)];
             lp.voxelSize = p.voxelSize * double(1 << l);
             f.leaves = countLeaves(strands, mappingFor(lp, lp.voxelSize), f.visits, extents[std::size_t(l)]);
         }
+        exact = true;
     }
     std::uint64_t leaves = 0;
     for (const FieldFootprint& f : footprints) leaves += f.leaves;
-    checkMemoryEstimate("estimateTangentField", estimatePeakBytes(footprints, MemoryUse::Field),
-                        std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) + " vertices, " +
-                            std::to_string(leaves) + " leaves at voxel size " + std::to_string(p.voxelSize),
+    const std::string counts = std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) +
+                               " vertices, " + std::to_string(leaves) + " leaves";
+    checkMemoryEstimate(where, estimatePeakBytes(footprints, use),
+                        counts + (use == MemoryUse::Refine ? " in " + std::to_string(levels) + " level(s) from voxel size "
+                                                           : std::string(" at voxel size ")) +
+                            std::to_string(p.voxelSize),
                         p);
+    if (footprintsOut) *footprintsOut = std::move(footprints);
+    if (exactOut) *exactOut = exact;
     return extents;
 }
 
@@ -897,6 +909,32 @@ TangentField estimateTangentField(const StrandSet& strands, const FieldParams& p
     const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
     const std::vector<Extent> extents = checkFieldMemory(strands, p, 1);
     return estimateLevel(strands, p, p.voxelSize, 0, 1, threaded, interrupter, extents.empty() ? nullptr : &extents[0]);
+}
+
+TangentField estimateTangentFieldAfterCheck(const StrandSet& strands, const FieldParams& params, MemoryUse use, int levels,
+                                            const char* where, std::vector<FieldFootprint>& footprints, bool threaded,
+                                            openvdb::util::NullInterrupter* interrupter)
+{
+    if (levels < 1 || levels > FieldParams::kMaxLevels) {
+        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + " must be between 1 and " +
+                         std::to_string(FieldParams::kMaxLevels));
+    }
+    const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
+    bool exact = false;
+    const std::vector<Extent> extents = checkFieldMemory(strands, p, levels, use, where, &footprints, &exact);
+    TangentField field = estimateLevel(strands, p, p.voxelSize, 0, 1, threaded, interrupter, &extents[0]);
+    if (!exact) {
+        // The check needed only the bound. Level 0's leaves are the field's own (the blocks its
+        // segments pass through, what countLeaves() walks); the coarser levels' are walked.
+        footprints[0].leaves = field.tangent->tree().leafCount();
+        FieldParams lp = p;
+        for (int l = 1; l < levels; ++l) {
+            FieldFootprint& f = footprints[std::size_t(l)];
+            lp.voxelSize = p.voxelSize * double(1 << l);
+            f.leaves = countLeaves(strands, mappingFor(lp, lp.voxelSize), f.visits, extents[std::size_t(l)]);
+        }
+    }
+    return field;
 }
 
 std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, const FieldParams& params, int levels,

@@ -176,6 +176,17 @@ std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, c
                                                      int levels, bool threaded = true,
                                                      openvdb::util::NullInterrupter* interrupter = nullptr);
 
+/// @brief estimateTangentField(@a strands, @a params) after the memory check of @a use over
+/// @a levels levels from its voxel size (estimatePeakBytes(), refused as checkMemoryEstimate()
+/// does, naming @a where), one pass over the strands serving both: how refineStrands() checks
+/// the whole refinement before its first field. @a footprints receives each level's footprint,
+/// its leaves exact (estimateFieldFootprint()'s). Unlike estimateTangentField(), it checks even
+/// without a limit (params.maxMemory at its largest), since the footprints are asked for.
+/// @throw as estimateTangentField(); LimitError above the memory available.
+TangentField estimateTangentFieldAfterCheck(const StrandSet& strands, const FieldParams& params, MemoryUse use, int levels,
+                                            const char* where, std::vector<FieldFootprint>& footprints, bool threaded = true,
+                                            openvdb::util::NullInterrupter* interrupter = nullptr);
+
 /// @brief An upper bound on the voxel visits of estimating at @a params (what maxVoxels caps).
 std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params);
 

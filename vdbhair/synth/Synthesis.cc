@@ -280,7 +280,7 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
             rp.measure = false;
             rp.field.voxelSize = res.refineVoxelSizes[std::size_t(l)];
             if (scalp) rp.head = HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper);
-            RefineResult rr = refineStrands(strands, rp, threaded, interrupter);
+            RefineResult rr = refineStrands(std::move(strands), rp, threaded, interrupter);
             if (!rr.levels.empty()) res.refinedCorrected[std::size_t(l)] = rr.levels.front().consistency.corrected;
             strands = std::move(rr.strands);
             StrandSamples again = sampleStrands(strands, map, level.vertices, threaded);
