@@ -10,6 +10,9 @@
 /// retraced strands, the bytes writers assemble.
 #pragma once
 
+#include <vdbhair/Parallel.h>
+
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
@@ -42,6 +45,22 @@ void reserveHugePages(ContainerT& v, std::size_t n)
 {
     v.reserve(n);
     adviseHugePages(v.data(), v.capacity() * sizeof(*v.data()));
+}
+
+/// @brief Write a zero byte into every 4 KiB page of the storage [p, p + bytes), from TBB's
+/// threads when @a threaded: the first touch of fresh memory is the kernel's work (a fault, and
+/// zeroing), which one thread does alone when the storage is then value-initialized or copied
+/// into in order. For a buffer about to be overwritten, such as a vector's reserved capacity
+/// before resize(): nothing it held is kept.
+inline void prefaultPages(void* p, std::size_t bytes, bool threaded)
+{
+    constexpr std::size_t kPage = 4096, kBlock = std::size_t(2) << 20;
+    if (!p || bytes == 0) return;
+    char* base = static_cast<char*>(p);
+    forEachIndex((bytes + kBlock - 1) / kBlock, threaded, [&](std::size_t b) {
+        const std::size_t end = std::min(bytes, (b + 1) * kBlock);
+        for (std::size_t at = b * kBlock; at < end; at += kPage) base[at] = 0;
+    }, 1);
 }
 
 } // namespace vdbhair

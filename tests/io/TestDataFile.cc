@@ -196,6 +196,17 @@ TEST_CASE("summarizeData: the summary, warnings and first error of reading the f
     // The same on one thread.
     tbb::task_arena one(1);
     one.execute([&] { requireSameSummary(read, summarizeData(path)); });
+    // readData() copies the strands in parallel: the same set on one thread, vertex for vertex.
+    const StrandSet all = readData(path);
+    REQUIRE(all.numVertices() > 0);
+    one.execute([&] {
+        const StrandSet serial = readData(path);
+        REQUIRE(serial.offsets == all.offsets);
+        REQUIRE(serial.positions == all.positions);
+    });
+    // File strand i has vertex j at (i, j, i j / 2); file strand 0 (1 vertex) is dropped, so kept strand 0 is file strand 1.
+    REQUIRE(all.data(0)[3] == Vec3f(1.f, 3.f, 1.5f));
+    REQUIRE(all.data(1)[3] == Vec3f(2.f, 3.f, 3.f));
 
     // Whichever fault comes first in the file is the one reported, by both.
     ReadOptions strict;

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Memory.h>
+#include <vdbhair/Parallel.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
@@ -411,12 +412,23 @@ void retraceInto(const StrandSet& strands, StrandSet& out, const TangentField& f
     if (!field.tangent || !field.spread) throw ValueError("retraceConsistent: the field needs its tangent and spread grids");
     const FieldMapping map = FieldMapping::fromGrid(*field.tangent);
     const double step = resolveStepLength(params.step, map.worldVoxelSize(), "retraceConsistent");
-    // A strand needs about length / step sub-steps: refuse a step that would take forever.
+    // A strand needs about length / step sub-steps: refuse a step that would take forever. The
+    // length is summed per chunk of strands in parallel, then over the chunks in order: the same
+    // sum for any thread count.
+    constexpr std::size_t kChunk = 256;
+    const std::size_t nS = strands.numStrands(), nChunks = (nS + kChunk - 1) / kChunk;
+    std::vector<double> lengths(nChunks, 0.0);
+    const auto measureChunk = [&](std::size_t c) {
+        double sum = 0.0;
+        for (std::size_t i = c * kChunk, last = std::min(nS, i + kChunk); i < last; ++i) {
+            const Vec3f* s = strands.data(i);
+            for (std::size_t j = 0; j + 1 < strands.size(i); ++j) sum += double((s[j + 1] - s[j]).length());
+        }
+        lengths[c] = sum;
+    };
+    forEachIndex(nChunks, threaded, measureChunk, 16);
     double total = 0.0;
-    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
-        const Vec3f* s = strands.data(i);
-        for (std::size_t j = 0; j + 1 < strands.size(i); ++j) total += double((s[j + 1] - s[j]).length());
-    }
+    for (double l : lengths) total += l;
     if (total / step > 4e9) {
         throw LimitError("retraceConsistent: step " + std::to_string(step) + " needs about " + std::to_string(total / step) +
                          " sub-steps for a hairstyle of total length " + std::to_string(total) + " (at most 4e9)");
@@ -435,13 +447,11 @@ void retraceInto(const StrandSet& strands, StrandSet& out, const TangentField& f
                         std::sin(params.minSpreadDeg * M_PI / 180.0), 1.0 / (params.returnVoxels * map.worldVoxelSize()), out,
                         &out == &strands};
 
-    const std::size_t nS = strands.numStrands();
     // Strands in spatial order (Measures.h): neighbouring strands sample the same bricks, which
     // then stay in cache (synthesized roots come in random order). Each strand is traced on its
     // own and the counts are integers, so the order changes nothing in the result.
     const std::vector<std::uint32_t> order = spatialOrder(strands);
-    constexpr std::size_t kChunk = 256;
-    const std::size_t nChunks = (nS + kChunk - 1) / kChunk;
+
     std::vector<Counts> counts(nChunks);
     ProgressCounter progress(interrupter, "retracing (consistent)", nS, "strands");
     auto run = [&](std::size_t c) {

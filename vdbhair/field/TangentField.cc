@@ -1,6 +1,7 @@
 #include "TangentField.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parallel.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
@@ -15,6 +16,7 @@
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -589,9 +591,19 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
 
     // Topology: every block any chunk touched, as leaves of the output trees.
     // The other trees copy the tangent tree's topology, in parallel (OpenVDB's topology copy).
+    // The leaves are made in parallel (each fills its buffer: fresh pages, which the threads then
+    // fault in together) and then linked into the tree, which is what touchLeaf() would make.
     openvdb::Vec3STree::Ptr tangentTree(new openvdb::Vec3STree(openvdb::Vec3f(0.f)));
-    for (const Chunk& c : chunks) {
-        for (const Coord& origin : c.origins) tangentTree->touchLeaf(origin);
+    {
+        using LeafT = openvdb::Vec3STree::LeafNodeType;
+        std::vector<Coord> origins;
+        for (const Chunk& c : chunks) origins.insert(origins.end(), c.origins.begin(), c.origins.end());
+        std::sort(origins.begin(), origins.end());
+        origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+        std::vector<std::unique_ptr<LeafT>> made(origins.size());
+        const auto make = [&](std::size_t i) { made[i].reset(new LeafT(origins[i], openvdb::Vec3f(0.f), false)); };
+        forEachIndex(origins.size(), threaded, make);
+        for (std::unique_ptr<LeafT>& leaf : made) tangentTree->addLeaf(leaf.release());  // the tree owns it from here
     }
     openvdb::FloatTree::Ptr densityTree, coherenceTree, spreadTree;
     const auto copyTopology = [&](openvdb::FloatTree::Ptr& tree) {
@@ -649,9 +661,16 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     const double voxelVolume = voxelSize * voxelSize * voxelSize;
     double reference = p.densityReference;
     if (!(reference > 0.0)) {
-        std::vector<float> values;
-        values.reserve(std::size_t(densityTree->activeVoxelCount()));
-        for (auto it = densityTree->cbeginValueOn(); it; ++it) values.push_back(*it);
+        // The active values (all in leaves: the trees are built leaf by leaf), gathered leaf by
+        // leaf in parallel; the percentile does not depend on their order.
+        openvdb::tree::LeafManager<const openvdb::FloatTree> dleaves(*densityTree);
+        std::vector<std::size_t> start(dleaves.leafCount() + 1, 0);
+        for (std::size_t i = 0; i < dleaves.leafCount(); ++i) start[i + 1] = start[i] + dleaves.leaf(i).onVoxelCount();
+        std::vector<float> values(start.back());
+        forEachIndex(dleaves.leafCount(), threaded, [&](std::size_t i) {
+            std::size_t k = start[i];
+            for (auto it = dleaves.leaf(i).cbeginValueOn(); it; ++it) values[k++] = *it;
+        });
         if (!values.empty()) {
             const std::size_t k = std::min(values.size() - 1, std::size_t(0.95 * double(values.size())));
             std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());

@@ -1,5 +1,7 @@
 #include "DataFile.h"
 
+#include <vdbhair/Memory.h>
+
 #include <vdbhair/io/ByteReader.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/MappedFile.h>
@@ -116,19 +118,34 @@ StrandSet readData(const std::string& path, const ReadOptions& opts, ReadReport*
     const MappedFile file(path, where, opts.interrupter);
     ByteReader in(file.data(), file.size(), where);
     StrandSet out;
-    // Bounded by the file size: what follows the strand count, 12 bytes a vertex.
-    out.reserve(0, (file.size() - std::min<std::size_t>(file.size(), 4)) / 12);
     std::exception_ptr fault;
-    // Each strand's positions are copied and checked where its count is read (a dropped strand's
-    // are overwritten by the next one's).
-    const std::vector<DataSpan> spans = scanData(file.data(), in, opts, report, where, fault, [&](const DataSpan& sp) {
-        out.positions.resize(sp.first + sp.vertices);
-        float* dst = reinterpret_cast<float*>(out.positions.data() + sp.first);
-        std::memcpy(dst, file.data() + sp.posAt, 12 * std::size_t(sp.vertices));
-        throwIfNonFinite(sp, file.data() + sp.posAt, allFinite(dst, 3 * std::size_t(sp.vertices)), where);
-    });
+    // The counts first (a chain of loads through the file), then every strand's positions copied
+    // and checked in parallel, into storage the threads fault in together (prefaultPages()).
+    const std::vector<DataSpan> spans = scanData(file.data(), in, opts, report, where, fault, [](const DataSpan&) {});
+    const std::size_t total = keptVertices(spans);
+    reserveHugePages(out.positions, total);
+    prefaultPages(out.positions.data(), total * sizeof(Vec3f), true);
+    out.positions.resize(total);
+    std::vector<char> finite(spans.size(), 1);
+    forEachIndex(spans.size(), true, [&](std::size_t i) {
+        const DataSpan& sp = spans[i];
+        const char* src = file.data() + sp.posAt;
+        if (sp.kept) {
+            float* dst = reinterpret_cast<float*>(out.positions.data() + sp.first);
+            std::memcpy(dst, src, 12 * std::size_t(sp.vertices));
+            finite[i] = allFinite(dst, 3 * std::size_t(sp.vertices)) ? 1 : 0;
+        } else {
+            // A dropped strand (fewer than 2 vertices) is checked too, as one pass in file order would.
+            float v[3];
+            for (std::size_t k = 0; k < sp.vertices && finite[i]; ++k) {
+                std::memcpy(v, src + 12 * k, 12);
+                finite[i] = allFinite(v, 3) ? 1 : 0;
+            }
+        }
+    }, 256);
+    // The first fault in file order: a strand's values before a later count's fault.
+    for (std::size_t i = 0; i < spans.size(); ++i) throwIfNonFinite(spans[i], file.data() + spans[i].posAt, finite[i] != 0, where);
     if (fault) std::rethrow_exception(fault);
-    out.positions.resize(keptVertices(spans));
     out.reserve(spans.size(), 0);
     for (const DataSpan& sp : spans) {
         if (sp.kept) out.offsets.push_back(std::uint32_t(sp.first + sp.vertices));

@@ -5,6 +5,8 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -210,24 +212,42 @@ std::uint32_t spreadBits(std::uint32_t v)
 
 namespace {
 /// The Morton order of @a n points given by @a point(i) (see spatialOrder()).
+/// In parallel above a few thousand points (each point's read is a cache miss when the points are
+/// a strand set's roots): the box is a min and max, and the keys are unique (they hold the index),
+/// so the result is the same for any thread count.
 template<typename PointFn>
 std::vector<std::uint32_t> mortonOrder(std::size_t n, PointFn&& point)
 {
-    BBox box;
-    for (std::size_t i = 0; i < n; ++i) box.expand(point(i));
+    constexpr std::size_t kGrain = 4096;
+    BBox box = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, kGrain), BBox(),
+        [&](const tbb::blocked_range<std::size_t>& r, BBox b) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) b.expand(point(i));
+            return b;
+        },
+        [](BBox a, const BBox& b) {
+            if (!b.empty()) {
+                a.expand(b.min);
+                a.expand(b.max);
+            }
+            return a;
+        });
     const Vec3f e = box.extent();
     std::vector<std::uint64_t> keys(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec3f p = point(i);
-        std::uint32_t code = 0;
-        for (int k = 0; k < 3; ++k) {
-            const float f = e[k] > 0.f ? (p[k] - box.min[k]) / e[k] : 0.f;
-            const std::uint32_t q = std::uint32_t(std::min(1023.f, std::max(0.f, f * 1024.f)));
-            code |= spreadBits(q) << k;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3f p = point(i);
+            std::uint32_t code = 0;
+            for (int k = 0; k < 3; ++k) {
+                const float f = e[k] > 0.f ? (p[k] - box.min[k]) / e[k] : 0.f;
+                const std::uint32_t q = std::uint32_t(std::min(1023.f, std::max(0.f, f * 1024.f)));
+                code |= spreadBits(q) << k;
+            }
+            keys[i] = (std::uint64_t(code) << 32) | std::uint64_t(i);
         }
-        keys[i] = (std::uint64_t(code) << 32) | std::uint64_t(i);
-    }
-    std::sort(keys.begin(), keys.end());
+    });
+    if (n > kGrain) tbb::parallel_sort(keys.begin(), keys.end());
+    else std::sort(keys.begin(), keys.end());
     std::vector<std::uint32_t> order(n);
     for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(keys[i] & 0xffffffffu);
     return order;
