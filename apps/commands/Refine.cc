@@ -73,6 +73,7 @@ nlohmann::json measuresJson(const RefineMeasures& m)
 nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp)
 {
     nlohmann::json j = rp.measure ? measuresJson(r.levels.front().measures) : nlohmann::json::object();
+    j["strands"] = r.strands.numStrands();  // also without the measures (the scale benchmark reads it)
     j["mode"] = refineModeName(rp.mode);
     j["voxel_size"] = r.voxelSize;
     j["levels"] = rp.levels;

@@ -212,15 +212,13 @@ std::uint32_t spreadBits(std::uint32_t v)
 
 namespace {
 /// The Morton order of @a n points given by @a point(i) (see spatialOrder()).
-/// In parallel above a few thousand points (each point's read is a cache miss when the points are
-/// a strand set's roots): the box is a min and max, and the keys are unique (they hold the index),
-/// so the result is the same for any thread count.
+/// The box of the @a n points @a point(i), in parallel in ranges of @a grain (a min and a max: the
+/// same box for any split; non-finite coordinates are left out, as BBox::expand() does).
 template<typename PointFn>
-std::vector<std::uint32_t> mortonOrder(std::size_t n, PointFn&& point)
+BBox boxOf(std::size_t n, PointFn&& point, std::size_t grain)
 {
-    constexpr std::size_t kGrain = 4096;
-    BBox box = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, n, kGrain), BBox(),
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, grain), BBox(),
         [&](const tbb::blocked_range<std::size_t>& r, BBox b) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) b.expand(point(i));
             return b;
@@ -232,6 +230,16 @@ std::vector<std::uint32_t> mortonOrder(std::size_t n, PointFn&& point)
             }
             return a;
         });
+}
+
+/// In parallel above a few thousand points (each point's read is a cache miss when the points are
+/// a strand set's roots): the box is a min and max, and the keys are unique (they hold the index),
+/// so the result is the same for any thread count.
+template<typename PointFn>
+std::vector<std::uint32_t> mortonOrder(std::size_t n, PointFn&& point)
+{
+    constexpr std::size_t kGrain = 4096;
+    const BBox box = boxOf(n, point, kGrain);
     const Vec3f e = box.extent();
     std::vector<std::uint64_t> keys(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -253,6 +261,13 @@ std::vector<std::uint32_t> mortonOrder(std::size_t n, PointFn&& point)
     return order;
 }
 } // namespace
+
+/// (Declared in StrandSet.h; here beside spatialOrder(), with the box's one parallel reduction.)
+BBox computeBBox(const StrandSet& strands)
+{
+    const std::vector<Vec3f>& v = strands.positions;
+    return boxOf(v.size(), [&](std::size_t i) { return v[i]; }, std::size_t(1) << 16);
+}
 
 std::vector<std::uint32_t> spatialOrder(const StrandSet& strands)
 {

@@ -3,9 +3,6 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Memory.h>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
-
 #include <cmath>
 #include <limits>
 
@@ -121,25 +118,6 @@ void StrandSet::append(StrandSet&& other)
         return;
     }
     append(static_cast<const StrandSet&>(other));
-}
-
-BBox computeBBox(const StrandSet& strands)
-{
-    // In parallel (a min and a max: the same box for any split of the vertices).
-    const std::vector<Vec3f>& v = strands.positions;
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, v.size(), std::size_t(1) << 16), BBox(),
-        [&](const tbb::blocked_range<std::size_t>& r, BBox box) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) box.expand(v[i]);
-            return box;
-        },
-        [](BBox a, const BBox& b) {
-            if (!b.empty()) {
-                a.expand(b.min);
-                a.expand(b.max);
-            }
-            return a;
-        });
 }
 
 StrandSet selectStrands(const StrandSet& strands, const std::vector<char>& keep)
