@@ -129,6 +129,7 @@ StrandSet readData(const std::string& path, const ReadOptions& opts, ReadReport*
     std::vector<char> finite(spans.size(), 1);
     forEachIndex(spans.size(), true, [&](std::size_t i) {
         const DataSpan& sp = spans[i];
+        if (sp.vertices == 0) return;  // nothing to copy (and no storage at all when every strand is empty)
         const char* src = file.data() + sp.posAt;
         if (sp.kept) {
             float* dst = reinterpret_cast<float*>(out.positions.data() + sp.first);
