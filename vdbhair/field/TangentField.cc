@@ -763,6 +763,28 @@ FieldFootprint footprintOf(const StrandSet& strands, const FieldParams& params, 
     return f;
 }
 
+/// Each level's leaves from level @a first on, counted exactly (countLeaves()'s walk) over the
+/// extents measured for the bound.
+void countLeavesExactly(const StrandSet& strands, const FieldParams& p, std::vector<FieldFootprint>& footprints,
+                        const std::vector<Extent>& extents, std::size_t first)
+{
+    FieldParams lp = p;
+    for (std::size_t l = first; l < footprints.size(); ++l) {
+        FieldFootprint& f = footprints[l];
+        lp.voxelSize = p.voxelSize * double(1 << l);
+        f.leaves = countLeaves(strands, mappingFor(lp, lp.voxelSize), f.visits, extents[l]);
+    }
+}
+
+/// The levels rule of the multi-level estimates: ValueError naming @a where outside [1, FieldParams::kMaxLevels].
+void checkLevels(int levels, const char* where)
+{
+    if (levels < 1 || levels > FieldParams::kMaxLevels) {
+        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + " must be between 1 and " +
+                         std::to_string(FieldParams::kMaxLevels));
+    }
+}
+
 /// Refuse a @a use of @a levels levels at @a p (voxel size resolved) whose estimate exceeds the
 /// memory it may use (the message names @a where); nothing is counted when there is no limit
 /// (maxMemory at its largest) and @a footprintsOut is null.
@@ -786,11 +808,7 @@ std::vector<Extent> checkFieldMemory(const StrandSet& strands, const FieldParams
     // CPU) is only taken for a request that may not fit, whose message names the exact count.
     bool exact = false;
     if (estimatePeakBytes(footprints, use) > availableMemoryBytes(p)) {
-        for (int l = 0; l < levels; ++l) {
-            FieldFootprint& f = footprints[std::size_t(l)];
-            lp.voxelSize = p.voxelSize * double(1 << l);
-            f.leaves = countLeaves(strands, mappingFor(lp, lp.voxelSize), f.visits, extents[std::size_t(l)]);
-        }
+        countLeavesExactly(strands, p, footprints, extents, 0);
         exact = true;
     }
     std::uint64_t leaves = 0;
@@ -934,10 +952,7 @@ TangentField estimateTangentFieldAfterCheck(const StrandSet& strands, const Fiel
                                             const char* where, std::vector<FieldFootprint>& footprints, bool threaded,
                                             openvdb::util::NullInterrupter* interrupter)
 {
-    if (levels < 1 || levels > FieldParams::kMaxLevels) {
-        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + " must be between 1 and " +
-                         std::to_string(FieldParams::kMaxLevels));
-    }
+    checkLevels(levels, where);
     const FieldParams p = resolvedParams(strands, params, "estimateTangentField");
     bool exact = false;
     const std::vector<Extent> extents = checkFieldMemory(strands, p, levels, use, where, &footprints, &exact);
@@ -946,12 +961,7 @@ TangentField estimateTangentFieldAfterCheck(const StrandSet& strands, const Fiel
         // The check needed only the bound. Level 0's leaves are the field's own (the blocks its
         // segments pass through, what countLeaves() walks); the coarser levels' are walked.
         footprints[0].leaves = field.tangent->tree().leafCount();
-        FieldParams lp = p;
-        for (int l = 1; l < levels; ++l) {
-            FieldFootprint& f = footprints[std::size_t(l)];
-            lp.voxelSize = p.voxelSize * double(1 << l);
-            f.leaves = countLeaves(strands, mappingFor(lp, lp.voxelSize), f.visits, extents[std::size_t(l)]);
-        }
+        countLeavesExactly(strands, p, footprints, extents, 1);
     }
     return field;
 }
@@ -959,10 +969,7 @@ TangentField estimateTangentFieldAfterCheck(const StrandSet& strands, const Fiel
 std::vector<TangentField> estimateTangentFieldLevels(const StrandSet& strands, const FieldParams& params, int levels,
                                                      bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
-    if (levels < 1 || levels > FieldParams::kMaxLevels) {
-        throw ValueError("estimateTangentField: levels " + std::to_string(levels) + " must be between 1 and " +
-                         std::to_string(FieldParams::kMaxLevels));
-    }
+    checkLevels(levels, "estimateTangentField");
     FieldParams lp = resolvedParams(strands, params, "estimateTangentField");
     const std::vector<Extent> extents = checkFieldMemory(strands, lp, levels);
     const double voxelSize = lp.voxelSize;
