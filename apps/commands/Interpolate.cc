@@ -1,20 +1,19 @@
 // vdbhair interpolate GUIDES -o OUT (--roots ROOTS | --scalp scalp.vdb --count N): new hairs from
-// guide hairs, by interpolating their helicoid parameters (Piuze et al. 2011, §4) or, as the
-// peers do, their points (--method points).
+// guide hairs, by blending the guides' points by group and likeness (the default) or their helicoid
+// parameters (Piuze et al. 2011, §4), kept out of the head (vdbhair/helicoid/GuideInterpolation.h).
 #include "../Command.h"
 
 #include <vdbhair/Exceptions.h>
-#include <vdbhair/helicoid/HelicoidFit.h>
-#include <vdbhair/helicoid/HelicoidInterpolation.h>
-#include <vdbhair/helicoid/PointInterpolation.h>
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/IdList.h>
 #include <vdbhair/io/PointFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/Follicles.h>
 
-#include <chrono>
 #include <cmath>
 
 namespace vdbhair::app {
@@ -23,75 +22,99 @@ namespace {
 
 struct InterpolateCmdParams
 {
-    std::string guides, output, roots, scalp, method = "helicoid", frames = "auto";
+    std::string guides, output, roots, scalp, head, guideGroups, rootGroups;
+    InterpolateParams op;
+    std::string method = interpolationMethodName(InterpolateParams{}.method);
+    std::string frames = frameRuleName(InterpolateParams{}.frames);
+    std::string grouping = guideGroupingName(PointInterpolationParams{}.grouping);
     std::string up = axisName(HelicoidInterpolationParams{}.up);
     std::string blend = helicoidBlendName(HelicoidInterpolationParams{}.blend);
     std::int64_t count = -1;  ///< -1: not given
-    std::uint64_t seed = 0;
-    HelicoidInterpolationParams helicoid;
-    PointInterpolationParams points;
-    int neighbors = 0;  ///< 0: not given (each method's own default)
+    int neighbors = 0;        ///< 0: not given (each method's own default)
     CLI::Option* neighborsOpt = nullptr;
 };
 
 Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
 
-/// The guides as a scene: read, or fitted to a strand file on the fly.
-Scene loadGuides(const std::string& path, const CommonOptions& common, double& fitSeconds)
-{
-    if (fileExtension(path) == ".json") return readScene(path);
-    const StrandSet strands = loadStrands("interpolate", path, common);
-    const auto t0 = std::chrono::steady_clock::now();
-    Scene scene = guideSceneFromStrands(strands, FitParams{}, path, true, common.interrupter);
-    fitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return scene;
-}
-
 int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
 {
     // Arguments first, before any work.
-    const bool points = p.method == "points";
-    if (p.method != "helicoid" && !points) throw ValueError("--method '" + p.method + "' is not one of helicoid, points");
-    if (p.frames != "auto" && p.frames != "world" && p.frames != "surface") throw ValueError("--frames '" + p.frames + "' is not one of auto, world, surface");
-    const bool sceneOut = fileExtension(p.output) == ".json";
-    if (sceneOut && points) throw ValueError(p.output + ": --method points makes strands, not helicoids; write a strand format or use --method helicoid");
-    if (!sceneOut) strandFormatFromPath(p.output, /*forWriting=*/true);
+    InterpolateParams& op = p.op;
+    op.method = interpolationMethodFromName(p.method);
+    const bool points = op.method == InterpolationMethod::Points;
+    try {
+        op.frames = frameRuleFromName(p.frames);
+    } catch (const ValueError&) {
+        throw ValueError("--frames '" + p.frames + "' is not one of world, surface");
+    }
+    op.points.grouping = guideGroupingFromName(p.grouping);
+    if (!(op.points.likeness > 0.0) || !std::isfinite(op.points.likeness)) {
+        throw ValueError("--likeness " + formatValue(op.points.likeness) + ": must be a positive fraction of the guide length (default " +
+                         formatValue(PointInterpolationParams{}.likeness) + ")");
+    }
+    op.returnScene = fileExtension(p.output) == ".json";
+    if (op.returnScene && points) throw ValueError(p.output + ": --method points makes strands, not helicoids; write a strand format or use --method helicoid");
+    if (!op.returnScene) strandFormatFromPath(p.output, /*forWriting=*/true);
     if (p.roots.empty() == p.scalp.empty()) throw ValueError("needs --roots ROOTS or --scalp SCALP.vdb --count N (one of them)");
     if (!p.scalp.empty() && p.count < 0) throw ValueError("--scalp needs --count N");
     if (p.count == 0) throw ValueError("--count 0: must be at least 1");
-    p.helicoid.blend = helicoidBlendFromName(p.blend);
-    if (!(p.helicoid.shepard.power > 0.0) || !std::isfinite(p.helicoid.shepard.power)) {
-        throw ValueError("--power " + formatValue(p.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
+    if (!points && (!p.guideGroups.empty() || !p.rootGroups.empty())) throw ValueError("--guide-groups and --root-groups need --method points");
+    op.helicoid.blend = helicoidBlendFromName(p.blend);
+    if (!(op.helicoid.shepard.power > 0.0) || !std::isfinite(op.helicoid.shepard.power)) {
+        throw ValueError("--power " + formatValue(op.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
     }
     if (p.neighborsOpt && p.neighborsOpt->count() > 0) {
         if (p.neighbors < 1) throw ValueError("--neighbors " + std::to_string(p.neighbors) + ": must be at least 1 (omit it to use " + (points ? std::to_string(PointInterpolationParams{}.neighbors) : std::string("every guide")) + ")");
-        p.helicoid.shepard.neighbors = p.neighbors;
-        p.points.neighbors = p.neighbors;
+        op.helicoid.shepard.neighbors = p.neighbors;
+        op.points.neighbors = p.neighbors;
     }
-    p.helicoid.up = axisFromName(p.up, "--up");
+    op.helicoid.up = axisFromName(p.up, "--up");
+    op.points.maxVertices = op.helicoid.maxVertices;
 
-    double fitSeconds = 0.0;
-    const Scene guides = loadGuides(p.guides, common, fitSeconds);
-    if (guides.guides.empty()) throw ValueError(p.guides + ": no guides: interpolation needs at least one");
-    validateGuideScene(guides);
-    const HelicoidInterpolator probe(guides, p.helicoid);  // checks the guides; bounds a hair's vertices
+    // The guides: a scene, or strands (blended as they are, or fitted for helicoids).
+    Scene scene;
+    StrandSet guideStrands;
+    InterpolationGuides guides;
+    guides.where = p.guides;
+    if (fileExtension(p.guides) == ".json") {
+        scene = readScene(p.guides);
+        if (scene.guides.empty()) throw ValueError(p.guides + ": no guides: interpolation needs at least one");
+        validateGuideScene(scene);
+        guides.scene = &scene;
+    } else {
+        guideStrands = loadStrands("interpolate", p.guides, common);
+        if (guideStrands.empty()) throw ValueError(p.guides + ": no guides: interpolation needs at least one");
+        guides.strands = &guideStrands;
+    }
+    const std::size_t G = guides.scene ? scene.guides.size() : guideStrands.numStrands();
+    if (!p.guideGroups.empty()) guides.groups = readIdList(p.guideGroups, G, "guides");
+    // A bound of the vertices a new hair has, for the cap before the roots are made.
+    std::size_t perHair = 0;
+    if (guides.scene) {
+        const HelicoidInterpolator probe(scene, op.helicoid);  // checks the guides; bounds a hair's vertices
+        perHair = probe.maxVerticesPerHair();
+    } else {
+        for (std::size_t i = 0; i < G; ++i) perHair = std::max(perHair, guideStrands.size(i));
+        if (!points) perHair *= 64;  // fits are traced finer than the strands are sampled; the library checks exactly
+    }
     auto checkCount = [&](double count) {
-        const double estimate = count * double(probe.maxVerticesPerHair());
-        if (estimate > double(p.helicoid.maxVertices)) {
+        const double estimate = count * double(perHair);
+        if (estimate > double(op.helicoid.maxVertices)) {
             throw LimitError(formatValue(count) + " strands would grow up to " + formatValue(estimate) + " vertices, more than the cap of " +
-                             std::to_string(p.helicoid.maxVertices) + " (--max-vertices; 12 bytes a vertex): ask for fewer strands");
+                             std::to_string(op.helicoid.maxVertices) + " (--max-vertices; 12 bytes a vertex): ask for fewer strands");
         }
     };
 
     // Roots: a root file (PLY points with optional normals, or the roots of any strand file), or follicles on a scalp.
     InterpolationRoots roots;
+    HeadObstacle head;
     if (!p.roots.empty()) {
         if (fileExtension(p.roots) == ".ply" && plyElementCount(p.roots, "vertex") > 0) {
             const Stage stage(common, "reading " + p.roots);
-            const OrientedPoints op = readPlyPoints(p.roots);
-            checkCount(double(op.size()));
-            for (const Vec3f& v : op.positions) roots.positions.push_back(toD(v));
-            for (const Vec3f& v : op.normals) roots.normals.push_back(toD(v));
+            const OrientedPoints pts = readPlyPoints(p.roots);
+            checkCount(double(pts.size()));
+            for (const Vec3f& v : pts.positions) roots.positions.push_back(toD(v));
+            for (const Vec3f& v : pts.normals) roots.normals.push_back(toD(v));
         } else {
             const StrandSet s = loadStrands("interpolate", p.roots, common);
             checkCount(double(s.numStrands()));
@@ -110,52 +133,51 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         }
         FollicleParams fp;
         fp.count = std::size_t(p.count);
-        fp.seed = p.seed;
-        fp.up = p.helicoid.up;
+        fp.seed = op.seed;
+        fp.up = op.helicoid.up;
         const Follicles f = sampleFollicles(surface, region, fp, true, common.interrupter);
         for (const Vec3f& v : f.positions) roots.positions.push_back(toD(v));
         for (const Vec3f& v : f.normals) roots.normals.push_back(toD(v));
+        head = HeadObstacle::levelSet(surface);
+        head.setLabel("--scalp " + p.scalp);
     }
-    if (p.frames == "world") roots.normals.clear();
-    if (p.frames == "surface" && roots.normals.empty()) {
+    if (!p.rootGroups.empty()) roots.groups = readIdList(p.rootGroups, roots.positions.size(), "roots");
+    if (op.frames == FrameRule::Surface && roots.normals.empty()) {
         throw ValueError((p.roots.empty() ? p.scalp : p.roots) + ": the roots have no normals (PLY nx ny nz); --frames surface needs them");
     }
-    // Guide normals: radial on the scene's head sphere, else those of the nearest roots (the library's rule).
-    std::vector<Vec3d> guideNormals;
-    if (!roots.normals.empty()) guideNormals = sceneGuideNormals(guides);
+    // The head: --head, else --scalp's surface, else the scene's sphere, else a sphere fitted to the guide roots.
+    if (p.head == "none") head = HeadObstacle::none();
+    else if (!p.head.empty()) head = readHeadObstacle(p.head, "--head " + p.head);
+    else if (head.empty() && guides.scene && scene.head) head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
+    else if (head.empty() && guides.strands) head = headFromRoots(guideStrands, op.helicoid.up);
 
-    const auto t0 = std::chrono::steady_clock::now();
-    StrandSet strands;
-    Scene out;
-    if (points) {
-        // The guides' own strands (no wisps), blended point by point.
-        strands = interpolatePoints(guides, roots, p.points, guideNormals, true, common.interrupter);
-    } else {
-        out = interpolateHelicoids(guides, roots, p.helicoid, guideNormals, true, common.interrupter);
-        out.seed = p.seed;
-        if (!sceneOut) {
-            GrowOptions grow;
-            grow.maxVertices = p.helicoid.maxVertices;
-            strands = growScene(out, grow, true, common.interrupter);
-        }
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const InterpolateResult r = interpolateGuides(guides, roots, head, op, true, common.interrupter);
     {
         const Stage stage(common, "writing " + p.output);
-        if (sceneOut) writeScene(p.output, out);
-        else writeStrands(p.output, strands);
+        if (op.returnScene) writeScene(p.output, r.scene);
+        else writeStrands(p.output, r.strands);
     }
     const std::size_t count = roots.positions.size();
+    const double enteringShare = double(r.enteringHead) / double(count);
+    const double guidesEnteringShare = double(r.guidesEnteringHead) / double(std::max<std::size_t>(1, r.guides));
     if (common.json) {
         printJson({{"output", p.output}, {"method", p.method}, {"blend", points ? nlohmann::json(nullptr) : nlohmann::json(p.blend)},
-                   {"guides", guides.guides.size()}, {"strands", count},
-                   {"vertices", sceneOut ? nlohmann::json(nullptr) : nlohmann::json(strands.numVertices())},
-                   {"frames", roots.normals.empty() ? "world" : "surface"}, {"seconds", seconds},
-                   {"strands_per_second", double(count) / seconds}, {"fit_seconds", fitSeconds}});
+                   {"grouping", points ? nlohmann::json(p.grouping) : nlohmann::json(nullptr)}, {"groups", r.groups},
+                   {"guides", r.guides}, {"strands", count},
+                   {"vertices", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json(r.strands.numVertices())},
+                   {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe())},
+                   {"pushed_out", r.pushedOut}, {"vertices_too_deep", r.verticesTooDeep},
+                   {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
+                   {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
     } else if (!common.quiet) {
-        std::cout << "interpolated " << count << " strands from " << guides.guides.size() << " guides (" << p.method << ", "
-                  << (roots.normals.empty() ? "world" : "surface") << " frames) in " << seconds << " s (" << double(count) / seconds
-                  << " strands/s)\nwrote " << p.output << "\n";
+        std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << p.method << ", " << frameRuleName(op.frames) << " frames";
+        if (points) std::cout << ", " << r.groups << (r.groups == 1 ? " group" : " groups") << ", grouping " << p.grouping;
+        std::cout << ") in " << formatValue(r.seconds) << " s\n";
+        if (!head.empty() && !op.returnScene) {
+            std::cout << "head: " << head.describe() << "; " << r.pushedOut << " strands pushed out; entering it: "
+                      << formatValue(100.0 * enteringShare) << " % of the new strands, " << formatValue(100.0 * guidesEnteringShare) << " % of the guides\n";
+        }
+        std::cout << "wrote " << p.output << "\n";
     }
     return 0;
 }
@@ -165,30 +187,33 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
 Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<InterpolateCmdParams>();
+    InterpolateCmdParams& p = *params;
     CLI::App* sub = addVerb(app, "interpolate");
-    sub->add_option("guides", params->guides, "Guides: a helicoid scene (.json, e.g. from vdbhair fit) or any strand file (fitted first)")->required();
-    sub->add_option("-o,--output", params->output, "Output: any strand format, or a scene (.json, --method helicoid)")->required();
-    sub->add_option("--roots", params->roots, "Roots: PLY points (x y z, optional nx ny nz, as vdbhair roots writes) or the roots of any strand file");
-    sub->add_option("--scalp", params->scalp, "Scalp .vdb (vdbhair scalp): spread --count roots over it (and its region)");
-    sub->add_option("--count", params->count, "Number of roots on --scalp");
-    sub->add_option("--method", params->method, "helicoid (Piuze et al.) or points (Blender's Interpolate Curves)")->capture_default_str();
-    sub->add_option("--blend", params->blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "
-                                              "so guides blend alike) or fitted (the fits' own pieces, as the paper prints it)")->capture_default_str();
-    sub->add_option("--arcs", params->helicoid.arcs, "--blend arcs: arcs per hair (0: one per 0.2 radian of the most-turning guide, 16 to 512)")->capture_default_str();
-    sub->add_option("--power", params->helicoid.shepard.power, "Shepard exponent p: weights |x - x_i|^-p")->capture_default_str();
-    params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair, nearest by root (default: every guide for helicoid, " +
-                                           std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
-    sub->add_option("--frames", params->frames, "auto (surface when the roots have normals), world, or surface (the scalp's frame, 4.3)")->capture_default_str();
-    sub->add_option("--up", params->up, "Reference axis of surface frames: x, y, z, -x, -y or -z")->capture_default_str();
-    sub->add_option("--seed", params->seed, "Seed of the roots on --scalp and of waviness noise")->capture_default_str();
-    sub->add_option("--max-vertices", params->helicoid.maxVertices, "Refuse requests that would make more vertices (12 bytes each)")->capture_default_str();
+    sub->add_option("guides", p.guides, "Guides: any strand file, or a helicoid scene (.json, e.g. from vdbhair fit)")->required();
+    sub->add_option("-o,--output", p.output, "Output: any strand format, or a scene (.json, --method helicoid)")->required();
+    sub->add_option("--roots", p.roots, "Roots: PLY points (x y z, optional nx ny nz, as vdbhair roots writes) or the roots of any strand file");
+    sub->add_option("--scalp", p.scalp, "Scalp .vdb (vdbhair scalp): spread --count roots over it (and its region); it is also the head");
+    sub->add_option("--count", p.count, "Number of roots on --scalp");
+    sub->add_option("--method", p.method, "points (the guides' own points, by group and likeness) or helicoid (their helicoid parameters, Piuze et al.)")->capture_default_str();
+    sub->add_option("--grouping", p.grouping, "points: shape (a new hair blends only guides shaped like its nearest one: partings and layers stay apart) or none")->capture_default_str();
+    sub->add_option("--likeness", p.op.points.likeness, "--grouping shape: the shape distance, a fraction of the guide length, at which a guide stops taking part")->capture_default_str();
+    sub->add_option("--guide-groups", p.guideGroups, "points: a text file of one integer group id per guide; new hairs blend only guides of one group");
+    sub->add_option("--root-groups", p.rootGroups, "points: a text file of one group id per root (default: the group of the nearest guide)");
+    sub->add_option("--head", p.head, "The head new hair may not enter deeper than its guides: a mesh (.ply, .obj), a .vdb level set, or 'none' "
+                                      "(default: --scalp's surface, else the scene's head, else a sphere fitted to the guide roots)");
+    sub->add_option("--blend", p.blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "
+                                        "so guides blend alike) or fitted (the fits' own pieces, as the paper prints it)")->capture_default_str();
+    sub->add_option("--arcs", p.op.helicoid.arcs, "--blend arcs: arcs per hair (0: one per 0.2 radian of the most-turning guide, 16 to 512)")->capture_default_str();
+    sub->add_option("--power", p.op.helicoid.shepard.power, "helicoid: Shepard exponent p, weights |x - x_i|^-p")->capture_default_str();
+    p.neighborsOpt = sub->add_option("--neighbors", p.neighbors, "Guides per new hair, nearest by root (default: " + std::to_string(PointInterpolationParams{}.neighbors) +
+                                                                     " for points, every guide for helicoid)");
+    sub->add_option("--frames", p.frames, "world (guides carried as they are) or surface (turned with the roots' normals, 4.3; flares long hair)")->capture_default_str();
+    sub->add_option("--up", p.up, "Reference axis of surface frames and of roots on --scalp: x, y, z, -x, -y or -z")->capture_default_str();
+    sub->add_option("--seed", p.op.seed, "Seed of the roots on --scalp and of waviness noise")->capture_default_str();
+    sub->add_option("--max-vertices", p.op.helicoid.maxVertices, "Refuse requests that would make more vertices (12 bytes each)")->capture_default_str();
     addCommonOptions(sub, common);
-    sub->footer("Example: vdbhair interpolate guides.json --roots roots.ply -o hair.hair --json");
-    return {sub, [params, &common] {
-                params->points.maxVertices = params->helicoid.maxVertices;
-                return runInterpolate(*params, common);
-            },
-            {{"blend", "--blend"}}};
+    sub->footer("Example: vdbhair interpolate guides.hair --scalp scalp.vdb --count 20000 -o hair.hair --json");
+    return {sub, [params, &common] { return runInterpolate(*params, common); }, {{"blend", "--blend"}, {"likeness", "--likeness"}, {"grouping", "--grouping"}}};
 }
 
 } // namespace vdbhair::app

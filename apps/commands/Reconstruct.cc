@@ -17,8 +17,9 @@ namespace {
 
 struct ReconstructCmdParams
 {
-    std::string input, output, method = "helicoid", select = "random", errors;
+    std::string input, output, method = "points", select = "random", errors;
     std::string blend = helicoidBlendName(ReconstructParams{}.helicoid.blend);
+    std::string grouping = guideGroupingName(ReconstructParams{}.points.grouping);
     std::string guides = formatValue(100.0 * ReconstructParams{}.guideFraction) + "%";
     ReconstructParams rec;
     int neighbors = 0;
@@ -44,6 +45,7 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
     else if (p.select == "cluster") p.rec.selection = GuideSelection::Cluster;
     else throw ValueError("--select '" + p.select + "' is not one of random, cluster");
     p.rec.guideFraction = parsePercent(p.guides);
+    p.rec.points.grouping = guideGroupingFromName(p.grouping);
     p.rec.helicoid.blend = helicoidBlendFromName(p.blend);
     strandFormatFromPath(p.output, /*forWriting=*/true);
     if (!(p.rec.helicoid.shepard.power > 0.0) || !std::isfinite(p.rec.helicoid.shepard.power)) {
@@ -62,12 +64,13 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
         writeStrands(p.output, p.method == "points" ? r.points : r.helicoid);
         if (!p.errors.empty()) {
             std::ostringstream csv;
-            csv << "strand,guide,helicoid,points\n";
+            csv << "strand,guide,helicoid,points,nearest\n";
             std::vector<char> isGuide(strands.numStrands(), 0);
             for (std::size_t g : r.guides) isGuide[g] = 1;
             char line[128];
             for (std::size_t i = 0; i < strands.numStrands(); ++i) {
-                std::snprintf(line, sizeof line, "%zu,%d,%.9g,%.9g\n", i, int(isGuide[i]), r.helicoidErrors.relative[i], r.pointErrors.relative[i]);
+                std::snprintf(line, sizeof line, "%zu,%d,%.9g,%.9g,%.9g\n", i, int(isGuide[i]), r.helicoidErrors.relative[i], r.pointErrors.relative[i],
+                              r.nearestErrors.relative[i]);
                 csv << line;
             }
             writeFileAtomic(p.errors, csv.str(), "reconstruct(" + p.errors + ")");
@@ -82,7 +85,8 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
         printJson({{"output", p.output}, {"method", p.method}, {"strands", S}, {"guides", r.guides.size()}, {"unfitted", r.unfitted},
                    {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", p.select}, {"blend", p.blend},
                    {"fit", {{"mean", r.fitSummary.meanRelative}, {"p95", r.fitSummary.p95Relative}, {"pieces_per_strand", r.fitSummary.piecesPerStrand}, {"seconds", r.fitSeconds}}},
-                   {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}}}});
+                   {"grouping", guideGroupingName(p.rec.points.grouping)},
+                   {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}, {"nearest", stats(r.nearestErrors)}}}});
     } else if (!common.quiet) {
         char buf[256];
         std::cout << "reconstructed " << S << " strands from " << r.guides.size() << " guides (" << formatValue(100.0 * double(r.guides.size()) / double(S))
@@ -91,9 +95,10 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
                   << "discrete Frechet distance / strand length:\n";
         std::snprintf(buf, sizeof buf, "%-17s %10s %10s %14s %14s %9s\n", "method", "mean", "p95", "mean interp.", "p95 interp.", "time s");
         std::cout << buf;
-        for (int m = 0; m < 2; ++m) {
-            const ReconstructErrors& e = m == 0 ? r.helicoidErrors : r.pointErrors;
-            std::snprintf(buf, sizeof buf, "%-17s %9.3f%% %9.3f%% %13.3f%% %13.3f%% %9.3f\n", m == 0 ? ("helicoid (" + p.blend + ")").c_str() : "points", 100.0 * e.mean, 100.0 * e.p95,
+        for (int m = 0; m < 3; ++m) {
+            const ReconstructErrors& e = m == 0 ? r.helicoidErrors : m == 1 ? r.pointErrors : r.nearestErrors;
+            const std::string name = m == 0 ? "helicoid (" + p.blend + ")" : m == 1 ? "points (" + std::string(guideGroupingName(p.rec.points.grouping)) + ")" : "nearest guide";
+            std::snprintf(buf, sizeof buf, "%-17s %9.3f%% %9.3f%% %13.3f%% %13.3f%% %9.3f\n", name.c_str(), 100.0 * e.mean, 100.0 * e.p95,
                           100.0 * e.meanInterpolated, 100.0 * e.p95Interpolated, e.seconds);
             std::cout << buf;
         }
@@ -111,7 +116,9 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "The reconstructed strands (any strand format), by --method")->required();
     sub->add_option("--guides", params->guides, "Share of the strands used as guides, in (0, 100] %")->capture_default_str();
-    sub->add_option("--method", params->method, "Which reconstruction to write: helicoid or points (both are measured)")->capture_default_str();
+    sub->add_option("--method", params->method, "Which reconstruction to write: points (the guides' points, by likeness) or helicoid (all three are measured)")->capture_default_str();
+    sub->add_option("--grouping", params->grouping, "points: shape (a strand blends only guides shaped like its nearest one) or none")->capture_default_str();
+    sub->add_option("--likeness", params->rec.points.likeness, "--grouping shape: the shape distance, a fraction of the guide length, at which a guide stops taking part")->capture_default_str();
     sub->add_option("--select", params->select, "Guide choice: random, or cluster (k-means of the roots)")->capture_default_str();
     sub->add_option("--seed", params->rec.seed, "Seed of the guide choice")->capture_default_str();
     sub->add_option("--blend", params->blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "

@@ -3,6 +3,8 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/field/Refine.h>
+#include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
 #include <vdbhair/helicoid/Reconstruction.h>
@@ -521,33 +523,44 @@ Returns:
     The scene as a dict (one guide per fitted strand, in input order), which grow() regrows
     and ``json.dump`` saves as a scene file; or (scene, summary) with return_summary.)doc");
 
-    const HelicoidInterpolationParams interpDefaults;
+    const InterpolateParams interpDefaults;
     m.def(
         "interpolate",
         [](const pyb::object& guidesArg, const pyb::object& rootsArg, const pyb::object& normalsArg, const std::string& method,
-           double power, std::optional<int> neighbors, const std::string& blend, const std::string& frames, std::array<double, 3> up, std::uint64_t seed,
-           std::size_t maxVertices, bool returnScene, int threads, const pyb::object& progress) -> pyb::object {
+           const std::string& grouping, double likeness, const pyb::object& guideGroups, const pyb::object& rootGroups,
+           const pyb::object& headArg, double power, std::optional<int> neighbors, const std::string& blend, const std::string& frames,
+           std::array<double, 3> up, std::uint64_t seed, std::size_t maxVertices, bool returnScene, int threads,
+           const pyb::object& progress) -> pyb::object {
             // Arguments first, as the command checks them.
-            const bool points = method == "points";
-            if (method != "helicoid" && !points) throw ValueError("interpolate: method '" + method + "' is not one of helicoid, points");
-            if (frames != "auto" && frames != "world" && frames != "surface")
-                throw ValueError("interpolate: frames '" + frames + "' is not one of auto, world, surface");
-            if (returnScene && points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
-            HelicoidInterpolationParams hp;
-            PointInterpolationParams pp;
-            hp.blend = blendArgument("interpolate", blend);
+            InterpolateParams op;
+            auto named = [](auto parse, const std::string& value) {
+                try {
+                    return parse(value);
+                } catch (const ValueError& e) {
+                    throw ValueError(std::string("interpolate: ") + e.what());
+                }
+            };
+            op.method = named(interpolationMethodFromName, method);
+            op.frames = named(frameRuleFromName, frames);
+            op.points.grouping = named(guideGroupingFromName, grouping);
+            op.points.likeness = likeness;
+            if (!(likeness > 0.0) || !std::isfinite(likeness)) throw ValueError("interpolate: likeness=" + std::to_string(likeness) + ": must be a positive fraction of the guide length");
+            op.returnScene = returnScene;
+            if (returnScene && op.method == InterpolationMethod::Points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
+            op.helicoid.blend = blendArgument("interpolate", blend);
             if (!(power > 0.0) || !std::isfinite(power))
                 throw ValueError("interpolate: power=" + std::to_string(power) + ": must be a positive finite exponent (the paper uses 3)");
-            hp.shepard.power = power;
+            op.helicoid.shepard.power = power;
             if (neighbors) {
                 if (*neighbors < 1) throw ValueError("interpolate: neighbors=" + std::to_string(*neighbors) + ": must be at least 1 (None: each method's default)");
-                hp.shepard.neighbors = *neighbors;
-                pp.neighbors = *neighbors;
+                op.helicoid.shepard.neighbors = *neighbors;
+                op.points.neighbors = *neighbors;
             }
             const Vec3d u(up[0], up[1], up[2]);
             if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("interpolate: up must be a non-zero finite vector");
-            hp.up = u / u.length();
-            hp.maxVertices = pp.maxVertices = maxVertices;
+            op.helicoid.up = u / u.length();
+            op.helicoid.maxVertices = op.points.maxVertices = maxVertices;
+            op.seed = seed;
             InterpolationRoots roots;
             if (pyb::isinstance<StrandSet>(rootsArg)) {
                 const StrandSet& r = rootsArg.cast<const StrandSet&>();
@@ -562,53 +575,61 @@ Returns:
                     throw ValueError("interpolate: " + std::to_string(roots.normals.size()) + " normals for " +
                                      std::to_string(roots.positions.size()) + " roots");
             }
-            if (frames == "world") roots.normals.clear();
-            if (frames == "surface" && roots.normals.empty()) throw ValueError("interpolate: frames='surface' needs normals");
+            if (op.frames == FrameRule::Surface && roots.normals.empty()) throw ValueError("interpolate: frames='surface' needs normals");
+            if (!rootGroups.is_none()) roots.groups = rootGroups.cast<std::vector<std::int32_t>>();
+            const HeadArgument headArgument(headArg, "no-deeper");
             const bool fromStrands = pyb::isinstance<StrandSet>(guidesArg);
             std::shared_ptr<StrandSet> guideStrands = fromStrands ? guidesArg.cast<std::shared_ptr<StrandSet>>() : nullptr;
-            Scene guides = fromStrands ? Scene() : sceneArgument(guidesArg, "interpolate");
-            std::pair<Scene, StrandSet> result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                if (fromStrands) guides = guideSceneFromStrands(*guideStrands, FitParams{}, "interpolate(guides)", true, interrupter);
-                validateGuideScene(guides);
-                const std::vector<Vec3d> guideNormals = roots.normals.empty() ? std::vector<Vec3d>() : sceneGuideNormals(guides);
-                std::pair<Scene, StrandSet> r;
-                if (points) {
-                    r.second = interpolatePoints(guides, roots, pp, guideNormals, true, interrupter);
-                } else {
-                    r.first = interpolateHelicoids(guides, roots, hp, guideNormals, true, interrupter);
-                    r.first.seed = seed;
-                    if (!returnScene) {
-                        GrowOptions grow;
-                        grow.maxVertices = maxVertices;
-                        r.second = growScene(r.first, grow, true, interrupter);
-                    }
-                }
-                return r;
+            const Scene scene = fromStrands ? Scene() : sceneArgument(guidesArg, "interpolate");
+            InterpolationGuides guides;
+            guides.where = "interpolate(guides)";
+            if (fromStrands) guides.strands = guideStrands.get();
+            else guides.scene = &scene;
+            if (!guideGroups.is_none()) guides.groups = guideGroups.cast<std::vector<std::int32_t>>();
+            InterpolateResult result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
+                HeadObstacle head = headArgument.get("interpolate");
+                // None: the scene's head sphere, else a sphere fitted to the guide roots (as the command).
+                if (head.unset() && !fromStrands && scene.head) head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
+                else if (head.unset() && fromStrands) head = headFromRoots(*guideStrands, op.helicoid.up);
+                return interpolateGuides(guides, roots, head, op, true, interrupter);
             });
-            if (returnScene) return toPython(sceneToJson(result.first));
-            return pyb::cast(std::make_shared<StrandSet>(std::move(result.second)));
+            if (returnScene) return toPython(sceneToJson(result.scene));
+            return pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
         },
-        pyb::arg("guides"), pyb::arg("roots"), pyb::kw_only(), pyb::arg("normals") = pyb::none(), pyb::arg("method") = "helicoid",
-        pyb::arg("power") = interpDefaults.shepard.power, pyb::arg("neighbors") = pyb::none(),
-        pyb::arg("blend") = helicoidBlendName(interpDefaults.blend), pyb::arg("frames") = "auto",
-        pyb::arg("up") = std::array<double, 3>{interpDefaults.up.x(), interpDefaults.up.y(), interpDefaults.up.z()},
-        pyb::arg("seed") = 0, pyb::arg("max_vertices") = interpDefaults.maxVertices, pyb::arg("return_scene") = false,
+        pyb::arg("guides"), pyb::arg("roots"), pyb::kw_only(), pyb::arg("normals") = pyb::none(),
+        pyb::arg("method") = interpolationMethodName(interpDefaults.method),
+        pyb::arg("grouping") = guideGroupingName(interpDefaults.points.grouping), pyb::arg("likeness") = interpDefaults.points.likeness,
+        pyb::arg("guide_groups") = pyb::none(), pyb::arg("root_groups") = pyb::none(), pyb::arg("head") = pyb::none(),
+        pyb::arg("power") = interpDefaults.helicoid.shepard.power, pyb::arg("neighbors") = pyb::none(),
+        pyb::arg("blend") = helicoidBlendName(interpDefaults.helicoid.blend), pyb::arg("frames") = frameRuleName(interpDefaults.frames),
+        pyb::arg("up") = std::array<double, 3>{interpDefaults.helicoid.up.x(), interpDefaults.helicoid.up.y(), interpDefaults.helicoid.up.z()},
+        pyb::arg("seed") = 0, pyb::arg("max_vertices") = interpDefaults.helicoid.maxVertices, pyb::arg("return_scene") = false,
         pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(New hairs from guide hairs (Piuze et al. 2011, Sec. 4): ``vdbhair interpolate``.
 
 Args:
-    guides: a scene (a path to a scene .json or a dict, as fit() returns) or a Strands, each of
-        whose strands is fitted first.
+    guides: a Strands (blended as they are; fitted first for method="helicoid"), or a scene (a
+        path to a scene .json or a dict, as fit() returns).
     roots: an (N, 3) array of root positions (world units), or a Strands whose roots are used.
     normals: None, or an (N, 3) array of outward normals at the roots (surface frames, Sec. 4.3).
-    method: "helicoid" (blend the guides' helicoid parameters, the paper's) or "points" (blend
-        their points, as Blender's and Houdini's interpolation do).
+    method: "points" (blend the guides' own points by group and likeness, as production tools do;
+        the default, which measures best on real hair) or "helicoid" (blend their helicoid
+        parameters, the paper's).
+    grouping: points: "shape" (a new hair blends only guides shaped like its nearest one, so
+        partings and layers stay apart) or "none".
+    likeness: the shape distance, a fraction of the guide length, at which a guide stops taking part.
+    guide_groups: None, or one integer group id per guide: new hairs blend guides of one group.
+    root_groups: None, or one group id per root (None: the group of the nearest guide).
+    head: the head new hair may enter no deeper than its guides: None (the scene's head sphere,
+        else a sphere fitted to the guide roots), "none", a path (mesh or .vdb level set) or
+        (x, y, z, r).
     power: Shepard exponent p of the weights |x - x_i|^-p (the paper: 3).
     neighbors: blend only the K nearest guides by root; None: every guide (helicoid), 4 (points).
     blend: "fitted" (the fits' own pieces, as the paper prints it) or "arcs" (each guide
         re-described as equal circular arcs in its rotation-minimizing frame, so guides blend
         alike; reconstruct's default).
-    frames: "auto" (surface frames when normals are given), "world" or "surface".
+    frames: "world" (the guides carried as they are) or "surface" (turned with the roots'
+        normals, Sec. 4.3; flares long hair).
     up: reference axis of the surface frames.
     seed: the scene's seed (recorded; the new hairs have no wisps).
     max_vertices: refuse requests that would grow more vertices (estimated before any work).
@@ -623,9 +644,17 @@ Returns:
     m.def(
         "reconstruct",
         [](const StrandsPtr& strands, double guides, const std::string& select, std::uint64_t seed, double power,
-           std::optional<int> neighbors, const std::string& blend, double maxError, int threads, const pyb::object& progress) {
+           std::optional<int> neighbors, const std::string& blend, const std::string& grouping, double likeness, double maxError, int threads,
+           const pyb::object& progress) {
             ReconstructParams p;
             p.helicoid.blend = blendArgument("reconstruct", blend);
+            try {
+                p.points.grouping = guideGroupingFromName(grouping);
+            } catch (const ValueError& e) {
+                throw ValueError(std::string("reconstruct: ") + e.what());
+            }
+            if (!(likeness > 0.0) || !std::isfinite(likeness)) throw ValueError("reconstruct: likeness=" + std::to_string(likeness) + ": must be a positive fraction of the guide length");
+            p.points.likeness = likeness;
             p.guideFraction = guides;
             if (select == "random") p.selection = GuideSelection::Random;
             else if (select == "cluster") p.selection = GuideSelection::Cluster;
@@ -659,11 +688,13 @@ Returns:
                                       pyb::arg("pieces_per_strand") = r.fitSummary.piecesPerStrand, pyb::arg("seconds") = r.fitSeconds);
             report["helicoid"] = stats(r.helicoidErrors);
             report["points"] = stats(r.pointErrors);
+            report["nearest"] = stats(r.nearestErrors);
             return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.helicoid)), std::make_shared<StrandSet>(std::move(r.points)), report);
         },
         pyb::arg("strands"), pyb::kw_only(), pyb::arg("guides") = reconstructDefaults.guideFraction, pyb::arg("select") = "random",
         pyb::arg("seed") = reconstructDefaults.seed, pyb::arg("power") = reconstructDefaults.helicoid.shepard.power,
         pyb::arg("neighbors") = pyb::none(), pyb::arg("blend") = helicoidBlendName(reconstructDefaults.helicoid.blend),
+        pyb::arg("grouping") = guideGroupingName(reconstructDefaults.points.grouping), pyb::arg("likeness") = reconstructDefaults.points.likeness,
         pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(Rebuild a hairstyle from a share of its strands (Piuze et al. 2011, Sec. 5.4):
@@ -683,6 +714,8 @@ Args:
     blend: "arcs" (each guide re-described as equal circular arcs in its rotation-minimizing
         frame, so guides blend alike; only guides shaped like the heaviest take part) or "fitted"
         (the fits' own pieces, as the paper prints it).
+    grouping: points: "shape" (a strand blends only guides shaped like its nearest one) or "none".
+    likeness: the shape distance, a fraction of the guide length, at which a guide stops taking part.
     max_error: the fits' accepted discrete Frechet distance, a fraction of the strand length.
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``.
@@ -690,7 +723,8 @@ Args:
 Returns:
     (helicoid, points, report): both reconstructions as Strands in input order, and a dict with
     ``guides`` (the guide strands' indices), ``unfitted``, ``fit`` (mean, p95, pieces_per_strand,
-    seconds) and for ``helicoid`` and ``points``: ``relative`` (each strand's error), ``mean``,
+    seconds) and for ``helicoid``, ``points`` and ``nearest`` (the baseline: each strand its
+    nearest guide, translated): ``relative`` (each strand's error), ``mean``,
     ``p95``, ``mean_interpolated``, ``p95_interpolated``, ``seconds``.)doc");
 
     const RenderParams renderDefaults;

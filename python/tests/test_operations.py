@@ -201,14 +201,34 @@ def test_interpolate():
             assert chord[0] / np.linalg.norm(chord) == pytest.approx(1.0, abs=1e-4), method
     # A root on a guide's root gives that guide back; the scene grows to the same strands; one or two threads.
     on_guide = vdbhair.interpolate(guides, guides.positions[guides.offsets[:-1]][:2])
+    for i in range(2):  # points (the default): the guide itself
+        assert np.array_equal(on_guide[i], guides[i])
+    on_fit = vdbhair.interpolate(guides, guides.positions[guides.offsets[:-1]][:2], method="helicoid")
     for i in range(2):
         for end in (0, -1):  # the fit regrown at its own step: the same root and tip
-            assert np.allclose(on_guide[i][end], guides[i][end], atol=1e-3)
-    scene = vdbhair.interpolate(vdbhair.fit(guides), roots, return_scene=True)
+            assert np.allclose(on_fit[i][end], guides[i][end], atol=1e-3)
+    scene = vdbhair.interpolate(vdbhair.fit(guides), roots, method="helicoid", return_scene=True)
     assert len(scene["guides"]) == 3
-    assert np.array_equal(vdbhair.grow(scene).positions, vdbhair.interpolate(vdbhair.fit(guides), roots).positions)
-    assert np.array_equal(vdbhair.interpolate(guides, roots, threads=1).positions,
-                          vdbhair.interpolate(guides, roots, threads=2).positions)
+    assert np.array_equal(vdbhair.grow(scene).positions, vdbhair.interpolate(vdbhair.fit(guides), roots, method="helicoid").positions)
+    for method in ("helicoid", "points"):
+        assert np.array_equal(vdbhair.interpolate(guides, roots, method=method, threads=1).positions,
+                              vdbhair.interpolate(guides, roots, method=method, threads=2).positions)
+    # Groups (one id per guide, one per root); the parting itself is tested in C++ (TestInterpolation.cc).
+    groups = [int(guides[i][0][1] > 0.3) for i in range(len(guides))]
+    out = vdbhair.interpolate(guides, roots, guide_groups=groups, root_groups=[1, 1, 1], neighbors=2, grouping="none")
+    assert len(out) == 3 and np.allclose(out[0][-1] - out[0][0], [4.0, 0.0, 0.0], atol=1e-5)
+    with pytest.raises(ValueError, match="root 0: group 7 has no guides"):
+        vdbhair.interpolate(guides, roots, guide_groups=groups, root_groups=[7, 1, 1])
+    with pytest.raises(ValueError, match="2 guide group ids for 25 guides"):
+        vdbhair.interpolate(guides, roots, guide_groups=[0, 1])
+    with pytest.raises(ValueError, match="grouping 'sideways' is not one of shape, none"):
+        vdbhair.interpolate(guides, roots, grouping="sideways")
+    # The head: a sphere the straight guides would cut through is kept out of.
+    through = vdbhair.interpolate(guides, roots, head=(2.0, 0.35, -0.5, 0.6))
+    for strand in through:
+        assert np.all(np.linalg.norm(strand - np.array([2.0, 0.35, -0.5]), axis=1) >= 0.6 - 1e-4)
+    free = vdbhair.interpolate(guides, roots, head="none")
+    assert any(np.any(np.linalg.norm(s - np.array([2.0, 0.35, -0.5]), axis=1) < 0.6 - 1e-3) for s in free)
     # Roots as a Strands, normals (surface frames) and the errors.
     assert len(vdbhair.interpolate(guides, guides, normals=np.tile([1.0, 0.0, 0.0], (25, 1)))) == 25
     with pytest.raises(ValueError, match="roots: must be an .N, 3. array"):
@@ -221,3 +241,5 @@ def test_interpolate():
         vdbhair.interpolate(guides, roots, frames="surface")
     with pytest.raises(ValueError, match="return_scene=True needs method='helicoid'"):
         vdbhair.interpolate(guides, roots, method="points", return_scene=True)
+    with pytest.raises(ValueError, match="return_scene=True needs method='helicoid'"):
+        vdbhair.interpolate(guides, roots, return_scene=True)

@@ -1,6 +1,8 @@
 #include "../TestUtil.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/FrameAverage.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
@@ -157,7 +159,9 @@ TEST_CASE("interpolateHelicoids: Fig. 6, two pi-rotated guides vary smoothly, le
     const InterpolationRoots roots = rootsOnLine(Vec3d(0, 0, 0), Vec3d(1, 0, 0), 11);
     const StrandSet helicoid = growScene(interpolateHelicoids(scene, roots, {}));
     const StrandSet guides = growScene(scene);
-    const StrandSet points = interpolatePoints(guides, roots, {});
+    PointInterpolationParams blender;  // Blender's node: every guide by distance alone
+    blender.grouping = GuideGrouping::None;
+    const StrandSet points = interpolatePoints(guides, roots, blender);
     double varHelicoid = 0.0, varPoints = 0.0;
     for (std::size_t i = 0; i + 1 < roots.positions.size(); ++i) {
         varHelicoid += meanAbsDiff(curvatureProfile(helicoid, i), curvatureProfile(helicoid, i + 1));
@@ -456,4 +460,127 @@ TEST_CASE("interpolateHelicoids, arcs: hair does not blend across a parting", "[
     CAPTURE(curveDistance(s, 0, guides, 0, Vec3f(0.4f, 0.f, 0.f)), curveDistance(s, 1, guides, 1, Vec3f(-0.4f, 0.f, 0.f)));
     REQUIRE(curveDistance(s, 0, guides, 0, Vec3f(0.4f, 0.f, 0.f)) < 0.01 * 3.0);
     REQUIRE(curveDistance(s, 1, guides, 1, Vec3f(-0.4f, 0.f, 0.f)) < 0.01 * 3.0);
+}
+
+namespace {
+
+/// A parting along x = 0: guides at x in [-1, 1] rise 1 along y, then sweep 1 along -x (left of
+/// the parting) or +x (right of it), 12 vertices each.
+StrandSet partedGuides(int count)
+{
+    StrandSet g;
+    for (int i = 0; i < count; ++i) {
+        const float x = -1.f + 2.f * float(i) / float(count - 1) + 0.013f;  // none exactly on the parting
+        const float side = x < 0.f ? -1.f : 1.f;
+        std::vector<Vec3f> p;
+        for (int k = 0; k < 6; ++k) p.emplace_back(x, 0.2f * float(k), 0.f);
+        for (int k = 1; k <= 6; ++k) p.emplace_back(x + side * 0.2f * float(k), 1.f, 0.f);
+        g.addStrand(p);
+    }
+    return g;
+}
+
+} // namespace
+
+TEST_CASE("interpolatePoints: a parting stays a parting with shape grouping, and spikes without", "[helicoid][interp]")
+{
+    const StrandSet guides = partedGuides(21);
+    InterpolationRoots roots;
+    for (int i = 0; i <= 200; ++i) roots.positions.emplace_back(-0.9 + 1.8 * i / 200.0, 0.0, 0.0);
+    const StrandSet grouped = interpolatePoints(guides, roots, {});
+    PointInterpolationParams none;
+    none.grouping = GuideGrouping::None;
+    const StrandSet blended = interpolatePoints(guides, roots, none);
+    std::vector<Vec3d> guideRoots;
+    for (std::size_t g = 0; g < guides.numStrands(); ++g) guideRoots.emplace_back(guides.root(g).x(), 0.0, 0.0);
+    const GuideLocator locator(guideRoots);
+    double weakestSweep = 1e9, weakestBlended = 1e9;
+    for (std::size_t i = 0; i < roots.positions.size(); ++i) {
+        CAPTURE(i, roots.positions[i].x());
+        const std::uint32_t nearest = locator.nearest(roots.positions[i]);
+        const float side = guides.positions[guides.begin(nearest) + 11].x() - guides.root(nearest).x();
+        const float sweep = grouped.positions[grouped.begin(i) + grouped.size(i) - 1].x() - grouped.root(i).x();
+        REQUIRE(sweep * side > 0.f);  // the side of the nearest guide
+        weakestSweep = std::min(weakestSweep, double(std::abs(sweep)));
+        weakestBlended = std::min(weakestBlended, double(std::abs(blended.positions[blended.begin(i) + blended.size(i) - 1].x() - blended.root(i).x())));
+    }
+    CAPTURE(weakestSweep, weakestBlended);
+    CHECK(weakestSweep == Approx(1.2).margin(1e-4));  // every new hair sweeps as its guides: 1.2 = 6 x 0.2
+    CHECK(weakestBlended < 0.3);                       // distance alone averages the two sweeps away at the parting
+    REQUIRE(likenessDistance(guides.positions.data(), 12, guides.positions.data() + guides.begin(20), 12) > 0.25);
+    REQUIRE(likenessDistance(guides.positions.data(), 12, guides.positions.data() + guides.begin(1), 12) == Approx(0.0).margin(1e-6));
+}
+
+TEST_CASE("interpolatePoints: explicit groups, and a root on a guide's root is that guide bit for bit", "[helicoid][interp]")
+{
+    const StrandSet guides = partedGuides(21);
+    GuideContext context;
+    for (std::size_t g = 0; g < guides.numStrands(); ++g) context.groups.push_back(guides.root(g).x() < 0.f ? 3 : 8);
+    InterpolationRoots roots;
+    for (int i = 0; i <= 20; ++i) roots.positions.emplace_back(-0.9 + 1.8 * i / 20.0, 0.0, 0.0);
+    roots.groups.assign(roots.positions.size(), 8);  // every root on the right side's group
+    PointInterpolationParams none;
+    none.grouping = GuideGrouping::None;  // groups alone decide
+    std::size_t groups = 0;
+    const StrandSet out = interpolatePoints(guides, roots, none, context, true, nullptr, &groups);
+    CHECK(groups == 2);
+    for (std::size_t i = 0; i < out.numStrands(); ++i) {
+        CAPTURE(i);
+        REQUIRE(out.positions[out.begin(i) + out.size(i) - 1].x() - out.root(i).x() == Approx(1.2f).margin(1e-4));
+    }
+    // Roots on the guides' roots reproduce the guides exactly.
+    InterpolationRoots own;
+    for (std::size_t g = 0; g < guides.numStrands(); ++g) own.positions.emplace_back(guides.root(g).x(), guides.root(g).y(), guides.root(g).z());
+    const StrandSet same = interpolatePoints(guides, own, {}, context);
+    REQUIRE(same.offsets == guides.offsets);
+    REQUIRE(same.positions == guides.positions);
+    // Bad groups: refused, naming the count or the group.
+    roots.groups[4] = 5;
+    REQUIRE_THROWS_WITH(interpolatePoints(guides, roots, {}, context), Contains("root 4: group 5 has no guides"));
+    roots.groups.pop_back();
+    REQUIRE_THROWS_WITH(interpolatePoints(guides, roots, {}, context), Contains("20 root group ids for 21 roots"));
+    context.groups.pop_back();
+    REQUIRE_THROWS_WITH(interpolatePoints(guides, own, {}, context), Contains("20 guide group ids for 21 guides"));
+    PointInterpolationParams bad;
+    bad.likeness = 0.0;
+    REQUIRE_THROWS_WITH(interpolatePoints(guides, own, bad), Contains("likeness 0: must be a positive"));
+}
+
+TEST_CASE("interpolateGuides: new hair is kept out of the head, both methods", "[helicoid][interp]")
+{
+    // Guides on a unit sphere's top cap, combed flat along +x: they follow the sphere at 0.02 above it.
+    StrandSet guides;
+    for (int i = 0; i < 9; ++i) {
+        const double phi = -0.4 + 0.1 * i;
+        std::vector<Vec3f> p;
+        for (int k = 0; k < 16; ++k) {
+            const double t = 0.08 * k;  // angle along the sphere from the top, towards +x
+            p.emplace_back(float(1.02 * std::sin(t) * std::cos(phi)), float(1.02 * std::cos(t)), float(1.02 * std::sin(phi)));
+        }
+        guides.addStrand(p);
+    }
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    REQUIRE(countStrandsEnteringHead(guides, head, 0.0) == 0);
+    // Roots off the guides' line, where their translated shapes cut into the sphere.
+    InterpolationRoots roots;
+    for (int i = 0; i < 50; ++i) {
+        const double t = -0.3 + 0.012 * i;
+        roots.positions.emplace_back(1.02 * std::sin(t), 1.02 * std::cos(t), 0.05);
+    }
+    InterpolationGuides g;
+    g.strands = &guides;
+    for (InterpolationMethod method : {InterpolationMethod::Points, InterpolationMethod::Helicoid}) {
+        CAPTURE(interpolationMethodName(method));
+        InterpolateParams params;
+        params.method = method;
+        const InterpolateResult free = interpolateGuides(g, roots, HeadObstacle::none(), params);
+        CHECK(countStrandsEnteringHead(free.strands, head, 0.0) > 10);
+        CHECK(free.pushedOut == 0);
+        const InterpolateResult kept = interpolateGuides(g, roots, head, params);
+        CHECK(kept.enteringHead == 0);
+        CHECK(countStrandsEnteringHead(kept.strands, head, 0.0) == 0);
+        CHECK(kept.pushedOut > 10);
+        CHECK(kept.verticesTooDeep == 0);
+        CHECK(kept.guidesEnteringHead == 0);
+    }
 }

@@ -51,6 +51,8 @@ public:
     HeadPolicy policy() const { return mPolicy; }
     const Vec3d& center() const { return mCenter; }
     double radius() const { return mRadius; }
+    /// @brief The level set's voxel size (world units); 0 for a sphere or no head.
+    double voxelSize() const { return mGrid ? mGrid->voxelSize()[0] : 0.0; }
     /// @brief Set the words describe() adds on where the head came from ("fitted to the roots").
     void setLabel(const std::string& label) { mLabel = label; }
     /// @brief A short description for reports ("sphere (0, 1.6, 0) r 0.11", "level set 'surface'").

@@ -130,6 +130,9 @@ struct InterpolationRoots
 {
     std::vector<Vec3d> positions;
     std::vector<Vec3d> normals;
+    /// #R group ids or empty: a root blends only guides of its group (interpolatePoints(); empty:
+    /// each root takes the group of the guide nearest it)
+    std::vector<std::int32_t> groups;
 };
 
 /// @brief The surface frame W at a root with normal @a normal (see above).

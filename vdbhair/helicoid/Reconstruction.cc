@@ -207,9 +207,30 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
     res.pointErrors.seconds = seconds(t0);
     res.points = assemble(rawGuides, interpPoints);
 
+    // The baseline: the nearest guide, translated to the root.
+    t0 = std::chrono::steady_clock::now();
+    StrandSet nearest;
+    {
+        std::vector<Vec3d> guideRoots;
+        for (std::size_t g = 0; g < rawGuides.numStrands(); ++g) guideRoots.push_back(toD(rawGuides.root(g)));
+        const GuideLocator locator(guideRoots);
+        nearest.offsets.assign(1, 0);
+        std::size_t o = 0;
+        for (std::size_t i = 0; i < S; ++i) {
+            const std::size_t g = isGuide[i] ? std::size_t(-1) : locator.nearest(roots.positions[o++]);
+            const StrandSet& src = isGuide[i] ? strands : rawGuides;
+            const std::size_t k = isGuide[i] ? i : g;
+            const Vec3f shift = isGuide[i] ? Vec3f(0.f) : strands.root(i) - rawGuides.root(g);
+            for (std::size_t v = 0; v < src.size(k); ++v) nearest.positions.push_back(src.positions[src.begin(k) + v] + shift);
+            nearest.offsets.push_back(std::uint32_t(nearest.positions.size()));
+        }
+    }
+    res.nearestErrors.seconds = seconds(t0);
+
     // Errors, every strand at the fits' spacing.
     res.helicoidErrors.relative.assign(S, 0.0);
     res.pointErrors.relative.assign(S, 0.0);
+    res.nearestErrors.relative.assign(S, 0.0);
     auto measure = [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const std::size_t n = strands.size(i);
@@ -221,12 +242,14 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
             if (!(spacing > 0.0)) spacing = 1.0;
             res.helicoidErrors.relative[i] = relativeFrechet(a, n, res.helicoid.positions.data() + res.helicoid.begin(i), res.helicoid.size(i), spacing);
             res.pointErrors.relative[i] = relativeFrechet(a, n, res.points.positions.data() + res.points.begin(i), res.points.size(i), spacing);
+            res.nearestErrors.relative[i] = relativeFrechet(a, n, nearest.positions.data() + nearest.begin(i), nearest.size(i), spacing);
         }
     };
     if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 16), measure);
     else measure(tbb::blocked_range<std::size_t>(0, S));
     summarize(res.helicoidErrors, isGuide);
     summarize(res.pointErrors, isGuide);
+    summarize(res.nearestErrors, isGuide);
     return res;
 }
 

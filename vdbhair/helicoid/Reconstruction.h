@@ -6,6 +6,9 @@
 /// discrete Fréchet distance relative to its length. The same is done the peers' way
 /// (PointInterpolation.h) from the same guides' raw points, so the two can be compared.
 ///
+/// A third way is measured as the baseline both must beat: each strand replaced by its nearest
+/// guide (by root), translated to its root.
+///
 /// Guide strands are reconstructed as their fits (the helicoid way) or as themselves (the points
 /// way), so with every strand a guide the helicoid error is the fits' own error and the points
 /// error is zero; the statistics are reported over all strands and over the interpolated ones.
@@ -63,6 +66,7 @@ struct ReconstructResult
     std::size_t unfitted = 0;         ///< selected strands that could not be fitted (zero length): interpolated instead
     StrandSet helicoid, points;       ///< #S reconstructed strands each, in input order
     ReconstructErrors helicoidErrors, pointErrors;
+    ReconstructErrors nearestErrors;  ///< the baseline: every strand its nearest guide, translated
     FitSummary fitSummary;
     double fitSeconds = 0.0;
 };

@@ -247,6 +247,13 @@ std::size_t sceneVertexCount(const Scene& scene)
     return total;
 }
 
+StrandSet growGuides(const Scene& scene, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    Scene bare = scene;
+    for (SceneGuide& g : bare.guides) g.wisp.reset();
+    return growScene(bare, {}, threaded, interrupter);
+}
+
 StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded, openvdb::util::NullInterrupter* interrupter,
                     GrowReport* report)
 {

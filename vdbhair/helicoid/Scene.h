@@ -112,6 +112,11 @@ struct GrowReport
 StrandSet growScene(const Scene& scene, const GrowOptions& options = {}, bool threaded = true,
                     openvdb::util::NullInterrupter* interrupter = nullptr, GrowReport* report = nullptr);
 
+/// @brief The guides of @a scene alone, one strand each, without their wisps (what point
+/// interpolation blends when its guides come as a scene).
+/// @throw as growScene().
+StrandSet growGuides(const Scene& scene, bool threaded = true, openvdb::util::NullInterrupter* interrupter = nullptr);
+
 /// @brief The vertex count growScene() would produce (checked against overflow).
 std::size_t sceneVertexCount(const Scene& scene);
 

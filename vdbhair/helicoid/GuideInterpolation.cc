@@ -1,0 +1,109 @@
+#include "GuideInterpolation.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/strands/Measures.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace vdbhair {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace
+
+const char* interpolationMethodName(InterpolationMethod method) { return method == InterpolationMethod::Points ? "points" : "helicoid"; }
+
+InterpolationMethod interpolationMethodFromName(const std::string& name)
+{
+    if (name == "points") return InterpolationMethod::Points;
+    if (name == "helicoid") return InterpolationMethod::Helicoid;
+    throw ValueError("method '" + name + "' is not one of points, helicoid");
+}
+
+const char* frameRuleName(FrameRule frames) { return frames == FrameRule::World ? "world" : "surface"; }
+
+FrameRule frameRuleFromName(const std::string& name)
+{
+    if (name == "world") return FrameRule::World;
+    if (name == "surface") return FrameRule::Surface;
+    throw ValueError("frames '" + name + "' is not one of world, surface");
+}
+
+InterpolateResult interpolateGuides(const InterpolationGuides& guides, const InterpolationRoots& rootsIn, const HeadObstacle& head,
+                                    const InterpolateParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    if ((guides.strands == nullptr) == (guides.scene == nullptr)) throw ValueError("interpolateGuides: give the guides as strands or as a scene (one of them)");
+    const bool points = params.method == InterpolationMethod::Points;
+    if (params.returnScene && points) throw ValueError("a scene of new hairs needs the helicoid method (points make strands)");
+    if (!points && !guides.groups.empty()) throw ValueError("guide groups need the points method; helicoid interpolation blends every guide");
+    if (params.frames == FrameRule::Surface && rootsIn.normals.empty()) throw ValueError("surface frames need root normals; the roots have none");
+    if (rootsIn.positions.empty()) throw ValueError("no roots: interpolation needs at least one root");
+    InterpolationRoots roots = rootsIn;
+    if (params.frames == FrameRule::World) roots.normals.clear();
+
+    InterpolateResult res;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (points) {
+        // The guides' own points (a scene's guides grown, without wisps).
+        StrandSet grown;
+        if (guides.scene) {
+            validateGuideScene(*guides.scene);
+            grown = growGuides(*guides.scene, threaded, interrupter);
+        }
+        const StrandSet& g = guides.scene ? grown : *guides.strands;
+        if (g.empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
+        for (std::size_t i = 0; i < g.numStrands(); ++i) {
+            const std::size_t n = g.size(i);
+            if (n < 2) throw ValueError(guides.where + ": guide strand " + std::to_string(i) + ": " + std::to_string(n) + " vertex; a guide needs at least 2");
+            if (!(polylineLength(g.positions.data() + g.begin(i), n) > 0.0)) {
+                throw ValueError(guides.where + ": guide strand " + std::to_string(i) + ": zero length; a guide must have a positive length");
+            }
+        }
+        GuideContext context;
+        context.groups = guides.groups;
+        context.frames = params.frames;
+        if (guides.scene && params.frames == FrameRule::Surface) context.normals = sceneGuideNormals(*guides.scene);
+        res.strands = interpolatePoints(g, roots, params.points, context, threaded, interrupter, &res.groups);
+        res.guides = g.numStrands();
+        res.guidesEnteringHead = countStrandsEnteringHead(g, head, headTolerance(head), threaded);
+    } else {
+        Scene fitted;
+        if (guides.strands) {
+            if (guides.strands->empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
+            fitted = guideSceneFromStrands(*guides.strands, FitParams{}, guides.where, threaded, interrupter);
+            res.fitSeconds = secondsSince(t0);
+        }
+        const Scene& scene = guides.strands ? fitted : *guides.scene;
+        if (scene.guides.empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
+        validateGuideScene(scene);
+        const std::vector<Vec3d> guideNormals = roots.normals.empty() ? std::vector<Vec3d>() : sceneGuideNormals(scene);
+        res.scene = interpolateHelicoids(scene, roots, params.helicoid, guideNormals, threaded, interrupter);
+        res.scene.seed = params.seed;
+        res.guides = scene.guides.size();
+        if (!params.returnScene) {
+            GrowOptions grow;
+            grow.maxVertices = params.helicoid.maxVertices;
+            res.strands = growScene(res.scene, grow, threaded, interrupter);
+            res.guidesEnteringHead = countStrandsEnteringHead(guides.strands ? *guides.strands : growGuides(scene, threaded, interrupter), head, headTolerance(head), threaded);
+        }
+    }
+    // The head: no new hair deeper inside it than its root (HeadCollision.h).
+    if (!head.empty() && !params.returnScene) {
+        const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), {}, threaded);
+        res.pushedOut = hc.strandsMoved;
+        res.verticesTooDeep = hc.verticesTooDeep;
+    }
+    res.enteringHead = countStrandsEnteringHead(res.strands, head, headTolerance(head), threaded);
+    res.seconds = secondsSince(t0) - res.fitSeconds;
+    return res;
+}
+
+} // namespace vdbhair

@@ -1,0 +1,86 @@
+/// @file GuideInterpolation.h
+/// @brief The `interpolate` operation: new hairs at roots from guide hairs, by either method, with
+/// the head as an obstacle (no new vertex deeper inside it than its strand's root, pushed out
+/// smoothly: HeadCollision.h) and a report of what came out. The command line and Python both call
+/// interpolateGuides(); the methods themselves are PointInterpolation.h (the default) and
+/// HelicoidInterpolation.h (Piuze et al. 2011, §4).
+///
+/// Why points is the default: measured on real grooms with their own heads (docs/interpolation.md),
+/// blending the guides' points by group and likeness keeps new hair inside the guides' hair volume
+/// about as well as the groom itself; blending helicoid parameters fans and flares it (fits of
+/// neighbouring real strands are not parameterized alike), and rotating guides by their roots'
+/// surface normals flares long hair. Helicoid interpolation stays available (`--method helicoid`),
+/// as the paper prints it.
+#pragma once
+
+#include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/helicoid/HelicoidInterpolation.h>
+#include <vdbhair/helicoid/PointInterpolation.h>
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <openvdb/util/NullInterrupter.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vdbhair {
+
+enum class InterpolationMethod
+{
+    Points,    ///< the guides' own points, by group and likeness (PointInterpolation.h): the default
+    Helicoid,  ///< the guides' p-helicoid parameters (HelicoidInterpolation.h, Piuze et al. §4)
+};
+
+/// @brief "points" or "helicoid".
+const char* interpolationMethodName(InterpolationMethod method);
+/// @throw ValueError naming @a name and the choices.
+InterpolationMethod interpolationMethodFromName(const std::string& name);
+/// @brief "world" or "surface".
+const char* frameRuleName(FrameRule frames);
+/// @throw ValueError naming @a name and the choices.
+FrameRule frameRuleFromName(const std::string& name);
+
+struct InterpolateParams
+{
+    InterpolationMethod method = InterpolationMethod::Points;
+    FrameRule frames = FrameRule::World;  ///< Surface needs root normals (§4.3)
+    HelicoidInterpolationParams helicoid;
+    PointInterpolationParams points;
+    std::uint64_t seed = 0;    ///< waviness noise of the new helicoid hairs
+    bool returnScene = false;  ///< Helicoid: keep the new hairs as a scene, not grown (no head collision then)
+};
+
+/// @brief The guides: strands (blended as they are by points; fitted first for helicoids) or a
+/// helicoid scene (grown without wisps for points). Exactly one of the two.
+struct InterpolationGuides
+{
+    const StrandSet* strands = nullptr;
+    const Scene* scene = nullptr;
+    std::vector<std::int32_t> groups;  ///< empty or #G group ids (points only)
+    std::string where = "guides";      ///< names the guides in messages (a path)
+};
+
+struct InterpolateResult
+{
+    StrandSet strands;  ///< the new hairs (empty with returnScene)
+    Scene scene;        ///< Helicoid: the new hairs as helicoids
+    std::size_t guides = 0, groups = 1;
+    std::size_t pushedOut = 0;         ///< new strands the head pushed out
+    std::size_t verticesTooDeep = 0;   ///< vertices the push could not bring out (HeadCollision.h)
+    /// strands that pass into the head (countStrandsEnteringHead(), headTolerance()): of the new hair, and of the guides
+    std::size_t enteringHead = 0, guidesEnteringHead = 0;
+    double fitSeconds = 0.0;  ///< fitting strand guides (Helicoid)
+    double seconds = 0.0;     ///< interpolating (and growing, and the head)
+};
+
+/// @brief New hairs at @a roots from @a guides (see above). Identical for any thread count.
+/// @param head the head to keep the new hair out of (empty: none)
+/// @throw ValueError (bad guides, roots, groups or params, groups with Helicoid, surface frames
+/// without normals), LimitError (too many vertices, before any work), InterruptedError.
+InterpolateResult interpolateGuides(const InterpolationGuides& guides, const InterpolationRoots& roots, const HeadObstacle& head,
+                                    const InterpolateParams& params, bool threaded = true,
+                                    openvdb::util::NullInterrupter* interrupter = nullptr);
+
+} // namespace vdbhair
