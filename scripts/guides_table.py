@@ -198,7 +198,9 @@ def main():
         # Regrown at the groom's roots.
         out1 = os.path.join(tmp, name + "_at_roots.hair")
         head_opt = [] if "--head" in extra else ["--head", scalp]
-        run([args.vdbhair, "interpolate", guide_file, "--roots", hair_path, "-o", out1, "--up", up, "--quiet"] + head_opt + extra)
+        # The groom's roots have no normals: surface frames apply on the scalp only.
+        at_roots = [a for i, a in enumerate(extra) if not ("--frames" in extra[i - 1:i + 1] and "surface" in extra[i:i + 2])]
+        run([args.vdbhair, "interpolate", guide_file, "--roots", hair_path, "-o", out1, "--up", up, "--quiet"] + head_opt + at_roots)
         new1 = strands_of(vdbhair.read(out1))
         groots = np.array([g[0] for g in guides])
         errs, near = [], []
