@@ -46,8 +46,8 @@ bool sweep(std::size_t n, const std::function<double(std::size_t)>& floorAt, Hea
         }
         const Vec3d dHat = d / dl;
         w.p[k] = a + dHat * l;
-        const double floor = floorAt(k);
-        if (!(probe.distance(w.p[k]) < floor)) continue;
+        const double floor = floorAt(k), d0 = probe.distance(w.p[k]);
+        if (!(d0 < floor)) continue;
         Vec3d nrm = probe.normal(w.p[k]);
         if (nrm.lengthSqr() == 0.0) nrm = probe.normal(a);
         Vec3d t = nrm - dHat * dHat.dot(nrm);
@@ -57,21 +57,31 @@ bool sweep(std::size_t n, const std::function<double(std::size_t)>& floorAt, Hea
         }
         t.normalize();
         // The least angle towards t that lifts vertex k out, up to a half turn (to a hair past its
-        // floor, so the float vertex does not round back in).
+        // floor, so the float vertex does not round back in): bracketed from the first-order
+        // estimate d(θ) ≈ d(0) + l θ (n · t), then bisected to a 64th of the bracket.
         const double target = floor + 1e-4 * l;
         auto at = [&](double theta) { return a + (dHat * std::cos(theta) + t * std::sin(theta)) * l; };
+        const double slope = l * nrm.dot(t);
         double lo = 0.0, hi = M_PI;
         bool found = false;
-        for (double angle : {M_PI / 16.0, M_PI / 8.0, M_PI / 4.0, M_PI / 2.0, 3.0 * M_PI / 4.0, M_PI}) {
-            if (!(probe.distance(at(angle)) < target)) {
-                hi = angle;
-                found = true;
-                break;
+        const double guess = slope > 0.0 ? 1.25 * (target - d0) / slope : 0.0;
+        if (guess > 0.0 && guess < M_PI && !(probe.distance(at(guess)) < target)) {
+            hi = guess;
+            found = true;
+        } else {
+            if (guess > 0.0 && guess < M_PI) lo = guess;
+            for (double angle : {M_PI / 16.0, M_PI / 8.0, M_PI / 4.0, M_PI / 2.0, 3.0 * M_PI / 4.0, M_PI}) {
+                if (angle <= lo) continue;
+                if (!(probe.distance(at(angle)) < target)) {
+                    hi = angle;
+                    found = true;
+                    break;
+                }
+                lo = angle;
             }
-            lo = angle;
         }
         if (!found) continue;  // no turn lifts it (the vertex before is deep itself): the last pass pushes it
-        for (int it = 0; it < 20; ++it) {
+        for (int it = 0; it < 6; ++it) {
             const double mid = 0.5 * (lo + hi);
             if (probe.distance(at(mid)) < target) lo = mid;
             else hi = mid;
@@ -121,7 +131,9 @@ bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle
     // What is still too deep, vertex by vertex.
     for (std::size_t k = 1; k < n; ++k) {
         const double floor = floorAt(k);
-        if (probe.distance(w.p[k]) < floor) probe.pushOut(w.p[k], floor);
+        pos[k] = Vec3f(float(w.p[k].x()), float(w.p[k].y()), float(w.p[k].z()));
+        if (!(probe.distance(toD(pos[k])) < floor)) continue;
+        probe.pushOut(w.p[k], floor);
         pos[k] = Vec3f(float(w.p[k].x()), float(w.p[k].y()), float(w.p[k].z()));
         if (probe.distance(toD(pos[k])) < floor) ++tooDeep;
     }

@@ -32,7 +32,7 @@ struct HeadCollisionParams
     /// How far along the strand from a pushed vertex the bend is relaxed, a fraction of the
     /// strand's length: wide enough that a strand lifts off the scalp over a stretch.
     double spread = 0.15;
-    int passes = 6;     ///< push-and-relax passes before the vertex-by-vertex one
+    int passes = 4;     ///< sweep-and-relax passes before the vertex-by-vertex one
     int smoothing = 4;  ///< Laplacian steps of each pass
 };
 
