@@ -15,6 +15,7 @@
 #include <vdbhair/scalp/Follicles.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace vdbhair::app {
 
@@ -165,17 +166,21 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
                    {"grouping", points ? nlohmann::json(p.grouping) : nlohmann::json(nullptr)}, {"groups", r.groups},
                    {"guides", r.guides}, {"strands", count},
                    {"vertices", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json(r.strands.numVertices())},
-                   {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe())},
+                   {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe(false))},
                    {"pushed_out", r.pushedOut}, {"vertices_too_deep", r.verticesTooDeep},
                    {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
                    {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
     } else if (!common.quiet) {
         std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << p.method << ", " << frameRuleName(op.frames) << " frames";
         if (points) std::cout << ", " << r.groups << (r.groups == 1 ? " group" : " groups") << ", grouping " << p.grouping;
-        std::cout << ") in " << formatValue(r.seconds) << " s\n";
+        char seconds[32];
+        std::snprintf(seconds, sizeof seconds, "%.3f", r.seconds);
+        std::cout << ") in " << seconds << " s\n";
         if (!head.empty() && !op.returnScene) {
-            std::cout << "head: " << head.describe() << "; " << r.pushedOut << " strands pushed out; entering it: "
-                      << formatValue(100.0 * enteringShare) << " % of the new strands, " << formatValue(100.0 * guidesEnteringShare) << " % of the guides\n";
+            char shares[96];
+            std::snprintf(shares, sizeof shares, "%.1f %% of the new strands, %.1f %% of the guides", 100.0 * enteringShare, 100.0 * guidesEnteringShare);
+            std::cout << "head: " << head.describe(false) << " (no new vertex deeper than its root); " << r.pushedOut
+                      << " strands pushed out; passing into it: " << shares << "\n";
         }
         std::cout << "wrote " << p.output << "\n";
     }

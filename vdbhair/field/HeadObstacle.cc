@@ -61,7 +61,7 @@ HeadObstacle HeadObstacle::levelSet(openvdb::FloatGrid::ConstPtr grid, HeadPolic
     return h;
 }
 
-std::string HeadObstacle::describe() const
+std::string HeadObstacle::describe(bool withPolicy) const
 {
     std::ostringstream s;
     switch (mKind) {
@@ -73,7 +73,7 @@ std::string HeadObstacle::describe() const
     case Kind::LevelSet: s << "level set '" << mGrid->getName() << "' (voxel " << mGrid->voxelSize()[0] << ")"; break;
     }
     if (!mLabel.empty()) s << ", " << mLabel;
-    if (!empty()) s << (mPolicy == HeadPolicy::NoDeeper ? ", no vertex deeper inside than the input's" : ", every vertex kept outside");
+    if (!empty() && withPolicy) s << (mPolicy == HeadPolicy::NoDeeper ? ", no vertex deeper inside than the input's" : ", every vertex kept outside");
     return s.str();
 }
 

@@ -55,8 +55,9 @@ public:
     double voxelSize() const { return mGrid ? mGrid->voxelSize()[0] : 0.0; }
     /// @brief Set the words describe() adds on where the head came from ("fitted to the roots").
     void setLabel(const std::string& label) { mLabel = label; }
-    /// @brief A short description for reports ("sphere (0, 1.6, 0) r 0.11", "level set 'surface'").
-    std::string describe() const;
+    /// @brief A short description for reports ("sphere (0, 1.6, 0) r 0.11", "level set 'surface'"),
+    /// with what the policy allows unless @a withPolicy is false (callers with a rule of their own).
+    std::string describe(bool withPolicy = true) const;
 
     /// @brief Signed distance and outward unit normal at world points; one per thread.
     class Probe
