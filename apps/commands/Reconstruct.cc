@@ -80,19 +80,30 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
         return nlohmann::json{{"mean", e.mean}, {"p95", e.p95}, {"mean_interpolated", e.meanInterpolated},
                               {"p95_interpolated", e.p95Interpolated}, {"seconds", e.seconds}};
     };
+    // HairGS's oriented points and Perm's strand pairs, per way (Compare.h).
+    auto papers = [](const ReconstructErrors& e) {
+        nlohmann::json oriented = nlohmann::json::array();
+        for (const OrientedMatch& m : e.oriented) {
+            oriented.push_back({{"distance_mm", 1000.0 * m.threshold.distance}, {"angle_degrees", m.threshold.angleDegrees}, {"precision", m.precision},
+                                {"recall", m.recall}, {"f1", m.f1}, {"strand_consistency", m.strandConsistency}});
+        }
+        return nlohmann::json{{"oriented_points", e.oriented.empty() ? nlohmann::json(nullptr) : oriented},
+                              {"perm_position", e.permPosition}, {"perm_curvature", e.permCurvature}};
+    };
     const std::size_t S = strands.numStrands();
     if (common.json) {
         printJson({{"output", p.output}, {"method", p.method}, {"strands", S}, {"guides", r.guides.size()}, {"unfitted", r.unfitted},
                    {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", p.select}, {"blend", p.blend},
                    {"fit", {{"mean", r.fitSummary.meanRelative}, {"p95", r.fitSummary.p95Relative}, {"pieces_per_strand", r.fitSummary.piecesPerStrand}, {"seconds", r.fitSeconds}}},
                    {"grouping", guideGroupingName(p.rec.points.grouping)},
-                   {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}, {"nearest", stats(r.nearestErrors)}}}});
+                   {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}, {"nearest", stats(r.nearestErrors)}}},
+                   {"measures", {{"helicoid", papers(r.helicoidErrors)}, {"points", papers(r.pointErrors)}, {"nearest", papers(r.nearestErrors)}}},
+                   {"meters_per_unit", p.rec.metersPerUnit > 0.0 ? nlohmann::json(p.rec.metersPerUnit) : nlohmann::json(nullptr)}});
     } else if (!common.quiet) {
         char buf[256];
-        std::cout << "reconstructed " << S << " strands from " << r.guides.size() << " guides (" << formatValue(100.0 * double(r.guides.size()) / double(S))
-                  << " %, " << p.select << "); fits: mean " << formatValue(100.0 * r.fitSummary.meanRelative) << " %, "
-                  << formatValue(r.fitSummary.piecesPerStrand) << " pieces, " << formatValue(r.fitSeconds) << " s\n"
-                  << "discrete Frechet distance / strand length:\n";
+        std::snprintf(buf, sizeof buf, " guides (%.3g %%, %s); fits: mean %.3g %%, %.2f pieces, %.3f s\n", 100.0 * double(r.guides.size()) / double(S),
+                      p.select.c_str(), 100.0 * r.fitSummary.meanRelative, r.fitSummary.piecesPerStrand, r.fitSeconds);
+        std::cout << "reconstructed " << S << " strands from " << r.guides.size() << buf << "discrete Frechet distance / strand length:\n";
         std::snprintf(buf, sizeof buf, "%-17s %10s %10s %14s %14s %9s\n", "method", "mean", "p95", "mean interp.", "p95 interp.", "time s");
         std::cout << buf;
         for (int m = 0; m < 3; ++m) {
@@ -101,6 +112,18 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
             std::snprintf(buf, sizeof buf, "%-17s %9.3f%% %9.3f%% %13.3f%% %13.3f%% %9.3f\n", name.c_str(), 100.0 * e.mean, 100.0 * e.p95,
                           100.0 * e.meanInterpolated, 100.0 * e.p95Interpolated, e.seconds);
             std::cout << buf;
+        }
+        std::cout << "as papers measure (all strands): Perm's root-aligned position error / curvature error"
+                  << (r.pointErrors.oriented.empty() ? "" : "; HairGS F1 at 2 mm/20, 3 mm/30, 4 mm/40, 4 mm/90 degrees") << ":\n";
+        for (int m = 0; m < 3; ++m) {
+            const ReconstructErrors& e = m == 0 ? r.helicoidErrors : m == 1 ? r.pointErrors : r.nearestErrors;
+            std::snprintf(buf, sizeof buf, "%-17s %10.4g %10.4g", m == 0 ? "helicoid" : m == 1 ? "points" : "nearest guide", e.permPosition, e.permCurvature);
+            std::cout << buf;
+            for (const OrientedMatch& o : e.oriented) {
+                std::snprintf(buf, sizeof buf, " %6.3f", o.f1);
+                std::cout << buf;
+            }
+            std::cout << "\n";
         }
         std::cout << "wrote " << p.output << " (" << p.method << ")" << (p.errors.empty() ? "" : " and " + p.errors) << "\n";
     }
@@ -128,10 +151,11 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair (default: every guide for helicoid, " +
                                            std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
     sub->add_option("--max-error", params->rec.fit.maxError, "Fits: accepted discrete Frechet distance, a fraction of the strand length")->capture_default_str();
-    sub->add_option("--errors", params->errors, "Also write every strand's relative error, both methods, as CSV");
+    sub->add_option("--errors", params->errors, "Also write every strand's relative error, every way, as CSV");
+    sub->add_option("--meters-per-unit", params->rec.metersPerUnit, "The file's unit in metres (0.01: centimetres), for HairGS's oriented-point F1 at 2-4 mm (0: unknown, not measured)")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair reconstruct straight.hair -o rebuilt.hair --guides 10% --json");
-    return {sub, [params, &common] { return runReconstruct(*params, common); }, {{"maxError", "--max-error"}, {"blend", "--blend"}}};
+    return {sub, [params, &common] { return runReconstruct(*params, common); }, {{"maxError", "--max-error"}, {"blend", "--blend"}, {"metersPerUnit", "--meters-per-unit"}}};
 }
 
 } // namespace vdbhair::app

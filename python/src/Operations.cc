@@ -644,9 +644,12 @@ Returns:
     m.def(
         "reconstruct",
         [](const StrandsPtr& strands, double guides, const std::string& select, std::uint64_t seed, double power,
-           std::optional<int> neighbors, const std::string& blend, const std::string& grouping, double likeness, double maxError, int threads,
-           const pyb::object& progress) {
+           std::optional<int> neighbors, const std::string& blend, const std::string& grouping, double likeness, double maxError,
+           double metersPerUnit, int threads, const pyb::object& progress) {
             ReconstructParams p;
+            if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit))
+                throw ValueError("reconstruct: meters_per_unit=" + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
+            p.metersPerUnit = metersPerUnit;
             p.helicoid.blend = blendArgument("reconstruct", blend);
             try {
                 p.points.grouping = guideGroupingFromName(grouping);
@@ -671,7 +674,7 @@ Returns:
             ReconstructResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 return reconstructHairstyle(*strands, p, true, interrupter);
             });
-            auto stats = [](const ReconstructErrors& e) {
+            auto stats = [metersPerUnit](const ReconstructErrors& e) {
                 pyb::dict d;
                 d["relative"] = pyb::array_t<double>(e.relative.size(), e.relative.data());
                 d["mean"] = e.mean;
@@ -679,6 +682,19 @@ Returns:
                 d["mean_interpolated"] = e.meanInterpolated;
                 d["p95_interpolated"] = e.p95Interpolated;
                 d["seconds"] = e.seconds;
+                d["perm_position"] = e.permPosition;
+                d["perm_curvature"] = e.permCurvature;
+                if (e.oriented.empty()) {
+                    d["oriented_points"] = pyb::none();
+                } else {
+                    pyb::list oriented;
+                    for (const OrientedMatch& m : e.oriented) {
+                        oriented.append(pyb::dict(pyb::arg("distance_mm") = 1000.0 * m.threshold.distance * metersPerUnit, pyb::arg("angle_degrees") = m.threshold.angleDegrees,
+                                                  pyb::arg("precision") = m.precision, pyb::arg("recall") = m.recall, pyb::arg("f1") = m.f1,
+                                                  pyb::arg("strand_consistency") = m.strandConsistency));
+                    }
+                    d["oriented_points"] = oriented;
+                }
                 return d;
             };
             pyb::dict report;
@@ -695,7 +711,7 @@ Returns:
         pyb::arg("seed") = reconstructDefaults.seed, pyb::arg("power") = reconstructDefaults.helicoid.shepard.power,
         pyb::arg("neighbors") = pyb::none(), pyb::arg("blend") = helicoidBlendName(reconstructDefaults.helicoid.blend),
         pyb::arg("grouping") = guideGroupingName(reconstructDefaults.points.grouping), pyb::arg("likeness") = reconstructDefaults.points.likeness,
-        pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("threads") = 0,
+        pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("meters_per_unit") = reconstructDefaults.metersPerUnit, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(Rebuild a hairstyle from a share of its strands (Piuze et al. 2011, Sec. 5.4):
 ``vdbhair reconstruct``. The guides are fitted with p-helicoids and new hairs interpolated at every
@@ -716,6 +732,8 @@ Args:
         (the fits' own pieces, as the paper prints it).
     grouping: points: "shape" (a strand blends only guides shaped like its nearest one) or "none".
     likeness: the shape distance, a fraction of the guide length, at which a guide stops taking part.
+    meters_per_unit: the strands' unit in metres (0.01: centimetres), for HairGS's oriented-point
+        measures at 2-4 mm; 0: unknown, not measured.
     max_error: the fits' accepted discrete Frechet distance, a fraction of the strand length.
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``.
@@ -724,8 +742,10 @@ Returns:
     (helicoid, points, report): both reconstructions as Strands in input order, and a dict with
     ``guides`` (the guide strands' indices), ``unfitted``, ``fit`` (mean, p95, pieces_per_strand,
     seconds) and for ``helicoid``, ``points`` and ``nearest`` (the baseline: each strand its
-    nearest guide, translated): ``relative`` (each strand's error), ``mean``,
-    ``p95``, ``mean_interpolated``, ``p95_interpolated``, ``seconds``.)doc");
+    nearest guide, translated): ``relative`` (each strand's error), ``mean``, ``p95``,
+    ``mean_interpolated``, ``p95_interpolated``, ``seconds``, ``perm_position``,
+    ``perm_curvature`` and ``oriented_points`` (None, or per HairGS threshold: distance_mm,
+    angle_degrees, precision, recall, f1, strand_consistency).)doc");
 
     const RenderParams renderDefaults;
     m.def(

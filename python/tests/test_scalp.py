@@ -151,9 +151,17 @@ def test_reconstruct_straight_hair():
     with pytest.raises(ValueError, match="blend 'sideways' is not one of arcs, fitted"):
         vdbhair.reconstruct(hair, blend="sideways")
     # Every strand a guide: the points way returns the strands themselves.
-    _, same, everything = vdbhair.reconstruct(hair, guides=1.0)
+    _, same, everything = vdbhair.reconstruct(hair, guides=1.0, meters_per_unit=0.01)
     assert everything["points"]["mean"] == 0.0
     assert np.array_equal(same.positions, hair.positions)
+    # As papers measure: the strands themselves match every oriented point, at no position error.
+    assert report["points"]["oriented_points"] is None  # no unit: not measured
+    assert [m["distance_mm"] for m in everything["points"]["oriented_points"]] == pytest.approx([2.0, 3.0, 4.0, 4.0])
+    assert all(m["f1"] == 1.0 and m["strand_consistency"] == 1.0 for m in everything["points"]["oriented_points"])
+    assert everything["points"]["perm_position"] == 0.0 and everything["points"]["perm_curvature"] == 0.0
+    assert report["nearest"]["perm_position"] >= 0.0
+    with pytest.raises(ValueError, match="meters_per_unit=-1"):
+        vdbhair.reconstruct(hair, meters_per_unit=-1.0)
     h1 = vdbhair.reconstruct(hair, guides=0.25, seed=1, threads=1)[0]
     assert np.array_equal(h1.positions, helicoid.positions)
     with pytest.raises(ValueError, match="must be more than 0 %"):

@@ -136,6 +136,9 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
                                        openvdb::util::NullInterrupter* interrupter)
 {
     validateShepardParams(params.helicoid.shepard);
+    if (!(params.metersPerUnit >= 0.0) || !std::isfinite(params.metersPerUnit)) {
+        throw ValueError("metersPerUnit " + formatNumber(params.metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
+    }
     if (params.points.neighbors < 1) throw ValueError("neighbors " + std::to_string(params.points.neighbors) + ": must be at least 1");
     const std::size_t S = strands.numStrands();
     ReconstructResult res;
@@ -250,6 +253,21 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
     summarize(res.helicoidErrors, isGuide);
     summarize(res.pointErrors, isGuide);
     summarize(res.nearestErrors, isGuide);
+
+    // As hair papers measure (Compare.h).
+    std::vector<OrientedThreshold> thresholds;
+    if (params.metersPerUnit > 0.0) {
+        thresholds = hairGsThresholds();
+        for (OrientedThreshold& t : thresholds) t.distance /= params.metersPerUnit;
+    }
+    const std::pair<ReconstructErrors*, const StrandSet*> ways[] = {{&res.helicoidErrors, &res.helicoid}, {&res.pointErrors, &res.points},
+                                                                     {&res.nearestErrors, &nearest}};
+    for (const auto& way : ways) {
+        if (!thresholds.empty()) way.first->oriented = matchOrientedPoints(*way.second, strands, thresholds, false, threaded);
+        const StrandPairErrors perm = strandPairErrors(strands, *way.second, 100, threaded);
+        way.first->permPosition = perm.meanPosition;
+        way.first->permCurvature = perm.meanCurvature;
+    }
     return res;
 }
 

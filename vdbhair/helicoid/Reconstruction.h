@@ -9,6 +9,9 @@
 /// A third way is measured as the baseline both must beat: each strand replaced by its nearest
 /// guide (by root), translated to its root.
 ///
+/// Each way is also measured as hair papers measure (Compare.h): HairGS's oriented-point
+/// precision, recall and F1 (when the unit is known) and Perm's strand-pair errors.
+///
 /// Guide strands are reconstructed as their fits (the helicoid way) or as themselves (the points
 /// way), so with every strand a guide the helicoid error is the fits' own error and the points
 /// error is zero; the statistics are reported over all strands and over the interpolated ones.
@@ -25,6 +28,7 @@
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
+#include <vdbhair/strands/Compare.h>
 
 #include <openvdb/util/NullInterrupter.h>
 
@@ -49,6 +53,9 @@ struct ReconstructParams
         return p;
     }();
     PointInterpolationParams points;
+    /// The file's unit in metres (0.01 for centimetres); 0: unknown, and the oriented-point
+    /// measures, whose thresholds are in millimetres, are not computed.
+    double metersPerUnit = 0.0;
 };
 
 /// @brief Per-strand errors of one method and their statistics (fractions of the strand length).
@@ -58,6 +65,11 @@ struct ReconstructErrors
     double mean = 0.0, p95 = 0.0;   ///< over all strands
     double meanInterpolated = 0.0, p95Interpolated = 0.0;  ///< over the non-guide strands (0 if none)
     double seconds = 0.0;           ///< time to build the method's strands (fitting included for helicoids)
+    /// HairGS's precision, recall, F1 and strand consistency against the original at its four
+    /// thresholds (Compare.h; empty without ReconstructParams::metersPerUnit), all strands
+    std::vector<OrientedMatch> oriented;
+    /// Perm's root-aligned position error (world units) and curvature error, means over all strands
+    double permPosition = 0.0, permCurvature = 0.0;
 };
 
 struct ReconstructResult

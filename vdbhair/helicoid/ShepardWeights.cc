@@ -2,7 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
-#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/PointCloud.h>
 
 #include <algorithm>
 #include <cmath>

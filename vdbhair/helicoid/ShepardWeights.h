@@ -2,7 +2,7 @@
 /// @brief Interpolation weights of new roots over guide roots: Shepard's inverse distance
 /// weighting (Piuze et al. 2011, §4.1) and the faded K-nearest weights of Blender's Interpolate
 /// Curves node (the point-blending baseline), over one nanoflann k-d tree of the guide roots
-/// (scalp/PointCloud.h).
+/// (strands/PointCloud.h).
 ///
 /// Shepard: w_i = φ_i / Σ φ_j with φ_i = |x̃ - x_i|^-p over every guide, or over the K nearest by
 /// root. p = 3 is the paper's choice for all its examples: larger p gives clumps around each guide,

@@ -3,7 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Random.h>
-#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/synth/Pca.h>
 
 #include <tbb/parallel_for.h>

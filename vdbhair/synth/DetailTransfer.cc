@@ -5,7 +5,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/strands/Resample.h>
-#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/synth/impl/BalancedMatch.h>
 

@@ -1,7 +1,7 @@
 #include "FeatureMap.h"
 
 #include <vdbhair/Exceptions.h>
-#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/PointCloud.h>
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Random.h>
-#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <vdbhair/Parallel.h>

@@ -1,7 +1,7 @@
 #include "SynthesisReport.h"
 
 #include <vdbhair/helicoid/Frechet.h>
-#include <vdbhair/scalp/PointCloud.h>
+#include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
 

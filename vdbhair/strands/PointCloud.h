@@ -1,6 +1,6 @@
 /// @file PointCloud.h
 /// @brief nanoflann's view of a vector of world positions, and the k-d tree over it that the
-/// scalp module's neighbour searches share (follicle repulsion, regions from roots).
+/// neighbour searches share (follicle repulsion, regions from roots, guide weights, comparisons).
 #pragma once
 
 #include <vdbhair/Types.h>

@@ -1,0 +1,199 @@
+#include "Compare.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/strands/PointCloud.h>
+#include <vdbhair/strands/Resample.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace vdbhair {
+
+namespace {
+
+/// The oriented points of a hairstyle: each segment's start, its unit direction and its strand.
+struct OrientedPoints
+{
+    std::vector<Vec3d> position;
+    std::vector<Vec3d> direction;
+    std::vector<std::uint32_t> strand;
+};
+
+OrientedPoints orientedPoints(const StrandSet& s)
+{
+    OrientedPoints o;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        const Vec3f* p = s.positions.data() + s.begin(i);
+        for (std::size_t k = 0; k + 1 < s.size(i); ++k) {
+            const Vec3d a(p[k].x(), p[k].y(), p[k].z()), b(p[k + 1].x(), p[k + 1].y(), p[k + 1].z());
+            const Vec3d d = b - a;
+            const double l = d.length();
+            if (!(l > 0.0)) continue;  // a repeated vertex has no direction
+            o.position.push_back(a);
+            o.direction.push_back(d / l);
+            o.strand.push_back(std::uint32_t(i));
+        }
+    }
+    return o;
+}
+
+/// For every point of @a from, whether a point of @a to matches it at each threshold; and with
+/// @a consistency, each strand of @a from's consistency at each threshold.
+void matchShare(const OrientedPoints& from, const OrientedPoints& to, const std::vector<OrientedThreshold>& thresholds, bool bidirectional,
+                bool threaded, std::vector<double>& share, std::vector<double>* consistency)
+{
+    const std::size_t T = thresholds.size(), N = from.position.size();
+    double maxDistance = 0.0;
+    for (const OrientedThreshold& t : thresholds) maxDistance = std::max(maxDistance, t.distance);
+    std::vector<double> cosines(T);
+    for (std::size_t t = 0; t < T; ++t) cosines[t] = std::cos(thresholds[t].angleDegrees * M_PI / 180.0);
+    const PointCloud cloud{&to.position};
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    std::vector<std::uint8_t> matched(N * T, 0);
+    // Per point and threshold, the predicted strands it matches (for consistency): kept per point.
+    std::vector<std::vector<std::uint32_t>> matchedStrands(consistency ? N * T : 0);
+    auto run = [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<std::pair<std::uint32_t, double>> nb;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            nb.clear();
+            const Vec3d q = from.position[i];
+            tree.radiusSearch(q.asPointer(), maxDistance * maxDistance, nb, nanoflann::SearchParams(32, 0.f, false));
+            for (std::size_t t = 0; t < T; ++t) {
+                const double d2 = thresholds[t].distance * thresholds[t].distance;
+                for (const auto& m : nb) {
+                    if (m.second > d2) continue;
+                    double c = from.direction[i].dot(to.direction[m.first]);
+                    if (bidirectional) c = std::abs(c);
+                    if (c < cosines[t]) continue;
+                    matched[i * T + t] = 1;
+                    if (!consistency) break;
+                    matchedStrands[i * T + t].push_back(to.strand[m.first]);
+                }
+                if (consistency) {
+                    std::vector<std::uint32_t>& v = matchedStrands[i * T + t];
+                    std::sort(v.begin(), v.end());
+                    v.erase(std::unique(v.begin(), v.end()), v.end());
+                }
+            }
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, N, 512), run);
+    else run(tbb::blocked_range<std::size_t>(0, N));
+    share.assign(T, 0.0);
+    for (std::size_t t = 0; t < T; ++t) {
+        std::size_t count = 0;
+        for (std::size_t i = 0; i < N; ++i) count += matched[i * T + t];
+        share[t] = N ? double(count) / double(N) : 0.0;
+    }
+    if (!consistency) return;
+    // Per strand of @a from (its points are consecutive): the most points matching one strand.
+    consistency->assign(T, 0.0);
+    for (std::size_t t = 0; t < T; ++t) {
+        double sum = 0.0;
+        std::size_t counted = 0;
+        std::vector<std::uint32_t> ids;
+        for (std::size_t begin = 0; begin < N;) {
+            std::size_t end = begin;
+            while (end < N && from.strand[end] == from.strand[begin]) ++end;
+            ids.clear();
+            for (std::size_t i = begin; i < end; ++i) ids.insert(ids.end(), matchedStrands[i * T + t].begin(), matchedStrands[i * T + t].end());
+            std::sort(ids.begin(), ids.end());
+            std::size_t best = 0;
+            for (std::size_t a = 0; a < ids.size();) {
+                std::size_t b = a;
+                while (b < ids.size() && ids[b] == ids[a]) ++b;
+                best = std::max(best, b - a);
+                a = b;
+            }
+            sum += double(best) / double(end - begin);
+            ++counted;
+            begin = end;
+        }
+        (*consistency)[t] = counted ? sum / double(counted) : 0.0;
+    }
+}
+
+} // namespace
+
+std::vector<OrientedThreshold> hairGsThresholds()
+{
+    return {{0.002, 20.0}, {0.003, 30.0}, {0.004, 40.0}, {0.004, 90.0}};
+}
+
+std::vector<OrientedMatch> matchOrientedPoints(const StrandSet& predicted, const StrandSet& reference,
+                                               const std::vector<OrientedThreshold>& thresholds, bool bidirectional, bool threaded)
+{
+    for (const OrientedThreshold& t : thresholds) {
+        if (!(t.distance >= 0.0) || !std::isfinite(t.distance)) throw ValueError("oriented match: distance " + std::to_string(t.distance) + ": must be finite and >= 0");
+        if (!(t.angleDegrees >= 0.0 && t.angleDegrees <= 180.0)) throw ValueError("oriented match: angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees");
+    }
+    const OrientedPoints p = orientedPoints(predicted), r = orientedPoints(reference);
+    if (p.position.empty()) throw ValueError("oriented match: the predicted hair has no segment");
+    if (r.position.empty()) throw ValueError("oriented match: the reference hair has no segment");
+    std::vector<double> precision, recall, consistency;
+    matchShare(p, r, thresholds, bidirectional, threaded, precision, nullptr);
+    matchShare(r, p, thresholds, bidirectional, threaded, recall, &consistency);
+    std::vector<OrientedMatch> out(thresholds.size());
+    for (std::size_t t = 0; t < thresholds.size(); ++t) {
+        OrientedMatch& m = out[t];
+        m.threshold = thresholds[t];
+        m.precision = precision[t];
+        m.recall = recall[t];
+        m.f1 = m.precision + m.recall > 0.0 ? 2.0 * m.precision * m.recall / (m.precision + m.recall) : 0.0;
+        m.strandConsistency = consistency[t];
+    }
+    return out;
+}
+
+StrandPairErrors strandPairErrors(const StrandSet& a, const StrandSet& b, std::size_t samples, bool threaded)
+{
+    if (a.numStrands() != b.numStrands()) {
+        throw ValueError("strand pairs: " + std::to_string(a.numStrands()) + " strands against " + std::to_string(b.numStrands()) + ": the counts must agree");
+    }
+    if (samples < 3) throw ValueError("strand pairs: " + std::to_string(samples) + " samples: at least 3 (a curvature needs three points)");
+    const std::size_t S = a.numStrands();
+    StrandPairErrors e;
+    e.position.assign(S, 0.0);
+    e.curvature.assign(S, 0.0);
+    // The curvature of the circle through three points: 2 sin(angle at q) / |r - p|.
+    auto curvature = [](const Vec3f& p, const Vec3f& q, const Vec3f& r) {
+        const Vec3d u(q.x() - p.x(), q.y() - p.y(), q.z() - p.z()), v(r.x() - q.x(), r.y() - q.y(), r.z() - q.z());
+        const Vec3d w = u + v;
+        const double lu = u.length(), lv = v.length(), lw = w.length();
+        if (!(lu > 0.0) || !(lv > 0.0) || !(lw > 0.0)) return 0.0;
+        return 2.0 * u.cross(v).length() / (lu * lv * lw);
+    };
+    auto run = [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<Vec3f> ra(samples), rb(samples);
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            if (a.size(i) == 0 || b.size(i) == 0) continue;
+            resamplePolyline(a.positions.data() + a.begin(i), a.size(i), samples, ra.data());
+            resamplePolyline(b.positions.data() + b.begin(i), b.size(i), samples, rb.data());
+            const Vec3f shift = ra[0] - rb[0];
+            double position = 0.0, curv = 0.0;
+            for (std::size_t k = 0; k < samples; ++k) position += double((ra[k] - (rb[k] + shift)).length());
+            for (std::size_t k = 1; k + 1 < samples; ++k) {
+                curv += std::abs(curvature(ra[k - 1], ra[k], ra[k + 1]) - curvature(rb[k - 1], rb[k], rb[k + 1]));
+            }
+            e.position[i] = position / double(samples);
+            e.curvature[i] = curv / double(samples - 2);
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 64), run);
+    else run(tbb::blocked_range<std::size_t>(0, S));
+    for (std::size_t i = 0; i < S; ++i) {  // in strand order: independent of threads
+        e.meanPosition += e.position[i];
+        e.meanCurvature += e.curvature[i];
+    }
+    if (S) {
+        e.meanPosition /= double(S);
+        e.meanCurvature /= double(S);
+    }
+    return e;
+}
+
+} // namespace vdbhair
