@@ -4,9 +4,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <openvdb/tools/LevelSetSphere.h>
+
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 using namespace vdbhair;
@@ -107,4 +110,27 @@ TEST_CASE("resolveHeadCollisions: identical for 1 and 2 threads", "[field]")
     REQUIRE(r[0].positions == r[1].positions);
     REQUIRE(countStrandsEnteringHead(s, head, 0.0) == s.numStrands());
     REQUIRE(countStrandsEnteringHead(r[0], head, 0.0) == 0);
+}
+
+TEST_CASE("HeadObstacle::Probe::distance with its direction: the trilinear cell's value and gradient on a level-set sphere", "[field]")
+{
+    openvdb::FloatGrid::Ptr grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.2f, -0.1f, 0.3f), 0.05f, 3.0f);
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+    const HeadObstacle head = HeadObstacle::levelSet(grid);
+    HeadObstacle::Probe probe(head);
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int i = 0; i < 500; ++i) {
+        Vec3d dir(u(rng), u(rng), u(rng));
+        if (dir.length() < 1e-3) continue;
+        dir.normalize();
+        const Vec3d p = Vec3d(0.2, -0.1, 0.3) + dir * (1.0 + 0.08 * u(rng));  // within the band
+        Vec3d g;
+        const double d = probe.distance(p, g);
+        CAPTURE(i, p);
+        CHECK(d == Approx(probe.distance(p)).margin(1e-6));
+        CHECK(d == Approx((p - Vec3d(0.2, -0.1, 0.3)).length() - 1.0).margin(0.01));
+        CHECK(g.length() == Approx(1.0).margin(1e-9));
+        CHECK(g.dot(dir) > std::cos(5.0 * M_PI / 180.0));  // radial within 5 degrees at 20 voxels a radius
+    }
 }

@@ -46,10 +46,10 @@ bool sweep(std::size_t n, const std::function<double(std::size_t)>& floorAt, Hea
         }
         const Vec3d dHat = d / dl;
         w.p[k] = a + dHat * l;
-        const double floor = floorAt(k), d0 = probe.distance(w.p[k]);
+        Vec3d nrm;
+        const double floor = floorAt(k), d0 = probe.distance(w.p[k], nrm);
         if (!(d0 < floor)) continue;
-        Vec3d nrm = probe.normal(w.p[k]);
-        if (nrm.lengthSqr() == 0.0) nrm = probe.normal(a);
+        if (nrm.lengthSqr() == 0.0) probe.distance(a, nrm);
         Vec3d t = nrm - dHat * dHat.dot(nrm);
         if (t.lengthSqr() < 1e-20) {  // straight in or straight out: any perpendicular
             t = std::abs(dHat.x()) < 0.9 ? Vec3d(1.0, 0.0, 0.0) : Vec3d(0.0, 1.0, 0.0);

@@ -94,6 +94,49 @@ double HeadObstacle::Probe::distance(const Vec3d& p)
     return std::numeric_limits<double>::infinity();
 }
 
+double HeadObstacle::Probe::distance(const Vec3d& p, Vec3d& direction)
+{
+    direction = Vec3d(0.0);
+    switch (mHead.mKind) {
+    case Kind::None:
+    case Kind::Disabled: return std::numeric_limits<double>::infinity();
+    case Kind::Sphere: {
+        const Vec3d r = p - mHead.mCenter;
+        const double l = r.length();
+        if (l > 0.0) direction = r / l;
+        return l - mHead.mRadius;
+    }
+    case Kind::LevelSet: {
+        const Vec3d x = mHead.mGrid->worldToIndex(p);
+        const openvdb::Coord c(openvdb::Coord::floor(x));
+        const Vec3d f = x - Vec3d(c.x(), c.y(), c.z());
+        double v[2][2][2];
+        for (int i = 0; i < 2; ++i)
+            for (int j = 0; j < 2; ++j)
+                for (int k = 0; k < 2; ++k) v[i][j][k] = double(mAcc->getValue(c.offsetBy(i, j, k)));
+        auto lerp = [](double a, double b, double t) { return a + (b - a) * t; };
+        // The value and the partial derivatives of the trilinear cell, in index space.
+        const double y0z0 = lerp(v[0][0][0], v[1][0][0], f.x()), y1z0 = lerp(v[0][1][0], v[1][1][0], f.x());
+        const double y0z1 = lerp(v[0][0][1], v[1][0][1], f.x()), y1z1 = lerp(v[0][1][1], v[1][1][1], f.x());
+        const double z0 = lerp(y0z0, y1z0, f.y()), z1 = lerp(y0z1, y1z1, f.y());
+        const double value = lerp(z0, z1, f.z());
+        double gx = 0.0;
+        for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k) gx += (v[1][j][k] - v[0][j][k]) * (j ? f.y() : 1.0 - f.y()) * (k ? f.z() : 1.0 - f.z());
+        double gy = 0.0;
+        for (int i = 0; i < 2; ++i)
+            for (int k = 0; k < 2; ++k) gy += (v[i][1][k] - v[i][0][k]) * (i ? f.x() : 1.0 - f.x()) * (k ? f.z() : 1.0 - f.z());
+        const double gz = z1 - z0;
+        // Index-space gradient to world space (the inverse transpose of the map's Jacobian).
+        const Vec3d g = mHead.mGrid->transform().baseMap()->applyIJT(Vec3d(gx, gy, gz), x);
+        const double l = g.length();
+        direction = l > 0.0 ? g / l : (p - mHead.mCenter).unitSafe();  // flat cell (beyond the band): away from its centre
+        return value;
+    }
+    }
+    return std::numeric_limits<double>::infinity();
+}
+
 Vec3d HeadObstacle::Probe::normal(const Vec3d& p)
 {
     Vec3d g(0.0);

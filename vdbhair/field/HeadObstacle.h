@@ -68,6 +68,11 @@ public:
         double distance(const Vec3d& p);
         /// Outward unit normal at @a p (zero without an obstacle).
         Vec3d normal(const Vec3d& p);
+        /// @brief Signed distance at @a p and, in @a direction, the outward unit direction of
+        /// its gradient there: on a level set the analytic gradient of the trilinear cell that
+        /// gives the distance (one cell's eight values for both; normal()'s central differences
+        /// take six more samples). Zero without an obstacle or where the cell is flat.
+        double distance(const Vec3d& p, Vec3d& direction);
         /// @brief Move @a p along the normal until its distance is at least @a minDistance (a few
         /// Newton steps on a level set); @return whether it moved.
         bool pushOut(Vec3d& p, double minDistance);
