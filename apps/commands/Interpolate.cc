@@ -95,8 +95,9 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         const HelicoidInterpolator probe(scene, op.helicoid);  // checks the guides; bounds a hair's vertices
         perHair = probe.maxVerticesPerHair();
     } else {
+        // The guides' own counts: exact for points; for helicoids a first bound (fits are traced at
+        // their own step), which interpolateHelicoids() checks exactly before growing anything.
         for (std::size_t i = 0; i < G; ++i) perHair = std::max(perHair, guideStrands.size(i));
-        if (!points) perHair *= 64;  // fits are traced finer than the strands are sampled; the library checks exactly
     }
     auto checkCount = [&](double count) {
         const double estimate = count * double(perHair);
