@@ -25,4 +25,13 @@ void forEachIndex(std::size_t count, bool threaded, Body&& body, std::size_t gra
     }
 }
 
+/// @brief @a body(range) over [0, @a count): on TBB's threads in ranges of at least @a grain
+/// indices when @a threaded, else one range in order (for bodies with per-range scratch space).
+template <typename Body>
+void forEachRange(std::size_t count, bool threaded, std::size_t grain, Body&& body)
+{
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, grain), body);
+    else body(tbb::blocked_range<std::size_t>(0, count));
+}
+
 } // namespace vdbhair

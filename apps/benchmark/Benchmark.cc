@@ -25,6 +25,7 @@
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/helicoid/HelicoidField.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
 #include <vdbhair/helicoid/Scene.h>
@@ -311,6 +312,63 @@ void benchmarkInterpolation(int reps)
                     "helicoid/points %.2fx  vs the paper %.0fx\n",
                     count, th, tb, tg, th / double(count) * 1e6, h.numVertices(), tp, tp / double(count) * 1e6, p.numVertices(), th / tp,
                     0.67e-3 * double(count) / th);
+    }
+}
+
+/// Hair from guides at production scale (the guides issue, item 7): 1,000 guides of 16 vertices on
+/// a head sphere's upper half, hanging down it, in four groups (two partings), and 1,000,000 new
+/// roots on the same cap, through `interpolateGuides()` at its defaults with clumps (and with curl),
+/// without a head and with the sphere as the head. Peak memory is the process's (getrusage).
+void benchmarkGroom(int reps, std::size_t strands)
+{
+    std::printf("\n== hair from guides: %zu strands from 1,000 guides (16 vertices), 4 groups, clumps; the target is under 5 s ==\n", strands);
+    const double radius = 10.0;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto onCap = [&]() {
+        // Uniform on the sphere above the equator (y up).
+        const double y = u(rng), phi = 2.0 * M_PI * u(rng), r = std::sqrt(1.0 - y * y);
+        return Vec3d(r * std::cos(phi), y, r * std::sin(phi)) * radius;
+    };
+    StrandSet guides;
+    std::vector<std::int32_t> guideGroups;
+    for (int g = 0; g < 1000; ++g) {
+        const Vec3d root = onCap();
+        std::vector<Vec3f> p(16);
+        Vec3d x = root, d = root.unit();
+        for (int k = 0; k < 16; ++k) {
+            p[k] = Vec3f(float(x.x()), float(x.y()), float(x.z()));
+            d = (d + Vec3d(0.0, -0.25, 0.0)).unit();  // bends down
+            x += d * 1.5;
+        }
+        guides.addStrand(p);
+        guideGroups.push_back((root.x() > 0.0 ? 1 : 0) + (root.z() > 0.0 ? 2 : 0));
+    }
+    InterpolationGuides in;
+    in.strands = &guides;
+    in.groups = guideGroups;
+    InterpolationRoots roots;
+    roots.positions.reserve(strands);
+    for (std::size_t i = 0; i < strands; ++i) roots.positions.push_back(onCap());
+    const HeadObstacle sphere = HeadObstacle::sphere(Vec3d(0.0), radius);
+    struct Row { const char* name; double clump, curl; bool head; };
+    const Row rows[] = {{"points, groups", 0.0, 0.0, false},
+                        {"points, groups, clumps (radius 0.5)", 0.5, 0.0, false},
+                        {"points, groups, clumps, the head sphere", 0.5, 0.0, true},
+                        {"points, groups, clumps, curl, the head sphere", 0.5, 0.15, true}};
+    for (const Row& row : rows) {
+        InterpolateParams p;
+        p.groom.clump.radius = row.clump;
+        p.groom.curl.amplitude = row.curl;
+        p.groom.curl.frequency = row.curl > 0.0 ? 2.0 : 0.0;
+        InterpolateResult r;
+        const double t = timeBest(reps, [&] { r = interpolateGuides(in, roots, row.head ? sphere : HeadObstacle::none(), p); });
+        rusage usage{};
+        getrusage(RUSAGE_SELF, &usage);
+        std::printf("%-46s %.2f s  %zu strands, %zu vertices (%.0f MiB), %zu clumps, peak resident %.0f MiB so far\n", row.name, t,
+                    r.strands.numStrands(), r.strands.numVertices(), double(r.strands.numVertices()) * 12.0 / double(1 << 20), r.groom.clumps,
+                    double(usage.ru_maxrss) / 1024.0);
+        std::fflush(stdout);
     }
 }
 
@@ -711,13 +769,14 @@ int main(int argc, char** argv)
     std::size_t strands = 100000, vertices = 64;
     int reps = 3, threads = 0;
     double voxelSize = 0.0;
-    std::string sections = "field,helicoids,helicoid-fields,fit,roots,interpolate,synth";
+    std::string sections = "field,helicoids,helicoid-fields,fit,roots,interpolate,groom,synth";
     int e2eRuns = 5;
     std::string e2eCommand;
     std::size_t fitStrands = 2000;
     std::vector<std::size_t> rootCounts{10000, 100000};
     std::string rootHeads;
     std::vector<std::size_t> scaleStrands{1000000};
+    std::size_t groomStrands = 1000000;
     app.add_option("--data", data, "The shared data folder (real hairstyles)")->capture_default_str();
     app.add_option("--scene", source, "The vdbhair checkout (for scenes/default)")->capture_default_str();
     app.add_option("--strands", strands, "Strands of the synthetic hairstyle")->capture_default_str();
@@ -725,7 +784,7 @@ int main(int argc, char** argv)
     app.add_option("--reps", reps, "Repetitions (the best time is reported)")->capture_default_str();
     app.add_option("--threads", threads, "Threads (0: all cores)")->capture_default_str();
     app.add_option("--voxel-size", voxelSize, "Voxel size (0: vdbhair's suggestion for each input)");
-    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots, interpolate, synth, "
+    app.add_option("--sections", sections, "Sections to run: field, helicoids, helicoid-fields, fit, roots, interpolate, groom, synth, "
                                            "and e2e (the command and a stock-OpenVDB peer as processes) and scale (refine of 1,000,000 strands x 32 vertices: "
                                            "time, peak memory, the memory estimate), both opt-in (comma-separated)")->capture_default_str();
     app.add_option("--e2e-runs", e2eRuns, "Counted runs of each command in the e2e section (after one warm-up)")->capture_default_str();
@@ -734,6 +793,7 @@ int main(int argc, char** argv)
     app.add_option("--fit-strands", fitStrands, "Most strands per fitting row (an evenly strided subset; 0: all)")->capture_default_str();
     app.add_option("--root-counts", rootCounts, "Root counts of the follicle rows")->delimiter(',')->capture_default_str();
     app.add_option("--root-heads", rootHeads, "Only the shared heads whose path contains this");
+    app.add_option("--groom-strands", groomStrands, "New strands of the groom section (from 1,000 guides)")->capture_default_str();
     app.add_option("--scale-strands", scaleStrands, "Strand counts of the scale section (32 vertices each)")->delimiter(',')->capture_default_str();
     CLI11_PARSE(app, argc, argv);
     auto wants = [&](const char* s) { return ("," + sections + ",").find("," + std::string(s) + ",") != std::string::npos; };
@@ -762,6 +822,7 @@ int main(int argc, char** argv)
     if (wants("fit")) benchmarkFitting(data, fitStrands, reps);
     if (wants("roots")) benchmarkRoots(data, rootCounts, rootHeads);
     if (wants("interpolate")) benchmarkInterpolation(reps);
+    if (wants("groom")) benchmarkGroom(reps, groomStrands);
     if (wants("synth")) benchmarkSynthesis(data, source, strands, vertices);
     if (wants("e2e")) benchmarkEndToEnd(source, strands, vertices, std::max(1, e2eRuns), e2eCommand);
     if (wants("scale")) benchmarkScale(source, scaleStrands, e2eCommand);

@@ -13,9 +13,12 @@
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/RootValues.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 namespace vdbhair::app {
 
@@ -23,7 +26,7 @@ namespace {
 
 struct InterpolateCmdParams
 {
-    std::string guides, output, roots, scalp, head, guideGroups, rootGroups;
+    std::string guides, output, roots, scalp, head, guideGroups, rootGroups, density, length;
     InterpolateParams op;
     std::string method = interpolationMethodName(InterpolateParams{}.method);
     std::string frames = frameRuleName(InterpolateParams{}.frames);
@@ -70,6 +73,10 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         op.points.neighbors = p.neighbors;
     }
     op.helicoid.up = axisFromName(p.up, "--up");
+    validateGroomParams(op.groom);
+    if (op.returnScene && (op.groom.clump.radius > 0.0 || op.groom.curl.amplitude > 0.0 || op.groom.curl.frizz > 0.0 || !p.density.empty() || !p.length.empty())) {
+        throw ValueError(p.output + ": a scene of new hairs takes no --density, --length, --clump-radius, --curl or --frizz; write strands");
+    }
     op.points.maxVertices = op.helicoid.maxVertices;
 
     // The guides: a scene, or strands (blended as they are, or fitted for helicoids).
@@ -144,6 +151,13 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         head.setLabel("--scalp " + p.scalp);
     }
     if (!p.rootGroups.empty()) roots.groups = readIdList(p.rootGroups, roots.positions.size(), "roots");
+    // Density and length per root: a number, a mask grid, a painted mesh property, or a list (RootValues.h).
+    for (auto [spec, values, option, grid] : {std::tuple{&p.density, &roots.density, "--density", "density"}, std::tuple{&p.length, &roots.length, "--length", "length"}}) {
+        if (spec->empty()) continue;
+        *values = readRootValues(*spec, roots.positions, option, grid);
+        const bool any = std::any_of(values->begin(), values->end(), [](float v) { return v > 0.f; });
+        if (!any) throw ValueError(std::string(option) + " " + *spec + ": 0 at every one of the " + std::to_string(values->size()) + " roots: no hair would grow (a mask that covers none of them?)");
+    }
     if (op.frames == FrameRule::Surface && roots.normals.empty()) {
         throw ValueError((p.roots.empty() ? p.scalp : p.roots) + ": the roots have no normals (PLY nx ny nz); --frames surface needs them");
     }
@@ -159,7 +173,7 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         if (op.returnScene) writeScene(p.output, r.scene);
         else writeStrands(p.output, r.strands);
     }
-    const std::size_t count = roots.positions.size();
+    const std::size_t count = r.strands.numStrands() > 0 ? r.strands.numStrands() : r.scene.guides.size();
     const double enteringShare = double(r.enteringHead) / double(count);
     const double guidesEnteringShare = double(r.guidesEnteringHead) / double(std::max<std::size_t>(1, r.guides));
     if (common.json) {
@@ -168,8 +182,11 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
                    {"guides", r.guides}, {"strands", count},
                    {"vertices", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json(r.strands.numVertices())},
                    {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe(false))},
+                   {"roots", r.roots}, {"roots_dropped", r.rootsDropped}, {"cut", r.cut},
+                   {"clumps", r.groom.clumps}, {"clumped", r.groom.clumped}, {"curled", r.groom.curled},
                    {"pushed_out", r.pushedOut}, {"vertices_too_deep", r.verticesTooDeep},
                    {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
+                   {"leaving_guide_volume", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json({{"strands", double(r.leavingVolume) / double(std::max<std::size_t>(1, count))}, {"voxel", r.volumeVoxel}})},
                    {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
     } else if (!common.quiet) {
         std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << p.method << ", " << frameRuleName(op.frames) << " frames";
@@ -177,11 +194,21 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         char seconds[32];
         std::snprintf(seconds, sizeof seconds, "%.3f", r.seconds);
         std::cout << ") in " << seconds << " s\n";
+        if (r.rootsDropped > 0 || r.cut > 0) {
+            std::cout << "density and length: " << r.rootsDropped << " of " << r.roots << " roots left bare, " << r.cut << " hairs cut shorter\n";
+        }
+        if (r.groom.clumps > 0) std::cout << "clumps: " << r.groom.clumps << " centres, " << r.groom.clumped << " hairs pulled in\n";
+        if (r.groom.curled > 0) std::cout << "curl: " << r.groom.curled << " hairs (" << r.groom.addedVertices << " vertices added for " << int(kCurlVerticesPerTurn) << " a turn)\n";
         if (!head.empty() && !op.returnScene) {
             char shares[96];
             std::snprintf(shares, sizeof shares, "%.1f %% of the new strands, %.1f %% of the guides", 100.0 * enteringShare, 100.0 * guidesEnteringShare);
             std::cout << "head: " << head.describe(false) << " (no new vertex deeper than its root); " << r.pushedOut
                       << " strands pushed out; passing into it: " << shares << "\n";
+        }
+        if (!op.returnScene) {
+            char share[64];
+            std::snprintf(share, sizeof share, "%.1f %%", 100.0 * double(r.leavingVolume) / double(std::max<std::size_t>(1, count)));
+            std::cout << "leaving the guides' hair volume (voxel " << formatValue(r.volumeVoxel) << ", dilated by one): " << share << " of the new strands\n";
         }
         std::cout << "wrote " << p.output << "\n";
     }
@@ -205,6 +232,16 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--likeness", p.op.points.likeness, "--grouping shape: the shape distance, a fraction of the guide length, at which a guide stops taking part")->capture_default_str();
     sub->add_option("--guide-groups", p.guideGroups, "points: a text file of one integer group id per guide; new hairs blend only guides of one group");
     sub->add_option("--root-groups", p.rootGroups, "points: a text file of one group id per root (default: the group of the nearest guide)");
+    sub->add_option("--density", p.density, "Share of the roots that grow hair, in [0, 1]: a number, MASK.vdb[:GRID] (a float or bool grid; "
+                                            "default grid 'density'), MESH.ply:PROPERTY (painted on the head's vertices), or a text file of one value per root");
+    sub->add_option("--length", p.length, "Share of each new hair's length kept, in [0, 1] (0 grows none): as --density (default grid 'length')");
+    sub->add_option("--clump-radius", p.op.groom.clump.radius, "Clumps: hairs within this distance (world units) of a clump centre are pulled to its hair (0: no clumps)")->capture_default_str();
+    sub->add_option("--clump-tightness", p.op.groom.clump.tightness, "Clumps: the share of the way to the centre's hair a tip moves, in [0, 1]")->capture_default_str();
+    sub->add_option("--clump-profile", p.op.groom.clump.profile, "Clumps: the pull at a fraction t of the length is tightness * t^profile (higher: looser near the root)")->capture_default_str();
+    sub->add_option("--clump-likeness", p.op.groom.clump.likeness, "Clumps: hairs shaped unlike their centre by more than this (as --likeness) stay out (0: any)")->capture_default_str();
+    sub->add_option("--curl", p.op.groom.curl.amplitude, "Curl: the amplitude a of Eq. 4 (world units; 0: none), about each hair")->capture_default_str();
+    sub->add_option("--curl-frequency", p.op.groom.curl.frequency, "Curl: b of Eq. 4, radians per unit length (a turn every 2 pi / b)")->capture_default_str();
+    sub->add_option("--frizz", p.op.groom.curl.frizz, "Frizz: the deviation of a random offset at the tip, from 0 at the root (world units)")->capture_default_str();
     sub->add_option("--head", p.head, "The head new hair may not enter deeper than its guides: a mesh (.ply, .obj), a .vdb level set, or 'none' "
                                       "(default: --scalp's surface, else the scene's head, else a sphere fitted to the guide roots)");
     sub->add_option("--blend", p.blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "
@@ -215,7 +252,7 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
                                                                      " for points, every guide for helicoid)");
     sub->add_option("--frames", p.frames, "world (guides carried as they are) or surface (turned with the roots' normals, 4.3; flares long hair)")->capture_default_str();
     sub->add_option("--up", p.up, "Reference axis of surface frames and of roots on --scalp: x, y, z, -x, -y or -z")->capture_default_str();
-    sub->add_option("--seed", p.op.seed, "Seed of the roots on --scalp and of waviness noise")->capture_default_str();
+    sub->add_option("--seed", p.op.seed, "Seed of the roots on --scalp, density, clumps, curl phases, frizz and waviness noise")->capture_default_str();
     sub->add_option("--max-vertices", p.op.helicoid.maxVertices, "Refuse requests that would make more vertices (12 bytes each)")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair interpolate guides.hair --scalp scalp.vdb --count 20000 -o hair.hair --json");

@@ -93,17 +93,8 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         detail["region"] = {{"vertex", p.regionVertex}, {"threshold", p.regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
     } else if (!p.regionMask.empty()) {
         // The mask: the grid named, else 'region', else the file's first bool or float grid that is not a level set.
-        std::string name = p.regionGrid;
-        if (name.empty()) {
-            const std::vector<std::string> names = vdbGridNames(p.regionMask, p.regionMask);
-            if (std::find(names.begin(), names.end(), "region") != names.end()) name = "region";
-            for (std::size_t i = 0; name.empty() && i < names.size(); ++i) {
-                const openvdb::GridBase::Ptr g = readVdbGrid(p.regionMask, names[i], p.regionMask);
-                if ((g->isType<openvdb::BoolGrid>() || g->isType<openvdb::FloatGrid>()) && g->getGridClass() != openvdb::GRID_LEVEL_SET) name = names[i];
-            }
-            if (name.empty()) throw LookupError(p.regionMask + ": no bool or float grid to use as a region mask (--region-grid NAME)");
-        }
-        const openvdb::GridBase::Ptr mask = readVdbGrid(p.regionMask, name, p.regionMask);
+        const openvdb::GridBase::Ptr mask = readMaskGrid(p.regionMask, p.regionGrid, "region", "a region mask (--region-grid NAME)");
+        const std::string name = mask->getName();
         const Stage stage(common, "region from the mask '" + name + "' of " + p.regionMask);
         region = regionFromMask(*surface, *mask, p.regionThreshold, p.regionMask);
         grids.push_back(region);

@@ -13,6 +13,7 @@
 #include <vdbhair/io/VdbInspect.h>
 #include <vdbhair/render/Image.h>
 #include <vdbhair/render/StrandRenderer.h>
+#include <vdbhair/scalp/RootValues.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/synth/Comb.h>
 #include <vdbhair/synth/HairTransfer.h>
@@ -24,6 +25,7 @@
 
 #include <cmath>
 #include <memory>
+#include <tuple>
 
 namespace vdbhair::py {
 
@@ -529,10 +531,23 @@ Returns:
         [](const pyb::object& guidesArg, const pyb::object& rootsArg, const pyb::object& normalsArg, const std::string& method,
            const std::string& grouping, double likeness, const pyb::object& guideGroups, const pyb::object& rootGroups,
            const pyb::object& headArg, double power, std::optional<int> neighbors, const std::string& blend, const std::string& frames,
-           std::array<double, 3> up, std::uint64_t seed, std::size_t maxVertices, bool returnScene, int threads,
-           const pyb::object& progress) -> pyb::object {
+           std::array<double, 3> up, std::uint64_t seed, std::size_t maxVertices, bool returnScene, const pyb::object& densityArg,
+           const pyb::object& lengthArg, double clumpRadius, double clumpTightness, double clumpProfile, double clumpLikeness, double curl,
+           double curlFrequency, double frizz, int threads, const pyb::object& progress) -> pyb::object {
             // Arguments first, as the command checks them.
             InterpolateParams op;
+            op.groom.clump.radius = clumpRadius;
+            op.groom.clump.tightness = clumpTightness;
+            op.groom.clump.profile = clumpProfile;
+            op.groom.clump.likeness = clumpLikeness;
+            op.groom.curl.amplitude = curl;
+            op.groom.curl.frequency = curlFrequency;
+            op.groom.curl.frizz = frizz;
+            try {
+                validateGroomParams(op.groom);
+            } catch (const ValueError& e) {
+                throw ValueError(std::string("interpolate: ") + e.what());
+            }
             auto named = [](auto parse, const std::string& value) {
                 try {
                     return parse(value);
@@ -577,6 +592,19 @@ Returns:
             }
             if (op.frames == FrameRule::Surface && roots.normals.empty()) throw ValueError("interpolate: frames='surface' needs normals");
             if (!rootGroups.is_none()) roots.groups = rootGroups.cast<std::vector<std::int32_t>>();
+            // Density and length: one value per root, or what the command reads (a number, a mask, a painted mesh, a list).
+            for (auto [arg, values, option, grid] : {std::tuple{&densityArg, &roots.density, "density", "density"}, std::tuple{&lengthArg, &roots.length, "length", "length"}}) {
+                if (arg->is_none()) continue;
+                if (pyb::isinstance<pyb::str>(*arg) || pyb::hasattr(*arg, "__fspath__")) {
+                    *values = readRootValues(pyb::str(*arg).cast<std::string>(), roots.positions, std::string("interpolate: ") + option + "=", grid);
+                } else if (pyb::isinstance<pyb::float_>(*arg) || pyb::isinstance<pyb::int_>(*arg)) {
+                    values->assign(roots.positions.size(), arg->cast<float>());
+                } else {
+                    *values = arg->cast<std::vector<float>>();
+                    if (values->size() != roots.positions.size())
+                        throw ValueError(std::string("interpolate: ") + option + "= has " + std::to_string(values->size()) + " values for " + std::to_string(roots.positions.size()) + " roots: one per root");
+                }
+            }
             const HeadArgument headArgument(headArg, "no-deeper");
             const bool fromStrands = pyb::isinstance<StrandSet>(guidesArg);
             std::shared_ptr<StrandSet> guideStrands = fromStrands ? guidesArg.cast<std::shared_ptr<StrandSet>>() : nullptr;
@@ -604,6 +632,10 @@ Returns:
         pyb::arg("blend") = helicoidBlendName(interpDefaults.helicoid.blend), pyb::arg("frames") = frameRuleName(interpDefaults.frames),
         pyb::arg("up") = std::array<double, 3>{interpDefaults.helicoid.up.x(), interpDefaults.helicoid.up.y(), interpDefaults.helicoid.up.z()},
         pyb::arg("seed") = 0, pyb::arg("max_vertices") = interpDefaults.helicoid.maxVertices, pyb::arg("return_scene") = false,
+        pyb::arg("density") = pyb::none(), pyb::arg("length") = pyb::none(), pyb::arg("clump_radius") = interpDefaults.groom.clump.radius,
+        pyb::arg("clump_tightness") = interpDefaults.groom.clump.tightness, pyb::arg("clump_profile") = interpDefaults.groom.clump.profile,
+        pyb::arg("clump_likeness") = interpDefaults.groom.clump.likeness, pyb::arg("curl") = interpDefaults.groom.curl.amplitude,
+        pyb::arg("curl_frequency") = interpDefaults.groom.curl.frequency, pyb::arg("frizz") = interpDefaults.groom.curl.frizz,
         pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
         R"doc(New hairs from guide hairs (Piuze et al. 2011, Sec. 4): ``vdbhair interpolate``.
 
@@ -634,6 +666,16 @@ Args:
     seed: the scene's seed (recorded; the new hairs have no wisps).
     max_vertices: refuse requests that would grow more vertices (estimated before any work).
     return_scene: return the new hairs as a scene dict (helicoid only) instead of growing them.
+    density: None, the share of roots that grow hair in [0, 1]: a number, one value per root, or
+        a spec as the command's --density ("mask.vdb[:GRID]", "head.ply:PROPERTY", a text file).
+    length: None, the share of each new hair's length kept in [0, 1] (0 grows none), as density.
+    clump_radius: clumps (0: none): hairs within this distance of a clump centre are pulled to its hair.
+    clump_tightness: the share of the way to the centre's hair a tip moves, in [0, 1].
+    clump_profile: the pull at a fraction t of the length is tightness * t**profile.
+    clump_likeness: hairs shaped unlike their centre by more than this stay out (0: any).
+    curl: the amplitude a of the waviness of Eq. 4 about each hair (world units; 0: none).
+    curl_frequency: b of Eq. 4, radians per unit length.
+    frizz: the deviation of a random offset across the hair at its tip (world units).
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``.
 

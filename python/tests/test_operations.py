@@ -185,6 +185,33 @@ def test_transfer_and_comb():
         vdbhair.comb(pony, [into], head_policy="sideways")
 
 
+def test_interpolate_groom_controls(tmp_path):
+    # Straight guides along x; 400 roots between them. Density from an array, length from a list
+    # file given as a pathlib.Path, clumps and curl: the counts, roots and lengths the controls say.
+    guides = straight_bundle(count=5, vertices=9, length=4.0, spacing=0.25)
+    rng = np.random.default_rng(0)
+    roots = np.zeros((400, 3))
+    roots[:, 1] = rng.uniform(-0.5, 0.5, 400)
+    density = (roots[:, 1] > 0.0).astype(float)
+    values = tmp_path / "length.txt"
+    values.write_text("\n".join(["0.5"] * 400))
+    out = vdbhair.interpolate(guides, roots, density=density, length=values, clump_radius=0.2, curl=0.02, curl_frequency=20.0, head="none")
+    kept = roots[density > 0]
+    assert len(out) == len(kept)
+    for i, strand in enumerate(out):
+        assert np.allclose(strand[0], kept[i], atol=1e-5)
+        assert strand[-1][0] == pytest.approx(2.0, abs=0.05)  # half of 4 along x; curl and clumps act across
+    # The same with one thread, and bad values named.
+    again = vdbhair.interpolate(guides, roots, density=density, length=str(values), clump_radius=0.2, curl=0.02, curl_frequency=20.0, head="none", threads=1)
+    assert np.array_equal(again.positions, out.positions)
+    with pytest.raises(ValueError, match="--curl 0.02 needs --curl-frequency"):
+        vdbhair.interpolate(guides, roots, curl=0.02)
+    with pytest.raises(ValueError, match="density= has 3 values for 400 roots"):
+        vdbhair.interpolate(guides, roots, density=[1.0, 1.0, 1.0])
+    with pytest.raises(ValueError, match="density 2 at root 0"):
+        vdbhair.interpolate(guides, roots, density=2.0)
+
+
 def test_interpolate():
     # Straight parallel guides along x: every new hair between them is straight, as long, along x.
     guides = straight_bundle(count=5, vertices=9, length=4.0, spacing=0.25)

@@ -151,3 +151,22 @@ TEST_CASE("strandPairErrors: Perm's root-aligned position and three-point curvat
     REQUIRE_THROWS_WITH(strandPairErrors(a, StrandSet()), Contains("1 strands against 0"));
     REQUIRE_THROWS_WITH(strandPairErrors(a, a, 2), Contains("at least 3"));
 }
+
+TEST_CASE("a strand leaves a reference's hair volume when a point is more than a voxel outside its voxels", "[compare]")
+{
+    // The reference: a straight strand along x from 0 to 10 with two vertices (its segment is
+    // sampled at half a voxel); voxel 0.5, so the volume is |y|, |z| <= 0.75 around it.
+    StrandSet ref;
+    ref.addStrand({Vec3f(0.f), Vec3f(10.f, 0.f, 0.f)});
+    StrandSet s;
+    s.addStrand({Vec3f(1.f, 0.f, 0.f), Vec3f(9.f, 0.f, 0.f)});         // along it: in
+    s.addStrand({Vec3f(1.f, 0.5f, 0.f), Vec3f(9.f, 0.5f, 0.f)});       // one voxel off: in (dilated)
+    s.addStrand({Vec3f(1.f, 0.f, 0.f), Vec3f(5.f, 0.f, 0.f), Vec3f(6.f, 1.6f, 0.f)});  // its tip three voxels off: out
+    s.addStrand({Vec3f(1.f, 0.f, 0.f), Vec3f(12.f, 0.f, 0.f)});        // past the reference's end by 4 voxels: out
+    CHECK(countStrandsLeavingVolume(s, ref, 0.5) == 2);
+    CHECK(countStrandsLeavingVolume(s, ref, 0.5, false) == 2);
+    CHECK(countStrandsLeavingVolume(ref, ref, 0.5) == 0);
+    CHECK(countStrandsLeavingVolume(s, ref, 2.0) == 0);  // coarse voxels hold all of it
+    REQUIRE_THROWS_WITH(countStrandsLeavingVolume(s, ref, 0.0), Catch::Matchers::Contains("must be a positive length"));
+    REQUIRE_THROWS_WITH(countStrandsLeavingVolume(s, ref, 1e-6), Catch::Matchers::Contains("give a larger voxel"));
+}

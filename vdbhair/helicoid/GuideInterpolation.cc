@@ -2,6 +2,8 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/strands/Compare.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <algorithm>
@@ -46,19 +48,46 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
     if (!points && !guides.groups.empty()) throw ValueError("guide groups need the points method; helicoid interpolation blends every guide");
     if (params.frames == FrameRule::Surface && rootsIn.normals.empty()) throw ValueError("surface frames need root normals; the roots have none");
     if (rootsIn.positions.empty()) throw ValueError("no roots: interpolation needs at least one root");
-    InterpolationRoots roots = rootsIn;
+    const bool groomed = params.groom.clump.radius > 0.0 || params.groom.curl.amplitude > 0.0 || params.groom.curl.frizz > 0.0;
+    if (params.returnScene && (groomed || !rootsIn.density.empty() || !rootsIn.length.empty())) {
+        throw ValueError("a scene of new hairs takes no groom controls (density, length, clumps, curl, frizz): grow it first");
+    }
+    validateGroomParams(params.groom);
+    // Density (and a length of 0) leave roots bare before any hair is made.
+    const std::size_t R0 = rootsIn.positions.size();
+    if (!rootsIn.normals.empty() && rootsIn.normals.size() != R0) {
+        throw ValueError(std::to_string(rootsIn.normals.size()) + " root normals for " + std::to_string(R0) + " roots: one per root");
+    }
+    if (!rootsIn.groups.empty() && rootsIn.groups.size() != R0) {
+        throw ValueError(std::to_string(rootsIn.groups.size()) + " root group ids for " + std::to_string(R0) + " roots: one per root");
+    }
+    const std::vector<char> keep = rootsKept(R0, rootsIn.density, rootsIn.length, params.seed);
+    InterpolationRoots roots;
+    for (std::size_t i = 0; i < R0; ++i) {
+        if (!keep[i]) continue;
+        roots.positions.push_back(rootsIn.positions[i]);
+        if (!rootsIn.normals.empty()) roots.normals.push_back(rootsIn.normals[i]);
+        if (!rootsIn.groups.empty()) roots.groups.push_back(rootsIn.groups[i]);
+        if (!rootsIn.length.empty()) roots.length.push_back(rootsIn.length[i]);
+    }
+    if (roots.positions.empty()) throw ValueError("the density and length leave none of the " + std::to_string(R0) + " roots to grow hair: no hair would be made");
     if (params.frames == FrameRule::World) roots.normals.clear();
 
     InterpolateResult res;
+    res.roots = R0;
+    res.rootsDropped = R0 - roots.positions.size();
+    std::vector<std::uint32_t> rootGroups;
+    StrandSet grownGuides;                  // a scene's guides as strands (the volume measure, the head share)
+    const StrandSet* guidePoints = guides.strands;
     const auto t0 = std::chrono::steady_clock::now();
     if (points) {
         // The guides' own points (a scene's guides grown, without wisps).
-        StrandSet grown;
         if (guides.scene) {
             validateGuideScene(*guides.scene);
-            grown = growGuides(*guides.scene, threaded, interrupter);
+            grownGuides = growGuides(*guides.scene, threaded, interrupter);
+            guidePoints = &grownGuides;
         }
-        const StrandSet& g = guides.scene ? grown : *guides.strands;
+        const StrandSet& g = *guidePoints;
         if (g.empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
         for (std::size_t i = 0; i < g.numStrands(); ++i) {
             const std::size_t n = g.size(i);
@@ -71,7 +100,7 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
         context.groups = guides.groups;
         context.frames = params.frames;
         if (guides.scene && params.frames == FrameRule::Surface) context.normals = sceneGuideNormals(*guides.scene);
-        res.strands = interpolatePoints(g, roots, params.points, context, threaded, interrupter, &res.groups);
+        res.strands = interpolatePoints(g, roots, params.points, context, threaded, interrupter, &res.groups, &rootGroups);
         res.guides = g.numStrands();
         res.guidesEnteringHead = countStrandsEnteringHead(g, head, headTolerance(head), threaded);
     } else {
@@ -92,7 +121,21 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
             GrowOptions grow;
             grow.maxVertices = params.helicoid.maxVertices;
             res.strands = growScene(res.scene, grow, threaded, interrupter);
-            res.guidesEnteringHead = countStrandsEnteringHead(guides.strands ? *guides.strands : growGuides(scene, threaded, interrupter), head, headTolerance(head), threaded);
+            if (!guides.strands) {
+                grownGuides = growGuides(scene, threaded, interrupter);
+                guidePoints = &grownGuides;
+            }
+            res.guidesEnteringHead = countStrandsEnteringHead(*guidePoints, head, headTolerance(head), threaded);
+        }
+    }
+    // Length, curl, clumps (within groups), frizz (GroomControls.h).
+    if (!params.returnScene) {
+        if (!roots.length.empty()) res.cut = cutStrands(res.strands, roots.length, threaded);
+        if (groomed) {
+            GroomParams groom = params.groom;
+            groom.seed = params.seed;
+            groom.maxVertices = points ? params.points.maxVertices : params.helicoid.maxVertices;
+            res.groom = applyGroomControls(res.strands, groom, rootGroups, threaded, interrupter);
         }
     }
     // The head: no new hair deeper inside it than its root (HeadCollision.h).
@@ -102,6 +145,10 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
         res.verticesTooDeep = hc.verticesTooDeep;
     }
     res.enteringHead = countStrandsEnteringHead(res.strands, head, headTolerance(head), threaded);
+    if (!params.returnScene && guidePoints) {
+        res.volumeVoxel = suggestVoxelSize(*guidePoints);
+        res.leavingVolume = countStrandsLeavingVolume(res.strands, *guidePoints, res.volumeVoxel, threaded);
+    }
     res.seconds = secondsSince(t0) - res.fitSeconds;
     return res;
 }

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/helicoid/GroomControls.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
 #include <vdbhair/helicoid/Scene.h>
@@ -48,8 +49,10 @@ struct InterpolateParams
     FrameRule frames = FrameRule::World;  ///< Surface needs root normals (§4.3)
     HelicoidInterpolationParams helicoid;
     PointInterpolationParams points;
-    std::uint64_t seed = 0;    ///< waviness noise of the new helicoid hairs
-    bool returnScene = false;  ///< Helicoid: keep the new hairs as a scene, not grown (no head collision then)
+    /// Curl, clumps and frizz on the new hair (its seed is `seed`); density and length come with the roots
+    GroomParams groom;
+    std::uint64_t seed = 0;    ///< the density draw, the groom controls, waviness noise of the new helicoid hairs
+    bool returnScene = false;  ///< Helicoid: keep the new hairs as a scene, not grown (no head collision, no groom controls then)
 };
 
 /// @brief The guides: strands (blended as they are by points; fitted first for helicoids) or a
@@ -67,15 +70,24 @@ struct InterpolateResult
     StrandSet strands;  ///< the new hairs (empty with returnScene)
     Scene scene;        ///< Helicoid: the new hairs as helicoids
     std::size_t guides = 0, groups = 1;
+    std::size_t roots = 0;          ///< roots given
+    std::size_t rootsDropped = 0;   ///< of them, left bare by density or a length of 0
+    std::size_t cut = 0;            ///< new hairs cut to a length under 1
+    GroomStats groom;               ///< curl, clumps, frizz
     std::size_t pushedOut = 0;         ///< new strands the head pushed out
     std::size_t verticesTooDeep = 0;   ///< vertices the push could not bring out (HeadCollision.h)
     /// strands that pass into the head (countStrandsEnteringHead(), headTolerance()): of the new hair, and of the guides
     std::size_t enteringHead = 0, guidesEnteringHead = 0;
+    /// new strands that leave the guides' hair volume (countStrandsLeavingVolume(), Compare.h) at
+    /// the guides' suggested voxel size `volumeVoxel` (suggestVoxelSize())
+    std::size_t leavingVolume = 0;
+    double volumeVoxel = 0.0;
     double fitSeconds = 0.0;  ///< fitting strand guides (Helicoid)
     double seconds = 0.0;     ///< interpolating (and growing, and the head)
 };
 
-/// @brief New hairs at @a roots from @a guides (see above). Identical for any thread count.
+/// @brief New hairs at @a roots from @a guides (see above), then the groom controls in
+/// GroomControls.h's order and the head. Identical for any thread count.
 /// @param head the head to keep the new hair out of (empty: none)
 /// @throw ValueError (bad guides, roots, groups or params, groups with Helicoid, surface frames
 /// without normals), LimitError (too many vertices, before any work), InterruptedError.

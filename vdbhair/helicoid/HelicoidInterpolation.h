@@ -133,6 +133,9 @@ struct InterpolationRoots
     /// #R group ids or empty: a root blends only guides of its group (interpolatePoints(); empty:
     /// each root takes the group of the guide nearest it)
     std::vector<std::int32_t> groups;
+    /// #R values in [0, 1] or empty (interpolateGuides(), GroomControls.h): the share of roots kept
+    /// (density) and the share of each new hair's length kept (length; 0 grows none)
+    std::vector<float> density, length;
 };
 
 /// @brief The surface frame W at a root with normal @a normal (see above).

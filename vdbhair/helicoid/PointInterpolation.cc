@@ -78,7 +78,7 @@ double likenessDistance(const Vec3f* a, std::size_t na, const Vec3f* b, std::siz
 
 StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& roots, const PointInterpolationParams& params,
                             const GuideContext& context, bool threaded, openvdb::util::NullInterrupter* interrupter,
-                            std::size_t* groupsOut)
+                            std::size_t* groupsOut, std::vector<std::uint32_t>* rootGroupsOut)
 {
     // Arguments, before any work.
     const std::size_t G = guides.numStrands(), R = roots.positions.size();
@@ -180,6 +180,7 @@ StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& r
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const Vec3d& x = roots.positions[i];
             const std::uint32_t group = roots.groups.empty() ? (all ? guideGroup[all->nearest(x)] : 0u) : rootGroup[i];
+            rootGroup[i] = group;
             const GroupLocator& gl = groups[group];
             std::vector<GuideWeight>& ws = weights[i];
             gl.locator->fadedWeights(x, params.neighbors, ws);
@@ -259,6 +260,7 @@ StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& r
     if (progress.stopped()) throw InterruptedError("interpolatePoints: interrupted");
 
     if (groupsOut) *groupsOut = M;
+    if (rootGroupsOut) *rootGroupsOut = std::move(rootGroup);
     return out;
 }
 

@@ -87,9 +87,12 @@ struct GuideContext
 /// neighbors or likeness, normals or groups of the wrong size, a root group with no guide, surface
 /// frames without normals), LimitError (estimated before any work), InterruptedError.
 /// @param[out] groups optional: the number of distinct guide groups
+/// @param[out] rootGroups optional: #R, the group each new hair blended (0 .. groups - 1, ids in
+/// ascending order), so that later steps (clumps) keep groups apart too
 StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& roots, const PointInterpolationParams& params,
                             const GuideContext& context = {}, bool threaded = true,
-                            openvdb::util::NullInterrupter* interrupter = nullptr, std::size_t* groups = nullptr);
+                            openvdb::util::NullInterrupter* interrupter = nullptr, std::size_t* groups = nullptr,
+                            std::vector<std::uint32_t>* rootGroups = nullptr);
 
 /// @brief The likeness distance u of two strands (step 3): the mean distance between their
 /// root-relative points at 16 equal fractions of their lengths, over the longer length (0 for two

@@ -18,6 +18,10 @@ struct WavinessParams
     double frequency = 0.0;  ///< b, radians per unit length (the paper's "frequency 2πb" with b here already in radians)
     double phase = 0.0;      ///< radians
     double noise = 0.0;      ///< world units
+    /// Arc length over which the offset rises from 0 at the root to its full size (a smoothstep
+    /// of s / ramp), so that a root stays where it is; 0: the paper's constant offset, which moves
+    /// the root by a too. New hair on a scalp (GroomControls.h) uses one wavelength, 2π / b.
+    double ramp = 0.0;
 };
 
 /// @brief Write the displaced points of @a trace to @a out (trace.points.size() entries).

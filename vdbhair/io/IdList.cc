@@ -4,17 +4,24 @@
 #include <vdbhair/io/FileUtil.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 
 namespace vdbhair {
 
-std::vector<std::int32_t> readIdList(const std::string& path, std::size_t expected, const std::string& what)
+namespace {
+
+/// Every token of @a path (white space or commas between, '#' comments), parsed by @a parse into
+/// @a out; @a kind names a good token in messages.
+template <typename T, typename Parse>
+std::vector<T> readList(const std::string& path, std::size_t expected, const std::string& what, const char* function, const char* kind, const char* noun, Parse&& parse)
 {
-    const std::string where = "readIdList(" + path + ")";
+    const std::string where = std::string(function) + "(" + path + ")";
     requireRegularFile(path, where);
     const std::vector<char> bytes = readFileBytes(path, where);
-    std::vector<std::int32_t> ids;
+    const std::string one = what.substr(0, what.size() - (what.size() > 1 && what.back() == 's' ? 1 : 0));
+    std::vector<T> out;
     std::size_t line = 1, i = 0;
     const std::size_t n = bytes.size();
     while (i < n) {
@@ -28,25 +35,42 @@ std::vector<std::int32_t> readIdList(const std::string& path, std::size_t expect
         std::size_t j = i;
         while (j < n && bytes[j] != '\n' && bytes[j] != ' ' && bytes[j] != '\t' && bytes[j] != '\r' && bytes[j] != ',' && bytes[j] != '#') ++j;
         const std::string token(bytes.data() + i, j - i);
-        char* end = nullptr;
-        errno = 0;
-        const long long v = std::strtoll(token.c_str(), &end, 10);
-        if (token.empty() || *end != '\0' || errno == ERANGE || v < std::numeric_limits<std::int32_t>::min() ||
-            v > std::numeric_limits<std::int32_t>::max()) {
-            throw FormatError(where + ": line " + std::to_string(line) + ": '" + token.substr(0, 40) + "' is not a 32-bit integer id");
+        T v;
+        if (!parse(token, v)) throw FormatError(where + ": line " + std::to_string(line) + ": '" + token.substr(0, 40) + "' is not " + kind);
+        if (expected > 0 && out.size() == expected) {
+            throw ValueError(where + ": more than " + std::to_string(expected) + " " + noun + " for " + std::to_string(expected) + " " + what + ": one per " + one);
         }
-        if (expected > 0 && ids.size() == expected) {
-            throw ValueError(where + ": more than " + std::to_string(expected) + " ids for " + std::to_string(expected) + " " + what + ": one per " +
-                             what.substr(0, what.size() - (what.size() > 1 && what.back() == 's' ? 1 : 0)));
-        }
-        ids.push_back(std::int32_t(v));
+        out.push_back(v);
         i = j;
     }
-    if (expected > 0 && ids.size() != expected) {
-        throw ValueError(where + ": " + std::to_string(ids.size()) + " ids for " + std::to_string(expected) + " " + what + ": one per " +
-                         what.substr(0, what.size() - (what.size() > 1 && what.back() == 's' ? 1 : 0)));
+    if (expected > 0 && out.size() != expected) {
+        throw ValueError(where + ": " + std::to_string(out.size()) + " " + noun + " for " + std::to_string(expected) + " " + what + ": one per " + one);
     }
-    return ids;
+    return out;
+}
+
+} // namespace
+
+std::vector<std::int32_t> readIdList(const std::string& path, std::size_t expected, const std::string& what)
+{
+    return readList<std::int32_t>(path, expected, what, "readIdList", "a 32-bit integer id", "ids", [](const std::string& token, std::int32_t& v) {
+        char* end = nullptr;
+        errno = 0;
+        const long long x = std::strtoll(token.c_str(), &end, 10);
+        if (token.empty() || *end != '\0' || errno == ERANGE || x < std::numeric_limits<std::int32_t>::min() || x > std::numeric_limits<std::int32_t>::max()) return false;
+        v = std::int32_t(x);
+        return true;
+    });
+}
+
+std::vector<double> readValueList(const std::string& path, std::size_t expected, const std::string& what)
+{
+    return readList<double>(path, expected, what, "readValueList", "a finite number", "values", [](const std::string& token, double& v) {
+        char* end = nullptr;
+        errno = 0;
+        v = std::strtod(token.c_str(), &end);
+        return !token.empty() && *end == '\0' && errno != ERANGE && std::isfinite(v);
+    });
 }
 
 } // namespace vdbhair

@@ -6,11 +6,13 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
+#include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/ScalpSampler.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -148,18 +150,65 @@ openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const o
     return region;
 }
 
+struct VertexValueSampler::Tree
+{
+    PointCloud cloud;
+    PointKdTree tree;
+    explicit Tree(const std::vector<Vec3d>& v) : cloud{&v}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {}
+};
+
+VertexValueSampler::VertexValueSampler(const TriangleMesh& mesh, std::vector<float> values, const std::string& where)
+    : mVertices(mesh.vertices.begin(), mesh.vertices.end()), mValues(std::move(values))
+{
+    if (mValues.size() != mVertices.size())
+        throw ValueError(where + ": " + std::to_string(mValues.size()) + " values for " + std::to_string(mVertices.size()) + " vertices; give one per vertex");
+    if (mVertices.empty()) throw ValueError(where + ": the mesh has no vertices");
+    mTree = std::make_unique<Tree>(mVertices);
+}
+
+VertexValueSampler::~VertexValueSampler() = default;
+
+double VertexValueSampler::at(const Vec3d& p) const
+{
+    const std::size_t k = std::min<std::size_t>(4, mVertices.size());
+    std::uint32_t idx[4];
+    double d2[4];
+    const std::size_t found = mTree->tree.knnSearch(p.asPointer(), k, idx, d2);
+    double sum = 0.0, weight = 0.0;
+    for (std::size_t j = 0; j < found; ++j) {
+        if (d2[j] == 0.0) return mValues[idx[j]];
+        const double wj = 1.0 / std::sqrt(d2[j]);
+        sum += wj * double(mValues[idx[j]]);
+        weight += wj;
+    }
+    return weight > 0.0 ? sum / weight : 0.0;
+}
+
+openvdb::GridBase::Ptr readMaskGrid(const std::string& path, const std::string& name, const std::string& preferred, const std::string& option)
+{
+    std::string use = name;
+    if (use.empty()) {
+        const std::vector<std::string> names = vdbGridNames(path, path);
+        if (!preferred.empty() && std::find(names.begin(), names.end(), preferred) != names.end()) use = preferred;
+        for (std::size_t i = 0; use.empty() && i < names.size(); ++i) {
+            const openvdb::GridBase::Ptr g = readVdbGrid(path, names[i], path);
+            if ((g->isType<openvdb::BoolGrid>() || g->isType<openvdb::FloatGrid>()) && g->getGridClass() != openvdb::GRID_LEVEL_SET) use = names[i];
+        }
+        if (use.empty()) throw LookupError(path + ": no bool or float grid to use as " + option + " (a level set is a surface, not a mask)");
+    }
+    const openvdb::GridBase::Ptr g = readVdbGrid(path, use, path);
+    if (!g->isType<openvdb::BoolGrid>() && !g->isType<openvdb::FloatGrid>()) {
+        throw TypeError(path + ": grid '" + use + "' is a " + g->valueType() + " grid; " + option + " reads a bool or float grid");
+    }
+    return g;
+}
+
 openvdb::BoolGrid::Ptr regionFromVertexValues(const openvdb::FloatGrid& surface, const TriangleMesh& mesh, const std::vector<float>& values,
                                               double threshold, const std::string& source)
 {
     const std::string where = "regionFromVertexValues(" + (source.empty() ? std::string("mesh") : source) + ")";
-    if (values.size() != mesh.vertices.size())
-        throw ValueError(where + ": " + std::to_string(values.size()) + " values for " + std::to_string(mesh.vertices.size()) + " vertices; give one per vertex");
     if (!std::isfinite(threshold)) throw ValueError(where + ": threshold " + std::to_string(threshold) + " must be finite");
-    if (mesh.vertices.empty()) throw ValueError(where + ": the mesh has no vertices");
-    const std::vector<Vec3d> verts(mesh.vertices.begin(), mesh.vertices.end());
-    const PointCloud cloud{&verts};
-    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    const std::size_t k = std::min<std::size_t>(4, verts.size());
+    const VertexValueSampler sampler(mesh, values, where);
     openvdb::BoolGrid::Ptr region = openvdb::BoolGrid::create(false);
     region->setTransform(surface.transform().copy());
     auto out = region->getAccessor();
@@ -167,17 +216,7 @@ openvdb::BoolGrid::Ptr regionFromVertexValues(const openvdb::FloatGrid& surface,
     for (auto it = surface.cbeginValueOn(); it; ++it) {
         if (!it.isVoxelValue() || !(std::abs(double(*it)) < band)) continue;
         const Vec3d w = surface.transform().indexToWorld(it.getCoord());
-        std::uint32_t idx[4];
-        double d2[4];
-        const std::size_t found = tree.knnSearch(w.asPointer(), k, idx, d2);
-        double sum = 0.0, weight = 0.0;
-        for (std::size_t j = 0; j < found; ++j) {
-            if (d2[j] == 0.0) { sum = values[idx[j]]; weight = 1.0; break; }
-            const double wj = 1.0 / std::sqrt(d2[j]);
-            sum += wj * double(values[idx[j]]);
-            weight += wj;
-        }
-        if (weight > 0.0 && sum / weight > threshold) out.setValueOn(it.getCoord(), true);
+        if (sampler.at(w) > threshold) out.setValueOn(it.getCoord(), true);
     }
     if (region->activeVoxelCount() == 0)
         throw LookupError(where + ": no vertex value near the surface exceeds the threshold " + formatNumber(threshold) + "; the region would be empty");

@@ -9,6 +9,7 @@
 #include <openvdb/openvdb.h>
 
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,5 +60,32 @@ openvdb::BoolGrid::Ptr regionFromMask(const openvdb::FloatGrid& surface, const o
 /// LookupError (no voxel's value exceeds the threshold: the region would be empty).
 openvdb::BoolGrid::Ptr regionFromVertexValues(const openvdb::FloatGrid& surface, const TriangleMesh& mesh, const std::vector<float>& values,
                                               double threshold = kDefaultRegionThreshold, const std::string& source = "");
+
+/// @brief Values painted on a mesh's vertices, read anywhere: the inverse-distance average
+/// (weights 1/d, an exact hit its vertex's value) of the values at the 4 vertices nearest a point.
+/// regionFromVertexValues() and per-root values (RootValues.h) both use it.
+class VertexValueSampler
+{
+public:
+    /// @throw ValueError (a value count that is not the vertex count, no vertices).
+    VertexValueSampler(const TriangleMesh& mesh, std::vector<float> values, const std::string& where);
+    ~VertexValueSampler();
+    VertexValueSampler(const VertexValueSampler&) = delete;
+    VertexValueSampler& operator=(const VertexValueSampler&) = delete;
+    double at(const Vec3d& p) const;
+
+private:
+    std::vector<Vec3d> mVertices;
+    std::vector<float> mValues;
+    struct Tree;
+    std::unique_ptr<Tree> mTree;
+};
+
+/// @brief A mask grid of a .vdb file: the grid @a name; without one, the grid @a preferred if the
+/// file has it, else the file's first bool or float grid that is not a level set.
+/// @param option what the grid is for, in messages ("a region mask (--region-grid NAME)")
+/// @throw LookupError (no such grid, or no bool or float grid: the message says how to name one),
+/// TypeError (the named grid is neither bool nor float), and the reader's errors.
+openvdb::GridBase::Ptr readMaskGrid(const std::string& path, const std::string& name, const std::string& preferred, const std::string& option);
 
 } // namespace vdbhair

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <unordered_set>
 #include <cmath>
 #include <string>
 
@@ -194,6 +195,84 @@ StrandPairErrors strandPairErrors(const StrandSet& a, const StrandSet& b, std::s
         e.meanCurvature /= double(S);
     }
     return e;
+}
+
+namespace {
+
+/// Calls @a visit with the packed voxel of every point of strand @a i (vertices, and points at
+/// most half a voxel apart on each segment).
+template <typename Visit>
+void visitStrandVoxels(const StrandSet& s, std::size_t i, double voxel, Visit&& visit)
+{
+    const auto pack = [&](const Vec3d& p) {
+        const auto c = [&](double v) { return std::uint64_t(std::int64_t(std::llround(v / voxel)) + (std::int64_t(1) << 20)) & 0x1fffff; };
+        return c(p.x()) | (c(p.y()) << 21) | (c(p.z()) << 42);
+    };
+    const Vec3f* p = s.data(i);
+    const std::size_t n = s.size(i);
+    for (std::size_t k = 0; k < n; ++k) {
+        const Vec3d a(p[k].x(), p[k].y(), p[k].z());
+        if (!visit(pack(a))) return;
+        if (k + 1 == n) break;
+        const Vec3d b(p[k + 1].x(), p[k + 1].y(), p[k + 1].z());
+        const double steps = std::ceil((b - a).length() / (0.5 * voxel));
+        if (!(steps < double(1 << 24))) throw ValueError("voxel " + std::to_string(voxel) + ": a segment of strand " + std::to_string(i) + " would take over 2^24 points");
+        const std::size_t m = std::size_t(steps);
+        for (std::size_t j = 1; j < m; ++j) {
+            if (!visit(pack(a + (b - a) * (double(j) / double(m))))) return;
+        }
+    }
+}
+
+} // namespace
+
+std::size_t countStrandsLeavingVolume(const StrandSet& strands, const StrandSet& reference, double voxel, bool threaded)
+{
+    if (!(voxel > 0.0) || !std::isfinite(voxel)) throw ValueError("voxel " + std::to_string(voxel) + ": must be a positive length");
+    for (const StrandSet* s : {&strands, &reference}) {
+        const BBox box = computeBBox(*s);
+        if (s->empty()) continue;
+        const double reach = std::max({std::abs(double(box.min.x())), std::abs(double(box.min.y())), std::abs(double(box.min.z())),
+                                       std::abs(double(box.max.x())), std::abs(double(box.max.y())), std::abs(double(box.max.z()))});
+        if (!(reach / voxel < double(1 << 19))) {
+            throw ValueError("voxel " + std::to_string(voxel) + ": over 2^19 voxels from the origin to the hair (" + std::to_string(reach) + "); give a larger voxel");
+        }
+    }
+    std::unordered_set<std::uint64_t> occupied;
+    for (std::size_t i = 0; i < reference.numStrands(); ++i) {
+        visitStrandVoxels(reference, i, voxel, [&](std::uint64_t key) {
+            occupied.insert(key);
+            return true;
+        });
+    }
+    // Dilated by one voxel: the 27 packed offsets (21 bits a coordinate; no coordinate reaches the wrap).
+    std::unordered_set<std::uint64_t> volume;
+    volume.reserve(occupied.size() * 4);
+    for (const std::uint64_t key : occupied) {
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const std::uint64_t x = ((key & 0x1fffff) + std::uint64_t(dx)) & 0x1fffff;
+                    const std::uint64_t y = (((key >> 21) & 0x1fffff) + std::uint64_t(dy)) & 0x1fffff;
+                    const std::uint64_t z = (((key >> 42) & 0x1fffff) + std::uint64_t(dz)) & 0x1fffff;
+                    volume.insert(x | (y << 21) | (z << 42));
+                }
+    }
+    std::vector<char> leaves(strands.numStrands(), 0);
+    auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            visitStrandVoxels(strands, i, voxel, [&](std::uint64_t key) {
+                if (volume.count(key)) return true;
+                leaves[i] = 1;
+                return false;
+            });
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, strands.numStrands(), 256), body);
+    else body(tbb::blocked_range<std::size_t>(0, strands.numStrands()));
+    std::size_t count = 0;
+    for (char c : leaves) count += std::size_t(c);
+    return count;
 }
 
 } // namespace vdbhair

@@ -17,6 +17,11 @@
 /// 100 points by arc length; the position error is the mean distance between corresponding points
 /// after moving B's root onto A's (root-aligned), the curvature error the mean absolute difference
 /// of the curvature of the circle through each three consecutive points (1/R = 2 sin∠ / chord).
+///
+/// **Leaving the volume** (the guides issue's measure of spikes and flares): a strand leaves a
+/// reference's hair volume when one of its points lies outside the voxels the reference's points
+/// occupy, dilated by one voxel (its 26 neighbours). A strand's points are its vertices and points
+/// at most half a voxel apart on its segments; a point is in the voxel it rounds to (world / voxel).
 #pragma once
 
 #include <vdbhair/strands/StrandSet.h>
@@ -62,5 +67,11 @@ struct StrandPairErrors
 /// @param samples points per resampled strand (Perm: 100), at least 3
 /// @throw ValueError when the strand counts differ or samples < 3.
 StrandPairErrors strandPairErrors(const StrandSet& a, const StrandSet& b, std::size_t samples = 100, bool threaded = true);
+
+/// @brief The number of @a strands that leave the hair volume of @a reference at @a voxel (see
+/// above). In parallel; identical for any thread count.
+/// @throw ValueError for a voxel that is not positive and finite, or one so small that a segment
+/// would take more than 2^24 points.
+std::size_t countStrandsLeavingVolume(const StrandSet& strands, const StrandSet& reference, double voxel, bool threaded = true);
 
 } // namespace vdbhair
