@@ -186,7 +186,7 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
                    {"clumps", r.groom.clumps}, {"clumped", r.groom.clumped}, {"curled", r.groom.curled},
                    {"pushed_out", r.pushedOut}, {"vertices_too_deep", r.verticesTooDeep},
                    {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
-                   {"leaving_guide_volume", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json({{"strands", double(r.leavingVolume) / double(std::max<std::size_t>(1, count))}, {"voxel", r.volumeVoxel}})},
+                   {"leaving_guide_volume", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json({{"strands", double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample))}, {"sample", r.volumeSample}, {"voxel", r.volumeVoxel}})},
                    {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
     } else if (!common.quiet) {
         std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << p.method << ", " << frameRuleName(op.frames) << " frames";
@@ -207,8 +207,10 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         }
         if (!op.returnScene) {
             char share[64];
-            std::snprintf(share, sizeof share, "%.1f %%", 100.0 * double(r.leavingVolume) / double(std::max<std::size_t>(1, count)));
-            std::cout << "leaving the guides' hair volume (voxel " << formatValue(r.volumeVoxel) << ", dilated by one): " << share << " of the new strands\n";
+            std::snprintf(share, sizeof share, "%.1f %%", 100.0 * double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample)));
+            std::cout << "leaving the guides' hair volume (voxel " << formatValue(r.volumeVoxel) << ", dilated by one): " << share << " of the new strands";
+            if (r.volumeSample < count) std::cout << " (measured on " << r.volumeSample << " spread over them)";
+            std::cout << "\n";
         }
         std::cout << "wrote " << p.output << "\n";
     }

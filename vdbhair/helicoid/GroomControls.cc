@@ -314,7 +314,8 @@ GroomStats applyGroomControls(StrandSet& strands, const GroomParams& params, con
                 const Vec3d qEnd = toD(q[m - 1]), pAtEnd = pointAt(p, ap, lq);
                 for (std::size_t k = 1; k < n; ++k) {
                     const double s = ap[k];
-                    const double pull = cp.tightness * std::pow(s / lp, cp.profile);
+                    const double t = s / lp;
+                    const double pull = cp.tightness * (cp.profile == 1.0 ? t : std::pow(t, cp.profile));
                     const Vec3d own = toD(p[k]);
                     // Beyond the centre's tip a longer hair keeps its own shape from there on.
                     const Vec3d target = s <= lq ? pointAt(q, aq, s) : qEnd + (own - pAtEnd);

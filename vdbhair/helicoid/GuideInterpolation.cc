@@ -147,7 +147,16 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
     res.enteringHead = countStrandsEnteringHead(res.strands, head, headTolerance(head), threaded);
     if (!params.returnScene && guidePoints) {
         res.volumeVoxel = suggestVoxelSize(*guidePoints);
-        res.leavingVolume = countStrandsLeavingVolume(res.strands, *guidePoints, res.volumeVoxel, threaded);
+        const std::size_t S = res.strands.numStrands();
+        if (S <= kVolumeSample) {
+            res.volumeSample = S;
+            res.leavingVolume = countStrandsLeavingVolume(res.strands, *guidePoints, res.volumeVoxel, threaded);
+        } else {
+            std::vector<char> pick(S, 0);
+            for (std::size_t k = 0; k < kVolumeSample; ++k) pick[k * S / kVolumeSample] = 1;
+            res.volumeSample = kVolumeSample;
+            res.leavingVolume = countStrandsLeavingVolume(selectStrands(res.strands, pick), *guidePoints, res.volumeVoxel, threaded);
+        }
     }
     res.seconds = secondsSince(t0) - res.fitSeconds;
     return res;
