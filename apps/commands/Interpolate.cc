@@ -8,7 +8,6 @@
 #include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/FileUtil.h>
-#include <vdbhair/io/IdList.h>
 #include <vdbhair/io/PointFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
@@ -95,7 +94,11 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         guides.strands = &guideStrands;
     }
     const std::size_t G = guides.scene ? scene.guides.size() : guideStrands.numStrands();
-    if (!p.guideGroups.empty()) guides.groups = readIdList(p.guideGroups, G, "guides");
+    if (!p.guideGroups.empty()) {
+        std::vector<Vec3d> guideRoots(G);
+        for (std::size_t i = 0; i < G; ++i) guideRoots[i] = guides.scene ? scene.guides[i].root : toD(guideStrands.root(i));
+        guides.groups = readRootIds(p.guideGroups, guideRoots, "--guide-groups", "guides");
+    }
     // A bound of the vertices a new hair has, for the cap before the roots are made.
     std::size_t perHair = 0;
     if (guides.scene) {
@@ -150,7 +153,7 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         head = HeadObstacle::levelSet(surface);
         head.setLabel("--scalp " + p.scalp);
     }
-    if (!p.rootGroups.empty()) roots.groups = readIdList(p.rootGroups, roots.positions.size(), "roots");
+    if (!p.rootGroups.empty()) roots.groups = readRootIds(p.rootGroups, roots.positions, "--root-groups", "roots");
     // Density and length per root: a number, a mask grid, a painted mesh property, or a list (RootValues.h).
     for (auto [spec, values, option, grid] : {std::tuple{&p.density, &roots.density, "--density", "density"}, std::tuple{&p.length, &roots.length, "--length", "length"}}) {
         if (spec->empty()) continue;
@@ -232,8 +235,10 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--method", p.method, "points (the guides' own points, by group and likeness) or helicoid (their helicoid parameters, Piuze et al.)")->capture_default_str();
     sub->add_option("--grouping", p.grouping, "points: shape (a new hair blends only guides shaped like its nearest one: partings and layers stay apart) or none")->capture_default_str();
     sub->add_option("--likeness", p.op.points.likeness, "--grouping shape: the shape distance, a fraction of the guide length, at which a guide stops taking part")->capture_default_str();
-    sub->add_option("--guide-groups", p.guideGroups, "points: a text file of one integer group id per guide; new hairs blend only guides of one group");
-    sub->add_option("--root-groups", p.rootGroups, "points: a text file of one group id per root (default: the group of the nearest guide)");
+    sub->add_option("--guide-groups", p.guideGroups, "points: group ids of the guides, new hairs blending only guides of one group: a text file of one integer "
+                                                      "per guide, MASK.vdb[:GRID] (the voxel at each guide root; grid 'groups'), MESH.ply:PROPERTY (the nearest vertex's), "
+                                                      "or MESH.ply|obj:islands (the mesh's connected pieces: a scalp cut along its partings)");
+    sub->add_option("--root-groups", p.rootGroups, "points: group ids of the roots, as --guide-groups (default: the group of the nearest guide)");
     sub->add_option("--density", p.density, "Share of the roots that grow hair, in [0, 1]: a number, MASK.vdb[:GRID] (a float or bool grid; "
                                             "default grid 'density'), MESH.ply:PROPERTY (painted on the head's vertices), or a text file of one value per root");
     sub->add_option("--length", p.length, "Share of each new hair's length kept, in [0, 1] (0 grows none): as --density (default grid 'length')");

@@ -17,7 +17,7 @@ namespace {
 
 struct ReconstructCmdParams
 {
-    std::string input, output, method = "points", select = "random", errors;
+    std::string input, output, method = "points", select = "random", errors, head;
     std::string blend = helicoidBlendName(ReconstructParams{}.helicoid.blend);
     std::string grouping = guideGroupingName(ReconstructParams{}.points.grouping);
     std::string guides = formatValue(100.0 * ReconstructParams{}.guideFraction) + "%";
@@ -58,7 +58,9 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
         p.rec.points.neighbors = p.neighbors;
     }
     const StrandSet strands = loadStrands("reconstruct", p.input, common);
-    const ReconstructResult r = reconstructHairstyle(strands, p.rec, true, common.interrupter);
+    HeadObstacle head;
+    if (!p.head.empty() && p.head != "none") head = readHeadObstacle(p.head, "--head " + p.head);
+    const ReconstructResult r = reconstructHairstyle(strands, p.rec, true, common.interrupter, head.unset() || head.empty() ? nullptr : &head);
     {
         const Stage stage(common, "writing " + p.output);
         writeStrands(p.output, p.method == "points" ? r.points : r.helicoid);
@@ -98,7 +100,12 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
                    {"grouping", guideGroupingName(p.rec.points.grouping)},
                    {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}, {"nearest", stats(r.nearestErrors)}}},
                    {"measures", {{"helicoid", papers(r.helicoidErrors)}, {"points", papers(r.pointErrors)}, {"nearest", papers(r.nearestErrors)}}},
-                   {"meters_per_unit", p.rec.metersPerUnit > 0.0 ? nlohmann::json(p.rec.metersPerUnit) : nlohmann::json(nullptr)}});
+                   {"meters_per_unit", p.rec.metersPerUnit > 0.0 ? nlohmann::json(p.rec.metersPerUnit) : nlohmann::json(nullptr)},
+                   {"leaving_guide_volume", {{"voxel", r.volumeVoxel}, {"original", r.originalLeavingVolume}, {"helicoid", r.helicoidErrors.leavingVolume},
+                                             {"points", r.pointErrors.leavingVolume}, {"nearest", r.nearestErrors.leavingVolume}}},
+                   {"entering_head", r.headMeasured ? nlohmann::json({{"original", r.originalEnteringHead}, {"helicoid", r.helicoidErrors.enteringHead},
+                                                                     {"points", r.pointErrors.enteringHead}, {"nearest", r.nearestErrors.enteringHead}})
+                                                    : nlohmann::json(nullptr)}});
     } else if (!common.quiet) {
         char buf[256];
         std::snprintf(buf, sizeof buf, " guides (%.3g %%, %s); fits: mean %.3g %%, %.2f pieces, %.3f s\n", 100.0 * double(r.guides.size()) / double(S),
@@ -124,6 +131,14 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
                 std::cout << buf;
             }
             std::cout << "\n";
+        }
+        std::snprintf(buf, sizeof buf, "%.1f %% of the original strands, helicoid %.1f %%, points %.1f %%, nearest guide %.1f %%", 100.0 * r.originalLeavingVolume,
+                      100.0 * r.helicoidErrors.leavingVolume, 100.0 * r.pointErrors.leavingVolume, 100.0 * r.nearestErrors.leavingVolume);
+        std::cout << "leaving the guides' hair volume (voxel " << formatValue(r.volumeVoxel) << ", interpolated strands): " << buf << "\n";
+        if (r.headMeasured) {
+            std::snprintf(buf, sizeof buf, "%.1f %% of the original strands, helicoid %.1f %%, points %.1f %%, nearest guide %.1f %%", 100.0 * r.originalEnteringHead,
+                          100.0 * r.helicoidErrors.enteringHead, 100.0 * r.pointErrors.enteringHead, 100.0 * r.nearestErrors.enteringHead);
+            std::cout << "passing into the head (" << head.describe(false) << "): " << buf << "\n";
         }
         std::cout << "wrote " << p.output << " (" << p.method << ")" << (p.errors.empty() ? "" : " and " + p.errors) << "\n";
     }
@@ -151,6 +166,7 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair (default: every guide for helicoid, " +
                                            std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
     sub->add_option("--max-error", params->rec.fit.maxError, "Fits: accepted discrete Frechet distance, a fraction of the strand length")->capture_default_str();
+    sub->add_option("--head", params->head, "A head (mesh or .vdb level set) to measure the shares of strands passing into it against (nothing is moved)");
     sub->add_option("--errors", params->errors, "Also write every strand's relative error, every way, as CSV");
     sub->add_option("--meters-per-unit", params->rec.metersPerUnit, "The file's unit in metres (0.01: centimetres), for HairGS's oriented-point F1 at 2-4 mm (0: unknown, not measured)")->capture_default_str();
     addCommonOptions(sub, common);

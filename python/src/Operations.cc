@@ -591,7 +591,11 @@ Returns:
                                      std::to_string(roots.positions.size()) + " roots");
             }
             if (op.frames == FrameRule::Surface && roots.normals.empty()) throw ValueError("interpolate: frames='surface' needs normals");
-            if (!rootGroups.is_none()) roots.groups = rootGroups.cast<std::vector<std::int32_t>>();
+            auto isPath = [](const pyb::object& o) { return pyb::isinstance<pyb::str>(o) || pyb::hasattr(o, "__fspath__"); };
+            if (!rootGroups.is_none()) {
+                roots.groups = isPath(rootGroups) ? readRootIds(pyb::str(rootGroups).cast<std::string>(), roots.positions, "interpolate: root_groups=", "roots")
+                                                  : rootGroups.cast<std::vector<std::int32_t>>();
+            }
             // Density and length: one value per root, or what the command reads (a number, a mask, a painted mesh, a list).
             for (auto [arg, values, option, grid] : {std::tuple{&densityArg, &roots.density, "density", "density"}, std::tuple{&lengthArg, &roots.length, "length", "length"}}) {
                 if (arg->is_none()) continue;
@@ -613,7 +617,14 @@ Returns:
             guides.where = "interpolate(guides)";
             if (fromStrands) guides.strands = guideStrands.get();
             else guides.scene = &scene;
-            if (!guideGroups.is_none()) guides.groups = guideGroups.cast<std::vector<std::int32_t>>();
+            if (!guideGroups.is_none() && isPath(guideGroups)) {
+                std::vector<Vec3d> guideRoots;
+                if (fromStrands) for (std::size_t i = 0; i < guideStrands->numStrands(); ++i) guideRoots.push_back(Vec3d(guideStrands->root(i)));
+                else for (const SceneGuide& g : scene.guides) guideRoots.push_back(g.root);
+                guides.groups = readRootIds(pyb::str(guideGroups).cast<std::string>(), guideRoots, "interpolate: guide_groups=", "guides");
+            } else if (!guideGroups.is_none()) {
+                guides.groups = guideGroups.cast<std::vector<std::int32_t>>();
+            }
             InterpolateResult result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 HeadObstacle head = headArgument.get("interpolate");
                 // None: the scene's head sphere, else a sphere fitted to the guide roots (as the command).
@@ -650,8 +661,11 @@ Args:
     grouping: points: "shape" (a new hair blends only guides shaped like its nearest one, so
         partings and layers stay apart) or "none".
     likeness: the shape distance, a fraction of the guide length, at which a guide stops taking part.
-    guide_groups: None, or one integer group id per guide: new hairs blend guides of one group.
-    root_groups: None, or one group id per root (None: the group of the nearest guide).
+    guide_groups: None, one integer group id per guide (new hairs blend guides of one group), or a
+        spec as the command's --guide-groups: a list file, "mask.vdb[:GRID]", "head.ply:PROPERTY",
+        "head.obj:islands".
+    root_groups: None, one group id per root, or a spec as guide_groups (None: the group of the
+        nearest guide).
     head: the head new hair may enter no deeper than its guides: None (the scene's head sphere,
         else a sphere fitted to the guide roots), "none", a path (mesh or .vdb level set) or
         (x, y, z, r).
@@ -687,8 +701,9 @@ Returns:
         "reconstruct",
         [](const StrandsPtr& strands, double guides, const std::string& select, std::uint64_t seed, double power,
            std::optional<int> neighbors, const std::string& blend, const std::string& grouping, double likeness, double maxError,
-           double metersPerUnit, int threads, const pyb::object& progress) {
+           double metersPerUnit, const pyb::object& headArg, int threads, const pyb::object& progress) {
             ReconstructParams p;
+            const HeadArgument headArgument(headArg, "no-deeper");
             if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit))
                 throw ValueError("reconstruct: meters_per_unit=" + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
             p.metersPerUnit = metersPerUnit;
@@ -714,7 +729,8 @@ Returns:
             p.fit.maxError = maxError;
             validateFitKeywords(p.fit, "reconstruct");
             ReconstructResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                return reconstructHairstyle(*strands, p, true, interrupter);
+                const HeadObstacle head = headArgument.get("reconstruct");
+                return reconstructHairstyle(*strands, p, true, interrupter, head.unset() || head.empty() ? nullptr : &head);
             });
             auto stats = [metersPerUnit](const ReconstructErrors& e) {
                 pyb::dict d;
@@ -726,6 +742,8 @@ Returns:
                 d["seconds"] = e.seconds;
                 d["perm_position"] = e.permPosition;
                 d["perm_curvature"] = e.permCurvature;
+                d["leaving_volume"] = e.leavingVolume;
+                d["entering_head"] = e.enteringHead;
                 if (e.oriented.empty()) {
                     d["oriented_points"] = pyb::none();
                 } else {
@@ -747,13 +765,15 @@ Returns:
             report["helicoid"] = stats(r.helicoidErrors);
             report["points"] = stats(r.pointErrors);
             report["nearest"] = stats(r.nearestErrors);
+            report["original"] = pyb::dict(pyb::arg("leaving_volume") = r.originalLeavingVolume, pyb::arg("entering_head") = r.originalEnteringHead);
+            report["volume_voxel"] = r.volumeVoxel;
             return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.helicoid)), std::make_shared<StrandSet>(std::move(r.points)), report);
         },
         pyb::arg("strands"), pyb::kw_only(), pyb::arg("guides") = reconstructDefaults.guideFraction, pyb::arg("select") = "random",
         pyb::arg("seed") = reconstructDefaults.seed, pyb::arg("power") = reconstructDefaults.helicoid.shepard.power,
         pyb::arg("neighbors") = pyb::none(), pyb::arg("blend") = helicoidBlendName(reconstructDefaults.helicoid.blend),
         pyb::arg("grouping") = guideGroupingName(reconstructDefaults.points.grouping), pyb::arg("likeness") = reconstructDefaults.points.likeness,
-        pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("meters_per_unit") = reconstructDefaults.metersPerUnit, pyb::arg("threads") = 0,
+        pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("meters_per_unit") = reconstructDefaults.metersPerUnit, pyb::arg("head") = pyb::none(), pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(Rebuild a hairstyle from a share of its strands (Piuze et al. 2011, Sec. 5.4):
 ``vdbhair reconstruct``. The guides are fitted with p-helicoids and new hairs interpolated at every
@@ -777,6 +797,8 @@ Args:
     meters_per_unit: the strands' unit in metres (0.01: centimetres), for HairGS's oriented-point
         measures at 2-4 mm; 0: unknown, not measured.
     max_error: the fits' accepted discrete Frechet distance, a fraction of the strand length.
+    head: None or "none" (no head), a path (mesh or .vdb level set) or (x, y, z, r): the head the
+        shares of strands passing into it are measured against (nothing is moved).
     threads: worker threads, 0 for all cores (results do not depend on it).
     progress: optional callable ``progress(stage, done, total, unit)``.
 

@@ -160,6 +160,13 @@ def test_reconstruct_straight_hair():
     assert all(m["f1"] == 1.0 and m["strand_consistency"] == 1.0 for m in everything["points"]["oriented_points"])
     assert everything["points"]["perm_position"] == 0.0 and everything["points"]["perm_curvature"] == 0.0
     assert report["nearest"]["perm_position"] >= 0.0
+    # Parallel straight hair stays inside its guides' volume; a head sphere across the strands'
+    # middles is entered by as many rebuilt strands (points) as original ones.
+    assert report["original"]["leaving_volume"] == 0.0 and report["points"]["leaving_volume"] == 0.0
+    assert report["volume_voxel"] > 0.0 and report["points"]["entering_head"] == 0.0
+    with_head = vdbhair.reconstruct(hair, guides=0.25, seed=1, head=(1.5, 0.0, 0.0, 0.3))[2]
+    assert 0.0 < with_head["original"]["entering_head"] <= 1.0
+    assert with_head["points"]["entering_head"] == pytest.approx(with_head["original"]["entering_head"])
     with pytest.raises(ValueError, match="meters_per_unit=-1"):
         vdbhair.reconstruct(hair, meters_per_unit=-1.0)
     h1 = vdbhair.reconstruct(hair, guides=0.25, seed=1, threads=1)[0]

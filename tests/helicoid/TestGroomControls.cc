@@ -305,3 +305,32 @@ TEST_CASE("interpolate with density, length, clumps and curl: the hairs and the 
     p.groom.curl.frequency = 0.0;
     REQUIRE_THROWS_WITH(interpolateGuides(g, roots, HeadObstacle::none(), p), Contains("--curl 0.05 needs --curl-frequency"));
 }
+
+TEST_CASE("group ids from a mask grid, a painted mesh property and a mesh's islands", "[groom]")
+{
+    // Two triangles apart (two islands, the second welded to a third by a shared position), with
+    // a vertex property 'part'.
+    const std::string ply = tempPath("islands.ply");
+    writeFileAtomic(ply,
+                    "ply\nformat ascii 1.0\nelement vertex 9\nproperty float x\nproperty float y\nproperty float z\nproperty float part\n"
+                    "element face 3\nproperty list uchar int vertex_indices\nend_header\n"
+                    "0 0 0 3\n1 0 0 3\n0 1 0 3\n"
+                    "10 0 0 7\n11 0 0 7\n10 1 0 7\n"
+                    "11 0 0 7\n12 0 0 7\n11 1 0 7\n"
+                    "3 0 1 2\n3 3 4 5\n3 6 7 8\n",
+                    "test");
+    const std::vector<Vec3d> points{Vec3d(0.2, 0.2, 0.0), Vec3d(11.8, 0.1, 0.0), Vec3d(10.1, 0.9, 0.0), Vec3d(0.9, 0.0, 0.1)};
+    CHECK(readRootIds(ply + ":islands", points, "--root-groups", "roots") == std::vector<std::int32_t>{0, 1, 1, 0});
+    CHECK(readRootIds(ply + ":part", points, "--root-groups", "roots") == std::vector<std::int32_t>{3, 7, 7, 3});
+    const std::string list = tempPath("ids.txt");
+    writeFileAtomic(list, "1 2 3 4\n", "test");
+    CHECK(readRootIds(list, points, "--root-groups", "roots") == std::vector<std::int32_t>{1, 2, 3, 4});
+    // A float grid holding 0.5 is no group id.
+    openvdb::initialize();
+    openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.5f);
+    g->setName("groups");
+    const std::string vdb = tempPath("groups.vdb");
+    writeVdbGrids(vdb, {g}, "test");
+    REQUIRE_THROWS_WITH(readRootIds(vdb, points, "--guide-groups", "guides"), Contains("the value 0.5 at guide 0 is not an integer group id"));
+    for (const std::string& f : {ply, list, vdb}) std::filesystem::remove(f);
+}

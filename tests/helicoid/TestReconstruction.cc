@@ -1,6 +1,7 @@
 #include "../TestUtil.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/strands/Resample.h>
@@ -124,4 +125,44 @@ TEST_CASE("reconstructHairstyle: real straight hair at 10 % guides", "[helicoid]
     std::cout << "  the same with --blend fitted: helicoid mean " << f.helicoidErrors.meanInterpolated << " p95 "
               << f.helicoidErrors.p95Interpolated << "\n";
     REQUIRE(r.helicoidErrors.meanInterpolated < f.helicoidErrors.meanInterpolated);
+}
+
+TEST_CASE("reconstructHairstyle: the shares leaving the guides' volume and passing into a head", "[helicoid][interp]")
+{
+    // 400 straight strands hanging down (-z) from a 20 x 20 grid of roots at z = 0, x in [0, 1.9],
+    // y in [-0.95, 0.95]; a head sphere of radius 1.5 about (0, 0, -2) below. Parallel guides give
+    // every strand back exactly by points, so the points way passes into the head exactly where
+    // the original does: where the root lies within 1.5 (less the tolerance) of the z axis.
+    StrandSet s;
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j) {
+            std::vector<Vec3f> p(41);
+            for (int k = 0; k < 41; ++k) p[k] = Vec3f(0.1f * float(i), -0.95f + 0.1f * float(j), -0.1f * float(k));
+            s.addStrand(p);
+        }
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0, 0.0, -2.0), 1.5);
+    ReconstructParams params;
+    const ReconstructResult r = reconstructHairstyle(s, params, true, nullptr, &head);
+    REQUIRE(r.headMeasured);
+    CHECK(r.volumeVoxel > 0.0);
+    std::vector<char> isGuide(s.numStrands(), 0);
+    for (std::size_t g : r.guides) isGuide[g] = 1;
+    const double tol = headTolerance(head);
+    std::size_t inside = 0, others = 0;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        if (isGuide[i]) continue;
+        ++others;
+        const Vec3f root = s.root(i);
+        if (std::hypot(double(root.x()), double(root.y())) < 1.5 - tol) ++inside;
+    }
+    REQUIRE(inside > 0);
+    REQUIRE(inside < others);
+    CHECK(r.originalEnteringHead == Approx(double(inside) / double(others)));
+    CHECK(r.pointErrors.enteringHead == Approx(r.originalEnteringHead));
+    CHECK(r.originalLeavingVolume == 0.0);  // the groom fills its own guides' volume
+    CHECK(r.pointErrors.leavingVolume == 0.0);
+    CHECK(r.nearestErrors.leavingVolume == 0.0);
+    const ReconstructResult none = reconstructHairstyle(s, params);
+    CHECK_FALSE(none.headMeasured);
+    CHECK(none.pointErrors.enteringHead == 0.0);
 }

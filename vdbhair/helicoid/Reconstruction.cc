@@ -3,6 +3,8 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Random.h>
+#include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/field/TangentField.h>
 #include <vdbhair/helicoid/Frechet.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/helicoid/ShepardWeights.h>
@@ -133,7 +135,7 @@ double relativeFrechet(const Vec3f* a, std::size_t na, const Vec3f* b, std::size
 }
 
 ReconstructResult reconstructHairstyle(const StrandSet& strands, const ReconstructParams& params, bool threaded,
-                                       openvdb::util::NullInterrupter* interrupter)
+                                       openvdb::util::NullInterrupter* interrupter, const HeadObstacle* head)
 {
     validateShepardParams(params.helicoid.shepard);
     if (!(params.metersPerUnit >= 0.0) || !std::isfinite(params.metersPerUnit)) {
@@ -267,6 +269,24 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
         const StrandPairErrors perm = strandPairErrors(strands, *way.second, 100, threaded);
         way.first->permPosition = perm.meanPosition;
         way.first->permCurvature = perm.meanCurvature;
+    }
+    // Spikes, flares and the head: the interpolated strands against the guides' hair volume, and
+    // the original strands at the same roots for comparison.
+    if (!others.empty()) {
+        std::vector<char> interpolated(S, 0);
+        for (std::size_t i : others) interpolated[i] = 1;
+        res.volumeVoxel = suggestVoxelSize(rawGuides);
+        const double n = double(others.size());
+        const bool withHead = head && !head->unset() && !head->empty();
+        res.headMeasured = withHead;
+        const double tolerance = withHead ? headTolerance(*head) : 0.0;
+        auto shares = [&](const StrandSet& set, double& leaving, double& entering) {
+            const StrandSet sub = selectStrands(set, interpolated);
+            leaving = double(countStrandsLeavingVolume(sub, rawGuides, res.volumeVoxel, threaded)) / n;
+            entering = withHead ? double(countStrandsEnteringHead(sub, *head, tolerance, threaded)) / n : 0.0;
+        };
+        shares(strands, res.originalLeavingVolume, res.originalEnteringHead);
+        for (const auto& way : ways) shares(*way.second, way.first->leavingVolume, way.first->enteringHead);
     }
     return res;
 }

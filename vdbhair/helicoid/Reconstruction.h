@@ -25,6 +25,7 @@
 /// clusters are topped up from the random order).
 #pragma once
 
+#include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/helicoid/PointInterpolation.h>
@@ -70,6 +71,10 @@ struct ReconstructErrors
     std::vector<OrientedMatch> oriented;
     /// Perm's root-aligned position error (world units) and curvature error, means over all strands
     double permPosition = 0.0, permCurvature = 0.0;
+    /// Of the interpolated (non-guide) strands, the shares that leave the guides' hair volume
+    /// (countStrandsLeavingVolume() at ReconstructResult::volumeVoxel) and that pass into the head
+    /// (countStrandsEnteringHead(); 0 without a head)
+    double leavingVolume = 0.0, enteringHead = 0.0;
 };
 
 struct ReconstructResult
@@ -81,6 +86,11 @@ struct ReconstructResult
     ReconstructErrors nearestErrors;  ///< the baseline: every strand its nearest guide, translated
     FitSummary fitSummary;
     double fitSeconds = 0.0;
+    /// The same shares for the original strands at the interpolated roots: what a reconstruction
+    /// is held to (the guides issue: leaving at most 1.5 times this, entering the head at most this plus 1 point)
+    double originalLeavingVolume = 0.0, originalEnteringHead = 0.0;
+    double volumeVoxel = 0.0;   ///< suggestVoxelSize() of the guides
+    bool headMeasured = false;  ///< whether a head was given
 };
 
 /// @brief The strands chosen as guides (ascending indices), see above.
@@ -97,7 +107,8 @@ double relativeFrechet(const Vec3f* a, std::size_t na, const Vec3f* b, std::size
 /// thread count.
 /// @throw ValueError (bad fraction, no strand could be fitted, bad interpolation parameters),
 /// LimitError, InterruptedError.
+/// @param head optional: the head the shares entering it are measured against (nothing is pushed out)
 ReconstructResult reconstructHairstyle(const StrandSet& strands, const ReconstructParams& params, bool threaded = true,
-                                       openvdb::util::NullInterrupter* interrupter = nullptr);
+                                       openvdb::util::NullInterrupter* interrupter = nullptr, const HeadObstacle* head = nullptr);
 
 } // namespace vdbhair

@@ -7,6 +7,7 @@
 
 #include <vdbhair/Types.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,20 @@ namespace vdbhair {
 /// @param option names the option in messages ("--density")
 /// @throw ValueError (a value count that is not the root count, a non-finite value), LookupError,
 /// TypeError, FormatError, IoError from the readers, each naming the file.
-std::vector<float> readRootValues(const std::string& spec, const std::vector<Vec3d>& roots, const std::string& option, const std::string& preferred);
+/// @param nearest sample without blending (ids): a float grid's value in the voxel holding the
+/// root, a mesh property's value at the nearest vertex
+std::vector<float> readRootValues(const std::string& spec, const std::vector<Vec3d>& roots, const std::string& option, const std::string& preferred,
+                                  bool nearest = false);
+
+/// @brief Integer ids (groups) at @a points from @a spec: a text file of one id per point
+/// (readIdList()); `MASK.vdb[:GRID]` (the value of the voxel holding each point; default grid
+/// `groups`); `MESH.ply:PROPERTY` (the nearest vertex's value); or `MESH.ply:islands` /
+/// `MESH.obj:islands`, the mesh's connected pieces (vertices at one position are one vertex),
+/// numbered from 0 in the order of their first triangle, each point taking the piece of its
+/// nearest vertex: Blender's "part by mesh islands" (a scalp cut along its partings).
+/// @param what what the points are, in messages ("guides", "roots")
+/// @throw ValueError (a value that is not an integer, a count that is not the point count), and
+/// the readers' errors, each naming the file.
+std::vector<std::int32_t> readRootIds(const std::string& spec, const std::vector<Vec3d>& points, const std::string& option, const std::string& what);
 
 } // namespace vdbhair

@@ -157,8 +157,8 @@ struct VertexValueSampler::Tree
     explicit Tree(const std::vector<Vec3d>& v) : cloud{&v}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {}
 };
 
-VertexValueSampler::VertexValueSampler(const TriangleMesh& mesh, std::vector<float> values, const std::string& where)
-    : mVertices(mesh.vertices.begin(), mesh.vertices.end()), mValues(std::move(values))
+VertexValueSampler::VertexValueSampler(const TriangleMesh& mesh, std::vector<float> values, const std::string& where, int neighbors)
+    : mVertices(mesh.vertices.begin(), mesh.vertices.end()), mValues(std::move(values)), mNeighbors(std::size_t(std::clamp(neighbors, 1, 4)))
 {
     if (mValues.size() != mVertices.size())
         throw ValueError(where + ": " + std::to_string(mValues.size()) + " values for " + std::to_string(mVertices.size()) + " vertices; give one per vertex");
@@ -170,7 +170,7 @@ VertexValueSampler::~VertexValueSampler() = default;
 
 double VertexValueSampler::at(const Vec3d& p) const
 {
-    const std::size_t k = std::min<std::size_t>(4, mVertices.size());
+    const std::size_t k = std::min<std::size_t>(mNeighbors, mVertices.size());
     std::uint32_t idx[4];
     double d2[4];
     const std::size_t found = mTree->tree.knnSearch(p.asPointer(), k, idx, d2);

@@ -68,7 +68,8 @@ class VertexValueSampler
 {
 public:
     /// @throw ValueError (a value count that is not the vertex count, no vertices).
-    VertexValueSampler(const TriangleMesh& mesh, std::vector<float> values, const std::string& where);
+    /// @param neighbors the vertices averaged, 1 to 4 (1: the nearest vertex's value, for ids)
+    VertexValueSampler(const TriangleMesh& mesh, std::vector<float> values, const std::string& where, int neighbors = 4);
     ~VertexValueSampler();
     VertexValueSampler(const VertexValueSampler&) = delete;
     VertexValueSampler& operator=(const VertexValueSampler&) = delete;
@@ -77,6 +78,7 @@ public:
 private:
     std::vector<Vec3d> mVertices;
     std::vector<float> mValues;
+    std::size_t mNeighbors = 4;
     struct Tree;
     std::unique_ptr<Tree> mTree;
 };
