@@ -87,11 +87,9 @@ def main():
         report = run([args.vdbhair, "interpolate", guides, "--scalp", scalp, "--count", "20000", "--up", "y", "-o", out] + extra)
         print("## %s: %s" % (name, " ".join(extra)))
         print(report.strip())
-        run([args.vdbhair, "render", out, "-o", os.path.join(args.out, name + ".png"), "--head", head, "--view", "three-quarter",
-             "--width", "768", "--height", "768", "--quiet"])
-    for view in ("back", "top"):
-        out = os.path.join(tmp, "density.hair")
-        run([args.vdbhair, "render", out, "-o", os.path.join(args.out, "density_%s.png" % view), "--head", head, "--view", view,
+        # The parting of the density mask shows from the back.
+        view = "back" if name == "density" else "three-quarter"
+        run([args.vdbhair, "render", out, "-o", os.path.join(args.out, name + ".png"), "--head", head, "--view", view,
              "--width", "768", "--height", "768", "--quiet"])
 
 
