@@ -814,7 +814,7 @@ int main(int argc, char** argv)
         const StrandSet big = jitteredCopies(base, strands, vertices, 0.3f);
         benchmark("synthetic: jittered copies of the bundled ponytail", big, voxelSizeFor(big, voxelSize), reps);
         // The tracing target's reference: the same counts on a field held in the cache, where a
-        // step costs only arithmetic, for the tracer and the peer alike (README, Speed).
+        // step costs only arithmetic, for the tracer and the peer alike (docs/performance.md).
         benchmark("reference: a bundle whose field fits in the cache", bundleInCache(strands, vertices), 1.0, reps);
     }
     if (wants("helicoids")) benchmarkHelicoids(source, reps);

@@ -47,7 +47,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
         writeStrands(p.output, r.strands);
     }
     const CombStats& s = r.stats;
-    // Checks (README, "Detail transfer and combing"): tangents in reach turned toward the strokes,
+    // Checks (docs/editing.md): tangents in reach turned toward the strokes,
     // curl kept within 10 % on the moved strands.
     const nlohmann::json checks = {
         {"turned", s.reachVertices == 0 || s.angleAfter < s.angleBefore},

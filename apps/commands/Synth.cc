@@ -107,7 +107,7 @@ nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, const S
     const NoveltyStats nov = measureNovelty(example, output, radius);
     j["novelty"] = {{"output_to_example_median", nov.outputMedian}, {"example_to_example_median", nov.exampleMedian},
                     {"copies", nov.copies}};
-    // The thresholds (README, "Synthesis", says why each).
+    // The thresholds (docs/synthesis.md, says why each).
     checks = {{"length", j["length_distance"].get<double>() <= 0.15},
               {"turning", j["turning_distance"].get<double>() <= 0.25},
               {"coherence", co >= ce - 0.03},

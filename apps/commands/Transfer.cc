@@ -70,7 +70,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
         const Stage stage(common, "writing " + job.output);
         writeSynthStrands(job.output, r.strands, r.clusterOf);
     }
-    // What the transfer did (README, "Detail transfer and combing", says why each check): only
+    // What the transfer did (docs/editing.md, says why each check): only
     // measured to be printed.
     if (common.quiet && !common.json) return 0;
     const int ns = params.synth.vertices;

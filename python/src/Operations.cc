@@ -261,7 +261,7 @@ Returns:
 
 Hierarchical clustering, PCA feature maps and texture optimization, cluster-oriented detail
 transfer and vector-field refinement per level; deterministic for a seed, the same for any
-thread count. README, "Example-based synthesis", explains every option and its measured default.
+thread count. docs/synthesis.md, explains every option and its measured default.
 
 Args:
     example: Strands (many: at least 4^(levels-1)).
@@ -355,7 +355,7 @@ Returns:
         pyb::arg("progress") = pyb::none(),
         R"doc(The base's global flow with the details' wisps and waves (Wang et al. 2009, §6): ``vdbhair transfer``.
 
-README, "Editing hairstyles", explains every option and its measured default.
+docs/editing.md, explains every option and its measured default.
 
 Args:
     details: Strands whose detail is taken.

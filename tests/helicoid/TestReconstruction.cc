@@ -110,7 +110,7 @@ TEST_CASE("reconstructHairstyle: real straight hair at 10 % guides", "[helicoid]
               << " p95 " << r.helicoidErrors.p95Interpolated << "; points mean " << r.pointErrors.meanInterpolated << " p95 "
               << r.pointErrors.p95Interpolated << " (interpolated strands, fraction of length)\n";
     // Every strand is reported, finitely; the errors themselves are measured, not asserted here
-    // (README, "Interpolation and reconstruction": helicoid blending of independent fits misses the
+    // (docs/interpolation.md: helicoid blending of independent fits misses the
     // issue's goal on real hair).
     REQUIRE(r.helicoidErrors.relative.size() == some.numStrands());
     REQUIRE(r.guides.size() == 100u);

@@ -482,7 +482,7 @@ TEST_CASE("readVdbStrands: every single flipped bit of the checked layout reads 
     // and leaf buffers after them: there OpenVDB 10's io::bloscFromStream reads a declared raw
     // chunk size into a fixed buffer before it compares the two (a flipped bit at byte 19447 of
     // this file corrupts the heap), and flips in the leaf buffers made OpenVDB hold 5 GB; nothing
-    // short of reimplementing OpenVDB's tree reader can check those beforehand (README, "Fuzzing").
+    // short of reimplementing OpenVDB's tree reader can check those beforehand (docs/development.md, "Fuzzing").
     // The per-leaf checks of strandsFromGrid are tested on grids damaged in memory above.
     initializeOpenVdb();
     const std::string good = test::tempPath("flip.vdb");

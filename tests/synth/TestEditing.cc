@@ -318,7 +318,7 @@ TEST_CASE("transferHairstyle: curls onto a straight base keep the base's flow an
     CHECK(std::abs(to - tc) < 0.1 * tc);
     // These constructed wisps span whole sectors of the head (a tenth of the cap each), far wider
     // than real ones, and the output's wisp means drift by 0.13 of their length (measured; real
-    // pairs in the README: 0.01-0.10). A drift beyond a fifth would be a fault.
+    // pairs in docs/editing.md: 0.01-0.10). A drift beyond a fifth would be a fault.
     CHECK(meanDev < 0.2);
     // The output's coarsest level is the base's, smoothed (and exactly the base's with the paper's rule).
     StrandSamples smoothed = tr.base.levels.back();
@@ -362,7 +362,7 @@ TEST_CASE("transferHairstyle: short curls onto a base four times as long keep th
     // Turning per length at the curls' own sample spacing. Laid vertex by vertex (the paper's rule)
     // the curls stretch four times and keep a tenth of it; laid by arc length they keep two thirds
     // (measured 0.66; onto a base of their own length 0.99: the third is lost to the matching of
-    // centres by size, README "Editing hairstyles"). Below half, or below four times the paper's
+    // centres by size, docs/editing.md). Below half, or below four times the paper's
     // rule, is a fault.
     const double spacing = polylineLength(curly.data(0), curly.size(0)) / 63.0;
     const double tc = meanTurningPerLengthAtSpacing(curly, spacing), to = meanTurningPerLengthAtSpacing(tr.result.strands, spacing);

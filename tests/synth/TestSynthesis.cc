@@ -209,7 +209,7 @@ TEST_CASE("synthesizeHair: Curly_100's curls keep their length and turning", "[s
         const double dl = relativeWasserstein(le, lo), dt = relativeWasserstein(te, turningPerLength(r.strands));
         CAPTURE(seed, dl, dt);
         WARN("Curly_100, seed " << seed << ": length distance " << dl << ", turning distance " << dt);
-        // The thresholds of `synth --json`'s checks (README, "Example-based synthesis").
+        // The thresholds of `synth --json`'s checks (docs/synthesis.md).
         CHECK(dl <= 0.15);
         CHECK(dt <= 0.25);
     }

@@ -3,7 +3,7 @@
 /// its root through the robust tangent field (Wang et al. 2009, §5.3), but at each step the
 /// direction blends the strand's own direction with the field's by how much of an *outlier* the
 /// strand is there. Each sub-step is a step of the streamline engine (Streamline.h) through that
-/// blended direction: forward Euler by default, RK2/RK3/RK4 with ConsistencyParams::integrator. This goes beyond the paper (see below and README, "Refinement").
+/// blended direction: forward Euler by default, RK2/RK3/RK4 with ConsistencyParams::integrator. This goes beyond the paper (see below and docs/fields.md, "Refinement").
 ///
 /// Wang et al. replace every strand by a streamline of the field. On real hair that combs waves
 /// and curls straight (the field averages strands of different phase), swaps crossing wisps (a

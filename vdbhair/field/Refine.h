@@ -9,7 +9,7 @@
 ///   field only where a strand is an outlier among the hair around it, and otherwise the strand's
 ///   own direction. Strands keep their detail (waves, curls, crossing wisps) through any number
 ///   of levels, their length and vertex count, and never enter the head deeper than they were.
-///   This goes beyond the paper; README, "Refinement", shows both modes on the shared hair.
+///   This goes beyond the paper; docs/fields.md, "Refinement", shows both modes on the shared hair.
 /// - **field** is the paper's rule: every strand is replaced by the streamline of the field from
 ///   its root, for its own length (StreamlineTracer.h). It smooths everything at the voxel's
 ///   scale: waves are combed straight and crossing wisps are merged. Strands stop where the

@@ -1,6 +1,6 @@
 /// @file RefineReport.h
 /// @brief What an artist sees of a refinement, measured against the input hairstyle
-/// (README, "Refinement"): whether strands leave the hair, enter the head, lose their curls,
+/// (docs/fields.md, "Refinement"): whether strands leave the hair, enter the head, lose their curls,
 /// reach their length, move, and whether the flow got more coherent.
 #pragma once
 

@@ -836,7 +836,7 @@ FieldFootprint estimateFieldFootprint(const StrandSet& strands, const FieldParam
 namespace {
 
 /// The memory model's terms (bytes), fitted to the peak resident memory of `vdbhair field` and
-/// `vdbhair refine` (README, "Memory at scale": 100,000 strands at three voxel sizes and with 3
+/// `vdbhair refine` (docs/performance.md, "Memory at scale": 100,000 strands at three voxel sizes and with 3
 /// levels, 250,000 and 500,000 strands, x 32 vertices) so that the estimate stays above every
 /// measured peak, by 4-19 %. Per leaf: a leaf's cost depends on how many of its 512 voxels the
 /// hair fills, which is not known before the estimate, so the fit takes the larger of the

@@ -105,7 +105,7 @@ enum class MemoryUse
 /// first), the sum of per-vertex, per-strand and per-leaf terms. The one home of the memory
 /// model (its constants, in TangentField.cc, say what each term holds); fitted to the peak
 /// resident memory of `vdbhair field` and `vdbhair refine` from 100,000 to 1,000,000 strands
-/// (README, "Memory at scale"), which it stays a little above.
+/// (docs/performance.md, "Memory at scale"), which it stays a little above.
 std::uint64_t estimatePeakBytes(const std::vector<FieldFootprint>& footprints, MemoryUse use);
 
 /// @brief params.maxMemory if set, else MemAvailable of /proc/meminfo (the memory the kernel can

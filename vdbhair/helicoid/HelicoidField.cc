@@ -157,7 +157,7 @@ struct PieceFit
 /// starting from the tangent field's direction @a t0 at the voxel; @a h the voxel size.
 PieceFit fitPieces(const std::vector<const SegmentPiece*>& near, const std::vector<Vec3d>& rel, const Vec3d& t0, double h)
 {
-    // Measured on the benchmark's helicoid-field section (issue 19; README "Helicoid fields in VDB").
+    // Measured on the benchmark's helicoid-field section (issue 19; docs/helicoids.md, "Helicoid fields in VDB").
     constexpr int kPasses = 3;         // Eq. 9 weights against the tangent field, then twice against the fit
     constexpr double kRidge = 0.01;    // on the gradient, relative to the weight: unresolved directions -> 0
     constexpr double kSupport = 1.5;   // tent weights reach zero 1.5 voxels from the centre on each axis

@@ -59,7 +59,7 @@ HelicoidFieldGrids estimateHelicoidField(const StrandSet& strands, const openvdb
 
 /// @brief Fit a helicoid at every active voxel of a world-space tangent field, from the field
 /// alone (for a field read from a file, without its strands; the overload above fits the strands
-/// and retraces more closely, README "Helicoid fields in VDB").
+/// and retraces more closely, docs/helicoids.md, "Helicoid fields in VDB").
 ///
 /// Frame: T is the field's direction; N is the direction of the flow's curvature vector
 /// (T·∇)T, estimated by central differences of the trilinearly sampled field one voxel ahead and
@@ -83,7 +83,7 @@ HelicoidFieldGrids readHelicoidField(const std::string& path);
 /// default stays TraceParams' Euler). A helicoid field is for accuracy on curls, and forward Euler
 /// at half a voxel is not: its own error on a curl (the same through either field) hid the
 /// helicoid field's gain, 0.86-0.99x the tangent field's accuracy on Fig. 5's curls at Euler
-/// against 1.25-1.73x with RK4 for both (benchmark, helicoid-field section; README "Helicoid
+/// against 1.25-1.73x with RK4 for both (benchmark, helicoid-field section; docs/helicoids.md, "Helicoid
 /// fields in VDB"). RK4 costs `retrace --helicoid` about 1.7 times Euler's time end to end
 /// (4,933 strands: 0.22 s against 0.13 s).
 inline constexpr Integrator kHelicoidRetraceIntegrator = Integrator::RK4;

@@ -29,7 +29,7 @@ public:
     /// times the suggested voxel): power 1 (plain trilinear) Curly_100 1.19 / 1.04 / 1.08x, Fig. 5
     /// 1.12 / 1.25 / 1.42x; power 2: 1.22 / 1.02 / 1.09x and 1.19 / 1.39 / 1.52x; 4: 1.25 / 1.03 /
     /// 1.11x and 1.22 / 1.39 / 1.63x; 8: 1.29 / 1.03 / 1.08x and 1.25 / 1.39 / 1.73x; 30: 1.31 /
-    /// 1.07 / 1.06x and 1.23 / 1.47 / 1.67x. README "Helicoid fields in VDB".
+    /// 1.07 / 1.06x and 1.23 / 1.47 / 1.67x. docs/helicoids.md, "Helicoid fields in VDB".
     static constexpr int kCornerSharpness = 8;
 
     HelicoidFieldSampler(const HelicoidFieldGrids& f, double vanishThreshold)

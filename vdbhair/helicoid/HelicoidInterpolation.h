@@ -50,7 +50,7 @@
 /// **Arcs** (HelicoidBlend::Arcs; `--blend arcs`, the default of reconstruction): fits of neighbouring real strands
 /// are not parameterized alike (their first frames differ by a 90th percentile of 70° of roll that
 /// their k compensate, and their pieces break at different places), so averaging their (Q, k)
-/// makes a curve like neither (README, "Interpolation": 26 % error against point blending's 2.4 %
+/// makes a curve like neither (docs/interpolation.md: 26 % error against point blending's 2.4 %
 /// on straight hair). Under this rule each guide is first re-described, from its own trace, as A
 /// equal pieces with k = (kT, 0, 0, 0), which Eq. 1 makes circular arcs, joined with rolls: a
 /// p-helicoid (§3.4) in which the frame carried from piece to piece (Eq. 2 along an arc) is the
@@ -73,7 +73,7 @@
 /// above, as the paper prints them. The two differ where guides differ: arcs blend curvature
 /// vectors, so opposite bends cancel as blended points do (Fig. 6's π-rotated guides meet in a
 /// straight hair), where fitted pieces keep the guides' curvature between them (Fig. 6, tested);
-/// arcs follow captured hair far more closely (README, "Interpolation").
+/// arcs follow captured hair far more closely (docs/interpolation.md).
 ///
 /// **Exactness**: a root with a single weight (a coincident root, or a single guide) returns that
 /// guide unchanged, translated to the root (and rotated by W W_iᵀ with surface frames).
@@ -118,7 +118,7 @@ struct HelicoidInterpolationParams
     ShepardParams shepard;
     HelicoidBlend blend = HelicoidBlend::Fitted;  ///< the paper's; ReconstructParams chooses Arcs
     std::size_t arcs = 0;  ///< HelicoidBlend::Arcs: arcs per hair; 0: one per 0.2 radian of the most-turning guide (16..512)
-    PieceCountRule pieceCount = PieceCountRule::Heaviest;  ///< HelicoidBlend::Fitted; measured: Most is far worse on fitted real hair (see README)
+    PieceCountRule pieceCount = PieceCountRule::Heaviest;  ///< HelicoidBlend::Fitted; measured: Most is far worse on fitted real hair (docs/interpolation.md)
     bool kTSignRule = true;                    ///< §4.1; off only to show what it prevents
     Vec3d up{0.0, 1.0, 0.0};                   ///< reference axis of surface frames (as `vdbhair roots --up`)
     std::size_t maxVertices = std::size_t(1) << 28;  ///< refuse requests that would grow more (12 bytes each: 3 GB)

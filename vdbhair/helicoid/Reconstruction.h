@@ -47,7 +47,7 @@ struct ReconstructParams
     std::uint64_t seed = 0;
     FitParams fit;
     /// Arcs, not interpolation's Fitted: a reconstruction is judged against the captured strands,
-    /// which arcs follow far more closely (README, "Interpolation").
+    /// which arcs follow far more closely (docs/interpolation.md).
     HelicoidInterpolationParams helicoid = [] {
         HelicoidInterpolationParams p;
         p.blend = HelicoidBlend::Arcs;

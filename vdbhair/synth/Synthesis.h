@@ -66,7 +66,7 @@ struct SynthParams
     DetailBlend detailBlend = DetailBlend::Edges;
     /// Each strand at its own length and pitch: the output's centres come from the example, of
     /// its lengths (transfer between hairstyles lays detail by arc length, HairTransfer.h).
-    /// Measured on Curly_100 (--json, seeds 0-6): see the README, "Example-based synthesis".
+    /// Measured on Curly_100 (--json, seeds 0-6): see the docs/synthesis.md.
     DetailScale detailScale = DetailScale::Strand;
     DetailMatchParams match;  ///< how output wisps choose the example's (balanced, DetailTransfer.h)
     int vertices = StrandSamples::kDefaultVertices;  ///< n_s (Table 1)
