@@ -187,7 +187,7 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
                    {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe(false))},
                    {"roots", r.roots}, {"roots_dropped", r.rootsDropped}, {"cut", r.cut},
                    {"clumps", r.groom.clumps}, {"clumped", r.groom.clumped}, {"curled", r.groom.curled},
-                   {"pushed_out", r.pushedOut}, {"vertices_too_deep", r.verticesTooDeep},
+                   {"pushed_out", r.pushedOut}, {"pushed_out_after_controls", r.groomPushedOut}, {"vertices_too_deep", r.verticesTooDeep},
                    {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
                    {"leaving_guide_volume", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json({{"strands", double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample))}, {"sample", r.volumeSample}, {"voxel", r.volumeVoxel}})},
                    {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
@@ -205,8 +205,9 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
         if (!head.empty() && !op.returnScene) {
             char shares[96];
             std::snprintf(shares, sizeof shares, "%.1f %% of the new strands, %.1f %% of the guides", 100.0 * enteringShare, 100.0 * guidesEnteringShare);
-            std::cout << "head: " << head.describe(false) << " (no new vertex deeper than its root); " << r.pushedOut
-                      << " strands pushed out; passing into it: " << shares << "\n";
+            std::cout << "head: " << head.describe(false) << " (no new vertex deeper than its root); " << r.pushedOut << " strands pushed out";
+            if (r.groom.curled > 0 || r.groom.clumped > 0 || op.groom.curl.frizz > 0.0) std::cout << " (and " << r.groomPushedOut << " touched up after curl, clumps and frizz)";
+            std::cout << "; passing into it: " << shares << "\n";
         }
         if (!op.returnScene) {
             char share[64];

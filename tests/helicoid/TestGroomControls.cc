@@ -334,3 +334,42 @@ TEST_CASE("group ids from a mask grid, a painted mesh property and a mesh's isla
     REQUIRE_THROWS_WITH(readRootIds(vdb, points, "--guide-groups", "guides"), Contains("the value 0.5 at guide 0 is not an integer group id"));
     for (const std::string& f : {ply, list, vdb}) std::filesystem::remove(f);
 }
+
+TEST_CASE("curl on hair lying on the head: flattened against it where it dips in, not turned away", "[groom]")
+{
+    // Guides lie on a sphere of radius 10 (0.05 above it) along meridians from near the top down
+    // the side; new hair at roots between them, curled with an amplitude of 0.3. Every vertex the
+    // curl moves inside the head is pushed out along the normal, so each tip stays within the
+    // curl's reach of where the same hair ends without curl (a sweep would have turned the whole
+    // rest of the strand off the head at the first dip).
+    const double R = 10.05;
+    StrandSet guides;
+    for (int g = 0; g < 36; ++g) {
+        const double phi = 2.0 * M_PI * g / 36.0;
+        std::vector<Vec3f> p;
+        for (int k = 0; k < 40; ++k) {
+            const double theta = 0.2 + 1.2 * k / 39.0;  // from the crown down
+            p.emplace_back(float(R * std::sin(theta) * std::cos(phi)), float(R * std::cos(theta)), float(R * std::sin(theta) * std::sin(phi)));
+        }
+        guides.addStrand(p);
+    }
+    InterpolationGuides g;
+    g.strands = &guides;
+    InterpolationRoots roots;
+    for (int i = 0; i < 200; ++i) {
+        const double phi = 2.0 * M_PI * (i + 0.5) / 200.0;
+        roots.positions.emplace_back(R * std::sin(0.2) * std::cos(phi), R * std::cos(0.2), R * std::sin(0.2) * std::sin(phi));
+    }
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 10.0);
+    InterpolateParams plain, curled;
+    curled.groom.curl.amplitude = 0.3;
+    curled.groom.curl.frequency = 6.0;
+    const InterpolateResult a = interpolateGuides(g, roots, head, plain), b = interpolateGuides(g, roots, head, curled);
+    CHECK(b.enteringHead == 0);
+    CHECK(b.groomPushedOut > 0);  // the curl did dip in
+    REQUIRE(a.strands.numStrands() == b.strands.numStrands());
+    for (std::size_t i = 0; i < a.strands.numStrands(); ++i) {
+        CHECK((b.strands.tip(i) - a.strands.tip(i)).length() < 0.7f);  // the curl's reach, and what resampling moves
+        CHECK(b.strands.root(i) == a.strands.root(i));
+    }
+}

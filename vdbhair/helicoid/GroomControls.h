@@ -5,8 +5,9 @@
 /// wisps, around interpolated centres), and frizz.
 ///
 /// The order, each step on the result of the one before: density thins the roots (before any
-/// hair is made); length cuts each new hair; curl winds it; clumps pull each hair towards its clump
-/// centre's hair; frizz roughens it; the head (HeadCollision.h) comes last. Every random choice
+/// hair is made); length cuts each new hair; the head sweeps it out (HeadCollision.h); curl winds
+/// it; clumps pull each hair towards its clump centre's hair; frizz roughens it; and what these
+/// last three moved into the head is pushed out vertex by vertex (interpolateGuides()). Every random choice
 /// draws from a stream seeded by (seed, root index, the control), so the result does not depend on
 /// the thread count, and turning one control on does not change what the others draw.
 #pragma once

@@ -128,21 +128,31 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
             res.guidesEnteringHead = countStrandsEnteringHead(*guidePoints, head, headTolerance(head), threaded);
         }
     }
-    // Length, curl, clumps (within groups), frizz (GroomControls.h).
+    // Length (GroomControls.h), then the head: no new hair deeper inside it than its root, the
+    // hair swept out along its length (HeadCollision.h).
     if (!params.returnScene) {
         if (!roots.length.empty()) res.cut = cutStrands(res.strands, roots.length, threaded);
-        if (groomed) {
-            GroomParams groom = params.groom;
-            groom.seed = params.seed;
-            groom.maxVertices = points ? params.points.maxVertices : params.helicoid.maxVertices;
-            res.groom = applyGroomControls(res.strands, groom, rootGroups, threaded, interrupter);
+        if (!head.empty()) {
+            const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), {}, threaded);
+            res.pushedOut = hc.strandsMoved;
+            res.verticesTooDeep = hc.verticesTooDeep;
         }
     }
-    // The head: no new hair deeper inside it than its root (HeadCollision.h).
-    if (!head.empty() && !params.returnScene) {
-        const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), {}, threaded);
-        res.pushedOut = hc.strandsMoved;
-        res.verticesTooDeep = hc.verticesTooDeep;
+    // Curl, clumps (within groups), frizz on the hair as it lies, and only the vertices they move
+    // into the head pushed out, one by one: a curl that dips into the scalp is flattened against
+    // it, not turned away with the rest of the strand (a sweep would flare curly hair out).
+    if (!params.returnScene && groomed) {
+        GroomParams groom = params.groom;
+        groom.seed = params.seed;
+        groom.maxVertices = points ? params.points.maxVertices : params.helicoid.maxVertices;
+        res.groom = applyGroomControls(res.strands, groom, rootGroups, threaded, interrupter);
+        if (!head.empty()) {
+            HeadCollisionParams vertexOnly;
+            vertexOnly.passes = 0;
+            const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), vertexOnly, threaded);
+            res.groomPushedOut = hc.strandsMoved;
+            res.verticesTooDeep = hc.verticesTooDeep;
+        }
     }
     res.enteringHead = countStrandsEnteringHead(res.strands, head, headTolerance(head), threaded);
     if (!params.returnScene && guidePoints) {

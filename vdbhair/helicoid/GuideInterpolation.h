@@ -78,7 +78,8 @@ struct InterpolateResult
     std::size_t rootsDropped = 0;   ///< of them, left bare by density or a length of 0
     std::size_t cut = 0;            ///< new hairs cut to a length under 1
     GroomStats groom;               ///< curl, clumps, frizz
-    std::size_t pushedOut = 0;         ///< new strands the head pushed out
+    std::size_t pushedOut = 0;         ///< new strands the head pushed out (swept, before curl, clumps and frizz)
+    std::size_t groomPushedOut = 0;    ///< strands with vertices that curl, clumps or frizz moved into the head, pushed back out one by one
     std::size_t verticesTooDeep = 0;   ///< vertices the push could not bring out (HeadCollision.h)
     /// strands that pass into the head (countStrandsEnteringHead(), headTolerance()): of the new hair, and of the guides
     std::size_t enteringHead = 0, guidesEnteringHead = 0;
