@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Parallel.h>
+#include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/io/JsonFile.h>
 #include <vdbhair/strands/Resample.h>
@@ -259,12 +260,11 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
     }
     if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("combing interrupted");
     // 2. Every strand of a combed cluster: its edges turned by its centre's rotations at its arc
-    // length, and turned aside where the head is in the way.
+    // length; then the head (below).
     const HeadObstacle head = !params.head.unset() ? params.head
                               : scalp             ? HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper)
                                                   : headFromRoots(strands);
     const bool relative = head.policy() == HeadPolicy::NoDeeper;
-    std::vector<std::uint8_t> deflected(n, 0);
     res.strands = strands;
     {
         SynthStageTimer t{res.stages, "detail re-transfer"};
@@ -285,9 +285,6 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
         forEach(n, [&](std::size_t s) {
             const std::size_t c = std::size_t(res.cluster[s]);
             if (!touched[c]) return;
-            std::optional<HeadObstacle::Probe> probe;
-            if (!head.empty()) probe.emplace(head);
-            Quat aside = Quat::Identity();  // what the head turned the strand by so far
             const Vec3f* in = strands.data(s);
             Vec3f* out = res.strands.data(s);
             const std::vector<double>& m = mids[c];
@@ -304,43 +301,41 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
                 if (mid <= m.front()) Q = R.front();
                 else if (k + 1 >= m.size()) Q = R.back();
                 else Q = R[k].slerp((mid - m[k]) / std::max(1e-300, m[k + 1] - m[k]), R[k + 1]);
-                EVec step = aside * (Q * e);
-                if (probe) {
-                    // An edge that would take its end into the head (deeper than the input's end,
-                    // under NoDeeper) is slid along the surface at its own length; the rest of
-                    // the strand turns with it.
-                    const Vec3d at = fromE(q);
-                    Vec3d end = fromE(q + step);
-                    const double d = probe->distance(end);
-                    const double floor = d < 0.0 && relative ? std::min(0.0, probe->distance(Vec3d(in[v + 1]))) : 0.0;
-                    if (d < floor) {
-                        const double len = step.norm();
-                        Vec3d dir = fromE(step);
-                        const Vec3d nrm = probe->normal(at);
-                        const double dn = dir.dot(nrm);
-                        const Vec3d slide = dir - dn * nrm;
-                        if (dn < 0.0 && slide.length() > 1e-9 * len) dir = slide * (len / slide.length());
-                        end = at + dir;
-                        for (int it = 0; it < 4 && probe->pushOut(end, floor); ++it) {
-                            const Vec3d g = end - at;
-                            if (g.length() > 0.0) end = at + g * (len / g.length());
-                        }
-                        const EVec turned = toE(end - at);
-                        aside = (Quat::FromTwoVectors(step, turned) * aside).normalized();
-                        step = turned;
-                        deflected[s] = 1;
-                    }
-                }
+                const EVec step = Q * e;
                 q += step;
                 out[v + 1] = Vec3f(fromE(q));
             }
         });
     }
+    // The head: the combed strands swept out of it along their length, no vertex deeper inside it
+    // than the input's (NoDeeper) or none inside (KeepOutside) (HeadCollision.h: a strand that
+    // meets the head follows it over a length instead of bending at one vertex).
+    if (!head.empty()) {
+        std::vector<char> touchedStrand(n, 0);
+        for (std::size_t s = 0; s < n; ++s) touchedStrand[s] = char(touched[std::size_t(res.cluster[s])]);
+        StrandSet combed = selectStrands(res.strands, touchedStrand);
+        std::vector<float> allowed(combed.numVertices(), 0.f);
+        if (relative) {
+            std::size_t w = 0;
+            HeadObstacle::Probe probe(head);
+            for (std::size_t s = 0; s < n; ++s) {
+                if (!touchedStrand[s]) continue;
+                for (std::size_t v = 0; v < strands.size(s); ++v, ++w) allowed[w] = float(std::max(0.0, -probe.distance(Vec3d(strands.data(s)[v]))));
+            }
+        }
+        const HeadCollisionStats hc = resolveHeadCollisions(combed, head, allowed, {}, threaded);
+        std::size_t t = 0;
+        for (std::size_t s = 0; s < n; ++s) {
+            if (!touchedStrand[s]) continue;
+            std::copy(combed.data(t), combed.data(t) + combed.size(t), res.strands.data(s));
+            ++t;
+        }
+        res.stats.headDeflected = hc.strandsMoved;
+    }
     // 3. What the strokes did.
     CombStats& st = res.stats;
     st.clusters = K;
     st.head = head.empty() ? std::string("none") : head.describe();
-    for (std::uint8_t u : deflected) st.headDeflected += u;
     for (std::uint8_t u : touched) st.combedClusters += u;
     std::vector<std::uint8_t> moved(n, 0);
     for (std::size_t s = 0; s < n; ++s) moved[s] = touched[std::size_t(res.cluster[s])];

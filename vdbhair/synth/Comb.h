@@ -74,9 +74,10 @@ struct CombParams
     double smoothing = StrandSamples::kDetailSmoothing;  ///< σ of the strand directions, a fraction of the vertices
     /// The head the combed strands may not enter, with its policy (HeadObstacle.h): under NoDeeper
     /// (readHeadObstacle()'s default) no vertex goes deeper into it than the input's vertex of the
-    /// same index was, so a vertex outside stays outside. A strand edge that would enter it is
-    /// turned aside (slid along the surface at its own length) and the rest of the strand turns
-    /// with it, curl and all, as hair drapes over a head. Unset: the scalp's level set when
+    /// same index was, so a vertex outside stays outside. The combed strands are swept out of it
+    /// along their length (resolveHeadCollisions(), HeadCollision.h, as new hair is): a strand that
+    /// meets it follows it, its lengths kept, the bend spread over a stretch rather than made at
+    /// one vertex (which kinked combed hair at the shoulders). Unset: the scalp's level set when
     /// combHair() is given one, else the sphere fitted to the roots (headFromRoots(), NoDeeper);
     /// HeadObstacle::none(): no head.
     HeadObstacle head;
@@ -97,7 +98,7 @@ struct CombStats
     /// Mean total turning per unit length of the moved strands, before and after (radians per unit)
     double turningBefore = 0.0, turningAfter = 0.0;
     std::string head;               ///< the head used (HeadObstacle::describe()), "none" without one
-    std::size_t headDeflected = 0;  ///< moved strands whose edges the head turned aside
+    std::size_t headDeflected = 0;  ///< moved strands the head pushed out
     /// Vertices of the moved strands inside the head (signed distance below 0), before and after
     std::size_t insideHeadBefore = 0, insideHeadAfter = 0;
 };
