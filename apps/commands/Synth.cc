@@ -22,6 +22,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 namespace vdbhair::app {
@@ -31,7 +32,7 @@ namespace {
 struct SynthCmdParams
 {
     double outputTurnDeg = 0.0;
-    std::string input, output, scalp, saveMaps, region, outputScalp, layout = synthLayoutName(SynthParams{}.layout);
+    std::string input, output, scalp, saveMaps, region, outputScalp, head, layout = synthLayoutName(SynthParams{}.layout);
     SynthOptionText text;
     std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;
@@ -201,7 +202,11 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
         pts.reserve(region.size());
         for (const Vec3d& q : region) pts.emplace_back(q);
         outputMap = scalpMapOfPoints(pts, p.synth.up, other);
+        p.synth.head = HeadObstacle::levelSet(other);  // the head the hair grows on
+        p.synth.head.setLabel("--output-scalp " + p.outputScalp);
     }
+    if (p.head == "none") p.synth.head = HeadObstacle::none();
+    else if (!p.head.empty()) p.synth.head = readHeadObstacle(p.head, "--head " + p.head);
     const auto t0 = std::chrono::steady_clock::now();
     const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter, regionFrom.empty() ? nullptr : &region, outputMap);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -261,6 +266,9 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
                    {"head_radius", r.map->radius()}, {"region", regionFrom.empty() ? "the example's" : regionFrom}, {"output_area", r.outputArea},
                    {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)}, {"detail_scale", detailScaleName(p.synth.detailScale)},
                    {"match", {{"balance", p.synth.match.balance}, {"candidates", p.synth.match.candidates}}},
+                   {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
+                             {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
+                                           {"example", outputMap ? nlohmann::json(nullptr) : nlohmann::json(double(r.exampleEnteringHead) / double(example.numStrands()))}}}}},
                    {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}});
     } else if (!common.quiet) {
         std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
@@ -269,7 +277,18 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
             std::cout << "  level " << l << ": example " << r.example.levels[l].count() << ", output " << r.output[l].count() << "\n";
         std::cout << "  length distance " << stats["length_distance"] << ", turning distance " << stats["turning_distance"]
                   << ", coherence " << stats["coherence"]["output"] << " (example " << stats["coherence"]["example"] << ")"
-                  << ", copies " << stats["novelty"]["copies"] << "\nwrote " << p.output << "\n";
+                  << ", copies " << stats["novelty"]["copies"] << "\n";
+        if (r.head != "none") {
+            char shares[128];
+            std::snprintf(shares, sizeof shares, "%.1f %% of the output", 100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())));
+            std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares;
+            if (!outputMap) {
+                std::snprintf(shares, sizeof shares, ", %.1f %% of the example", 100.0 * double(r.exampleEnteringHead) / double(example.numStrands()));
+                std::cout << shares;
+            }
+            std::cout << "\n";
+        }
+        std::cout << "wrote " << p.output << "\n";
     }
     return 0;
 }
@@ -337,6 +356,8 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--region", params->region, "Where the new hair grows (default: the example's region): a scalp .vdb's 'region' grid (vdbhair scalp --region...), roots (.ply points, as vdbhair roots writes) or the roots of a hairstyle; the strand count scales with the area");
     sub->add_option("--strands", params->strands, "Strands in the output (default: the example's density over the region; every level scales alike)");
     sub->add_option("--output-turn", params->outputTurnDeg, "With --output-scalp: degrees about the up axis that the layout turns on the other head (for heads that face different ways)")->capture_default_str();
+    sub->add_option("--head", params->head, "The head new hair may enter no deeper than its root: a mesh (.ply, .obj), a .vdb level set, or 'none' "
+                                             "(default: --output-scalp's, else --scalp's surface, else the sphere fitted to the roots)");
     sub->add_option("--output-scalp", params->outputScalp, "Grow the new hair on another head: a scalp .vdb (its 'region' grid is where the hair grows, unless --region says) or a head mesh with --region; the hairstyle moves there through scalp space");
     sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();
     sub->add_option("--layout", params->layout, "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: a variation that keeps its global flow exactly)")->capture_default_str();

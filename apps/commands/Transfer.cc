@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 namespace vdbhair::app {
 
@@ -105,14 +106,23 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                    {"output_vertices", tr.outputVertices}, {"details_smoothing", tr.detailsSmoothing},
                    {"turning_per_head_radius", {{"details", turnDetails * rd}, {"base", turnBase * rb}, {"output", turnOut * rb}}},
                    {"coarse_deviation", {{"mean", mean(dev)}, {"p90", percentile(dev, 0.9)}, {"clusters", dev.size()}}},
+                   {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
+                             {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
+                                           {"base", double(r.exampleEnteringHead) / double(base.numStrands())}}}}},
                    {"stages", stages}, {"seconds", seconds}, {"checks", checks}});
     } else if (!common.quiet) {
         std::cout << "transferred the detail of " << job.details << " (" << details.numStrands() << " strands) onto "
                   << job.base << " (" << base.numStrands() << "): " << r.strands.numStrands() << " strands in " << seconds << " s\n"
                   << "  turning per head radius: details " << turnDetails * rd << ", base " << turnBase * rb << ", output " << turnOut * rb << "\n"
                   << "  output wisps from the base's coarsest strands: " << mean(dev) * 100.0 << " % of their length (mean)\n"
-                  << "  wisp length ratio base/details " << tr.lengthRatio << ", detail scale " << tr.detailScale << "\n"
-                  << "wrote " << job.output << "\n";
+                  << "  wisp length ratio base/details " << tr.lengthRatio << ", detail scale " << tr.detailScale << "\n";
+        if (r.head != "none") {
+            char shares[128];
+            std::snprintf(shares, sizeof shares, "%.1f %% of the output, %.1f %% of the base",
+                          100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())), 100.0 * double(r.exampleEnteringHead) / double(base.numStrands()));
+            std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares << "\n";
+        }
+        std::cout << "wrote " << job.output << "\n";
     }
     return 0;
 }

@@ -219,7 +219,9 @@ Returns:
                 std::shared_ptr<const ScalpMap> other;
                 if (outputScalp) {
                     std::vector<Vec3f> pts(regionPoints.begin(), regionPoints.end());
-                    other = scalpMapOfPoints(pts, p.up, readScalp(*outputScalp, interrupter));
+                    const openvdb::FloatGrid::Ptr otherGrid = readScalp(*outputScalp, interrupter);
+                    other = scalpMapOfPoints(pts, p.up, otherGrid);
+                    p.head = HeadObstacle::levelSet(otherGrid);  // the head the hair grows on (as the command)
                 }
                 return synthesizeHair(*example, p, grid, true, interrupter, region ? &regionPoints : nullptr, other);
             });
@@ -243,6 +245,8 @@ Returns:
             report["head_radius"] = r.map->radius();
             report["up"] = pyb::make_tuple(r.up.x(), r.up.y(), r.up.z());
             report["output_area"] = r.outputArea;
+            report["head"] = pyb::dict(pyb::arg("head") = r.head, pyb::arg("pushed_out") = r.headPushedOut, pyb::arg("entering_output") = r.enteringHead,
+                                       pyb::arg("entering_example") = r.exampleEnteringHead);
             return pyb::make_tuple(out, report);
         },
         pyb::arg("example"), pyb::kw_only(), pyb::arg("levels") = synthDefaults.cluster.levels, pyb::arg("strands") = pyb::none(),
@@ -290,7 +294,8 @@ Args:
     output_scalp: a path to another head (scalp .vdb or mesh) that region= lies on: the hairstyle
         is made at the region's (u, v) and moved onto it through scalp space.
     output_turn: degrees about the up axis the layout turns on output_scalp (heads facing different ways).
-    return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up, output_area).
+    return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up, output_area,
+        head: the head new hair is kept out of, the strands pushed out, the output's and the example's strands passing into it).
     threads: worker threads, 0 for all cores.
     progress: optional callable ``progress(stage, done, total, unit)``.
 

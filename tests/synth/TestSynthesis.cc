@@ -1,6 +1,7 @@
 #include "SynthTestUtil.h"
 #include "TestUtil.h"
 
+#include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/Synthesis.h>
@@ -47,7 +48,10 @@ TEST_CASE("synthesizeHair: a wisp hairstyle gives a new one with its counts, len
     std::vector<std::string> names;
     for (const SynthStage& s : r.stages) names.push_back(s.name);
     CHECK(names == std::vector<std::string>{"scalp", "clustering", "feature maps", "texture optimization",
-                                            "coarsest level", "refinement", "detail transfer"});
+                                            "coarsest level", "refinement", "detail transfer", "head"});
+    // The head (the sphere fitted to the example's roots): no new hair passes into it.
+    CHECK_THAT(r.head, Catch::Matchers::Contains("fitted to the roots"));
+    CHECK(r.enteringHead == 0);
     // Roots on the scalp (the fitted unit sphere), strands of the example's lengths and bends.
     for (std::size_t s = 0; s < r.strands.numStrands(); ++s) CHECK(Vec3d(r.strands.root(s)).length() == Approx(1.0).margin(1e-3));
     std::vector<double> le, lo;
@@ -213,4 +217,27 @@ TEST_CASE("synthesizeHair: Curly_100's curls keep their length and turning", "[s
         CHECK(dl <= 0.15);
         CHECK(dt <= 0.25);
     }
+}
+
+TEST_CASE("synthesizeHair on a real short groom with its head: no more hair in the head than the example", "[synth][data]")
+{
+    // Ruby's short layered hair on her own head mesh. Without the head, 37.8 % of the synthesized
+    // strands passed into it (the example: 9.3 %); swept out as interpolate's new hair is, none.
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string dir = test::sharedData();
+    const StrandSet example = readStrands(dir + "/hair/tressfx/ascii_v2/ruby_short_hair_16_guide.tfx");
+    SynthParams params;
+    params.head = HeadObstacle::none();
+    const SynthResult free = synthesizeHair(example, params);
+    params.head = readHeadObstacle(dir + "/scalp/tressfx/ruby_head.obj", "test");
+    const SynthResult kept = synthesizeHair(example, params);
+    const HeadObstacle& head = params.head;
+    const std::size_t freeEntering = countStrandsEnteringHead(free.strands, head, headTolerance(head));
+    INFO("entering the head: without it " << freeEntering << ", with it " << kept.enteringHead << ", the example " << kept.exampleEnteringHead
+                                          << " of " << example.numStrands());
+    CHECK(free.head == "none");
+    CHECK(freeEntering > kept.exampleEnteringHead);  // synthesis alone puts hair into the head
+    CHECK(kept.enteringHead <= kept.exampleEnteringHead);
+    CHECK(kept.enteringHead * 100 <= kept.strands.numStrands());
+    CHECK(kept.headPushedOut > 0);
 }

@@ -177,6 +177,8 @@ TransferResult transferHairstyle(const StrandSet& details, const StrandSet& base
             for (const Clustering& cl : tr.base.clusterings) c = cl.label[c];
             tr.baseLabel[baseOrder[i]] = std::int32_t(c);
         }
+    // The head: BASE's (its scalp, else the sphere fitted to its roots), no new vertex deeper than its root.
+    keepHairOutOfHead(res, synthesisHead(sp, baseScalp, false, base, res.up), &base, threaded);
     return tr;
 }
 

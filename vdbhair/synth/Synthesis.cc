@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
+#include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/synth/DetailTransfer.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/RootScatter.h>
@@ -250,6 +251,7 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     synthesizeFinerLevels(res, res.example, [&](int l) { return LevelRoots{scatter(l).positions, {}}; }, params, finestVoxel,
                           /*refineCoarsest=*/true, scalp, threaded, interrupter);
     if (outputScalp) res.strands = moveToScalp(res.strands, map, *outputScalp, params.outputTurn, threaded);
+    keepHairOutOfHead(res, synthesisHead(params, scalp, outputScalp != nullptr, example, res.up), outputScalp ? nullptr : &example, threaded);
     return res;
 }
 
@@ -317,6 +319,25 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
         for (std::size_t i = 0; i < n; ++i) at[i] = std::int32_t(parent[std::size_t(l)][std::size_t(at[i])]);
         res.clusterOf.push_back(at);
     }
+}
+
+HeadObstacle synthesisHead(const SynthParams& params, openvdb::FloatGrid::ConstPtr scalp, bool otherHead, const StrandSet& roots, const Vec3d& up)
+{
+    if (!params.head.unset()) return params.head;
+    if (otherHead) return HeadObstacle::none();
+    if (scalp) return HeadObstacle::levelSet(scalp);
+    return headFromRoots(roots, up);
+}
+
+void keepHairOutOfHead(SynthResult& res, const HeadObstacle& head, const StrandSet* reference, bool threaded)
+{
+    res.head = head.empty() ? std::string("none") : head.describe(false);
+    if (head.empty()) return;
+    SynthStageTimer t{res.stages, "head"};
+    res.headPushedOut = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), {}, threaded).strandsMoved;
+    const double tolerance = headTolerance(head);
+    res.enteringHead = countStrandsEnteringHead(res.strands, head, tolerance, threaded);
+    if (reference) res.exampleEnteringHead = countStrandsEnteringHead(*reference, head, tolerance, threaded);
 }
 
 } // namespace vdbhair

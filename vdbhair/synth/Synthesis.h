@@ -26,6 +26,7 @@
 /// Deterministic for a seed and independent of the thread count.
 #pragma once
 
+#include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/strands/StrandSet.h>
 #include <vdbhair/synth/Clustering.h>
@@ -113,6 +114,13 @@ struct SynthParams
     std::uint64_t maxVertices = std::uint64_t(1) << 28;
 
     /// @throw ValueError naming the parameter, its value and the rule.
+    /// The head the new hair may enter no deeper than its root, swept out of it along a length as
+    /// `interpolate`'s new hair is (HeadCollision.h). Unset: the scalp's level set when
+    /// synthesizeHair() is given one, else the sphere fitted to the example's roots; with an
+    /// output scalp and no head set, none (the caller knows the other head: the CLI passes its
+    /// level set). HeadObstacle::none(): no head.
+    HeadObstacle head;
+
     void validate(const char* where) const;
 };
 
@@ -140,6 +148,10 @@ struct SynthResult
     std::vector<double> refineVoxelSizes;       ///< per output level (0 the finest), world units
     Vec3d up{0.0, 1.0, 0.0};                    ///< the up axis used
     double outputArea = 0.0;                    ///< area of a given output region on the example's scalp (0: the example's region)
+    std::string head;                           ///< the head used (HeadObstacle::describe()), "none" without one
+    std::size_t headPushedOut = 0;              ///< output strands the head pushed out
+    /// strands passing into the head (countStrandsEnteringHead(), headTolerance()): of the output, and of the example (0 on another head)
+    std::size_t enteringHead = 0, exampleEnteringHead = 0;
 };
 
 /// Stage 1, the scalp map of a hairstyle (hairScalpMap(), scalpMapOfPoints()), is in field/ScalpMap.h.
@@ -199,5 +211,16 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params,
                            openvdb::FloatGrid::ConstPtr scalp = nullptr, bool threaded = true,
                            openvdb::util::NullInterrupter* interrupter = nullptr,
                            const std::vector<Vec3d>* outputRegion = nullptr, std::shared_ptr<const ScalpMap> outputScalp = nullptr);
+
+/// @brief The head a synthesis keeps its new hair out of (SynthParams::head): the one set; else
+/// none when the hair grows on @a otherHead (the caller sets that head); else @a scalp's level
+/// set; else the sphere fitted to @a roots' roots (headFromRoots()).
+HeadObstacle synthesisHead(const SynthParams& params, openvdb::FloatGrid::ConstPtr scalp, bool otherHead, const StrandSet& roots, const Vec3d& up);
+
+/// @brief The last step of synthesizeHair() and transferHairstyle(): @a res.strands swept out of
+/// @a head along a length, no vertex deeper than its root (HeadCollision.h), and the strands
+/// passing into it counted, of the output and of @a reference (the example or the base; null:
+/// not counted). Sets SynthResult::head, headPushedOut, enteringHead, exampleEnteringHead.
+void keepHairOutOfHead(SynthResult& res, const HeadObstacle& head, const StrandSet* reference, bool threaded = true);
 
 } // namespace vdbhair
