@@ -106,3 +106,20 @@ TEST_CASE("readTfx: 2^32-1 strands of 0 vertices are refused before allocating",
     REQUIRE_THROWS_WITH(readTfx(test::writeBytes("t4_zero.tfx", v4)),
                         Contains("at byte 8: 4294967295 strands of 0 vertices: every strand of a TressFX file has the same count, and a strand needs at least 2"));
 }
+
+TEST_CASE("readTfx: ASCII vertices written with commas, and follow-hair counts in the header", "[io]")
+{
+    // Some exporters write "x, y, z" (and the follow-hair settings) in the ASCII format; the
+    // same strands as with spaces.
+    const std::string commas = "version 2.0\nnumStrands 2\nnumFollowHairsPerGuideHair 4\ntipSeparationFactor 2.0\n"
+                               "strand 0 numVerts 3 texcoord 0 0\n0.0, 0.0, 0.0\n0.0, 1.0, 0.0\n0.5,2.0,0.0\n"
+                               "strand 1 numVerts 2 texcoord 0 0\n1 0 0\n1, 1, 0\n";
+    const StrandSet s = readTfx(test::writeBytes("c1.tfx", commas));
+    REQUIRE(s.numStrands() == 2);
+    REQUIRE(s.numVertices() == 5);
+    CHECK(s.positions[2] == Vec3f(0.5f, 2.f, 0.f));
+    CHECK(s.positions[4] == Vec3f(1.f, 1.f, 0.f));
+    // A comma is not a number: a vertex line of two values and an empty field is still refused.
+    REQUIRE_THROWS_WITH(readTfx(test::writeBytes("c2.tfx", "version 2.0\nnumStrands 1\nstrand 0 numVerts 2 texcoord 0 0\n0, 0\n1, 1, 1\n")),
+                        Contains("a vertex line needs 3 numbers"));
+}

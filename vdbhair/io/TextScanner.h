@@ -24,9 +24,10 @@ public:
     TextScanner(const char* data, std::size_t size, std::string where, std::size_t begin = 0)
         : mData(data), mSize(size), mPos(begin), mWhere(std::move(where)) {}
 
-    /// @brief Split the next line into whitespace-separated tokens.
+    /// @brief Split the next line into whitespace-separated tokens (with @a commas, commas separate
+    /// them too: "x, y, z", as some TressFX exporters write vertices).
     /// @return false at the end of the text.
-    bool nextLine(std::vector<std::string_view>& tokens)
+    bool nextLine(std::vector<std::string_view>& tokens, bool commas = false)
     {
         tokens.clear();
         if (mPos >= mSize) return false;
@@ -35,9 +36,9 @@ public:
         while (end < mSize && mData[end] != '\n') ++end;
         std::size_t i = mPos;
         while (i < end) {
-            while (i < end && isSpace(mData[i])) ++i;
+            while (i < end && (isSpace(mData[i]) || (commas && mData[i] == ','))) ++i;
             const std::size_t start = i;
-            while (i < end && !isSpace(mData[i])) ++i;
+            while (i < end && !isSpace(mData[i]) && !(commas && mData[i] == ',')) ++i;
             if (i > start) tokens.emplace_back(mData + start, i - start);
         }
         mPos = (end < mSize) ? end + 1 : end;

@@ -112,7 +112,7 @@ StrandSet readAscii(const MappedFile& file, const std::string& where,
             const std::size_t first = out.positions.size();
             for (std::int64_t j = 0; j < k; ++j) {
                 poll();
-                if (!text.nextLine(tok)) text.fail("file ends inside strand " + std::to_string(strandsSeen) + " (" + std::to_string(j) + " of " + std::to_string(k) + " vertices read)");
+                if (!text.nextLine(tok, /*commas=*/true)) text.fail("file ends inside strand " + std::to_string(strandsSeen) + " (" + std::to_string(j) + " of " + std::to_string(k) + " vertices read)");
                 if (tok.size() < 3) text.fail("a vertex line needs 3 numbers");
                 const Vec3f p(text.toFloat(tok[0], "x"), text.toFloat(tok[1], "y"), text.toFloat(tok[2], "z"));
                 checkFinite(p, out.positions.size(), where, "line " + std::to_string(text.line()));
