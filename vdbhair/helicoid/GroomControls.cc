@@ -336,6 +336,7 @@ GroomStats applyGroomControls(StrandSet& strands, const GroomParams& params, con
             const std::size_t n = strands.size(i);
             std::vector<double> arc;
             arcOf(p, n, arc);
+            if (!(arc.back() > 0.0)) return;  // a strand of zero length has no across
             const std::vector<Vec3f> before(p, p + n);
             Rng rng(params.seed, i, kFrizzStream);
             for (std::size_t k = 1; k < n; ++k) {
