@@ -115,6 +115,11 @@ def test_synth(tmp_path):
     assert [lv["output"] for lv in report["levels"]][0] == 800
     assert [name for name, _ in report["stages"]][:3] == ["scalp", "clustering", "feature maps"]
     assert len(report["cluster_of"]) == 2 and report["cluster_of"][0].shape == (800,)
+    # The head (the sphere fitted to the example's roots, which a third of the example's strands
+    # pass into): the new hair is pushed out of it, at most a strand in a hundred still touching it.
+    head = report["head"]
+    assert "fitted to the roots" in head["head"] and head["pushed_out"] > 0
+    assert head["entering_output"] <= 8 and head["entering_example"] > 400
     # Deterministic for a seed and independent of the thread count; another seed differs.
     again = vdbhair.synth(example, strands=800, seed=3, threads=1)
     assert np.array_equal(again.positions, out.positions)
