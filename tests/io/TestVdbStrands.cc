@@ -3,7 +3,9 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/HairFile.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/VdbInfo.h>
+#include <vdbhair/io/VdbPrescan.h>
 #include <vdbhair/io/VdbStrandGrid.h>
 
 #include <openvdb/io/Stream.h>
@@ -389,7 +391,7 @@ TEST_CASE("checkVdbFileLayout: what OpenVDB reads differently by version, type a
         // leak is OpenVDB's); vdbhair turns the throw into its one-line error.
         const std::string path = test::regressionInput("fuzz_vdb_rootnode_leak.vdb");
         REQUIRE(std::filesystem::file_size(path) == 10822);
-        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("cannot read grid 'strands' (RuntimeError: Expected to read a 480-byte uncompressed chunk"));
+        REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("not a VDB file this reader can bound: at byte 9049: grid 'strands': internal node values: uncompressed chunk of 0 bytes for a destination of 480"));
     }
     const std::string good = test::tempPath("typed.vdb");
     writeVdbStrands(good, test::sampleStrands(false));
@@ -581,3 +583,45 @@ TEST_CASE("pointsVoxelSize: OpenVDB's computeVoxelSize, bit for bit", "[vdb][io]
     }
     REQUIRE_THROWS_AS(pointsVoxelSize(cloud, 0), ValueError);
 }
+
+TEST_CASE("prescanVdbFile: every chunk size and array size of a strands .vdb set to -1000 or 2^40 is refused before OpenVDB reads it", "[io][fuzz]")
+{
+    // Debian's OpenVDB 10.0.1 writes a negative chunk size of any length into a leaf's buffer
+    // (fixed in 11.0), allocates positive ones as declared, and slices attribute pages without
+    // bounds: setting these fields of a 100-strand file crashed `vdbhair convert` (SIGSEGV,
+    // free(): invalid pointer, an assertion in StreamCompression.cc). Every one must now end in one
+    // FormatError naming the file, before OpenVDB reads a byte of the grid.
+    StrandSet s;
+    for (int i = 0; i < 100; ++i) {
+        std::vector<Vec3f> p;
+        for (int k = 0; k < 12; ++k) p.emplace_back(float(i % 10), float(i / 10), 0.5f * float(k));
+        s.addStrand(p);
+    }
+    const std::string path = test::tempPath("prescan_base.vdb");
+    writeVdbStrands(path, s);
+    std::vector<VdbPrescanField> fields;
+    REQUIRE(prescanVdbFile(path, "base", nullptr, &fields));
+    CHECK(readVdbStrands(path).numStrands() == 100);
+    const std::vector<char> bytes = readFileBytes(path, "test");
+    std::size_t mutated = 0;
+    for (const VdbPrescanField& f : fields) {
+        const bool chunk = f.kind == "chunk64blosc" || f.kind == "chunk64zip";
+        if (!chunk && f.kind != "arraybytes" && f.kind != "page32") continue;
+        for (const std::int64_t value : {std::int64_t(-1000), std::int64_t(1) << 40}) {
+            std::vector<char> m = bytes;
+            if (f.kind == "page32") {
+                const std::int32_t v = value < 0 ? std::int32_t(value) : std::int32_t(1) << 30;
+                std::memcpy(m.data() + f.offset, &v, 4);
+            } else {
+                std::memcpy(m.data() + f.offset, &value, 8);
+            }
+            const std::string bad = test::tempPath("prescan_bad.vdb");
+            writeFileAtomic(bad, std::string(m.begin(), m.end()), "test");
+            INFO(f.kind << " at byte " << f.offset << " set to " << value);
+            REQUIRE_THROWS_AS(readVdbStrands(bad), FormatError);
+            ++mutated;
+        }
+    }
+    CHECK(mutated >= 8);
+}
+

@@ -1,4 +1,5 @@
 #include "VdbFile.h"
+#include "VdbPrescan.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
@@ -301,6 +302,7 @@ void openFile(openvdb::io::File& file, const std::string& path, const std::strin
 {
     requireRegularFile(path, where);
     checkVdbFileLayout(path, where);
+    prescanVdbFile(path, where);  // every chunk, count and string bounded before OpenVDB reads it (VdbPrescan.h)
     try {
 
         file.open(/*delayLoad=*/false);
