@@ -166,6 +166,4 @@ std::vector<Command> addCommands(CLI::App& app, CommonOptions& common)
     return commands;
 }
 
-int run(int argc, char** argv) { return runVerbs(argc, argv, addCommands); }
-
 } // namespace vdbhair::app

@@ -1,6 +1,5 @@
-// The command line's light half (Command.h): the verbs' table, the options every verb shares, and
-// parsing and dispatch with the one-line errors and exit codes. No OpenVDB library: the light
-// program (lite/Lite.cc) links it as the full one does.
+// The command line (Command.h): the verbs' table, the options every verb shares, and parsing and
+// dispatch with the one-line errors and exit codes.
 #include "Command.h"
 #include "TerminalProgress.h"
 
@@ -46,12 +45,6 @@ constexpr Verb kVerbs[] = {
     {"batch", "Run one verb over a dataset: each input in its own process, records in OUTDIR/batch.jsonl, resumable, sharded for schedulers (Slurm arrays)"},
 };
 } // namespace
-
-void keepUntilExit(std::shared_ptr<const void> object)
-{
-    static std::vector<std::shared_ptr<const void>> kept;
-    kept.push_back(std::move(object));
-}
 
 const std::vector<Verb>& verbs()
 {
@@ -193,7 +186,7 @@ std::string withFlagNames(const std::string& message, const FlagNames& names)
     return out;
 }
 
-int runVerbs(int argc, char** argv, const AddCommands& addCommands)
+int run(int argc, char** argv)
 {
     CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
                  ": hair geometry on OpenVDB - strands, tangent fields and generalized helicoids.\n"

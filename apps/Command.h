@@ -220,26 +220,13 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
 /// @brief Every verb, registered on @a app in the order of verbs().
 std::vector<Command> addCommands(CLI::App& app, CommonOptions& common);
 
-/// Registers a program's verbs: addCommands() in the full program, lite/Lite.cc's in the light one.
-using AddCommands = std::function<std::vector<Command>(CLI::App&, CommonOptions&)>;
-
 /// @brief The verbs of @a verbs nearest to @a word (edit distance, a prefix counting as 1), for
 /// "did you mean"; empty when none is close.
 std::vector<std::string> nearestVerbs(const std::string& word, const std::vector<std::string>& verbs);
 
-/// @brief Keep @a object alive until the process ends: a verb hands over what is large and made of
-/// many allocations (a field's trees) once its outputs are written, and the program's main ends
-/// without destroying it (std::_Exit after flushing the streams; the kernel takes the memory back
-/// at once). Freeing a field's leaves one by one took 20-35 ms of `vdbhair field`'s 0.5 s. In a
-/// process that returns from main (the tests), the objects are destroyed at its end as usual.
-void keepUntilExit(std::shared_ptr<const void> object);
-
 /// @brief Parse, dispatch, and turn errors into `vdbhair <verb>: <message>` with an exit code:
 /// 0 success, 1 a failed run (bad input file, I/O), 2 a bad command line, 130 interrupted
-/// (Ctrl-C: nothing written). The verbs are those @a addCommands registers.
-int runVerbs(int argc, char** argv, const AddCommands& addCommands);
-
-/// @brief runVerbs() with every verb: the full program's main.
+/// (Ctrl-C: nothing written): the program's main.
 int run(int argc, char** argv);
 
 } // namespace vdbhair::app

@@ -21,6 +21,24 @@ pid_t startChild(const std::vector<std::string>& argv, const std::string& cwd, c
     std::vector<char*> cargv;
     for (const std::string& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
     cargv.push_back(nullptr);
+    // The children's malloc asks for transparent huge pages for the memory it maps (glibc's
+    // tunable glibc.malloc.hugetlb=1; a setting the batch's environment has is kept): a child
+    // reads and writes whole hairstyles, where a page fault per 4 KiB is a visible share of the
+    // time (docs/performance.md). A tunable is read when a process starts, so it is set here.
+    std::vector<std::string> env;
+    bool hasTunable = false;
+    for (char** e = environ; *e; ++e) {
+        std::string v = *e;
+        if (v.rfind("GLIBC_TUNABLES=", 0) == 0) {
+            if (v.find("glibc.malloc.hugetlb") == std::string::npos) v += (v.size() > 15 ? ":" : "") + std::string("glibc.malloc.hugetlb=1");
+            hasTunable = true;
+        }
+        env.push_back(std::move(v));
+    }
+    if (!hasTunable) env.push_back("GLIBC_TUNABLES=glibc.malloc.hugetlb=1");
+    std::vector<char*> cenv;
+    for (const std::string& e : env) cenv.push_back(const_cast<char*>(e.c_str()));
+    cenv.push_back(nullptr);
     const pid_t parent = ::getpid();
     const pid_t pid = ::fork();
     if (pid < 0) throw IoError("cannot start a process for " + argv.back() + ": " + std::strerror(errno));
@@ -38,7 +56,7 @@ pid_t startChild(const std::vector<std::string>& argv, const std::string& cwd, c
         (void)!::write(2, msg, sizeof msg - 1);
         ::_exit(127);
     }
-    ::execv(cargv[0], cargv.data());
+    ::execve(cargv[0], cargv.data(), cenv.data());
     static const char msg[] = "vdbhair batch: cannot run the vdbhair program\n";
     (void)!::write(2, msg, sizeof msg - 1);
     ::_exit(127);

@@ -172,7 +172,6 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         std::cout << "wrote " << p.output << "\n";
         if (!p.dense.empty()) std::cout << "wrote " << p.dense << ": orientation volume " << p.denseSize[0] << " x " << p.denseSize[1] << " x " << p.denseSize[2] << " x 4\n";
     }
-    keepUntilExit(std::make_shared<openvdb::GridCPtrVec>(grids));  // the trees, freed with the process
     return 0;
 }
 

@@ -1,5 +1,4 @@
-// vdbhair info FILE [--json]: what a strand file or a .vdb file holds. This half needs no OpenVDB
-// library (the light program runs it); a .vdb file is InfoVdb.cc's.
+// vdbhair info FILE [--json]: what a strand file or a .vdb file holds; a .vdb file is InfoVdb.cc's.
 #include "Info.h"
 
 #include <vdbhair/io/FileUtil.h>
@@ -73,7 +72,7 @@ int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadRe
 }
 
 
-Command addInfoVerb(CLI::App& app, CommonOptions& common, const InfoVdbRunner& vdbFile)
+Command addInfoCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<InfoParams>();
     CLI::App* sub = addVerb(app, "info");
@@ -82,8 +81,8 @@ Command addInfoVerb(CLI::App& app, CommonOptions& common, const InfoVdbRunner& v
     sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair info scenes/default/ponytail.hair --json");
-    return {sub, [params, &common, vdbFile] {
-                if (fileExtension(params->input) == ".vdb") return vdbFile(*params, common);
+    return {sub, [params, &common] {
+                if (fileExtension(params->input) == ".vdb") return infoVdbFile(*params, common);
                 ReadReport report;
                 const StrandSummary s = summarizeStrandFile(params->input, params->readOptions(), &report);
                 return printStrandSummary(*params, s, report, common);

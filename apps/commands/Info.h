@@ -1,6 +1,6 @@
 /// @file Info.h
-/// @brief `vdbhair info`, in two halves: Info.cc (registration and strand files, no OpenVDB
-/// library: the light program links it) and InfoVdb.cc (.vdb files).
+/// @brief `vdbhair info`, in two halves: Info.cc (registration and strand files) and InfoVdb.cc
+/// (.vdb files).
 #pragma once
 
 #include "../Command.h"
@@ -26,12 +26,6 @@ struct InfoParams
 /// @brief Print the summary @a s of the strand file @a p.input (and the reader's warnings of
 /// @a report), as prose or JSON. @return 0
 int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadReport& report, const CommonOptions& common);
-
-/// Runs `info` on a .vdb file: InfoVdb.cc's infoVdbFile() in the full program.
-using InfoVdbRunner = std::function<int(const InfoParams&, const CommonOptions&)>;
-
-/// @brief `info` registered on @a app; a .vdb file goes to @a vdbFile.
-Command addInfoVerb(CLI::App& app, CommonOptions& common, const InfoVdbRunner& vdbFile);
 
 /// @brief `info` of a .vdb file: its grids, or with --grid the strands of that points grid.
 int infoVdbFile(const InfoParams& p, const CommonOptions& common);

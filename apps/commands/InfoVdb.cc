@@ -71,6 +71,5 @@ int infoVdbFile(const InfoParams& p, const CommonOptions& common)
     return 0;
 }
 
-Command addInfoCommand(CLI::App& app, CommonOptions& common) { return addInfoVerb(app, common, infoVdbFile); }
 
 } // namespace vdbhair::app

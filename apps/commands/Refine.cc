@@ -163,7 +163,6 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
         if (!p.saveField.empty()) std::cout << "wrote " << p.saveField << "\n";
         std::cout << "wrote " << p.output << "\n";
     }
-    for (const TangentField& f : r.fields) keepUntilExit(std::make_shared<openvdb::GridCPtrVec>(f.grids()));  // freed with the process
     return 0;
 }
 

@@ -145,7 +145,6 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         printTraceReport(stats, angles, disp);
         std::cout << "wrote " << p.output << "\n";
     }
-    keepUntilExit(grid);  // the field's tree, freed with the process
     return 0;
 }
 

@@ -3,7 +3,7 @@
 twice - with a fresh output path and with an existing output. Each run must exit non-zero, print
 exactly one line on stderr that names the file (or the verb or option at fault) and the rule
 broken, leave no output and no temporary file, and leave an existing output byte-identical.
-The cases run two at a time, through forkrun.py (a process start is most of a case's time); each has a folder of its
+The cases run two at a time (a process start is most of a case's time); each has a folder of its
 own for its output, so that what one case leaves is checked after each of its runs, and the input
 folder and the whole output folder are checked again once every case has run.
 
@@ -18,7 +18,6 @@ import struct
 import subprocess
 import sys
 
-import forkrun
 
 CLI, WORK = sys.argv[1], sys.argv[2]
 shutil.rmtree(WORK, ignore_errors=True)
@@ -213,7 +212,8 @@ def run_case(i):
                 with open(o, "wb") as f:
                     f.write(sentinel)
         try:
-            returncode, _, stderr = forkrun.run([CLI] + args, timeout=60)
+            done = subprocess.run([CLI] + args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=60)
+            returncode, stderr = done.returncode, done.stderr
         except subprocess.TimeoutExpired:
             failures.append("%s: still running after 60 s" % name)
             continue

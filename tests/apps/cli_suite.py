@@ -23,9 +23,6 @@ and no temporary output (".STEM.vdbhair-tmp-*") may be left next to any PATH nam
 Every case runs, in the order of the file, whatever the others do; the group fails if one does,
 and the report names each failed case with its command, stdout and stderr. The environment variable
 VDBHAIR_CLI_CASES=RE runs only the cases whose name matches RE (e.g. to rerun one failure).
-Commands of `vdbhair` itself run through forkrun.py (forked from a parent that has loaded the
-program, when CTest says where vdbhair_forkserver is); VDBHAIR_CLI_EXEC=1 starts every command as a
-process of its own.
 """
 import hashlib
 import os
@@ -34,7 +31,6 @@ import subprocess
 import sys
 import time
 
-import forkrun
 
 OPTIONS_WITH_VALUE = {"--exit", "--stdout", "--no-stdout", "--stderr", "--stderr-lines", "--absent", "--exists", "--keep"}
 
@@ -110,7 +106,8 @@ def run_case(args):
             subprocess.run(["rm", "-rf", path], check=True)
         elif os.path.lexists(path):
             os.remove(path)
-    code, out, err = forkrun.run(command)
+    done = subprocess.run(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    code, out, err = done.returncode, done.stdout, done.stderr
     status = code if code >= 0 else 128 - code
     out = out.decode("utf-8", "replace")
     err = err.decode("utf-8", "replace")

@@ -491,8 +491,7 @@ StrandSet retraceConsistent(const StrandSet& strands, const TangentField& field,
 {
     // Topology and attributes; positions are overwritten. The positions' storage is reserved
     // first, hinted for huge pages (Memory.h): copy-assignment keeps storage that is large enough,
-    // so the copy faults in 2 MiB pages instead of 4 KiB ones (a 77 MB set: 19,000 faults in a
-    // process without the launcher's malloc setting, such as the benchmark or Python).
+    // so the copy faults in 2 MiB pages instead of 4 KiB ones (a 77 MB set: 19,000 faults fewer).
     StrandSet out;
     reserveHugePages(out.positions, strands.numVertices());
     out = strands;

@@ -12,8 +12,7 @@ namespace vdbhair {
 
 /// @brief summarizeStrands(readNonVdbStrands(@a path, @a opts, @a report)), the same figures,
 /// warnings and errors; a `.data` file is measured in place (summarizeData(), DataFile.h), any
-/// other format is read first. No OpenVDB library: the light program (apps/lite) runs it. The
-/// strands of a `.vdb` file are summarized with summarizeStrands(readStrands()).
+/// other format is read first. The strands of a `.vdb` file are summarized with summarizeStrands(readStrands()).
 /// @throw ValueError for a `.vdb` file.
 StrandSummary summarizeStrandFile(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 

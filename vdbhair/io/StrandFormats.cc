@@ -1,5 +1,5 @@
-// The strand formats and their readers that need no OpenVDB library (StrandIO.h): what the light
-// program (apps/lite) links. The .vdb reader and writer are in StrandIO.cc.
+// The strand formats and their readers other than .vdb (StrandIO.h); the .vdb reader and writer
+// are in StrandIO.cc.
 #include "StrandIO.h"
 
 #include <vdbhair/Exceptions.h>

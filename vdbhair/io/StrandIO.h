@@ -47,8 +47,7 @@ StrandFormat strandFileFormat(const std::string& path);
 /// @brief Read strands from any supported file.
 StrandSet readStrands(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 
-/// @brief Read strands from a file of any supported format but .vdb: readStrands() without the
-/// OpenVDB library (StrandFormats.cc), for the light program (apps/lite).
+/// @brief Read strands from a file of any supported format but .vdb (StrandFormats.cc).
 /// @throw ValueError for a .vdb file; what readStrands() throws otherwise.
 StrandSet readNonVdbStrands(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 

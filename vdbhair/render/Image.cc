@@ -117,8 +117,7 @@ const char* fontPath()
 namespace {
 
 /// The image module (ImageModule.h), loaded on first use: $VDBHAIR_IMAGE_MODULE if set, else next
-/// to the running program's install layout (bin/../lib/vdbhair, or libexec/vdbhair/../../lib/vdbhair), the
-/// install prefix, the build tree.
+/// to the running program's install layout (bin/../lib/vdbhair), the install prefix, the build tree.
 /// @throw IoError naming every place tried when none loads.
 const VdbhairImageModule& imageModule()
 {
@@ -131,10 +130,8 @@ const VdbhairImageModule& imageModule()
         std::error_code ec;
         const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
         if (!ec) {
-            // The prefix of a program in bin/ (the Python module's interpreter, a user's program)
-            // or in libexec/vdbhair/ (the vdbhair program, started by bin/vdbhair).
+            // The prefix of a program in bin/ (vdbhair, the Python module's interpreter, a user's program).
             candidates.push_back((exe.parent_path().parent_path() / VDBHAIR_IMAGE_MODULE_RELATIVE).string());
-            candidates.push_back((exe.parent_path().parent_path().parent_path() / VDBHAIR_IMAGE_MODULE_RELATIVE).string());
         }
         candidates.push_back(VDBHAIR_IMAGE_MODULE_INSTALLED);
         candidates.push_back(VDBHAIR_IMAGE_MODULE_BUILT);
