@@ -106,6 +106,10 @@ resume_case() {
   local pid=$! seen=" " waiting="" c i; bg=$pid
   for i in $(seq $after); do
     c=$(next_stopped $pid "$seen") || fail "no child $i of the batch stopped at its start in 20 s"
+    # Each child starts with glibc's malloc on huge pages (ChildProcess.cc), the environment kept.
+    tr '\0' '\n' < /proc/$c/environ | grep -q '^GLIBC_TUNABLES=\(.*:\)\?glibc.malloc.hugetlb=1' ||
+      fail "child $c did not get GLIBC_TUNABLES=glibc.malloc.hugetlb=1: $(tr '\0' ' ' < /proc/$c/environ | grep -o 'GLIBC_TUNABLES=[^ ]*')"
+    tr '\0' '\n' < /proc/$c/environ | grep -q '^VDBHAIR_TEST_STOP_AT_START=field$' || fail "child $c lost the batch's environment"
     seen="$seen$c "; kill -CONT "$c"
   done
   wait_for "$after records" recorded_at_least run/batch.jsonl $after
