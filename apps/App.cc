@@ -159,7 +159,7 @@ std::vector<Command> addCommands(CLI::App& app, CommonOptions& common)
         {"retrace", addRetraceCommand}, {"refine", addRefineCommand}, {"grow", addGrowCommand},
         {"fit", addFitCommand}, {"scalp", addScalpCommand}, {"roots", addRootsCommand},
         {"interpolate", addInterpolateCommand}, {"reconstruct", addReconstructCommand}, {"synth", addSynthCommand},
-        {"transfer", addTransferCommand}, {"comb", addCombCommand}, {"inspect", addInspectCommand},
+        {"transfer", addTransferCommand}, {"comb", addCombCommand}, {"inspect", addInspectCommand}, {"compare", addCompareCommand},
         {"render", addRenderCommand}, {"demo", addDemoCommand}, {"batch", addBatchCommand}};
     std::vector<Command> commands;
     for (const Verb& v : verbs()) commands.push_back(adders.at(v.name)(app, common));

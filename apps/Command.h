@@ -168,6 +168,7 @@ CLI::App* addVerb(CLI::App& app, const std::string& name);
 
 // One function per subcommand file, each returning the registered command.
 Command addInfoCommand(CLI::App& app, CommonOptions& common);
+Command addCompareCommand(CLI::App& app, CommonOptions& common);
 Command addConvertCommand(CLI::App& app, CommonOptions& common);
 Command addDemoCommand(CLI::App& app, CommonOptions& common);
 Command addFieldCommand(CLI::App& app, CommonOptions& common);

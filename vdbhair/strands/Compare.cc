@@ -150,6 +150,52 @@ std::vector<OrientedMatch> matchOrientedPoints(const StrandSet& predicted, const
     return out;
 }
 
+namespace {
+
+/// For every vertex of @a from, the distance to the nearest vertex of @a to.
+std::vector<double> nearestDistances(const StrandSet& from, const StrandSet& to, bool threaded)
+{
+    std::vector<Vec3d> pts(to.positions.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) pts[i] = Vec3d(to.positions[i].x(), to.positions[i].y(), to.positions[i].z());
+    const PointCloud cloud{&pts};
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    std::vector<double> out(from.positions.size());
+    auto run = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3f& p = from.positions[i];
+            const double q[3] = {p.x(), p.y(), p.z()};
+            std::uint32_t index = 0;
+            double d2 = 0.0;
+            tree.knnSearch(q, 1, &index, &d2);
+            out[i] = std::sqrt(d2);
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.size(), 1024), run);
+    else run(tbb::blocked_range<std::size_t>(0, out.size()));
+    return out;
+}
+
+} // namespace
+
+ChamferDistances chamferDistances(const StrandSet& a, const StrandSet& b, bool threaded)
+{
+    if (a.positions.empty() || b.positions.empty()) throw ValueError("Chamfer distance: a hairstyle has no vertex");
+    const std::vector<double> ab = nearestDistances(a, b, threaded), ba = nearestDistances(b, a, threaded);
+    ChamferDistances c;
+    for (double d : ab) c.aToB += d;  // in vertex order: independent of threads
+    for (double d : ba) c.bToA += d;
+    c.aToB /= double(ab.size());
+    c.bToA /= double(ba.size());
+    c.mean = 0.5 * (c.aToB + c.bToA);
+    c.perStrandA.assign(a.numStrands(), 0.0);
+    for (std::size_t s = 0; s < a.numStrands(); ++s) {
+        double sum = 0.0;
+        for (std::size_t k = a.begin(s); k < a.begin(s) + a.size(s); ++k) sum += ab[k];
+        c.perStrandA[s] = a.size(s) ? sum / double(a.size(s)) : 0.0;
+    }
+    return c;
+}
+
 StrandPairErrors strandPairErrors(const StrandSet& a, const StrandSet& b, std::size_t samples, bool threaded)
 {
     if (a.numStrands() != b.numStrands()) {

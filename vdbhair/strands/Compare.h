@@ -18,6 +18,10 @@
 /// after moving B's root onto A's (root-aligned), the curvature error the mean absolute difference
 /// of the curvature of the circle through each three consecutive points (1/R = 2 sin∠ / chord).
 ///
+/// **Chamfer distance** (point-set papers, hair reconstruction's geometric baseline): the mean over
+/// A's vertices of the distance to the nearest vertex of B, and the same from B to A; reported each
+/// way and as their mean (the symmetric Chamfer distance with unsquared distances).
+///
 /// **Leaving the volume** (the guides issue's measure of spikes and flares): a strand leaves a
 /// reference's hair volume when one of its points lies outside the voxels the reference's points
 /// occupy, dilated by one voxel (its 26 neighbours). A strand's points are its vertices and points
@@ -67,6 +71,18 @@ struct StrandPairErrors
 /// @param samples points per resampled strand (Perm: 100), at least 3
 /// @throw ValueError when the strand counts differ or samples < 3.
 StrandPairErrors strandPairErrors(const StrandSet& a, const StrandSet& b, std::size_t samples = 100, bool threaded = true);
+
+struct ChamferDistances
+{
+    double aToB = 0.0, bToA = 0.0;  ///< mean nearest-vertex distance each way (world units)
+    double mean = 0.0;              ///< (aToB + bToA) / 2
+    std::vector<double> perStrandA; ///< #A strands: the mean over each strand's vertices of their distance to B
+};
+
+/// @brief The Chamfer distances between the vertices of @a a and @a b (see above). In parallel;
+/// identical for any thread count.
+/// @throw ValueError when either has no vertex.
+ChamferDistances chamferDistances(const StrandSet& a, const StrandSet& b, bool threaded = true);
 
 /// @brief The number of @a strands that leave the hair volume of @a reference at @a voxel (see
 /// above). In parallel; identical for any thread count.

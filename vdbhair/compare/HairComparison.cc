@@ -1,0 +1,138 @@
+#include "HairComparison.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Parallel.h>
+#include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/Frechet.h>
+#include <vdbhair/strands/Measures.h>
+#include <vdbhair/strands/Resample.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace vdbhair {
+
+void CompareParams::validate() const
+{
+    if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit)) {
+        throw ValueError("metersPerUnit " + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
+    }
+    if (samples < 3) throw ValueError("samples " + std::to_string(samples) + ": must be at least 3 (a curvature needs three points)");
+    for (const OrientedThreshold& t : thresholds) {
+        if (!(t.distance > 0.0) || !std::isfinite(t.distance)) throw ValueError("thresholds: distance " + std::to_string(t.distance) + ": must be positive and finite");
+        if (!(t.angleDegrees >= 0.0 && t.angleDegrees <= 180.0)) throw ValueError("thresholds: angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees");
+    }
+}
+
+namespace {
+
+/// The discrete Fréchet distance of each strand pair over the length of A's strand (see the header).
+std::vector<double> relativeFrechetPairs(const StrandSet& a, const StrandSet& b, std::size_t samples, bool threaded)
+{
+    std::vector<double> out(a.numStrands(), 0.0);
+    forEachRange(a.numStrands(), threaded, 16, [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<Vec3f> ra(samples), rb(samples);
+        std::vector<Vec3d> da(samples), db(samples);
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (a.size(i) == 0 || b.size(i) == 0) continue;
+            const double length = polylineLength(a.positions.data() + a.begin(i), a.size(i));
+            if (!(length > 0.0)) continue;
+            resamplePolyline(a.positions.data() + a.begin(i), a.size(i), samples, ra.data());
+            resamplePolyline(b.positions.data() + b.begin(i), b.size(i), samples, rb.data());
+            for (std::size_t k = 0; k < samples; ++k) {
+                da[k] = Vec3d(ra[k].x(), ra[k].y(), ra[k].z());
+                db[k] = Vec3d(rb[k].x(), rb[k].y(), rb[k].z());
+            }
+            out[i] = discreteFrechet(da.data(), samples, db.data(), samples) / length;
+        }
+    });
+    return out;
+}
+
+} // namespace
+
+HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const CompareParams& params,
+                                 const HeadObstacle* head, bool threaded)
+{
+    params.validate();
+    HairComparison c;
+    c.strandsA = a.numStrands();
+    c.strandsB = b.numStrands();
+    c.verticesA = a.numVertices();
+    c.verticesB = b.numVertices();
+    c.metersPerUnit = params.metersPerUnit;
+
+    std::vector<OrientedThreshold> thresholds = params.thresholds;
+    if (thresholds.empty() && params.metersPerUnit > 0.0) thresholds = hairGsThresholds();
+    if (params.metersPerUnit > 0.0) {
+        for (OrientedThreshold& t : thresholds) t.distance /= params.metersPerUnit;  // metres to file units
+    }
+    if (!thresholds.empty()) c.oriented = matchOrientedPoints(b, a, thresholds, params.bidirectional, threaded);
+
+    c.chamfer = chamferDistances(a, b, threaded);
+
+    c.paired = a.numStrands() == b.numStrands();
+    if (c.paired) {
+        c.perm = strandPairErrors(a, b, params.samples, threaded);
+        c.frechet = relativeFrechetPairs(a, b, params.samples, threaded);
+        for (double f : c.frechet) {
+            c.frechetMean += f;
+            c.frechetMax = std::max(c.frechetMax, f);
+        }
+        if (!c.frechet.empty()) {
+            c.frechetMean /= double(c.frechet.size());
+            std::vector<double> sorted = c.frechet;
+            const std::size_t k = std::min(sorted.size() - 1, std::size_t(std::ceil(0.95 * double(sorted.size()))) - 1);
+            std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
+            c.frechetP95 = sorted[k];
+        }
+    }
+
+    c.volumeVoxel = suggestVoxelSize(a);
+    if (c.strandsB) c.leavingVolume = double(countStrandsLeavingVolume(b, a, c.volumeVoxel, threaded)) / double(c.strandsB);
+
+    if (head && !head->unset() && !head->empty()) {
+        c.headMeasured = true;
+        const double tolerance = headTolerance(*head);
+        if (c.strandsA) c.enteringHeadA = double(countStrandsEnteringHead(a, *head, tolerance, threaded)) / double(c.strandsA);
+        if (c.strandsB) c.enteringHeadB = double(countStrandsEnteringHead(b, *head, tolerance, threaded)) / double(c.strandsB);
+    }
+    return c;
+}
+
+nlohmann::json toJson(const HairComparison& c)
+{
+    nlohmann::json j;
+    j["strands"] = {{"a", c.strandsA}, {"b", c.strandsB}};
+    j["vertices"] = {{"a", c.verticesA}, {"b", c.verticesB}};
+    j["meters_per_unit"] = c.metersPerUnit > 0.0 ? nlohmann::json(c.metersPerUnit) : nlohmann::json(nullptr);
+    nlohmann::json oriented = nlohmann::json::array();
+    for (const OrientedMatch& m : c.oriented) {
+        nlohmann::json t = {{"distance", m.threshold.distance}, {"angle_degrees", m.threshold.angleDegrees},
+                            {"precision", m.precision}, {"recall", m.recall}, {"f1", m.f1},
+                            {"strand_consistency", m.strandConsistency}};
+        if (c.metersPerUnit > 0.0) t["distance_mm"] = m.threshold.distance * c.metersPerUnit * 1000.0;
+        oriented.push_back(t);
+    }
+    j["oriented_points"] = oriented;
+    j["chamfer"] = {{"a_to_b", c.chamfer.aToB}, {"b_to_a", c.chamfer.bToA}, {"mean", c.chamfer.mean}};
+    j["paired"] = c.paired;
+    if (c.paired) {
+        j["position_error"] = c.perm.meanPosition;
+        j["curvature_error"] = c.perm.meanCurvature;
+        j["frechet"] = {{"mean", c.frechetMean}, {"p95", c.frechetP95}, {"max", c.frechetMax}};
+    } else {
+        j["position_error"] = nullptr;
+        j["curvature_error"] = nullptr;
+        j["frechet"] = nullptr;
+    }
+    j["leaving_volume"] = c.leavingVolume;
+    j["volume_voxel"] = c.volumeVoxel;
+    j["entering_head"] = c.headMeasured ? nlohmann::json({{"a", c.enteringHeadA}, {"b", c.enteringHeadB}}) : nlohmann::json(nullptr);
+    return j;
+}
+
+} // namespace vdbhair

@@ -1,0 +1,74 @@
+/// @file HairComparison.h
+/// @brief `vdbhair compare A B`: every measure of strands/Compare.h, the discrete Fréchet distance
+/// of strand pairs and the shares of strands passing into a head, for one reference hairstyle A and
+/// one candidate B, in one report that the command line and Python print alike (toJson()).
+///
+/// A is the reference, B the candidate (HairGS's "predicted"): precision is the share of B's
+/// oriented points matched in A, recall the share of A's matched in B. The measures that pair
+/// strand i of A with strand i of B (Perm's errors, Fréchet) need equal strand counts and are left
+/// out otherwise (HairComparison::paired).
+#pragma once
+
+#include <vdbhair/strands/Compare.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <vector>
+
+namespace vdbhair {
+
+class HeadObstacle;
+
+struct CompareParams
+{
+    /// The files' unit in metres (0.01: centimetres, 1: metres); 0: unknown. HairGS's thresholds
+    /// are millimetres: with an unknown unit the oriented-point measures need @a thresholds in file
+    /// units, and are left out without them.
+    double metersPerUnit = 0.0;
+    /// Oriented-point thresholds, distances in metres when metersPerUnit > 0, else in file units;
+    /// empty: HairGS's four (hairGsThresholds()) when the unit is known.
+    std::vector<OrientedThreshold> thresholds;
+    /// Directions match either way round (a strand stored tip first still matches).
+    bool bidirectional = false;
+    /// Points per strand for the strand-pair measures (Perm: 100), at least 3.
+    std::size_t samples = 100;
+
+    /// @throw ValueError naming the parameter, its value and the rule.
+    void validate() const;
+};
+
+struct HairComparison
+{
+    std::size_t strandsA = 0, strandsB = 0, verticesA = 0, verticesB = 0;
+    double metersPerUnit = 0.0;
+    /// At each threshold (distances in file units); empty when not measured (see CompareParams).
+    std::vector<OrientedMatch> oriented;
+    ChamferDistances chamfer;
+    /// Strand i of A against strand i of B (only when the counts agree).
+    bool paired = false;
+    StrandPairErrors perm;
+    /// #S discrete Fréchet distance between the strands, both resampled to CompareParams::samples
+    /// points by arc length, over the length of A's strand (0 for a strand of zero length).
+    std::vector<double> frechet;
+    double frechetMean = 0.0, frechetP95 = 0.0, frechetMax = 0.0;
+    /// The share of B's strands that leave A's hair volume (countStrandsLeavingVolume() at
+    /// volumeVoxel, A's suggested voxel size): spikes and flares.
+    double leavingVolume = 0.0, volumeVoxel = 0.0;
+    /// With a head: the shares of A's and of B's strands that pass into it (countStrandsEnteringHead()).
+    bool headMeasured = false;
+    double enteringHeadA = 0.0, enteringHeadB = 0.0;
+};
+
+/// @brief Compare @a b (candidate) with @a a (reference); @a head may be null. In parallel,
+/// identical for any thread count.
+/// @throw ValueError for bad @a params or a hairstyle without segments.
+HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const CompareParams& params,
+                                 const HeadObstacle* head = nullptr, bool threaded = true);
+
+/// @brief The report as JSON: the same keys from the command line (`compare --json`) and Python
+/// (`vdbhair.compare()`); per-strand values are left out (they go to a file or to NumPy).
+nlohmann::json toJson(const HairComparison& c);
+
+} // namespace vdbhair
