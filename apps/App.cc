@@ -21,9 +21,8 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
                       const std::string& vdbGrid)
 {
     const Stage stage(common, "reading " + path);
-    ReadOptions opts;
+    ReadOptions opts = readOptions(common);
     opts.vdbGrid = vdbGrid;
-    opts.interrupter = common.interrupter;
     if (strict) opts.shortStrands = ShortStrandPolicy::Reject;
     ReadReport report;
     StrandSet strands = readStrands(path, opts, &report);

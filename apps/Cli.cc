@@ -70,11 +70,37 @@ void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson)
     sub->add_flag("--quiet,-q", common.quiet, "No progress and no warnings on stderr");
 }
 
+void addReadOptions(CLI::App* sub, CommonOptions& common)
+{
+    sub->add_option("--points-per-strand", common.pointsPerStrand,
+                    "For a .ply of points only (NeuralHaircut, GaussianHaircut: 100): each run of N consecutive points is one strand");
+    sub->add_option("--curve-samples", common.curveSamples,
+                    "For .obj curves (curv): points per curve, evenly in its parameter (0: automatic, within 1 % of the curve's length)");
+}
+
+ReadOptions readOptions(const CommonOptions& common)
+{
+    ReadOptions opts;
+    opts.interrupter = common.interrupter;
+    opts.pointsPerStrand = common.pointsPerStrand;
+    opts.curveSamples = common.curveSamples;
+    return opts;
+}
+
+/// The readers' parameters, as their messages name them, spelled as flags.
+const FlagNames& readerFlagNames()
+{
+    static const FlagNames names = {{"RenderParams::up", "--up"},
+                                    {"ReadOptions::pointsPerStrand", "--points-per-strand"},
+                                    {"ReadOptions::curveSamples", "--curve-samples"}};
+    return names;
+}
+
 void printWarnings(const std::string& verb, const ReadReport& report, const CommonOptions& common)
 {
     if (common.quiet) return;
     // Readers name library parameters; a verb that reads strands may render them (`render --up`).
-    static const FlagNames readerFlags = {{"RenderParams::up", "--up"}};
+    const FlagNames& readerFlags = readerFlagNames();
     for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << withFlagNames(w, readerFlags) << "\n";
 }
 
@@ -263,6 +289,7 @@ int run(int argc, char** argv)
         // spelled as this verb's flags.
         FlagNames flags = c.flags;
         flags.emplace_back("OverwritePolicy::NoClobber", "--no-clobber");
+        flags.insert(flags.end(), readerFlagNames().begin(), readerFlagNames().end());
         auto fail = [&](int code, const std::string& message) {
             progress.clear();
             std::cerr << "vdbhair " << verb << ": " << withFlagNames(message, flags) << "\n";

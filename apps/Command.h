@@ -39,7 +39,18 @@ struct CommonOptions
     /// The progress bar and Ctrl-C (TerminalProgress.h), set by run() before the verb runs: hand it to
     /// every library call that takes an interrupter.
     WorkInterrupter* interrupter = nullptr;
+    /// How strand files are read (addReadOptions(): --points-per-strand, --curve-samples).
+    std::size_t pointsPerStrand = 0;
+    std::size_t curveSamples = 0;
 };
+
+/// @brief Add the strand readers' options (--points-per-strand, --curve-samples) to a verb that
+/// reads strand files.
+void addReadOptions(CLI::App* sub, CommonOptions& common);
+
+/// @brief The reader's options of @a common: the one place the command line becomes ReadOptions
+/// (loadStrands(), info and convert start from it).
+ReadOptions readOptions(const CommonOptions& common);
 
 /// @brief A named step of a command that the library does not report on itself (reading or
 /// writing a file): the progress line shows its name and the time spent. Null-safe.

@@ -92,6 +92,7 @@ Command addCombCommand(CLI::App& app, CommonOptions& common)
     addHeadOptions(sub, p->head, "--scalp's level set if given, else a sphere fitted to the roots");
     addSynthHierarchyOptions(sub, p->params.synth, p->text);
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair comb scenes/default/head.json --stroke scenes/comb/sweep_ponytail.json -o combed.hair --json");
     return {sub, [p, &common] { return runComb(*p, common); }, synthTransferFlags()};
 }

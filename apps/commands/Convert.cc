@@ -116,14 +116,13 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     if (!(p.metersPerUnit > 0.0) || !std::isfinite(p.metersPerUnit)) throw ValueError("--meters-per-unit " + formatValue(p.metersPerUnit) + ": must be a positive length");
     wopts.usd.metersPerUnit = p.metersPerUnit;
 
-    ReadOptions ropts;
+    ReadOptions ropts = readOptions(common);
     ropts.vdbGrid = p.grid;
     if (!p.rootNear.empty()) {
         if (p.rootNear.size() != 3) throw ValueError("--root-near needs X,Y,Z");
         ropts.objRootNear = Vec3f(float(p.rootNear[0]), float(p.rootNear[1]), float(p.rootNear[2]));
     }
     if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
-    ropts.interrupter = common.interrupter;
     StrandSet strands;
     ReadReport report;
     for (const std::string& in : inputs) {
@@ -192,6 +191,7 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--format", params->format, "The format of '-' (standard input or output): hair, data, obj, ply, vdb or usda");
     sub->add_option("--grid", params->grid, "VDB input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");
     return {sub, [params, &common] { return runConvert(*params, common); }};
 }

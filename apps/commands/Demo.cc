@@ -124,6 +124,7 @@ Command addDemoCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing)")->capture_default_str();
     addRefineOptions(sub, params->refine);
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair demo scenes/default/head.json -o out --levels 2");
     return {sub, [params, &common] { return runDemo(*params, common); }};
 }

@@ -97,6 +97,7 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--skip-degenerate", params->skipDegenerate, "Leave out strands of zero length instead of failing");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair fit hair.hair -o fits.json --json && vdbhair grow fits.json -o regrown.hair");
     return {sub, [params, &common] { return runFit(*params, common); }, {{"maxError", "--max-error"}, {"lambda", "--lambda"}, {"maxPieces", "--max-pieces"}, {"maxEvaluations", "--max-evaluations"},
                                                                  {"prefitIterations", "--prefit-iterations"}, {"step", "--step"}}};

@@ -31,9 +31,9 @@ namespace vdbhair::app {
 
 using namespace info;
 
-ReadOptions InfoParams::readOptions() const
+ReadOptions InfoParams::readOptions(const CommonOptions& common) const
 {
-    ReadOptions ropts;
+    ReadOptions ropts = vdbhair::app::readOptions(common);
     if (strict) ropts.shortStrands = ShortStrandPolicy::Reject;
     if (!grid.empty()) ropts.vdbGrid = grid;
     return ropts;
@@ -80,11 +80,12 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair info scenes/default/ponytail.hair --json");
     return {sub, [params, &common] {
                 if (fileExtension(params->input) == ".vdb") return infoVdbFile(*params, common);
                 ReadReport report;
-                const StrandSummary s = summarizeStrandFile(params->input, params->readOptions(), &report);
+                const StrandSummary s = summarizeStrandFile(params->input, params->readOptions(common), &report);
                 return printStrandSummary(*params, s, report, common);
             }};
 }

@@ -19,8 +19,8 @@ struct InfoParams
     bool strict = false;
     std::string grid;  ///< a .vdb's points grid to summarize as strands; empty: list every grid
 
-    /// The reader's options these ask for (--strict, --grid).
-    ReadOptions readOptions() const;
+    /// The reader's options these ask for (--strict, --grid) and @a common's.
+    ReadOptions readOptions(const CommonOptions& common) const;
 };
 
 /// @brief Print the summary @a s of the strand file @a p.input (and the reader's warnings of

@@ -38,7 +38,7 @@ int infoVdbFile(const InfoParams& p, const CommonOptions& common)
 {
     if (!p.grid.empty()) {
         ReadReport report;
-        const StrandSummary s = summarizeStrands(readStrands(p.input, p.readOptions(), &report));
+        const StrandSummary s = summarizeStrands(readStrands(p.input, p.readOptions(common), &report));
         return printStrandSummary(p, s, report, common);
     }
     const std::vector<GridInfo> grids = describeVdbFile(p.input);

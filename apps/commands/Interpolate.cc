@@ -263,6 +263,7 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--seed", p.op.seed, "Seed of the roots on --scalp, density, clumps, curl phases, frizz and waviness noise")->capture_default_str();
     sub->add_option("--max-vertices", p.op.helicoid.maxVertices, "Refuse requests that would make more vertices (12 bytes each)")->capture_default_str();
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair interpolate guides.hair --scalp scalp.vdb --count 20000 -o hair.hair --json");
     return {sub, [params, &common] { return runInterpolate(*params, common); }, {{"blend", "--blend"}, {"likeness", "--likeness"}, {"grouping", "--grouping"}}};
 }

@@ -170,6 +170,7 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--errors", params->errors, "Also write every strand's relative error, every way, as CSV");
     sub->add_option("--meters-per-unit", params->rec.metersPerUnit, "The file's unit in metres (0.01: centimetres), for HairGS's oriented-point F1 at 2-4 mm (0: unknown, not measured)")->capture_default_str();
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair reconstruct straight.hair -o rebuilt.hair --guides 10% --json");
     return {sub, [params, &common] { return runReconstruct(*params, common); }, {{"maxError", "--max-error"}, {"blend", "--blend"}, {"metersPerUnit", "--meters-per-unit"}}};
 }

@@ -206,6 +206,7 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
                   "Also measure the output against the input at every level: full length, hair volume, head, curvature, "
                   "tips, displacement, coherence (an extra field estimate per level: about a fifth of the run)");
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --measure --json");
     return {sub, [params, &common] { return runRefine(*params, common); }, {{"maxVoxels", "--max-voxels"}, {"maxMemory", "--max-memory"}, {"zStart", "--outlier-start"}, {"zFull", "--outlier-full"},
                                                                        {"minSpreadDeg", "--min-spread"}, {"levels", "--levels"}}};

@@ -111,6 +111,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--grid", params->grid, "For a .vdb input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
     sub->add_flag("--sheet", params->sheet, "One image with the front, side, top and three-quarter views");
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair render scenes/default/head.json -o head.png --sheet");
     return {sub, [params, &common] { return runRender(*params, common); }, {{"colorBy", "--color-by"}}};
 }

@@ -172,6 +172,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
                   "Also report the mean angle between strand tangents and the field before and after "
                   "(samples the field at every input and output vertex: about half of the run)");
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --measure --json");
     return {sub, [params, &common] { return runRetrace(*params, common); },
             {{"step", "--step"}, {"margin", "--margin"}, {"vanishThreshold", "--vanish"}, {"maxSteps", "--max-steps"},

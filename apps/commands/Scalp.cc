@@ -160,6 +160,7 @@ Command addScalpCommand(CLI::App& app, CommonOptions& common)
                     "A PLY mesh input's vertex property paints the region: a colour channel (red, green, blue, alpha; uchar scaled to 0-1) or any named scalar, above --region-threshold");
     sub->add_option("--region-threshold", params->regionThreshold, "A float mask or vertex value covers where it exceeds this")->capture_default_str();
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Examples:\n  vdbhair scalp head.ply -o scalp.vdb --voxel-size 0.5 --region hair.hair\n"
                 "  vdbhair scalp --sphere 0,0,0,10 -o ball.vdb --voxel-size 0.2");
     return {sub, [params, &common] { return runScalp(*params, common); }};

@@ -370,6 +370,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--coarse-guides", params->coarseGuides, "With --coarse: BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over the guides' region (--strands sets the output count)");
     sub->add_option("--save-maps", params->saveMaps, "Write input_map.png, output_map.png (first three PCA channels as RGB) and clusters.png to this folder");
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair synth example.hair -o new.hair --levels 3 --seed 1 --json");
     Command c{sub, [params, &common] { return runSynth(*params, common); },
             {{"initialClusters", "--initial-clusters"}, {"threshold", "--threshold"}, {"levels", "--levels"}, {"vertices", "--vertices"},

@@ -143,6 +143,7 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
     addSynthHierarchyOptions(sub, s, p->text);
     addSynthTransferOptions(sub, s, p->text);
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair transfer curly.hair straight.hair -o curly_straight.hair --json");
     return {sub, [p, &common] {
                 TransferParams params = p->params;

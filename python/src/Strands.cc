@@ -156,9 +156,30 @@ pyb::array strandView(const pyb::object& self, const StrandSet& s, std::ptrdiff_
     return readOnlyView(reinterpret_cast<const float*>(s.data(std::size_t(i))), s.size(std::size_t(i)), 3, self);
 }
 
-ReadOptions readOptions(bool strict, const std::string& grid, const std::optional<std::array<float, 3>>& rootNear)
+/// @a message with the readers' parameter names spelled as read()'s keywords.
+std::string withReadKeywords(std::string message)
 {
+    for (const auto& [name, keyword] : {std::pair<std::string, std::string>{"ReadOptions::pointsPerStrand", "points_per_strand="},
+                                        {"ReadOptions::curveSamples", "curve_samples="}}) {
+        for (std::size_t at = message.find(name); at != std::string::npos; at = message.find(name, at + keyword.size())) {
+            // "points_per_strand=N", not "points_per_strand= N"
+            const bool value = at + name.size() < message.size() && message[at + name.size()] == ' ';
+            message.replace(at, name.size() + (value ? 1 : 0), keyword);
+        }
+    }
+    return message;
+}
+
+ReadOptions readOptions(bool strict, const std::string& grid, const std::optional<std::array<float, 3>>& rootNear,
+                        std::int64_t pointsPerStrand = 0, std::int64_t curveSamples = 0)
+{
+    if (pointsPerStrand < 0) throw ValueError("points_per_strand=" + std::to_string(pointsPerStrand) + ": must be 0 (not set) or a count of points");
+    if (curveSamples < 0 || curveSamples == 1) {
+        throw ValueError("curve_samples=" + std::to_string(curveSamples) + ": must be 0 (automatic) or 2 or more");
+    }
     ReadOptions opts;
+    opts.pointsPerStrand = std::size_t(pointsPerStrand);
+    opts.curveSamples = std::size_t(curveSamples);
     opts.shortStrands = strict ? ShortStrandPolicy::Reject : ShortStrandPolicy::Drop;
     opts.vdbGrid = grid;
     if (rootNear) opts.objRootNear = Vec3f((*rootNear)[0], (*rootNear)[1], (*rootNear)[2]);
@@ -310,25 +331,32 @@ Raises:
     m.def(
         "read",
         [](const std::string& path, bool strict, const std::string& grid, std::optional<std::array<float, 3>> rootNear,
-           const pyb::object& progress) {
+           std::int64_t pointsPerStrand, std::int64_t curveSamples, const pyb::object& progress) {
             ReadReport report;
-            const ReadOptions base = readOptions(strict, grid, rootNear);
+            const ReadOptions base = readOptions(strict, grid, rootNear, pointsPerStrand, curveSamples);
             auto set = runLong(0, progress, [&](WorkInterrupter* interrupter) {
                 ReadOptions opts = base;
                 opts.interrupter = interrupter;
-                return std::make_shared<StrandSet>(readStrands(path, opts, &report));
+                try {
+                    return std::make_shared<StrandSet>(readStrands(path, opts, &report));
+                } catch (const FormatError& e) {
+                    throw FormatError(withReadKeywords(e.what()));
+                }
             });
             if (!report.warnings.empty()) {
                 pyb::module_ warnings = pyb::module_::import("warnings");
-                for (const std::string& w : report.warnings) warnings.attr("warn")(w, pyb::module_::import("builtins").attr("UserWarning"), 2);
+                for (const std::string& w : report.warnings) {
+                    warnings.attr("warn")(withReadKeywords(w), pyb::module_::import("builtins").attr("UserWarning"), 2);
+                }
             }
             return set;
         },
         pyb::arg("path"), pyb::kw_only(), pyb::arg("strict") = false, pyb::arg("grid") = ReadOptions{}.vdbGrid,
-        pyb::arg("root_near") = pyb::none(), pyb::arg("progress") = pyb::none(),
+        pyb::arg("root_near") = pyb::none(), pyb::arg("points_per_strand") = 0, pyb::arg("curve_samples") = 0,
+        pyb::arg("progress") = pyb::none(),
         R"doc(Read strands from a file, the format chosen by extension (and checked by magic).
 
-Formats: .hair (cyHair), .data (USC-HairSalon), .obj (line elements), .ply (hairutil), .vdb
+Formats: .hair (cyHair), .data (USC-HairSalon), .obj (line elements and curv curves), .ply (hairutil, line sets, points in runs), .vdb
 (points grid), .usda (USD BasisCurves), .tfx (TressFX), .bin (CT2Hair), .convdata (HairNet).
 
 Args:
@@ -337,7 +365,12 @@ Args:
         UserWarning (the CLI's ``--strict``).
     grid: for a .vdb, the points grid holding the strands (the CLI's ``--grid``).
     root_near: for an .obj, root each strand at its end nearest this (x, y, z) (world units)
-        instead of its end with the lower vertex index.
+        instead of its end with the lower vertex index (and for a .ply line set).
+    points_per_strand: for a .ply of points only (NeuralHaircut, GaussianHaircut write 100), each
+        run of this many consecutive points is one strand (the CLI's ``--points-per-strand``).
+    curve_samples: for .obj free-form curves, the points each curve is evaluated at, evenly in its
+        parameter; 0 chooses them so that the polyline keeps the curve within 1 % of its length
+        (the CLI's ``--curve-samples``).
     progress: optional callable ``progress(stage, done, total, unit)``.
 
 Returns:

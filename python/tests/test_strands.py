@@ -119,6 +119,30 @@ def test_read_errors_are_typed(tmp_path):
     assert not (tmp_path / "out.tfx").exists()
 
 
+def test_ply_points_in_runs_and_obj_curves_take_keywords(tmp_path):
+    # A PLY of points only, 3 strands of 4 points (NeuralHaircut's layout), written here.
+    pts = np.arange(36, dtype=np.float32).reshape(12, 3)
+    path = tmp_path / "runs.ply"
+    path.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 12\nproperty float x\nproperty float y\n"
+                     b"property float z\nend_header\n" + pts.tobytes())
+    s = vdbhair.read(str(path), points_per_strand=4)
+    assert len(s) == 3 and np.array_equal(s[1], pts[4:8])
+    with pytest.raises(vdbhair.FormatError, match="read it with points_per_strand=N"):
+        vdbhair.read(str(path))
+    with pytest.raises(vdbhair.FormatError, match="not a multiple of points_per_strand=5"):
+        vdbhair.read(str(path), points_per_strand=5)
+    with pytest.raises(ValueError, match="points_per_strand=-1"):
+        vdbhair.read(str(path), points_per_strand=-1)
+    # A cubic Bezier curve, sampled at 7 points on request.
+    obj = tmp_path / "curve.obj"
+    obj.write_text("v 0 0 0\nv 1 2 0\nv 3 2 0\nv 4 0 0\ncstype bezier\ndeg 3\ncurv 0 1 -4 -3 -2 -1\nend\n")
+    c = vdbhair.read(str(obj), curve_samples=7)
+    assert len(c) == 1 and c[0].shape == (7, 3)
+    assert np.allclose(c[0][3], [2.0, 1.5, 0.0])  # the Bezier's middle: (P0 + 3 P1 + 3 P2 + P3) / 8
+    with pytest.raises(ValueError, match="curve_samples=1"):
+        vdbhair.read(str(obj), curve_samples=1)
+
+
 def test_short_strands_dropped_with_a_warning_or_rejected(tmp_path):
     # A .data file with a strand of one vertex between two good ones.
     path = tmp_path / "short.data"

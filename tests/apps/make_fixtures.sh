@@ -38,6 +38,9 @@ printf 'ply\nformat binary_big_endian 1.0\nend_header\n' > big_endian.ply
 { printf '\x00\x00\x18\x41'; head -c 400 /dev/zero; } > version9.tfx
 printf 'some text\n' > unknown.abc
 : > empty.obj
+# Issue 50: a PLY of points only, 2 strands of 4 points (NeuralHaircut's layout), and an OBJ cubic Bezier curve.
+printf 'ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n0 1 0\n0 2 0\n0 3 1\n1 0 0\n1 1 0\n1 2 0\n1 3 1\n' > runs_of_4.ply
+printf 'v 0 0 0\nv 1 2 0\nv 3 2 0\nv 4 0 0\ncstype bezier\ndeg 3\ncurv 0 1 -4 -3 -2 -1\nend\n' > bezier.obj
 # A .vdb written by another OpenVDB client (pyopenvdb) without a strands grid.
 /usr/bin/python3 -c "import pyopenvdb as vdb; g = vdb.FloatGrid(); g.name = 'density'; g.fill((0, 0, 0), (3, 3, 3), 1.0); vdb.write('density.vdb', grids=[g])"
 /usr/bin/python3 -c "import pyopenvdb as vdb; g = vdb.BoolGrid(); g.name = 'region'; vdb.write('empty_region.vdb', grids=[g])"

@@ -48,8 +48,22 @@ void readOnce(const std::string& path)
     if (sReader == "hair") readHair(path, opts, &report);
     else if (sReader == "data") readData(path, opts, &report);
     else if (sReader == "bin") readBin(path, opts, &report);
-    else if (sReader == "obj") readObj(path, opts, &report);
-    else if (sReader == "ply") readPly(path, opts, &report);
+    else if (sReader == "obj") {
+        readObj(path, opts, &report);
+        ReadOptions samples;  // free-form curves at an explicit count, as well as automatic (issue 50)
+        samples.curveSamples = 9;
+        readObj(path, samples, &report);
+    }
+    else if (sReader == "ply") {
+        try {
+            readPly(path, opts, &report);
+        } catch (const vdbhair::Error&) {
+            // A PLY of points only (issue 50) is read again in runs of 4 points.
+        }
+        ReadOptions runs;
+        runs.pointsPerStrand = 4;
+        readPly(path, runs, &report);
+    }
     else if (sReader == "tfx") readTfx(path, opts, &report);
     else if (sReader == "convdata") readConvdata(path, opts, &report);
     else if (sReader == "usda") readUsda(path, opts, &report);

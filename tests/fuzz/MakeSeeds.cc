@@ -68,6 +68,29 @@ int main(int argc, char** argv)
     writeObj((out / "obj/polylines.obj").string(), plain, ObjLineStyle::Polylines);
     writePly((out / "ply/binary.ply").string(), s, PlyEncoding::Binary);
     writePly((out / "ply/ascii.ply").string(), plain, PlyEncoding::Ascii);
+    // Issue 50's variants: OBJ free-form curves, PLY line sets and points in runs (the harness
+    // reads a .ply without topology with 4 points a strand).
+    writeRaw(out / "obj/curves.obj",
+             "v 0 0 0\nv 1 2 0\nv 3 2 0\nv 4 0 0\nv 5 -2 0 0.5\nv 7 -1 0\nv 8 0 0\n"
+             "cstype bezier\ndeg 3\ncurv 0 2 1 2 3 4 5 6 7\nparm u 0 1 2\nend\n"
+             "cstype rat bspline\ndeg 2\ncurv 0.0 1.0 -4 -3 \\\n -2 -1\nparm u 0 0 0 0.5 1 1 1\nend\n"
+             "cstype cardinal\ndeg 3\ncurv 0 1 1 2 3 4 5\nend\n"
+             "surf 0 1 0 1 1 2 3 4\nend\nl 1 2\n");
+    {
+        std::string runs = "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+        for (int i = 0; i < 24; ++i) put(runs, float(i % 7) * 0.5f);
+        writeRaw(out / "ply/runs_binary.ply", runs);
+        writeRaw(out / "ply/runs_ascii.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+                                             "0 0 0\n0 1 0\n0 2 0\n0 3 1\n");
+        writeRaw(out / "ply/lineset_ascii.ply", "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                                                "element edge 3\nproperty int vertex1\nproperty int vertex2\nproperty uchar red\nend_header\n"
+                                                "0 0 0\n0 1 0\n0 2 0\n5 5 5\n5 6 5\n1 0 9\n1 2 9\n4 3 9\n");
+        std::string lines = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+                            "element edge 2\nproperty int vertex1\nproperty int vertex2\nend_header\n";
+        for (int i = 0; i < 12; ++i) put(lines, double(i));
+        for (std::int32_t v : {0, 1, 2, 3}) put(lines, v);
+        writeRaw(out / "ply/lineset_binary.ply", lines);
+    }
     writeUsda((out / "usda/tiny.usda").string(), s);
     writeVdbStrands((out / "vdb/float.vdb").string(), plain);
     VdbPointsOptions fixed;

@@ -143,3 +143,97 @@ TEST_CASE("readObj: a branching vertex and a closed loop are errors naming the v
     REQUIRE(report.warnings.size() == 1);
     REQUIRE_THAT(report.warnings[0], Contains("ignored 1 repeated edge(s)"));
 }
+
+TEST_CASE("readObj: free-form curves (bspline, bezier, rat, cardinal) with negative indices, after the lines", "[io][curves]")
+{
+    // The cubic Bezier (0,0,0) (1,2,0) (3,2,0) (4,0,0) at u = i/4 by its Bernstein form.
+    auto bezier = [](double t) {
+        const double s = 1.0 - t;
+        return Vec3f(float(3 * s * s * t * 1 + 3 * s * t * t * 3 + t * t * t * 4), float(3 * s * s * t * 2 + 3 * s * t * t * 2), 0.f);
+    };
+    const std::string text =
+        "# a line strand, then curves\n"
+        "v 9 9 9\nv 9 8 9\nl 1 2\n"
+        "v 0 0 0\nv 1 2 0\nv 3 2 0\nv 4 0 0\n"
+        "cstype bezier\ndeg 3\n"
+        "curv 0.0 1.0 3 4 5 6\nend\n"              // positive indices
+        "curv 0.0 1.0 -4 -3 -2 -1\nparm u 0 1\nend\n"  // the same curve, relative indices
+        "v 1 0 0 1\nv 1 1 0 0.70710678118654752\nv 0 1 0\n"
+        "cstype rat bezier\ndeg 2\n"
+        "curv 0 1 -3 \\\n -2 -1\n"                  // a continued line
+        "end\n"
+        "cstype bspline\ndeg 1\n"
+        "curv 0 1 3 4 5\nparm u 0 0 0.5 1 1\nend\n"   // degree 1: the control polygon itself
+        "v 0 0 5\nv 1 1 5\nv 2 0 6\nv 3 1 6\n"
+        "cstype cardinal\ndeg 3\ncurv 0 1 -4 -3 -2 -1\nend\n";
+    ReadOptions opts;
+    opts.curveSamples = 5;
+    ReadReport report;
+    const StrandSet s = readObj(test::writeBytes("curves.obj", text), opts, &report);
+    REQUIRE(report.warnings.empty());
+    REQUIRE(s.numStrands() == 6);
+    REQUIRE(s.size(0) == 2);  // the line first
+    REQUIRE(s.root(0) == Vec3f(9.f, 9.f, 9.f));
+    for (std::size_t i : {1, 2}) {
+        REQUIRE(s.size(i) == 5);
+        for (std::size_t k = 0; k < 5; ++k) REQUIRE((s.positions[s.begin(i) + k] - bezier(double(k) / 4.0)).length() < 1e-6f);
+    }
+    for (std::size_t k = 0; k < 5; ++k) REQUIRE(s.positions[s.begin(3) + k].length() == Approx(1.f).margin(1e-6));  // the quarter circle
+    REQUIRE(s.root(3) == Vec3f(1.f, 0.f, 0.f));
+    REQUIRE(s.tip(3).y() == Approx(1.f));
+    // Degree 1 over knots 0 0 0.5 1 1: control points at u = 0, 0.5, 1; samples at 0, 0.25, ...
+    REQUIRE(s.positions[s.begin(4) + 1] == Vec3f(0.5f, 1.f, 0.f));
+    REQUIRE(s.positions[s.begin(4) + 2] == Vec3f(1.f, 2.f, 0.f));
+    REQUIRE(s.root(5) == Vec3f(1.f, 1.f, 5.f));  // cardinal: from the second control point
+    REQUIRE(s.tip(5) == Vec3f(2.f, 0.f, 6.f));   // to the last but one
+
+    // Automatic samples: more than the 4 control points, and root and tip on the end points.
+    const StrandSet a = readObj(test::writeBytes("curves.obj", text));
+    REQUIRE(a.numStrands() == 6);
+    REQUIRE(a.size(1) > 4);
+    REQUIRE(a.root(1) == Vec3f(0.f, 0.f, 0.f));
+    REQUIRE((a.tip(1) - Vec3f(4.f, 0.f, 0.f)).length() < 1e-6f);
+}
+
+TEST_CASE("readObj: curves only; curv2 and surf skipped with a warning; taylor refused", "[io][curves]")
+{
+    const std::string curve = "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 3 1 0\ncstype bspline\ndeg 3\ncurv 0 1 1 2 3 4\nparm u 0 0 0 0 1 1 1 1\nend\n";
+    REQUIRE(readObj(test::writeBytes("c1.obj", curve)).numStrands() == 1);
+    ReadReport report;
+    const StrandSet s = readObj(test::writeBytes("c2.obj", curve + "vp 0 0\nvp 1 0\ncurv2 1 2\nparm u 0 1\nend\nsurf 0 1 0 1 1 2 3 4\nparm u 0 1\nparm v 0 1\nend\n"), {}, &report);
+    REQUIRE(s.numStrands() == 1);
+    REQUIRE(report.warnings.size() == 2);  // the vp lines; the curv2 and surf elements
+    REQUIRE_THAT(report.warnings[1], Contains("skipped 2 curv2/surf element(s) (first on line 12)"));
+    REQUIRE_THROWS_AS(readObj(test::writeBytes("c3.obj", "v 0 0 0\ncstype taylor\n")), UnsupportedError);
+    REQUIRE_THROWS_WITH(readObj(test::writeBytes("c3.obj", "v 0 0 0\ncstype taylor\n")), Contains("line 2: cstype taylor is not supported (bspline, bezier and cardinal curves are"));
+}
+
+TEST_CASE("readObj: each kind of bad curve has its own error, at the curv line", "[io][curves]")
+{
+    const std::string v4 = "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 3 1 0\n";
+    auto fails = [&](const std::string& body, const std::string& message) {
+        CAPTURE(body);
+        REQUIRE_THROWS_WITH(readObj(test::writeBytes("bad_curve.obj", v4 + body)), Contains(message));
+    };
+    fails("cstype bspline\ndeg 3\ncurv 0 1 1 2 5\nend\n", "line 7: vertex index 5 is out of range: 4 vertices are defined so far");
+    fails("cstype bspline\ndeg 3\ncurv 0 1 -5 -1\nend\n", "line 7: vertex index -5 is out of range");
+    fails("cstype bspline\ndeg 3\ncurv 0 1 1 2 3\nend\n", "line 7: curve: degree 3 needs at least 4 control points, got 3");
+    fails("cstype bspline\ndeg 3\ncurv 0 1 1 2 3 4\nparm u 0 0 0 1 0 1 1 1\nend\n", "line 7: curve: knot 5 (0) is below knot 4 (1)");
+    fails("cstype bspline\ndeg 3\ncurv 0 1 1 2 3 4\nparm u 0 1\nend\n", "the knot vector (parm u) has 2 values; 4 control points of degree 3 need 8");
+    fails("cstype bezier\ndeg 2\ncurv 0 1 1 2 3 4\nend\n", "a Bezier curve of degree 2 needs 2 k + 1 control points (k segments), got 4");
+    fails("cstype bspline\ndeg 0\n", "line 6: degree 0 is outside 1..31");
+    fails("cstype bspline\ndeg 2000000000\n", "line 6: degree 2000000000 is outside 1..31");
+    fails("cstype bspline\ndeg 3\ncurv 0 1 1 2 3 4\n", "line 7: the curve begun here has no 'end'");
+    fails("cstype bspline\ndeg 3\ncurv 0 1 1 2 3 4\ncurv 0 1 1 2 3 4\n", "line 8: 'curv' before the 'end' of the curve begun on line 7");
+    fails("curv 0 1 1 2 3 4\nend\n", "line 5: 'curv' before any 'cstype'");
+    fails("cstype bspline\ncurv 0 1 1\nend\n", "line 6: 'curv' needs u0 u1 and at least two control point indices");
+    fails("cstype nurbs\n", "line 5: unknown cstype 'nurbs'");
+    fails("parm u 0 1\n", "line 5: 'parm' outside a curve");
+    fails("end\n", "line 5: 'end' without a 'curv'");
+    fails("cstype bspline\ndeg 3\ncurv 0 x 1 2 3 4\nend\n", "line 7: 'x' is not a valid number (curv u1)");
+    fails("cstype rat bspline\ndeg 3\nv 0 0 1 0\ncurv 0 1 1 2 3 5\nend\n", "control point 4 has weight 0; a rational curve needs weights above 0");
+    ReadOptions one;
+    one.curveSamples = 1;
+    REQUIRE_THROWS_WITH(readObj(test::writeBytes("bad_curve.obj", v4 + "cstype bezier\ndeg 3\ncurv 0 1 1 2 3 4\nend\n"), one),
+                        Contains("a sample count of 1 makes no strand"));
+}

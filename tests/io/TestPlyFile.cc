@@ -4,7 +4,10 @@
 #include <vdbhair/io/HairFile.h>
 #include <vdbhair/io/PlyFile.h>
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <random>
 #include <cstring>
 #include <limits>
 
@@ -155,4 +158,154 @@ TEST_CASE("readPly: binary files are read in place with the generic reader's str
     for (float n : {1.f, 0.5f, 2.f}) test::put(frac, n);
     REQUIRE_THROWS_WITH(readPly(test::writeBytes("frac.ply", frac)),
                         Contains("at byte " + std::to_string(frac.size() - 4) + ": strand 1 has nsegs 0.500000; it must be a non-negative integer"));
+}
+
+namespace {
+
+/// @a v in the shortest decimal that reads back the same.
+std::string shortFloat(float v)
+{
+    char buf[32];
+    return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
+}
+
+/// A PLY of @a s's vertices only (as NeuralHaircut and GaussianHaircut write: no topology),
+/// written here independently of writePly().
+std::string plyPointsOnly(const StrandSet& s, bool binary)
+{
+    std::string b = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") + " 1.0\ncomment points in runs\nelement vertex " +
+                    std::to_string(s.numVertices()) + "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    for (const Vec3f& p : s.positions) {
+        if (binary) for (int c = 0; c < 3; ++c) test::put(b, p[c]);
+        else b += shortFloat(p.x()) + " " + shortFloat(p.y()) + " " + shortFloat(p.z()) + "\n";
+    }
+    return b;
+}
+
+/// A line set of @a s (Open3D's layout: vertex, then edge with int vertex1, vertex2 and the
+/// edge's colour), its edges shuffled and each in a random direction.
+std::string plyLineSet(const StrandSet& s, bool binary, std::mt19937& rng)
+{
+    std::vector<std::pair<std::int32_t, std::int32_t>> edges;
+    for (std::size_t i = 0; i < s.numStrands(); ++i)
+        for (std::size_t v = s.begin(i); v + 1 < s.end(i); ++v) edges.push_back({std::int32_t(v), std::int32_t(v + 1)});
+    std::shuffle(edges.begin(), edges.end(), rng);
+    for (auto& e : edges) if (rng() % 2) std::swap(e.first, e.second);
+    std::string b = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") + " 1.0\nelement vertex " +
+                    std::to_string(s.numVertices()) + "\nproperty double x\nproperty double y\nproperty double z\nelement edge " +
+                    std::to_string(edges.size()) + "\nproperty int vertex1\nproperty int vertex2\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+    for (const Vec3f& p : s.positions) {
+        if (binary) for (int c = 0; c < 3; ++c) test::put(b, double(p[c]));
+        else b += shortFloat(p.x()) + " " + shortFloat(p.y()) + " " + shortFloat(p.z()) + "\n";
+    }
+    for (const auto& [a, c] : edges) {
+        if (binary) { test::put(b, a); test::put(b, c); for (int k = 0; k < 3; ++k) test::put(b, std::uint8_t(200)); }
+        else b += std::to_string(a) + " " + std::to_string(c) + " 200 200 200\n";
+    }
+    return b;
+}
+
+} // namespace
+
+TEST_CASE("readPly: points in runs of ReadOptions::pointsPerStrand (NeuralHaircut's layout)", "[io][ply-runs]")
+{
+    // 3 strands of 5 points each.
+    StrandSet s;
+    for (int i = 0; i < 3; ++i) s.addStrand(test::helix(1.0 + i, 0.2, 3.0, 5));
+    ReadOptions runs;
+    runs.pointsPerStrand = 5;
+    for (bool binary : {true, false}) {
+        CAPTURE(binary);
+        const std::string path = test::writeBytes("runs.ply", plyPointsOnly(s, binary));
+        test::requireSameStrands(s, readPly(path, runs));
+        // Without the option: one line that says what to set.
+        REQUIRE_THROWS_WITH(readPly(path), Contains("the file has only points: no 'strand' element") &&
+                                               Contains("read it with ReadOptions::pointsPerStrand N"));
+        ReadOptions four;
+        four.pointsPerStrand = 4;
+        REQUIRE_THROWS_WITH(readPly(path, four), Contains("the 'vertex' element has 15 vertices, which is not a multiple of ReadOptions::pointsPerStrand 4"));
+        ReadOptions all;
+        all.pointsPerStrand = 15;
+        REQUIRE(readPly(path, all).numStrands() == 1);
+        ReadOptions single;
+        single.pointsPerStrand = 1;
+        ReadReport report;
+        REQUIRE(readPly(path, single, &report).numStrands() == 0);  // one-point strands are dropped, as every reader does
+        REQUIRE(report.droppedStrands == 15);
+    }
+    // A vertex count far beyond the file: refused before anything is allocated.
+    std::string huge = "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    huge += std::string(24, '\0');
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("runs_huge.ply", huge), runs),
+                        Contains("element 'vertex' declares 4000000000 items of at least 12 bytes but only 24 bytes remain"));
+    // A file with a strand element keeps its own topology; the option is named in a warning.
+    const StrandSet sample = test::sampleStrands(false);
+    const std::string hairutil = test::tempPath("runs_hairutil.ply");
+    writePly(hairutil, sample);
+    ReadReport report;
+    test::requireSameStrands(sample, readPly(hairutil, runs, &report));
+    REQUIRE(report.warnings.size() == 1);
+    REQUIRE_THAT(report.warnings[0], Contains("ReadOptions::pointsPerStrand 5 is ignored"));
+}
+
+TEST_CASE("readPly: vertex + edge line sets (Open3D, trimesh) chained into strands", "[io][ply-edges]")
+{
+    const StrandSet s = test::sampleStrands(false);
+    std::mt19937 rng(50);
+    for (int trial = 0; trial < 4; ++trial) {
+        const bool binary = trial % 2 == 0;
+        CAPTURE(trial, binary);
+        ReadReport report;
+        const StrandSet r = readPly(test::writeBytes("lineset.ply", plyLineSet(s, binary, rng)), {}, &report);
+        test::requireSameStrands(s, r, binary ? 0.f : 1e-6f);
+        REQUIRE(report.warnings.empty());
+    }
+    // Roots nearest a point, as for OBJ edges.
+    ReadOptions near;
+    near.objRootNear = s.tip(0);
+    const StrandSet flipped = readPly(test::writeBytes("lineset.ply", plyLineSet(s, true, rng)), near);
+    REQUIRE(flipped.root(0) == s.tip(0));
+    // The round trip of a hairutil file whose strand element a tool dropped: its edges alone.
+    std::string written = test::readBytes([&] { const std::string p = test::tempPath("rt_edges.ply"); writePly(p, s, PlyEncoding::Ascii); return p; }());
+    const std::size_t at = written.find("element strand");
+    written.erase(at, written.find("element edge") - at);
+    const std::size_t body = written.find("end_header\n") + 11;
+    std::size_t line = body;
+    for (std::size_t v = 0; v < s.numVertices(); ++v) line = written.find('\n', line) + 1;
+    std::size_t nsegsEnd = line;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) nsegsEnd = written.find('\n', nsegsEnd) + 1;
+    written.erase(line, nsegsEnd - line);
+    test::requireSameStrands(s, readPly(test::writeBytes("rt_edges.ply", written)), 1e-6f);
+}
+
+TEST_CASE("readPly: each kind of bad line set has its own error", "[io][ply-edges]")
+{
+    const std::string head = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n";
+    const std::string verts = "0 0 0\n1 0 0\n2 0 0\n3 0 0\n";
+    auto edges = [&](int n, const std::string& body) {
+        return head + "element edge " + std::to_string(n) + "\nproperty int vertex1\nproperty int vertex2\nend_header\n" + verts + body;
+    };
+    REQUIRE(readPly(test::writeBytes("le0.ply", edges(2, "0 1\n2 3\n"))).numStrands() == 2);
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("le1.ply", edges(2, "0 1\n2 4\n"))), Contains("line 16: edge 1 names vertex 4 but the 'vertex' element has 4 (indices are 0-based)"));
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("le2.ply", edges(1, "-1 2\n"))), Contains("edge 0 names vertex -1"));
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("le3.ply", edges(3, "0 1\n1 2\n3 1\n"))),
+                        Contains("vertex 1 joins 3 or more others (edges 0, 1 and 2); a strand cannot branch"));
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("le4.ply", edges(3, "0 1\n1 2\n2 0\n"))), Contains("vertex 0 lies on a closed loop of edges (edge 0)"));
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("le5.ply", head + "element edge 1\nproperty int a\nproperty int b\nend_header\n" + verts + "0 1\n")),
+                        Contains("the 'edge' element needs scalar properties vertex1 and vertex2"));
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("le6.ply", edges(1, "2 2\n"))), Contains("the 'edge' element joins no two vertices"));
+    ReadReport report;
+    REQUIRE(readPly(test::writeBytes("le7.ply", edges(2, "0 1\n1 0\n")), {}, &report).numStrands() == 1);
+    REQUIRE(report.warnings.size() == 2);
+    REQUIRE_THAT(report.warnings[0], Contains("ignored 1 repeated edge(s)"));
+    REQUIRE_THAT(report.warnings[1], Contains("2 of 4 vertices are on no edge and were ignored"));
+    // An edge count far beyond the file (binary): refused before anything is allocated.
+    std::string huge = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+                       "element edge 4000000000\nproperty int vertex1\nproperty int vertex2\nend_header\n";
+    for (float f : {0.f, 0.f, 0.f, 1.f, 1.f, 1.f}) test::put(huge, f);
+    test::put(huge, std::int32_t(0));
+    test::put(huge, std::int32_t(1));
+    REQUIRE_THROWS_WITH(readPly(test::writeBytes("le_huge.ply", huge)), Contains("element 'edge' declares 4000000000 items of at least 8 bytes but only 8 bytes remain"));
+    huge.replace(huge.find("4000000000"), 10, "1");
+    REQUIRE(readPly(test::writeBytes("le_one.ply", huge)).numStrands() == 1);
 }

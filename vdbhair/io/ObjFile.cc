@@ -4,7 +4,9 @@
 #include <vdbhair/io/MeshFile.h>
 
 #include <vdbhair/Version.h>
+#include <vdbhair/io/EdgeChains.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/FreeFormCurve.h>
 #include <vdbhair/io/TextScanner.h>
 
 #include <algorithm>
@@ -54,20 +56,41 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
     const std::vector<char> bytes = readFileBytes(path, where, opts.interrupter);
     TextScanner text(bytes, where);
 
-    // Pass 1: vertices, and every `l` element as edges between consecutive vertices.
+    // Pass 1: vertices, every `l` element as edges between consecutive vertices, and every
+    // free-form curve (`curv` ... `end`) evaluated to a polyline as soon as it ends.
     std::vector<Vec3f> vertices;
     std::vector<Vec3f> colors;
+    std::vector<double> weights;  // `v x y z w`: filled (with 1) only once a vertex has a weight
     bool anyColor = false;
-    struct Edge { std::uint32_t a, b; std::uint32_t line; };
-    std::vector<Edge> edges;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> singles;  // (vertex, line) of one-vertex elements
-    std::size_t lineElements = 0, ignored = 0, selfEdges = 0;
-    std::vector<std::string_view> tok;
+    EdgeList edges;
+    std::size_t lineElements = 0, ignored = 0, curves = 0, skippedFreeForm = 0;
+    std::size_t skippedFreeFormLine = 0;
+    std::vector<std::string_view> tok, more;
     std::vector<std::uint32_t> element;
+
+    // Free-form state: the attributes in force (cstype, deg) and the curve being read.
+    FreeFormCurve attrs;
+    bool haveCstype = false;
+    bool inCurve = false;
+    std::size_t curveLine = 0;
+    FreeFormCurve curve;
+    std::vector<std::uint32_t> curveIndices;
+    std::vector<Vec3f> curvePoints;
+    std::vector<std::uint32_t> curveOffsets{0};
+    auto curveFail = [&](const std::string& rule) {
+        throw FormatError(where + ": line " + std::to_string(curveLine) + ": curve: " + rule);
+    };
 
     InterruptPoll poll(opts.interrupter, where);
     while (text.nextLine(tok)) {
         poll();
+        // A line ending in a backslash continues on the next (the OBJ specification; Maya breaks
+        // long curv and parm lines so).
+        while (!tok.empty() && tok.back() == "\\" && text.nextLine(more)) {
+            tok.pop_back();
+            tok.insert(tok.end(), more.begin(), more.end());
+        }
+        if (!tok.empty() && tok.back() == "\\") tok.pop_back();
         if (tok.empty()) continue;
         const std::string_view key = tok[0];
         if (key == "v") {
@@ -76,7 +99,12 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
             if (tok.size() >= 7) {
                 c = Vec3f(text.toFloat(tok[4], "red"), text.toFloat(tok[5], "green"), text.toFloat(tok[6], "blue"));
                 anyColor = true;
+            } else if (tok.size() == 5) {
+                const double w = text.toDouble(tok[4], "weight");
+                if (weights.empty() && w != 1.0) weights.assign(vertices.size() - 1, 1.0);
+                if (!weights.empty()) weights.push_back(w);
             }
+            if (!weights.empty() && weights.size() < vertices.size()) weights.push_back(1.0);
             colors.push_back(c);
         } else if (key == "l") {
             if (tok.size() < 2) text.fail("an 'l' element needs at least one vertex index");
@@ -84,106 +112,104 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
             element.clear();
             for (std::size_t j = 1; j < tok.size(); ++j) element.push_back(objVertexIndex(text, tok[j], vertices.size()));
             const std::uint32_t line = std::uint32_t(std::min<std::size_t>(text.line(), 0xffffffffu));
-            if (element.size() == 1) singles.push_back({element[0], line});
+            if (element.size() == 1) edges.singles.push_back({element[0], line});
             for (std::size_t j = 0; j + 1 < element.size(); ++j) {
-                if (element[j] == element[j + 1]) { ++selfEdges; continue; }
-                edges.push_back({std::min(element[j], element[j + 1]), std::max(element[j], element[j + 1]), line});
+                if (element[j] == element[j + 1]) { ++edges.selfEdges; continue; }
+                edges.edges.push_back({std::min(element[j], element[j + 1]), std::max(element[j], element[j + 1]), line});
             }
+        } else if (key == "cstype") {
+            if (tok.size() < 2 || tok.size() > 3 || (tok.size() == 3 && tok[1] != "rat")) {
+                text.fail("'cstype' needs a type, optionally after 'rat': cstype [rat] bspline|bezier|cardinal");
+            }
+            const std::string_view type = tok.back();
+            attrs.rational = tok.size() == 3;
+            if (type == "bspline") attrs.basis = CurveBasis::BSpline;
+            else if (type == "bezier") attrs.basis = CurveBasis::Bezier;
+            else if (type == "cardinal") attrs.basis = CurveBasis::Cardinal;
+            else if (type == "taylor" || type == "bmatrix") {
+                throw UnsupportedError(where + ": line " + std::to_string(text.line()) + ": cstype " + std::string(type) +
+                                       " is not supported (bspline, bezier and cardinal curves are; convert the curves to one of them or to polylines)");
+            } else {
+                text.fail("unknown cstype '" + std::string(type) + "' (the OBJ types are bspline, bezier, cardinal, taylor, bmatrix)");
+            }
+            haveCstype = true;
+        } else if (key == "deg") {
+            if (tok.size() < 2) text.fail("'deg' needs a degree");
+            const std::int64_t d = text.toInt(tok[1], "degree");
+            if (d < 1 || d > kMaxCurveDegree) {
+                text.fail("degree " + std::to_string(d) + " is outside 1.." + std::to_string(kMaxCurveDegree) + " (the degrees this reader evaluates)");
+            }
+            attrs.degree = int(d);
+        } else if (key == "curv") {
+            if (inCurve) text.fail("'curv' before the 'end' of the curve begun on line " + std::to_string(curveLine));
+            if (!haveCstype) text.fail("'curv' before any 'cstype' (cstype bspline, bezier or cardinal)");
+            if (tok.size() < 5) text.fail("'curv' needs u0 u1 and at least two control point indices, got " + std::to_string(tok.size() - 1) + " values");
+            inCurve = true;
+            curveLine = text.line();
+            curve = attrs;
+            curve.u0 = text.toDouble(tok[1], "curv u0");
+            curve.u1 = text.toDouble(tok[2], "curv u1");
+            curveIndices.clear();
+            for (std::size_t j = 3; j < tok.size(); ++j) curveIndices.push_back(objVertexIndex(text, tok[j], vertices.size()));
+        } else if (key == "parm") {
+            if (!inCurve) text.fail("'parm' outside a curve (between 'curv' and 'end')");
+            if (tok.size() < 2 || tok[1] != "u") text.fail("a curve takes 'parm u' values only");
+            curve.parms.clear();
+            for (std::size_t j = 2; j < tok.size(); ++j) curve.parms.push_back(text.toDouble(tok[j], "parm u"));
+        } else if (key == "end") {
+            if (!inCurve) text.fail("'end' without a 'curv'");
+            inCurve = false;
+            curve.points.clear();
+            curve.weights.clear();
+            for (const std::uint32_t v : curveIndices) {
+                curve.points.emplace_back(vertices[v].x(), vertices[v].y(), vertices[v].z());
+                curve.weights.push_back(weights.empty() ? 1.0 : weights[v]);
+            }
+            if (std::string rule = flattenCurve(curve, opts.curveSamples, curvePoints); !rule.empty()) curveFail(rule);
+            curveOffsets.push_back(std::uint32_t(curvePoints.size()));
+            ++curves;
+        } else if (key == "curv2" || key == "surf") {
+            // Curves on surfaces (trimming) and surfaces are not strands: skipped, up to their 'end'.
+            ++skippedFreeForm;
+            if (!skippedFreeFormLine) skippedFreeFormLine = text.line();
+            if (inCurve) text.fail("'" + std::string(key) + "' before the 'end' of the curve begun on line " + std::to_string(curveLine));
+            while (text.nextLine(tok) && !(tok.size() == 1 && tok[0] == "end")) poll();
         } else if (key[0] == '#') {
             continue;
         } else {
-            ++ignored;  // f, vn, vt, o, g, s, usemtl, mtllib, curv, ...
+            ++ignored;  // f, vn, vt, vp, o, g, s, usemtl, mtllib, trim, hole, ...
         }
     }
-    if (lineElements == 0) {
-        throw FormatError(where + ": no polylines: the file has no 'l' elements" +
+    if (inCurve) throw FormatError(where + ": line " + std::to_string(curveLine) + ": the curve begun here has no 'end'");
+    if (lineElements == 0 && curves == 0) {
+        throw FormatError(where + ": no polylines: the file has no 'l' elements and no curves ('curv')" +
                           (ignored ? " (" + std::to_string(ignored) + " other lines, e.g. faces, were ignored)" : std::string()));
     }
     if (ignored && report) {
         report->warnings.push_back(where + ": " + std::to_string(ignored) + " lines other than v and l (faces, normals, groups, ...) were ignored");
     }
-
-    // Pass 2: the same edge listed twice counts once; every vertex joins at most two others.
-    std::stable_sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
-    const std::size_t before = edges.size();
-    edges.erase(std::unique(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.a == y.a && x.b == y.b; }), edges.end());
-    if (report && (before != edges.size() || selfEdges)) {
-        report->warnings.push_back(where + ": ignored " + std::to_string(before - edges.size()) + " repeated edge(s) and " +
-                                   std::to_string(selfEdges) + " edge(s) from a vertex to itself");
+    if (skippedFreeForm && report) {
+        report->warnings.push_back(where + ": skipped " + std::to_string(skippedFreeForm) + " curv2/surf element(s) (first on line " +
+                                   std::to_string(skippedFreeFormLine) + "): curves on surfaces and surfaces are not strands");
     }
-    constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-    const std::size_t nV = vertices.size();
-    std::vector<std::uint32_t> adj(2 * nV, kNone);  // the (at most two) neighbours of each vertex
-    std::vector<std::uint32_t> adjLine(2 * nV, 0);
-    std::vector<std::uint8_t> degree(nV, 0);
-    auto link = [&](std::uint32_t v, std::uint32_t w, std::uint32_t line) {
-        if (degree[v] == 2) {
-            throw FormatError(where + ": vertex " + std::to_string(v + 1) + " joins 3 or more others (edges on lines " +
-                              std::to_string(adjLine[2 * v]) + ", " + std::to_string(adjLine[2 * v + 1]) + " and " +
-                              std::to_string(line) + "); a strand cannot branch, so every vertex may join at most two");
-        }
-        adj[2 * v + degree[v]] = w;
-        adjLine[2 * v + degree[v]] = line;
-        ++degree[v];
-    };
-    for (const Edge& e : edges) {
-        link(e.a, e.b, e.line);
-        link(e.b, e.a, e.line);
-    }
-    std::vector<std::uint32_t> singleLine(nV, 0);
-    for (const auto& [v, line] : singles) if (degree[v] == 0 && singleLine[v] == 0) singleLine[v] = line;
 
-    // Pass 3: walk each chain from its lower-index end; strands in the order of that end.
+    // Strands: the chains of the `l` elements, then the curves in file order.
     StrandSet out;
-    out.reserve(edges.size() ? nV - edges.size() : singles.size(), nV);
-    ShortStrandFilter filter(opts, report, where);
-    std::vector<char> visited(nV, 0);
-    std::vector<std::uint32_t> chain;
-    std::size_t strand = 0;
-    for (std::uint32_t v = 0; v < nV; ++v) {
-        poll();
-        if (visited[v]) continue;
-        chain.clear();
-        std::string location;
-        if (degree[v] == 0) {
-            if (singleLine[v] == 0) continue;  // a vertex no line element uses
-            chain.push_back(v);
-            location = "line " + std::to_string(singleLine[v]);
-        } else if (degree[v] == 1) {
-            location = "line " + std::to_string(adjLine[2 * v]);
-            std::uint32_t prev = kNone, cur = v;
-            while (cur != kNone) {
-                visited[cur] = 1;
-                chain.push_back(cur);
-                const std::uint32_t next = adj[2 * cur] != prev ? adj[2 * cur] : adj[2 * cur + 1];
-                prev = cur;
-                cur = (next != kNone && !visited[next]) ? next : kNone;
-            }
-        } else {
-            continue;  // inside a chain (reached from its end) or on a loop (found below)
-        }
-        visited[v] = 1;
-        if (opts.objRootNear && chain.size() >= 2) {
-            const Vec3f& p = *opts.objRootNear;
-            if ((vertices[chain.back()] - p).lengthSqr() < (vertices[chain.front()] - p).lengthSqr()) {
-                std::reverse(chain.begin(), chain.end());
-            }
-        }
-        if (filter.keep(strand++, chain.size(), location)) {
-            for (const std::uint32_t w : chain) {
-                out.positions.push_back(vertices[w]);
-                if (anyColor) out.color.push_back(colors[w]);
-            }
+    if (lineElements) {
+        EdgeNaming naming;
+        naming.vertexBase = 1;
+        naming.place = "line";
+        naming.places = "edges on lines";
+        out = strandsFromEdges(vertices, anyColor ? colors : std::vector<Vec3f>{}, edges, naming, where, opts, report);
+    }
+    if (curves) {
+        // A curve's points have no colour of their own: the default grey where the lines have colours.
+        for (std::size_t i = 0; i + 1 < curveOffsets.size(); ++i) {
+            out.positions.insert(out.positions.end(), curvePoints.begin() + curveOffsets[i], curvePoints.begin() + curveOffsets[i + 1]);
+            if (anyColor) out.color.resize(out.positions.size(), Vec3f(0.5f));
             out.offsets.push_back(std::uint32_t(out.positions.size()));
         }
     }
-    for (std::uint32_t v = 0; v < nV; ++v) {
-        if (degree[v] == 2 && !visited[v]) {
-            throw FormatError(where + ": vertex " + std::to_string(v + 1) + " lies on a closed loop of edges (line " +
-                              std::to_string(adjLine[2 * v]) + "); a strand needs two ends, a root and a tip");
-        }
-    }
-    filter.finish();
     return out;
 }
 

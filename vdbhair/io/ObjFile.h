@@ -19,8 +19,20 @@
 /// errors naming the vertex (1-based, as in the file) and the lines involved. A one-vertex `l`
 /// element on a vertex no edge uses is a one-vertex strand (dropped or rejected like any short
 /// strand). Indices are 1-based; negative ones count back from the latest vertex; `i/t` forms
-/// take the vertex index. Faces and other elements are ignored (counted in a warning); a file
-/// without `l` elements is an error.
+/// take the vertex index. The chaining is EdgeChains.h's, shared with the PLY reader.
+///
+/// Free-form curves (Maya, ZBrush, character creators, Blender's "Curves as NURBS"): `cstype [rat]
+/// bspline|bezier|cardinal`, `deg N` (3 when absent), `curv u0 u1 i1 i2 ...` (indices as for `l`,
+/// negative ones relative), `parm u ...` (the knot vector of a bspline, uniform and clamped when
+/// absent; a bezier's or cardinal's segment ends) and `end`; a rational curve takes each control
+/// point's weight from `v x y z w`. Each curve becomes one strand, root at its first control
+/// point, evaluated at ReadOptions::curveSamples points or by FreeFormCurve.h's adaptive rule
+/// (within 1 % of the curve's length); curve strands follow the line strands, in file order.
+/// `cstype taylor` and `bmatrix` are refused (UnsupportedError); `curv2` and `surf` elements are
+/// skipped with a warning. Lines ending in `\` continue on the next line.
+///
+/// Faces and other elements are ignored (counted in a warning); a file without `l` elements and
+/// curves is an error.
 ///
 /// **Axes.** OBJ has no up axis. Blender's OBJ importer (default "Up: Y, Forward: -Z") turns the
 /// file's +Y into Blender's +Z (x, y, z) -> (x, -z, y), and its exporter turns it back with the
@@ -45,7 +57,8 @@ enum class ObjLineStyle
 ObjLineStyle objLineStyleFromName(const std::string& name);
 
 /// @throw IoError, FormatError (bad numbers, index out of range or zero, no polylines, a
-/// branching vertex, a closed loop).
+/// branching vertex, a closed loop, a curve that breaks a rule of its basis), UnsupportedError
+/// (taylor and basis-matrix curves).
 StrandSet readObj(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 
 /// @brief Write positions (and colours when present) as line elements.

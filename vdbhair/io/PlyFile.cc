@@ -6,6 +6,7 @@
 #include <vdbhair/Memory.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/ByteReader.h>
+#include <vdbhair/io/EdgeChains.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/MappedFile.h>
 #include <vdbhair/io/TextScanner.h>
@@ -279,6 +280,14 @@ void readPlyBody(const char* data, std::size_t size, const PlyHeader& hdr, const
 }
 
 
+/// Where a PLY's strands come from.
+enum class PlyTopology
+{
+    Strands,  ///< hairutil: an element `strand` with `nsegs`
+    Edges,    ///< a line set (Open3D, trimesh): an element `edge` with `vertex1`, `vertex2`
+    Runs,     ///< points only (NeuralHaircut, GaussianHaircut): ReadOptions::pointsPerStrand a strand
+};
+
 /// @brief The items of a binary element whose properties are all scalars lie @a stride bytes
 /// apart: where each property is within an item.
 std::vector<std::size_t> propertyOffsets(const Element& e, std::size_t& stride)
@@ -302,16 +311,40 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
     const Element* vertexEl = nullptr;
     const Element* strandEl = nullptr;
+    const Element* edgeEl = nullptr;
     for (const Element& e : hdr.elements) {
         if (e.name == "vertex") vertexEl = &e;
         if (e.name == "strand") strandEl = &e;
+        if (e.name == "edge") edgeEl = &e;
     }
     if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
     const int ix = findProperty(vertexEl, "x"), iy = findProperty(vertexEl, "y"), iz = findProperty(vertexEl, "z");
     if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
-    if (!strandEl) throw FormatError(where + ": the header has no 'strand' element (hairutil layout: element strand with property nsegs)");
+
+    // The topology: hairutil's strand element; else an edge element (a line set); else runs of
+    // ReadOptions::pointsPerStrand vertices.
+    PlyTopology topology = PlyTopology::Strands;
+    const int iv1 = findProperty(edgeEl, "vertex1"), iv2 = findProperty(edgeEl, "vertex2");
+    if (!strandEl) {
+        if (edgeEl && iv1 >= 0 && iv2 >= 0) {
+            topology = PlyTopology::Edges;
+        } else if (opts.pointsPerStrand > 0) {
+            topology = PlyTopology::Runs;
+        } else if (edgeEl) {
+            throw FormatError(where + ": line " + std::to_string(edgeEl->line) + ": the 'edge' element needs scalar properties vertex1 and vertex2");
+        } else {
+            throw FormatError(where + ": the file has only points: no 'strand' element (hairutil layout: element strand with property nsegs) "
+                              "and no 'edge' element (a line set); if each run of N consecutive vertices is one strand (NeuralHaircut and "
+                              "GaussianHaircut write 100), read it with ReadOptions::pointsPerStrand N");
+        }
+    } else if (opts.pointsPerStrand > 0 && report) {
+        report->warnings.push_back(where + ": ReadOptions::pointsPerStrand " + std::to_string(opts.pointsPerStrand) +
+                                   " is ignored: the file's 'strand' element says where each strand ends");
+    }
     const int iseg = findProperty(strandEl, "nsegs");
-    if (iseg < 0) throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the 'strand' element needs an integer property 'nsegs'");
+    if (strandEl && iseg < 0) throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the 'strand' element needs an integer property 'nsegs'");
+    if (topology != PlyTopology::Strands) strandEl = nullptr;
+    if (topology != PlyTopology::Edges) edgeEl = nullptr;
     const int ir = findProperty(vertexEl, "red"), ig = findProperty(vertexEl, "green"), ib = findProperty(vertexEl, "blue");
     const bool hasColor = ir >= 0 && ig >= 0 && ib >= 0;
     const float colorScale = hasColor && vertexEl->props[std::size_t(ir)].type == PlyType::UInt8 ? 1.f / 255.f : 1.f;
@@ -321,6 +354,20 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     std::vector<Vec3f>& positions = out.positions;
     std::vector<Vec3f>& colors = out.color;
     std::vector<std::uint64_t> counts;
+    EdgeList edges;                // PlyTopology::Edges
+    // One edge, checked against the header's vertex count (the 'vertex' element may come after
+    // it); @a fail(msg) throws at the item's place.
+    auto addEdge = [&](std::uint64_t n, double a, double b, auto&& fail) {
+        for (const double v : {a, b}) {
+            if (!(v >= 0.0) || v >= double(vertexEl->count) || v != std::floor(v)) {
+                fail("edge " + std::to_string(n) + " names vertex " + formatNumber(v) + " but the 'vertex' element has " +
+                     std::to_string(vertexEl->count) + " (indices are 0-based)");
+            }
+        }
+        const std::uint32_t place = std::uint32_t(std::min<std::uint64_t>(n, 0xffffffffu));
+        if (a == b) { ++edges.selfEdges; return; }
+        edges.edges.push_back({std::uint32_t(std::min(a, b)), std::uint32_t(std::max(a, b)), place});
+    };
     std::uint64_t nsegsSum = 0;    // vertices the strands use
     bool nsegsSaturated = false;   // their sum exceeds 2^64-1
     // One strand's nsegs, checked; @a fail(msg) throws at the item's place.
@@ -333,6 +380,10 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
         if (!nsegsSaturated) nsegsSum += c;
         counts.push_back(c);
     };
+    if (edgeEl && vertexEl->count > std::numeric_limits<std::uint32_t>::max()) {
+        throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": a line set of " + std::to_string(vertexEl->count) +
+                          " vertices; edges index at most 2^32-1");
+    }
     const bool anyList = std::any_of(hdr.elements.begin(), hdr.elements.end(), [](const Element& e) {
         return std::any_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.isList; });
     });
@@ -395,12 +446,22 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
                         bin.failAt(first + (n + 1) * stride, msg);
                     });
                 }
+            } else if (&e == edgeEl) {
+                edges.edges.reserve(e.count);
+                const PlyType t1 = e.props[std::size_t(iv1)].type, t2 = e.props[std::size_t(iv2)].type;
+                for (std::uint64_t n = 0; n < e.count; ++n) {
+                    poll();
+                    const char* item = items + n * stride;
+                    addEdge(n, loadValue(t1, item + at[std::size_t(iv1)]), loadValue(t2, item + at[std::size_t(iv2)]),
+                            [&](const std::string& msg) { bin.failAt(first + (n + 1) * stride, msg); });
+                }
             }
         }
     } else {
         readPlyBody(file.data(), file.size(), hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
             if (&e == vertexEl) { reserveHugePages(positions, e.count); if (hasColor) colors.reserve(e.count); }
             if (&e == strandEl) counts.reserve(e.count);
+            if (&e == edgeEl) edges.edges.reserve(e.count);
         }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
             if (&e == vertexEl) {
                 const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
@@ -409,8 +470,46 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
                 if (hasColor) colors.emplace_back(float(values[std::size_t(ir)]) * colorScale, float(values[std::size_t(ig)]) * colorScale, float(values[std::size_t(ib)]) * colorScale);
             } else if (&e == strandEl) {
                 addStrand(n, values[std::size_t(iseg)], [&](const std::string& msg) { src.fail(msg); });
+            } else if (&e == edgeEl) {
+                addEdge(n, values[std::size_t(iv1)], values[std::size_t(iv2)], [&](const std::string& msg) { src.fail(msg); });
             }
         });
+    }
+    if (topology == PlyTopology::Edges) {
+        // A line set: the edges chained into strands as the OBJ reader chains `l` elements.
+        if (edges.edges.empty()) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'edge' element joins no two vertices; a line set needs edges");
+        const std::vector<Vec3f> vertices = std::move(positions);
+        const std::vector<Vec3f> vertexColors = std::move(colors);
+        EdgeNaming naming;  // 0-based vertices, edges by their item number
+        out = strandsFromEdges(vertices, vertexColors, edges, naming, where, opts, report);
+        if (report && out.numVertices() < vertices.size()) {
+            report->warnings.push_back(where + ": " + std::to_string(vertices.size() - out.numVertices()) + " of " +
+                                       std::to_string(vertices.size()) + " vertices are on no edge and were ignored");
+        }
+        return out;
+    }
+    if (topology == PlyTopology::Runs) {
+        // Points in runs: each run of pointsPerStrand consecutive vertices is one strand.
+        const std::size_t run = opts.pointsPerStrand, nV = positions.size();
+        if (nV % run != 0) {
+            throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element has " + std::to_string(nV) +
+                              " vertices, which is not a multiple of ReadOptions::pointsPerStrand " + std::to_string(run) +
+                              " (each run of that many consecutive vertices is one strand)");
+        }
+        if (nV > std::numeric_limits<std::uint32_t>::max()) {
+            throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": " + std::to_string(nV) + " vertices; a strand set holds at most 2^32-1");
+        }
+        ShortStrandFilter filter(opts, report, where);
+        if (run < 2) {
+            for (std::size_t i = 0; i < nV; ++i) filter.keep(i, run, "vertex " + std::to_string(i));
+            positions.clear();
+            colors.clear();
+        } else {
+            out.offsets.reserve(nV / run + 1);
+            for (std::size_t v = run; v <= nV; v += run) out.offsets.push_back(std::uint32_t(v));
+        }
+        filter.finish();
+        return out;
     }
     if (nsegsSaturated || nsegsSum != positions.size()) {
         throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " +

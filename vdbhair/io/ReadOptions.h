@@ -33,10 +33,19 @@ struct ReadOptions
     /// `.vdb`: the name of the points grid that holds the strands (Houdini and the demo's
     /// `strands_input` use other names than the default).
     std::string vdbGrid = "strands";
-    /// `.obj`: edges carry no direction, so each strand rebuilt from them is rooted at the end
+    /// `.obj` and `.ply` edges: edges carry no direction, so each strand rebuilt from them is rooted at the end
     /// nearest this point (e.g. the scalp's centre) when it is set, otherwise at its end with the
     /// lower vertex index (which is the root of every file vdbhair and Blender write).
+    /// (PLY edge line sets too.)
     std::optional<Vec3f> objRootNear;
+    /// `.ply` without strand topology (only a `vertex` element, as NeuralHaircut and GaussianHaircut
+    /// write): each run of this many consecutive vertices is one strand (they write 100). 0: not
+    /// set, and such a file is an error that says to set it. Ignored when the file has topology.
+    std::size_t pointsPerStrand = 0;
+    /// `.obj` free-form curves (`curv`): the points each curve is evaluated at, evenly in its
+    /// parameter. 0: chosen per curve so that the polyline keeps the curve's shape within 1 % of
+    /// its length (FreeFormCurve.h explains the rule).
+    std::size_t curveSamples = 0;
 };
 
 /// @brief What a reader noticed but did not fail on.
