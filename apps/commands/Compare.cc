@@ -137,6 +137,7 @@ Command addCompareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--head", params->head, "A head (mesh or .vdb level set): the shares of A's and B's strands passing into it");
     sub->add_option("--per-strand", params->perStrand, "Write each strand of A's values as CSV: chamfer, and with equal strand counts position, curvature, frechet");
     addCommonOptions(sub, common);
+    addReadOptions(sub, common);
     sub->footer("Example: vdbhair compare straight.hair rebuilt.hair --unit cm --json");
     return {sub, [params, &common] { return runCompare(*params, common); }, {{"samples", "--samples"}, {"metersPerUnit", "--unit"}, {"thresholds", "--threshold"}}};
 }

@@ -42,79 +42,102 @@ OrientedPoints orientedPoints(const StrandSet& s)
     return o;
 }
 
-/// For every point of @a from, whether a point of @a to matches it at each threshold; and with
-/// @a consistency, each strand of @a from's consistency at each threshold.
+/// nanoflann's result set for one oriented point: each point within the largest threshold distance
+/// is tested against every threshold at once, as the tree finds it. Without @a hits it stops the
+/// search as soon as every threshold has a match (all precision and recall need); with them it
+/// records each (threshold, strand) match for the strand consistency.
+struct MatchVisitor
+{
+    const OrientedPoints& to;
+    const std::vector<OrientedThreshold>& thresholds;
+    const std::vector<double>& cosines;
+    bool bidirectional;
+    double radius2;
+    Vec3d direction;
+    std::uint32_t matched = 0, all = 0;
+    std::vector<std::uint64_t>* hits = nullptr;  ///< threshold << 32 | strand of @a to
+
+    bool addPoint(double d2, std::uint32_t index)
+    {
+        double c = direction.dot(to.direction[index]);
+        if (bidirectional) c = std::abs(c);
+        for (std::size_t t = 0; t < thresholds.size(); ++t) {
+            if (d2 > thresholds[t].distance * thresholds[t].distance || c < cosines[t]) continue;
+            matched |= 1u << t;
+            if (hits) hits->push_back(std::uint64_t(t) << 32 | to.strand[index]);
+        }
+        return hits != nullptr || matched != all;
+    }
+    double worstDist() const { return radius2; }
+    bool full() const { return true; }
+};
+
+/// For every point of @a from, whether a point of @a to matches it at each threshold (the share
+/// matched, per threshold); and with @a consistency, each strand of @a from's consistency at each
+/// threshold. Strands of @a from are independent: processed in parallel, summed in order.
 void matchShare(const OrientedPoints& from, const OrientedPoints& to, const std::vector<OrientedThreshold>& thresholds, bool bidirectional,
                 bool threaded, std::vector<double>& share, std::vector<double>* consistency)
 {
     const std::size_t T = thresholds.size(), N = from.position.size();
+    if (T > 32) throw ValueError("oriented match: " + std::to_string(T) + " thresholds: at most 32");
     double maxDistance = 0.0;
     for (const OrientedThreshold& t : thresholds) maxDistance = std::max(maxDistance, t.distance);
     std::vector<double> cosines(T);
     for (std::size_t t = 0; t < T; ++t) cosines[t] = std::cos(thresholds[t].angleDegrees * M_PI / 180.0);
     const PointCloud cloud{&to.position};
     const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    std::vector<std::uint8_t> matched(N * T, 0);
-    // Per point and threshold, the predicted strands it matches (for consistency): kept per point.
-    std::vector<std::vector<std::uint32_t>> matchedStrands(consistency ? N * T : 0);
+    // The points of each strand of @a from (consecutive): [first[s], first[s + 1]).
+    std::vector<std::size_t> first{0};
+    for (std::size_t i = 1; i <= N; ++i) if (i == N || from.strand[i] != from.strand[i - 1]) first.push_back(i);
+    const std::size_t S = first.size() - 1;
+    std::vector<std::uint32_t> matched(N, 0);                   // per point: a bit per threshold
+    std::vector<double> strandConsistency(consistency ? S * T : 0);
+    const std::uint32_t all = T == 32 ? ~0u : (1u << T) - 1u;
     auto run = [&](const tbb::blocked_range<std::size_t>& r) {
-        std::vector<std::pair<std::uint32_t, double>> nb;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            nb.clear();
-            const Vec3d q = from.position[i];
-            tree.radiusSearch(q.asPointer(), maxDistance * maxDistance, nb, nanoflann::SearchParams(32, 0.f, false));
-            for (std::size_t t = 0; t < T; ++t) {
-                const double d2 = thresholds[t].distance * thresholds[t].distance;
-                for (const auto& m : nb) {
-                    if (m.second > d2) continue;
-                    double c = from.direction[i].dot(to.direction[m.first]);
-                    if (bidirectional) c = std::abs(c);
-                    if (c < cosines[t]) continue;
-                    matched[i * T + t] = 1;
-                    if (!consistency) break;
-                    matchedStrands[i * T + t].push_back(to.strand[m.first]);
-                }
-                if (consistency) {
-                    std::vector<std::uint32_t>& v = matchedStrands[i * T + t];
-                    std::sort(v.begin(), v.end());
-                    v.erase(std::unique(v.begin(), v.end()), v.end());
-                }
+        std::vector<std::uint64_t> hits, strandHits;
+        for (std::size_t s = r.begin(); s != r.end(); ++s) {
+            strandHits.clear();
+            for (std::size_t i = first[s]; i < first[s + 1]; ++i) {
+                MatchVisitor v{to, thresholds, cosines, bidirectional, maxDistance * maxDistance, from.direction[i]};
+                v.all = all;
+                hits.clear();
+                if (consistency) v.hits = &hits;
+                const Vec3d q = from.position[i];
+                tree.findNeighbors(v, q.asPointer(), nanoflann::SearchParams(32, 0.f, false));
+                matched[i] = v.matched;
+                if (!consistency) continue;
+                // A point counts each strand it matches once.
+                std::sort(hits.begin(), hits.end());
+                hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+                strandHits.insert(strandHits.end(), hits.begin(), hits.end());
+            }
+            if (!consistency) continue;
+            // Per threshold, the most of this strand's points that match one and the same strand.
+            std::sort(strandHits.begin(), strandHits.end());
+            const double points = double(first[s + 1] - first[s]);
+            for (std::size_t a = 0; a < strandHits.size();) {
+                std::size_t b = a;
+                while (b < strandHits.size() && strandHits[b] == strandHits[a]) ++b;
+                double& best = strandConsistency[s * T + (strandHits[a] >> 32)];
+                best = std::max(best, double(b - a) / points);
+                a = b;
             }
         }
     };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, N, 512), run);
-    else run(tbb::blocked_range<std::size_t>(0, N));
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 16), run);
+    else run(tbb::blocked_range<std::size_t>(0, S));
     share.assign(T, 0.0);
     for (std::size_t t = 0; t < T; ++t) {
         std::size_t count = 0;
-        for (std::size_t i = 0; i < N; ++i) count += matched[i * T + t];
+        for (std::size_t i = 0; i < N; ++i) count += (matched[i] >> t) & 1u;
         share[t] = N ? double(count) / double(N) : 0.0;
     }
     if (!consistency) return;
-    // Per strand of @a from (its points are consecutive): the most points matching one strand.
     consistency->assign(T, 0.0);
     for (std::size_t t = 0; t < T; ++t) {
         double sum = 0.0;
-        std::size_t counted = 0;
-        std::vector<std::uint32_t> ids;
-        for (std::size_t begin = 0; begin < N;) {
-            std::size_t end = begin;
-            while (end < N && from.strand[end] == from.strand[begin]) ++end;
-            ids.clear();
-            for (std::size_t i = begin; i < end; ++i) ids.insert(ids.end(), matchedStrands[i * T + t].begin(), matchedStrands[i * T + t].end());
-            std::sort(ids.begin(), ids.end());
-            std::size_t best = 0;
-            for (std::size_t a = 0; a < ids.size();) {
-                std::size_t b = a;
-                while (b < ids.size() && ids[b] == ids[a]) ++b;
-                best = std::max(best, b - a);
-                a = b;
-            }
-            sum += double(best) / double(end - begin);
-            ++counted;
-            begin = end;
-        }
-        (*consistency)[t] = counted ? sum / double(counted) : 0.0;
+        for (std::size_t s = 0; s < S; ++s) sum += strandConsistency[s * T + t];  // in strand order
+        (*consistency)[t] = S ? sum / double(S) : 0.0;
     }
 }
 
