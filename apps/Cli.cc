@@ -1,6 +1,7 @@
 // The command line (Command.h): the verbs' table, the options every verb shares, and parsing and
 // dispatch with the one-line errors and exit codes.
 #include "Command.h"
+#include "HeadOptions.h"
 #include "TerminalProgress.h"
 
 #include <vdbhair/Exceptions.h>
@@ -76,6 +77,16 @@ void addReadOptions(CLI::App* sub, CommonOptions& common)
                     "For a .ply of points only (NeuralHaircut, GaussianHaircut: 100): each run of N consecutive points is one strand");
     sub->add_option("--curve-samples", common.curveSamples,
                     "For .obj curves (curv): points per curve, evenly in its parameter (0: automatic, within 1 % of the curve's length)");
+    CLI::Option* head = sub->get_option_no_throw("--head");
+    // interpolate's --roots names its root positions: there the option is only --root-end.
+    const bool rootsTaken = sub->get_option_no_throw("--roots") != nullptr;
+    sub->add_option(rootsTaken ? "--root-end" : "--roots,--root-end", common.roots,
+                    std::string("Which end of each stored strand is its root: first (the convention), last (every strand reversed), or auto: ") +
+                        (head ? "the end nearer --head in most strands, or without --head " : "") +
+                        "the end whose sphere has more of the hair outside it, for the whole file (a warning says when it reversed them)")
+        ->check(CLI::IsMember({"first", "last", "auto"}))
+        ->capture_default_str();
+    if (head) head->each([&common](const std::string& path) { common.rootsHead = path; });
 }
 
 ReadOptions readOptions(const CommonOptions& common)
@@ -84,6 +95,10 @@ ReadOptions readOptions(const CommonOptions& common)
     opts.interrupter = common.interrupter;
     opts.pointsPerStrand = common.pointsPerStrand;
     opts.curveSamples = common.curveSamples;
+    opts.roots = rootEndFromName(common.roots);
+    if (opts.roots == RootEnd::Auto && !common.rootsHead.empty() && common.rootsHead != "none") {
+        opts.rootsHeadDistance = headSurfaceDistance(common.rootsHead);
+    }
     return opts;
 }
 
@@ -92,7 +107,8 @@ const FlagNames& readerFlagNames()
 {
     static const FlagNames names = {{"RenderParams::up", "--up"},
                                     {"ReadOptions::pointsPerStrand", "--points-per-strand"},
-                                    {"ReadOptions::curveSamples", "--curve-samples"}};
+                                    {"ReadOptions::curveSamples", "--curve-samples"},
+                                    {"ReadOptions::roots", "--roots"}};  // interpolate: --root-end (see run())
     return names;
 }
 
@@ -100,7 +116,10 @@ void printWarnings(const std::string& verb, const ReadReport& report, const Comm
 {
     if (common.quiet) return;
     // Readers name library parameters; a verb that reads strands may render them (`render --up`).
-    const FlagNames& readerFlags = readerFlagNames();
+    FlagNames readerFlags = readerFlagNames();
+    if (verb == "interpolate") {  // its --roots names root positions; the root end is --root-end there
+        for (auto& [name, flag] : readerFlags) if (name == "ReadOptions::roots") flag = "--root-end";
+    }
     for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << withFlagNames(w, readerFlags) << "\n";
 }
 

@@ -42,10 +42,12 @@ struct CommonOptions
     /// How strand files are read (addReadOptions(): --points-per-strand, --curve-samples).
     std::size_t pointsPerStrand = 0;
     std::size_t curveSamples = 0;
+    std::string roots = "first";  ///< --roots first|last|auto
+    std::string rootsHead;        ///< the verb's --head, when it has one (for --roots auto)
 };
 
-/// @brief Add the strand readers' options (--points-per-strand, --curve-samples) to a verb that
-/// reads strand files.
+/// @brief Add the strand readers' options (--points-per-strand, --curve-samples, --roots) to a verb
+/// that reads strand files. Call it after the verb's --head, if it has one: --roots auto then uses it.
 void addReadOptions(CLI::App* sub, CommonOptions& common);
 
 /// @brief The reader's options of @a common: the one place the command line becomes ReadOptions

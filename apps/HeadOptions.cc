@@ -1,6 +1,12 @@
 #include "HeadOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/MeshFile.h>
+#include <vdbhair/strands/PointCloud.h>
+
+#include <cmath>
+#include <memory>
 
 namespace vdbhair::app {
 
@@ -27,6 +33,35 @@ HeadObstacle headFromOptions(const HeadOptions& o, const HeadObstacle& fallback)
     if (o.path == "none") return HeadObstacle::none();
     if (!o.path.empty()) return readHeadObstacle(o.path, "--head " + o.path, policy);
     return fallback;
+}
+
+SurfaceDistanceFn headSurfaceDistance(const std::string& path)
+{
+    const std::string ext = fileExtension(path);
+    if (ext == ".ply" || ext == ".obj") {
+        // The tree and its points live as long as the function (shared: std::function copies).
+        struct Nearest
+        {
+            std::vector<Vec3d> pts;
+            PointCloud cloud{&pts};
+            std::unique_ptr<PointKdTree> tree;
+        };
+        auto n = std::make_shared<Nearest>();
+        for (const Vec3f& v : readTriangleMesh(path).vertices) n->pts.emplace_back(v.x(), v.y(), v.z());
+        if (n->pts.empty()) throw FormatError("--head " + path + ": the mesh has no vertices");
+        n->tree = std::make_unique<PointKdTree>(3, n->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+        n->tree->buildIndex();
+        return [n](const Vec3f& p) {
+            const double q[3] = {p.x(), p.y(), p.z()};
+            std::uint32_t index = 0;
+            double d2 = 0.0;
+            n->tree->knnSearch(q, 1, &index, &d2);
+            return std::sqrt(d2);
+        };
+    }
+    auto head = std::make_shared<HeadObstacle>(readHeadObstacle(path, "--head " + path));
+    auto probe = std::make_shared<HeadObstacle::Probe>(*head);  // one thread: readStrands() calls it in order
+    return [head, probe](const Vec3f& p) { return std::abs(probe->distance(Vec3d(p.x(), p.y(), p.z()))); };
 }
 
 } // namespace vdbhair::app

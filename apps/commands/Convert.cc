@@ -31,8 +31,9 @@ struct ConvertParams
     std::string objLines = "edges";
     std::vector<double> rootNear;  ///< x, y, z; empty: OBJ roots at the lower-index end
     std::string grid = ReadOptions{}.vdbGrid;
-    std::string usdUp = WriteOptions{}.usd.upAxis == "Z" ? "z" : "y";
+    std::string usdUp;  ///< empty: the input's declared up axis, else y
     double metersPerUnit = WriteOptions{}.usd.metersPerUnit;
+    float width = WriteOptions{}.usd.width;
     std::string format;  ///< the format of `-` (standard input or output), e.g. "obj"
     std::string up = "y";  ///< the input's up axis; rotated onto +Y
 };
@@ -49,7 +50,9 @@ void rotateUpToY(StrandSet& strands, const Vec3d& up)
         if (up.y() < -0.5) return Vec3f(p.x(), -p.y(), -p.z()); // 180 deg about X
         return p;
     };
+    if (up.y() > 0.5) return;
     for (Vec3f& p : strands.positions) p = map(p);
+    strands.upAxis = 'Y';
 }
 
 /// Files standing in for `-`: standard input copied into one, standard output written from one.
@@ -111,10 +114,12 @@ int runConvert(ConvertParams p, const CommonOptions& common)
     wopts.vdb.voxelSize = p.voxelSize;
     wopts.objLines = objLineStyleFromName(p.objLines);
     axisFromName(p.up, "--up");
-    if (p.usdUp != "y" && p.usdUp != "z" && p.usdUp != "Y" && p.usdUp != "Z") throw ValueError("--usd-up '" + p.usdUp + "': must be y or z (USD's choices)");
-    wopts.usd.upAxis = p.usdUp == "z" || p.usdUp == "Z" ? "Z" : "Y";
-    if (!(p.metersPerUnit > 0.0) || !std::isfinite(p.metersPerUnit)) throw ValueError("--meters-per-unit " + formatValue(p.metersPerUnit) + ": must be a positive length");
+    if (!p.usdUp.empty() && p.usdUp != "y" && p.usdUp != "z" && p.usdUp != "Y" && p.usdUp != "Z") throw ValueError("--usd-up '" + p.usdUp + "': must be y or z (USD's choices)");
+    wopts.usd.upAxis = p.usdUp.empty() ? "" : p.usdUp == "z" || p.usdUp == "Z" ? "Z" : "Y";
+    if (!(p.metersPerUnit >= 0.0) || !std::isfinite(p.metersPerUnit)) throw ValueError("--meters-per-unit " + formatValue(p.metersPerUnit) + ": must be a positive length (0: the input's own, else 0.01)");
     wopts.usd.metersPerUnit = p.metersPerUnit;
+    if (!(p.width >= 0.f) || !std::isfinite(p.width)) throw ValueError("--width " + formatValue(p.width) + ": must be a positive length in world units (0: automatic)");
+    wopts.usd.width = p.width;
 
     ReadOptions ropts = readOptions(common);
     ropts.vdbGrid = p.grid;
@@ -183,8 +188,12 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--root-near", params->rootNear,
                     "OBJ input: root each strand at its end nearest X,Y,Z (e.g. the head's centre) instead of its lower-index end")
         ->delimiter(',')->expected(3);
-    sub->add_option("--usd-up", params->usdUp, "USD output: the stage's upAxis, y or z (coordinates are not rotated)")->capture_default_str();
-    sub->add_option("--meters-per-unit", params->metersPerUnit, "USD output: the stage's metersPerUnit (0.01: centimetres)")->capture_default_str();
+    sub->add_option("--usd-up", params->usdUp, "USD output: the stage's upAxis, y or z (coordinates are not rotated; default: the input's declared axis, else y)");
+    sub->add_option("--meters-per-unit", params->metersPerUnit,
+                    "USD output: the stage's metersPerUnit (0: the input's own, from a USD stage, else 0.01: centimetres); nothing is scaled")
+        ->capture_default_str();
+    sub->add_option("--width", params->width,
+                    "USD output: the widths (world units) of strands without thickness (default: the file's own default thickness, else 1/1000 of the bounding box's diagonal)");
     sub->add_option("--up", params->up,
                     "The input's up axis (x, y, z, -x, -y, -z), turned onto +Y, vdbhair's and OBJ's convention (cyHair models: z)")
         ->capture_default_str();

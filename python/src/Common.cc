@@ -172,16 +172,37 @@ void PyInterrupter::report(std::uint64_t done, bool force)
     }
 }
 
+bool isPathLike(const pyb::handle& obj)
+{
+    return pyb::isinstance<pyb::str>(obj) || pyb::isinstance<pyb::bytes>(obj) || pyb::hasattr(obj, "__fspath__");
+}
+
+std::string pathString(const pyb::handle& obj, const std::string& what)
+{
+    if (!isPathLike(obj)) {
+        throw TypeError(what + ": must be a path (str or os.PathLike such as pathlib.Path), got " +
+                        std::string(pyb::str(obj.get_type().attr("__name__"))));
+    }
+    const pyb::module_ os = pyb::module_::import("os");
+    return os.attr("fsdecode")(os.attr("fspath")(obj)).cast<std::string>();
+}
+
 HeadArgument::HeadArgument(const pyb::object& h, const std::string& policyName) : policy(headPolicyFromName(policyName))
 {
     if (h.is_none()) return;
-    if (pyb::isinstance<pyb::str>(h)) {
-        const std::string name = h.cast<std::string>();
+    if (isPathLike(h)) {
+        const std::string name = pathString(h, "head");
         if (name == "none") head = HeadObstacle::none();
         else path = name;
         return;
     }
-    const auto s = h.cast<std::array<double, 4>>();
+    std::array<double, 4> s{};
+    try {
+        s = h.cast<std::array<double, 4>>();
+    } catch (const pyb::cast_error&) {
+        throw TypeError("head: must be None, 'none', a path to a mesh or a .vdb level set (str or os.PathLike), or a sphere (x, y, z, r); got " +
+                        std::string(pyb::str(h.get_type().attr("__name__"))));
+    }
     head = HeadObstacle::sphere(Vec3d(s[0], s[1], s[2]), s[3], policy);
 }
 

@@ -158,6 +158,21 @@ struct HeadArgument
     HeadPolicy policy;
 };
 
+/// @brief A file path argument: a str or any os.PathLike (pathlib.Path), as Python's own open()
+/// takes (os.fspath; bytes paths decoded with os.fsdecode). A std::string, so it goes wherever
+/// the library takes a path. Registered by the type caster below.
+struct PathArg : std::string
+{
+    PathArg() = default;
+    PathArg(std::string s) : std::string(std::move(s)) {}
+};
+
+/// @brief Whether @a obj is a path (str, bytes or os.PathLike).
+bool isPathLike(const pyb::handle& obj);
+/// @brief @a obj as a path string (os.fsdecode(os.fspath(obj))).
+/// @throw TypeError naming @a what when it is not a path.
+std::string pathString(const pyb::handle& obj, const std::string& what = "path");
+
 // The bindings of each file.
 void bindStrands(pyb::module_& m);
 void bindFields(pyb::module_& m);
@@ -165,3 +180,19 @@ void bindOperations(pyb::module_& m);
 void bindScalp(pyb::module_& m);
 
 } // namespace vdbhair::py
+
+namespace pybind11::detail {
+/// str or os.PathLike -> PathArg (a pathlib.Path, as every Python file API accepts).
+template <>
+struct type_caster<vdbhair::py::PathArg>
+{
+    PYBIND11_TYPE_CASTER(vdbhair::py::PathArg, const_name("os.PathLike | str"));
+    bool load(handle src, bool)
+    {
+        if (!src || !vdbhair::py::isPathLike(src)) return false;
+        value = vdbhair::py::PathArg(vdbhair::py::pathString(src));
+        return true;
+    }
+    static handle cast(const vdbhair::py::PathArg& p, return_value_policy, handle) { return pybind11::str(p).release(); }
+};
+} // namespace pybind11::detail

@@ -357,7 +357,7 @@ void addArrayMethods(ClassT& cls, GetT get, const char* subject)
 /// The scalp argument of estimate_tangent_field() and refine(), as `--space`, `--scalp` and `--up`:
 /// a sphere (cx, cy, cz, r), a head (the path of a scalp .vdb or a mesh) or None (the sphere
 /// fitted to the roots), for space="scalp" only.
-using ScalpArgument = std::optional<std::variant<std::array<double, 4>, std::string>>;
+using ScalpArgument = std::optional<std::variant<std::array<double, 4>, PathArg>>;
 
 /// @return the head's level set when @a scalp named one (refine's default head), else null
 openvdb::FloatGrid::Ptr applyScalpArgument(FieldParams& fp, const StrandSet& strands, const std::string& space,
@@ -375,7 +375,7 @@ openvdb::FloatGrid::Ptr applyScalpArgument(FieldParams& fp, const StrandSet& str
     ScalpSphere given;
     openvdb::FloatGrid::Ptr surface;
     if (scalp) {
-        if (const auto* path = std::get_if<std::string>(&*scalp)) {
+        if (const auto* path = std::get_if<PathArg>(&*scalp)) {
             surface = readScalp(*path);
         } else {
             const auto& v = std::get<std::array<double, 4>>(*scalp);
@@ -408,7 +408,7 @@ are shared, not copied: a Grid taken from a field sees the same voxels.)doc");
     addArrayMethods(grid, [](const PyGrid& g) -> const openvdb::GridBase& { return *g.grid; }, "the grid");
     grid.def(
         "write",
-        [](const PyGrid& g, const std::string& path) {
+        [](const PyGrid& g, const PathArg& path) {
             pyb::gil_scoped_release release;
             writeVdbGrids(path, {g.grid}, "Grid.write(" + path + ")");
         },
@@ -452,7 +452,7 @@ and ``spread`` (both in [0, 1]).)doc");
         "The grids [tangent, density, hair_length, coherence, spread] as Grid objects.");
     field.def(
         "write",
-        [](const PyField& f, const std::string& path) {
+        [](const PyField& f, const PathArg& path) {
             pyb::gil_scoped_release release;
             writeVdbGrids(path, f.field.grids(), "TangentField.write(" + path + ")");
         },
@@ -467,7 +467,7 @@ and ``spread`` (both in [0, 1]).)doc");
     // ---- Reading and writing grids ---------------------------------------------------------
     m.def(
         "read_grid",
-        [](const std::string& path, const std::string& name) {
+        [](const PathArg& path, const std::string& name) {
             pyb::gil_scoped_release release;
             return PyGrid{readVdbGrid(path, name, "read_grid(" + path + ")")};
         },
@@ -479,7 +479,7 @@ Raises:
     vdbhair.FormatError.)doc");
     m.def(
         "read_grids",
-        [](const std::string& path) {
+        [](const PathArg& path) {
             openvdb::GridPtrVec grids;
             {
                 pyb::gil_scoped_release release;
@@ -493,7 +493,7 @@ Raises:
                           "without array access; read strands with vdbhair.read).");
     m.def(
         "write_grids",
-        [](const std::string& path, const std::vector<pyb::object>& items) {
+        [](const PathArg& path, const std::vector<pyb::object>& items) {
             openvdb::GridCPtrVec grids;
             for (const pyb::object& o : items) {
                 if (pyb::isinstance<PyGrid>(o)) grids.push_back(o.cast<const PyGrid&>().grid);

@@ -43,8 +43,8 @@ pyb::object toPython(const nlohmann::json& j)
 /// A scene argument: a path to a scene .json, or the scene itself as a dict.
 Scene sceneArgument(const pyb::handle& scene, const std::string& where = "grow")
 {
-    if (pyb::isinstance<pyb::str>(scene)) {
-        const std::string path = scene.cast<std::string>();
+    if (isPathLike(scene)) {
+        const std::string path = pathString(scene, where + ": scene");
         pyb::gil_scoped_release release;
         return readScene(path);
     }
@@ -180,9 +180,9 @@ Returns:
            double threshold, int initialClusters, int components, double mapSpacing, const std::string& layout,
            const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, double placeWeight,
            double nearby, bool refine, std::optional<std::string> refineMode,
-           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp,
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp,
            std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region,
-           std::optional<std::string> outputScalp, double outputTurn, bool returnReport, int threads,
+           std::optional<PathArg> outputScalp, double outputTurn, bool returnReport, int threads,
            const pyb::object& progress) -> pyb::object {
             SynthParams p;
             std::vector<Vec3d> regionPoints;
@@ -310,7 +310,7 @@ Returns:
            bool smoothBase, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters, int components,
            const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, bool refine,
            std::optional<std::string> refineMode,
-           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp, bool returnReport,
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp, bool returnReport,
            int threads, const pyb::object& progress) -> pyb::object {
             TransferParams p;
             p.guides = guides;
@@ -382,14 +382,18 @@ Returns:
     m.def(
         "comb",
         [](const StrandsPtr& strands, const pyb::object& strokes, double smoothing, int levels, std::uint64_t seed, int vertices,
-           double threshold, int initialClusters, std::optional<std::array<double, 3>> up, std::optional<std::string> scalp,
+           double threshold, int initialClusters, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp,
            const pyb::object& head, const std::string& headPolicy, bool returnReport, int threads,
            const pyb::object& progress) -> pyb::object {
             const HeadArgument headArg(head, headPolicy);
             std::vector<CombStroke> list;
-            if (pyb::isinstance<pyb::str>(strokes)) {
-                list = readStrokes(strokes.cast<std::string>());
+            if (isPathLike(strokes)) {
+                list = readStrokes(pathString(strokes, "comb: strokes"));
             } else {
+                if (!pyb::hasattr(strokes, "__iter__")) {
+                    throw TypeError("comb: strokes must be a path to a strokes .json or a list of dicts, got " +
+                                    std::string(pyb::str(strokes.get_type().attr("__name__"))));
+                }
                 for (const pyb::handle& h : strokes) {
                     const pyb::dict d = h.cast<pyb::dict>();
                     CombStroke st;
@@ -820,9 +824,9 @@ Returns:
     const RenderParams renderDefaults;
     m.def(
         "render",
-        [](const StrandsPtr& strands, std::optional<std::string> path, const std::string& view, int width, int height,
+        [](const StrandsPtr& strands, std::optional<PathArg> path, const std::string& view, int width, int height,
            const std::string& colorBy, std::array<double, 3> up, std::optional<std::array<double, 3>> facing,
-           const std::string& title, bool sheet, const StrandsPtr& guides, std::optional<std::string> head, int threads,
+           const std::string& title, bool sheet, const StrandsPtr& guides, std::optional<PathArg> head, int threads,
            const pyb::object& progress) -> pyb::object {
             RenderParams rp;
             rp.view = viewFromName(view);
@@ -896,7 +900,7 @@ Returns:
 
     m.def(
         "inspect",
-        [](const std::string& path) {
+        [](const PathArg& path) {
             std::vector<GridReport> reports;
             {
                 pyb::gil_scoped_release release;

@@ -80,9 +80,9 @@ void bindScalp(pyb::module_& m)
             if (regionRadius < 0.0 || !std::isfinite(regionRadius)) throw ValueError("scalp: region_radius=" + std::to_string(regionRadius) + ": must be a positive length (0: the default)");
             if (int(!regionArg.is_none()) + int(!regionMask.is_none()) + int(bool(regionVertex)) > 1)
                 throw ValueError("scalp: more than one of region, region_mask and region_vertex: give one");
-            if (regionVertex && !(pyb::isinstance<pyb::str>(source) && fileExtension(source.cast<std::string>()) == ".ply"))
+            if (regionVertex && !(isPathLike(source) && fileExtension(pathString(source)) == ".ply"))
                 throw ValueError("scalp: region_vertex='" + *regionVertex + "' reads a vertex property of a PLY mesh; the source is not a .ply path");
-            if (!normals.is_none() && (pyb::isinstance<pyb::str>(source) || pyb::isinstance<StrandSet>(source)))
+            if (!normals.is_none() && (isPathLike(source) || pyb::isinstance<StrandSet>(source)))
                 throw ValueError("scalp: normals go with an (N, 3) array of points as the source");
             ScalpParams sp;
             sp.voxelSize = voxelSize;
@@ -92,8 +92,8 @@ void bindScalp(pyb::module_& m)
             // Arrays are read with the GIL held, before the work.
             std::optional<std::string> path;
             OrientedPoints points;
-            if (pyb::isinstance<pyb::str>(source)) {
-                path = source.cast<std::string>();
+            if (isPathLike(source)) {
+                path = pathString(source, "scalp: source");
             } else if (pyb::isinstance<StrandSet>(source)) {
                 points = orientedRoots(source.cast<const StrandSet&>());
                 sp.source = "roots of Strands";
@@ -188,8 +188,8 @@ Returns:
             const Vec3d u(up[0], up[1], up[2]);
             if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("roots: up must be a non-zero finite vector");
             fp.up = u / u.length();
-            const bool fromPath = pyb::isinstance<pyb::str>(scalp);
-            const std::string path = fromPath ? scalp.cast<std::string>() : std::string();
+            const bool fromPath = isPathLike(scalp);
+            const std::string path = fromPath ? pathString(scalp, "roots: scalp") : std::string();
             openvdb::FloatGrid::Ptr surface = fromPath ? nullptr : scalpGridArgument(scalp, "roots");
             openvdb::BoolGrid::Ptr region;
             const bool noRegion = pyb::isinstance<pyb::bool_>(regionArg) && !regionArg.cast<bool>();

@@ -160,7 +160,8 @@ pyb::array strandView(const pyb::object& self, const StrandSet& s, std::ptrdiff_
 std::string withReadKeywords(std::string message)
 {
     for (const auto& [name, keyword] : {std::pair<std::string, std::string>{"ReadOptions::pointsPerStrand", "points_per_strand="},
-                                        {"ReadOptions::curveSamples", "curve_samples="}}) {
+                                        {"ReadOptions::curveSamples", "curve_samples="},
+                                        {"ReadOptions::roots", "roots="}}) {
         for (std::size_t at = message.find(name); at != std::string::npos; at = message.find(name, at + keyword.size())) {
             // "points_per_strand=N", not "points_per_strand= N"
             const bool value = at + name.size() < message.size() && message[at + name.size()] == ' ';
@@ -171,13 +172,14 @@ std::string withReadKeywords(std::string message)
 }
 
 ReadOptions readOptions(bool strict, const std::string& grid, const std::optional<std::array<float, 3>>& rootNear,
-                        std::int64_t pointsPerStrand = 0, std::int64_t curveSamples = 0)
+                        std::int64_t pointsPerStrand = 0, std::int64_t curveSamples = 0, const std::string& roots = "first")
 {
     if (pointsPerStrand < 0) throw ValueError("points_per_strand=" + std::to_string(pointsPerStrand) + ": must be 0 (not set) or a count of points");
     if (curveSamples < 0 || curveSamples == 1) {
         throw ValueError("curve_samples=" + std::to_string(curveSamples) + ": must be 0 (automatic) or 2 or more");
     }
     ReadOptions opts;
+    opts.roots = rootEndFromName(roots);  // "roots='x': must be first, last or auto" after withReadKeywords()
     opts.pointsPerStrand = std::size_t(pointsPerStrand);
     opts.curveSamples = std::size_t(curveSamples);
     opts.shortStrands = strict ? ShortStrandPolicy::Reject : ShortStrandPolicy::Drop;
@@ -186,9 +188,36 @@ ReadOptions readOptions(bool strict, const std::string& grid, const std::optiona
     return opts;
 }
 
-void writeWithOptions(const StrandSet& s, const std::string& path, const std::string& plyEncoding, const std::string& objLines)
+/// The CLI's write options (convert), as write()'s keywords.
+struct WriteKeywords
+{
+    std::string plyEncoding = "binary", objLines = "edges";
+    std::optional<std::string> usdUp;     ///< None: the strands' declared axis, else y
+    double metersPerUnit = WriteOptions{}.usd.metersPerUnit;
+    float width = WriteOptions{}.usd.width;
+    std::string codec = positionCodecName(WriteOptions{}.vdb.codec);
+};
+
+void writeWithOptions(const StrandSet& s, const PathArg& path, const std::string& plyEncoding, const std::string& objLines,
+                      const std::optional<std::string>& usdUp = std::nullopt, double metersPerUnit = WriteOptions{}.usd.metersPerUnit,
+                      float width = WriteOptions{}.usd.width, const std::string& codec = positionCodecName(WriteOptions{}.vdb.codec))
 {
     WriteOptions opts;
+    if (usdUp) {
+        if (*usdUp != "y" && *usdUp != "z" && *usdUp != "Y" && *usdUp != "Z") throw ValueError("usd_up='" + *usdUp + "': must be 'y' or 'z' (USD's choices)");
+        opts.usd.upAxis = *usdUp == "z" || *usdUp == "Z" ? "Z" : "Y";
+    }
+    if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit)) {
+        throw ValueError("meters_per_unit=" + std::to_string(metersPerUnit) + ": must be a positive length in metres (0: the strands' own, else 0.01)");
+    }
+    opts.usd.metersPerUnit = metersPerUnit;
+    if (!(width >= 0.f) || !std::isfinite(width)) throw ValueError("width=" + std::to_string(width) + ": must be a positive length in world units (0: automatic)");
+    opts.usd.width = width;
+    try {
+        opts.vdb.codec = positionCodecFromName(codec);
+    } catch (const ValueError&) {
+        throw ValueError("codec='" + codec + "': must be one of float, fixed16, fixed8");
+    }
     if (plyEncoding == "binary") opts.plyEncoding = PlyEncoding::Binary;
     else if (plyEncoding == "ascii") opts.plyEncoding = PlyEncoding::Ascii;
     else throw ValueError("ply_encoding='" + plyEncoding + "' is not one of binary, ascii");
@@ -324,16 +353,23 @@ Raises:
     cls.def("__repr__", [](const StrandSet& s) {
         return "<vdbhair.Strands: " + std::to_string(s.numStrands()) + " strands, " + std::to_string(s.numVertices()) + " vertices>";
     });
-    cls.def("write", &writeWithOptions, pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = "binary",
-            pyb::arg("obj_lines") = "edges",
+    const WriteKeywords wk;
+    cls.def("write", &writeWithOptions, pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = wk.plyEncoding,
+            pyb::arg("obj_lines") = wk.objLines, pyb::arg("usd_up") = wk.usdUp, pyb::arg("meters_per_unit") = wk.metersPerUnit,
+            pyb::arg("width") = wk.width, pyb::arg("codec") = wk.codec,
             "Write to ``path`` in the format of its extension (.hair .data .obj .ply .vdb .usda), atomically; see vdbhair.write.");
 
     m.def(
         "read",
-        [](const std::string& path, bool strict, const std::string& grid, std::optional<std::array<float, 3>> rootNear,
-           std::int64_t pointsPerStrand, std::int64_t curveSamples, const pyb::object& progress) {
+        [](const PathArg& path, bool strict, const std::string& grid, std::optional<std::array<float, 3>> rootNear,
+           std::int64_t pointsPerStrand, std::int64_t curveSamples, const std::string& roots, const pyb::object& progress) {
             ReadReport report;
-            const ReadOptions base = readOptions(strict, grid, rootNear, pointsPerStrand, curveSamples);
+            ReadOptions base;
+            try {
+                base = readOptions(strict, grid, rootNear, pointsPerStrand, curveSamples, roots);
+            } catch (const ValueError& e) {
+                throw ValueError(withReadKeywords(e.what()));
+            }
             auto set = runLong(0, progress, [&](WorkInterrupter* interrupter) {
                 ReadOptions opts = base;
                 opts.interrupter = interrupter;
@@ -353,14 +389,14 @@ Raises:
         },
         pyb::arg("path"), pyb::kw_only(), pyb::arg("strict") = false, pyb::arg("grid") = ReadOptions{}.vdbGrid,
         pyb::arg("root_near") = pyb::none(), pyb::arg("points_per_strand") = 0, pyb::arg("curve_samples") = 0,
-        pyb::arg("progress") = pyb::none(),
+        pyb::arg("roots") = "first", pyb::arg("progress") = pyb::none(),
         R"doc(Read strands from a file, the format chosen by extension (and checked by magic).
 
 Formats: .hair (cyHair), .data (USC-HairSalon), .obj (line elements and curv curves), .ply (hairutil, line sets, points in runs), .vdb
 (points grid), .usda (USD BasisCurves), .tfx (TressFX), .bin (CT2Hair), .convdata (HairNet).
 
 Args:
-    path: the file.
+    path: the file, a str or any os.PathLike (pathlib.Path).
     strict: reject strands of fewer than 2 vertices (FormatError) instead of dropping them with a
         UserWarning (the CLI's ``--strict``).
     grid: for a .vdb, the points grid holding the strands (the CLI's ``--grid``).
@@ -371,6 +407,11 @@ Args:
     curve_samples: for .obj free-form curves, the points each curve is evaluated at, evenly in its
         parameter; 0 chooses them so that the polyline keeps the curve within 1 % of its length
         (the CLI's ``--curve-samples``).
+    roots: which end of each stored strand is its root (the CLI's ``--roots``): "first" (the
+        convention), "last" (every strand reversed) or "auto": decided once for the file, the end
+        whose least-squares sphere has more of the hair outside it (roots lie on the scalp, hair
+        outside it); a UserWarning says when it reversed the strands, or that fewer than 32
+        strands were too few to tell (then they are kept as stored).
     progress: optional callable ``progress(stage, done, total, unit)``.
 
 Returns:
@@ -381,10 +422,12 @@ Raises:
     file, the byte offset or line and the rule; KeyboardInterrupt on Ctrl-C.)doc");
     m.def(
         "write",
-        [](const StrandSet& s, const std::string& path, const std::string& plyEncoding, const std::string& objLines) {
-            writeWithOptions(s, path, plyEncoding, objLines);
+        [](const StrandSet& s, const PathArg& path, const std::string& plyEncoding, const std::string& objLines,
+           const std::optional<std::string>& usdUp, double metersPerUnit, float width, const std::string& codec) {
+            writeWithOptions(s, path, plyEncoding, objLines, usdUp, metersPerUnit, width, codec);
         },
-        pyb::arg("strands"), pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = "binary", pyb::arg("obj_lines") = "edges",
+        pyb::arg("strands"), pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = wk.plyEncoding, pyb::arg("obj_lines") = wk.objLines,
+        pyb::arg("usd_up") = wk.usdUp, pyb::arg("meters_per_unit") = wk.metersPerUnit, pyb::arg("width") = wk.width, pyb::arg("codec") = wk.codec,
         R"doc(Write strands in the format of ``path``'s extension, atomically (a temporary file renamed
 into place: a failed write leaves nothing and never damages an existing file).
 
@@ -392,10 +435,19 @@ Writable formats: .hair .data .obj .ply .vdb .usda.
 
 Args:
     strands: a Strands.
-    path: the output file.
+    path: the output file, a str or any os.PathLike (pathlib.Path).
     ply_encoding: "binary" (little-endian) or "ascii", for .ply (the CLI's ``--ply-encoding``).
     obj_lines: "edges" (one two-vertex ``l`` per segment, what Blender reads whole) or
         "polylines" (one ``l`` per strand), for .obj (the CLI's ``--obj-lines``).
+    usd_up: "y" or "z", the USD stage's upAxis (the CLI's ``--usd-up``); None: the axis the
+        strands' source declared (a USD stage's), else "y". Coordinates are not rotated.
+    meters_per_unit: the USD stage's metersPerUnit (the CLI's ``--meters-per-unit``); 0: the
+        strands' own (read from a USD stage), else 0.01. Nothing is scaled.
+    width: for .usda, the widths (world units) of strands without thickness (the CLI's
+        ``--width``); 0: the source's default thickness if it declared one, else 1/1000 of the
+        bounding box's diagonal.
+    codec: for .vdb, the position codec: "float" (exact), "fixed16" or "fixed8" (the CLI's
+        ``--codec``).
 
 Raises:
     vdbhair.ArgumentError (a ValueError) for a format that cannot be written, vdbhair.IoError.)doc");

@@ -188,3 +188,70 @@ def test_real_data_file_as_numpy_would_read_it(shared_data):
     assert len(s) == count == 7905
     np.testing.assert_array_equal(s.offsets, offsets)
     np.testing.assert_array_equal(s.positions, np.concatenate(pos))
+
+
+def hair_on_sphere(count=64, vertices=12, radius=10.0, seed=3):
+    """Strands rooted on the upper half of a sphere, leaving along the normal and falling to -y."""
+    rng = np.random.default_rng(seed)
+    points = []
+    for _ in range(count):
+        phi, cos_t = rng.uniform(0, 2 * np.pi), rng.uniform(0.1, 1.0)
+        n = np.array([np.sqrt(1 - cos_t**2) * np.cos(phi), cos_t, np.sqrt(1 - cos_t**2) * np.sin(phi)])
+        p, length = radius * n, radius * rng.uniform(0.5, 2.5)
+        for k in range(vertices):
+            points.append(p.copy())
+            t = k / (vertices - 1)
+            d = (1 - t) * n + t * np.array([0.0, -1.0, 0.0])
+            p += length / (vertices - 1) * d / np.linalg.norm(d)
+    return vdbhair.Strands(np.array(points, dtype=np.float32), np.arange(count + 1) * vertices)
+
+
+def test_read_roots_last_and_auto(tmp_path):
+    hair = hair_on_sphere()
+    path = tmp_path / "rooted.hair"
+    hair.write(path)
+    tip_first = vdbhair.read(path, roots="last")
+    np.testing.assert_array_equal(tip_first[0], hair[0][::-1])
+    tip_first.write(tmp_path / "tip_first.hair")
+    with pytest.warns(UserWarning, match=r"roots=auto reversed 100 % of the strands \(64 of 64\)"):
+        back = vdbhair.read(tmp_path / "tip_first.hair", roots="auto")
+    np.testing.assert_array_equal(back.positions, hair.positions)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # hair rooted first: kept, without a word
+        np.testing.assert_array_equal(vdbhair.read(path, roots="auto").positions, hair.positions)
+    with pytest.raises(vdbhair.ArgumentError, match="roots='tip': must be first, last or auto"):
+        vdbhair.read(path, roots="tip")
+
+
+def test_paths_may_be_pathlib(tmp_path):
+    hair = hair_on_sphere(count=4)
+    vdbhair.write(hair, tmp_path / "a.ply")
+    hair.write(tmp_path / "b.obj")
+    assert len(vdbhair.read(tmp_path / "a.ply")) == 4
+    assert len(vdbhair.read(str(tmp_path / "b.obj"))) == 4
+    field = vdbhair.estimate_tangent_field(hair, voxel_size=2.0)
+    field.write(tmp_path / "f.vdb")
+    assert "tangent" in vdbhair.read_grids(tmp_path / "f.vdb")
+    assert vdbhair.inspect(tmp_path / "f.vdb")
+
+
+def test_write_takes_the_cli_write_options(tmp_path):
+    hair = hair_on_sphere(count=4)
+    out = tmp_path / "h.usda"
+    vdbhair.write(hair, out, usd_up="z", meters_per_unit=1.0, width=0.25)
+    text = out.read_text()
+    assert 'upAxis = "Z"' in text and "metersPerUnit = 1\n" in text
+    assert 'float[] widths = [0.25] (\n        interpolation = "constant"' in text
+    again = vdbhair.read(out)
+    again.write(tmp_path / "h2.usda")  # USD to USD keeps the unit and the axis
+    text2 = (tmp_path / "h2.usda").read_text()
+    assert 'upAxis = "Z"' in text2 and "metersPerUnit = 1\n" in text2
+    hair.write(tmp_path / "h.vdb", codec="fixed8")
+    assert np.abs(vdbhair.read(tmp_path / "h.vdb").positions - hair.positions).max() < 0.5
+    with pytest.raises(vdbhair.ArgumentError, match="codec='zip': must be one of float, fixed16, fixed8"):
+        hair.write(tmp_path / "x.vdb", codec="zip")
+    with pytest.raises(vdbhair.ArgumentError, match="usd_up='x': must be 'y' or 'z'"):
+        vdbhair.write(hair, out, usd_up="x")
+    with pytest.raises(vdbhair.ArgumentError, match="meters_per_unit=-1.000000: must be a positive length"):
+        vdbhair.write(hair, out, meters_per_unit=-1)

@@ -1,6 +1,8 @@
 // Reads a .usda file with tinyusdz (TinyUSDZ compiled to WebAssembly, from the npm registry) and
 // checks what it parsed against the counts vdbhair wrote:
-//   node check_tinyusdz.mjs TINYUSDZ_DIR FILE.usda STRANDS VERTICES
+//   node check_tinyusdz.mjs TINYUSDZ_DIR FILE.usda STRANDS VERTICES [WANT...]
+// WANT: mpu=X (metersPerUnit), up=Y|Z, widths=constant|vertex, color=constant|vertex, width=X
+// (the one constant width), each compared with what tinyusdz parsed.
 // TINYUSDZ_DIR is the installed package (node_modules/tinyusdz). The package is built for the web:
 // under node 20 it needs `process.type` set (so it does not take the node path it was not built
 // for), `window = globalThis`, and the .wasm bytes handed to it.
@@ -8,7 +10,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 
-const [dir, file, wantStrands, wantVertices] = process.argv.slice(2);
+const [dir, file, wantStrands, wantVertices, ...wants] = process.argv.slice(2);
 const fail = (msg) => { console.log('FAIL: ' + msg); process.exit(1); };
 
 process.type = 'renderer';
@@ -50,4 +52,14 @@ if (type !== 'linear') fail('type is ' + type + ', expected linear');
 if (countList.length !== Number(wantStrands)) fail(`${countList.length} curves, vdbhair wrote ${wantStrands}`);
 if (sum !== Number(wantVertices) || nPoints !== Number(wantVertices)) fail(`${sum} counted and ${nPoints} points, vdbhair wrote ${wantVertices}`);
 if (!widths || !color || !upAxis || !mpu) fail('widths, displayColor, upAxis or metersPerUnit missing');
+const parsed = {mpu: mpu, up: upAxis, widths: widths[2], color: color[2],
+                width: widths[2] === 'constant' ? widths[1].trim() : 'per vertex'};
+for (const want of wants) {
+  const [key, value] = want.split('=');
+  if (!(key in parsed)) fail('unknown check ' + want);
+  const got = parsed[key];
+  const same = key === 'mpu' || key === 'width' ? Math.abs(Number(got) - Number(value)) <= 1e-6 * Math.abs(Number(value)) : got === value;
+  if (!same) fail(`${key} is ${got} in tinyusdz's reading, expected ${value}`);
+  console.log(`ok: ${key} = ${got}`);
+}
 console.log('ok: tinyusdz reads every curve and point vdbhair wrote');

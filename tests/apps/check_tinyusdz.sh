@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs tinyusdz from the npm registry into SCRATCH (once) and reads FILE.usda with it:
-#   check_tinyusdz.sh SCRATCH FILE.usda STRANDS VERTICES
+#   check_tinyusdz.sh SCRATCH FILE.usda STRANDS VERTICES [WANT...]
+# Each WANT (mpu=1, up=Z, widths=constant, color=constant, width=0.5) is checked against what
+# tinyusdz parsed.
 # Skips (prints SKIPPED: and exits 0) when node or npm is missing or the registry is unreachable.
 set -u
-scratch=$1; file=$2; strands=$3; vertices=$4
+scratch=$1; file=$2; strands=$3; vertices=$4; shift 4
 here=$(cd "$(dirname "$0")" && pwd)
 command -v node >/dev/null 2>&1 || { echo "SKIPPED: node is not installed (apt-get install nodejs npm)"; exit 0; }
 command -v npm >/dev/null 2>&1 || { echo "SKIPPED: npm is not installed (apt-get install npm)"; exit 0; }
@@ -17,4 +19,4 @@ if [ ! -f "$pkg/tinyusdz.wasm" ]; then
     exit 0
   fi
 fi
-exec node "$here/check_tinyusdz.mjs" "$pkg" "$file" "$strands" "$vertices"
+exec node "$here/check_tinyusdz.mjs" "$pkg" "$file" "$strands" "$vertices" "$@"

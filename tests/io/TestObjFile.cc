@@ -237,3 +237,17 @@ TEST_CASE("readObj: each kind of bad curve has its own error, at the curv line",
     REQUIRE_THROWS_WITH(readObj(test::writeBytes("bad_curve.obj", v4 + "cstype bezier\ndeg 3\ncurv 0 1 1 2 3 4\nend\n"), one),
                         Contains("a sample count of 1 makes no strand"));
 }
+
+TEST_CASE("writeObj: the header names the up axis the data has, not always +Y", "[io][units]")
+{
+    StrandSet s = test::sampleStrands(false);
+    const std::string out = test::tempPath("up.obj");
+    writeObj(out, s);
+    REQUIRE_THAT(test::readBytes(out), Contains("up axis not declared by the source (Blender's importer takes +Y as up; Z-up data: vdbhair convert --up z)"));
+    s.upAxis = 'Z';
+    writeObj(out, s);
+    REQUIRE_THAT(test::readBytes(out), Contains("root to tip, +Z up (import into Blender with Up: Z)"));
+    s.upAxis = 'Y';
+    writeObj(out, s);
+    REQUIRE_THAT(test::readBytes(out), Contains("root to tip, +Y up;"));
+}

@@ -213,6 +213,14 @@ StrandSet readObj(const std::string& path, const ReadOptions& opts, ReadReport* 
     return out;
 }
 
+std::string objUpAxisWords(char upAxis)
+{
+    // OBJ declares no axes; Blender's importer reads +Y as up by default ("Up: Y, Forward: -Z").
+    if (upAxis == 'Y') return "+Y up";
+    if (upAxis == 'Z') return "+Z up (import into Blender with Up: Z)";
+    return "up axis not declared by the source (Blender's importer takes +Y as up; Z-up data: vdbhair convert --up z)";
+}
+
 void writeObj(const std::string& path, const StrandSet& strands, ObjLineStyle style)
 {
     const std::string where = "writeObj(" + path + ")";
@@ -221,7 +229,7 @@ void writeObj(const std::string& path, const StrandSet& strands, ObjLineStyle st
     out += "# ";
     out += creatorString();
     out += ": " + std::to_string(strands.numStrands()) + " strands, " + std::to_string(strands.numVertices()) +
-           " vertices, root to tip, +Y up; " +
+           " vertices, root to tip, " + objUpAxisWords(strands.upAxis) + "; " +
            (style == ObjLineStyle::Edges ? "one two-vertex 'l' edge per segment, chained per strand (Blender reads every segment)\n"
                                          : "one 'l' polyline per strand\n");
     char buf[32];

@@ -61,6 +61,10 @@ ObjLineStyle objLineStyleFromName(const std::string& name);
 /// (taylor and basis-matrix curves).
 StrandSet readObj(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 
+/// @brief The words writeObj()'s header comment uses for StrandSet::upAxis: "+Y up", "+Z up
+/// (import into Blender with Up: Z)", or that the source declared none (0).
+std::string objUpAxisWords(char upAxis);
+
 /// @brief Write positions (and colours when present) as line elements.
 void writeObj(const std::string& path, const StrandSet& strands, ObjLineStyle style = ObjLineStyle::Edges);
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/RootEnd.h>
 #include <vdbhair/Types.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -46,6 +47,12 @@ struct ReadOptions
     /// parameter. 0: chosen per curve so that the polyline keeps the curve's shape within 1 % of
     /// its length (FreeFormCurve.h explains the rule).
     std::size_t curveSamples = 0;
+    /// Which end of each strand is its root (RootEnd.h): First (the default), Last (every strand
+    /// reversed), or Auto (measured on the file). Applied by readStrands() after any reader.
+    RootEnd roots = RootEnd::First;
+    /// For RootEnd::Auto: unsigned distance to the head's surface (the end nearer it is the root);
+    /// empty: the rule without a head.
+    SurfaceDistanceFn rootsHeadDistance;
 };
 
 /// @brief What a reader noticed but did not fail on.

@@ -25,6 +25,7 @@ constexpr FormatEntry kFormats[] = {
     {".ply", StrandFormat::Ply, "PLY (hairutil layout)", true},
     {".vdb", StrandFormat::Vdb, "OpenVDB points", true},
     {".usda", StrandFormat::Usda, "USD BasisCurves (text)", true},
+    {".usd", StrandFormat::Usda, "USD BasisCurves (text in a .usd)", false},
     {".tfx", StrandFormat::Tfx, "TressFX", false},
     {".bin", StrandFormat::Bin, "CT2Hair", false},
     {".convdata", StrandFormat::Convdata, "HairNet convdata", false},

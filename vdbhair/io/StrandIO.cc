@@ -8,11 +8,23 @@
 
 namespace vdbhair {
 
-StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadReport* report)
+namespace {
+StrandSet readAnyStrands(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
     if (fileExtension(path) != ".vdb") return readNonVdbStrands(path, opts, report);  // checks the path itself
     strandFileFormat(path);  // a folder named .vdb: the same message as any other format's
     return readVdbStrands(path, opts, report, opts.vdbGrid);
+}
+} // namespace
+
+StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    StrandSet strands = readAnyStrands(path, opts, report);
+    // The one place ReadOptions::roots is applied, whichever reader ran (RootEnd.h).
+    const RootEndDecision d = orientStrandRoots(strands, opts.roots, opts.rootsHeadDistance);
+    const std::string line = opts.roots == RootEnd::Auto ? describeRootEndDecision(d) : std::string();
+    if (report && !line.empty()) report->warnings.push_back(path + ": " + line);
+    return strands;
 }
 
 void writeStrands(const std::string& path, const StrandSet& strands, const WriteOptions& opts)

@@ -5,6 +5,7 @@
 #include <vdbhair/Version.h>
 #include <vdbhair/io/FileUtil.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -37,6 +38,10 @@ public:
     {
         // The magic line.
         static const char kMagic[] = "#usda";
+        if (mSize >= 8 && std::memcmp(mData, "PXR-USDC", 8) == 0) {
+            throw UnsupportedError(mWhere + ": a binary USD (crate, PXR-USDC) file; vdbhair reads USD text (USDA, in a .usda or .usd "
+                                   "file): convert it first with 'usdcat in.usd -o out.usda'");
+        }
         if (mSize < 5 || std::memcmp(mData, kMagic, 5) != 0) {
             throw FormatError(mWhere + ": line 1: not a USD text file: it must start with '#usda 1.0'"
                               " (binary .usdc files are not read)");
@@ -277,6 +282,7 @@ struct UsdDocument
 {
     std::vector<CurvesPrim> curves;
     std::string upAxis;
+    double metersPerUnit = 0.0;  ///< 0: not in the stage's metadata
     std::size_t xformOps = 0, timeSamples = 0;
 };
 
@@ -364,6 +370,13 @@ UsdDocument parseUsda(const std::vector<char>& bytes, const std::string& where)
     if (lex.isPunct('(')) {
         const auto meta = parseMetadata(lex);
         if (const auto it = meta.find("upAxis"); it != meta.end() && !it->second.words.empty()) doc.upAxis = it->second.words[0];
+        if (const auto it = meta.find("metersPerUnit"); it != meta.end()) {
+            const FlatValue& v = it->second;
+            if (v.numbers.size() != 1 || !(v.numbers[0] > 0.0) || !std::isfinite(v.numbers[0])) {
+                lex.fail("metersPerUnit must be one positive number (the stage's unit in metres)");
+            }
+            doc.metersPerUnit = v.numbers[0];
+        }
     }
     while (lex.peek().kind != Tok::End) {
         if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) parsePrim(lex, doc, 1);
@@ -459,13 +472,38 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         StrandDefaults defaults = out.defaults;
         std::vector<float> widths, colors, opacity;
         float opacityConstant = 1.f - defaults.transparency;
-        perVertex("widths", 1, widths, &defaults.thickness);
-        perVertex("primvars:displayColor", 3, colors, &defaults.color[0]);
-        if (perVertex("primvars:displayOpacity", 1, opacity, &opacityConstant) && opacity.empty()) defaults.transparency = 1.f - opacityConstant;
-        // vdbhair's own record of the defaults (exact, and kept when the arrays are per vertex).
-        if (const Property* d = find("vdbhair_default_thickness"); d && d->value.numbers.size() == 1) defaults.thickness = float(d->value.numbers[0]);
-        if (const Property* d = find("vdbhair_default_transparency"); d && d->value.numbers.size() == 1) defaults.transparency = float(d->value.numbers[0]);
-        if (const Property* d = find("vdbhair_default_color"); d && d->value.numbers.size() == 3) {
+        const bool constantWidth = perVertex("widths", 1, widths, &defaults.thickness) && widths.empty();
+        const bool constantColor = perVertex("primvars:displayColor", 3, colors, &defaults.color[0]) && colors.empty();
+        const bool constantOpacity = perVertex("primvars:displayOpacity", 1, opacity, &opacityConstant) && opacity.empty();
+        if (constantOpacity) defaults.transparency = 1.f - opacityConstant;
+        // A per-vertex array of one value that writeUsda() wrote once (vdbhair_uniform_*): the
+        // array again, so .hair -> .usda -> .hair keeps it.
+        auto uniform = [&](const char* name) {
+            const Property* f = find(name);
+            return f && !f->value.words.empty() && f->value.words[0] == "true";
+        };
+        const bool uniformWidth = constantWidth && uniform("vdbhair_uniform_thickness");
+        const bool displayWidth = constantWidth && uniform("vdbhair_display_width");
+        const bool uniformColor = constantColor && uniform("vdbhair_uniform_color");
+        const bool uniformOpacity = constantOpacity && uniform("vdbhair_uniform_transparency");
+        if (uniformWidth) widths.assign(nP, defaults.thickness);
+        if (uniformColor) {
+            colors.resize(3 * nP);
+            for (std::size_t k = 0; k < nP; ++k) for (int c = 0; c < 3; ++c) colors[3 * k + c] = defaults.color[c];
+        }
+        if (uniformOpacity) opacity.assign(nP, opacityConstant);
+        // vdbhair's own record of the defaults (exact, and kept when the arrays are per vertex); a
+        // constant primvar that is not such an array is what the file says for every vertex, and
+        // wins (a width given to the writer).
+        if (const Property* d = find("vdbhair_default_thickness"); d && d->value.numbers.size() == 1 && (!constantWidth || uniformWidth || displayWidth)) {
+            defaults.thickness = float(d->value.numbers[0]);
+        }
+        if (const Property* d = find("vdbhair_default_transparency"); d && d->value.numbers.size() == 1) {
+            // Exact where the constant opacity says the same (1 - t rounds in float).
+            const float t = float(d->value.numbers[0]);
+            if (!constantOpacity || uniformOpacity || 1.f - t == opacityConstant) defaults.transparency = t;
+        }
+        if (const Property* d = find("vdbhair_default_color"); d && d->value.numbers.size() == 3 && (!constantColor || uniformColor)) {
             defaults.color = Vec3f(float(d->value.numbers[0]), float(d->value.numbers[1]), float(d->value.numbers[2]));
         }
         if (first) out.defaults = defaults;
@@ -499,17 +537,33 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         }
     }
     filter.finish();
+    // The stage's space, carried (not applied): USD's fallbacks are centimetres and +Y up.
+    out.metersPerUnit = doc.metersPerUnit > 0.0 ? doc.metersPerUnit : 0.01;
+    out.upAxis = doc.upAxis == "Z" ? 'Z' : 'Y';
     return out;
+}
+
+float automaticUsdWidth(const StrandSet& strands)
+{
+    const BBox box = computeBBox(strands);
+    const Vec3f d = box.max - box.min;
+    const float diagonal = std::sqrt(d.x() * d.x() + d.y() * d.y() + d.z() * d.z());
+    return diagonal > 0.f ? kAutomaticWidthPerDiagonal * diagonal : 1.f;
 }
 
 void writeUsda(const std::string& path, const StrandSet& strands, const UsdWriteOptions& opts)
 {
     const std::string where = "writeUsda(" + path + ")";
     if (strands.empty()) throw ValueError(where + ": the hairstyle has no strands; there is nothing to write");
-    if (opts.upAxis != "Y" && opts.upAxis != "Z") throw ValueError(where + ": up axis '" + opts.upAxis + "' must be Y or Z (USD's choices)");
-    if (!(opts.metersPerUnit > 0.0) || !std::isfinite(opts.metersPerUnit)) {
-        throw ValueError(where + ": metersPerUnit " + std::to_string(opts.metersPerUnit) + " must be positive and finite");
+    if (!opts.upAxis.empty() && opts.upAxis != "Y" && opts.upAxis != "Z") throw ValueError(where + ": up axis '" + opts.upAxis + "' must be Y or Z (USD's choices)");
+    const std::string upAxis = !opts.upAxis.empty() ? opts.upAxis : strands.upAxis == 'Z' ? "Z" : "Y";
+    if (!(opts.metersPerUnit >= 0.0) || !std::isfinite(opts.metersPerUnit)) {
+        throw ValueError(where + ": metersPerUnit " + std::to_string(opts.metersPerUnit) + " must be positive and finite (0: the strands' own, else 0.01)");
     }
+    if (!(opts.width >= 0.0f) || !std::isfinite(opts.width)) {
+        throw ValueError(where + ": width " + std::to_string(opts.width) + " must be positive and finite (0: automatic)");
+    }
+    const double metersPerUnit = opts.metersPerUnit > 0.0 ? opts.metersPerUnit : strands.metersPerUnit > 0.0 ? strands.metersPerUnit : 0.01;
     const std::size_t nV = strands.numVertices(), nS = strands.numStrands();
     std::string out;
     reserveHugePages(out, 64 * nV + 8 * nS + 1024);
@@ -526,8 +580,8 @@ void writeUsda(const std::string& path, const StrandSet& strands, const UsdWrite
     out += "#usda 1.0\n(\n    defaultPrim = \"hair\"\n    doc = \"";
     out += creatorString();
     out += ": " + std::to_string(nS) + " strands, " + std::to_string(nV) + " vertices, root to tip\"\n    metersPerUnit = ";
-    num(opts.metersPerUnit, false);
-    out += "\n    upAxis = \"" + opts.upAxis + "\"\n)\n\n";
+    num(metersPerUnit, false);
+    out += "\n    upAxis = \"" + upAxis + "\"\n)\n\n";
     out += "def BasisCurves \"hair\"\n{\n";
     out += "    uniform token type = \"linear\"\n";
     out += "    uniform token wrap = \"nonperiodic\"\n";
@@ -542,19 +596,38 @@ void writeUsda(const std::string& path, const StrandSet& strands, const UsdWrite
         vec3(strands.positions[v]);
     }
     out += "]\n";
-    // Widths, colour and opacity: per vertex where the set has them, else its defaults, constant.
-    out += "    float[] widths = [";
-    if (strands.thickness.empty()) num(strands.defaults.thickness);
-    else for (std::size_t v = 0; v < nV; ++v) { if (v) out += ", "; num(strands.thickness[v]); }
-    out += std::string("] (\n        interpolation = \"") + (strands.thickness.empty() ? "constant" : "vertex") + "\"\n    )\n";
-    out += "    color3f[] primvars:displayColor = [";
-    if (strands.color.empty()) vec3(strands.defaults.color);
-    else for (std::size_t v = 0; v < nV; ++v) { if (v) out += ", "; vec3(strands.color[v]); }
-    out += std::string("] (\n        interpolation = \"") + (strands.color.empty() ? "constant" : "vertex") + "\"\n    )\n";
-    out += "    float[] primvars:displayOpacity = [";
-    if (strands.transparency.empty()) num(1.f - strands.defaults.transparency);
-    else for (std::size_t v = 0; v < nV; ++v) { if (v) out += ", "; num(1.f - strands.transparency[v]); }
-    out += std::string("] (\n        interpolation = \"") + (strands.transparency.empty() ? "constant" : "vertex") + "\"\n    )\n";
+    // Widths, colour and opacity: per vertex where the set has them and they vary; one value with
+    // "constant" interpolation where they do not (a .hair file's colour array of one colour, the
+    // defaults where the set has no array).
+    auto uniformValue = [](const auto& values) {
+        return std::all_of(values.begin(), values.end(), [&](const auto& v) { return v == values.front(); });
+    };
+    std::string uniformFlags;  // vdbhair_uniform_*: which constants stand for a per-vertex array
+    auto primvar = [&](const char* decl, const auto& values, const auto& constant, auto write, const char* flag) {
+        const bool constantValue = values.empty() || uniformValue(values);
+        if (!values.empty() && constantValue) uniformFlags += std::string("    custom bool vdbhair_uniform_") + flag + " = true\n";
+        out += std::string("    ") + decl + " = [";
+        if (constantValue) write(values.empty() ? constant : values.front());
+        else for (std::size_t v = 0; v < values.size(); ++v) { if (v) out += ", "; write(values[v]); }
+        out += std::string("] (\n        interpolation = \"") + (constantValue ? "constant" : "vertex") + "\"\n    )\n";
+    };
+    auto writeFloat = [&](float x) { num(x); };
+    auto writeVec3 = [&](const Vec3f& v) { vec3(v); };
+    // Curves without thickness: --width, else the file's declared default, else automatic (a
+    // thousandth of the bounding box's diagonal; writing 1 drew hair in metres as a blob).
+    float constantWidth = strands.defaults.thickness;
+    if (strands.thickness.empty()) {
+        if (opts.width > 0.f) constantWidth = opts.width;
+        else if (strands.defaults.thickness == StrandDefaults{}.thickness) constantWidth = automaticUsdWidth(strands);
+    }
+    // A width chosen for display (not the strands' thickness): vdbhair reads the defaults back
+    // exactly, other tools draw the width.
+    if (constantWidth != strands.defaults.thickness) uniformFlags += "    custom bool vdbhair_display_width = true\n";
+    primvar("float[] widths", strands.thickness, constantWidth, writeFloat, "thickness");
+    primvar("color3f[] primvars:displayColor", strands.color, strands.defaults.color, writeVec3, "color");
+    std::vector<float> opacity(strands.transparency.size());
+    for (std::size_t v = 0; v < opacity.size(); ++v) opacity[v] = 1.f - strands.transparency[v];
+    primvar("float[] primvars:displayOpacity", opacity, 1.f - strands.defaults.transparency, writeFloat, "transparency");
     // The defaults themselves (cyHair's header), exactly, whether or not the arrays are per vertex.
     out += "    custom float vdbhair_default_thickness = ";
     num(strands.defaults.thickness);
@@ -562,7 +635,7 @@ void writeUsda(const std::string& path, const StrandSet& strands, const UsdWrite
     num(strands.defaults.transparency);
     out += "\n    custom color3f vdbhair_default_color = ";
     vec3(strands.defaults.color);
-    out += "\n";
+    out += "\n" + uniformFlags;
     const BBox box = computeBBox(strands);
     out += "    float3[] extent = [";
     vec3(box.min);

@@ -30,8 +30,9 @@
 /// ```
 ///
 /// Widths are vdbhair's thickness (a diameter in world units, as USD's `widths`); per-vertex
-/// arrays are written with "vertex" interpolation, and where the set has none its defaults (the
-/// cyHair header's) are written as one "constant" value; the defaults are also written exactly as
+/// arrays are written with "vertex" interpolation unless every value is the same, and where the
+/// set has none its defaults (the cyHair header's) are written as one "constant" value (widths:
+/// UsdWriteOptions::width, else the declared default, else automaticUsdWidth()); the defaults are also written exactly as
 /// custom attributes `vdbhair_default_*`, so `.hair -> .usda -> .hair` keeps both.
 /// Floats are written in the shortest form that reads back exactly.
 ///
@@ -40,8 +41,11 @@
 /// prim and property metadata, and other prims and properties (ignored). Transforms
 /// (`xformOp`s) are not applied and time samples are not read (a warning says so). A `cubic`
 /// curve's control points are read as a polyline, with a warning. `upAxis` and `metersPerUnit`
-/// are kept as they are (no rotation or scaling; a "Z" up axis is reported in a warning:
-/// render such hair with `--up z`).
+/// are carried in StrandSet::upAxis and StrandSet::metersPerUnit (USD's fallbacks, Y and 0.01,
+/// when the stage has none), never applied (no rotation or scaling; a "Z" up axis is reported in a
+/// warning: render such hair with `--up z`), and written again by writeUsda() unless told
+/// otherwise, so USD to USD keeps them. A `.usd` file holding USD text reads the same; a binary
+/// (crate) `.usd` is refused with UnsupportedError.
 #pragma once
 
 #include <vdbhair/io/ReadOptions.h>
@@ -53,12 +57,30 @@ namespace vdbhair {
 
 struct UsdWriteOptions
 {
-    /// The stage's `upAxis`: "Y" (vdbhair's convention: +Y up, face towards +Z) or "Z".
-    /// Coordinates are written unchanged; this only declares how to read them.
-    std::string upAxis = "Y";
-    /// The stage's `metersPerUnit` (USD's own fallback is 0.01, centimetres).
-    double metersPerUnit = 0.01;
+    /// The stage's `upAxis`: "Y" (vdbhair's convention: +Y up, face towards +Z) or "Z"; empty: the
+    /// strands' declared axis (StrandSet::upAxis), else "Y". Coordinates are written unchanged;
+    /// this only declares how to read them.
+    std::string upAxis;
+    /// The stage's `metersPerUnit`; 0: the strands' own (StrandSet::metersPerUnit, read from a
+    /// USD stage), else 0.01 (USD's own fallback, centimetres).
+    double metersPerUnit = 0.0;
+    /// `widths` (world units) of curves without thickness; 0: the file's declared default
+    /// thickness if it differs from 1, else automatic (automaticUsdWidth()).
+    float width = 0.f;
 };
+
+/// @brief The width automaticUsdWidth() gives, as a share of the bounding box's diagonal.
+///
+/// Measured on the shared hairstyles in their declared units (docs/formats.md): 0.37 mm (CT2Hair's
+/// Bangs and Curly, mm), 0.58-0.69 mm (HairNet's, metres), 0.94-1.97 mm (TressFX's Ruby and
+/// ponytail, cm), 1.1 mm (Ratboy, metres), 1.22 mm (Yuksel's straight, cm): thin lines, 5 to 25
+/// real hairs wide (0.05-0.1 mm), the same for 5 guides or 10,000 strands, where the constant 1
+/// drew hair in metres a metre wide (five times the head) and hair in cm 10 mm wide.
+constexpr float kAutomaticWidthPerDiagonal = 1e-3f;
+
+/// @brief The `widths` written for curves without thickness when no width is given: the bounding
+/// box's diagonal times kAutomaticWidthPerDiagonal (1 for a set of one point).
+float automaticUsdWidth(const StrandSet& strands);
 
 /// @throw IoError, FormatError naming the file, the line and the rule (no BasisCurves prim,
 /// counts that do not add up to the points, an array of the wrong length, a syntax error).

@@ -84,7 +84,15 @@ void StrandSet::append(const StrandSet& other)
         throw ValueError("StrandSet::append: " + std::to_string(nV) +
                          " vertices exceed the limit of 2^32-1 vertices per set");
     }
-    if (empty()) defaults = other.defaults;
+    if (empty()) {
+        defaults = other.defaults;
+        metersPerUnit = other.metersPerUnit;
+        upAxis = other.upAxis;
+    } else {
+        // Declared space: kept where both sides agree, unknown where they differ.
+        if (metersPerUnit != other.metersPerUnit) metersPerUnit = 0.0;
+        if (upAxis != other.upAxis) upAxis = 0;
+    }
     positions.insert(positions.end(), other.positions.begin(), other.positions.end());
     for (std::size_t i = 1; i < other.offsets.size(); ++i) {
         offsets.push_back(static_cast<std::uint32_t>(nV0 + other.offsets[i]));
@@ -124,6 +132,8 @@ StrandSet selectStrands(const StrandSet& strands, const std::vector<char>& keep)
 {
     StrandSet out;
     out.defaults = strands.defaults;
+    out.metersPerUnit = strands.metersPerUnit;
+    out.upAxis = strands.upAxis;
     const bool hasT = !strands.thickness.empty(), hasA = !strands.transparency.empty(),
                hasC = !strands.color.empty(), hasUV = !strands.rootUV.empty(),
                hasId = !strands.strandId.empty();

@@ -38,6 +38,12 @@ struct StrandSet
     std::vector<Vec2f> rootUV;        ///< #S or empty
     std::vector<std::int32_t> strandId;  ///< #S or empty (ids of an upstream source)
     StrandDefaults defaults;
+    /// The unit the source file declared (USD's `metersPerUnit`), 0 when it declared none: carried
+    /// so that a writer with a unit (USD) keeps it; nothing is ever scaled by it.
+    double metersPerUnit = 0.0;
+    /// The up axis the source declared or the data was turned to: 'Y', 'Z', or 0 when unknown
+    /// (USD's `upAxis`; `convert --up` makes it 'Y'); OBJ's header comment says it.
+    char upAxis = 0;
 
     std::size_t numStrands() const { return offsets.empty() ? 0 : offsets.size() - 1; }
     std::size_t numVertices() const { return positions.size(); }
