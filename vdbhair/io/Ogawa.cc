@@ -105,8 +105,7 @@ Reader::Group Reader::group(std::uint64_t pos, const std::string& what) const
         failAt(pos, what + ": group declares " + std::to_string(count) + " children but only " +
                         std::to_string((size - pos - 8) / 8) + " fit in the rest of the file");
     }
-    g.children.resize(std::size_t(count));
-    if (count) std::memcpy(g.children.data(), mBytes.current() - mBytes.offset() + pos + 8, count * 8);
+    g.children = Words(mBytes.current() - mBytes.offset() + pos + 8, count);
     return g;
 }
 

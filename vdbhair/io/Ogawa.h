@@ -87,8 +87,26 @@ public:
     /// @throw FormatError (no "Ogawa" magic, unfinished file, unknown version, root out of range).
     Reader(const char* data, std::size_t size, std::string where);
 
-    /// A group's children (the words as stored) and where it is.
-    struct Group { std::uint64_t pos = 0; std::vector<std::uint64_t> children; };
+    /// A group's child words as stored, read in place (no copy, so a group's size costs nothing).
+    class Words
+    {
+    public:
+        Words() = default;
+        Words(const char* data, std::uint64_t count) : mData(data), mCount(count) {}
+        std::uint64_t size() const { return mCount; }
+        bool empty() const { return mCount == 0; }
+        std::uint64_t operator[](std::uint64_t i) const
+        {
+            std::uint64_t v;
+            std::memcpy(&v, mData + 8 * i, 8);
+            return v;
+        }
+    private:
+        const char* mData = nullptr;
+        std::uint64_t mCount = 0;
+    };
+    /// A group: where it is and its children.
+    struct Group { std::uint64_t pos = 0; Words children; };
     /// A data block: its bytes in the file.
     struct Data { std::uint64_t pos = 0; const char* bytes = nullptr; std::uint64_t size = 0; };
 
