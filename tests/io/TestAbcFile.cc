@@ -75,7 +75,8 @@ struct TestCurves
     int frames = 1;  // frames > 1: P gets that many samples (each moved by +1 in x)
 };
 
-std::string buildArchive(const std::vector<TestCurves>& objects, bool underXform)
+std::string buildArchive(const std::vector<TestCurves>& objects, bool underXform,
+                         const std::vector<std::uint8_t>& ops = {}, const std::vector<double>& vals = {})
 {
     ogawa::Writer w;
     std::vector<ogawa::Writer::Node> objectGroups;
@@ -106,7 +107,16 @@ std::string buildArchive(const std::vector<TestCurves>& objects, bool underXform
         childHeaders += md;
     }
     childHeaders += std::string(32, '\0');
-    std::vector<ogawa::Writer::Node> parentChildren{w.addGroup({})};
+    // The parent's properties: none, or (under an Xform with operations) .xform with .ops and
+    // .vals as scalars, as OXform writes a static transform.
+    ogawa::Writer::Node parentProps = w.addGroup({});
+    if (underXform && !ops.empty()) {
+        const std::vector<TestProperty> fields{{".ops", "", 1, 1, unsigned(ops.size()), {bytesOf(ops)}},
+                                               {".vals", "", 1, 11, unsigned(vals.size()), {bytesOf(vals)}}};
+        const auto xform = w.addGroup({propertyGroup(w, fields[0]), propertyGroup(w, fields[1]), w.addData(propertyHeaders(fields))});
+        parentProps = w.addGroup({xform, w.addData(propertyHeaders({{".xform", "schema=AbcGeom_Xform_v3", 0, 0, 0, {}}}))});
+    }
+    std::vector<ogawa::Writer::Node> parentChildren{parentProps};
     parentChildren.insert(parentChildren.end(), objectGroups.begin(), objectGroups.end());
     parentChildren.push_back(w.addData(childHeaders));
     ogawa::Writer::Node top = w.addGroup(parentChildren);
@@ -328,9 +338,28 @@ TEST_CASE("readAbc: several objects under an Xform, widths by scope, animation's
     REQUIRE(s.thickness[0] == 0.5f);  // a's constant width, filled in
     REQUIRE(s.thickness[3] == 0.1f);  // uniform: per curve
     REQUIRE(s.thickness[6] == 0.2f);
-    REQUIRE(report.warnings.size() == 2);
-    REQUIRE_THAT(report.warnings[0], Contains("under an Xform; parent transforms are not applied"));
-    REQUIRE_THAT(report.warnings[1], Contains("/groom/b/P has 3 samples; the first is read"));
+    REQUIRE(report.warnings.size() == 1);
+    REQUIRE_THAT(report.warnings[0], Contains("/groom/b/P has 3 samples; the first is read"));
+}
+
+TEST_CASE("readAbc: a parent Xform's operations are applied as Alembic composes them", "[io][abc]")
+{
+    // Operations translate (10, 0, 0), rotate Z 90 degrees, scale 2 (AbcGeom's XformSample order:
+    // each premultiplies, so a point is scaled, then rotated, then translated).
+    TestCurves a{"a", {Vec3f(0.f), Vec3f(1.f, 0.f, 0.f), Vec3f(0.f, 0.f, 1.f)}, {3}, {1, 0, 0, 0}, {}, "vtx", 1};
+    const std::string path = test::writeBytes("xform.abc", buildArchive({a}, true, {0x10, 0x60, 0x00},
+                                                                          {10, 0, 0, 90, 2, 2, 2}));
+    ReadReport report;
+    const StrandSet s = readAbc(path, {}, &report);
+    REQUIRE(report.warnings.empty());
+    REQUIRE(s.positions[0].x() == Approx(10.f).margin(1e-5));
+    REQUIRE(s.positions[1].x() == Approx(10.f).margin(1e-5));
+    REQUIRE(s.positions[1].y() == Approx(2.f).margin(1e-5));
+    REQUIRE(s.positions[2].z() == Approx(2.f).margin(1e-5));
+    REQUIRE(s.positions[2].y() == Approx(0.f).margin(1e-5));
+    // Too few values for the operations is an error of its own.
+    const std::string bad = test::writeBytes("xform_bad.abc", buildArchive({a}, true, {0x10, 0x30}, {1, 2, 3, 4}));
+    REQUIRE_THROWS_WITH(readAbc(bad), Contains("the operations need more than the 4 values of .vals"));
 }
 
 TEST_CASE("readAbc: bad input is a FormatError naming the file, the byte and the rule", "[io][abc]")

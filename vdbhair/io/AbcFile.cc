@@ -9,6 +9,8 @@
 #include <vdbhair/io/Ogawa.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstring>
 #include <unordered_set>
 
@@ -51,6 +53,31 @@ std::string metaValue(const std::string& md, const std::string& key)
         at = end + 1;
     }
     return {};
+}
+
+/// A 4x4 matrix in Imath's convention (Alembic's): row vectors, p' = p M, translation in row 3.
+using Matrix = std::array<double, 16>;
+constexpr Matrix kIdentity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+Matrix multiply(const Matrix& a, const Matrix& b)
+{
+    Matrix c{};
+    for (int r = 0; r < 4; ++r)
+        for (int k = 0; k < 4; ++k)
+            for (int j = 0; j < 4; ++j) c[4 * r + j] += a[4 * r + k] * b[4 * k + j];
+    return c;
+}
+
+/// Imath's Matrix44::setAxisAngle: rotation by @a degrees about @a axis (row-vector form).
+Matrix axisAngle(double x, double y, double z, double degrees)
+{
+    const double len = std::sqrt(x * x + y * y + z * z);
+    if (len > 0) { x /= len; y /= len; z /= len; }
+    const double a = degrees * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a), t = 1 - c;
+    return Matrix{t * x * x + c,     t * x * y + s * z, t * x * z - s * y, 0,
+                  t * x * y - s * z, t * y * y + c,     t * y * z + s * x, 0,
+                  t * x * z + s * y, t * y * z - s * x, t * z * z + c,     0,
+                  0, 0, 0, 1};
 }
 
 class AbcReader
@@ -102,7 +129,12 @@ private:
     }
 
     std::vector<PropertyIn> readPropertyHeaders(const ogawa::Reader::Group& g, const std::string& what) const;
-    void readCurves(const ogawa::Reader::Group& object, const std::string& name, StrandSet& out);
+    void readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out);
+    /// The local matrix of an Xform object (AbcGeom's XformSample::getMatrix) and whether it
+    /// inherits its parent's.
+    Matrix readXform(const ogawa::Reader::Group& object, const std::string& name, bool& inherits);
+    /// Sample 0 of a scalar property: its bytes after the digest.
+    ogawa::Reader::Data scalarSample(const ogawa::Reader::Group& compound, const PropertyIn& p, const std::string& what);
     /// Sample 0 of an array property: its bytes, checked to be whole elements of pod x extent.
     ogawa::Reader::Data arraySample(const ogawa::Reader::Group& compound, const PropertyIn& p,
                                     const std::string& what, std::uint64_t& count);
@@ -120,7 +152,7 @@ private:
     ReadReport* mReport;
     std::vector<std::string> mIndexedMetaData;
     std::unordered_set<std::uint64_t> mVisited;
-    bool mWarnedAnimated = false, mWarnedXform = false;
+    bool mWarnedAnimated = false;
 };
 
 std::vector<PropertyIn> AbcReader::readPropertyHeaders(const ogawa::Reader::Group& g, const std::string& what) const
@@ -265,8 +297,8 @@ StrandSet AbcReader::read()
 
     // Objects depth first, children in file order, with an explicit stack.
     StrandSet out;
-    struct Item { std::uint64_t pos; std::string name, metaData; bool underXform; };
-    std::vector<Item> stack{{mOgawa.childGroup(root, 2, "top object"), "", "", false}};
+    struct Item { std::uint64_t pos; std::string name, metaData; Matrix world; };
+    std::vector<Item> stack{{mOgawa.childGroup(root, 2, "top object"), "", "", kIdentity}};
     std::size_t curveObjects = 0;
     InterruptPoll poll(mOpts.interrupter, mWhere);
     while (!stack.empty()) {
@@ -278,13 +310,14 @@ StrandSet AbcReader::read()
         const ogawa::Reader::Group g = mOgawa.group(item.pos, what);
         if (g.children.empty()) continue;
         const std::string schema = metaValue(item.metaData, "schema");
+        Matrix world = item.world;
         if (schema.rfind("AbcGeom_Curve_v", 0) == 0) {
-            if (item.underXform && !mWarnedXform) {
-                mWarnedXform = true;
-                warn(what + " is under an Xform; parent transforms are not applied");
-            }
-            readCurves(g, item.name, out);
+            readCurves(g, item.name, world, out);
             ++curveObjects;
+        } else if (schema.rfind("AbcGeom_Xform_v", 0) == 0) {
+            bool inherits = true;
+            const Matrix local = readXform(g, item.name, inherits);
+            world = inherits ? multiply(local, item.world) : local;  // row vectors: local first
         }
         // Children: headers in the last block (ending with 32 bytes of hashes), groups 1..n.
         const ogawa::Reader::Data h = mOgawa.childData(g, g.children.size() - 1, what + " child headers");
@@ -304,7 +337,7 @@ StrandSet AbcReader::read()
             } else {
                 child.metaData = indexedMetaData(mdi, start);
             }
-            child.underXform = item.underXform || schema.rfind("AbcGeom_Xform_v", 0) == 0;
+            child.world = world;
             const std::size_t index = children.size() + 1;
             if (index + 1 >= g.children.size()) {
                 mOgawa.failAt(start, what + ": child header " + std::to_string(index - 1) + " (" + child.name +
@@ -321,7 +354,84 @@ StrandSet AbcReader::read()
     return out;
 }
 
-void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string& name, StrandSet& out)
+ogawa::Reader::Data AbcReader::scalarSample(const ogawa::Reader::Group& compound, const PropertyIn& p, const std::string& what)
+{
+    const std::uint64_t pos = mOgawa.childGroup(compound, p.child, what);
+    const ogawa::Reader::Group g = mOgawa.group(pos, what);
+    ogawa::Reader::Data d = mOgawa.childData(g, 0, what + " sample 0");
+    const std::uint64_t bytes = std::uint64_t(kPodBytes[p.pod]) * p.extent;
+    if (d.size != 16 + bytes) {
+        mOgawa.failAt(d.pos, what + ": sample of " + std::to_string(d.size) + " bytes; 16 + " + std::to_string(bytes) + " expected");
+    }
+    if (p.numSamples > 1 && !p.constant && !mWarnedAnimated) {
+        mWarnedAnimated = true;
+        warn(what + " has " + std::to_string(p.numSamples) + " samples; the first is read (animation is not)");
+    }
+    d.bytes += 16;
+    d.size -= 16;
+    return d;
+}
+
+Matrix AbcReader::readXform(const ogawa::Reader::Group& object, const std::string& name, bool& inherits)
+{
+    // The object's properties, then its .xform compound: .ops (one byte per operation, type in
+    // the high 4 bits), .vals (float64 channels, scalar or array), .inherits (bool).
+    const std::string what = name + "/.xform";
+    const std::uint64_t propsPos = mOgawa.childGroup(object, 0, name + " properties");
+    enterGroup(propsPos, name + " properties");
+    const ogawa::Reader::Group props = mOgawa.group(propsPos, name + " properties");
+    const PropertyIn* xformHeader = nullptr;
+    const std::vector<PropertyIn> top = readPropertyHeaders(props, name);
+    for (const PropertyIn& p : top) if (p.name == ".xform" && p.type == kCompound) xformHeader = &p;
+    if (!xformHeader) return kIdentity;
+    const std::uint64_t xPos = mOgawa.childGroup(props, xformHeader->child, what);
+    enterGroup(xPos, what);
+    const ogawa::Reader::Group xform = mOgawa.group(xPos, what);
+    const std::vector<PropertyIn> fields = readPropertyHeaders(xform, what);
+    std::vector<std::uint8_t> ops;
+    std::vector<double> vals;
+    for (const PropertyIn& p : fields) {
+        if (p.name == ".inherits" && p.type == kScalar && p.pod == 0 && p.extent == 1) {
+            inherits = scalarSample(xform, p, what + "/.inherits").bytes[0] != 0;
+        } else if (p.name == ".ops" && p.type == kScalar && p.pod == kUint8) {
+            const ogawa::Reader::Data d = scalarSample(xform, p, what + "/.ops");
+            ops.assign(d.bytes, d.bytes + d.size);
+        } else if (p.name == ".vals" && p.pod == kFloat64) {
+            std::uint64_t n = 0;
+            const ogawa::Reader::Data d = p.type == kScalar ? scalarSample(xform, p, what + "/.vals")
+                                                            : arraySample(xform, p, what + "/.vals", n);
+            vals.resize(std::size_t(d.size / 8));
+            if (!vals.empty()) std::memcpy(vals.data(), d.bytes, vals.size() * 8);
+        }
+    }
+    // XformSample::getMatrix: each operation's matrix premultiplies the product so far.
+    Matrix m = kIdentity;
+    std::size_t at = 0;
+    for (std::uint8_t op : ops) {
+        const unsigned type = op >> 4;
+        const std::size_t channels = type == 3 ? 16 : type == 2 ? 4 : type >= 4 && type <= 6 ? 1 : 3;
+        if (type > 6) throw FormatError(mWhere + ": " + what + "/.ops: operation type " + std::to_string(type) + "; types are 0-6");
+        if (at + channels > vals.size()) {
+            throw FormatError(mWhere + ": " + what + ": the operations need more than the " + std::to_string(vals.size()) +
+                              " values of .vals");
+        }
+        const double* v = vals.data() + at;
+        at += channels;
+        Matrix o = kIdentity;
+        if (type == 0) { o[0] = v[0]; o[5] = v[1]; o[10] = v[2]; }            // scale
+        else if (type == 1) { o[12] = v[0]; o[13] = v[1]; o[14] = v[2]; }     // translate
+        else if (type == 2) o = axisAngle(v[0], v[1], v[2], v[3]);             // rotate about an axis
+        else if (type == 3) std::copy(v, v + 16, o.begin());                  // matrix
+        else o = axisAngle(type == 4, type == 5, type == 6, v[0]);             // rotate X, Y, Z
+        m = multiply(o, m);
+    }
+    for (double x : m) {
+        if (!std::isfinite(x)) throw FormatError(mWhere + ": " + what + ": a transform value is not finite");
+    }
+    return m;
+}
+
+void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out)
 {
     const std::string what = name;
     // The object's properties, then its .geom compound.
@@ -423,6 +533,18 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
         for (std::size_t i = 0; i < points.size(); ++i) {
             const std::size_t bytes = pP->pod == kFloat32 ? 12 : 24;
             checkFinite(points[i], i, mWhere, "at byte " + std::to_string(dP.pos + 24 + bytes * i) + ": " + what + "/P");
+        }
+    }
+    if (world != kIdentity) {  // the parent Xforms' transform, in double precision
+        const Matrix& m = world;
+        for (Vec3f& p : points) {
+            const double x = p.x(), y = p.y(), z = p.z();
+            const double w = x * m[3] + y * m[7] + z * m[11] + m[15];
+            p = Vec3f(float((x * m[0] + y * m[4] + z * m[8] + m[12]) / w), float((x * m[1] + y * m[5] + z * m[9] + m[13]) / w),
+                      float((x * m[2] + y * m[6] + z * m[10] + m[14]) / w));
+        }
+        if (!allFinite(points.data(), 3 * points.size())) {
+            throw FormatError(mWhere + ": " + what + ": a point is not finite after its parents' transform");
         }
     }
 

@@ -32,8 +32,10 @@
 /// evaluated into polylines by FreeFormCurve.h (ReadOptions::curveSamples points per curve, or its
 /// adaptive 1 % rule when 0), with per-vertex widths interpolated along the polyline. Widths of
 /// any scope (constant, uniform, varying, vertex), indexed or not, and a uniform or indexed root
-/// `uv` are read. Animated properties are read at their first sample, with a warning; parent
-/// Xform transforms are not applied (a warning says so); NURBS (`kVariableOrder`) curves other
+/// `uv` are read. Animated properties are read at their first sample, with a warning; the
+/// transforms of parent Xform objects are applied to the points (their `.ops` and `.vals`
+/// composed as AbcGeom's XformSample::getMatrix does, `.inherits` honoured; widths are not
+/// scaled); NURBS (`kVariableOrder`) curves other
 /// than order 2, Hermite and power bases are refused (UnsupportedError).
 ///
 /// Every offset and count in the file is checked against the file size before it is used, and
