@@ -4,12 +4,12 @@
 #include "AbcFile.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/AbcXform.h>
 #include <vdbhair/io/FreeFormCurve.h>
 #include <vdbhair/io/MappedFile.h>
 #include <vdbhair/io/Ogawa.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstring>
 #include <unordered_set>
@@ -53,31 +53,6 @@ std::string metaValue(const std::string& md, const std::string& key)
         at = end + 1;
     }
     return {};
-}
-
-/// A 4x4 matrix in Imath's convention (Alembic's): row vectors, p' = p M, translation in row 3.
-using Matrix = std::array<double, 16>;
-constexpr Matrix kIdentity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-
-Matrix multiply(const Matrix& a, const Matrix& b)
-{
-    Matrix c{};
-    for (int r = 0; r < 4; ++r)
-        for (int k = 0; k < 4; ++k)
-            for (int j = 0; j < 4; ++j) c[4 * r + j] += a[4 * r + k] * b[4 * k + j];
-    return c;
-}
-
-/// Imath's Matrix44::setAxisAngle: rotation by @a degrees about @a axis (row-vector form).
-Matrix axisAngle(double x, double y, double z, double degrees)
-{
-    const double len = std::sqrt(x * x + y * y + z * z);
-    if (len > 0) { x /= len; y /= len; z /= len; }
-    const double a = degrees * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a), t = 1 - c;
-    return Matrix{t * x * x + c,     t * x * y + s * z, t * x * z - s * y, 0,
-                  t * x * y - s * z, t * y * y + c,     t * y * z + s * x, 0,
-                  t * x * z + s * y, t * y * z - s * x, t * z * z + c,     0,
-                  0, 0, 0, 1};
 }
 
 class AbcReader
@@ -404,30 +379,9 @@ Matrix AbcReader::readXform(const ogawa::Reader::Group& object, const std::strin
             if (!vals.empty()) std::memcpy(vals.data(), d.bytes, vals.size() * 8);
         }
     }
-    // XformSample::getMatrix: each operation's matrix premultiplies the product so far.
     Matrix m = kIdentity;
-    std::size_t at = 0;
-    for (std::uint8_t op : ops) {
-        const unsigned type = op >> 4;
-        const std::size_t channels = type == 3 ? 16 : type == 2 ? 4 : type >= 4 && type <= 6 ? 1 : 3;
-        if (type > 6) throw FormatError(mWhere + ": " + what + "/.ops: operation type " + std::to_string(type) + "; types are 0-6");
-        if (at + channels > vals.size()) {
-            throw FormatError(mWhere + ": " + what + ": the operations need more than the " + std::to_string(vals.size()) +
-                              " values of .vals");
-        }
-        const double* v = vals.data() + at;
-        at += channels;
-        Matrix o = kIdentity;
-        if (type == 0) { o[0] = v[0]; o[5] = v[1]; o[10] = v[2]; }            // scale
-        else if (type == 1) { o[12] = v[0]; o[13] = v[1]; o[14] = v[2]; }     // translate
-        else if (type == 2) o = axisAngle(v[0], v[1], v[2], v[3]);             // rotate about an axis
-        else if (type == 3) std::copy(v, v + 16, o.begin());                  // matrix
-        else o = axisAngle(type == 4, type == 5, type == 6, v[0]);             // rotate X, Y, Z
-        m = multiply(o, m);
-    }
-    for (double x : m) {
-        if (!std::isfinite(x)) throw FormatError(mWhere + ": " + what + ": a transform value is not finite");
-    }
+    const std::string rule = composeXformOps(ops, vals, m);
+    if (!rule.empty()) throw FormatError(mWhere + ": " + what + ": " + rule);
     return m;
 }
 
@@ -536,13 +490,7 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
         }
     }
     if (world != kIdentity) {  // the parent Xforms' transform, in double precision
-        const Matrix& m = world;
-        for (Vec3f& p : points) {
-            const double x = p.x(), y = p.y(), z = p.z();
-            const double w = x * m[3] + y * m[7] + z * m[11] + m[15];
-            p = Vec3f(float((x * m[0] + y * m[4] + z * m[8] + m[12]) / w), float((x * m[1] + y * m[5] + z * m[9] + m[13]) / w),
-                      float((x * m[2] + y * m[6] + z * m[10] + m[14]) / w));
-        }
+        for (Vec3f& p : points) p = transformPoint(world, p);
         if (!allFinite(points.data(), 3 * points.size())) {
             throw FormatError(mWhere + ": " + what + ": a point is not finite after its parents' transform");
         }
