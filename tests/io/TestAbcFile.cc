@@ -73,6 +73,7 @@ struct TestCurves
     std::vector<float> widths;
     std::string widthScope = "vtx";
     int frames = 1;  // frames > 1: P gets that many samples (each moved by +1 in x)
+    std::vector<std::uint32_t> widthIndices;  // not empty: width is indexed (.vals and .indices)
 };
 
 std::string buildArchive(const std::vector<TestCurves>& objects, bool underXform,
@@ -92,9 +93,16 @@ std::string buildArchive(const std::vector<TestCurves>& objects, bool underXform
         props.push_back(P);
         props.push_back({"nVertices", "", 2, 6, 1, {bytesOf(c.counts)}});
         props.push_back({"curveBasisAndType", "", 1, 1, 4, {bytesOf(c.basisAndType)}});
-        if (!c.widths.empty()) props.push_back({"width", "geoScope=" + c.widthScope + ";isGeomParam=true", 2, 10, 1, {bytesOf(c.widths)}});
+        const std::string widthMd = "geoScope=" + c.widthScope + ";isGeomParam=true";
+        if (!c.widths.empty() && c.widthIndices.empty()) props.push_back({"width", widthMd, 2, 10, 1, {bytesOf(c.widths)}});
         std::vector<ogawa::Writer::Node> geomChildren;
         for (const TestProperty& p : props) geomChildren.push_back(propertyGroup(w, p));
+        if (!c.widthIndices.empty()) {  // an indexed parameter: a compound of .vals and .indices
+            const std::vector<TestProperty> sub{{".vals", widthMd, 2, 10, 1, {bytesOf(c.widths)}},
+                                                {".indices", "", 2, 5, 1, {bytesOf(c.widthIndices)}}};
+            geomChildren.push_back(w.addGroup({propertyGroup(w, sub[0]), propertyGroup(w, sub[1]), w.addData(propertyHeaders(sub))}));
+            props.push_back({"width", widthMd, 0, 0, 0, {}});
+        }
         geomChildren.push_back(w.addData(propertyHeaders(props)));
         const auto geom = w.addGroup(geomChildren);
         const auto objProps = w.addGroup({geom, w.addData(propertyHeaders({{".geom", "schema=AbcGeom_Curve_v2", 0, 0, 0, {}}}))});
@@ -340,6 +348,17 @@ TEST_CASE("readAbc: several objects under an Xform, widths by scope, animation's
     REQUIRE(s.thickness[6] == 0.2f);
     REQUIRE(report.warnings.size() == 1);
     REQUIRE_THAT(report.warnings[0], Contains("/groom/b/P has 3 samples; the first is read"));
+}
+
+TEST_CASE("readAbc: indexed widths are expanded; an index past the values is an error", "[io][abc]")
+{
+    TestCurves a{"a", {Vec3f(0.f), Vec3f(1.f, 0.f, 0.f), Vec3f(2.f, 0.f, 0.f), Vec3f(0.f, 1.f, 0.f), Vec3f(1.f, 1.f, 0.f)},
+                 {3, 2}, {1, 0, 0, 0}, {0.5f, 0.25f}, "vtx", 1, {0, 1, 1, 0, 1}};
+    const StrandSet s = readAbc(test::writeBytes("indexed.abc", buildArchive({a}, false)));
+    REQUIRE(s.thickness == std::vector<float>{0.5f, 0.25f, 0.25f, 0.5f, 0.25f});
+    a.widthIndices[3] = 2;
+    REQUIRE_THROWS_WITH(readAbc(test::writeBytes("indexed_bad.abc", buildArchive({a}, false))),
+                        Contains("/a/width.indices[3] = 2 but .vals has 2 values"));
 }
 
 TEST_CASE("readAbc: a parent Xform's operations are applied as Alembic composes them", "[io][abc]")
