@@ -149,6 +149,10 @@ CASES = [
     ("convdata: shape product wrapping 2^64", ["convert", write("wrap.convdata", npy("(4611686018427387904, 4, 1)", bytes(64))), "{out}.obj"], ["wrap.convdata", "floats, more than 2^64 bytes"]),
     ("convdata: dimension beyond 2^64", ["convert", write("dim.convdata", npy("(99999999999999999999999, 1, 1)", bytes(16))), "{out}.obj"], ["dim.convdata", "beyond 2^64-1"]),
     ("convdata: float64", ["convert", write("f8.convdata", npy("(4, 1, 1)", bytes(32), "<f8")), "{out}.obj"], ["f8.convdata", "dtype '<f8' is not supported"]),
+    # Alembic (Ogawa): the header's root offset and a group's child count are bounded by the file
+    ("abc: HDF5 archive, not Ogawa", ["convert", write("hdf5.abc", b"\x89HDF\r\n\x1a\n" + bytes(40)), "{out}.obj"], ["hdf5.abc", "no \"Ogawa\" magic"]),
+    ("abc: root group past the end", ["convert", write("root.abc", b"Ogawa\xff\x00\x01" + struct.pack("<Q", 1 << 40) + bytes(16)), "{out}.obj"], ["root.abc", "at byte 8: root group offset 1099511627776 lies outside"]),
+    ("abc: 2^60 children", ["convert", write("kids.abc", b"Ogawa\xff\x00\x01" + struct.pack("<QQ", 16, 1 << 60) + bytes(16)), "{out}.obj"], ["kids.abc", "at byte 16: archive root: group declares 1152921504606846976 children"]),
     # OBJ
     ("obj: index beyond the vertices", ["convert", write("idx.obj", "v 0 0 0\nv 1 1 1\nl 1 5\n"), "{out}.hair"], ["idx.obj", "5"]),
     ("obj: NaN vertex", ["convert", write("nan.obj", "v 0 0 0\nv nan 1 1\nl 1 2\n"), "{out}.hair"], ["nan.obj", "non-finite"]),

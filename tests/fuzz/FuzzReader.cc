@@ -8,6 +8,7 @@
 // -malloc_limit_mb - is a finding.
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/AbcFile.h>
 #include <vdbhair/io/BinFile.h>
 #include <vdbhair/io/ConvdataFile.h>
 #include <vdbhair/io/DataFile.h>
@@ -67,6 +68,12 @@ void readOnce(const std::string& path)
     else if (sReader == "tfx") readTfx(path, opts, &report);
     else if (sReader == "convdata") readConvdata(path, opts, &report);
     else if (sReader == "usda") readUsda(path, opts, &report);
+    else if (sReader == "abc") {
+        readAbc(path, opts, &report);
+        ReadOptions samples;  // cubic curves at an explicit count too
+        samples.curveSamples = 5;
+        readAbc(path, samples, &report);
+    }
     else if (sReader == "vdb") readVdbStrands(path, opts, &report);
     else if (sReader == "mesh") readTriangleMesh(path);
     else if (sReader == "scene") readScene(path);
@@ -79,11 +86,11 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv)
     const std::string self = *argc > 0 ? (*argv)[0] : "";
     const std::size_t at = self.rfind("fuzz_");
     sReader = at == std::string::npos ? "" : self.substr(at + 5);
-    const char* known[] = {"hair", "data", "bin", "obj", "ply", "tfx", "convdata", "usda", "vdb", "mesh", "scene"};
+    const char* known[] = {"hair", "data", "bin", "obj", "ply", "tfx", "convdata", "usda", "abc", "vdb", "mesh", "scene"};
     bool ok = false;
     for (const char* k : known) ok = ok || sReader == k;
     if (!ok) {
-        std::fprintf(stderr, "vdbhair fuzz: '%s' names no reader; run it as fuzz_<hair|data|bin|obj|ply|tfx|convdata|usda|vdb|mesh|scene>\n", self.c_str());
+        std::fprintf(stderr, "vdbhair fuzz: '%s' names no reader; run it as fuzz_<hair|data|bin|obj|ply|tfx|convdata|usda|abc|vdb|mesh|scene>\n", self.c_str());
         std::exit(2);
     }
     sPath = "/tmp/vdbhair-fuzz-" + sReader + "-" + std::to_string(::getpid());

@@ -8,6 +8,7 @@
 #include <vdbhair/io/ObjFile.h>
 #include <vdbhair/io/PlyFile.h>
 #include <vdbhair/io/UsdFile.h>
+#include <vdbhair/io/AbcFile.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrands.h>
 
@@ -54,7 +55,7 @@ int main(int argc, char** argv)
         return 2;
     }
     const fs::path out = argv[1];
-    for (const char* r : {"hair", "data", "bin", "obj", "ply", "tfx", "convdata", "usda", "vdb", "mesh", "scene"}) fs::create_directories(out / r);
+    for (const char* r : {"hair", "data", "bin", "obj", "ply", "tfx", "convdata", "usda", "abc", "vdb", "mesh", "scene"}) fs::create_directories(out / r);
     initializeOpenVdb();
     const StrandSet s = tinyStyle();
     StrandSet plain = s;
@@ -92,6 +93,8 @@ int main(int argc, char** argv)
         writeRaw(out / "ply/lineset_binary.ply", lines);
     }
     writeUsda((out / "usda/tiny.usda").string(), s);
+    writeAbc((out / "abc/tiny.abc").string(), s);
+    writeAbc((out / "abc/plain.abc").string(), plain);
     writeVdbStrands((out / "vdb/float.vdb").string(), plain);
     VdbPointsOptions fixed;
     fixed.codec = PositionCodec::Fixed16;

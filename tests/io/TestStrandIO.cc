@@ -27,7 +27,8 @@ TEST_CASE("strandFormatFromPath: by extension, case-insensitive, with clear erro
 {
     REQUIRE(strandFormatFromPath("a/b/HAIR.HAIR") == StrandFormat::Hair);
     REQUIRE(strandFormatFromPath("x.tfx") == StrandFormat::Tfx);
-    REQUIRE_THROWS_WITH(strandFormatFromPath("x.abc"), Contains("unknown strand format '.abc'; supported extensions are .hair"));
+    REQUIRE(strandFormatFromPath("x.ABC") == StrandFormat::Abc);
+    REQUIRE_THROWS_WITH(strandFormatFromPath("x.fbx"), Contains("unknown strand format '.fbx'; supported extensions are .hair"));
     REQUIRE_THROWS_WITH(strandFormatFromPath("x.tfx", true), Contains("is read-only in vdbhair"));
     REQUIRE_THROWS_AS(writeStrands(test::tempPath("x.bin"), test::sampleStrands()), ValueError);
 }

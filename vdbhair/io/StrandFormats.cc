@@ -3,6 +3,7 @@
 #include "StrandIO.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/AbcFile.h>
 #include <vdbhair/io/BinFile.h>
 #include <vdbhair/io/ConvdataFile.h>
 #include <vdbhair/io/DataFile.h>
@@ -26,6 +27,7 @@ constexpr FormatEntry kFormats[] = {
     {".vdb", StrandFormat::Vdb, "OpenVDB points", true},
     {".usda", StrandFormat::Usda, "USD BasisCurves (text)", true},
     {".usd", StrandFormat::Usda, "USD BasisCurves (text in a .usd)", false},
+    {".abc", StrandFormat::Abc, "Alembic Curves (Ogawa)", true},
     {".tfx", StrandFormat::Tfx, "TressFX", false},
     {".bin", StrandFormat::Bin, "CT2Hair", false},
     {".convdata", StrandFormat::Convdata, "HairNet convdata", false},
@@ -39,7 +41,7 @@ StrandFormat strandFormatFromPath(const std::string& path, bool forWriting)
         if (ext != f.ext) continue;
         if (forWriting && !f.writable) {
             throw ValueError(path + ": " + f.name + " (" + ext +
-                             ") is read-only in vdbhair; write .hair, .data, .obj, .ply, .vdb or .usda");
+                             ") is read-only in vdbhair; write .hair, .data, .obj, .ply, .vdb, .usda or .abc");
         }
         return f.format;
     }
@@ -89,6 +91,7 @@ StrandSet readNonVdbStrands(const std::string& path, const ReadOptions& opts, Re
     case StrandFormat::Ply: return readPly(path, opts, report);
     case StrandFormat::Vdb: break;
     case StrandFormat::Usda: return readUsda(path, opts, report);
+    case StrandFormat::Abc: return readAbc(path, opts, report);
     case StrandFormat::Tfx: return readTfx(path, opts, report);
     case StrandFormat::Bin: return readBin(path, opts, report);
     case StrandFormat::Convdata: return readConvdata(path, opts, report);

@@ -1,6 +1,7 @@
 #include "StrandIO.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/AbcFile.h>
 #include <vdbhair/io/DataFile.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/HairFile.h>
@@ -36,6 +37,7 @@ void writeStrands(const std::string& path, const StrandSet& strands, const Write
     case StrandFormat::Ply: writePly(path, strands, opts.plyEncoding); return;
     case StrandFormat::Vdb: writeVdbStrands(path, strands, opts.vdb); return;
     case StrandFormat::Usda: writeUsda(path, strands, opts.usd); return;
+    case StrandFormat::Abc: writeAbc(path, strands); return;
     default: break;
     }
     throw ValueError(path + ": format is not writable");

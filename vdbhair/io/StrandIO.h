@@ -10,6 +10,7 @@
 /// | .ply | hairutil PLY, ascii / binary LE (PlyFile.h) | yes | yes |
 /// | .vdb | OpenVDB points grid `strands` (VdbStrands.h) | yes | yes |
 /// | .usda | USD BasisCurves, text (UsdFile.h) | yes | yes |
+/// | .abc | Alembic Curves, Ogawa (AbcFile.h) | yes | yes |
 /// | .tfx | TressFX binary 3/4, ASCII 1/2 (TfxFile.h) | yes | no |
 /// | .bin | CT2Hair (BinFile.h) | yes | no |
 /// | .convdata | HairNet (ConvdataFile.h) | yes | no |
@@ -26,7 +27,7 @@
 
 namespace vdbhair {
 
-enum class StrandFormat { Hair, Data, Obj, Ply, Vdb, Usda, Tfx, Bin, Convdata };
+enum class StrandFormat { Hair, Data, Obj, Ply, Vdb, Usda, Abc, Tfx, Bin, Convdata };
 
 /// @brief The format of @a path from its extension.
 /// @param forWriting also require a writable format

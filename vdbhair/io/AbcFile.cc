@@ -1,0 +1,608 @@
+// Reading Alembic Curves from the Ogawa container (AbcFile.h; writing is in AbcWrite.cc). The
+// encoding follows the reference library's AbcCoreOgawa (ReadPropertyHeaders, ReadObjectHeaders,
+// MetaDataMap) and AbcGeom's ICurves; checked against it (docs/development.md).
+#include "AbcFile.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/io/AbcXform.h>
+#include <vdbhair/io/FreeFormCurve.h>
+#include <vdbhair/io/MappedFile.h>
+#include <vdbhair/io/Ogawa.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <unordered_set>
+
+namespace vdbhair {
+
+namespace {
+
+using namespace abc;
+
+/// Values of "varying" scope on a curve of @a n control points: one per segment end (AbcGeom's
+/// ICurves: linear curves have n, Bezier ones (n - 1) / 3 + 1, B-spline and Catmull-Rom n - 2).
+std::size_t varyingCount(std::uint32_t n, bool linear, unsigned basis)
+{
+    if (linear) return n;
+    if (n < 4) return 0;
+    return basis == 1 ? (n - 1) / 3 + 1 : n - 2;
+}
+
+struct PropertyIn
+{
+    std::string name, metaData;
+    PropertyType type = kCompound;
+    unsigned pod = 0, extent = 0;
+    std::uint32_t numSamples = 0;
+    bool constant = false;  // every sample the same (one stored)
+    std::size_t child = 0;  // its group's index in the compound
+};
+
+/// The value of @a key in serialized metadata "k1=v1;k2=v2" ("" if absent).
+std::string metaValue(const std::string& md, const std::string& key)
+{
+    std::size_t at = 0;
+    while (at < md.size()) {
+        std::size_t end = md.find(';', at);
+        if (end == std::string::npos) end = md.size();
+        const std::size_t eq = md.find('=', at);
+        if (eq != std::string::npos && eq < end && md.compare(at, eq - at, key) == 0) {
+            return md.substr(eq + 1, end - eq - 1);
+        }
+        at = end + 1;
+    }
+    return {};
+}
+
+class AbcReader
+{
+public:
+    AbcReader(const std::string& path, const ReadOptions& opts, ReadReport* report)
+        : mWhere("readAbc(" + path + ")"), mFile(path, mWhere, opts.interrupter),
+          mOgawa(mFile.data(), mFile.size(), mWhere), mOpts(opts), mReport(report) {}
+
+    StrandSet read();
+
+private:
+    std::uint32_t readU32(const ogawa::Reader::Data& d, std::uint64_t& at, unsigned hint, const char* what) const
+    {
+        const unsigned n = hint == 0 ? 1 : hint == 1 ? 2 : 4;
+        if (at + n > d.size) {
+            mOgawa.failAt(d.pos + 8 + at, std::string(what) + " needs " + std::to_string(n) +
+                                              " bytes but the header block ends at its byte " + std::to_string(d.size));
+        }
+        std::uint32_t v = 0;
+        for (unsigned i = 0; i < n; ++i) v |= std::uint32_t(static_cast<unsigned char>(d.bytes[at + i])) << (8 * i);
+        at += n;
+        return v;
+    }
+    std::string readString(const ogawa::Reader::Data& d, std::uint64_t& at, std::uint32_t n, const char* what) const
+    {
+        if (n > d.size - at) {
+            mOgawa.failAt(d.pos + 8 + at, std::string(what) + " of " + std::to_string(n) +
+                                              " bytes runs past the header block's " + std::to_string(d.size) + " bytes");
+        }
+        std::string s(d.bytes + at, std::size_t(n));
+        at += n;
+        return s;
+    }
+    std::string indexedMetaData(std::uint32_t index, std::uint64_t at) const
+    {
+        if (index == 0) return {};
+        if (index - 1 >= mIndexedMetaData.size()) {
+            mOgawa.failAt(at, "metadata index " + std::to_string(index) + " but the archive has " +
+                                  std::to_string(mIndexedMetaData.size()) + " indexed metadata strings");
+        }
+        return mIndexedMetaData[index - 1];
+    }
+    void enterGroup(std::uint64_t pos, const std::string& what)
+    {
+        if (pos != 0 && !mVisited.insert(pos).second) {
+            mOgawa.failAt(pos, what + ": group reached a second time; Alembic's groups form a tree (a cycle?)");
+        }
+    }
+
+    std::vector<PropertyIn> readPropertyHeaders(const ogawa::Reader::Group& g, const std::string& what) const;
+    void readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out);
+    /// The local matrix of an Xform object (AbcGeom's XformSample::getMatrix) and whether it
+    /// inherits its parent's.
+    Matrix readXform(const ogawa::Reader::Group& object, const std::string& name, bool& inherits);
+    /// Sample 0 of a scalar property: its bytes after the digest.
+    ogawa::Reader::Data scalarSample(const ogawa::Reader::Group& compound, const PropertyIn& p, const std::string& what);
+    /// Sample 0 of an array property: its bytes, checked to be whole elements of pod x extent.
+    ogawa::Reader::Data arraySample(const ogawa::Reader::Group& compound, const PropertyIn& p,
+                                    const std::string& what, std::uint64_t& count);
+    std::vector<float> floatParam(const ogawa::Reader::Group& compound, const PropertyIn& p,
+                                  unsigned extent, const std::string& what, std::string& scope);
+    void warn(const std::string& msg)
+    {
+        if (mReport) mReport->warnings.push_back(mWhere + ": " + msg);
+    }
+
+    std::string mWhere;
+    MappedFile mFile;
+    ogawa::Reader mOgawa;
+    const ReadOptions& mOpts;
+    ReadReport* mReport;
+    std::vector<std::string> mIndexedMetaData;
+    std::unordered_set<std::uint64_t> mVisited;
+    bool mWarnedAnimated = false;
+};
+
+std::vector<PropertyIn> AbcReader::readPropertyHeaders(const ogawa::Reader::Group& g, const std::string& what) const
+{
+    std::vector<PropertyIn> props;
+    if (g.children.empty()) return props;
+    const ogawa::Reader::Data d = mOgawa.childData(g, g.children.size() - 1, what + " property headers");
+    std::uint64_t at = 0;
+    while (at < d.size) {
+        const std::uint64_t start = d.pos + 8 + at;
+        PropertyIn p;
+        const std::uint32_t info = readU32(d, at, 2, "property info");
+        const unsigned hint = (info >> 2) & 3;
+        if (hint == 3) mOgawa.failAt(start, what + ": property info " + std::to_string(info) + " has size hint 3; hints are 0, 1 or 2");
+        const unsigned kind = info & 3;
+        p.type = kind == 0 ? kCompound : kind == 1 ? kScalar : kArray;
+        if (p.type != kCompound) {
+            p.pod = (info >> 4) & 0xf;
+            p.extent = (info >> 12) & 0xff;
+            if (p.pod >= 12 || p.extent == 0) {
+                mOgawa.failAt(start, what + ": property of pod " + std::to_string(p.pod) + " and extent " +
+                                         std::to_string(p.extent) + "; numeric pods are 0-11 with an extent of at least 1");
+            }
+            p.numSamples = readU32(d, at, hint, "sample count");
+            p.constant = (info & 0x800) != 0;
+            if (info & 0x200) { readU32(d, at, hint, "first changed"); readU32(d, at, hint, "last changed"); }
+            if (info & 0x100) readU32(d, at, hint, "time sampling index");
+        }
+        const std::uint32_t nameSize = readU32(d, at, hint, "property name size");
+        p.name = readString(d, at, nameSize, "property name");
+        const std::uint32_t mdi = (info >> 20) & 0xff;
+        if (mdi == 255) {
+            const std::uint32_t mdSize = readU32(d, at, hint, "metadata size");
+            p.metaData = readString(d, at, mdSize, "property metadata");
+        } else {
+            p.metaData = indexedMetaData(mdi, start);
+        }
+        p.child = props.size();
+        if (p.child >= g.children.size() - 1) {
+            mOgawa.failAt(start, what + ": property header " + std::to_string(p.child) + " (" + p.name +
+                                     ") has no group: the compound has " + std::to_string(g.children.size() - 1));
+        }
+        props.push_back(std::move(p));
+    }
+    return props;
+}
+
+ogawa::Reader::Data AbcReader::arraySample(const ogawa::Reader::Group& compound, const PropertyIn& p,
+                                           const std::string& what, std::uint64_t& count)
+{
+    const std::uint64_t pos = mOgawa.childGroup(compound, p.child, what);
+    enterGroup(pos, what);
+    const ogawa::Reader::Group g = mOgawa.group(pos, what);
+    if (p.numSamples > 1 && !p.constant && !mWarnedAnimated) {
+        mWarnedAnimated = true;
+        warn(what + " has " + std::to_string(p.numSamples) + " samples; the first is read (animation is not)");
+    }
+    if (p.numSamples == 0 || g.children.empty()) { count = 0; return {}; }
+    ogawa::Reader::Data d = mOgawa.childData(g, 0, what + " sample 0");
+    if (d.size == 0) { count = 0; return d; }
+    if (d.size < 16) mOgawa.failAt(d.pos, what + ": sample of " + std::to_string(d.size) + " bytes; a sample starts with a 16-byte digest");
+    d.bytes += 16;
+    d.size -= 16;
+    const std::uint64_t element = std::uint64_t(kPodBytes[p.pod]) * p.extent;
+    if (d.size % element != 0) {
+        mOgawa.failAt(d.pos, what + ": sample of " + std::to_string(d.size) + " bytes is not a whole number of " +
+                                 std::to_string(element) + "-byte elements");
+    }
+    count = d.size / element;
+    return d;
+}
+
+std::vector<float> AbcReader::floatParam(const ogawa::Reader::Group& compound, const PropertyIn& p,
+                                         unsigned extent, const std::string& what, std::string& scope)
+{
+    scope = metaValue(p.metaData, "geoScope");
+    std::vector<float> vals;
+    auto readVals = [&](const ogawa::Reader::Group& g, const PropertyIn& v) {
+        if (v.type != kArray || v.pod != kFloat32 || v.extent != extent) {
+            mOgawa.failAt(g.pos, what + " (" + v.name + ") has pod " + std::to_string(v.pod) + " and extent " +
+                                     std::to_string(v.extent) + "; float32 with extent " + std::to_string(extent) + " is read");
+        }
+        std::uint64_t n = 0;
+        const ogawa::Reader::Data d = arraySample(g, v, what, n);
+        vals.resize(std::size_t(n * extent));
+        if (n) std::memcpy(vals.data(), d.bytes, std::size_t(d.size));
+    };
+    if (p.type != kCompound) { readVals(compound, p); return vals; }
+    // An indexed geometry parameter: a compound of .vals and .indices.
+    const std::uint64_t pos = mOgawa.childGroup(compound, p.child, what);
+    enterGroup(pos, what);
+    const ogawa::Reader::Group g = mOgawa.group(pos, what);
+    const std::vector<PropertyIn> sub = readPropertyHeaders(g, what);
+    const PropertyIn *pv = nullptr, *pi = nullptr;
+    for (const PropertyIn& s : sub) { if (s.name == ".vals") pv = &s; if (s.name == ".indices") pi = &s; }
+    if (!pv) mOgawa.failAt(g.pos, what + ": indexed parameter without .vals");
+    readVals(g, *pv);
+    if (scope.empty()) scope = metaValue(pv->metaData, "geoScope");
+    if (!pi) return vals;
+    if (pi->type != kArray || pi->pod != kUint32 || pi->extent != 1) {
+        mOgawa.failAt(g.pos, what + ".indices has pod " + std::to_string(pi->pod) + "; uint32 indices are read");
+    }
+    std::uint64_t n = 0;
+    const ogawa::Reader::Data d = arraySample(g, *pi, what + ".indices", n);
+    std::vector<float> out(std::size_t(n * extent));
+    const std::uint64_t numVals = vals.size() / extent;
+    for (std::uint64_t i = 0; i < n; ++i) {
+        std::uint32_t k;
+        std::memcpy(&k, d.bytes + 4 * i, 4);
+        if (k >= numVals) {
+            mOgawa.failAt(d.pos + 24 + 4 * i, what + ".indices[" + std::to_string(i) + "] = " + std::to_string(k) +
+                                                  " but .vals has " + std::to_string(numVals) + " values");
+        }
+        std::copy_n(vals.begin() + k * extent, extent, out.begin() + i * extent);
+    }
+    return out;
+}
+
+StrandSet AbcReader::read()
+{
+    // The archive: version, library version, top object, metadata, time samplings, indexed metadata.
+    const ogawa::Reader::Group root = mOgawa.group(mOgawa.rootPos(), "archive root");
+    if (root.children.size() < 6) {
+        mOgawa.failAt(root.pos, "archive root group has " + std::to_string(root.children.size()) +
+                                    " children; an Alembic archive has 6 (version, library version, top object, "
+                                    "metadata, time samplings, indexed metadata)");
+    }
+    const ogawa::Reader::Data version = mOgawa.childData(root, 0, "archive version");
+    std::int32_t fileVersion = -1;
+    if (version.size == 4) std::memcpy(&fileVersion, version.bytes, 4);
+    if (fileVersion != kOgawaFileVersion) {
+        mOgawa.failAt(version.pos, "archive file version " + std::to_string(fileVersion) + " (" +
+                                       std::to_string(version.size) + " bytes); version 0 (4 bytes) is read");
+    }
+    const ogawa::Reader::Data md = mOgawa.childData(root, 5, "indexed metadata");
+    for (std::uint64_t at = 0; at < md.size;) {
+        const unsigned n = static_cast<unsigned char>(md.bytes[at++]);
+        if (n > md.size - at) mOgawa.failAt(md.pos + 8 + at, "indexed metadata string of " + std::to_string(n) + " bytes runs past its block");
+        mIndexedMetaData.emplace_back(md.bytes + at, n);
+        at += n;
+    }
+
+    // Objects depth first, children in file order, with an explicit stack.
+    StrandSet out;
+    struct Item { std::uint64_t pos; std::string name, metaData; Matrix world; };
+    std::vector<Item> stack{{mOgawa.childGroup(root, 2, "top object"), "", "", kIdentity}};
+    std::size_t curveObjects = 0;
+    InterruptPoll poll(mOpts.interrupter, mWhere);
+    while (!stack.empty()) {
+        poll();
+        const Item item = std::move(stack.back());
+        stack.pop_back();
+        const std::string what = "object " + (item.name.empty() ? std::string("/") : item.name);
+        enterGroup(item.pos, what);
+        const ogawa::Reader::Group g = mOgawa.group(item.pos, what);
+        if (g.children.empty()) continue;
+        const std::string schema = metaValue(item.metaData, "schema");
+        Matrix world = item.world;
+        if (schema.rfind("AbcGeom_Curve_v", 0) == 0) {
+            readCurves(g, item.name, world, out);
+            ++curveObjects;
+        } else if (schema.rfind("AbcGeom_Xform_v", 0) == 0) {
+            bool inherits = true;
+            const Matrix local = readXform(g, item.name, inherits);
+            world = inherits ? multiply(local, item.world) : local;  // row vectors: local first
+        }
+        // Children: headers in the last block (ending with 32 bytes of hashes), groups 1..n.
+        const ogawa::Reader::Data h = mOgawa.childData(g, g.children.size() - 1, what + " child headers");
+        std::vector<Item> children;
+        const std::uint64_t end = h.size > 32 ? h.size - 32 : 0;
+        ogawa::Reader::Data body = h;
+        body.size = end;
+        for (std::uint64_t at = 0; at < end;) {
+            const std::uint64_t start = h.pos + 8 + at;
+            const std::uint32_t nameSize = readU32(body, at, 2, "object name size");
+            Item child;
+            child.name = item.name + "/" + readString(body, at, nameSize, "object name");
+            const std::uint32_t mdi = readU32(body, at, 0, "object metadata index");
+            if (mdi == 255) {
+                const std::uint32_t mdSize = readU32(body, at, 2, "object metadata size");
+                child.metaData = readString(body, at, mdSize, "object metadata");
+            } else {
+                child.metaData = indexedMetaData(mdi, start);
+            }
+            child.world = world;
+            const std::size_t index = children.size() + 1;
+            if (index + 1 >= g.children.size()) {
+                mOgawa.failAt(start, what + ": child header " + std::to_string(index - 1) + " (" + child.name +
+                                         ") has no group: the object has " + std::to_string(g.children.size()) + " children");
+            }
+            child.pos = mOgawa.childGroup(g, index, child.name);
+            children.push_back(std::move(child));
+        }
+        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(std::move(*it));
+    }
+    if (curveObjects == 0) {
+        throw FormatError(mWhere + ": no Curves object (schema AbcGeom_Curve_v2) in the archive");
+    }
+    return out;
+}
+
+ogawa::Reader::Data AbcReader::scalarSample(const ogawa::Reader::Group& compound, const PropertyIn& p, const std::string& what)
+{
+    const std::uint64_t pos = mOgawa.childGroup(compound, p.child, what);
+    const ogawa::Reader::Group g = mOgawa.group(pos, what);
+    ogawa::Reader::Data d = mOgawa.childData(g, 0, what + " sample 0");
+    const std::uint64_t bytes = std::uint64_t(kPodBytes[p.pod]) * p.extent;
+    if (d.size != 16 + bytes) {
+        mOgawa.failAt(d.pos, what + ": sample of " + std::to_string(d.size) + " bytes; 16 + " + std::to_string(bytes) + " expected");
+    }
+    if (p.numSamples > 1 && !p.constant && !mWarnedAnimated) {
+        mWarnedAnimated = true;
+        warn(what + " has " + std::to_string(p.numSamples) + " samples; the first is read (animation is not)");
+    }
+    d.bytes += 16;
+    d.size -= 16;
+    return d;
+}
+
+Matrix AbcReader::readXform(const ogawa::Reader::Group& object, const std::string& name, bool& inherits)
+{
+    // The object's properties, then its .xform compound: .ops (one byte per operation, type in
+    // the high 4 bits), .vals (float64 channels, scalar or array), .inherits (bool).
+    const std::string what = name + "/.xform";
+    const std::uint64_t propsPos = mOgawa.childGroup(object, 0, name + " properties");
+    enterGroup(propsPos, name + " properties");
+    const ogawa::Reader::Group props = mOgawa.group(propsPos, name + " properties");
+    const PropertyIn* xformHeader = nullptr;
+    const std::vector<PropertyIn> top = readPropertyHeaders(props, name);
+    for (const PropertyIn& p : top) if (p.name == ".xform" && p.type == kCompound) xformHeader = &p;
+    if (!xformHeader) return kIdentity;
+    const std::uint64_t xPos = mOgawa.childGroup(props, xformHeader->child, what);
+    enterGroup(xPos, what);
+    const ogawa::Reader::Group xform = mOgawa.group(xPos, what);
+    const std::vector<PropertyIn> fields = readPropertyHeaders(xform, what);
+    std::vector<std::uint8_t> ops;
+    std::vector<double> vals;
+    for (const PropertyIn& p : fields) {
+        if (p.name == ".inherits" && p.type == kScalar && p.pod == 0 && p.extent == 1) {
+            inherits = scalarSample(xform, p, what + "/.inherits").bytes[0] != 0;
+        } else if (p.name == ".ops" && p.type == kScalar && p.pod == kUint8) {
+            const ogawa::Reader::Data d = scalarSample(xform, p, what + "/.ops");
+            ops.assign(d.bytes, d.bytes + d.size);
+        } else if (p.name == ".vals" && p.pod == kFloat64) {
+            std::uint64_t n = 0;
+            const ogawa::Reader::Data d = p.type == kScalar ? scalarSample(xform, p, what + "/.vals")
+                                                            : arraySample(xform, p, what + "/.vals", n);
+            vals.resize(std::size_t(d.size / 8));
+            if (!vals.empty()) std::memcpy(vals.data(), d.bytes, vals.size() * 8);
+        }
+    }
+    Matrix m = kIdentity;
+    const std::string rule = composeXformOps(ops, vals, m);
+    if (!rule.empty()) throw FormatError(mWhere + ": " + what + ": " + rule);
+    return m;
+}
+
+void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out)
+{
+    const std::string what = name;
+    // The object's properties, then its .geom compound.
+    const std::uint64_t propsPos = mOgawa.childGroup(object, 0, what + " properties");
+    enterGroup(propsPos, what + " properties");
+    const ogawa::Reader::Group props = mOgawa.group(propsPos, what + " properties");
+    const PropertyIn* geomHeader = nullptr;
+    const std::vector<PropertyIn> top = readPropertyHeaders(props, what);
+    for (const PropertyIn& p : top) if (p.name == ".geom" && p.type == kCompound) geomHeader = &p;
+    if (!geomHeader) mOgawa.failAt(props.pos, what + ": a Curves object without its .geom compound");
+    const std::uint64_t geomPos = mOgawa.childGroup(props, geomHeader->child, what + "/.geom");
+    enterGroup(geomPos, what + "/.geom");
+    const ogawa::Reader::Group geom = mOgawa.group(geomPos, what + "/.geom");
+    const std::vector<PropertyIn> fields = readPropertyHeaders(geom, what + "/.geom");
+    auto find = [&](const char* n) -> const PropertyIn* {
+        for (const PropertyIn& p : fields) if (p.name == n) return &p;
+        return nullptr;
+    };
+
+    // Points, counts, basis and type.
+    const PropertyIn* pP = find("P");
+    const PropertyIn* pN = find("nVertices");
+    if (!pP || !pN) mOgawa.failAt(geom.pos, what + ": Curves without " + (pP ? "nVertices" : "P"));
+    if (pP->type != kArray || pP->extent != 3 || (pP->pod != kFloat32 && pP->pod != kFloat64)) {
+        mOgawa.failAt(geom.pos, what + "/P has pod " + std::to_string(pP->pod) + " and extent " +
+                                    std::to_string(pP->extent) + "; float32 or float64 points of extent 3 are read");
+    }
+    if (pN->type != kArray || pN->extent != 1 || pN->pod != kInt32) {
+        mOgawa.failAt(geom.pos, what + "/nVertices has pod " + std::to_string(pN->pod) + "; int32 counts are read");
+    }
+    std::uint64_t numPoints = 0, numCurves = 0;
+    const ogawa::Reader::Data dP = arraySample(geom, *pP, what + "/P", numPoints);
+    const ogawa::Reader::Data dN = arraySample(geom, *pN, what + "/nVertices", numCurves);
+    std::uint8_t basisAndType[4] = {1, 0, 0, 0};
+    if (const PropertyIn* pB = find("curveBasisAndType")) {
+        if (pB->type != kScalar || pB->pod != kUint8 || pB->extent != 4) {
+            mOgawa.failAt(geom.pos, what + "/curveBasisAndType has pod " + std::to_string(pB->pod) + " and extent " +
+                                        std::to_string(pB->extent) + "; uint8 x 4 is read");
+        }
+        const std::uint64_t pos = mOgawa.childGroup(geom, pB->child, what + "/curveBasisAndType");
+        const ogawa::Reader::Group g = mOgawa.group(pos, what + "/curveBasisAndType");
+        const ogawa::Reader::Data d = mOgawa.childData(g, 0, what + "/curveBasisAndType sample 0");
+        if (d.size != 20) mOgawa.failAt(d.pos, what + "/curveBasisAndType sample of " + std::to_string(d.size) + " bytes; 16 + 4 expected");
+        std::memcpy(basisAndType, d.bytes + 16, 4);
+    }
+    const unsigned type = basisAndType[0], wrap = basisAndType[1], basis = basisAndType[2];
+    if (type > 2 || wrap > 1 || basis > 5) {
+        mOgawa.failAt(geom.pos, what + ": curveBasisAndType (" + std::to_string(type) + ", " + std::to_string(wrap) + ", " +
+                                    std::to_string(basis) + "): type 0-2, wrap 0-1, basis 0-5");
+    }
+    bool linear = type == 1;
+    if (type == 2) {  // variable order: linear only when every order is 2
+        const PropertyIn* pO = find("orders");
+        std::uint64_t n = 0;
+        const ogawa::Reader::Data d = pO && pO->pod == kUint8 ? arraySample(geom, *pO, what + "/orders", n) : ogawa::Reader::Data{};
+        for (std::uint64_t i = 0; i < n; ++i) {
+            if (static_cast<unsigned char>(d.bytes[i]) != 2) {
+                throw UnsupportedError(mWhere + ": " + what + ": NURBS curves (kVariableOrder, order " +
+                                       std::to_string(static_cast<unsigned char>(d.bytes[i])) + ") are not read; linear and cubic curves are");
+            }
+        }
+        if (n == 0) throw UnsupportedError(mWhere + ": " + what + ": kVariableOrder curves without orders are not read");
+        linear = true;
+    } else if (!linear && (basis == 0 || basis >= 4)) {
+        throw UnsupportedError(mWhere + ": " + what + ": cubic curves of basis " + std::to_string(basis) +
+                               " (" + (basis == 4 ? "hermite" : basis == 5 ? "power" : "none") +
+                               ") are not read; bezier, bspline and catmullrom are");
+    }
+
+    // Counts must add up to the points (each bounded by the points, so no sum overflows).
+    std::vector<std::uint32_t> counts(static_cast<std::size_t>(numCurves));
+    std::uint64_t total = 0;
+    for (std::uint64_t i = 0; i < numCurves; ++i) {
+        std::int32_t c;
+        std::memcpy(&c, dN.bytes + 4 * i, 4);
+        if (c < 0 || std::uint64_t(c) > numPoints - total) {
+            mOgawa.failAt(dN.pos + 24 + 4 * i, what + "/nVertices[" + std::to_string(i) + "] = " + std::to_string(c) +
+                                                   " but only " + std::to_string(numPoints - total) + " of the " +
+                                                   std::to_string(numPoints) + " points remain");
+        }
+        counts[i] = std::uint32_t(c);
+        total += std::uint64_t(c);
+    }
+    if (total != numPoints) {
+        mOgawa.failAt(dN.pos, what + "/nVertices add up to " + std::to_string(total) + " but P has " +
+                                  std::to_string(numPoints) + " points");
+    }
+    std::vector<Vec3f> points(static_cast<std::size_t>(numPoints));
+    if (pP->pod == kFloat32) {
+        if (numPoints) std::memcpy(points.data(), dP.bytes, std::size_t(dP.size));
+    } else {
+        for (std::uint64_t i = 0; i < numPoints; ++i) {
+            double v[3];
+            std::memcpy(v, dP.bytes + 24 * i, 24);
+            points[i] = Vec3f(float(v[0]), float(v[1]), float(v[2]));
+        }
+    }
+    if (!allFinite(points.data(), 3 * points.size())) {
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const std::size_t bytes = pP->pod == kFloat32 ? 12 : 24;
+            checkFinite(points[i], i, mWhere, "at byte " + std::to_string(dP.pos + 24 + bytes * i) + ": " + what + "/P");
+        }
+    }
+    if (world != kIdentity) {  // the parent Xforms' transform, in double precision
+        for (Vec3f& p : points) p = transformPoint(world, p);
+        if (!allFinite(points.data(), 3 * points.size())) {
+            throw FormatError(mWhere + ": " + what + ": a point is not finite after its parents' transform");
+        }
+    }
+
+    // Widths and root UVs: sizes fixed by their scope.
+    std::vector<float> widths, uvs;
+    std::string widthScope, uvScope;
+    if (const PropertyIn* pW = find("width")) widths = floatParam(geom, *pW, 1, what + "/width", widthScope);
+    if (const PropertyIn* pU = find("uv")) uvs = floatParam(geom, *pU, 2, what + "/uv", uvScope);
+    std::size_t numVarying = 0;  // per segment end: one per control point of linear curves
+    for (std::uint32_t c : counts) numVarying += varyingCount(c, linear, basis);
+    auto widthCount = [&](const std::string& s) -> std::uint64_t {
+        if (s == "con") return 1;
+        if (s == "uni") return numCurves;
+        if (s == "var") return numVarying;
+        return numPoints;  // vtx, fvr or none
+    };
+    if (!widths.empty() && widths.size() != widthCount(widthScope)) {
+        warn(what + "/width has " + std::to_string(widths.size()) + " values but scope '" + widthScope + "' needs " +
+             std::to_string(widthCount(widthScope)) + "; widths ignored");
+        widths.clear();
+    }
+    const bool uvPerCurve = !uvs.empty() && uvs.size() == 2 * numCurves;
+    if (!uvs.empty() && !uvPerCurve) warn(what + "/uv is not one value per curve (scope '" + uvScope + "'); ignored");
+
+    // Curves to polylines.
+    StrandSet set;
+    const bool perVertexWidth = !widths.empty() && widths.size() > 1;
+    ShortStrandFilter filter(mOpts, mReport, mWhere + ": " + what);
+    std::vector<Vec3f> poly;
+    std::vector<float> polyWidth, keptWidths;
+    std::vector<Vec2f> keptUV;
+    std::uint64_t first = 0, firstVarying = 0;
+    for (std::uint64_t i = 0; i < numCurves; ++i) {
+        const std::uint32_t n = counts[i];
+        const Vec3f* cp = points.data() + first;
+        auto widthOf = [&](std::size_t k, std::size_t m) -> float {  // control k of m along the curve
+            if (widths.size() == 1) return widths[0];
+            if (widthScope == "uni") return widths[i];
+            if (widthScope == "var") {
+                const std::size_t nv = varyingCount(n, linear, basis);
+                return nv ? widths[firstVarying + std::min<std::size_t>(nv - 1, k * nv / std::max<std::size_t>(m, 1))] : 1.f;
+            }
+            return widths[first + std::min<std::size_t>(k, n - 1)];
+        };
+        poly.clear();
+        polyWidth.clear();
+        if (linear) {
+            poly.assign(cp, cp + n);
+            for (std::uint32_t k = 0; k < n; ++k) polyWidth.push_back(widths.empty() ? 0.f : widthOf(k, n));
+            if (wrap == 1 && n >= 2) { poly.push_back(cp[0]); polyWidth.push_back(polyWidth.front()); }
+        } else if (n >= 4) {
+            FreeFormCurve curve;
+            curve.degree = 3;
+            for (std::uint32_t k = 0; k < n; ++k) curve.points.push_back(Vec3d(cp[k]));
+            if (wrap == 1) {  // periodic: the first points again close the loop
+                const std::uint32_t extra = basis == 1 ? 1 : 3;
+                for (std::uint32_t k = 0; k < extra; ++k) curve.points.push_back(Vec3d(cp[k]));
+            }
+            const std::size_t m = curve.points.size();
+            curve.weights.assign(m, 1.0);
+            if (basis == 1) {
+                curve.basis = CurveBasis::Bezier;
+                curve.u1 = double((m - 1) / 3);
+            } else if (basis == 2) {  // uniform, unclamped: spans between knots 3 and m
+                curve.basis = CurveBasis::BSpline;
+                for (std::size_t k = 0; k < m + 4; ++k) curve.parms.push_back(double(k));
+                curve.u0 = 3.0;
+                curve.u1 = double(m);
+            } else {
+                curve.basis = CurveBasis::Cardinal;
+                curve.u1 = double(m - 3);
+            }
+            const std::string rule = flattenCurve(curve, mOpts.curveSamples, poly);
+            if (!rule.empty()) throw FormatError(mWhere + ": " + what + ": curve " + std::to_string(i) + ": " + rule);
+            if (!widths.empty()) {
+                for (std::size_t k = 0; k < poly.size(); ++k) {
+                    // Width along the curve, interpolated between the controls as evenly spaced.
+                    const double t = poly.size() > 1 ? double(k) / double(poly.size() - 1) * double(n - 1) : 0.0;
+                    const std::size_t k0 = std::min<std::size_t>(std::size_t(t), n - 1), k1 = std::min<std::size_t>(k0 + 1, n - 1);
+                    const float f = float(t - double(k0));
+                    polyWidth.push_back((1.f - f) * widthOf(k0, n) + f * widthOf(k1, n));
+                }
+            }
+        }
+        firstVarying += varyingCount(n, linear, basis);
+        first += n;
+        if (!filter.keep(std::size_t(i), poly.size(), "at byte " + std::to_string(dN.pos + 24 + 4 * i))) continue;
+        set.addStrand(poly);
+        if (perVertexWidth) keptWidths.insert(keptWidths.end(), polyWidth.begin(), polyWidth.end());
+        if (uvPerCurve) keptUV.emplace_back(uvs[2 * i], uvs[2 * i + 1]);
+    }
+    filter.finish();
+    if (widths.size() == 1) set.defaults.thickness = widths[0];
+    if (perVertexWidth) set.thickness = std::move(keptWidths);
+    if (uvPerCurve) set.rootUV = std::move(keptUV);
+    if (out.empty() && out.positions.empty()) {
+        out = std::move(set);
+    } else {
+        out.append(std::move(set));
+    }
+}
+
+} // namespace
+
+StrandSet readAbc(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    AbcReader reader(path, opts, report);
+    StrandSet s = reader.read();
+    s.validate("readAbc(" + path + ")");
+    return s;
+}
+
+} // namespace vdbhair
