@@ -236,7 +236,7 @@ int run(int argc, char** argv)
 {
     CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
                  ": hair geometry on OpenVDB - strands, tangent fields and generalized helicoids.\n"
-                 "Formats: .hair .data .obj .ply .vdb .usda (read and write), .tfx .bin .convdata (read).",
+                 "Formats: .hair .data .obj .ply .vdb .usda .abc (read and write), .usd (USD text) .tfx .bin .convdata (read).",
                  "vdbhair"};
     app.set_version_flag("--version", "vdbhair " VDBHAIR_VERSION_STRING);
     app.require_subcommand(1, 1);

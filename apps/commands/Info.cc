@@ -76,7 +76,7 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<InfoParams>();
     CLI::App* sub = addVerb(app, "info");
-    sub->add_option("file", params->input, "A strand file (.hair .data .obj .ply .usda .tfx .bin .convdata) or a .vdb file")->required();
+    sub->add_option("file", params->input, "A strand file (.hair .data .obj .ply .usda .usd .abc .tfx .bin .convdata) or a .vdb file")->required();
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
     addCommonOptions(sub, common);

@@ -36,7 +36,7 @@ printf 'v 0 0 0\nv 1 1 1\nl 1 5\n' > bad_index.obj
 printf 'this is not a vdb file\n' > not_a.vdb
 printf 'ply\nformat binary_big_endian 1.0\nend_header\n' > big_endian.ply
 { printf '\x00\x00\x18\x41'; head -c 400 /dev/zero; } > version9.tfx
-printf 'some text\n' > unknown.abc
+printf 'some text\n' > unknown.xyz
 : > empty.obj
 # Issue 50: a PLY of points only, 2 strands of 4 points (NeuralHaircut's layout), and an OBJ cubic Bezier curve.
 printf 'ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n0 1 0\n0 2 0\n0 3 1\n1 0 0\n1 1 0\n1 2 0\n1 3 1\n' > runs_of_4.ply
