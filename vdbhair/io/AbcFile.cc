@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <unordered_set>
 
 namespace vdbhair {
@@ -104,6 +105,10 @@ private:
     }
 
     std::vector<PropertyIn> readPropertyHeaders(const ogawa::Reader::Group& g, const std::string& what) const;
+    /// @a object's properties group (entered) and, among them, the compound @a compound (".geom",
+    /// ".xform") entered: its group, or nothing when the object has none.
+    std::optional<ogawa::Reader::Group> objectCompound(const ogawa::Reader::Group& object, const std::string& name,
+                                                       const std::string& compound, std::uint64_t& propsPos);
     void readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out);
     /// The local matrix of an Xform object (AbcGeom's XformSample::getMatrix) and whether it
     /// inherits its parent's.
@@ -347,21 +352,31 @@ ogawa::Reader::Data AbcReader::scalarSample(const ogawa::Reader::Group& compound
     return d;
 }
 
+std::optional<ogawa::Reader::Group> AbcReader::objectCompound(const ogawa::Reader::Group& object, const std::string& name,
+                                                              const std::string& compound, std::uint64_t& propsPos)
+{
+    propsPos = mOgawa.childGroup(object, 0, name + " properties");
+    enterGroup(propsPos, name + " properties");
+    const ogawa::Reader::Group props = mOgawa.group(propsPos, name + " properties");
+    const PropertyIn* header = nullptr;
+    const std::vector<PropertyIn> top = readPropertyHeaders(props, name);
+    for (const PropertyIn& p : top) if (p.name == compound && p.type == kCompound) header = &p;
+    if (!header) return std::nullopt;
+    const std::string what = name + "/" + compound;
+    const std::uint64_t pos = mOgawa.childGroup(props, header->child, what);
+    enterGroup(pos, what);
+    return mOgawa.group(pos, what);
+}
+
 Matrix AbcReader::readXform(const ogawa::Reader::Group& object, const std::string& name, bool& inherits)
 {
     // The object's properties, then its .xform compound: .ops (one byte per operation, type in
     // the high 4 bits), .vals (float64 channels, scalar or array), .inherits (bool).
     const std::string what = name + "/.xform";
-    const std::uint64_t propsPos = mOgawa.childGroup(object, 0, name + " properties");
-    enterGroup(propsPos, name + " properties");
-    const ogawa::Reader::Group props = mOgawa.group(propsPos, name + " properties");
-    const PropertyIn* xformHeader = nullptr;
-    const std::vector<PropertyIn> top = readPropertyHeaders(props, name);
-    for (const PropertyIn& p : top) if (p.name == ".xform" && p.type == kCompound) xformHeader = &p;
-    if (!xformHeader) return kIdentity;
-    const std::uint64_t xPos = mOgawa.childGroup(props, xformHeader->child, what);
-    enterGroup(xPos, what);
-    const ogawa::Reader::Group xform = mOgawa.group(xPos, what);
+    std::uint64_t propsPos = 0;
+    const std::optional<ogawa::Reader::Group> found = objectCompound(object, name, ".xform", propsPos);
+    if (!found) return kIdentity;
+    const ogawa::Reader::Group& xform = *found;
     const std::vector<PropertyIn> fields = readPropertyHeaders(xform, what);
     std::vector<std::uint8_t> ops;
     std::vector<double> vals;
@@ -389,16 +404,10 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
 {
     const std::string what = name;
     // The object's properties, then its .geom compound.
-    const std::uint64_t propsPos = mOgawa.childGroup(object, 0, what + " properties");
-    enterGroup(propsPos, what + " properties");
-    const ogawa::Reader::Group props = mOgawa.group(propsPos, what + " properties");
-    const PropertyIn* geomHeader = nullptr;
-    const std::vector<PropertyIn> top = readPropertyHeaders(props, what);
-    for (const PropertyIn& p : top) if (p.name == ".geom" && p.type == kCompound) geomHeader = &p;
-    if (!geomHeader) mOgawa.failAt(props.pos, what + ": a Curves object without its .geom compound");
-    const std::uint64_t geomPos = mOgawa.childGroup(props, geomHeader->child, what + "/.geom");
-    enterGroup(geomPos, what + "/.geom");
-    const ogawa::Reader::Group geom = mOgawa.group(geomPos, what + "/.geom");
+    std::uint64_t propsPos = 0;
+    const std::optional<ogawa::Reader::Group> found = objectCompound(object, what, ".geom", propsPos);
+    if (!found) mOgawa.failAt(propsPos, what + ": a Curves object without its .geom compound");
+    const ogawa::Reader::Group& geom = *found;
     const std::vector<PropertyIn> fields = readPropertyHeaders(geom, what + "/.geom");
     auto find = [&](const char* n) -> const PropertyIn* {
         for (const PropertyIn& p : fields) if (p.name == n) return &p;
