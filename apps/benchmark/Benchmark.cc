@@ -21,6 +21,7 @@
 // in a bundle whose field fits in the cache (the tracers' own work, without a large field's cache
 // misses). Speed is measured here, never in tests.
 #include <vdbhair/compare/HairComparison.h>
+#include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
@@ -390,8 +391,8 @@ void benchmarkGroom(int reps, std::size_t strands)
 
 /// `compare` (issue 54): a head of strands x 100 vertices against the same and against a jittered
 /// copy, every measure (HairGS's four thresholds at centimetres, Chamfer, strand pairs, Fréchet,
-/// the volume). The issue's target is 100,000 strands under 3 s (--compare-strands 100000), not
-/// met: the strand consistency needs every match of every point.
+/// the volume). The issue's target is 100,000 strands against the same under 3 s
+/// (--compare-strands 100000).
 void benchmarkCompare(int reps, std::size_t strands)
 {
     std::printf("\n== compare: a head of %zu strands x 100 vertices (cm) against the same and a jittered copy; the target is 100,000 under 3 s ==\n", strands);
@@ -412,6 +413,18 @@ void benchmarkCompare(int reps, std::size_t strands)
         const double t = timeBest(reps, [&] { c = compareHairstyles(a, *other, params); });
         std::printf("%-34s %.2f s  F1 at 2 mm %.4f, 4 mm/90 deg %.4f, Chamfer %.4g, position error %.4g, Frechet mean %.4g\n", name, t,
                     c.oriented[0].f1, c.oriented[3].f1, c.chamfer.mean, c.perm.meanPosition, c.frechetMean);
+        // Where the time goes: indexing both, then each measure alone on the indices (the
+        // Fréchet pairs are most of the rest).
+        std::vector<OrientedThreshold> thresholds = hairGsThresholds();
+        for (OrientedThreshold& th : thresholds) th.distance /= params.metersPerUnit;
+        const double tIndex = timeBest(1, [&] { const StrandIndex ia(a), ib(*other); });
+        const StrandIndex ia(a), ib(*other);
+        const double tOriented = timeBest(1, [&] { matchOrientedPoints(ib, ia, thresholds); });
+        const double tChamfer = timeBest(1, [&] { chamferDistances(ia, ib); });
+        const double tPairs = timeBest(1, [&] { strandPairErrors(a, *other); });
+        const double tVolume = timeBest(1, [&] { countStrandsLeavingVolume(*other, a, suggestVoxelSize(a)); });
+        std::printf("%-34s indexing %.2f s, oriented points %.2f s, Chamfer %.2f s, strand pairs %.2f s, volume %.2f s\n", "", tIndex,
+                    tOriented, tChamfer, tPairs, tVolume);
         std::fflush(stdout);
     }
 }
@@ -821,7 +834,7 @@ int main(int argc, char** argv)
     std::string rootHeads;
     std::vector<std::size_t> scaleStrands{1000000};
     std::size_t groomStrands = 1000000;
-    std::size_t compareStrands = 10000;
+    std::size_t compareStrands = 100000;
     app.add_option("--data", data, "The shared data folder (real hairstyles)")->capture_default_str();
     app.add_option("--scene", source, "The vdbhair checkout (for scenes/default)")->capture_default_str();
     app.add_option("--strands", strands, "Strands of the synthetic hairstyle")->capture_default_str();

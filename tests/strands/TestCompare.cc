@@ -1,4 +1,5 @@
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/HairVolume.h>
 #include <vdbhair/strands/Compare.h>
 
 #include <catch2/catch.hpp>
@@ -82,6 +83,45 @@ TEST_CASE("matchOrientedPoints: HairGS's precision, recall, F1 and strand consis
             CHECK(m[t].f1 == Approx(f1).margin(1e-12));
         }
         CHECK(m[3].precision > 0.0);
+    }
+}
+
+TEST_CASE("matchOrientedPoints: near copies (the likely strand, the listing and the counting), against brute force", "[strands]")
+{
+    // Dense, nearly parallel strands and a copy jittered by about a threshold, strands in another
+    // order, some reversed and some cut short: strands compete for each other's points, so the
+    // exact consistency needs the listing and the bounds, not only the likely strand.
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    StrandSet a;
+    for (int i = 0; i < 60; ++i) {
+        std::vector<Vec3f> p{Vec3f(0.02f * float(i % 10), 0.02f * float(i / 10), 0.f)};
+        for (int k = 1; k < 14; ++k) p.push_back(p.back() + Vec3f(0.01f * u(rng), 0.01f * u(rng), 0.05f));
+        a.addStrand(p);
+    }
+    for (const float jitter : {0.0f, 0.004f, 0.015f}) {
+        StrandSet b;
+        for (std::size_t n = 0; n < a.numStrands(); ++n) {
+            const std::size_t i = (n * 37) % a.numStrands();
+            std::vector<Vec3f> p(a.positions.begin() + std::ptrdiff_t(a.begin(i)), a.positions.begin() + std::ptrdiff_t(a.end(i)));
+            for (Vec3f& x : p) x += Vec3f(u(rng), u(rng), u(rng)) * jitter;
+            if (n % 9 == 0) std::reverse(p.begin(), p.end());
+            if (n % 7 == 0) p.resize(6);
+            b.addStrand(p);
+        }
+        const std::vector<OrientedThreshold> th{{0.01, 20.0}, {0.02, 30.0}, {0.03, 90.0}};
+        for (const bool threaded : {false, true}) {
+            const std::vector<OrientedMatch> m = matchOrientedPoints(b, a, th, false, threaded);
+            for (std::size_t t = 0; t < th.size(); ++t) {
+                CAPTURE(jitter, threaded, t);
+                double precision, recall, consistency, unused;
+                bruteForce(b, a, th[t], precision, unused);
+                bruteForce(a, b, th[t], recall, consistency);
+                CHECK(m[t].precision == Approx(precision).margin(1e-12));
+                CHECK(m[t].recall == Approx(recall).margin(1e-12));
+                CHECK(m[t].strandConsistency == Approx(consistency).margin(1e-12));
+            }
+        }
     }
 }
 

@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Parallel.h>
+#include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/field/TangentField.h>
@@ -70,9 +71,11 @@ HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const C
     if (params.metersPerUnit > 0.0) {
         for (OrientedThreshold& t : thresholds) t.distance /= params.metersPerUnit;  // metres to file units
     }
-    if (!thresholds.empty()) c.oriented = matchOrientedPoints(b, a, thresholds, params.bidirectional, threaded);
+    if (a.positions.empty() || b.positions.empty()) throw ValueError("compare: a hairstyle has no vertex");
+    const StrandIndex ia(a, threaded), ib(b, threaded);
+    if (!thresholds.empty()) c.oriented = matchOrientedPoints(ib, ia, thresholds, params.bidirectional, threaded);
 
-    c.chamfer = chamferDistances(a, b, threaded);
+    c.chamfer = chamferDistances(ia, ib, threaded);
 
     c.paired = a.numStrands() == b.numStrands();
     if (c.paired) {

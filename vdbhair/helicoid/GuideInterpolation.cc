@@ -1,6 +1,7 @@
 #include "GuideInterpolation.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/strands/Compare.h>

@@ -84,7 +84,7 @@ struct InterpolateResult
     /// strands that pass into the head (countStrandsEnteringHead(), headTolerance()): of the new hair, and of the guides
     std::size_t enteringHead = 0, guidesEnteringHead = 0;
     /// of `volumeSample` new strands (every one, or evenly spread kVolumeSample of them), those that
-    /// leave the guides' hair volume (countStrandsLeavingVolume(), Compare.h) at the guides'
+    /// leave the guides' hair volume (countStrandsLeavingVolume(), field/HairVolume.h) at the guides'
     /// suggested voxel size `volumeVoxel` (suggestVoxelSize())
     std::size_t leavingVolume = 0, volumeSample = 0;
     double volumeVoxel = 0.0;

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Random.h>
+#include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/helicoid/Frechet.h>

@@ -1,143 +1,360 @@
 #include "Compare.h"
 
 #include <vdbhair/Exceptions.h>
-#include <vdbhair/strands/PointCloud.h>
+#include <vdbhair/Parallel.h>
 #include <vdbhair/strands/Resample.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <unordered_set>
+#include <limits>
 #include <cmath>
 #include <string>
 
 namespace vdbhair {
 
-namespace {
-
-/// The oriented points of a hairstyle: each segment's start, its unit direction and its strand.
-struct OrientedPoints
+StrandIndex::StrandIndex(const StrandSet& strands, bool threaded) : mStrands(&strands), mGrid(strands.positions, threaded)
 {
-    std::vector<Vec3d> position;
-    std::vector<Vec3d> direction;
-    std::vector<std::uint32_t> strand;
-};
-
-OrientedPoints orientedPoints(const StrandSet& s)
-{
-    OrientedPoints o;
-    for (std::size_t i = 0; i < s.numStrands(); ++i) {
-        const Vec3f* p = s.positions.data() + s.begin(i);
-        for (std::size_t k = 0; k + 1 < s.size(i); ++k) {
-            const Vec3d a(p[k].x(), p[k].y(), p[k].z()), b(p[k + 1].x(), p[k + 1].y(), p[k + 1].z());
-            const Vec3d d = b - a;
+    const std::size_t V = strands.numVertices(), S = strands.numStrands();
+    mDirection.assign(V, Vec3f(0.f));
+    mStrandOf.resize(V);
+    forEachIndex(S, threaded, [&](std::size_t s) {
+        const Vec3f* p = strands.data(s);
+        for (std::size_t k = 0; k < strands.size(s); ++k) {
+            mStrandOf[strands.begin(s) + k] = std::uint32_t(s);
+            if (k + 1 == strands.size(s)) break;
+            const Vec3d d(double(p[k + 1].x()) - p[k].x(), double(p[k + 1].y()) - p[k].y(), double(p[k + 1].z()) - p[k].z());
             const double l = d.length();
-            if (!(l > 0.0)) continue;  // a repeated vertex has no direction
-            o.position.push_back(a);
-            o.direction.push_back(d / l);
-            o.strand.push_back(std::uint32_t(i));
+            if (l > 0.0) mDirection[strands.begin(s) + k] = Vec3f(float(d.x() / l), float(d.y() / l), float(d.z() / l));
         }
+    }, 256);
+    for (const Vec3f& d : mDirection) mOrientedPoints += d != Vec3f(0.f) ? 1 : 0;
+    // Strands by the Morton code of their middle vertex, 10 bits an axis over the bounding box.
+    {
+        const Vec3d lo = mGrid.origin(), extent = mGrid.extent();
+        const double longest = std::max({extent.x(), extent.y(), extent.z(), 1e-300});
+        auto spread = [](std::uint64_t x) {  // 10 bits to every third of 30
+            x &= 0x3ff;
+            x = (x | x << 16) & 0x30000ff;
+            x = (x | x << 8) & 0x300f00f;
+            x = (x | x << 4) & 0x30c30c3;
+            x = (x | x << 2) & 0x9249249;
+            return x;
+        };
+        std::vector<std::uint64_t> key(S);
+        for (std::size_t s = 0; s < S; ++s) {
+            std::uint64_t m = 0;
+            if (strands.size(s)) {
+                const Vec3f& x = strands.positions[strands.begin(s) + strands.size(s) / 2];
+                const Vec3d q = (Vec3d(x.x(), x.y(), x.z()) - lo) / longest * 1023.0;
+                m = spread(std::uint64_t(q.x())) | spread(std::uint64_t(q.y())) << 1 | spread(std::uint64_t(q.z())) << 2;
+            }
+            key[s] = m << 32 | s;
+        }
+        std::sort(key.begin(), key.end());
+        mOrder.resize(S);
+        for (std::size_t s = 0; s < S; ++s) mOrder[s] = std::uint32_t(key[s]);
     }
-    return o;
+    // Runs of up to kRun vertices of a strand, each in the sphere around its box's centre.
+    mFirstRun.reserve(S + 1);
+    for (std::size_t s = 0; s < S; ++s) {
+        mFirstRun.push_back(mRunBegin.size());
+        for (std::size_t b = strands.begin(s); b < strands.end(s); b += kRun) mRunBegin.push_back(b);
+    }
+    mFirstRun.push_back(mRunBegin.size());
+    const std::size_t R = mRunBegin.size();
+    mRunBegin.push_back(V);
+    mRunCentre.resize(R);
+    mRunRadius.resize(R);
+    forEachIndex(S, threaded, [&](std::size_t s) {
+        for (std::size_t r = mFirstRun[s]; r < mFirstRun[s + 1]; ++r) {
+            const std::size_t b = mRunBegin[r], e = std::min(b + kRun, strands.end(s));
+            BBox box;
+            for (std::size_t v = b; v < e; ++v) box.expand(strands.positions[v]);
+            const Vec3d c = 0.5 * (Vec3d(box.min.x(), box.min.y(), box.min.z()) + Vec3d(box.max.x(), box.max.y(), box.max.z()));
+            double r2 = 0.0;
+            for (std::size_t v = b; v < e; ++v) {
+                const Vec3f& q = strands.positions[v];
+                r2 = std::max(r2, (Vec3d(q.x(), q.y(), q.z()) - c).lengthSqr());
+            }
+            mRunCentre[r] = c;
+            mRunRadius[r] = std::sqrt(r2);
+        }
+    }, 256);
 }
 
-/// nanoflann's result set for one oriented point: each point within the largest threshold distance
-/// is tested against every threshold at once, as the tree finds it. Without @a hits it stops the
-/// search as soon as every threshold has a match (all precision and recall need); with them it
-/// records each (threshold, strand) match for the strand consistency.
-struct MatchVisitor
-{
-    const OrientedPoints& to;
-    const std::vector<OrientedThreshold>& thresholds;
-    const std::vector<double>& cosines;
-    bool bidirectional;
-    double radius2;
-    Vec3d direction;
-    std::uint32_t matched = 0, all = 0;
-    std::vector<std::uint64_t>* hits = nullptr;  ///< threshold << 32 | strand of @a to
+namespace {
 
-    bool addPoint(double d2, std::uint32_t index)
+Vec3d toDouble(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
+
+/// The thresholds as the tests use them: squared distances, cosines, the largest distance.
+struct Thresholds
+{
+    std::vector<double> distance2, cosine;
+    double maxDistance = 0.0;
+    bool bidirectional = false;
+    std::uint32_t all = 0;  ///< a bit per threshold
+
+    Thresholds(const std::vector<OrientedThreshold>& t, bool bidirectional_) : bidirectional(bidirectional_)
     {
-        double c = direction.dot(to.direction[index]);
-        if (bidirectional) c = std::abs(c);
-        for (std::size_t t = 0; t < thresholds.size(); ++t) {
-            if (d2 > thresholds[t].distance * thresholds[t].distance || c < cosines[t]) continue;
-            matched |= 1u << t;
-            if (hits) hits->push_back(std::uint64_t(t) << 32 | to.strand[index]);
+        if (t.size() > 32) throw ValueError("oriented match: " + std::to_string(t.size()) + " thresholds: at most 32");
+        for (const OrientedThreshold& x : t) {
+            distance2.push_back(x.distance * x.distance);
+            cosine.push_back(std::cos(x.angleDegrees * M_PI / 180.0));
+            maxDistance = std::max(maxDistance, x.distance);
         }
-        return hits != nullptr || matched != all;
+        all = t.size() == 32 ? ~0u : (1u << t.size()) - 1u;
     }
-    double worstDist() const { return radius2; }
-    bool full() const { return true; }
+
+    /// The thresholds at which two oriented points at squared distance @a d2 match (a bit each).
+    std::uint32_t bits(double d2, const Vec3d& u, const Vec3f& v) const
+    {
+        double c = u.x() * v.x() + u.y() * v.y() + u.z() * v.z();
+        if (bidirectional) c = std::abs(c);
+        std::uint32_t b = 0;
+        for (std::size_t t = 0; t < cosine.size(); ++t) {
+            if (d2 <= distance2[t] && c >= cosine[t]) b |= 1u << t;
+        }
+        return b;
+    }
 };
 
-/// For every point of @a from, whether a point of @a to matches it at each threshold (the share
-/// matched, per threshold); and with @a consistency, each strand of @a from's consistency at each
-/// threshold. Strands of @a from are independent: processed in parallel, summed in order.
-void matchShare(const OrientedPoints& from, const OrientedPoints& to, const std::vector<OrientedThreshold>& thresholds, bool bidirectional,
+/// The thresholds at which an oriented point of strand @a q of @a to matches (@a p, @a u), of those
+/// in @a want; stops when all of them match. @a hint: a vertex of @a to where the last match was
+/// (updated; any other value for none). The vertices just after it are tried first (walking along
+/// two strands side by side, the next match is there), then q's runs, the hint's first.
+std::uint32_t matchStrand(const StrandIndex& to, const Thresholds& th, const Vec3d& p, const Vec3d& u, std::size_t q, std::size_t& hint,
+                          std::uint32_t want)
+{
+    const std::size_t r0 = to.firstRun(q), r1 = to.firstRun(q + 1);
+    if (r0 == r1) return 0;
+    const std::size_t v0 = to.runBegin(r0), v1 = to.runBegin(r1);
+    const std::vector<Vec3f>& x = to.strands().positions;
+    const double maxD2 = th.maxDistance * th.maxDistance;
+    std::uint32_t bits = 0;
+    auto test = [&](std::size_t v) {
+        if (!to.oriented(v)) return false;
+        const double d2 = (p - toDouble(x[v])).lengthSqr();
+        if (d2 > maxD2) return false;
+        const std::uint32_t b = th.bits(d2, u, to.direction(v)) & want;
+        if (!(b & ~bits)) return false;
+        bits |= b;
+        hint = v;
+        return bits == want;
+    };
+    const bool near = hint >= v0 && hint < v1;
+    if (near) {
+        const std::size_t h = hint;
+        for (const std::size_t v : {h + 1, h, h + 2}) {
+            if (v < v1 && test(v)) return bits;
+        }
+    }
+    const std::size_t first = near ? r0 + (hint - v0) / StrandIndex::kRun : r0;
+    for (std::size_t k = 0; k < r1 - r0; ++k) {
+        const std::size_t r = k == 0 ? first : (r0 + k - 1 < first ? r0 + k - 1 : r0 + k);
+        const double reach = to.runRadius(r) + th.maxDistance;
+        if ((p - to.runCentre(r)).lengthSqr() > reach * reach) continue;
+        for (std::size_t v = to.runBegin(r); v < to.runBegin(r + 1); ++v) {
+            if (test(v)) return bits;
+        }
+    }
+    return bits;
+}
+
+/// For every oriented point of @a from, whether one of @a to matches it at each threshold (the
+/// share matched, per threshold); and with @a consistency, each strand of @a from's consistency at
+/// each threshold: the most of its points that match one and the same strand of @a to.
+///
+/// Consistency is found exactly without listing every match of every point. First each point's
+/// thresholds (any match), M_t points matching at t: no strand counts more. A strand's best count
+/// at t is at least L_t, the count of a likely strand (the one nearest its middle, root or tip),
+/// counted exactly. A strand that counts more than L_t matches more than L_t of the M_t points, so
+/// it matches one of any M_t - L_t of them: listing every match of the first M_t - L_t finds every
+/// strand that can do better, and those are counted exactly. A close copy (L = M) lists nothing;
+/// a poor match lists most points, as a plain count would.
+/// Strands of @a from are independent: processed in parallel, summed in order.
+void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vector<OrientedThreshold>& thresholds, bool bidirectional,
                 bool threaded, std::vector<double>& share, std::vector<double>* consistency)
 {
-    const std::size_t T = thresholds.size(), N = from.position.size();
-    if (T > 32) throw ValueError("oriented match: " + std::to_string(T) + " thresholds: at most 32");
-    double maxDistance = 0.0;
-    for (const OrientedThreshold& t : thresholds) maxDistance = std::max(maxDistance, t.distance);
-    std::vector<double> cosines(T);
-    for (std::size_t t = 0; t < T; ++t) cosines[t] = std::cos(thresholds[t].angleDegrees * M_PI / 180.0);
-    const PointCloud cloud{&to.position};
-    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    // The points of each strand of @a from (consecutive): [first[s], first[s + 1]).
-    std::vector<std::size_t> first{0};
-    for (std::size_t i = 1; i <= N; ++i) if (i == N || from.strand[i] != from.strand[i - 1]) first.push_back(i);
-    const std::size_t S = first.size() - 1;
-    std::vector<std::uint32_t> matched(N, 0);                   // per point: a bit per threshold
-    std::vector<double> strandConsistency(consistency ? S * T : 0);
-    const std::uint32_t all = T == 32 ? ~0u : (1u << T) - 1u;
-    auto run = [&](const tbb::blocked_range<std::size_t>& r) {
-        std::vector<std::uint64_t> hits, strandHits;
-        for (std::size_t s = r.begin(); s != r.end(); ++s) {
-            strandHits.clear();
-            for (std::size_t i = first[s]; i < first[s + 1]; ++i) {
-                MatchVisitor v{to, thresholds, cosines, bidirectional, maxDistance * maxDistance, from.direction[i]};
-                v.all = all;
-                hits.clear();
-                if (consistency) v.hits = &hits;
-                const Vec3d q = from.position[i];
-                tree.findNeighbors(v, q.asPointer(), nanoflann::SearchParams(32, 0.f, false));
-                matched[i] = v.matched;
-                if (!consistency) continue;
-                // A point counts each strand it matches once.
-                std::sort(hits.begin(), hits.end());
-                hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
-                strandHits.insert(strandHits.end(), hits.begin(), hits.end());
-            }
-            if (!consistency) continue;
-            // Per threshold, the most of this strand's points that match one and the same strand.
-            std::sort(strandHits.begin(), strandHits.end());
-            const double points = double(first[s + 1] - first[s]);
-            for (std::size_t a = 0; a < strandHits.size();) {
-                std::size_t b = a;
-                while (b < strandHits.size() && strandHits[b] == strandHits[a]) ++b;
-                double& best = strandConsistency[s * T + (strandHits[a] >> 32)];
-                best = std::max(best, double(b - a) / points);
-                a = b;
-            }
-        }
-    };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 16), run);
-    else run(tbb::blocked_range<std::size_t>(0, S));
+    const Thresholds th(thresholds, bidirectional);
+    const std::size_t T = thresholds.size();
     share.assign(T, 0.0);
+    if (consistency) consistency->assign(T, 0.0);
+    if (T == 0) return;
+    const StrandSet& fs = from.strands();
+    const std::size_t S = fs.numStrands();
+    std::vector<std::uint32_t> matched(fs.numVertices(), 0);  // per oriented point: a bit per threshold
+    std::vector<double> strandConsistency(consistency ? S * T : 0);
+    const std::vector<Vec3f>& xf = fs.positions;
+
+    // The thresholds at which any oriented point of @a to matches vertex v: the strand that matched
+    // the point before first (a strand's neighbours run beside it), then the grid out to the
+    // largest distance of the thresholds still unmatched, until every threshold matches.
+    auto matchAny = [&](std::size_t v, std::uint32_t& lastStrand, std::size_t& hint) {
+        const Vec3d p = toDouble(xf[v]), u = toDouble(from.direction(v));
+        std::uint32_t bits = lastStrand != ~0u ? matchStrand(to, th, p, u, lastStrand, hint, th.all) : 0u;
+        if (bits == th.all) return bits;
+        double radius2 = 0.0;
+        for (std::size_t t = 0; t < T; ++t) {
+            if (!((bits >> t) & 1u)) radius2 = std::max(radius2, th.distance2[t]);
+        }
+        to.grid().forEachWithin(p, std::sqrt(radius2), [&](std::uint32_t w, double d2) {
+            if (!to.oriented(w)) return true;
+            const std::uint32_t b = th.bits(d2, u, to.direction(w));
+            if (b & ~bits) {
+                bits |= b;
+                lastStrand = to.strandOf(w);
+                hint = w;
+            }
+            return bits != th.all;
+        });
+        return bits;
+    };
+
+    forEachRange(S, threaded, 16, [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<std::size_t> points;         // the strand's oriented points (vertex indices)
+        std::vector<std::uint64_t> strandHits;  // strand << 32 | threshold, one per listed point that matches
+        std::vector<std::uint64_t> pointHits;   // the same, for one point
+        std::vector<std::uint32_t> likely;
+        std::vector<std::size_t> best(T), count(T), partial(T), listedAt(T), matchedAt(T), left(T);
+        for (std::size_t o = range.begin(); o != range.end(); ++o) {
+            const std::size_t s = from.spatialOrder()[o];
+            points.clear();
+            for (std::size_t v = fs.begin(s); v < fs.end(s); ++v) {
+                if (from.oriented(v)) points.push_back(v);
+            }
+            const std::size_t n = points.size();
+            if (n == 0) continue;
+            // Which thresholds each point matches at all: M_t points match at t, and no strand
+            // can count more.
+            std::uint32_t lastStrand = ~0u;
+            std::size_t hint = ~std::size_t(0);
+            for (const std::size_t v : points) matched[v] = matchAny(v, lastStrand, hint);
+            if (!consistency) continue;
+            std::fill(matchedAt.begin(), matchedAt.end(), 0);
+            for (const std::size_t v : points) {
+                for (std::size_t t = 0; t < T; ++t) matchedAt[t] += (matched[v] >> t) & 1u;
+            }
+            // Strand q's matches of this strand's points at the thresholds of @a want, counted
+            // over the points that match at all, exactly as long as q can still beat the best
+            // count (a threshold is dropped once it cannot); the counts raise the best.
+            auto countStrand = [&](std::uint32_t q, std::uint32_t want) {
+                std::fill(count.begin(), count.end(), 0);
+                left = matchedAt;
+                std::size_t h = ~std::size_t(0);
+                for (std::size_t k = 0; k < n && want; ++k) {
+                    const std::size_t v = points[k];
+                    const std::uint32_t here = matched[v] & want;
+                    if (!here) continue;
+                    const std::uint32_t b = matchStrand(to, th, toDouble(xf[v]), toDouble(from.direction(v)), q, h, here);
+                    for (std::uint32_t t = 0, m = here; m; ++t, m >>= 1) {
+                        if (!(m & 1u)) continue;
+                        count[t] += (b >> t) & 1u;
+                        --left[t];
+                        if (count[t] + left[t] <= best[t]) want &= ~(1u << t);
+                    }
+                }
+                for (std::size_t t = 0; t < T; ++t) best[t] = std::max(best[t], count[t]);
+            };
+            auto settled = [&](std::size_t t) { return best[t] == matchedAt[t]; };
+            // L_t: the strands nearest the middle, the root and the tip, counted exactly.
+            std::fill(best.begin(), best.end(), 0);
+            likely.clear();
+            for (const std::size_t k : {n / 2, std::size_t(0), n - 1}) {
+                std::uint32_t want = 0;
+                for (std::size_t t = 0; t < T; ++t) want |= settled(t) ? 0u : 1u << t;
+                if (!want) break;
+                double d2 = std::numeric_limits<double>::infinity();
+                const std::uint32_t w = to.grid().nearest(toDouble(xf[points[k]]), d2);
+                if (w == ~0u) break;
+                const std::uint32_t q = to.strandOf(w);
+                if (std::find(likely.begin(), likely.end(), q) != likely.end()) continue;
+                likely.push_back(q);
+                countStrand(q, want);
+            }
+            // A strand that counts more than L_t at t matches one of any M_t - L_t of the points
+            // that match at t: every match of the first M_t - L_t of them finds all such strands.
+            // When that is half of them or more, listing all of them is cheaper than counting the
+            // strands found, and their counts come from the listing itself.
+            std::size_t listing = 0;
+            std::uint32_t complete = 0;
+            for (std::size_t t = 0; t < T; ++t) {
+                listedAt[t] = matchedAt[t] - best[t];
+                if (listedAt[t] > 0 && 2 * listedAt[t] >= matchedAt[t]) {
+                    listedAt[t] = matchedAt[t];
+                    complete |= 1u << t;
+                }
+                listing += listedAt[t];
+            }
+            strandHits.clear();
+            std::fill(partial.begin(), partial.end(), 0);  // here: the points listed so far at each t
+            for (std::size_t k = 0; k < n && listing; ++k) {
+                const std::size_t v = points[k];
+                std::uint32_t active = 0;  // the thresholds still listing at this point
+                double radius2 = 0.0;
+                for (std::size_t t = 0; t < T; ++t) {
+                    if (!((matched[v] >> t) & 1u) || partial[t] == listedAt[t]) continue;
+                    active |= 1u << t;
+                    radius2 = std::max(radius2, th.distance2[t]);
+                    ++partial[t];
+                    --listing;
+                }
+                if (!active) continue;
+                const Vec3d u = toDouble(from.direction(v));
+                pointHits.clear();
+                to.grid().forEachWithin(toDouble(xf[v]), std::sqrt(radius2), [&](std::uint32_t w, double d2) {
+                    if (!to.oriented(w)) return true;
+                    const std::uint32_t b = th.bits(d2, u, to.direction(w)) & active;
+                    for (std::uint32_t t = 0, m = b; m; ++t, m >>= 1) {
+                        if (m & 1u) pointHits.push_back(std::uint64_t(to.strandOf(w)) << 32 | t);
+                    }
+                    return true;
+                });
+                // A point counts each strand it matches once.
+                std::sort(pointHits.begin(), pointHits.end());
+                pointHits.erase(std::unique(pointHits.begin(), pointHits.end()), pointHits.end());
+                strandHits.insert(strandHits.end(), pointHits.begin(), pointHits.end());
+            }
+            // Per strand found: its matches among the listed points bound what it can count; those
+            // that can beat L are counted exactly.
+            std::sort(strandHits.begin(), strandHits.end());
+            for (std::size_t a = 0; a < strandHits.size();) {
+                const std::uint32_t q = std::uint32_t(strandHits[a] >> 32);
+                std::fill(partial.begin(), partial.end(), 0);
+                std::size_t b = a;
+                for (; b < strandHits.size() && std::uint32_t(strandHits[b] >> 32) == q; ++b) ++partial[strandHits[b] & 0xffffffffu];
+                a = b;
+                std::uint32_t want = 0;
+                for (std::size_t t = 0; t < T; ++t) {
+                    if ((complete >> t) & 1u) best[t] = std::max(best[t], partial[t]);  // the exact count
+                    else want |= partial[t] + (matchedAt[t] - listedAt[t]) > best[t] ? 1u << t : 0u;
+                }
+                if (want && std::find(likely.begin(), likely.end(), q) == likely.end()) countStrand(q, want);  // else counted already
+            }
+            for (std::size_t t = 0; t < T; ++t) strandConsistency[s * T + t] = double(best[t]) / double(n);
+        }
+    });
+    const std::size_t N = from.orientedPoints();
     for (std::size_t t = 0; t < T; ++t) {
-        std::size_t count = 0;
-        for (std::size_t i = 0; i < N; ++i) count += (matched[i] >> t) & 1u;
-        share[t] = N ? double(count) / double(N) : 0.0;
+        std::size_t c = 0;
+        for (std::size_t v = 0; v < matched.size(); ++v) c += (matched[v] >> t) & 1u;
+        share[t] = N ? double(c) / double(N) : 0.0;
     }
     if (!consistency) return;
-    consistency->assign(T, 0.0);
+    std::size_t strands = 0;  // with an oriented point
+    for (std::size_t s = 0; s < S; ++s) {
+        for (std::size_t v = fs.begin(s); v < fs.end(s); ++v) {
+            if (from.oriented(v)) {
+                ++strands;
+                break;
+            }
+        }
+    }
     for (std::size_t t = 0; t < T; ++t) {
         double sum = 0.0;
         for (std::size_t s = 0; s < S; ++s) sum += strandConsistency[s * T + t];  // in strand order
-        (*consistency)[t] = S ? sum / double(S) : 0.0;
+        (*consistency)[t] = strands ? sum / double(strands) : 0.0;
     }
 }
 
@@ -151,16 +368,21 @@ std::vector<OrientedThreshold> hairGsThresholds()
 std::vector<OrientedMatch> matchOrientedPoints(const StrandSet& predicted, const StrandSet& reference,
                                                const std::vector<OrientedThreshold>& thresholds, bool bidirectional, bool threaded)
 {
+    return matchOrientedPoints(StrandIndex(predicted, threaded), StrandIndex(reference, threaded), thresholds, bidirectional, threaded);
+}
+
+std::vector<OrientedMatch> matchOrientedPoints(const StrandIndex& predicted, const StrandIndex& reference,
+                                               const std::vector<OrientedThreshold>& thresholds, bool bidirectional, bool threaded)
+{
     for (const OrientedThreshold& t : thresholds) {
         if (!(t.distance >= 0.0) || !std::isfinite(t.distance)) throw ValueError("oriented match: distance " + std::to_string(t.distance) + ": must be finite and >= 0");
         if (!(t.angleDegrees >= 0.0 && t.angleDegrees <= 180.0)) throw ValueError("oriented match: angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees");
     }
-    const OrientedPoints p = orientedPoints(predicted), r = orientedPoints(reference);
-    if (p.position.empty()) throw ValueError("oriented match: the predicted hair has no segment");
-    if (r.position.empty()) throw ValueError("oriented match: the reference hair has no segment");
+    if (predicted.orientedPoints() == 0) throw ValueError("oriented match: the predicted hair has no segment");
+    if (reference.orientedPoints() == 0) throw ValueError("oriented match: the reference hair has no segment");
     std::vector<double> precision, recall, consistency;
-    matchShare(p, r, thresholds, bidirectional, threaded, precision, nullptr);
-    matchShare(r, p, thresholds, bidirectional, threaded, recall, &consistency);
+    matchShare(predicted, reference, thresholds, bidirectional, threaded, precision, nullptr);
+    matchShare(reference, predicted, thresholds, bidirectional, threaded, recall, &consistency);
     std::vector<OrientedMatch> out(thresholds.size());
     for (std::size_t t = 0; t < thresholds.size(); ++t) {
         OrientedMatch& m = out[t];
@@ -175,26 +397,36 @@ std::vector<OrientedMatch> matchOrientedPoints(const StrandSet& predicted, const
 
 namespace {
 
-/// For every vertex of @a from, the distance to the nearest vertex of @a to.
-std::vector<double> nearestDistances(const StrandSet& from, const StrandSet& to, bool threaded)
+/// For every vertex of @a from, the distance to the nearest vertex of @a to. Each search starts
+/// from the bound the previous vertex's nearest and its successor give (a strand's neighbours run
+/// beside it); the distance found is exact whatever the bound.
+std::vector<double> nearestDistances(const StrandIndex& from, const StrandIndex& to, bool threaded)
 {
-    std::vector<Vec3d> pts(to.positions.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) pts[i] = Vec3d(to.positions[i].x(), to.positions[i].y(), to.positions[i].z());
-    const PointCloud cloud{&pts};
-    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    std::vector<double> out(from.positions.size());
-    auto run = [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const Vec3f& p = from.positions[i];
-            const double q[3] = {p.x(), p.y(), p.z()};
-            std::uint32_t index = 0;
-            double d2 = 0.0;
-            tree.knnSearch(q, 1, &index, &d2);
-            out[i] = std::sqrt(d2);
+    const StrandSet& fs = from.strands();
+    const std::vector<Vec3f>& xt = to.strands().positions;
+    std::vector<double> out(fs.numVertices());
+    forEachRange(fs.numStrands(), threaded, 16, [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t o = range.begin(); o != range.end(); ++o) {
+            const std::size_t s = from.spatialOrder()[o];
+            std::uint32_t last = ~0u;
+            for (std::size_t v = fs.begin(s); v < fs.end(s); ++v) {
+                const Vec3d p = toDouble(fs.positions[v]);
+                double d2 = std::numeric_limits<double>::infinity();
+                if (last != ~0u) {
+                    const std::uint32_t from = last;
+                    for (std::uint32_t w = from; w < std::min<std::size_t>(std::size_t(from) + 2, xt.size()); ++w) {
+                        const double e2 = (p - toDouble(xt[w])).lengthSqr();
+                        if (e2 < d2) {
+                            d2 = e2;
+                            last = w;
+                        }
+                    }
+                }
+                if (d2 > 0.0) last = to.grid().nearest(p, d2);  // else the bound's vertex: nothing is nearer
+                out[v] = std::sqrt(d2);
+            }
         }
-    };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.size(), 1024), run);
-    else run(tbb::blocked_range<std::size_t>(0, out.size()));
+    });
     return out;
 }
 
@@ -203,7 +435,14 @@ std::vector<double> nearestDistances(const StrandSet& from, const StrandSet& to,
 ChamferDistances chamferDistances(const StrandSet& a, const StrandSet& b, bool threaded)
 {
     if (a.positions.empty() || b.positions.empty()) throw ValueError("Chamfer distance: a hairstyle has no vertex");
-    const std::vector<double> ab = nearestDistances(a, b, threaded), ba = nearestDistances(b, a, threaded);
+    return chamferDistances(StrandIndex(a, threaded), StrandIndex(b, threaded), threaded);
+}
+
+ChamferDistances chamferDistances(const StrandIndex& ia, const StrandIndex& ib, bool threaded)
+{
+    const StrandSet &a = ia.strands(), &b = ib.strands();
+    if (a.positions.empty() || b.positions.empty()) throw ValueError("Chamfer distance: a hairstyle has no vertex");
+    const std::vector<double> ab = nearestDistances(ia, ib, threaded), ba = nearestDistances(ib, ia, threaded);
     ChamferDistances c;
     for (double d : ab) c.aToB += d;  // in vertex order: independent of threads
     for (double d : ba) c.bToA += d;
@@ -264,84 +503,6 @@ StrandPairErrors strandPairErrors(const StrandSet& a, const StrandSet& b, std::s
         e.meanCurvature /= double(S);
     }
     return e;
-}
-
-namespace {
-
-/// Calls @a visit with the packed voxel of every point of strand @a i (vertices, and points at
-/// most half a voxel apart on each segment).
-template <typename Visit>
-void visitStrandVoxels(const StrandSet& s, std::size_t i, double voxel, Visit&& visit)
-{
-    const auto pack = [&](const Vec3d& p) {
-        const auto c = [&](double v) { return std::uint64_t(std::int64_t(std::llround(v / voxel)) + (std::int64_t(1) << 20)) & 0x1fffff; };
-        return c(p.x()) | (c(p.y()) << 21) | (c(p.z()) << 42);
-    };
-    const Vec3f* p = s.data(i);
-    const std::size_t n = s.size(i);
-    for (std::size_t k = 0; k < n; ++k) {
-        const Vec3d a(p[k].x(), p[k].y(), p[k].z());
-        if (!visit(pack(a))) return;
-        if (k + 1 == n) break;
-        const Vec3d b(p[k + 1].x(), p[k + 1].y(), p[k + 1].z());
-        const double steps = std::ceil((b - a).length() / (0.5 * voxel));
-        if (!(steps < double(1 << 24))) throw ValueError("voxel " + std::to_string(voxel) + ": a segment of strand " + std::to_string(i) + " would take over 2^24 points");
-        const std::size_t m = std::size_t(steps);
-        for (std::size_t j = 1; j < m; ++j) {
-            if (!visit(pack(a + (b - a) * (double(j) / double(m))))) return;
-        }
-    }
-}
-
-} // namespace
-
-std::size_t countStrandsLeavingVolume(const StrandSet& strands, const StrandSet& reference, double voxel, bool threaded)
-{
-    if (!(voxel > 0.0) || !std::isfinite(voxel)) throw ValueError("voxel " + std::to_string(voxel) + ": must be a positive length");
-    for (const StrandSet* s : {&strands, &reference}) {
-        const BBox box = computeBBox(*s);
-        if (s->empty()) continue;
-        const double reach = std::max({std::abs(double(box.min.x())), std::abs(double(box.min.y())), std::abs(double(box.min.z())),
-                                       std::abs(double(box.max.x())), std::abs(double(box.max.y())), std::abs(double(box.max.z()))});
-        if (!(reach / voxel < double(1 << 19))) {
-            throw ValueError("voxel " + std::to_string(voxel) + ": over 2^19 voxels from the origin to the hair (" + std::to_string(reach) + "); give a larger voxel");
-        }
-    }
-    std::unordered_set<std::uint64_t> occupied;
-    for (std::size_t i = 0; i < reference.numStrands(); ++i) {
-        visitStrandVoxels(reference, i, voxel, [&](std::uint64_t key) {
-            occupied.insert(key);
-            return true;
-        });
-    }
-    // Dilated by one voxel: the 27 packed offsets (21 bits a coordinate; no coordinate reaches the wrap).
-    std::unordered_set<std::uint64_t> volume;
-    volume.reserve(occupied.size() * 4);
-    for (const std::uint64_t key : occupied) {
-        for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const std::uint64_t x = ((key & 0x1fffff) + std::uint64_t(dx)) & 0x1fffff;
-                    const std::uint64_t y = (((key >> 21) & 0x1fffff) + std::uint64_t(dy)) & 0x1fffff;
-                    const std::uint64_t z = (((key >> 42) & 0x1fffff) + std::uint64_t(dz)) & 0x1fffff;
-                    volume.insert(x | (y << 21) | (z << 42));
-                }
-    }
-    std::vector<char> leaves(strands.numStrands(), 0);
-    auto body = [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            visitStrandVoxels(strands, i, voxel, [&](std::uint64_t key) {
-                if (volume.count(key)) return true;
-                leaves[i] = 1;
-                return false;
-            });
-        }
-    };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, strands.numStrands(), 256), body);
-    else body(tbb::blocked_range<std::size_t>(0, strands.numStrands()));
-    std::size_t count = 0;
-    for (char c : leaves) count += std::size_t(c);
-    return count;
 }
 
 } // namespace vdbhair

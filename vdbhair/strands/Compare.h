@@ -22,12 +22,10 @@
 /// A's vertices of the distance to the nearest vertex of B, and the same from B to A; reported each
 /// way and as their mean (the symmetric Chamfer distance with unsquared distances).
 ///
-/// **Leaving the volume** (the guides issue's measure of spikes and flares): a strand leaves a
-/// reference's hair volume when one of its points lies outside the voxels the reference's points
-/// occupy, dilated by one voxel (its 26 neighbours). A strand's points are its vertices and points
-/// at most half a voxel apart on its segments; a point is in the voxel it rounds to (world / voxel).
+/// The share of strands leaving a hairstyle's volume is field/HairVolume.h's countStrandsLeavingVolume().
 #pragma once
 
+#include <vdbhair/strands/PointGrid.h>
 #include <vdbhair/strands/StrandSet.h>
 
 #include <cstddef>
@@ -44,6 +42,48 @@ struct OrientedThreshold
 /// @brief HairGS's four thresholds in metres: 2 mm / 20°, 3 mm / 30°, 4 mm / 40°, 4 mm / 90°.
 std::vector<OrientedThreshold> hairGsThresholds();
 
+/// @brief A hairstyle's vertices indexed for the measures below, built once and shared by them:
+/// a grid of the vertices (PointGrid.h), each vertex's oriented point (the unit direction of the
+/// segment it starts; none for a strand's last vertex or a repeated one), its strand, and each
+/// strand's vertices in runs of up to kRun with a bounding sphere (to match against one strand).
+/// Refers to @a strands, which must outlive it.
+class StrandIndex
+{
+public:
+    static constexpr std::size_t kRun = 8;  ///< vertices a run
+
+    explicit StrandIndex(const StrandSet& strands, bool threaded = true);
+
+    const StrandSet& strands() const { return *mStrands; }
+    const PointGrid& grid() const { return mGrid; }
+    /// The direction of vertex @a v's segment; zero when it has none.
+    const Vec3f& direction(std::size_t v) const { return mDirection[v]; }
+    bool oriented(std::size_t v) const { return mDirection[v] != Vec3f(0.f); }
+    std::uint32_t strandOf(std::size_t v) const { return mStrandOf[v]; }
+    std::size_t orientedPoints() const { return mOrientedPoints; }
+    /// The strands in an order along a space-filling curve (by their middle vertex): strands near
+    /// in it are near in space, so queries made in this order find the grid's cells in cache.
+    const std::vector<std::uint32_t>& spatialOrder() const { return mOrder; }
+
+    /// The runs of strand @a s: [firstRun(s), firstRun(s + 1)); run r holds vertices
+    /// [runBegin(r), runBegin(r + 1)) within runRadius(r) of runCentre(r).
+    std::size_t firstRun(std::size_t s) const { return mFirstRun[s]; }
+    std::size_t runBegin(std::size_t r) const { return mRunBegin[r]; }
+    const Vec3d& runCentre(std::size_t r) const { return mRunCentre[r]; }
+    double runRadius(std::size_t r) const { return mRunRadius[r]; }
+
+private:
+    const StrandSet* mStrands;
+    PointGrid mGrid;
+    std::vector<Vec3f> mDirection;
+    std::vector<std::uint32_t> mStrandOf;
+    std::size_t mOrientedPoints = 0;
+    std::vector<std::uint32_t> mOrder;
+    std::vector<std::size_t> mFirstRun, mRunBegin;
+    std::vector<Vec3d> mRunCentre;
+    std::vector<double> mRunRadius;
+};
+
 struct OrientedMatch
 {
     OrientedThreshold threshold;
@@ -56,6 +96,10 @@ struct OrientedMatch
 /// @throw ValueError for a negative or non-finite distance, an angle outside [0, 180], or a
 /// hairstyle with no segment.
 std::vector<OrientedMatch> matchOrientedPoints(const StrandSet& predicted, const StrandSet& reference,
+                                               const std::vector<OrientedThreshold>& thresholds, bool bidirectional = false,
+                                               bool threaded = true);
+/// @brief The same, of hairstyles already indexed.
+std::vector<OrientedMatch> matchOrientedPoints(const StrandIndex& predicted, const StrandIndex& reference,
                                                const std::vector<OrientedThreshold>& thresholds, bool bidirectional = false,
                                                bool threaded = true);
 
@@ -83,11 +127,7 @@ struct ChamferDistances
 /// identical for any thread count.
 /// @throw ValueError when either has no vertex.
 ChamferDistances chamferDistances(const StrandSet& a, const StrandSet& b, bool threaded = true);
-
-/// @brief The number of @a strands that leave the hair volume of @a reference at @a voxel (see
-/// above). In parallel; identical for any thread count.
-/// @throw ValueError for a voxel that is not positive and finite, or one so small that a segment
-/// would take more than 2^24 points.
-std::size_t countStrandsLeavingVolume(const StrandSet& strands, const StrandSet& reference, double voxel, bool threaded = true);
+/// @brief The same, of hairstyles already indexed.
+ChamferDistances chamferDistances(const StrandIndex& a, const StrandIndex& b, bool threaded = true);
 
 } // namespace vdbhair
