@@ -87,13 +87,13 @@ std::uint32_t PointGrid::nearest(const Vec3d& p, double& d2) const
         }
         return true;
     };
-    // Every point within r is found: when the best lies within r it is the nearest. Out from one
-    // cell (or the bound, when nearer), twice as far each time, and never past the bound (the
+    // Every point within r is found: when the best lies within r it is the nearest. Out from a
+    // quarter cell (or the bound, when nearer), twice as far each time, and never past the bound (the
     // bound's point lies within it) or past the best found.
     const double limit = std::isfinite(d2) && d2 >= 0.0 ? std::sqrt(d2) * (1.0 + 1e-9) + 1e-300 : std::numeric_limits<double>::infinity();
     const double diagonal = mCell * std::sqrt(double(mDims[0]) * mDims[0] + double(mDims[1]) * mDims[1] + double(mDims[2]) * mDims[2]);
     const double farthest = 2.0 * diagonal + (p - mOrigin).length();  // every point lies within it
-    double r = std::min(limit, mCell);
+    double r = std::min(limit, 0.25 * mCell);  // at most 2^3 cells
     for (;;) {
         forEachWithin(p, r, closer);
         if (best != ~0u && bestD2 <= r * r) break;
