@@ -16,7 +16,7 @@ namespace {
 /// The command line of render; defaults from the library's RenderParams and ReadOptions.
 struct RenderCmdParams
 {
-    std::string input, output, guides, title, facing, head;
+    std::string input, output, guides, title, facing, head, reference;
     std::string view = viewName(RenderParams{}.view), colorBy = colorByName(RenderParams{}.colorBy);
     std::string up = axisName(RenderParams{}.up);
     std::string grid = ReadOptions{}.vdbGrid;
@@ -75,6 +75,15 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
         head = readTriangleMesh(p.head);
     }
     if (!head.triangles.empty()) rp.head = &head;
+    StrandSet reference;
+    if (rp.colorBy == ColorBy::Error && p.reference.empty()) {
+        throw ValueError("--color-by error: needs --reference, the hairstyle to measure each vertex's distance to");
+    }
+    if (!p.reference.empty()) {
+        if (rp.colorBy != ColorBy::Error) throw ValueError("--reference " + p.reference + ": only --color-by error uses it");
+        reference = loadStrandsOrScene("render", p.reference, common, p.grid);
+        rp.reference = &reference;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const Image image = p.sheet ? renderSheet(strands, rp) : renderStrands(strands, rp);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -100,7 +109,10 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--view", params->view, "front, side, top, back or three-quarter (perspective)")->capture_default_str();
     sub->add_option("--width", params->width, "Width in pixels")->capture_default_str();
     sub->add_option("--height", params->height, "Height in pixels")->capture_default_str();
-    sub->add_option("--color-by", params->colorBy, "shaded, root, tangent, depth, curvature or strand")->capture_default_str();
+    sub->add_option("--color-by", params->colorBy,
+                    "shaded, root, tangent, depth, curvature, strand, or error (each vertex's distance to the nearest of --reference)")
+        ->capture_default_str();
+    sub->add_option("--reference", params->reference, "For --color-by error: the hairstyle to measure against (e.g. the reference of `compare`)");
     sub->add_option("--head", params->head, "A head mesh (.ply, .obj) drawn behind the hair, e.g. from ../shared/data/scalp (default: a scene's own \"head\")");
     sub->add_option("--guides", params->guides, "Strands drawn on top in red (e.g. the guides of a scene)");
     sub->add_option("--title", params->title, "Text in the top-left corner");

@@ -826,8 +826,8 @@ Returns:
         "render",
         [](const StrandsPtr& strands, std::optional<PathArg> path, const std::string& view, int width, int height,
            const std::string& colorBy, std::array<double, 3> up, std::optional<std::array<double, 3>> facing,
-           const std::string& title, bool sheet, const StrandsPtr& guides, std::optional<PathArg> head, int threads,
-           const pyb::object& progress) -> pyb::object {
+           const std::string& title, bool sheet, const StrandsPtr& guides, std::optional<PathArg> head, const StrandsPtr& reference,
+           int threads, const pyb::object& progress) -> pyb::object {
             RenderParams rp;
             rp.view = viewFromName(view);
             rp.colorBy = colorByFromName(colorBy);
@@ -849,6 +849,7 @@ Returns:
                 RenderParams p = rp;
                 p.interrupter = interrupter;
                 if (guides) p.guides = guides.get();
+                if (reference) p.reference = reference.get();
                 if (head) {
                     headMesh = readTriangleMesh(*head);
                     if (!headMesh.triangles.empty()) p.head = &headMesh;
@@ -876,7 +877,8 @@ Returns:
         pyb::arg("color_by") = colorByName(renderDefaults.colorBy),
         pyb::arg("up") = std::array<double, 3>{renderDefaults.up.x(), renderDefaults.up.y(), renderDefaults.up.z()},
         pyb::arg("facing") = pyb::none(), pyb::arg("title") = renderDefaults.title, pyb::arg("sheet") = false,
-        pyb::arg("guides") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+        pyb::arg("guides") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("reference") = pyb::none(), pyb::arg("threads") = 0,
+        pyb::arg("progress") = pyb::none(),
         R"doc(A preview image of strands: lit fibres, depth-correct, anti-aliased (``vdbhair render``).
 
 Args:
@@ -885,13 +887,15 @@ Args:
         None returns the image instead.
     view: "front", "side", "top", "back" or "three-quarter" (perspective).
     width, height: pixels (1-16384).
-    color_by: "shaded", "root", "tangent", "depth", "curvature" or "strand".
+    color_by: "shaded", "root", "tangent", "depth", "curvature", "strand", or "error" (each
+        vertex's distance to the nearest vertex of ``reference``, 0 to its 95th percentile).
     up: the hairstyle's up axis (x, y, z); (0, 0, 1) for Yuksel's cyHair models.
     facing: the direction the face looks, perpendicular to up (default: +z, or -y for a z up).
     title: text in the top-left corner.
     sheet: one image with the front, side, top and three-quarter views.
     guides: Strands drawn on top in red.
     head: a head mesh (.ply, .obj) drawn behind the hair.
+    reference: Strands to measure against, for color_by="error".
     threads: worker threads, 0 for all cores.
     progress: optional callable ``progress(stage, done, total, unit)``.
 

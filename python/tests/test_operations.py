@@ -58,6 +58,25 @@ def test_render_returns_rgba_or_writes_a_file(tmp_path):
     np.testing.assert_array_equal(read_png_rgb(path), image[:, :, :3])
 
 
+def test_render_colours_by_the_distance_to_a_reference():
+    s = straight_bundle(count=3)
+    # The bundle and a copy half of it moved away: the moved strands take the map's high end
+    # (yellow), those on the reference its low end (dark purple).
+    positions = np.array(s.positions)
+    positions[len(positions) // 2:] += np.array([0.0, 5.0, 0.0], dtype=np.float32)
+    moved = vdbhair.Strands(positions, np.array(s.offsets))
+    image = vdbhair.render(moved, width=96, height=96, view="front", color_by="error", reference=s)
+    rgb = image[:, :, :3].astype(int)
+    hair = (rgb < 245).any(axis=-1)
+    yellow = hair & (rgb[:, :, 0] > 150) & (rgb[:, :, 1] > 150) & (rgb[:, :, 2] < 120)
+    purple = hair & (rgb[:, :, 1] < 60)
+    assert yellow.sum() > 10 and purple.sum() > 10
+    # Rows: the moved half is above the other in the front view (+y up).
+    assert np.nonzero(yellow)[0].mean() < np.nonzero(purple)[0].mean()
+    with pytest.raises(ValueError, match="colorBy error needs a reference"):
+        vdbhair.render(s, width=64, height=48, color_by="error")
+
+
 def read_png_rgb(path):
     """An 8-bit RGB PNG's pixels, decoded by the command-line tests' own reader (tests/apps/check_legend.py)."""
     spec = importlib.util.spec_from_file_location("check_legend", SOURCE_DIR / "tests" / "apps" / "check_legend.py")

@@ -218,3 +218,44 @@ TEST_CASE("renderStrands: real hairstyles cover their projected bounding box in 
         }
     }
 }
+
+TEST_CASE("renderStrands: --color-by error colours each vertex by its distance to a reference", "[render]")
+{
+    // B: a strand on the reference (distance 0: the colour map's low end) and one far from it
+    // (beyond the 95th percentile: its high end). Front view, one strand a side.
+    StrandSet reference, b;
+    std::vector<Vec3f> left, right;
+    for (int k = 0; k <= 20; ++k) {
+        left.emplace_back(-1.f, -1.f + 0.1f * float(k), 0.f);
+        right.emplace_back(1.f, -1.f + 0.1f * float(k), 0.f);
+    }
+    reference.addStrand(left);
+    b.addStrand(left);
+    b.addStrand(right);
+    RenderParams rp;
+    rp.view = View::Front;
+    rp.width = rp.height = 200;
+    rp.colorBy = ColorBy::Error;
+    rp.supersample = 1;  // one-pixel lines of their own colour, not blended with the background
+    REQUIRE_THROWS_WITH(renderStrands(b, rp), Catch::Matchers::Contains("needs a reference"));
+    rp.reference = &reference;
+    const Image im = renderStrands(b, rp);
+    const BBox frame = computeBBox(b);
+    auto colourAt = [&](const Vec3f& p) {
+        const Vec3d q = projectToImage(Vec3d(p), rp, frame);
+        // The strand's most saturated pixel near its projection (lines are thin and anti-aliased).
+        Vec3f best(1.f);
+        for (int dx = -2; dx <= 2; ++dx) {
+            const Vec3f c = im.at(int(q.x()) + dx, int(q.y()));
+            if (c.x() + c.y() + c.z() < best.x() + best.y() + best.z()) best = c;
+        }
+        return best;
+    };
+    const Vec3f low = colorMap(0.f), high = colorMap(1.f), onRef = colourAt(left[10]), far = colourAt(right[10]);
+    CAPTURE(low, high, onRef, far);
+    CHECK((onRef - low).length() < 0.05f);
+    CHECK((far - high).length() < 0.05f);
+    // The same image for the reference against itself: every vertex at distance 0.
+    const Image same = renderStrands(reference, rp);
+    CHECK(same.width == rp.width);
+}

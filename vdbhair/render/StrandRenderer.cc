@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Memory.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/strands/Compare.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <tbb/blocked_range.h>
@@ -51,6 +52,7 @@ const char* colorByName(ColorBy colorBy)
     case ColorBy::Depth: return "depth";
     case ColorBy::Curvature: return "curvature";
     case ColorBy::Strand: return "strand";
+    case ColorBy::Error: return "error";
     }
     return "shaded";
 }
@@ -63,7 +65,8 @@ ColorBy colorByFromName(const std::string& name)
     if (name == "depth") return ColorBy::Depth;
     if (name == "curvature") return ColorBy::Curvature;
     if (name == "strand") return ColorBy::Strand;
-    throw ValueError("colorBy '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand");
+    if (name == "error") return ColorBy::Error;
+    throw ValueError("colorBy '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand, error");
 }
 
 namespace {
@@ -204,6 +207,18 @@ std::vector<Vec3f> baseColors(const StrandSet& s, const RenderParams& p, const C
         lo = sorted[std::size_t(0.05 * double(nV - 1))];
         hi = sorted[std::size_t(0.95 * double(nV - 1))];
         for (std::size_t v = 0; v < nV; ++v) c[v] = colorMap(hi > lo ? float((k[v] - lo) / (hi - lo)) : 0.5f);
+        break;
+    }
+    case ColorBy::Error: {
+        lit = false;
+        if (nV == 0) break;
+        const std::vector<double> d = nearestVertexDistances(StrandIndex(s), StrandIndex(*p.reference));
+        std::vector<double> sorted = d;
+        const std::size_t at = std::size_t(0.95 * double(nV - 1));
+        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(at), sorted.end());
+        lo = 0.0;
+        hi = sorted[at];
+        for (std::size_t v = 0; v < nV; ++v) c[v] = colorMap(hi > 0.0 ? float(std::min(1.0, d[v] / hi)) : 0.f);
         break;
     }
     }
@@ -364,6 +379,9 @@ void checkSize(const RenderParams& p)
                          " must be between 1x1 and " + most + "x" + most + " pixels");
     }
     if (p.supersample < 1 || p.supersample > 8) throw ValueError("supersampling " + std::to_string(p.supersample) + " must be 1 to 8");
+    if (p.colorBy == ColorBy::Error && (!p.reference || p.reference->positions.empty())) {
+        throw ValueError("colorBy error needs a reference hairstyle with vertices to measure the distance to");
+    }
 }
 
 } // namespace
@@ -447,10 +465,10 @@ Image renderStrands(const StrandSet& strands, const RenderParams& params)
     });
     const int text = std::max(10, std::min(24, params.height / 40));
     if (!params.title.empty()) drawText(out, text / 2, text + text / 2, params.title, text, Vec3f(0.f));
-    if (params.colorBy == ColorBy::Depth || params.colorBy == ColorBy::Curvature) {
+    if (params.colorBy == ColorBy::Depth || params.colorBy == ColorBy::Curvature || params.colorBy == ColorBy::Error) {
         const int bh = params.height / 3, bw = std::max(8, params.width / 50);
         drawColorBar(out, params.width - bw - 8 * text / 2 - 8, params.height - bh - text, bw, bh, lo, hi,
-                     params.colorBy == ColorBy::Depth ? "depth" : "curvature");
+                     params.colorBy == ColorBy::Depth ? "depth" : params.colorBy == ColorBy::Curvature ? "curvature" : "distance");
     }
     return out;
 }

@@ -34,7 +34,8 @@ enum class ColorBy
     Tangent,    ///< |T| as RGB (world axes), unlit
     Depth,      ///< distance from the viewer, colour map with a legend
     Curvature,  ///< 1 / world units, colour map with a legend (5th to 95th percentile)
-    Strand      ///< a colour per strand, lit
+    Strand,     ///< a colour per strand, lit
+    Error       ///< distance to RenderParams::reference, colour map with a legend (0 to the 95th percentile)
 };
 /// @throw ValueError naming colorBy unless one of colorByName()'s names.
 ColorBy colorByFromName(const std::string& name);
@@ -66,6 +67,10 @@ struct RenderParams
     /// against, so that front views show the face framed by hair. Included in the default frame.
     const TriangleMesh* head = nullptr;
     Vec3f headColor{0.78f, 0.76f, 0.74f};
+    /// ColorBy::Error's reference: each vertex is coloured by its distance to the nearest vertex
+    /// of this hairstyle (the per-vertex term of the Chamfer distance, strands/Compare.h), so
+    /// where two hairstyles differ shows. Required by ColorBy::Error.
+    const StrandSet* reference = nullptr;
 };
 
 /// @brief The facing direction used when RenderParams::facing is not set (see there).

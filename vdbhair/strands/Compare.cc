@@ -395,12 +395,9 @@ std::vector<OrientedMatch> matchOrientedPoints(const StrandIndex& predicted, con
     return out;
 }
 
-namespace {
-
-/// For every vertex of @a from, the distance to the nearest vertex of @a to. Each search starts
-/// from the bound the previous vertex's nearest and its successor give (a strand's neighbours run
-/// beside it); the distance found is exact whatever the bound.
-std::vector<double> nearestDistances(const StrandIndex& from, const StrandIndex& to, bool threaded)
+/// Each search starts from the bound the previous vertex's nearest and its successor give (a
+/// strand's neighbours run beside it); the distance found is exact whatever the bound.
+std::vector<double> nearestVertexDistances(const StrandIndex& from, const StrandIndex& to, bool threaded)
 {
     const StrandSet& fs = from.strands();
     const std::vector<Vec3f>& xt = to.strands().positions;
@@ -430,8 +427,6 @@ std::vector<double> nearestDistances(const StrandIndex& from, const StrandIndex&
     return out;
 }
 
-} // namespace
-
 ChamferDistances chamferDistances(const StrandSet& a, const StrandSet& b, bool threaded)
 {
     if (a.positions.empty() || b.positions.empty()) throw ValueError("Chamfer distance: a hairstyle has no vertex");
@@ -442,7 +437,7 @@ ChamferDistances chamferDistances(const StrandIndex& ia, const StrandIndex& ib, 
 {
     const StrandSet &a = ia.strands(), &b = ib.strands();
     if (a.positions.empty() || b.positions.empty()) throw ValueError("Chamfer distance: a hairstyle has no vertex");
-    const std::vector<double> ab = nearestDistances(ia, ib, threaded), ba = nearestDistances(ib, ia, threaded);
+    const std::vector<double> ab = nearestVertexDistances(ia, ib, threaded), ba = nearestVertexDistances(ib, ia, threaded);
     ChamferDistances c;
     for (double d : ab) c.aToB += d;  // in vertex order: independent of threads
     for (double d : ba) c.bToA += d;

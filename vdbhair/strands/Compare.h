@@ -130,4 +130,8 @@ ChamferDistances chamferDistances(const StrandSet& a, const StrandSet& b, bool t
 /// @brief The same, of hairstyles already indexed.
 ChamferDistances chamferDistances(const StrandIndex& a, const StrandIndex& b, bool threaded = true);
 
+/// @brief For every vertex of @a from, the distance to the nearest vertex of @a to (Chamfer's
+/// terms: what `render --color-by error` shows). Exact; identical for any thread count.
+std::vector<double> nearestVertexDistances(const StrandIndex& from, const StrandIndex& to, bool threaded = true);
+
 } // namespace vdbhair
