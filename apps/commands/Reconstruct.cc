@@ -3,6 +3,7 @@
 #include "../Command.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/StrandIO.h>
@@ -83,13 +84,8 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
                               {"p95_interpolated", e.p95Interpolated}, {"seconds", e.seconds}};
     };
     // HairGS's oriented points and Perm's strand pairs, per way (Compare.h).
-    auto papers = [](const ReconstructErrors& e) {
-        nlohmann::json oriented = nlohmann::json::array();
-        for (const OrientedMatch& m : e.oriented) {
-            oriented.push_back({{"distance_mm", 1000.0 * m.threshold.distance}, {"angle_degrees", m.threshold.angleDegrees}, {"precision", m.precision},
-                                {"recall", m.recall}, {"f1", m.f1}, {"strand_consistency", m.strandConsistency}});
-        }
-        return nlohmann::json{{"oriented_points", e.oriented.empty() ? nlohmann::json(nullptr) : oriented},
+    auto papers = [&p](const ReconstructErrors& e) {
+        return nlohmann::json{{"oriented_points", e.oriented.empty() ? nlohmann::json(nullptr) : toJson(e.oriented, p.rec.metersPerUnit)},
                               {"perm_position", e.permPosition}, {"perm_curvature", e.permCurvature}};
     };
     const std::size_t S = strands.numStrands();

@@ -754,17 +754,7 @@ Returns:
                 d["perm_curvature"] = e.permCurvature;
                 d["leaving_volume"] = e.leavingVolume;
                 d["entering_head"] = e.enteringHead;
-                if (e.oriented.empty()) {
-                    d["oriented_points"] = pyb::none();
-                } else {
-                    pyb::list oriented;
-                    for (const OrientedMatch& m : e.oriented) {
-                        oriented.append(pyb::dict(pyb::arg("distance_mm") = 1000.0 * m.threshold.distance * metersPerUnit, pyb::arg("angle_degrees") = m.threshold.angleDegrees,
-                                                  pyb::arg("precision") = m.precision, pyb::arg("recall") = m.recall, pyb::arg("f1") = m.f1,
-                                                  pyb::arg("strand_consistency") = m.strandConsistency));
-                    }
-                    d["oriented_points"] = oriented;
-                }
+                d["oriented_points"] = e.oriented.empty() ? pyb::none() : toPython(toJson(e.oriented, metersPerUnit));
                 return d;
             };
             pyb::dict report;

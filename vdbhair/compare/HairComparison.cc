@@ -106,21 +106,26 @@ HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const C
     return c;
 }
 
+nlohmann::json toJson(const std::vector<OrientedMatch>& matches, double metersPerUnit)
+{
+    nlohmann::json oriented = nlohmann::json::array();
+    for (const OrientedMatch& m : matches) {
+        nlohmann::json t = {{"distance", m.threshold.distance}, {"angle_degrees", m.threshold.angleDegrees},
+                            {"precision", m.precision}, {"recall", m.recall}, {"f1", m.f1},
+                            {"strand_consistency", m.strandConsistency}};
+        if (metersPerUnit > 0.0) t["distance_mm"] = m.threshold.distance * metersPerUnit * 1000.0;
+        oriented.push_back(t);
+    }
+    return oriented;
+}
+
 nlohmann::json toJson(const HairComparison& c)
 {
     nlohmann::json j;
     j["strands"] = {{"a", c.strandsA}, {"b", c.strandsB}};
     j["vertices"] = {{"a", c.verticesA}, {"b", c.verticesB}};
     j["meters_per_unit"] = c.metersPerUnit > 0.0 ? nlohmann::json(c.metersPerUnit) : nlohmann::json(nullptr);
-    nlohmann::json oriented = nlohmann::json::array();
-    for (const OrientedMatch& m : c.oriented) {
-        nlohmann::json t = {{"distance", m.threshold.distance}, {"angle_degrees", m.threshold.angleDegrees},
-                            {"precision", m.precision}, {"recall", m.recall}, {"f1", m.f1},
-                            {"strand_consistency", m.strandConsistency}};
-        if (c.metersPerUnit > 0.0) t["distance_mm"] = m.threshold.distance * c.metersPerUnit * 1000.0;
-        oriented.push_back(t);
-    }
-    j["oriented_points"] = oriented;
+    j["oriented_points"] = toJson(c.oriented, c.metersPerUnit);
     j["chamfer"] = {{"a_to_b", c.chamfer.aToB}, {"b_to_a", c.chamfer.bToA}, {"mean", c.chamfer.mean}};
     j["paired"] = c.paired;
     if (c.paired) {
