@@ -1,5 +1,6 @@
 /// @file Memory.h
-/// @brief Large buffers that fill fast: a hint for transparent huge pages.
+/// @brief How much memory there is, how a request for more is refused before it allocates, and
+/// large buffers that fill fast: a hint for transparent huge pages.
 ///
 /// A fresh buffer costs one page fault per 4 KiB page the first time it is written. On the
 /// virtual machines vdbhair is measured on a fault costs about 20 µs, so the 77 MB of positions
@@ -15,12 +16,29 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
 
 namespace vdbhair {
+
+/// @brief @a maxMemory if set (> 0), else MemAvailable of /proc/meminfo (the memory the kernel
+/// can give without swapping), else (no such file) the largest value: no limit.
+std::uint64_t availableMemoryBytes(std::uint64_t maxMemory = 0);
+
+/// @brief Bytes as a person reads them: "1.37 GiB", "512 MiB", "900 B".
+std::string formatBytes(std::uint64_t bytes);
+
+/// @brief Refuse up front: LimitError "<where>: needs about <estimate> (<how>), more than the
+/// <available> available (MemAvailable)[ of maxMemory]; <advice>" when @a estimate exceeds
+/// availableMemoryBytes(@a maxMemory). Call it before allocating what a count from a file or a
+/// parameter asks for.
+/// @param how what the estimate holds, e.g. "1e9 vertices of 12 bytes"
+/// @param advice what to change, e.g. "fewer vertices per strand"
+void checkMemory(const std::string& where, std::uint64_t estimate, const std::string& how, const std::string& advice,
+                 std::uint64_t maxMemory = 0);
 
 /// @brief Ask for transparent huge pages over the 2 MiB-aligned part of [p, p + bytes); a hint
 /// that changes no contents (nothing happens below 4 MiB, or where the kernel declines).

@@ -232,6 +232,6 @@ TEST_CASE("withFlagNames: the library's parameter names become the verb's flags"
         FAIL("colorByFromName accepted plaid");
     } catch (const ValueError& e) {
         CHECK(withFlagNames(e.what(), v.command("render").flags) ==
-              "--color-by 'plaid' is not one of shaded, root, tangent, depth, curvature, strand");
+              "--color-by 'plaid' is not one of shaded, root, tangent, depth, curvature, strand, error");
     }
 }

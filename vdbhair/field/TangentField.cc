@@ -882,35 +882,15 @@ std::uint64_t estimatePeakBytes(const std::vector<FieldFootprint>& footprints, M
 
 std::uint64_t availableMemoryBytes(const FieldParams& params)
 {
-    if (params.maxMemory > 0) return params.maxMemory;
-    std::ifstream in("/proc/meminfo");
-    std::string key, unit;
-    std::uint64_t kib = 0;
-    while (in >> key >> kib) {
-        std::getline(in, unit);
-        if (key == "MemAvailable:") return kib * 1024;
-    }
-    return std::numeric_limits<std::uint64_t>::max();
-}
-
-std::string formatBytes(std::uint64_t bytes)
-{
-    char buf[64];
-    if (bytes >= (std::uint64_t(1) << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(1 << 30));
-    else if (bytes >= (std::uint64_t(1) << 20)) std::snprintf(buf, sizeof buf, "%.0f MiB", double(bytes) / double(1 << 20));
-    else if (bytes >= 1024) std::snprintf(buf, sizeof buf, "%.0f KiB", double(bytes) / 1024.0);
-    else std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
-    return buf;
+    return availableMemoryBytes(params.maxMemory);
 }
 
 void checkMemoryEstimate(const char* where, std::uint64_t estimate, const std::string& how, const FieldParams& params)
 {
-    const std::uint64_t available = availableMemoryBytes(params);
-    if (estimate <= available) return;
-    throw LimitError(std::string(where) + ": needs about " + formatBytes(estimate) + " (" + how + "), more than the " +
-                     formatBytes(available) + (params.maxMemory > 0 ? " of maxMemory" : " available (MemAvailable)") +
-                     "; a request whose estimate exceeds the memory it may use is refused before it allocates "
-                     "(raise maxMemory or the voxel size, or split the hairstyle)");
+    checkMemory(where, estimate, how,
+                "a request whose estimate exceeds the memory it may use is refused before it allocates "
+                "(raise maxMemory or the voxel size, or split the hairstyle)",
+                params.maxMemory);
 }
 
 std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params)

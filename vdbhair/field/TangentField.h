@@ -19,6 +19,7 @@
 /// are bitwise identical with any number of threads.
 #pragma once
 
+#include <vdbhair/Memory.h>
 #include <vdbhair/field/FieldTypes.h>
 #include <vdbhair/field/ScalpMap.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -108,17 +109,12 @@ enum class MemoryUse
 /// (docs/performance.md, "Memory at scale"), which it stays a little above.
 std::uint64_t estimatePeakBytes(const std::vector<FieldFootprint>& footprints, MemoryUse use);
 
-/// @brief params.maxMemory if set, else MemAvailable of /proc/meminfo (the memory the kernel can
-/// give without swapping), else (no such file) the largest value: no limit.
+/// @brief availableMemoryBytes(params.maxMemory) (Memory.h).
 std::uint64_t availableMemoryBytes(const FieldParams& params);
 
-/// @brief Refuse up front: LimitError "<where>: needs about <estimate> (<how>), more than the
-/// <available> <source>; ..." when @a estimate exceeds availableMemoryBytes(@a params).
+/// @brief checkMemory() (Memory.h) against params.maxMemory, advising a larger voxel.
 /// @param how the terms of the estimate, for the message
 void checkMemoryEstimate(const char* where, std::uint64_t estimate, const std::string& how, const FieldParams& params);
-
-/// @brief Bytes as a person reads them: "1.37 GiB", "512 MiB", "900 B".
-std::string formatBytes(std::uint64_t bytes);
 
 /// @brief The grids of one level.
 struct TangentField

@@ -1,6 +1,7 @@
 #include "Scene.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
 #include <vdbhair/Memory.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/io/FileUtil.h>
@@ -261,11 +262,15 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
         throw ValueError("growScene: step " + std::to_string(scene.step) + " must be a positive length");
     }
     const std::size_t estimate = sceneVertexCount(scene);
+    std::size_t wisps = 0;
+    for (const SceneGuide& g : scene.guides) wisps += g.wisp ? g.wisp->count : 0;
+    const std::string what = "about " + formatNumber(double(estimate)) + " vertices of " + std::to_string(sizeof(Vec3f)) + " bytes: " +
+                             std::to_string(scene.guides.size()) + " guides and " + std::to_string(wisps) + " wisp strands";
     if (estimate > options.maxVertices) {
-        throw LimitError("growScene: the scene would grow about " + std::to_string(estimate) +
-                         " vertices, more than the cap of " + std::to_string(options.maxVertices) +
-                         " (fewer wisps, shorter pieces or a larger step)");
+        throw LimitError("growScene: the scene would grow " + what + " (" + formatBytes(std::uint64_t(estimate) * sizeof(Vec3f)) +
+                         "), more than the cap of " + std::to_string(options.maxVertices) + " vertices (fewer wisps, shorter pieces or a larger step)");
     }
+    checkMemory("growScene", std::uint64_t(estimate) * sizeof(Vec3f), what, "fewer wisps, shorter pieces or a larger step");
     auto stepOf = [&](const SceneGuide& g) { return g.step > 0.0 ? g.step : scene.step; };
     const HelicoidIntegrator integrator = options.integrator ? *options.integrator : scene.integrator;
     // Layout: guide g, then its wisps; every strand of a guide has the guide's vertex count.

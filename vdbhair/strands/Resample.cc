@@ -1,6 +1,8 @@
 #include "Resample.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
+#include <vdbhair/Memory.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <tbb/blocked_range.h>
@@ -93,17 +95,32 @@ void resamplePolyline(const Vec3f* points, std::size_t n, std::size_t count, Vec
     out[0] = points[0];
 }
 
+namespace {
+
+/// The bytes a vertex of @a s takes: its position and the per-vertex attributes it carries.
+std::size_t bytesPerVertex(const StrandSet& s)
+{
+    return sizeof(Vec3f) + (s.thickness.empty() ? 0 : sizeof(float)) + (s.transparency.empty() ? 0 : sizeof(float)) +
+           (s.color.empty() ? 0 : sizeof(Vec3f));
+}
+
+} // namespace
+
 StrandSet resampleStrands(const StrandSet& strands, std::size_t verticesPerStrand)
 {
     if (verticesPerStrand < 2) {
         throw ValueError("resampleStrands: " + std::to_string(verticesPerStrand) +
                          " vertices per strand requested; a strand needs at least 2");
     }
-    const std::size_t total = strands.numStrands() * verticesPerStrand;
-    if (total > std::numeric_limits<std::uint32_t>::max()) {
-        throw ValueError("resampleStrands: " + std::to_string(total) +
-                         " vertices would exceed the limit of 2^32-1");
+    const double total = double(strands.numStrands()) * double(verticesPerStrand);
+    if (total > double(std::numeric_limits<std::uint32_t>::max())) {
+        throw ValueError("resampleStrands: " + std::to_string(strands.numStrands()) + " strands x " + std::to_string(verticesPerStrand) +
+                         " vertices = " + formatNumber(total) + " vertices: more than a hairstyle holds (2^32-1)");
     }
+    checkMemory("resampleStrands", std::uint64_t(total * double(bytesPerVertex(strands))),
+                std::to_string(strands.numStrands()) + " strands x " + std::to_string(verticesPerStrand) + " vertices = " + formatNumber(total) +
+                    " vertices of " + std::to_string(bytesPerVertex(strands)) + " bytes",
+                "fewer vertices per strand");
     std::vector<std::uint32_t> offsets(strands.numStrands() + 1);
     for (std::size_t i = 0; i < offsets.size(); ++i) offsets[i] = std::uint32_t(i * verticesPerStrand);
     return resampleWithCounts(strands, offsets);

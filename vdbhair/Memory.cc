@@ -1,0 +1,42 @@
+#include "Memory.h"
+
+#include <vdbhair/Exceptions.h>
+
+#include <cstdio>
+#include <fstream>
+#include <limits>
+
+namespace vdbhair {
+
+std::uint64_t availableMemoryBytes(std::uint64_t maxMemory)
+{
+    if (maxMemory > 0) return maxMemory;
+    std::ifstream in("/proc/meminfo");
+    std::string key, unit;
+    std::uint64_t kib = 0;
+    while (in >> key >> kib) {
+        std::getline(in, unit);
+        if (key == "MemAvailable:") return kib * 1024;
+    }
+    return std::numeric_limits<std::uint64_t>::max();
+}
+
+std::string formatBytes(std::uint64_t bytes)
+{
+    char buf[64];
+    if (bytes >= (std::uint64_t(1) << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(1 << 30));
+    else if (bytes >= (std::uint64_t(1) << 20)) std::snprintf(buf, sizeof buf, "%.0f MiB", double(bytes) / double(1 << 20));
+    else if (bytes >= 1024) std::snprintf(buf, sizeof buf, "%.0f KiB", double(bytes) / 1024.0);
+    else std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
+    return buf;
+}
+
+void checkMemory(const std::string& where, std::uint64_t estimate, const std::string& how, const std::string& advice, std::uint64_t maxMemory)
+{
+    const std::uint64_t available = availableMemoryBytes(maxMemory);
+    if (estimate <= available) return;
+    throw LimitError(where + ": needs about " + formatBytes(estimate) + " (" + how + "), more than the " + formatBytes(available) +
+                     (maxMemory > 0 ? " of maxMemory" : " available (MemAvailable)") + (advice.empty() ? "" : "; " + advice));
+}
+
+} // namespace vdbhair
