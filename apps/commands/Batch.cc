@@ -50,7 +50,7 @@ const std::map<std::string, AddCommand>& verbParsers()
         {"retrace", addRetraceCommand}, {"fit", addFitCommand},             {"render", addRenderCommand},
         {"grow", addGrowCommand},       {"reconstruct", addReconstructCommand}, {"interpolate", addInterpolateCommand},
         {"synth", addSynthCommand},     {"comb", addCombCommand},           {"scalp", addScalpCommand},
-        {"roots", addRootsCommand}};
+        {"roots", addRootsCommand}, {"prepare", addPrepareCommand}};
     return parsers;
 }
 
@@ -383,7 +383,7 @@ Command addBatchCommand(CLI::App& app, CommonOptions& common)
         "JOB (JSON; relative paths against the JOB's folder, where the runs start):\n"
         "  {\"inputs\": [\"a.hair\", \"b.data\"] | \"styles/*.data\" | {\"list\": \"paths.txt\"},\n"
         "   \"verb\": \"field\",  \"args\": [\"--voxel-size\", \"0.005\"],  \"output\": \"{stem}.vdb\"}\n"
-        "Verbs: convert field refine retrace fit render grow reconstruct interpolate synth comb scalp roots.\n"
+        "Verbs: convert field refine retrace fit render grow reconstruct interpolate synth comb scalp roots prepare.\n"
         "Placeholders in output and args: {stem} {name} {index} (sorted position); in args also {outdir}.\n"
         "An arg that starts with {outdir}/ is a second output (e.g. --dense {outdir}/{stem}.npy).\n"
         "A rerun skips inputs recorded ok (for the same verb, args and output rule) whose outputs exist.\n"

@@ -1,0 +1,128 @@
+#include "Prepare.h"
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Parallel.h>
+#include <vdbhair/strands/Resample.h>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+namespace vdbhair {
+
+void PrepareParams::validate() const
+{
+    if (points == 1) throw ValueError("PrepareParams::points 1: a strand needs at least 2 vertices (0 keeps them)");
+    align.validate();
+}
+
+void transformStrands(StrandSet& s, const Similarity& t)
+{
+    forEachIndex(s.positions.size(), true, [&](std::size_t i) {
+        const Vec3f& p = s.positions[i];
+        const Vec3d q = t.apply(Vec3d(p.x(), p.y(), p.z()));
+        s.positions[i] = Vec3f(float(q.x()), float(q.y()), float(q.z()));
+    }, 4096);
+    for (float& w : s.thickness) w = float(w * t.scale);
+    s.defaults.thickness = float(s.defaults.thickness * t.scale);
+}
+
+PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, const TriangleMesh* head,
+                             const TriangleMesh* alignTo, const HeadObstacle* fixHead, bool threaded)
+{
+    params.validate();
+    if (alignTo && !head) {
+        throw ValueError("prepareStrands: aligning to a common head needs the groom's own head mesh (head): the groom's head is "
+                         "fitted to the common head, not the strands");
+    }
+    PrepareReport r;
+    r.inputStrands = strands.numStrands();
+    r.inputVertices = strands.numVertices();
+
+    // 1. Even roots.
+    if (params.strands > 0) {
+        RootSelection sel;
+        strands = subsampleStrands(strands, params.strands, &sel, threaded);
+        sel.strands.clear();
+        r.subsample = std::move(sel);
+        r.requestedStrands = params.strands;
+    }
+    // 2. The groom's head onto the common head; the strands move with it.
+    if (alignTo) {
+        r.align = alignMeshes(*head, *alignTo, params.align, threaded);
+        transformStrands(strands, r.align->transform);
+    }
+    // 3. One vertex count (checked before resampleStrands() multiplies it out).
+    if (params.points >= 2) {
+        const std::size_t limit = std::numeric_limits<std::uint32_t>::max();
+        if (strands.numStrands() > 0 && params.points > limit / strands.numStrands()) {
+            throw ValueError("PrepareParams::points " + std::to_string(params.points) + ": " + std::to_string(strands.numStrands()) +
+                             " strands of that many vertices exceed the limit of 2^32-1 vertices");
+        }
+        strands = resampleStrands(strands, params.points);
+    }
+    r.points = params.points;
+    // 4. Out of the head, as deep as each root at most.
+    if (fixHead && !fixHead->empty()) {
+        r.fixed = true;
+        r.tolerance = headTolerance(*fixHead);
+        r.fixHead = fixHead->describe(false);
+        r.enteringBefore = countStrandsEnteringHead(strands, *fixHead, r.tolerance, threaded);
+        r.collision = resolveHeadCollisions(strands, *fixHead, rootDepthAllowance(strands, *fixHead, threaded), params.collision, threaded);
+        r.enteringAfter = countStrandsEnteringHead(strands, *fixHead, r.tolerance, threaded);
+    }
+    r.strands = strands.numStrands();
+    r.vertices = strands.numVertices();
+    return r;
+}
+
+nlohmann::json toJson(const Similarity& t)
+{
+    nlohmann::json rot = nlohmann::json::array(), matrix = nlohmann::json::array();
+    for (int i = 0; i < 3; ++i) {
+        rot.push_back({t.rotation(i, 0), t.rotation(i, 1), t.rotation(i, 2)});
+        matrix.push_back({t.scale * t.rotation(i, 0), t.scale * t.rotation(i, 1), t.scale * t.rotation(i, 2), t.translation[i]});
+    }
+    matrix.push_back({0.0, 0.0, 0.0, 1.0});
+    return {{"scale", t.scale}, {"rotation", rot}, {"translation", {t.translation.x(), t.translation.y(), t.translation.z()}},
+            {"matrix", matrix}};
+}
+
+nlohmann::json toJson(const PrepareReport& r)
+{
+    nlohmann::json j = {{"input_strands", r.inputStrands}, {"input_vertices", r.inputVertices},
+                        {"strands", r.strands},            {"vertices", r.vertices},
+                        {"points", r.points ? nlohmann::json(r.points) : nlohmann::json(nullptr)}};
+    if (r.subsample) {
+        j["subsample"] = {{"requested", r.requestedStrands}, {"kept", r.strands},
+                          {"min_root_spacing", r.subsample->minSpacing}, {"coverage_radius", r.subsample->coverageRadius}};
+    } else {
+        j["subsample"] = nullptr;
+    }
+    if (r.align) {
+        nlohmann::json a = toJson(r.align->transform);
+        a["method"] = alignMethodName(r.align->method);
+        a["residual_rms"] = r.align->rms;
+        a["residual_max"] = r.align->max;
+        a["residual_rms_all"] = r.align->rmsAll;
+        a["points"] = r.align->pairs;
+        a["iterations"] = r.align->iterations;
+        a["start"] = r.align->start;
+        j["align"] = a;
+    } else {
+        j["align"] = nullptr;
+    }
+    if (r.fixed) {
+        j["fix_penetration"] = {{"head", r.fixHead},
+                                {"entering_before", r.enteringBefore},
+                                {"entering_after", r.enteringAfter},
+                                {"strands_moved", r.collision.strandsMoved},
+                                {"vertices_too_deep", r.collision.verticesTooDeep},
+                                {"tolerance", r.tolerance}};
+    } else {
+        j["fix_penetration"] = nullptr;
+    }
+    return j;
+}
+
+} // namespace vdbhair

@@ -1,0 +1,73 @@
+/// @file Prepare.h
+/// @brief A hairstyle made ready for a dataset in one call, `vdbhair prepare`: evenly spread
+/// strands kept (RootSubsample.h), the groom moved onto a common head (SimilarityAlign.h), every
+/// strand resampled to one vertex count (strands/Resample.h), and strands pushed out of the head
+/// (field/HeadCollision.h), with a report of what each step did (toJson(): the CLI's --json, the
+/// batch manifest's columns and Python's dict alike).
+///
+/// The order: subsample (even roots are unchanged by a similarity, and later steps then touch
+/// fewer strands), align, resample, fix penetration. Penetration is fixed last because a
+/// resampled strand's chords cut inside a convex head where the strand wraps around it; the fix
+/// keeps every segment's length, so the vertex count and the equal spacing survive it.
+#pragma once
+
+#include <vdbhair/dataset/RootSubsample.h>
+#include <vdbhair/dataset/SimilarityAlign.h>
+#include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/io/MeshFile.h>
+#include <vdbhair/strands/StrandSet.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <optional>
+
+namespace vdbhair {
+
+struct PrepareParams
+{
+    std::size_t points = 0;   ///< vertices per strand after resampling (at least 2); 0 keeps them
+    std::size_t strands = 0;  ///< strands kept (even roots); 0 keeps all
+    AlignParams align;
+    HeadCollisionParams collision;
+
+    /// @throw ValueError naming the field, the value and the rule.
+    void validate() const;
+};
+
+struct PrepareReport
+{
+    std::size_t inputStrands = 0, inputVertices = 0;
+    std::size_t strands = 0, vertices = 0;  ///< after every step
+    std::optional<RootSelection> subsample;  ///< when params.strands was given (strand list left empty)
+    std::size_t requestedStrands = 0;
+    std::optional<AlignResult> align;         ///< when a target head was given
+    std::size_t points = 0;                   ///< params.points (0: kept)
+    /// Fixing penetration (when a head was given): strands entering the head (countStrandsEnteringHead()
+    /// at headTolerance()) before and after, and resolveHeadCollisions()' figures.
+    bool fixed = false;
+    std::size_t enteringBefore = 0, enteringAfter = 0;
+    HeadCollisionStats collision;
+    double tolerance = 0.0;
+    std::string fixHead;  ///< the head's description (HeadObstacle::describe())
+};
+
+/// @brief Prepare @a strands in place (see above).
+/// @param head the groom's own head (the source of the alignment); needed when @a alignTo is given
+/// @param alignTo the common head to move the groom onto, or null for no alignment
+/// @param fixHead the head to push strands out of (in the output's frame: the common head when
+/// aligning), or null; strands rooted inside its scalp may stay as deep as their root
+/// (rootDepthAllowance(), the rule new hair gets in `interpolate`), no deeper
+/// @throw ValueError for bad params, an alignment without @a head, or what alignMeshes() throws.
+PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, const TriangleMesh* head,
+                             const TriangleMesh* alignTo, const HeadObstacle* fixHead, bool threaded = true);
+
+/// @brief @a s moved by @a t: positions, and thickness (per vertex and default) scaled.
+void transformStrands(StrandSet& s, const Similarity& t);
+
+/// @brief The report as JSON (`prepare --json`, Python's vdbhair.prepare()).
+nlohmann::json toJson(const PrepareReport& r);
+/// @brief A similarity as JSON: scale, rotation (3 rows), translation, and the 4x4 matrix (rows).
+nlohmann::json toJson(const Similarity& t);
+
+} // namespace vdbhair
