@@ -104,9 +104,12 @@ struct IcpStep
     double rms = 0.0;
 };
 
-IcpStep pairUp(const std::vector<Vec3d>& src, const Tree& target, const Similarity& T, double overlap, bool threaded)
+/// @param matched how many of @a target's first points are matched back to the source (the
+/// others, triangle centroids, are targets of the source's points only: as sources of pairs they
+/// would pull the source towards the middle of triangles it has no vertex in)
+IcpStep pairUp(const std::vector<Vec3d>& src, const Tree& target, std::size_t matched, const Similarity& T, double overlap, bool threaded)
 {
-    const std::size_t n = src.size(), m = target.pts.size();
+    const std::size_t n = src.size(), m = matched;
     std::vector<Vec3d> moved(n);
     forEachIndex(n, threaded, [&](std::size_t i) { moved[i] = T.apply(src[i]); }, 1024);
     std::vector<std::uint32_t> fwd(n), rev(m);
@@ -134,10 +137,10 @@ IcpStep pairUp(const std::vector<Vec3d>& src, const Tree& target, const Similari
 }
 
 /// Trimmed ICP from @a T for at most @a iterations updates; @return the RMS at the final @a T.
-double runIcp(const std::vector<Vec3d>& src, const Tree& target, Similarity& T, int iterations, const AlignParams& params,
-              bool threaded, int* done)
+double runIcp(const std::vector<Vec3d>& src, const Tree& target, std::size_t matched, Similarity& T, int iterations,
+              const AlignParams& params, bool threaded, int* done)
 {
-    IcpStep step = pairUp(src, target, T, params.overlap, threaded);
+    IcpStep step = pairUp(src, target, matched, T, params.overlap, threaded);
     int it = 0;
     for (; it < iterations; ++it) {
         Similarity next;
@@ -146,7 +149,7 @@ double runIcp(const std::vector<Vec3d>& src, const Tree& target, Similarity& T, 
         } catch (const ValueError&) {
             break;  // the kept pairs collapsed to a point: keep the last transform
         }
-        IcpStep nextStep = pairUp(src, target, next, params.overlap, threaded);
+        IcpStep nextStep = pairUp(src, target, matched, next, params.overlap, threaded);
         if (!(nextStep.rms <= step.rms)) break;  // no longer improving (or not finite)
         const double change = step.rms - nextStep.rms;
         T = next;
@@ -264,7 +267,17 @@ const char* alignMethodName(AlignMethod method)
     return method == AlignMethod::Correspondence ? "correspondence" : "icp";
 }
 
-AlignResult alignPointSets(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to, const AlignParams& params, bool threaded)
+namespace {
+
+/// @a a then @a b.
+std::vector<Vec3d> joined(std::vector<Vec3d> a, const std::vector<Vec3d>& b)
+{
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
+
+AlignResult alignPointSetsImpl(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to, const std::vector<Vec3d>& toExtra,
+                               const AlignParams& params, bool threaded)
 {
     params.validate();
     checkPoints(from, "the source");
@@ -277,7 +290,8 @@ AlignResult alignPointSets(const std::vector<Vec3d>& from, const std::vector<Vec
     // result is the same on any thread count); the lowest RMS wins, ties to the lower start.
     const std::vector<openvdb::math::Mat3d> rotations = axisRotations();
     const std::vector<Vec3d> srcStart = evenSample(from, params.startSamples);
-    const Tree targetStart(evenSample(to, params.startSamples));
+    const std::vector<Vec3d> toStart = evenSample(to, params.startSamples);
+    const Tree targetStart(joined(toStart, evenSample(toExtra, params.startSamples)));
     std::vector<Similarity> starts(rotations.size());
     std::vector<double> score(rotations.size());
     forEachIndex(rotations.size(), threaded, [&](std::size_t k) {
@@ -286,7 +300,7 @@ AlignResult alignPointSets(const std::vector<Vec3d>& from, const std::vector<Vec
         T.rotation = rotations[k];
         T.translation = Vec3d(0.0);
         T.translation = ct - T.apply(cs);
-        score[k] = runIcp(srcStart, targetStart, T, params.startIterations, params, false, nullptr);
+        score[k] = runIcp(srcStart, targetStart, toStart.size(), T, params.startIterations, params, false, nullptr);
         starts[k] = T;
     }, 1);
     std::size_t best = 0;
@@ -300,11 +314,19 @@ AlignResult alignPointSets(const std::vector<Vec3d>& from, const std::vector<Vec
     r.start = int(best);
     r.transform = starts[best];
     const std::vector<Vec3d> src = evenSample(from, params.maxSamples);
-    const Tree target(evenSample(to, params.maxSamples));
-    runIcp(src, target, r.transform, params.iterations, params, threaded, &r.iterations);
-    const Tree fullTarget(to);
+    const std::vector<Vec3d> toRefine = evenSample(to, params.maxSamples);
+    const Tree target(joined(toRefine, evenSample(toExtra, params.maxSamples)));
+    runIcp(src, target, toRefine.size(), r.transform, params.iterations, params, threaded, &r.iterations);
+    const Tree fullTarget(joined(to, toExtra));
     measureResidual(from, fullTarget, r.transform, params.overlap, threaded, r);
     return r;
+}
+
+} // namespace
+
+AlignResult alignPointSets(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to, const AlignParams& params, bool threaded)
+{
+    return alignPointSetsImpl(from, to, {}, params, threaded);
 }
 
 AlignResult alignMeshes(const TriangleMesh& from, const TriangleMesh& to, const AlignParams& params, bool threaded)
@@ -329,13 +351,13 @@ AlignResult alignMeshes(const TriangleMesh& from, const TriangleMesh& to, const 
         r.pairs = src.size();
         return r;
     }
-    // The target surface: its vertices and its triangles' centroids.
-    std::vector<Vec3d> dst = toD(to.vertices);
-    dst.reserve(to.vertices.size() + to.triangles.size());
+    // The target surface: its vertices, and its triangles' centroids as targets of the source's points.
+    std::vector<Vec3d> centroids;
+    centroids.reserve(to.triangles.size());
     for (const auto& t : to.triangles) {
-        dst.push_back((Vec3d(to.vertices[t[0]]) + Vec3d(to.vertices[t[1]]) + Vec3d(to.vertices[t[2]])) / 3.0);
+        centroids.push_back((Vec3d(to.vertices[t[0]]) + Vec3d(to.vertices[t[1]]) + Vec3d(to.vertices[t[2]])) / 3.0);
     }
-    return alignPointSets(src, dst, params, threaded);
+    return alignPointSetsImpl(src, toD(to.vertices), centroids, params, threaded);
 }
 
 } // namespace vdbhair
