@@ -63,6 +63,10 @@ PAIRS = [
     ("transfer", "smoothing", "transfer", "--smoothing"),
     ("comb", "smoothing", "comb", "--smoothing"),
     ("comb", "levels", "comb", "--levels"),
+    ("prepare", "points", "prepare", "--points"),
+    ("prepare", "count", "prepare", "--strands"),
+    ("prepare", "overlap", "prepare", "--overlap"),
+    ("strand_statistics", "bins", "info", "--bins"),
 ]
 
 
