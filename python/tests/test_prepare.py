@@ -30,7 +30,7 @@ def sphere_mesh(path, scale=1.0, shift=(0.0, 0.0, 0.0), rings=10, segments=14):
 
 
 def test_prepare_counts_alignment_and_the_command_lines_report(tmp_path):
-    hair = straight_bundle(count=30, vertices=9, length=2.0, spacing=0.1)
+    hair = straight_bundle(count=6, vertices=9, length=2.0, spacing=0.1)  # 36 strands
     head = sphere_mesh(tmp_path / "head.obj")
     target = sphere_mesh(tmp_path / "target.obj", scale=0.5, shift=(0.0, 1.7, 0.0))
     out, report = vdbhair.prepare(hair, points=20, count=10, head=head, align_to=target)
@@ -41,7 +41,7 @@ def test_prepare_counts_alignment_and_the_command_lines_report(tmp_path):
     assert report["align"]["translation"] == pytest.approx([0.0, 1.7, 0.0], abs=1e-6)
     assert report["align"]["residual_rms"] < 1e-6
     assert report["subsample"]["min_root_spacing"] >= report["subsample"]["coverage_radius"]
-    assert len(hair) == 30  # the input is not changed
+    assert len(hair) == 36  # the input is not changed
     # The same run on the command line reports the same figures.
     vdbhair.write(hair, str(tmp_path / "in.hair"))
     line = subprocess.run([cli(), "prepare", str(tmp_path / "in.hair"), str(tmp_path / "out.hair"), "--points", "20", "--strands", "10",
@@ -56,10 +56,10 @@ def test_prepare_counts_alignment_and_the_command_lines_report(tmp_path):
 
 def test_prepare_fixes_penetration_of_a_sphere_and_refuses_bad_arguments():
     # Strands rooted on top of the unit sphere, aimed through it.
-    hair = straight_bundle(count=8, vertices=12, length=3.0, spacing=0.05, direction=(1.0, -0.8, 0.0))
-    hair = vdbhair.Strands(hair.positions + np.float32([0.0, 1.001, 0.0]), hair.offsets)
+    hair = straight_bundle(count=3, vertices=12, length=3.0, spacing=0.01, direction=(1.0, -0.8, 0.0))  # 9 strands
+    hair = vdbhair.Strands(hair.positions + np.float32([0.0, 1.05, 0.0]), hair.offsets)
     out, report = vdbhair.prepare(hair, fix_penetration=(0.0, 0.0, 0.0, 1.0))
-    assert report["fix_penetration"]["entering_before"] == 8
+    assert report["fix_penetration"]["entering_before"] == 9
     assert report["fix_penetration"]["entering_after"] == 0
     assert np.linalg.norm(out.positions, axis=1).min() > 1.0 - 1e-5
     with pytest.raises(vdbhair.Error, match="prepare: PrepareParams::points 1: a strand needs at least 2 vertices"):
@@ -69,11 +69,11 @@ def test_prepare_fixes_penetration_of_a_sphere_and_refuses_bad_arguments():
 
 
 def test_strand_statistics_histograms():
-    hair = straight_bundle(count=5, vertices=9, length=4.0)
+    hair = straight_bundle(count=5, vertices=9, length=4.0)  # 25 strands
     stats = vdbhair.strand_statistics(hair, bins=4)
-    assert sum(stats["length"]["counts"]) == 5
+    assert sum(stats["length"]["counts"]) == 25
     assert stats["turning_deg"]["range"]["max"] == 0.0
-    assert sum(stats["curvature"]["histogram"]["counts"]) + stats["curvature"]["histogram"]["above"] == 45
+    assert sum(stats["curvature"]["histogram"]["counts"]) + stats["curvature"]["histogram"]["above"] == 225
 
 
 @pytest.mark.data
