@@ -19,6 +19,7 @@ struct PrepareCmdParams
 {
     std::vector<std::string> files;  ///< IN OUT, or IN with -o OUT
     std::string output, head, alignTo, fixPenetration;
+    std::string targetUp = axisName(PrepareParams{}.targetUp);  ///< PrepareParams::targetUp by name
     bool strict = false;
     PrepareParams prepare;
 };
@@ -44,7 +45,7 @@ void printReport(const std::string& input, const std::string& output, const Prep
                   << fmt(t.translation.x()) << ", " << fmt(t.translation.y()) << ", " << fmt(t.translation.z()) << "), rotation rows";
         for (int i = 0; i < 3; ++i) std::cout << " (" << fmt(t.rotation(i, 0)) << ", " << fmt(t.rotation(i, 1)) << ", " << fmt(t.rotation(i, 2)) << ")";
         std::cout << "\n  residual: RMS " << fmt(r.align->rms) << ", max " << fmt(r.align->max) << " (nearest share), RMS "
-                  << fmt(r.align->rmsAll) << " over all " << r.align->pairs << " head vertices\n";
+                  << fmt(r.align->rmsAll) << " over all " << r.align->pairs << " head vertices used\n";
     }
     if (r.points) std::cout << "  resampled to " << r.points << " points per strand\n";
     if (r.fixed) {
@@ -68,6 +69,7 @@ int runPrepare(PrepareCmdParams p, const CommonOptions& common)
     const std::string& input = inputs[0];
     strandFormatFromPath(input);
     strandFormatFromPath(p.output, /*forWriting=*/true);
+    p.prepare.targetUp = axisFromName(p.targetUp, "--target-up");
     p.prepare.validate();
     if (!p.alignTo.empty() && p.head.empty()) {
         throw ValueError("--align-to " + p.alignTo + " needs --head, the groom's own head mesh: that head is fitted to " + p.alignTo +
@@ -134,6 +136,13 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--overlap", pp.align.overlap,
                     "--align-to between different heads: the share of nearest point pairs kept at each ICP iteration (necks cut at different heights)")
         ->capture_default_str();
+    sub->add_option("--head-crop", pp.headCrop,
+                    "--align-to by ICP: use the --head vertices within this many times the roots' radius of their centroid "
+                    "(the head, not a bust's shoulders; 0: every vertex)")
+        ->capture_default_str();
+    sub->add_option("--target-up", params->targetUp,
+                    "--align-to by ICP: the common head's up axis (x, y, z, -x, -y, -z); the groom's up is from its head to its roots")
+        ->capture_default_str();
     sub->add_option("--fix-penetration", params->fixPenetration,
                     "A head (mesh or .vdb level set) in the output's frame, e.g. the --align-to mesh: strands that enter it are bent out "
                     "(lengths kept, roots fixed; a root inside the scalp may stay as deep as it is)");
@@ -144,7 +153,7 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
                 "Example: vdbhair prepare straight.hair out.data --head woman_head.ply --align-to head_model.ply "
                 "--points 100 --strands 1000 --fix-penetration head_model.ply");
     return {sub, [params, &common] { return runPrepare(*params, common); },
-            {{"PrepareParams::points", "--points"}, {"PrepareParams::strands", "--strands"}, {"AlignParams::overlap", "--overlap"}}};
+            {{"PrepareParams::points", "--points"}, {"PrepareParams::strands", "--strands"}, {"AlignParams::overlap", "--overlap"}, {"PrepareParams::headCrop", "--head-crop"}}};
 }
 
 } // namespace vdbhair::app

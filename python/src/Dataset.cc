@@ -38,11 +38,12 @@ void bindDataset(pyb::module_& m)
     m.def(
         "prepare",
         [](const StrandsPtr& strands, std::size_t points, std::size_t count, const pyb::object& headArg, const pyb::object& alignToArg,
-           const pyb::object& fixArg, double overlap, int threads) {
+           const pyb::object& fixArg, double overlap, double headCrop, int threads) {
             PrepareParams p;
             p.points = points;
             p.strands = count;
             p.align.overlap = overlap;
+            p.headCrop = headCrop;
             try {
                 p.validate();
             } catch (const ValueError& e) {
@@ -68,7 +69,7 @@ void bindDataset(pyb::module_& m)
         },
         pyb::arg("strands"), pyb::kw_only(), pyb::arg("points") = defaults.points, pyb::arg("count") = defaults.strands,
         pyb::arg("head") = pyb::none(), pyb::arg("align_to") = pyb::none(), pyb::arg("fix_penetration") = pyb::none(),
-        pyb::arg("overlap") = defaults.align.overlap, pyb::arg("threads") = 0,
+        pyb::arg("overlap") = defaults.align.overlap, pyb::arg("head_crop") = defaults.headCrop, pyb::arg("threads") = 0,
         R"doc(Make a hairstyle ready for a dataset (``vdbhair prepare IN OUT --json``): keep ``count``
 strands with evenly spread roots, move the groom onto a common head, resample every strand to
 ``points`` vertices, push strands out of a head, in that order (the input is not changed).
@@ -84,6 +85,8 @@ Args:
     fix_penetration: None, a head (a path to a mesh or a .vdb level set) or (x, y, z, r), a
         sphere, in the output's frame: strands that enter it are bent out, lengths kept.
     overlap: the share of nearest pairs ICP keeps at each iteration.
+    head_crop: ICP uses the head's vertices within this many times the roots' radius of their
+        centroid (the head, not a bust's shoulders); 0: every vertex.
     threads: worker threads, 0 for all cores (results do not depend on it).
 
 Returns:

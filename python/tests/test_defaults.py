@@ -66,6 +66,7 @@ PAIRS = [
     ("prepare", "points", "prepare", "--points"),
     ("prepare", "count", "prepare", "--strands"),
     ("prepare", "overlap", "prepare", "--overlap"),
+    ("prepare", "head_crop", "prepare", "--head-crop"),
     ("strand_statistics", "bins", "info", "--bins"),
 ]
 

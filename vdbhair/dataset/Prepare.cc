@@ -4,6 +4,8 @@
 #include <vdbhair/Parallel.h>
 #include <vdbhair/strands/Resample.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -13,6 +15,9 @@ namespace vdbhair {
 void PrepareParams::validate() const
 {
     if (points == 1) throw ValueError("PrepareParams::points 1: a strand needs at least 2 vertices (0 keeps them)");
+    if (!(headCrop >= 0.0) || !std::isfinite(headCrop)) {
+        throw ValueError("PrepareParams::headCrop " + std::to_string(headCrop) + ": must be a finite factor, 0 or more (0 keeps the whole head)");
+    }
     align.validate();
 }
 
@@ -25,6 +30,21 @@ void transformStrands(StrandSet& s, const Similarity& t)
     }, 4096);
     for (float& w : s.thickness) w = float(w * t.scale);
     s.defaults.thickness = float(s.defaults.thickness * t.scale);
+}
+
+TriangleMesh cropMeshToRoots(const TriangleMesh& mesh, const StrandSet& strands, double factor)
+{
+    Vec3d c(0.0);
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) c += Vec3d(strands.root(i));
+    c /= double(std::max<std::size_t>(1, strands.numStrands()));
+    double radius = 0.0;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) radius = std::max(radius, (Vec3d(strands.root(i)) - c).length());
+    const double limit2 = (factor * radius) * (factor * radius);
+    TriangleMesh out;
+    for (const Vec3f& v : mesh.vertices) {
+        if ((Vec3d(v) - c).lengthSqr() <= limit2) out.vertices.push_back(v);
+    }
+    return out;  // the points only: ICP matches vertices, not triangles
 }
 
 PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, const TriangleMesh* head,
@@ -49,7 +69,28 @@ PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, co
     }
     // 2. The groom's head onto the common head; the strands move with it.
     if (alignTo) {
-        r.align = alignMeshes(*head, *alignTo, params.align, threaded);
+        const bool sameMesh = head->vertices.size() == alignTo->vertices.size() && head->triangles == alignTo->triangles;
+        if (sameMesh || params.headCrop == 0.0 || strands.empty()) {
+            r.align = alignMeshes(*head, *alignTo, params.align, threaded);
+            r.headVertices = head->vertices.size();
+        } else {
+            const TriangleMesh cropped = cropMeshToRoots(*head, strands, params.headCrop);
+            if (cropped.vertices.size() < 3) {
+                throw ValueError("prepareStrands: " + std::to_string(cropped.vertices.size()) + " vertices of the groom's head lie within " +
+                                 std::to_string(params.headCrop) + " x the roots' radius of their centroid; is it the head of these strands, "
+                                 "in their frame? (headCrop 0 uses the whole head)");
+            }
+            AlignParams align = params.align;
+            if (params.targetUp.lengthSqr() > 0.0) {
+                Vec3d roots(0.0), headCentre(0.0);
+                for (std::size_t i = 0; i < strands.numStrands(); ++i) roots += Vec3d(strands.root(i));
+                for (const Vec3f& v : cropped.vertices) headCentre += Vec3d(v);
+                align.sourceUp = roots / double(strands.numStrands()) - headCentre / double(cropped.vertices.size());
+                align.targetUp = params.targetUp;
+            }
+            r.align = alignMeshes(cropped, *alignTo, align, threaded);
+            r.headVertices = cropped.vertices.size();
+        }
         transformStrands(strands, r.align->transform);
     }
     // 3. One vertex count (checked before resampleStrands() multiplies it out).
@@ -106,6 +147,7 @@ nlohmann::json toJson(const PrepareReport& r)
         a["residual_max"] = r.align->max;
         a["residual_rms_all"] = r.align->rmsAll;
         a["points"] = r.align->pairs;
+        a["head_vertices"] = r.headVertices;
         a["iterations"] = r.align->iterations;
         a["start"] = r.align->start;
         j["align"] = a;

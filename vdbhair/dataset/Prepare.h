@@ -28,6 +28,18 @@ struct PrepareParams
 {
     std::size_t points = 0;   ///< vertices per strand after resampling (at least 2); 0 keeps them
     std::size_t strands = 0;  ///< strands kept (even roots); 0 keeps all
+    /// Aligning by ICP, the groom's head is first cut to its vertices within this many times the
+    /// roots' radius (their largest distance from their centroid) of the roots' centroid: the
+    /// head the hair grows on, without the bust or shoulders many groom meshes carry (TressFX's
+    /// Ruby: a bust 290 units wide), whose vertices would otherwise outweigh the head's and fit it
+    /// to the common head at half its size. 2 was chosen on the shared grooms (ruby_long,
+    /// the TressFX ponytail, straight.hair: docs/datasets.md): 1.5 leaves too little of some heads
+    /// (straight.hair's fitted on its side), 2.5 too much of Ruby's shoulders. 0 keeps every vertex.
+    double headCrop = 2.0;
+    /// The common head's up axis (vdbhair's convention, and USC-HairSalon's: +Y). The groom's up is
+    /// the direction from its (cropped) head's centroid to its roots' centroid; ICP starts only
+    /// from rotations that keep the two within 90 degrees (AlignParams::sourceUp). Zero: any start.
+    Vec3d targetUp{0.0, 1.0, 0.0};
     AlignParams align;
     HeadCollisionParams collision;
 
@@ -42,6 +54,7 @@ struct PrepareReport
     std::optional<RootSelection> subsample;  ///< when params.strands was given (strand list left empty)
     std::size_t requestedStrands = 0;
     std::optional<AlignResult> align;         ///< when a target head was given
+    std::size_t headVertices = 0;             ///< the groom's head vertices the alignment used (after headCrop)
     std::size_t points = 0;                   ///< params.points (0: kept)
     /// Fixing penetration (when a head was given): strands entering the head (countStrandsEnteringHead()
     /// at headTolerance()) before and after, and resolveHeadCollisions()' figures.
@@ -61,6 +74,10 @@ struct PrepareReport
 /// @throw ValueError for bad params, an alignment without @a head, or what alignMeshes() throws.
 PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, const TriangleMesh* head,
                              const TriangleMesh* alignTo, const HeadObstacle* fixHead, bool threaded = true);
+
+/// @brief The vertices of @a mesh within @a factor times the roots' radius of the roots' centroid
+/// (no triangles: what ICP matches). See PrepareParams::headCrop.
+TriangleMesh cropMeshToRoots(const TriangleMesh& mesh, const StrandSet& strands, double factor);
 
 /// @brief @a s moved by @a t: positions, and thickness (per vertex and default) scaled.
 void transformStrands(StrandSet& s, const Similarity& t);

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -72,6 +73,9 @@ double rmsRadius(const std::vector<Vec3d>& pts, const Vec3d& c)
     for (const Vec3d& p : pts) s += (p - c).lengthSqr();
     return std::sqrt(s / double(pts.size()));
 }
+
+/// How many of the best starts are refined on the larger samples.
+constexpr std::size_t kRefinedStarts = 3;
 
 /// The 24 proper rotations that map coordinate axes to coordinate axes (the cube's rotations).
 std::vector<openvdb::math::Mat3d> axisRotations()
@@ -260,6 +264,9 @@ void AlignParams::validate() const
     if (startSamples < 3) throw ValueError("AlignParams::startSamples " + std::to_string(startSamples) + ": must be 3 or more");
     if (maxSamples < 3) throw ValueError("AlignParams::maxSamples " + std::to_string(maxSamples) + ": must be 3 or more");
     if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) throw ValueError("AlignParams::tolerance " + num(tolerance) + ": must be finite and non-negative");
+    for (const Vec3d* v : {&sourceUp, &targetUp}) {
+        if (!std::isfinite(v->x()) || !std::isfinite(v->y()) || !std::isfinite(v->z())) throw ValueError("AlignParams: an up direction is not finite");
+    }
 }
 
 const char* alignMethodName(AlignMethod method)
@@ -303,20 +310,39 @@ AlignResult alignPointSetsImpl(const std::vector<Vec3d>& from, const std::vector
         score[k] = runIcp(srcStart, targetStart, toStart.size(), T, params.startIterations, params, false, nullptr);
         starts[k] = T;
     }, 1);
-    std::size_t best = 0;
-    for (std::size_t k = 1; k < starts.size(); ++k) {
-        if (score[k] < score[best]) best = k;
+    // Only the starts that keep up up, when the caller says which way is up.
+    const bool upright = params.sourceUp.lengthSqr() > 0.0 && params.targetUp.lengthSqr() > 0.0;
+    auto allowed = [&](std::size_t k) {
+        if (!upright) return true;
+        Similarity R;
+        R.rotation = rotations[k];
+        return R.apply(params.sourceUp).dot(params.targetUp) > 0.0;
+    };
+    std::vector<std::size_t> order;
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+        if (allowed(k)) order.push_back(k);
     }
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return score[a] < score[b]; });
 
-    // The refinement on the larger samples.
+    // The best few starts refined on the larger samples (on a subsample two starts can rank the
+    // other way round from where they end); the lowest final RMS wins, ties to the better start.
     AlignResult r;
     r.method = AlignMethod::Icp;
-    r.start = int(best);
-    r.transform = starts[best];
     const std::vector<Vec3d> src = evenSample(from, params.maxSamples);
     const std::vector<Vec3d> toRefine = evenSample(to, params.maxSamples);
     const Tree target(joined(toRefine, evenSample(toExtra, params.maxSamples)));
-    runIcp(src, target, toRefine.size(), r.transform, params.iterations, params, threaded, &r.iterations);
+    double bestRms = std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < std::min<std::size_t>(order.size(), kRefinedStarts); ++c) {
+        Similarity T = starts[order[c]];
+        int iterations = 0;
+        const double rms = runIcp(src, target, toRefine.size(), T, params.iterations, params, threaded, &iterations);
+        if (rms < bestRms) {
+            bestRms = rms;
+            r.transform = T;
+            r.start = int(order[c]);
+            r.iterations = iterations;
+        }
+    }
     const Tree fullTarget(joined(to, toExtra));
     measureResidual(from, fullTarget, r.transform, params.overlap, threaded, r);
     return r;

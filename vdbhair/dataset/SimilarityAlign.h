@@ -58,6 +58,11 @@ struct AlignParams
     std::size_t maxSamples = 20000;   ///< points of each set (evenly by index) used for the refinement
     /// Stop when the RMS of the kept pairs changes by less than this share of it in an iteration.
     double tolerance = 1e-10;
+    /// When both are non-zero, only the starts that turn @a sourceUp to within 90 degrees of
+    /// @a targetUp are tried: a head's rounded top fits the other head upside down nearly as well
+    /// as upright, so ICP needs to be told which way is up (prepareStrands() takes the source's up
+    /// from its head to its roots).
+    Vec3d sourceUp{0.0}, targetUp{0.0};
 
     /// @throw ValueError naming the field, the value and the rule.
     void validate() const;
@@ -82,7 +87,7 @@ struct AlignResult
 };
 
 /// @brief The similarity that moves the points @a from onto the points @a to, without pairs
-/// (trimmed ICP, both ways, from the 24 axis rotations; see above). Deterministic and independent
+/// (trimmed ICP, both ways, from the 24 axis rotations, or those of them that keep up up; see above). Deterministic and independent
 /// of the thread count.
 /// @throw ValueError for fewer than 3 points in either set, non-finite points, or bad params.
 AlignResult alignPointSets(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to, const AlignParams& params = {},
