@@ -41,10 +41,21 @@ TriangleMesh cropMeshToRoots(const TriangleMesh& mesh, const StrandSet& strands,
     for (std::size_t i = 0; i < strands.numStrands(); ++i) radius = std::max(radius, (Vec3d(strands.root(i)) - c).length());
     const double limit2 = (factor * radius) * (factor * radius);
     TriangleMesh out;
-    for (const Vec3f& v : mesh.vertices) {
-        if ((Vec3d(v) - c).lengthSqr() <= limit2) out.vertices.push_back(v);
+    std::vector<std::uint32_t> index(mesh.vertices.size(), std::numeric_limits<std::uint32_t>::max());
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+        if ((Vec3d(mesh.vertices[i]) - c).lengthSqr() > limit2) continue;
+        index[i] = std::uint32_t(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[i]);
     }
-    return out;  // the points only: ICP matches vertices, not triangles
+    for (const auto& t : mesh.triangles) {
+        if (t[0] >= index.size() || t[1] >= index.size() || t[2] >= index.size()) continue;
+        const std::array<std::uint32_t, 3> kept{index[t[0]], index[t[1]], index[t[2]]};
+        if (kept[0] != std::numeric_limits<std::uint32_t>::max() && kept[1] != std::numeric_limits<std::uint32_t>::max() &&
+            kept[2] != std::numeric_limits<std::uint32_t>::max()) {
+            out.triangles.push_back(kept);
+        }
+    }
+    return out;
 }
 
 PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, const TriangleMesh* head,

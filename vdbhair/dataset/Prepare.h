@@ -75,8 +75,8 @@ struct PrepareReport
 PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, const TriangleMesh* head,
                              const TriangleMesh* alignTo, const HeadObstacle* fixHead, bool threaded = true);
 
-/// @brief The vertices of @a mesh within @a factor times the roots' radius of the roots' centroid
-/// (no triangles: what ICP matches). See PrepareParams::headCrop.
+/// @brief The vertices of @a mesh within @a factor times the roots' radius of the roots' centroid,
+/// and the triangles between them. See PrepareParams::headCrop.
 TriangleMesh cropMeshToRoots(const TriangleMesh& mesh, const StrandSet& strands, double factor);
 
 /// @brief @a s moved by @a t: positions, and thickness (per vertex and default) scaled.

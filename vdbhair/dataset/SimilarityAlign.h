@@ -7,11 +7,13 @@
 /// (`--align-to`), never the strands themselves. When both meshes have the same vertex count and
 /// the same triangles (two copies of one head model, moved), vertex i corresponds to vertex i and
 /// the transform is Umeyama's closed form on those pairs. Otherwise the vertices are matched
-/// without pairs by trimmed ICP (Chetverikov et al. 2002): each iteration pairs every point of
-/// each set with its nearest point of the other (a k-d tree; the target also gets its triangles'
-/// centroids, so a pair is nearer the surface than the vertex spacing), drops the worst
-/// (1 - overlap) share of the pairs in each direction (necks and shoulders cut at different
-/// heights), and solves Umeyama on the rest. Matching both ways keeps the scale from collapsing
+/// without pairs by trimmed ICP (Chetverikov et al. 2002): each iteration pairs every (sampled)
+/// vertex of each mesh with the nearest point on the other's surface (a k-d tree of vertices, then
+/// the triangles around the nearest four), drops the worst (1 - overlap) share of the pairs in
+/// each direction (necks and shoulders cut at different heights), and takes a Gauss-Newton step
+/// of the similarity that moves each point onto the plane of its match (point-to-plane ICP, Chen
+/// & Medioni 1992, with a scale): matched point to point, ICP converges only linearly, and stalls
+/// one vertex off on two samplings of one surface. Matching both ways keeps the scale from collapsing
 /// onto a patch of the target, which one-way matching with a free scale rewards. Hairstyles come
 /// in any up axis and facing, so ICP starts from the 24 rotations that map axes to axes (each
 /// with the scale of the two sets' RMS radii and their centroids matched), run on a subsample, and
@@ -56,8 +58,9 @@ struct AlignParams
     int startIterations = 25;      ///< ICP iterations of each of the 24 starts
     std::size_t startSamples = 1500;  ///< points of each set (evenly by index) used for the starts
     std::size_t maxSamples = 20000;   ///< points of each set (evenly by index) used for the refinement
-    /// Stop when the RMS of the kept pairs changes by less than this share of it in an iteration.
-    double tolerance = 1e-10;
+    /// Stop when the RMS of the kept pairs changes by less than this share of it in an iteration
+    /// (point-to-plane steps converge in a few iterations; below this the change is rounding).
+    double tolerance = 1e-5;
     /// When both are non-zero, only the starts that turn @a sourceUp to within 90 degrees of
     /// @a targetUp are tried: a head's rounded top fits the other head upside down nearly as well
     /// as upright, so ICP needs to be told which way is up (prepareStrands() takes the source's up
