@@ -95,8 +95,9 @@ PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, co
             if (params.targetUp.lengthSqr() > 0.0) {
                 Vec3d roots(0.0), headCentre(0.0);
                 for (std::size_t i = 0; i < strands.numStrands(); ++i) roots += Vec3d(strands.root(i));
-                for (const Vec3f& v : cropped.vertices) headCentre += Vec3d(v);
-                align.sourceUp = roots / double(strands.numStrands()) - headCentre / double(cropped.vertices.size());
+                // The whole head's centroid (the cut one's is near the roots, by construction).
+                for (const Vec3f& v : head->vertices) headCentre += Vec3d(v);
+                align.sourceUp = roots / double(strands.numStrands()) - headCentre / double(head->vertices.size());
                 align.targetUp = params.targetUp;
             }
             r.align = alignMeshes(cropped, *alignTo, align, threaded);

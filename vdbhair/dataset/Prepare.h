@@ -32,12 +32,13 @@ struct PrepareParams
     /// roots' radius (their largest distance from their centroid) of the roots' centroid: the
     /// head the hair grows on, without the bust or shoulders many groom meshes carry (TressFX's
     /// Ruby: a bust 290 units wide), whose vertices would otherwise outweigh the head's and fit it
-    /// to the common head at half its size. 2 was chosen on the shared grooms (ruby_long,
-    /// the TressFX ponytail, straight.hair: docs/datasets.md): 1.5 leaves too little of some heads
-    /// (straight.hair's fitted on its side), 2.5 too much of Ruby's shoulders. 0 keeps every vertex.
+    /// to the common head at half its size. 2 was chosen on the shared grooms by looking at the
+    /// results (docs/datasets.md): at 1.5 straight.hair's head is fitted rolled 27 degrees (its
+    /// straight strands hang aslant), at 2.5 and more, or 0, Ruby's head at half size. 0 keeps
+    /// every vertex.
     double headCrop = 2.0;
     /// The common head's up axis (vdbhair's convention, and USC-HairSalon's: +Y). The groom's up is
-    /// the direction from its (cropped) head's centroid to its roots' centroid; ICP starts only
+    /// the direction from its whole head's centroid to its roots' centroid; ICP starts only
     /// from rotations that keep the two within 90 degrees (AlignParams::sourceUp). Zero: any start.
     Vec3d targetUp{0.0, 1.0, 0.0};
     AlignParams align;

@@ -77,6 +77,11 @@ double rmsRadius(const std::vector<Vec3d>& pts, const Vec3d& c)
 
 /// How many of the best starts are refined on the larger samples.
 constexpr std::size_t kRefinedStarts = 3;
+/// A result keeps up up when the source's up turns to within 30 degrees of the target's. The
+/// direction from a head's centroid to its roots' leans back from the vertical by 10-20 degrees
+/// on the shared grooms; fits of a rounded head on its side or upside down lean 38 degrees and
+/// more (docs/datasets.md).
+constexpr double kUprightCosine = 0.866;
 
 /// The 24 proper rotations that map coordinate axes to coordinate axes (the cube's rotations).
 std::vector<openvdb::math::Mat3d> axisRotations()
@@ -513,13 +518,18 @@ AlignResult alignSurfaces(const std::vector<Vec3d>& from, const std::vector<std:
     const std::vector<openvdb::math::Mat3d> rotations = axisRotations();
     const Side srcStart{&from, &fromTriangles, evenIndices(from.size(), params.startSamples)};
     const Side tgtStart{&to, &toTriangles, evenIndices(to.size(), params.startSamples)};
-    // Only the starts that keep up up, when the caller says which way is up.
+    // Only the starts that keep up up, when the caller says which way is up; and only the
+    // results that still do (ICP may slide a rounded head over the other until it is upside down).
     const bool upright = params.sourceUp.lengthSqr() > 0.0 && params.targetUp.lengthSqr() > 0.0;
+    auto upCosine = [&](const openvdb::math::Mat3d& rotation) {
+        Similarity R;
+        R.rotation = rotation;
+        return R.apply(params.sourceUp).unit().dot(params.targetUp.unit());
+    };
+    auto keepsUp = [&](const Similarity& T) { return !upright || upCosine(T.rotation) >= kUprightCosine; };
     std::vector<std::size_t> order;
     for (std::size_t k = 0; k < rotations.size(); ++k) {
-        Similarity R;
-        R.rotation = rotations[k];
-        if (!upright || R.apply(params.sourceUp).dot(params.targetUp) > 0.0) order.push_back(k);
+        if (!upright || upCosine(rotations[k]) > 0.0) order.push_back(k);
     }
     std::vector<Similarity> starts(rotations.size());
     std::vector<double> score(rotations.size(), std::numeric_limits<double>::infinity());
@@ -533,7 +543,13 @@ AlignResult alignSurfaces(const std::vector<Vec3d>& from, const std::vector<std:
         score[k] = runIcp(srcStart, target, tgtStart, T, params.startIterations, params, false, nullptr);
         starts[k] = T;
     }, 1);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return score[a] < score[b]; });
+    // Starts that slid out of upright rank after every upright one.
+    std::vector<char> upOk(rotations.size(), 1);
+    for (std::size_t k : order) upOk[k] = keepsUp(starts[k]);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        if (upOk[a] != upOk[b]) return upOk[a] > upOk[b];
+        return score[a] < score[b];
+    });
 
     // The best few starts refined on the larger samples (on a subsample two starts can rank the
     // other way round from where they end); the lowest final RMS wins, ties to the better start.
@@ -542,11 +558,14 @@ AlignResult alignSurfaces(const std::vector<Vec3d>& from, const std::vector<std:
     const Side src{&from, &fromTriangles, evenIndices(from.size(), params.maxSamples)};
     const Side tgt{&to, &toTriangles, evenIndices(to.size(), params.maxSamples)};
     double bestRms = std::numeric_limits<double>::infinity();
+    bool bestUp = false;
     for (std::size_t c = 0; c < std::min<std::size_t>(order.size(), kRefinedStarts); ++c) {
         Similarity T = starts[order[c]];
         int iterations = 0;
         const double rms = runIcp(src, target, tgt, T, params.iterations, params, threaded, &iterations);
-        if (rms < bestRms) {
+        const bool up = keepsUp(T);
+        if ((up && !bestUp) || (up == bestUp && rms < bestRms)) {
+            bestUp = up;
             bestRms = rms;
             r.transform = T;
             r.start = int(order[c]);

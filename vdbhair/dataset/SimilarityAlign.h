@@ -62,9 +62,10 @@ struct AlignParams
     /// (point-to-plane steps converge in a few iterations; below this the change is rounding).
     double tolerance = 1e-5;
     /// When both are non-zero, only the starts that turn @a sourceUp to within 90 degrees of
-    /// @a targetUp are tried: a head's rounded top fits the other head upside down nearly as well
-    /// as upright, so ICP needs to be told which way is up (prepareStrands() takes the source's up
-    /// from its head to its roots).
+    /// @a targetUp are tried, and a result that turns it to within 30 degrees wins over any that
+    /// does not: a head's rounded top fits the other head upside down or on its side nearly as
+    /// well as upright, so ICP needs to be told which way is up (prepareStrands() takes the
+    /// source's up from its head's centroid to its roots').
     Vec3d sourceUp{0.0}, targetUp{0.0};
 
     /// @throw ValueError naming the field, the value and the rule.
