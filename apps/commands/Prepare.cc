@@ -61,7 +61,7 @@ int runPrepare(PrepareCmdParams p, const CommonOptions& common)
     // The command line, before anything is read.
     std::vector<std::string> inputs = p.files;
     if (p.output.empty()) {
-        if (inputs.size() != 2) throw ValueError("needs an input and an output: 'prepare IN OUT' or 'prepare IN -o OUT'");
+        if (inputs.size() < 2) throw ValueError("needs an input and an output: 'prepare IN OUT' or 'prepare IN -o OUT'");
         p.output = inputs.back();
         inputs.pop_back();
     }

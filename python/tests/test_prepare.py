@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import vdbhair
-from conftest import shared_data, straight_bundle
+from conftest import straight_bundle
 from test_defaults import cli
 
 
@@ -77,8 +77,8 @@ def test_strand_statistics_histograms():
 
 
 @pytest.mark.data
-def test_prepare_a_usc_guide_set():
-    data = shared_data()
+def test_prepare_a_usc_guide_set(shared_data):
+    data = shared_data
     hair = vdbhair.read(str(data / "hair/usc_data/hairnet_cstrands/cstrands00001.data"))
     head = str(data / "scalp/usc_hairsalon/head_model.ply")
     out, report = vdbhair.prepare(hair, points=100, count=4, head=head, align_to=head, fix_penetration=head)
