@@ -122,7 +122,9 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
     sub->add_flag("--stats", params->stats, "Also histograms of strand length, turning (degrees per strand), curvature (per vertex) and vertices per strand");
-    sub->add_option("--bins", params->bins, "Bins per --stats histogram (1 to 10000)")->capture_default_str();
+    sub->add_option("--bins", params->bins, "Bins per --stats histogram (1 to 10000)")->check(CLI::Validator(
+        [](std::string& v) { return !v.empty() && v[0] == '-' ? "Value " + v + " is negative (1 to 10000 bins)" : std::string(); }, ""))
+        ->capture_default_str();
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair info scenes/default/ponytail.hair --json");

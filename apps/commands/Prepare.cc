@@ -15,6 +15,11 @@ namespace vdbhair::app {
 
 namespace {
 
+/// A count's check with a message in words (CLI::NonNegativeNumber's names a 309-digit bound):
+/// without it, -3 would wrap around to a huge unsigned count.
+const CLI::Validator kCount(
+    [](std::string& v) { return !v.empty() && v[0] == '-' ? "Value " + v + " is negative (a count is 0 or more)" : std::string(); }, "");
+
 struct PrepareCmdParams
 {
     std::vector<std::string> files;  ///< IN OUT, or IN with -o OUT
@@ -125,9 +130,11 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("files", params->files, "IN OUT, or IN with -o OUT")->required();
     sub->add_option("-o,--output", params->output, "Output strand file; its extension picks the format (.hair .data .obj .ply .vdb .usda .abc)");
     sub->add_option("--points", pp.points, "Resample every strand to exactly N vertices, equally spaced in arc length, root and tip kept (0: keep)")
+        ->check(kCount)
         ->capture_default_str();
     sub->add_option("--strands", pp.strands,
                     "Keep N strands with evenly spread roots (farthest-point sampling of the roots; 0: keep all; all when fewer)")
+        ->check(kCount)
         ->capture_default_str();
     sub->add_option("--head", params->head, "The groom's own head mesh (.ply, .obj), in the strands' frame: the source of --align-to");
     sub->add_option("--align-to", params->alignTo,
