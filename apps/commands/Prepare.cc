@@ -25,6 +25,7 @@ struct PrepareCmdParams
     std::vector<std::string> files;  ///< IN OUT, or IN with -o OUT
     std::string output, head, alignTo, fixPenetration;
     std::string targetUp = axisName(PrepareParams{}.targetUp);  ///< PrepareParams::targetUp by name
+    std::string rootDepth = rootDepthName(PrepareParams{}.rootDepth);
     bool strict = false;
     PrepareParams prepare;
 };
@@ -56,6 +57,7 @@ void printReport(const std::string& input, const std::string& output, const Prep
     if (r.fixed) {
         std::cout << "  penetration (" << r.fixHead << "): " << r.enteringBefore << " strands entered the head before, "
                   << r.enteringAfter << " after; " << r.collision.strandsMoved << " strands moved";
+        if (r.rootsLifted) std::cout << ", " << r.rootsLifted << " lifted to the surface by their root";
         if (r.collision.verticesTooDeep) std::cout << ", " << r.collision.verticesTooDeep << " vertices still too deep";
         std::cout << "\n";
     }
@@ -75,6 +77,7 @@ int runPrepare(PrepareCmdParams p, const CommonOptions& common)
     strandFormatFromPath(input);
     strandFormatFromPath(p.output, /*forWriting=*/true);
     p.prepare.targetUp = axisFromName(p.targetUp, "--target-up");
+    p.prepare.rootDepth = rootDepthFromName(p.rootDepth);
     p.prepare.validate();
     if (!p.alignTo.empty() && p.head.empty()) {
         throw ValueError("--align-to " + p.alignTo + " needs --head, the groom's own head mesh: that head is fitted to " + p.alignTo +
@@ -153,6 +156,10 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--fix-penetration", params->fixPenetration,
                     "A head (mesh or .vdb level set) in the output's frame, e.g. the --align-to mesh: strands that enter it are bent out "
                     "(lengths kept, roots fixed; a root inside the scalp may stay as deep as it is)");
+    sub->add_option("--root-depth", params->rootDepth,
+                    "--fix-penetration: keep (a root inside the head stays, its strand no deeper than it) or surface (the strand is "
+                    "first moved out along the head's normal until its root is on the surface: roots under a new scalp after --align-to)")
+        ->capture_default_str();
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
@@ -160,7 +167,7 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
                 "Example: vdbhair prepare straight.hair out.data --head woman_head.ply --align-to head_model.ply "
                 "--points 100 --strands 1000 --fix-penetration head_model.ply");
     return {sub, [params, &common] { return runPrepare(*params, common); },
-            {{"PrepareParams::points", "--points"}, {"PrepareParams::strands", "--strands"}, {"AlignParams::overlap", "--overlap"}, {"PrepareParams::headCrop", "--head-crop"}}};
+            {{"PrepareParams::points", "--points"}, {"PrepareParams::strands", "--strands"}, {"AlignParams::overlap", "--overlap"}, {"PrepareParams::headCrop", "--head-crop"}, {"PrepareParams::rootDepth", "--root-depth"}}};
 }
 
 } // namespace vdbhair::app

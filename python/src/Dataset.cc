@@ -38,12 +38,17 @@ void bindDataset(pyb::module_& m)
     m.def(
         "prepare",
         [](const StrandsPtr& strands, std::size_t points, std::size_t count, const pyb::object& headArg, const pyb::object& alignToArg,
-           const pyb::object& fixArg, double overlap, double headCrop, int threads) {
+           const pyb::object& fixArg, const std::string& rootDepth, double overlap, double headCrop, int threads) {
             PrepareParams p;
             p.points = points;
             p.strands = count;
             p.align.overlap = overlap;
             p.headCrop = headCrop;
+            try {
+                p.rootDepth = rootDepthFromName(rootDepth);
+            } catch (const ValueError&) {
+                throw ValueError("prepare: root_depth '" + rootDepth + "': must be keep or surface");
+            }
             try {
                 p.validate();
             } catch (const ValueError& e) {
@@ -69,6 +74,7 @@ void bindDataset(pyb::module_& m)
         },
         pyb::arg("strands"), pyb::kw_only(), pyb::arg("points") = defaults.points, pyb::arg("count") = defaults.strands,
         pyb::arg("head") = pyb::none(), pyb::arg("align_to") = pyb::none(), pyb::arg("fix_penetration") = pyb::none(),
+        pyb::arg("root_depth") = std::string(rootDepthName(defaults.rootDepth)),
         pyb::arg("overlap") = defaults.align.overlap, pyb::arg("head_crop") = defaults.headCrop, pyb::arg("threads") = 0,
         R"doc(Make a hairstyle ready for a dataset (``vdbhair prepare IN OUT --json``): keep ``count``
 strands with evenly spread roots, move the groom onto a common head, resample every strand to
@@ -84,6 +90,8 @@ Args:
         move with it.
     fix_penetration: None, a head (a path to a mesh or a .vdb level set) or (x, y, z, r), a
         sphere, in the output's frame: strands that enter it are bent out, lengths kept.
+    root_depth: "keep" (a root inside the head stays, its strand no deeper) or "surface" (the
+        strand is first moved out along the normal until its root is on the surface).
     overlap: the share of nearest pairs ICP keeps at each iteration.
     head_crop: ICP uses the head's vertices within this many times the roots' radius of their
         centroid (the head, not a bust's shoulders); 0: every vertex.

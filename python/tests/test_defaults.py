@@ -67,6 +67,7 @@ PAIRS = [
     ("prepare", "count", "prepare", "--strands"),
     ("prepare", "overlap", "prepare", "--overlap"),
     ("prepare", "head_crop", "prepare", "--head-crop"),
+    ("prepare", "root_depth", "prepare", "--root-depth"),
     ("strand_statistics", "bins", "info", "--bins"),
 ]
 

@@ -149,6 +149,7 @@ TEST_CASE("vdbhair --help: every default is the library's", "[apps]")
         {"prepare", "--overlap", shownAs(PrepareParams().align.overlap)},
         {"prepare", "--head-crop", shownAs(PrepareParams().headCrop)},
         {"prepare", "--target-up", axisName(PrepareParams().targetUp)},
+        {"prepare", "--root-depth", rootDepthName(PrepareParams().rootDepth)},
         {"info", "--bins", shownAs(kDefaultHistogramBins)},
         {"convert", "--grid", ReadOptions().vdbGrid},
         {"convert", "--codec", positionCodecName(WriteOptions().vdb.codec)},

@@ -84,6 +84,40 @@ TEST_CASE("prepareStrands: --fix-penetration leaves no vertex inside a sphere he
     }
 }
 
+TEST_CASE("prepareStrands: --root-depth surface lifts strands rooted inside a sphere head onto it", "[dataset]")
+{
+    // Strands rooted 0.1 inside the unit sphere, straight out and on through it again.
+    StrandSet s;
+    for (int i = 0; i < 12; ++i) {
+        const double a = 0.5 * i;
+        const Vec3d root = Vec3d(std::cos(a), 0.3, std::sin(a)).unit() * 0.9;
+        const Vec3d dir = Vec3d(-std::sin(a), -0.2, std::cos(a)).unit();
+        std::vector<Vec3f> pts;
+        for (int k = 0; k < 20; ++k) {
+            const Vec3d p = root + dir * (0.1 * k);
+            pts.emplace_back(float(p.x()), float(p.y()), float(p.z()));
+        }
+        s.addStrand(pts);
+    }
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    StrandSet kept = s;
+    PrepareParams keep;
+    prepareStrands(kept, keep, nullptr, nullptr, &head);
+    PrepareParams lift;
+    lift.rootDepth = RootDepth::Surface;
+    const PrepareReport r = prepareStrands(s, lift, nullptr, nullptr, &head);
+    CHECK(r.rootsLifted == 12);
+    HeadObstacle::Probe probe(head);
+    double deepest = 0.0, deepestKept = 0.0;
+    for (const Vec3f& v : s.positions) deepest = std::min(deepest, probe.distance(Vec3d(v.x(), v.y(), v.z())));
+    for (const Vec3f& v : kept.positions) deepestKept = std::min(deepestKept, probe.distance(Vec3d(v.x(), v.y(), v.z())));
+    CHECK(deepest > -1e-5);
+    CHECK(deepestKept < -0.09);  // keep: as deep as the roots
+    // On the surface, as pushOut() places a point: just outside it (1e-4 of the radius here).
+    for (std::size_t i = 0; i < s.numStrands(); ++i) CHECK(Vec3d(s.root(i)).length() == Approx(1.0).margin(2e-4));
+    REQUIRE_THROWS_WITH(rootDepthFromName("deep"), Contains("PrepareParams::rootDepth 'deep': must be keep or surface"));
+}
+
 TEST_CASE("prepareStrands: aligning a groom's head to a moved copy moves the strands by that transform", "[dataset]")
 {
     // The head: a coarse sphere mesh; the target: the same mesh scaled, turned and moved.

@@ -32,6 +32,38 @@ void transformStrands(StrandSet& s, const Similarity& t)
     s.defaults.thickness = float(s.defaults.thickness * t.scale);
 }
 
+RootDepth rootDepthFromName(const std::string& name)
+{
+    if (name == "keep") return RootDepth::Keep;
+    if (name == "surface") return RootDepth::Surface;
+    throw ValueError("PrepareParams::rootDepth '" + name + "': must be keep or surface");
+}
+
+const char* rootDepthName(RootDepth depth)
+{
+    return depth == RootDepth::Keep ? "keep" : "surface";
+}
+
+std::size_t liftRootsToSurface(StrandSet& strands, const HeadObstacle& head, bool threaded)
+{
+    std::vector<char> lifted(strands.numStrands(), 0);
+    forEachRange(strands.numStrands(), threaded, 64, [&](const tbb::blocked_range<std::size_t>& range) {
+        HeadObstacle::Probe probe(head);  // one per range: a probe holds a grid accessor
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const Vec3f& root = strands.root(i);
+            Vec3d p(root.x(), root.y(), root.z());
+            const Vec3d before = p;
+            if (!probe.pushOut(p, 0.0)) continue;
+            const Vec3f delta(float(p.x() - before.x()), float(p.y() - before.y()), float(p.z() - before.z()));
+            for (std::size_t v = strands.begin(i); v < strands.end(i); ++v) strands.positions[v] += delta;
+            lifted[i] = 1;
+        }
+    });
+    std::size_t n = 0;
+    for (char l : lifted) n += std::size_t(l);
+    return n;
+}
+
 TriangleMesh cropMeshToRoots(const TriangleMesh& mesh, const StrandSet& strands, double factor)
 {
     Vec3d c(0.0);
@@ -121,6 +153,7 @@ PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, co
         r.tolerance = headTolerance(*fixHead);
         r.fixHead = fixHead->describe(false);
         r.enteringBefore = countStrandsEnteringHead(strands, *fixHead, r.tolerance, threaded);
+        if (params.rootDepth == RootDepth::Surface) r.rootsLifted = liftRootsToSurface(strands, *fixHead, threaded);
         r.collision = resolveHeadCollisions(strands, *fixHead, rootDepthAllowance(strands, *fixHead, threaded), params.collision, threaded);
         r.enteringAfter = countStrandsEnteringHead(strands, *fixHead, r.tolerance, threaded);
     }
@@ -171,6 +204,7 @@ nlohmann::json toJson(const PrepareReport& r)
                                 {"entering_before", r.enteringBefore},
                                 {"entering_after", r.enteringAfter},
                                 {"strands_moved", r.collision.strandsMoved},
+                                {"roots_lifted", r.rootsLifted},
                                 {"vertices_too_deep", r.collision.verticesTooDeep},
                                 {"tolerance", r.tolerance}};
     } else {

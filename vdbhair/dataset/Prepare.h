@@ -24,6 +24,17 @@
 
 namespace vdbhair {
 
+/// What --fix-penetration does with a root inside the head.
+enum class RootDepth
+{
+    Keep,    ///< the root stays; its strand may be as deep as the root, no deeper (interpolate's rule)
+    Surface  ///< the strand is first moved along the head's normal at its root until the root is on the surface
+};
+
+/// @throw ValueError unless "keep" or "surface".
+RootDepth rootDepthFromName(const std::string& name);
+const char* rootDepthName(RootDepth depth);
+
 struct PrepareParams
 {
     std::size_t points = 0;   ///< vertices per strand after resampling (at least 2); 0 keeps them
@@ -43,6 +54,9 @@ struct PrepareParams
     Vec3d targetUp{0.0, 1.0, 0.0};
     AlignParams align;
     HeadCollisionParams collision;
+    /// Keep suits hair whose roots sit on the head; after aligning to another person's head,
+    /// roots can end under the new scalp and Surface brings them (and their strands) up to it.
+    RootDepth rootDepth = RootDepth::Keep;
 
     /// @throw ValueError naming the field, the value and the rule.
     void validate() const;
@@ -62,6 +76,7 @@ struct PrepareReport
     bool fixed = false;
     std::size_t enteringBefore = 0, enteringAfter = 0;
     HeadCollisionStats collision;
+    std::size_t rootsLifted = 0;  ///< strands moved up to the surface (RootDepth::Surface)
     double tolerance = 0.0;
     std::string fixHead;  ///< the head's description (HeadObstacle::describe())
 };
@@ -79,6 +94,10 @@ PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, co
 /// @brief The vertices of @a mesh within @a factor times the roots' radius of the roots' centroid,
 /// and the triangles between them. See PrepareParams::headCrop.
 TriangleMesh cropMeshToRoots(const TriangleMesh& mesh, const StrandSet& strands, double factor);
+
+/// @brief Every strand whose root is inside @a head moved, whole, along the head's normal until its
+/// root is on the surface (HeadObstacle::Probe::pushOut()). In parallel. @return how many moved.
+std::size_t liftRootsToSurface(StrandSet& strands, const HeadObstacle& head, bool threaded = true);
 
 /// @brief @a s moved by @a t: positions, and thickness (per vertex and default) scaled.
 void transformStrands(StrandSet& s, const Similarity& t);
