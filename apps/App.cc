@@ -159,7 +159,8 @@ std::vector<Command> addCommands(CLI::App& app, CommonOptions& common)
         {"fit", addFitCommand}, {"scalp", addScalpCommand}, {"roots", addRootsCommand},
         {"interpolate", addInterpolateCommand}, {"reconstruct", addReconstructCommand}, {"synth", addSynthCommand},
         {"transfer", addTransferCommand}, {"comb", addCombCommand}, {"inspect", addInspectCommand}, {"compare", addCompareCommand},
-        {"render", addRenderCommand}, {"demo", addDemoCommand}, {"batch", addBatchCommand}};
+        {"render", addRenderCommand}, {"demo", addDemoCommand}, {"batch", addBatchCommand},
+        {"prepare", addPrepareCommand}};
     std::vector<Command> commands;
     for (const Verb& v : verbs()) commands.push_back(adders.at(v.name)(app, common));
     return commands;

@@ -41,6 +41,7 @@ constexpr Verb kVerbs[] = {
     {"transfer", "BASE's global flow with DETAILS' wisps and curls (Wang et al. 2009, section 6): BASE keeps its coarsest level, the finer levels come from DETAILS by cluster-oriented detail transfer"},
     {"comb", "Detail-preserving combing (Wang et al. 2009, section 6): the coarsest wisps turn toward each stroke's direction, every strand follows its wisp with its own detail, lengths and roots kept"},
     {"compare", "Compare a hairstyle B with a reference A: oriented-point precision, recall and F1 (HairGS), Chamfer, strand-pair position, curvature and Frechet errors (Perm), shares leaving A's volume and entering a head"},
+    {"prepare", "Make a hairstyle ready for a dataset: even roots (--strands), aligned to a common head (--align-to), resampled (--points), pushed out of the head (--fix-penetration)"},
     {"inspect", "Look into a .vdb file: value statistics, tiles, memory, bounds, leaf fill, metadata in words; slices as images"},
     {"render", "Preview strands as an image: lit fibres, depth-correct, anti-aliased"},
     {"demo", "The main job: refine a hairstyle through its own tangent field, all results in one folder"},

@@ -199,6 +199,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common);
 Command addTransferCommand(CLI::App& app, CommonOptions& common);
 Command addCombCommand(CLI::App& app, CommonOptions& common);
 Command addBatchCommand(CLI::App& app, CommonOptions& common);
+Command addPrepareCommand(CLI::App& app, CommonOptions& common);
 
 /// @brief The options of `synth`, `transfer` and `comb` that are not plain SynthParams fields.
 struct SynthOptionText

@@ -114,7 +114,7 @@ void checkArgs(const std::vector<std::string>& args, const std::string& where)
 const std::vector<std::string>& batchVerbs()
 {
     static const std::vector<std::string> verbs{"convert", "field",       "refine", "retrace", "fit",   "render", "grow",
-                                                "reconstruct", "interpolate", "synth", "comb", "scalp", "roots"};
+                                                "reconstruct", "interpolate", "synth", "comb", "scalp", "roots", "prepare"};
     return verbs;
 }
 

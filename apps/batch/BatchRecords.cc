@@ -2,7 +2,10 @@
 
 #include <vdbhair/Exceptions.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <functional>
+#include <map>
 #include <cstring>
 #include <fstream>
 
@@ -11,6 +14,91 @@
 #include <unistd.h>
 
 namespace vdbhair::app {
+
+namespace {
+
+/// A report's cells by dotted path, in order met (a scalar, or an array of scalars joined by spaces).
+void flatten(const nlohmann::json& j, const std::string& prefix, std::vector<std::pair<std::string, std::string>>& out)
+{
+    auto scalar = [](const nlohmann::json& v) -> std::string {
+        if (v.is_string()) return v.get<std::string>();
+        if (v.is_null()) return "";
+        return v.dump();
+    };
+    if (j.is_object()) {
+        for (auto it = j.begin(); it != j.end(); ++it) flatten(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
+    } else if (j.is_array()) {
+        std::string cell;
+        bool flat = true;
+        std::function<void(const nlohmann::json&)> add = [&](const nlohmann::json& v) {
+            if (v.is_array()) {
+                for (const auto& e : v) add(e);
+            } else if (v.is_object()) {
+                flat = false;
+            } else {
+                cell += (cell.empty() ? "" : " ") + scalar(v);
+            }
+        };
+        add(j);
+        if (flat) out.emplace_back(prefix, cell);
+    } else {
+        out.emplace_back(prefix, scalar(j));
+    }
+}
+
+std::string csvCell(const std::string& s)
+{
+    if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+}
+
+} // namespace
+
+std::string manifestCsv(const std::vector<nlohmann::json>& records)
+{
+    std::vector<const nlohmann::json*> rows;
+    for (const nlohmann::json& r : records) rows.push_back(&r);
+    auto index = [](const nlohmann::json& r) { return r.contains("index") && r["index"].is_number() ? r["index"].get<long long>() : -1; };
+    std::stable_sort(rows.begin(), rows.end(), [&](const nlohmann::json* a, const nlohmann::json* b) {
+        if (index(*a) != index(*b)) return index(*a) < index(*b);
+        return a->value("input", std::string()) < b->value("input", std::string());
+    });
+    std::vector<std::string> columns{"index", "input", "output", "status", "seconds", "error"};
+    std::vector<std::map<std::string, std::string>> cells;
+    for (const nlohmann::json* r : rows) {
+        std::map<std::string, std::string> row;
+        for (const char* c : {"index", "input", "output", "status", "seconds", "error"}) {
+            if (r->contains(c)) {
+                std::vector<std::pair<std::string, std::string>> v;
+                flatten((*r)[c], c, v);
+                if (!v.empty()) row[c] = v.front().second;
+            }
+        }
+        if (r->contains("report") && (*r)["report"].is_object()) {
+            std::vector<std::pair<std::string, std::string>> v;
+            flatten((*r)["report"], "", v);
+            for (const auto& [name, value] : v) {
+                const std::string col = "report." + name;
+                if (std::find(columns.begin(), columns.end(), col) == columns.end()) columns.push_back(col);
+                row[col] = value;
+            }
+        }
+        cells.push_back(std::move(row));
+    }
+    std::string text;
+    for (std::size_t c = 0; c < columns.size(); ++c) text += (c ? "," : "") + csvCell(columns[c]);
+    text += "\n";
+    for (const auto& row : cells) {
+        for (std::size_t c = 0; c < columns.size(); ++c) {
+            const auto it = row.find(columns[c]);
+            text += (c ? "," : "") + (it == row.end() ? std::string() : csvCell(it->second));
+        }
+        text += "\n";
+    }
+    return text;
+}
 
 namespace {
 

@@ -32,6 +32,13 @@ RecordFile readRecords(const std::string& path);
 /// @brief The last record of each (input, job hash) among @a records.
 std::map<std::pair<std::string, std::string>, nlohmann::json> latestRecords(const std::vector<nlohmann::json>& records);
 
+/// @brief The dataset's manifest as CSV text: one row per record of @a records (their latest, as
+/// latestRecords() gives them) in order of "index", then input; columns index, input, output,
+/// status, seconds, error, then every number, string or boolean of the verb's report by its dotted
+/// path (align.residual_rms), in the order first met; an array of numbers is one cell of its values
+/// separated by spaces (align.matrix: 16 numbers, row by row); null and absent are empty cells.
+std::string manifestCsv(const std::vector<nlohmann::json>& records);
+
 /// @brief Appends records to a record file, each line with one write() and an fsync().
 class RecordAppender
 {

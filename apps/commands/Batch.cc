@@ -50,7 +50,7 @@ const std::map<std::string, AddCommand>& verbParsers()
         {"retrace", addRetraceCommand}, {"fit", addFitCommand},             {"render", addRenderCommand},
         {"grow", addGrowCommand},       {"reconstruct", addReconstructCommand}, {"interpolate", addInterpolateCommand},
         {"synth", addSynthCommand},     {"comb", addCombCommand},           {"scalp", addScalpCommand},
-        {"roots", addRootsCommand}};
+        {"roots", addRootsCommand}, {"prepare", addPrepareCommand}};
     return parsers;
 }
 
@@ -194,6 +194,19 @@ void printSummary(const Summary& s, nlohmann::json extra, const std::string& rec
     }
 }
 
+/// OUTDIR/manifest.csv (manifestCsv()): the latest record of each input, of the job @a hash (all
+/// jobs when empty), from the records of @a recordsPath. @return its path.
+std::string writeManifest(const std::string& outDir, const std::string& recordsPath, const std::string& hash)
+{
+    std::vector<nlohmann::json> latest;
+    for (auto& [key, record] : latestRecords(readRecords(recordsPath).records)) {
+        if (hash.empty() || key.second == hash) latest.push_back(record);
+    }
+    const std::string path = (fs::path(outDir) / "manifest.csv").string();
+    writeFileAtomic(path, manifestCsv(latest), "batch: manifest");
+    return path;
+}
+
 /// --merge OUTDIR: the shards' records joined into OUTDIR/batch.jsonl.
 int runMerge(const std::string& outDir, const CommonOptions& common)
 {
@@ -245,7 +258,8 @@ int runMerge(const std::string& outDir, const CommonOptions& common)
     if (skippedLines && !common.quiet) {
         std::cerr << "vdbhair batch: warning: " << skippedLines << " line(s) of the shard records are not records (a run killed while writing); skipped\n";
     }
-    printSummary(s, {{"merged", count}}, mergedPath, common);
+    const std::string manifest = writeManifest(outDir, mergedPath, "");
+    printSummary(s, {{"merged", count}, {"manifest", manifest}}, mergedPath, common);
     return s.failed ? 1 : 0;
 }
 
@@ -351,6 +365,10 @@ int runBatch(const BatchCmdParams& p, const CommonOptions& common)
     s.notRun += todo.size() - s.ok - s.failed;
 
     nlohmann::json summaryJson = {{"job", job.path}, {"hash", job.hash}, {"verb", job.verb}, {"outdir", outDir}, {"jobs", jobs}};
+    // A shard's manifest would list a part of the set (--merge writes the whole one); an
+    // interrupted run writes nothing more (its next run does).
+    const bool manifest = !shard.sharded() && !interruptRequested();
+    summaryJson["manifest"] = manifest ? nlohmann::json(writeManifest(outDir, recordsPath, job.hash)) : nlohmann::json(nullptr);
     summaryJson["shard"] = shard.sharded() ? nlohmann::json(std::to_string(shard.index) + "/" + std::to_string(shard.count)) : nlohmann::json(nullptr);
     if (interruptRequested()) {
         // 128 + the signal, as a shell reports a process its signal ended: 130 SIGINT, 143 SIGTERM.
@@ -383,9 +401,11 @@ Command addBatchCommand(CLI::App& app, CommonOptions& common)
         "JOB (JSON; relative paths against the JOB's folder, where the runs start):\n"
         "  {\"inputs\": [\"a.hair\", \"b.data\"] | \"styles/*.data\" | {\"list\": \"paths.txt\"},\n"
         "   \"verb\": \"field\",  \"args\": [\"--voxel-size\", \"0.005\"],  \"output\": \"{stem}.vdb\"}\n"
-        "Verbs: convert field refine retrace fit render grow reconstruct interpolate synth comb scalp roots.\n"
+        "Verbs: convert field refine retrace fit render grow reconstruct interpolate synth comb scalp roots prepare.\n"
         "Placeholders in output and args: {stem} {name} {index} (sorted position); in args also {outdir}.\n"
         "An arg that starts with {outdir}/ is a second output (e.g. --dense {outdir}/{stem}.npy).\n"
+        "OUTDIR/manifest.csv lists every input's latest record with the verb's report flattened to columns\n"
+        "(written after each unsharded run and by --merge).\n"
         "A rerun skips inputs recorded ok (for the same verb, args and output rule) whose outputs exist.\n"
         "Exit status: 0 every input ok, 1 an input failed (see the records), 2 a bad command line or JOB,\n"
         "130/143 interrupted by SIGINT/SIGTERM (finished inputs are recorded; the rest run on the next run).\n"

@@ -5,6 +5,8 @@
 #include <vdbhair/io/StrandFileSummary.h>
 #include <vdbhair/io/StrandIO.h>
 
+#include <vdbhair/Exceptions.h>
+
 #include <cstdio>
 
 namespace vdbhair::app::info {
@@ -39,7 +41,36 @@ ReadOptions InfoParams::readOptions(const CommonOptions& common) const
     return ropts;
 }
 
-int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadReport& report, const CommonOptions& common)
+namespace {
+
+nlohmann::json histogramJson(const Histogram& h)
+{
+    return {{"lo", h.lo}, {"hi", h.hi}, {"counts", h.counts}, {"above", h.above}};
+}
+
+nlohmann::json statsJson(const StrandStatistics& st)
+{
+    auto range = [](const RangeStats& r) { return nlohmann::json{{"min", r.min}, {"mean", r.mean}, {"max", r.max}}; };
+    return {{"length", histogramJson(st.length)},
+            {"turning_deg", {{"range", range(st.turning)}, {"histogram", histogramJson(st.turningHist)}}},
+            {"curvature", {{"range", range(st.curvature)}, {"p99", st.curvatureP99}, {"histogram", histogramJson(st.curvatureHist)}}},
+            {"vertices_per_strand", histogramJson(st.verticesPerStrand)}};
+}
+
+/// One histogram as prose: its range and its counts, bin by bin.
+void printHistogram(const std::string& name, const Histogram& h, const std::string& unit)
+{
+    std::cout << "  " << name << " [" << fmt(h.lo) << " .. " << fmt(h.hi) << (unit.empty() ? "" : " " + unit) << "] in "
+              << h.counts.size() << " bins:";
+    for (std::size_t c : h.counts) std::cout << " " << c;
+    if (h.above) std::cout << " (+" << h.above << " above)";
+    std::cout << "\n";
+}
+
+} // namespace
+
+int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadReport& report, const CommonOptions& common,
+                       const StrandStatistics* stats)
 {
     printWarnings("info", report, common);
     const Vec3d bmin = s.bbox.empty() ? Vec3d(0.0) : Vec3d(s.bbox.min.x(), s.bbox.min.y(), s.bbox.min.z());
@@ -55,7 +86,8 @@ int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadRe
                    {"length", {{"min", s.length.min}, {"mean", s.length.mean}, {"max", s.length.max}}},
                    {"vertices_per_strand",
                     {{"min", s.verticesPerStrand.min}, {"mean", s.verticesPerStrand.mean}, {"max", s.verticesPerStrand.max}}},
-                   {"dropped_strands", report.droppedStrands}});
+                   {"dropped_strands", report.droppedStrands},
+                   {"stats", stats ? statsJson(*stats) : nlohmann::json(nullptr)}});
         return 0;
     }
     std::cout << p.input << (p.grid.empty() ? std::string() : " (grid '" + p.grid + "')") << ": "
@@ -68,6 +100,16 @@ int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadRe
               << ", max " << fmt(s.length.max) << "\n"
               << "  bounding box:        " << fmtVec(bmin) << " .. " << fmtVec(bmax) << "\n";
     if (report.droppedStrands) std::cout << "  dropped strands:     " << report.droppedStrands << " (fewer than 2 vertices)\n";
+    if (stats) {
+        std::cout << "  turning per strand:  min " << fmt(stats->turning.min) << ", mean " << fmt(stats->turning.mean) << ", max "
+                  << fmt(stats->turning.max) << " deg\n"
+                  << "  curvature:           min " << fmt(stats->curvature.min) << ", mean " << fmt(stats->curvature.mean) << ", p99 "
+                  << fmt(stats->curvatureP99) << ", max " << fmt(stats->curvature.max) << " per unit length\n";
+        printHistogram("length", stats->length, "");
+        printHistogram("turning", stats->turningHist, "deg");
+        printHistogram("curvature", stats->curvatureHist, "per unit length");
+        printHistogram("vertices per strand", stats->verticesPerStrand, "");
+    }
     return 0;
 }
 
@@ -79,15 +121,29 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("file", params->input, "A strand file (.hair .data .obj .ply .usda .usd .abc .tfx .bin .convdata) or a .vdb file")->required();
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
+    sub->add_flag("--stats", params->stats, "Also histograms of strand length, turning (degrees per strand), curvature (per vertex) and vertices per strand");
+    sub->add_option("--bins", params->bins, "Bins per --stats histogram (1 to 10000)")->check(CLI::Validator(
+        [](std::string& v) { return !v.empty() && v[0] == '-' ? "Value " + v + " is negative (1 to 10000 bins)" : std::string(); }, ""))
+        ->capture_default_str();
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair info scenes/default/ponytail.hair --json");
     return {sub, [params, &common] {
+                if (params->stats) {
+                    if (fileExtension(params->input) == ".vdb" && params->grid.empty()) {
+                        throw ValueError("--stats of " + params->input + ": a .vdb needs --grid, the points grid holding the strands");
+                    }
+                    ReadReport report;
+                    const StrandSet strands = readStrands(params->input, params->readOptions(common), &report);
+                    const StrandStatistics stats = computeStrandStatistics(strands, params->bins);
+                    return printStrandSummary(*params, stats.summary, report, common, &stats);
+                }
                 if (fileExtension(params->input) == ".vdb") return infoVdbFile(*params, common);
                 ReadReport report;
                 const StrandSummary s = summarizeStrandFile(params->input, params->readOptions(common), &report);
                 return printStrandSummary(*params, s, report, common);
-            }};
+            },
+            {{"bins", "--bins"}}};
 }
 
 } // namespace vdbhair::app

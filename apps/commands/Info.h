@@ -7,6 +7,7 @@
 
 #include <vdbhair/io/ReadOptions.h>
 #include <vdbhair/strands/Measures.h>
+#include <vdbhair/strands/StrandStats.h>
 
 #include <functional>
 #include <string>
@@ -18,14 +19,17 @@ struct InfoParams
     std::string input;
     bool strict = false;
     std::string grid;  ///< a .vdb's points grid to summarize as strands; empty: list every grid
+    bool stats = false;  ///< --stats: histograms of length, turning, curvature, vertices per strand
+    std::size_t bins = kDefaultHistogramBins;
 
     /// The reader's options these ask for (--strict, --grid) and @a common's.
     ReadOptions readOptions(const CommonOptions& common) const;
 };
 
 /// @brief Print the summary @a s of the strand file @a p.input (and the reader's warnings of
-/// @a report), as prose or JSON. @return 0
-int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadReport& report, const CommonOptions& common);
+/// @a report), as prose or JSON, with the histograms of @a stats when given. @return 0
+int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadReport& report, const CommonOptions& common,
+                       const StrandStatistics* stats = nullptr);
 
 /// @brief `info` of a .vdb file: its grids, or with --grid the strands of that points grid.
 int infoVdbFile(const InfoParams& p, const CommonOptions& common);

@@ -178,6 +178,7 @@ void bindStrands(pyb::module_& m);
 void bindFields(pyb::module_& m);
 void bindOperations(pyb::module_& m);
 void bindScalp(pyb::module_& m);
+void bindDataset(pyb::module_& m);
 
 } // namespace vdbhair::py
 

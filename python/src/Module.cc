@@ -152,6 +152,7 @@ the library's one-line messages. Paths may be str or any os.PathLike (pathlib.Pa
     py::bindFields(m);
     py::bindOperations(m);
     py::bindScalp(m);
+    py::bindDataset(m);
     // Arguments of the wrong type: instead of pybind11's "incompatible function arguments" with
     // every overload's signature, the library's kind of message, naming the function, the
     // argument, the type it must have and the type it got ("read: strict must be a bool (True or

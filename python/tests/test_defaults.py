@@ -63,6 +63,12 @@ PAIRS = [
     ("transfer", "smoothing", "transfer", "--smoothing"),
     ("comb", "smoothing", "comb", "--smoothing"),
     ("comb", "levels", "comb", "--levels"),
+    ("prepare", "points", "prepare", "--points"),
+    ("prepare", "count", "prepare", "--strands"),
+    ("prepare", "overlap", "prepare", "--overlap"),
+    ("prepare", "head_crop", "prepare", "--head-crop"),
+    ("prepare", "root_depth", "prepare", "--root-depth"),
+    ("strand_statistics", "bins", "info", "--bins"),
 ]
 
 

@@ -6,6 +6,8 @@
 
 #include "Command.h"
 
+#include <vdbhair/dataset/Prepare.h>
+#include <vdbhair/strands/StrandStats.h>
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/field/Refine.h>
@@ -142,6 +144,13 @@ TEST_CASE("vdbhair --help: every default is the library's", "[apps]")
         {"render", "--color-by", colorByName(render.colorBy)},
         {"render", "--up", axisName(render.up)},
         {"render", "--grid", ReadOptions().vdbGrid},
+        {"prepare", "--points", shownAs(PrepareParams().points)},
+        {"prepare", "--strands", shownAs(PrepareParams().strands)},
+        {"prepare", "--overlap", shownAs(PrepareParams().align.overlap)},
+        {"prepare", "--head-crop", shownAs(PrepareParams().headCrop)},
+        {"prepare", "--target-up", axisName(PrepareParams().targetUp)},
+        {"prepare", "--root-depth", rootDepthName(PrepareParams().rootDepth)},
+        {"info", "--bins", shownAs(kDefaultHistogramBins)},
         {"convert", "--grid", ReadOptions().vdbGrid},
         {"convert", "--codec", positionCodecName(WriteOptions().vdb.codec)},
         {"convert", "--meters-per-unit", shownAs(WriteOptions().usd.metersPerUnit)},
