@@ -6,7 +6,10 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 
+#include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetUtil.h>
+
 
 #include <cmath>
 #include <limits>
@@ -49,6 +52,19 @@ HeadObstacle HeadObstacle::levelSet(openvdb::FloatGrid::ConstPtr grid, HeadPolic
     h.mKind = Kind::LevelSet;
     h.mPolicy = policy;
     h.mGrid = grid;
+    // Depth through the whole interior, not only its narrow band (fast sweeping into the
+    // interior's voxels): beyond the band every depth would read as the band's half width, and
+    // "no deeper than the input" could not tell a vertex 4 voxels deep from one 40 voxels deep.
+    {
+        openvdb::BoolGrid::Ptr interior = openvdb::tools::sdfInteriorMask(*grid);
+        interior->tree().voxelizeActiveTiles();
+        openvdb::FloatGrid::Ptr filled = openvdb::tools::maskSdf(*grid, *interior);
+        if (filled) {
+            filled->setGridClass(openvdb::GRID_LEVEL_SET);
+            filled->setName(grid->getName());
+            h.mGrid = filled;
+        }
+    }
     // The band's centre: where the normal points away from when a point is outside the band.
     Vec3d sum(0.0);
     double n = 0.0;
