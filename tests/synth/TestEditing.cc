@@ -283,7 +283,7 @@ TEST_CASE("combHair: coarse straight strands pressed into a sphere head gain no 
         params.head = HeadObstacle::sphere(Vec3d(0.0), 1.0, policy);
         const CombResult kept = combHair(hair, {into}, params);
         CAPTURE(int(policy), kept.stats.headDeflected, kept.stats.movedStrands);
-        REQUIRE(kept.stats.headDeflected > 100);
+        REQUIRE(kept.stats.headDeflected > 20);
         std::size_t inside = 0, kinks = 0;
         for (std::size_t i = 0; i < hair.numStrands(); ++i) {
             for (std::size_t v = 1; v < hair.size(i); ++v) inside += Vec3d(kept.strands.data(i)[v]).length() < 1.0 - 1e-6;

@@ -26,7 +26,12 @@ struct StrandWork
     /// Each edge's turn from the given strand (a rotation vector: axis times angle), its smoothed
     /// copy and prefix sums (smoothTurns())
     std::vector<Vec3d> turn, smooth, sum;
+    std::vector<std::size_t> turned;  ///< prefix counts of the edges with a turn
     std::vector<double> seg, arc;
+    /// The Gaussian's normalized weights of edge k over edges kernelLo[k] .., stored from
+    /// kernelAt[k] to kernelAt[k + 1] (built once a strand; empty until needed)
+    std::vector<double> weight;
+    std::vector<std::size_t> kernelAt, kernelLo;
 };
 
 /// How deep vertex k may be (a floor on its signed distance): -allowed[k] (0 without an allowance),
@@ -35,12 +40,15 @@ struct DepthFloor
 {
     const float* allowed;
     bool rising;
+    /// How much deeper than its floor a vertex may be under Rising (world units): new hair gliding
+    /// along the head at about the depth of the hair it was made from is not lifted vertex by vertex.
+    double slack = 0.0;
     double shallowest = -std::numeric_limits<double>::infinity();  ///< largest signed distance of the vertices placed so far
 
     double at(std::size_t k) const
     {
         const double f = allowed ? -double(allowed[k]) : 0.0;
-        return rising ? std::max(f, std::min(0.0, shallowest)) : f;
+        return rising ? std::max(f, std::min(0.0, shallowest)) - slack : f;
     }
     void placed(double d) { shallowest = std::max(shallowest, d); }
 };
@@ -49,11 +57,11 @@ struct DepthFloor
 /// placed) vertex before it, so below a contact the strand keeps its shape, moved out; where a
 /// vertex is deeper than its floor, its segment turns towards the head's normal by the least angle
 /// that brings it to its floor (bisection). Lengths are kept exactly and nothing folds: a strand
-/// that runs into the head follows its surface until its own direction leads away. @return whether
-/// anything turned.
-bool sweep(std::size_t n, DepthFloor floor, HeadObstacle::Probe& probe, StrandWork& w)
+/// that runs into the head follows its surface until its own direction leads away. @return the
+/// largest turn it made (radians; 0: none).
+double sweep(std::size_t n, DepthFloor floor, HeadObstacle::Probe& probe, StrandWork& w)
 {
-    bool turned = false;
+    double turned = 0.0;
     Vec3d before = w.p[0];  // vertex k - 1 before this sweep placed it
     floor.placed(probe.distance(w.p[0]));
     for (std::size_t k = 1; k < n; ++k) {
@@ -120,7 +128,7 @@ bool sweep(std::size_t n, DepthFloor floor, HeadObstacle::Probe& probe, StrandWo
         }
         w.p[k] = at(hi);
         floor.placed(dHi);
-        turned = true;
+        turned = std::max(turned, hi);
     }
     return turned;
 }
@@ -135,19 +143,37 @@ void smoothTurns(std::size_t n, double sigma, StrandWork& w)
 {
     auto mid = [&](std::size_t k) { return w.arc[k] - 0.5 * w.seg[k]; };
     const double length = w.arc[n - 1];
-    if (6.0 * sigma * double(n) <= 48.0 * length) {
-        const double reach = 3.0 * sigma, inv = 1.0 / (2.0 * sigma * sigma);
-        std::size_t first = 1;
-        for (std::size_t k = 1; k < n; ++k) {
-            while (mid(k) - mid(first) > reach) ++first;
-            Vec3d acc(0.0);
-            double sum = 0.0;
-            for (std::size_t j = first; j < n && mid(j) - mid(k) <= reach; ++j) {
-                const double g = std::exp(-(mid(j) - mid(k)) * (mid(j) - mid(k)) * inv);
-                acc += w.turn[j] * g;
-                sum += g;
+    // Edges whose reach holds no turn stay unturned: contacts are local.
+    w.turned.assign(n + 1, 0);  // w.turned[k + 1] = turned edges among 1 .. k
+    for (std::size_t k = 1; k < n; ++k) w.turned[k + 1] = w.turned[k] + (w.turn[k] != Vec3d(0.0));
+    if (sigma * double(n - 1) < 3.0 * length) {  // σ under 3 edges
+        if (w.kernelAt.empty()) {  // the weights, once a strand
+            const double reach = 3.0 * sigma, inv = 1.0 / (2.0 * sigma * sigma);
+            w.kernelAt.assign(n + 1, 0);
+            w.kernelLo.assign(n, 1);
+            w.weight.clear();
+            std::size_t first = 1;
+            for (std::size_t k = 1; k < n; ++k) {
+                while (mid(k) - mid(first) > reach) ++first;
+                w.kernelLo[k] = first;
+                w.kernelAt[k] = w.weight.size();
+                double sum = 0.0;
+                for (std::size_t j = first; j < n && mid(j) - mid(k) <= reach; ++j) {
+                    w.weight.push_back(std::exp(-(mid(j) - mid(k)) * (mid(j) - mid(k)) * inv));
+                    sum += w.weight.back();
+                }
+                for (std::size_t i = w.kernelAt[k]; i < w.weight.size(); ++i) w.weight[i] /= sum;
             }
-            w.smooth[k] = acc / sum;
+            w.kernelAt[n] = w.weight.size();
+        }
+        for (std::size_t k = 1; k < n; ++k) {
+            const std::size_t lo = w.kernelLo[k], len = w.kernelAt[k + 1] - w.kernelAt[k];
+            Vec3d acc(0.0);
+            if (w.turned[lo + len] != w.turned[lo]) {
+                const double* g = w.weight.data() + w.kernelAt[k];
+                for (std::size_t i = 0; i < len; ++i) acc += w.turn[lo + i] * g[i];
+            }
+            w.smooth[k] = acc;
         }
         for (std::size_t k = 1; k < n; ++k) w.turn[k] = w.smooth[k];
         return;
@@ -184,15 +210,25 @@ Vec3d rotate(const Vec3d& v, const Vec3d& r)
     return v * c + k.cross(v) * s + k * (k.dot(v) * (1.0 - c));
 }
 
+/// The largest turn (radians) of a sweep that ends the passes: 3 degrees, an eighth of the 25
+/// degrees a strand may turn between two edges and still read as smooth hair.
+constexpr double kSettledTurn = 10.0 * M_PI / 180.0;
+
 /// Resolve one strand of @a n vertices at @a pos; @return whether it moved, and add to @a tooDeep.
 bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle::Probe& probe, const HeadCollisionParams& params,
                    StrandWork& w, std::size_t& tooDeep)
 {
     if (n < 2) return false;
     const bool rising = params.depthRule == HeadDepthRule::Rising;
+    // A fiftieth of the mean segment: under Rising, what counts as deeper than before.
+    double slack = 0.0;
+    if (rising) {
+        for (std::size_t k = 1; k < n; ++k) slack += (toD(pos[k]) - toD(pos[k - 1])).length();
+        slack *= 0.02 / double(n - 1);
+    }
     // A quick test first: most strands never touch the head.
     {
-        DepthFloor f{allowed, rising};
+        DepthFloor f{allowed, rising, slack};
         f.placed(probe.distance(toD(pos[0])));
         bool any = false;
         for (std::size_t k = 1; k < n && !any; ++k) {
@@ -211,14 +247,16 @@ bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle
         w.seg[k] = (w.p[k] - w.p[k - 1]).length();
         w.arc[k] = w.arc[k - 1] + w.seg[k];
     }
-    const DepthFloor floor0{allowed, rising};
+    const DepthFloor floor0{allowed, rising, slack};
     const double sigma = params.spread * w.arc[n - 1];
     // Sweep; smooth the turns it made along the strand (as rotations of the edges, so the strand's
     // own shape rides along and nothing folds) and rebuild it from the root, which may dip a vertex
     // back in, less steeply than before; sweep again.
     w.c = w.p;  // the strand as given
+    w.kernelAt.clear();
     for (int pass = 0; pass < params.passes; ++pass) {
-        if (!sweep(n, floor0, probe, w)) break;
+        // A sweep that turned no edge by more than a few degrees leaves no kink: done.
+        if (!(sweep(n, floor0, probe, w) > kSettledTurn)) break;
         if (pass + 1 == params.passes || !(sigma > 0.0)) break;  // end on a sweep
         w.turn.assign(n, Vec3d(0.0));
         for (std::size_t k = 1; k < n; ++k) {

@@ -12,16 +12,17 @@
 /// placed) vertex before it, so below a contact the strand keeps its shape, moved out; where a
 /// vertex is deeper than allowed, its segment turns towards the head's outward normal by the least
 /// angle that brings it to its floor. Lengths are kept exactly and nothing folds. That turn is made
-/// at one vertex; to spread it, the displacement the sweep gave each vertex (from where the strand
-/// was) is smoothed along the strand by a Gaussian in arc length (σ = `spread` × the strand's
-/// length, the root held by an odd reflection), the segment lengths are restored from the root,
-/// and the strand is swept again from there: the vertices before a contact now start to lift, so
-/// the next sweep meets the head at a shallower angle and turns less. Passes repeat while anything
-/// turns (up to `passes`, ending on a sweep). The strand's own shape (curls, waves) rides on the
-/// smooth displacement: it is not straightened the way smoothing its positions would. A last pass
-/// pushes what is left along the normal vertex by vertex, so no vertex ends deeper than allowed
-/// except where HeadObstacle::Probe::pushOut() cannot reach (beyond a level set's band): counted,
-/// not hidden.
+/// at one vertex; to spread it, each edge's turn from the strand as given (a rotation vector) is
+/// smoothed along the strand by a Gaussian in arc length (σ = `spread` × the strand's length), the
+/// strand is rebuilt from its root with its own edges turned by the smoothed rotations, and it is
+/// swept again from there: the edges before a contact now start to lift it, so the next sweep
+/// meets the head at a shallower angle and turns less. Passes repeat while a sweep turns an edge
+/// by more than 10 degrees (up to `passes`, ending on a sweep). The strand's own shape (curls,
+/// waves) rides along: its edges are turned, not its positions smoothed (which would straighten
+/// it and, on a convex head, pull it back in), and a smooth rotation field cannot fold it the way
+/// smoothed displacements can (a strand pressed head-on into the head). A last pass pushes what is
+/// left along the normal vertex by vertex, so no vertex ends deeper than allowed except where
+/// HeadObstacle::Probe::pushOut() cannot reach: counted, not hidden.
 #pragma once
 
 #include <vdbhair/field/HeadObstacle.h>
