@@ -361,18 +361,22 @@ struct RootTree
 
 } // namespace
 
-std::size_t liftRootsToReference(StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded)
+std::size_t liftRootsToReference(StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded,
+                                 std::vector<std::uint32_t>* nearestOut)
 {
     if (head.empty() || strands.empty()) return 0;
     const RootTree roots(reference);
     std::vector<char> moved(strands.numStrands(), 0);
+    if (nearestOut) nearestOut->assign(strands.numStrands(), 0);
     auto run = [&](const tbb::blocked_range<std::size_t>& r) {
         HeadObstacle::Probe probe(head);
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const std::size_t n = strands.size(i), b = strands.begin(i);
             if (n == 0) continue;
             const Vec3d root = toD(strands.root(i));
-            const double own = probe.distance(root), ref = probe.distance(roots.roots[roots.nearest(root)]);
+            const std::uint32_t near = roots.nearest(root);
+            if (nearestOut) (*nearestOut)[i] = near;
+            const double own = probe.distance(root), ref = probe.distance(roots.roots[near]);
             if (!(own < ref)) continue;
             Vec3d q = root;
             if (!probe.pushOut(q, std::min(0.0, ref))) continue;
@@ -388,11 +392,18 @@ std::size_t liftRootsToReference(StrandSet& strands, const StrandSet& reference,
     return count;
 }
 
-std::vector<float> referenceDepthAllowance(const StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded)
+std::vector<float> referenceDepthAllowance(const StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded,
+                                           const std::vector<std::uint32_t>* nearestIn)
 {
     std::vector<float> allowed(strands.numVertices(), 0.f);
     if (head.empty() || strands.empty()) return allowed;
-    const RootTree roots(reference);
+    if (reference.numStrands() == 0) throw ValueError("head collision: the reference hair has no strands");
+    if (nearestIn && nearestIn->size() != strands.numStrands()) {
+        throw ValueError("head collision: " + std::to_string(nearestIn->size()) + " nearest reference strands for " +
+                         std::to_string(strands.numStrands()) + " strands");
+    }
+    std::unique_ptr<RootTree> roots;
+    if (!nearestIn) roots = std::make_unique<RootTree>(reference);
     auto run = [&](const tbb::blocked_range<std::size_t>& r) {
         HeadObstacle::Probe probe(head);
         std::vector<double> refArc, refDepth;
@@ -400,7 +411,8 @@ std::vector<float> referenceDepthAllowance(const StrandSet& strands, const Stran
             const std::size_t n = strands.size(i), b = strands.begin(i);
             if (n == 0) continue;
             const Vec3d root = toD(strands.root(i));
-            const std::uint32_t nearest = roots.nearest(root);
+            const std::uint32_t nearest = nearestIn ? (*nearestIn)[i] : roots->nearest(root);
+            if (nearest >= reference.numStrands()) continue;
             // The reference strand's depth by arc length.
             const std::size_t m = reference.size(nearest), rb = reference.begin(nearest);
             if (m == 0) continue;

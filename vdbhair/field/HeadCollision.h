@@ -29,6 +29,7 @@
 #include <vdbhair/strands/StrandSet.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace vdbhair {
@@ -78,15 +79,20 @@ std::vector<float> rootDepthAllowance(const StrandSet& strands, const HeadObstac
 /// allowance falls by at most tan 30° per unit of arc length from the strand's own root depth on
 /// (where the reference leaves the head within a segment, or the new root is deeper than the
 /// reference's), so that its floor rises over a length instead of at one vertex.
-/// @throw ValueError if @a reference has no strands.
-std::vector<float> referenceDepthAllowance(const StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded = true);
+/// @param nearest each strand's nearest @a reference strand (liftRootsToReference()'s), or null to search
+/// @throw ValueError if @a reference has no strands, or @a nearest is not one index a strand.
+std::vector<float> referenceDepthAllowance(const StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded = true,
+                                           const std::vector<std::uint32_t>* nearest = nullptr);
 
 /// @brief New hair grows where the reference's does: each strand of @a strands whose root is deeper
 /// inside @a head than the root of the @a reference strand nearest it is moved out, whole (its
 /// shape unchanged), along the head's normal at its root by the difference. In parallel, identical
 /// for any thread count. @return how many strands moved.
+/// @param nearest if given, receives each strand's nearest @a reference strand (#S indices), for
+/// referenceDepthAllowance() to reuse
 /// @throw ValueError if @a reference has no strands.
-std::size_t liftRootsToReference(StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded = true);
+std::size_t liftRootsToReference(StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded = true,
+                                 std::vector<std::uint32_t>* nearest = nullptr);
 
 /// @brief How many strands of @a strands pass into @a head: have a vertex after the root more than
 /// @a tolerance (world units) inside it and deeper than their root by as much. 0 for an empty head.

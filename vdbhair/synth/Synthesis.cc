@@ -272,6 +272,12 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
     res.refinedCorrected.assign(std::size_t(L), 0);
     res.refineVoxelSizes.assign(std::size_t(L), 0.0);
     for (int l = 0; l < L; ++l) res.refineVoxelSizes[std::size_t(l)] = finestVoxel * double(1 << l);
+    // The head the output is kept out of (SynthParams::head) when one is set, else the scalp's
+    // (made once: a level set's interior is filled when it becomes a head); unset: the sphere
+    // refineStrands() fits to the roots.
+    const HeadObstacle refineHead = !params.head.unset() ? params.head
+                                    : scalp              ? HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper)
+                                                         : HeadObstacle();
     // Refinement of one output level (§5.3), in place.
     StrandSet finestStrands;
     const auto refineLevel = [&](int l, bool refine) {
@@ -284,9 +290,7 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
             rp.mode = params.refineMode;
             rp.measure = false;
             rp.field.voxelSize = res.refineVoxelSizes[std::size_t(l)];
-            // The head the output is kept out of (SynthParams::head) when one is set, else the scalp's.
-            if (!params.head.unset()) rp.head = params.head;
-            else if (scalp) rp.head = HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper);
+            rp.head = refineHead;
             RefineResult rr = refineStrands(std::move(strands), rp, threaded, interrupter);
             if (!rr.levels.empty()) res.refinedCorrected[std::size_t(l)] = rr.levels.front().consistency.corrected;
             strands = std::move(rr.strands);
@@ -345,8 +349,9 @@ void keepHairOutOfHead(SynthResult& res, const HeadObstacle& head, const StrandS
     // another head, no deeper than its root.
     HeadCollisionParams hp;
     hp.depthRule = HeadDepthRule::Rising;
-    if (reference) liftRootsToReference(res.strands, *reference, head, threaded);
-    const std::vector<float> allowed = reference ? referenceDepthAllowance(res.strands, *reference, head, threaded)
+    std::vector<std::uint32_t> nearest;
+    if (reference) liftRootsToReference(res.strands, *reference, head, threaded, &nearest);
+    const std::vector<float> allowed = reference ? referenceDepthAllowance(res.strands, *reference, head, threaded, nearest.empty() ? nullptr : &nearest)
                                                  : rootDepthAllowance(res.strands, head, threaded);
     res.headPushedOut = resolveHeadCollisions(res.strands, head, allowed, hp, threaded).strandsMoved;
     const double tolerance = headTolerance(head);
