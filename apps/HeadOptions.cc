@@ -5,6 +5,7 @@
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/strands/PointCloud.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -61,7 +62,11 @@ SurfaceDistanceFn headSurfaceDistance(const std::string& path)
     }
     auto head = std::make_shared<HeadObstacle>(readHeadObstacle(path, "--head " + path));
     auto probe = std::make_shared<HeadObstacle::Probe>(*head);  // one thread: readStrands() calls it in order
-    return [head, probe](const Vec3f& p) { return std::abs(probe->distance(Vec3d(p.x(), p.y(), p.z()))); };
+    // Within the level set's band (its background, read far outside): its depth runs through the
+    // whole interior, and a root deep inside is no farther from the scalp for this vote than one
+    // at the band's edge, as a point far outside is not.
+    const double band = probe->distance(head->center() + Vec3d(1e9, 0.0, 0.0));
+    return [head, probe, band](const Vec3f& p) { return std::min(band, std::abs(probe->distance(Vec3d(p.x(), p.y(), p.z())))); };
 }
 
 } // namespace vdbhair::app

@@ -52,7 +52,8 @@ int runComb(CombCmdParams p, const CommonOptions& common)
     const nlohmann::json checks = {
         {"turned", s.reachVertices == 0 || s.angleAfter < s.angleBefore},
         {"curl_kept", s.movedStrands == 0 || std::abs(s.turningAfter - s.turningBefore) <= 0.1 * s.turningBefore},
-        {"kept_out_of_head", s.insideHeadAfter <= s.insideHeadBefore}};
+        {"kept_out_of_head", s.insideHeadAfter <= s.insideHeadBefore},
+        {"no_new_kinks", s.newKinks == 0}};
     if (s.combedClusters == 0 && !common.quiet)
         std::cerr << "vdbhair comb: warning: no stroke reaches a wisp of " << p.input << "; the output equals the input\n";
     if (common.json) {
@@ -62,6 +63,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
                    {"clusters", s.clusters}, {"combed_clusters", s.combedClusters}, {"moved_strands", s.movedStrands},
                    {"angle_to_stroke_deg", {{"before", s.angleBefore}, {"after", s.angleAfter}, {"vertices", s.reachVertices}}},
                    {"turning_per_length", {{"before", s.turningBefore}, {"after", s.turningAfter}}},
+                   {"new_kinks", {{"strands", s.newKinks}, {"degrees", kCombKinkDegrees}}},
                    {"head", {{"head", s.head}, {"deflected_strands", s.headDeflected},
                              {"inside_vertices", {{"before", s.insideHeadBefore}, {"after", s.insideHeadAfter}}}}},
                    {"stages", stages}, {"seconds", seconds}, {"checks", checks}});
@@ -71,6 +73,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
                   << seconds << " s\n"
                   << "  angle to the stroke within its reach: " << s.angleBefore << " -> " << s.angleAfter << " degrees\n"
                   << "  turning per length of the moved strands: " << s.turningBefore << " -> " << s.turningAfter << "\n"
+                  << "  moved strands with a new turn over " << kCombKinkDegrees << " degrees between two edges: " << s.newKinks << "\n"
                   << "  head: " << s.head << "; " << s.headDeflected << " strands pushed out of it, moved vertices inside it "
                   << s.insideHeadBefore << " -> " << s.insideHeadAfter << "\n"
                   << "wrote " << p.output << "\n";

@@ -356,7 +356,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--region", params->region, "Where the new hair grows (default: the example's region): a scalp .vdb's 'region' grid (vdbhair scalp --region...), roots (.ply points, as vdbhair roots writes) or the roots of a hairstyle; the strand count scales with the area");
     sub->add_option("--strands", params->strands, "Strands in the output (default: the example's density over the region; every level scales alike)");
     sub->add_option("--output-turn", params->outputTurnDeg, "With --output-scalp: degrees about the up axis that the layout turns on the other head (for heads that face different ways)")->capture_default_str();
-    sub->add_option("--head", params->head, "The head new hair may enter no deeper than its root: a mesh (.ply, .obj), a .vdb level set, or 'none' "
+    sub->add_option("--head", params->head, "The head new hair may enter no deeper than the example's hair: a mesh (.ply, .obj), a .vdb level set, or 'none' "
                                              "(default: --output-scalp's, else --scalp's surface, else the sphere fitted to the roots)");
     sub->add_option("--output-scalp", params->outputScalp, "Grow the new hair on another head: a scalp .vdb (its 'region' grid is where the hair grows, unless --region says) or a head mesh with --region; the hairstyle moves there through scalp space");
     sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();

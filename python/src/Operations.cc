@@ -431,6 +431,7 @@ Returns:
             report["head_deflected"] = r.stats.headDeflected;
             report["inside_head_before"] = r.stats.insideHeadBefore;
             report["inside_head_after"] = r.stats.insideHeadAfter;
+            report["new_kinks"] = r.stats.newKinks;
             report["cluster"] = pyb::array_t<std::int32_t>(pyb::ssize_t(r.cluster.size()), r.cluster.data());
             return pyb::make_tuple(out, report);
         },

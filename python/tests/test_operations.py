@@ -205,6 +205,10 @@ def test_transfer_and_comb():
     assert inside(through) > inside(pony) + 5000
     assert inside(kept) < inside(pony) // 2 and inside(no_deeper) <= inside(pony)
     assert rep["head_deflected"] > 0 and rep["head"].startswith("sphere")
+    # A ball just inside the roots, no deeper than the input: pushed out along their length, the
+    # strands gain (almost) no turn over 45 degrees between two edges.
+    _, rep28 = vdbhair.comb(pony, [into], head=(0.32, 87.9, 7.3, 28.0), return_report=True)
+    assert rep28["head_deflected"] > 1000 and rep28["new_kinks"] <= 2
     with pytest.raises(ValueError, match="head policy"):
         vdbhair.comb(pony, [into], head_policy="sideways")
 

@@ -39,6 +39,18 @@ double maxTurn(const StrandSet& s, std::size_t i)
     return worst;
 }
 
+/// The summed turning angles of strand @a i (radians).
+double totalTurn(const StrandSet& s, std::size_t i)
+{
+    double sum = 0.0;
+    for (std::size_t k = 1; k + 1 < s.size(i); ++k) {
+        const Vec3d a(s.positions[s.begin(i) + k] - s.positions[s.begin(i) + k - 1]);
+        const Vec3d b(s.positions[s.begin(i) + k + 1] - s.positions[s.begin(i) + k]);
+        sum += std::acos(std::clamp(a.dot(b) / (a.length() * b.length()), -1.0, 1.0));
+    }
+    return sum;
+}
+
 } // namespace
 
 TEST_CASE("resolveHeadCollisions: strands through a sphere come out smoothly, at their length, roots fixed", "[field]")
@@ -70,6 +82,127 @@ TEST_CASE("resolveHeadCollisions: strands through a sphere come out smoothly, at
         // hitting a unit sphere needs about 90 degrees in all over its 60 segments).
         CHECK(maxTurn(s, i) < 25.0 * M_PI / 180.0);
     }
+}
+
+TEST_CASE("resolveHeadCollisions: coarse strands aimed steeply into a sphere come out without a kink", "[field]")
+{
+    // 16 vertices a strand (TressFX guides, cyHair's straight.hair): a strand meeting the head at
+    // up to 80 degrees must turn that much, and a sweep alone turns it at one vertex. Seeded random
+    // roots on the upper half of the unit sphere, directions 20-80 degrees into it, 1-4 radii long.
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    std::mt19937 rng(49);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    StrandSet s;
+    for (int j = 0; j < 300; ++j) {
+        const double phi = 2.0 * M_PI * u(rng), theta = 0.5 * M_PI * u(rng);
+        const Vec3d n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+        Vec3d t = Vec3d(0.0, 1.0, 0.0).cross(n);
+        if (t.length() < 1e-3) t = Vec3d(1.0, 0.0, 0.0);
+        t.normalize();
+        t = t * std::cos(2.0 * M_PI * u(rng)) + n.cross(t) * std::sin(2.0 * M_PI * u(rng));
+        t.normalize();
+        const double into = (20.0 + 60.0 * u(rng)) * M_PI / 180.0;
+        const Vec3d dir = t * std::cos(into) - n * std::sin(into);
+        s.addStrand(line(Vec3f(n * 1.001), Vec3f(dir), float(1.0 + 3.0 * u(rng)), 16));
+    }
+    const StrandSet before = s;
+    REQUIRE(countStrandsEnteringHead(s, head, 0.0) == s.numStrands());
+    const HeadCollisionStats stats = resolveHeadCollisions(s, head, {});
+    CHECK(stats.strandsMoved == s.numStrands());
+    CHECK(stats.verticesTooDeep == 0);
+    HeadObstacle::Probe probe(head);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        CAPTURE(i);
+        REQUIRE(s.root(i) == before.root(i));
+        for (std::size_t k = 0; k < s.size(i); ++k) REQUIRE(probe.distance(Vec3d(s.positions[s.begin(i) + k])) >= -1e-6);
+        for (std::size_t k = 1; k < s.size(i); ++k) {
+            const double la = double((before.positions[before.begin(i) + k] - before.positions[before.begin(i) + k - 1]).length());
+            const double lb = double((s.positions[s.begin(i) + k] - s.positions[s.begin(i) + k - 1]).length());
+            REQUIRE(lb == Approx(la).epsilon(1e-4));
+        }
+        worst = std::max(worst, maxTurn(s, i));
+    }
+    INFO("largest turn between two segments: " << worst * 180.0 / M_PI << " degrees");
+    CHECK(worst < 45.0 * M_PI / 180.0);
+    // The same on one thread.
+    StrandSet one = before;
+    resolveHeadCollisions(one, head, {}, {}, false);
+    CHECK(one.positions == s.positions);
+}
+
+TEST_CASE("resolveHeadCollisions: a curly strand pushed out keeps its curls", "[field]")
+{
+    // A helix of radius 0.05 and pitch 0.1 around an axis aimed 45 degrees into the unit sphere:
+    // the push-out moves the curls as a whole (smoothing displacements, not positions), so each
+    // strand's turning stays within 10 % of its own.
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    StrandSet s;
+    for (int j = 0; j < 8; ++j) {
+        const double phi = 2.0 * M_PI * j / 8.0;
+        const Vec3d n(0.5 * std::cos(phi), std::sqrt(0.75), 0.5 * std::sin(phi));
+        Vec3d t = Vec3d(-std::sin(phi), 0.0, std::cos(phi));
+        const Vec3d axis = (t - n).unit(), b1 = t.cross(n).unit(), b2 = axis.cross(b1).unit();
+        std::vector<Vec3f> p;
+        for (int k = 0; k < 120; ++k) {
+            const double a = 0.025 * k;  // 3 units along the axis
+            const double w = 2.0 * M_PI * a / 0.1;
+            p.emplace_back(n * 1.06 + axis * a + (b1 * (std::cos(w) - 1.0) + b2 * std::sin(w)) * 0.05);
+        }
+        s.addStrand(p);
+    }
+    const StrandSet before = s;
+    REQUIRE(countStrandsEnteringHead(s, head, 0.0) == s.numStrands());
+    resolveHeadCollisions(s, head, {});
+    CHECK(countStrandsEnteringHead(s, head, 0.0) == 0);
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        const double ta = totalTurn(before, i), tb = totalTurn(s, i);
+        CAPTURE(i, ta, tb);
+        CHECK(tb == Approx(ta).epsilon(0.1));
+    }
+}
+
+TEST_CASE("resolveHeadCollisions: under HeadDepthRule::Rising new hair rises out of the scalp and does not dive back", "[field]")
+{
+    // Rooted 0.1 inside the unit sphere; each strand runs along the surface, dips deeper, then leaves.
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    StrandSet s;
+    for (int j = 0; j < 12; ++j) {
+        const double phi = 2.0 * M_PI * j / 12.0;
+        std::vector<Vec3f> p;
+        for (int k = 0; k < 24; ++k) {
+            const double a = 0.06 * k;  // angle from the top along the great circle through phi
+            const double r = 0.9 - 0.15 * std::sin(M_PI * std::min(1.0, a / 0.8)) + (a > 0.8 ? 0.5 * (a - 0.8) : 0.0);
+            p.emplace_back(Vec3d(std::sin(a) * std::cos(phi), std::cos(a), std::sin(a) * std::sin(phi)) * r);
+        }
+        s.addStrand(p);
+    }
+    const StrandSet before = s;
+    HeadCollisionParams rising;
+    rising.depthRule = HeadDepthRule::Rising;
+    // The root's depth allowed everywhere (rootDepthAllowance()): the dip is allowed...
+    const std::vector<float> allowed = rootDepthAllowance(s, head);
+    StrandSet asAllowed = s;
+    CHECK(resolveHeadCollisions(asAllowed, head, allowed).strandsMoved == s.numStrands());
+    // ...but not under Rising: no vertex deeper than one before it (to the bisection's 1e-4 of a segment).
+    CHECK(resolveHeadCollisions(s, head, allowed, rising).strandsMoved == s.numStrands());
+    HeadObstacle::Probe probe(head);
+    std::size_t insideBefore = 0, insideAfter = 0;
+    for (std::size_t i = 0; i < s.numStrands(); ++i) {
+        CAPTURE(i);
+        REQUIRE(s.root(i) == before.root(i));
+        double shallowest = probe.distance(Vec3d(s.root(i)));
+        for (std::size_t k = 1; k < s.size(i); ++k) {
+            const double d = probe.distance(Vec3d(s.positions[s.begin(i) + k]));
+            CAPTURE(k, d, shallowest);
+            CHECK(d >= std::min(0.0, shallowest) - 1e-4);
+            shallowest = std::max(shallowest, d);
+            insideAfter += d < 0.0;
+            insideBefore += probe.distance(Vec3d(before.positions[before.begin(i) + k])) < 0.0;
+        }
+        CHECK(maxTurn(s, i) < 45.0 * M_PI / 180.0);
+    }
+    CHECK(insideAfter < insideBefore);
 }
 
 TEST_CASE("resolveHeadCollisions: an allowance keeps strands as deep as allowed, and leaves others alone", "[field]")

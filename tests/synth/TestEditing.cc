@@ -267,6 +267,37 @@ TEST_CASE("combHair: a stroke into the head pushes strands out of it along a len
     CHECK(deep == 0);
 }
 
+TEST_CASE("combHair: coarse straight strands pressed into a sphere head gain no kink", "[synth]")
+{
+    // 16 vertices a strand, as TressFX guides and cyHair's straight.hair have: a contact turns a
+    // whole segment, so the turn must be spread over the strand (relaxing positions left kinks on
+    // a fifth of straight.hair's strands pressed into its head).
+    const StrandSet hair = test::wispHairstyle(1200, 12, nullptr, 16, 0.0);
+    CombStroke into;
+    into.points = {Vec3d(0.0, 2.3, 1.5), Vec3d(0.0, 0.9, 0.45)};
+    into.radius = 0.8;
+    into.strength = 1.0;
+    CombParams params = smallComb();
+    params.synth.vertices = 16;
+    for (const HeadPolicy policy : {HeadPolicy::KeepOutside, HeadPolicy::NoDeeper}) {
+        params.head = HeadObstacle::sphere(Vec3d(0.0), 1.0, policy);
+        const CombResult kept = combHair(hair, {into}, params);
+        CAPTURE(int(policy), kept.stats.headDeflected, kept.stats.movedStrands);
+        REQUIRE(kept.stats.headDeflected > 20);
+        std::size_t inside = 0, kinks = 0;
+        for (std::size_t i = 0; i < hair.numStrands(); ++i) {
+            for (std::size_t v = 1; v < hair.size(i); ++v) inside += Vec3d(kept.strands.data(i)[v]).length() < 1.0 - 1e-6;
+            kinks += maxEdgeTurnDegrees(kept.strands, i) > 45.0 && maxEdgeTurnDegrees(hair, i) <= 45.0;
+        }
+        CHECK(inside == 0);
+        CHECK(kinks == 0);
+        CHECK(kept.stats.newKinks == kinks);
+        CHECK(segmentLengthError(hair, kept.strands) < 1e-4);
+        for (std::size_t s = 0; s < hair.numStrands(); ++s) CHECK(kept.strands.root(s) == hair.root(s));
+        CHECK(combHair(hair, {into}, params, nullptr, false).strands.positions == kept.strands.positions);
+    }
+}
+
 TEST_CASE("combHair on a real groom with its head mesh: no kinks at the shoulders", "[synth][data]")
 {
     // Ruby's long hair swept sideways across her back by a stroke of radius 20, on her head and

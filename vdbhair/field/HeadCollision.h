@@ -4,36 +4,54 @@
 ///
 /// Each strand may reach into the head only as deep as it is allowed at each vertex (an allowance
 /// per vertex, world units: 0 keeps it outside; rootDepthAllowance(), what new hair gets, lets a
-/// strand rooted inside the scalp stay as deep as its root and no deeper). The
-/// root never moves. A sweep goes from root to tip, each segment keeping its direction and length
-/// from the (already placed) vertex before it, so below a contact the strand keeps its shape,
-/// moved out; where a vertex is deeper than allowed, its segment turns towards the head's outward
-/// normal by the least angle that brings it to its floor. Lengths are kept exactly and nothing
-/// folds: a strand that runs into the scalp follows it until its own direction leads away (a
-/// straight strand aimed into a sphere wraps around it, turning as the sphere does). The stretch within
-/// `spread` × the strand's length of a turn is then relaxed by Laplacian steps (segment lengths
-/// restored from the root after each), so the bend is spread over a length instead of made at one
-/// vertex, and swept again; passes repeat while anything turns (up to `passes`, ending on a
-/// sweep). A last pass pushes what is left along the normal vertex by vertex, so no vertex ends
-/// deeper than allowed except where HeadObstacle::Probe::pushOut() cannot reach (beyond a level
-/// set's band): counted, not hidden.
+/// strand rooted inside the scalp stay as deep as its root and no deeper; HeadDepthRule::Rising
+/// also keeps each vertex no deeper than the vertices before it, so new hair rises out of the
+/// scalp it grows from and does not dive back in). The root never moves.
+///
+/// A sweep goes from root to tip, each segment keeping its direction and length from the (already
+/// placed) vertex before it, so below a contact the strand keeps its shape, moved out; where a
+/// vertex is deeper than allowed, its segment turns towards the head's outward normal by the least
+/// angle that brings it to its floor. Lengths are kept exactly and nothing folds. That turn is made
+/// at one vertex; to spread it, each edge's turn from the strand as given (a rotation vector) is
+/// smoothed along the strand by a Gaussian in arc length (σ = `spread` × the strand's length), the
+/// strand is rebuilt from its root with its own edges turned by the smoothed rotations, and it is
+/// swept again from there: the edges before a contact now start to lift it, so the next sweep
+/// meets the head at a shallower angle and turns less. Passes repeat while a sweep turns an edge
+/// by more than 5 degrees (up to `passes`, ending on a sweep). The strand's own shape (curls,
+/// waves) rides along: its edges are turned, not its positions smoothed (which would straighten
+/// it and, on a convex head, pull it back in), and a smooth rotation field cannot fold it the way
+/// smoothed displacements can (a strand pressed head-on into the head). A last pass pushes what is
+/// left along the normal vertex by vertex, so no vertex ends deeper than allowed except where
+/// HeadObstacle::Probe::pushOut() cannot reach: counted, not hidden.
 #pragma once
 
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/strands/StrandSet.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace vdbhair {
 
+/// How deep a vertex may be: as its allowance says, or also no deeper than its strand was before it.
+enum class HeadDepthRule
+{
+    Allowance,  ///< each vertex as deep as its allowance (the input's own depth, for edits such as comb)
+    Rising      ///< and no deeper than the shallowest vertex before it (new hair: out of the scalp, never back in)
+};
+
 struct HeadCollisionParams
 {
-    /// How far along the strand from a pushed vertex the bend is relaxed, a fraction of the
-    /// strand's length: wide enough that a strand lifts off the scalp over a stretch.
-    double spread = 0.15;
-    int passes = 4;     ///< sweep-and-relax passes before the vertex-by-vertex one
-    int smoothing = 4;  ///< Laplacian steps of each pass
+    /// The reach of the smoothing that spreads a turn, a fraction of the strand's length (the
+    /// Gaussian's σ in arc length). A tenth, with 12 passes, brings the 16-vertex strands of Ruby's
+    /// long hair and of straight.hair pressed into their heads out with new turns over 45 degrees
+    /// between two edges on 0.2 % and 0.1 % of them (0.5 % and 0.2 % after 8 passes; 1.5 % and
+    /// 19.6 % with the Laplacian relaxation of positions used before); a fifth moves more of each
+    /// strand than the contact needs.
+    double spread = 0.1;
+    int passes = 12;  ///< sweep-and-smooth passes before the vertex-by-vertex one
+    HeadDepthRule depthRule = HeadDepthRule::Allowance;
 };
 
 struct HeadCollisionStats
@@ -52,6 +70,29 @@ HeadCollisionStats resolveHeadCollisions(StrandSet& strands, const HeadObstacle&
 /// @brief For each vertex of @a strands, how deep inside @a head its strand's root is (0 for a root
 /// outside): the allowance that keeps new hair from going deeper than where it grows.
 std::vector<float> rootDepthAllowance(const StrandSet& strands, const HeadObstacle& head, bool threaded = true);
+
+/// @brief For each vertex of @a strands, how deep inside @a head the strand of @a reference whose
+/// root is nearest its root is at the same arc length from the root (linear between its vertices,
+/// its tip's depth beyond its length; 0 where it is outside): the allowance that keeps new hair no
+/// deeper in the head than the hair it was made from, by refine --head's rule (HeadPolicy::NoDeeper:
+/// the input's vertex at the same arc length), with the example or the base as the input. The
+/// allowance falls by at most tan 30° per unit of arc length from the strand's own root depth on
+/// (where the reference leaves the head within a segment, or the new root is deeper than the
+/// reference's), so that its floor rises over a length instead of at one vertex.
+/// @param nearest each strand's nearest @a reference strand (liftRootsToReference()'s), or null to search
+/// @throw ValueError if @a reference has no strands, or @a nearest is not one index a strand.
+std::vector<float> referenceDepthAllowance(const StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded = true,
+                                           const std::vector<std::uint32_t>* nearest = nullptr);
+
+/// @brief New hair grows where the reference's does: each strand of @a strands whose root is deeper
+/// inside @a head than the root of the @a reference strand nearest it is moved out, whole (its
+/// shape unchanged), along the head's normal at its root by the difference. In parallel, identical
+/// for any thread count. @return how many strands moved.
+/// @param nearest if given, receives each strand's nearest @a reference strand (#S indices), for
+/// referenceDepthAllowance() to reuse
+/// @throw ValueError if @a reference has no strands.
+std::size_t liftRootsToReference(StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded = true,
+                                 std::vector<std::uint32_t>* nearest = nullptr);
 
 /// @brief How many strands of @a strands pass into @a head: have a vertex after the root more than
 /// @a tolerance (world units) inside it and deeper than their root by as much. 0 for an empty head.

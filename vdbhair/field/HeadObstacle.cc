@@ -6,7 +6,10 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 
+#include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetUtil.h>
+
 
 #include <cmath>
 #include <limits>
@@ -37,6 +40,13 @@ HeadObstacle HeadObstacle::sphere(const Vec3d& center, double radius, HeadPolicy
     return h;
 }
 
+namespace {
+/// How far into the interior a head's level set is extended beyond its band (voxels): 24 in all,
+/// a quarter of a head of 100 voxels across (vdbhair scalp's default), deeper than hair lies in
+/// the shared heads; beyond it every depth reads alike.
+constexpr int kInteriorVoxels = 21;
+} // namespace
+
 HeadObstacle HeadObstacle::levelSet(openvdb::FloatGrid::ConstPtr grid, HeadPolicy policy)
 {
     if (!grid) throw ValueError("head level set: no grid");
@@ -49,6 +59,18 @@ HeadObstacle HeadObstacle::levelSet(openvdb::FloatGrid::ConstPtr grid, HeadPolic
     h.mKind = Kind::LevelSet;
     h.mPolicy = policy;
     h.mGrid = grid;
+    // Depth beyond the narrow band, into the interior (fast sweeping): within the band alone every
+    // deeper point would read as the band's half width, and "no deeper than the input" could not
+    // tell a vertex 4 voxels deep from one 20 voxels deep.
+    {
+        openvdb::FloatGrid::Ptr filled = openvdb::tools::dilateSdf(*grid, kInteriorVoxels, openvdb::tools::NN_FACE_EDGE, 1,
+                                                                   openvdb::tools::FastSweepingDomain::SWEEP_LESS_THAN_ISOVALUE);
+        if (filled) {
+            filled->setGridClass(openvdb::GRID_LEVEL_SET);
+            filled->setName(grid->getName());
+            h.mGrid = filled;
+        }
+    }
     // The band's centre: where the normal points away from when a point is outside the band.
     Vec3d sum(0.0);
     double n = 0.0;

@@ -37,9 +37,10 @@ public:
     /// @throw ValueError unless @a radius is positive and finite and @a center finite.
     static HeadObstacle sphere(const Vec3d& center, double radius, HeadPolicy policy = HeadPolicy::KeepOutside);
 
-    /// @brief A narrow-band level set (negative inside). Outside its band the distance is the
-    /// grid's background with its sign, and the gradient falls back to the direction from the
-    /// band's centre of mass.
+    /// @brief A narrow-band level set (negative inside). Its distance is extended 21 voxels
+    /// further into the interior (OpenVDB's fast sweeping, tools::dilateSdf()), so depths compare
+    /// beyond the band; beyond that, and outside the band, the distance is the grid's background
+    /// with its sign, and the gradient falls back to the direction from the band's centre of mass.
     /// @throw TypeError unless @a grid is a level set, ValueError if it has no active voxels.
     static HeadObstacle levelSet(openvdb::FloatGrid::ConstPtr grid, HeadPolicy policy = HeadPolicy::KeepOutside);
 

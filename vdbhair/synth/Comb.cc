@@ -24,6 +24,20 @@ using Quat = Eigen::Quaterniond;
 using EVec = Eigen::Vector3d;
 
 EVec toE(const Vec3d& v) { return EVec(v.x(), v.y(), v.z()); }
+
+/// The largest angle between consecutive edges of the polyline @a p of @a n vertices, degrees
+/// (zero-length edges skipped).
+double maxEdgeTurnDegrees(const Vec3f* p, std::size_t n)
+{
+    double worst = 0.0;
+    for (std::size_t v = 1; v + 1 < n; ++v) {
+        const Vec3d a(p[v] - p[v - 1]), b(p[v + 1] - p[v]);
+        const double la = a.length(), lb = b.length();
+        if (!(la > 0.0) || !(lb > 0.0)) continue;
+        worst = std::max(worst, std::acos(std::clamp(a.dot(b) / (la * lb), -1.0, 1.0)));
+    }
+    return worst * 180.0 / M_PI;
+}
 Vec3d fromE(const EVec& v) { return Vec3d(v.x(), v.y(), v.z()); }
 Quat toQuat(const std::array<double, 4>& q) { return Quat(q[0], q[1], q[2], q[3]); }
 std::array<double, 4> fromQuat(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
@@ -344,6 +358,7 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
         // Per strand partial sums, added in strand order (the same on any thread count).
         std::vector<double> before(n, 0.0), after(n, 0.0);
         std::vector<std::size_t> count(n, 0), insideBefore(n, 0), insideAfter(n, 0);
+        std::vector<std::uint8_t> kinked(n, 0);
         forEach(n, [&](std::size_t s) {
             const Vec3f* a = strands.data(s);
             const Vec3f* b = res.strands.data(s);
@@ -356,6 +371,7 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
                 }
             }
             if (m < 2) return;
+            if (moved[s]) kinked[s] = maxEdgeTurnDegrees(b, m) > kCombKinkDegrees && !(maxEdgeTurnDegrees(a, m) > kCombKinkDegrees);
             for (const CombStroke& k : strokes)
                 for (std::size_t v = 0; v < m; ++v) {
                     Vec3d dirA, dirB;
@@ -375,6 +391,7 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
             st.reachVertices += count[s];
             st.insideHeadBefore += insideBefore[s];
             st.insideHeadAfter += insideAfter[s];
+            st.newKinks += kinked[s];
         }
         if (st.reachVertices) {
             st.angleBefore = sb / double(st.reachVertices) * 180.0 / M_PI;

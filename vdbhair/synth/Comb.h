@@ -101,7 +101,13 @@ struct CombStats
     std::size_t headDeflected = 0;  ///< moved strands the head pushed out
     /// Vertices of the moved strands inside the head (signed distance below 0), before and after
     std::size_t insideHeadBefore = 0, insideHeadAfter = 0;
+    /// Moved strands that turn by more than kCombKinkDegrees between two consecutive edges and did
+    /// not before: kinks the comb (or the head pushing hair out of it) made
+    std::size_t newKinks = 0;
 };
+
+/// A turn between two consecutive edges above this many degrees is a kink (CombStats::newKinks).
+constexpr double kCombKinkDegrees = 45.0;
 
 struct CombResult
 {

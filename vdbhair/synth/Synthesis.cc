@@ -248,7 +248,10 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     }
     // 6-7. Finer levels, refined from the coarsest on.
     const double finestVoxel = params.voxelSize > 0.0 ? params.voxelSize : suggestVoxelSize(example);
-    synthesizeFinerLevels(res, res.example, [&](int l) { return LevelRoots{scatter(l).positions, {}}; }, params, finestVoxel,
+    // Refined on the example's scalp: another head's obstacle (the output's) is not the one there.
+    SynthParams onExample = params;
+    if (outputScalp) onExample.head = HeadObstacle();
+    synthesizeFinerLevels(res, res.example, [&](int l) { return LevelRoots{scatter(l).positions, {}}; }, onExample, finestVoxel,
                           /*refineCoarsest=*/true, scalp, threaded, interrupter);
     if (outputScalp) res.strands = moveToScalp(res.strands, map, *outputScalp, params.outputTurn, threaded);
     keepHairOutOfHead(res, synthesisHead(params, scalp, outputScalp != nullptr, example, res.up), outputScalp ? nullptr : &example, threaded);
@@ -269,6 +272,12 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
     res.refinedCorrected.assign(std::size_t(L), 0);
     res.refineVoxelSizes.assign(std::size_t(L), 0.0);
     for (int l = 0; l < L; ++l) res.refineVoxelSizes[std::size_t(l)] = finestVoxel * double(1 << l);
+    // The head the output is kept out of (SynthParams::head) when one is set, else the scalp's
+    // (made once: a level set's interior is filled when it becomes a head); unset: the sphere
+    // refineStrands() fits to the roots.
+    const HeadObstacle refineHead = !params.head.unset() ? params.head
+                                    : scalp              ? HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper)
+                                                         : HeadObstacle();
     // Refinement of one output level (§5.3), in place.
     StrandSet finestStrands;
     const auto refineLevel = [&](int l, bool refine) {
@@ -281,7 +290,7 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
             rp.mode = params.refineMode;
             rp.measure = false;
             rp.field.voxelSize = res.refineVoxelSizes[std::size_t(l)];
-            if (scalp) rp.head = HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper);
+            rp.head = refineHead;
             RefineResult rr = refineStrands(std::move(strands), rp, threaded, interrupter);
             if (!rr.levels.empty()) res.refinedCorrected[std::size_t(l)] = rr.levels.front().consistency.corrected;
             strands = std::move(rr.strands);
@@ -334,7 +343,17 @@ void keepHairOutOfHead(SynthResult& res, const HeadObstacle& head, const StrandS
     res.head = head.empty() ? std::string("none") : head.describe(false);
     if (head.empty()) return;
     SynthStageTimer t{res.stages, "head"};
-    res.headPushedOut = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), {}, threaded).strandsMoved;
+    // New hair rises out of the scalp it grows from and goes no deeper than the hair it was made
+    // from: each vertex no deeper than the vertices before it, nor than the example's (or the
+    // base's) strand with the nearest root at the same arc length (refine --head's rule); on
+    // another head, no deeper than its root.
+    HeadCollisionParams hp;
+    hp.depthRule = HeadDepthRule::Rising;
+    std::vector<std::uint32_t> nearest;
+    if (reference) liftRootsToReference(res.strands, *reference, head, threaded, &nearest);
+    const std::vector<float> allowed = reference ? referenceDepthAllowance(res.strands, *reference, head, threaded, nearest.empty() ? nullptr : &nearest)
+                                                 : rootDepthAllowance(res.strands, head, threaded);
+    res.headPushedOut = resolveHeadCollisions(res.strands, head, allowed, hp, threaded).strandsMoved;
     const double tolerance = headTolerance(head);
     res.enteringHead = countStrandsEnteringHead(res.strands, head, tolerance, threaded);
     if (reference) res.exampleEnteringHead = countStrandsEnteringHead(*reference, head, tolerance, threaded);

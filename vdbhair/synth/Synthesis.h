@@ -114,7 +114,7 @@ struct SynthParams
     std::uint64_t maxVertices = std::uint64_t(1) << 28;
 
     /// @throw ValueError naming the parameter, its value and the rule.
-    /// The head the new hair may enter no deeper than its root, swept out of it along a length as
+    /// The head the new hair may enter no deeper than the example's hair (keepHairOutOfHead()), swept out of it along a length as
     /// `interpolate`'s new hair is (HeadCollision.h). Unset: the scalp's level set when
     /// synthesizeHair() is given one, else the sphere fitted to the example's roots; with an
     /// output scalp and no head set, none (the caller knows the other head: the CLI passes its
@@ -218,9 +218,12 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params,
 HeadObstacle synthesisHead(const SynthParams& params, openvdb::FloatGrid::ConstPtr scalp, bool otherHead, const StrandSet& roots, const Vec3d& up);
 
 /// @brief The last step of synthesizeHair() and transferHairstyle(): @a res.strands swept out of
-/// @a head along a length, no vertex deeper than its root (HeadCollision.h), and the strands
-/// passing into it counted, of the output and of @a reference (the example or the base; null:
-/// not counted). Sets SynthResult::head, headPushedOut, enteringHead, exampleEnteringHead.
+/// @a head along a length (HeadCollision.h) with HeadDepthRule::Rising, no vertex deeper than the
+/// @a reference strand (the example or the base) with the nearest root at the same arc length
+/// (referenceDepthAllowance(); roots deeper than that strand's lifted to its depth first,
+/// liftRootsToReference()), or than its own root when @a reference is null; and the strands
+/// passing into it counted, of the output and of @a reference. Sets SynthResult::head,
+/// headPushedOut, enteringHead, exampleEnteringHead.
 void keepHairOutOfHead(SynthResult& res, const HeadObstacle& head, const StrandSet* reference, bool threaded = true);
 
 } // namespace vdbhair
