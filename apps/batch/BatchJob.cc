@@ -197,7 +197,7 @@ BatchJob readBatchJob(const std::string& path)
     if (job.outputRule.find('/') != std::string::npos) {
         throw ValueError(where + ": \"output\" '" + job.outputRule + "' has a '/'; it names a file in the output folder (-o OUTDIR), e.g. \"{stem}.vdb\"");
     }
-    const BatchItem probe{0, "/x/probe.hair", ""};
+    const BatchItem probe{0, "/x/probe.hair", "", {}};
     expandPlaceholders(job.outputRule, probe, "", where + ": \"output\"");
     for (const std::string& a : job.args) expandPlaceholders(a, probe, "/outdir", where + ": \"args\"");
 
@@ -220,7 +220,7 @@ std::vector<BatchItem> planBatch(const BatchJob& job, const std::string& outDir)
     std::vector<BatchItem> items;
     std::map<std::string, std::size_t> byOutput;
     for (std::size_t i = 0; i < job.inputs.size(); ++i) {
-        BatchItem item{i, job.inputs[i], ""};
+        BatchItem item{i, job.inputs[i], "", {}};
         const std::string name = expandPlaceholders(job.outputRule, item, "", job.path + ": \"output\"");
         if (name == "." || name == ".." || name.empty()) throw ValueError(job.path + ": \"output\" gives '" + name + "' for " + item.input + "; it must name a file");
         if (name.rfind("batch", 0) == 0 && fs::path(name).extension() == ".jsonl") {

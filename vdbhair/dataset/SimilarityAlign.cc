@@ -179,8 +179,8 @@ public:
     {
         constexpr std::size_t kNear = 4;
         const double q[3] = {p.x(), p.y(), p.z()};
-        std::uint32_t idx[kNear];
-        double dist[kNear];
+        std::uint32_t idx[kNear] = {};
+        double dist[kNear] = {};
         const std::size_t found = mTree.index.knnSearch(q, kNear, idx, dist);
         Hit best;
         best.corner = {idx[0], idx[0], idx[0]};
