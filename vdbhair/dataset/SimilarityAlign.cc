@@ -1,8 +1,11 @@
 #include "SimilarityAlign.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
 #include <vdbhair/Parallel.h>
 #include <vdbhair/strands/PointCloud.h>
+
+#include <openvdb/math/Proximity.h>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -18,12 +21,6 @@ namespace vdbhair {
 
 namespace {
 
-std::string num(double v)
-{
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
 
 /// A k-d tree over its own copy of points.
 struct Tree
@@ -107,38 +104,14 @@ double quantile(std::vector<double> d2, double q)
     return d2[k];
 }
 
-/// The point of triangle (a, b, c) nearest @a p, as barycentric weights (Ericson, Real-Time
-/// Collision Detection, 5.1.5).
+/// The point of triangle (a, b, c) nearest @a p, as barycentric weights (OpenVDB's
+/// closestPointOnTriangleToPoint); a degenerate triangle gives its first corner.
 Vec3d closestOnTriangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c)
 {
-    const Vec3d ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-    if (d1 <= 0.0 && d2 <= 0.0) return Vec3d(1, 0, 0);
-    const Vec3d bp = p - b;
-    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-    if (d3 >= 0.0 && d4 <= d3) return Vec3d(0, 1, 0);
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-        const double v = d1 / (d1 - d3);
-        return Vec3d(1 - v, v, 0);
-    }
-    const Vec3d cp = p - c;
-    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-    if (d6 >= 0.0 && d5 <= d6) return Vec3d(0, 0, 1);
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-        const double w = d2 / (d2 - d6);
-        return Vec3d(1 - w, 0, w);
-    }
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return Vec3d(0, 1 - w, w);
-    }
-    const double denom = 1.0 / (va + vb + vc);
-    if (!std::isfinite(denom)) return Vec3d(1, 0, 0);  // a degenerate triangle: its first corner
-    const double v = vb * denom, w = vc * denom;
-    return Vec3d(1 - v - w, v, w);
+    Vec3d uvw(1.0, 0.0, 0.0);
+    openvdb::math::closestPointOnTriangleToPoint(a, b, c, p, uvw);
+    if (!std::isfinite(uvw.x()) || !std::isfinite(uvw.y()) || !std::isfinite(uvw.z())) return Vec3d(1.0, 0.0, 0.0);
+    return uvw;
 }
 
 /// A surface to find nearest points on: a mesh's vertices and triangles (or points alone). The
@@ -470,7 +443,7 @@ Similarity fitSimilarity(const std::vector<Vec3d>& from, const std::vector<Vec3d
     const Eigen::Matrix4d m = Eigen::umeyama(src, dst, true);
     const Eigen::Matrix3d cR = m.topLeftCorner<3, 3>();
     const double c = std::cbrt(cR.determinant());
-    if (!(c > 0.0) || !std::isfinite(c)) throw ValueError("fitSimilarity: the points determine no scale (scale " + num(c) + ")");
+    if (!(c > 0.0) || !std::isfinite(c)) throw ValueError("fitSimilarity: the points determine no scale (scale " + formatNumber(c) + ")");
     Similarity s;
     s.scale = c;
     for (int i = 0; i < 3; ++i) {
@@ -482,12 +455,12 @@ Similarity fitSimilarity(const std::vector<Vec3d>& from, const std::vector<Vec3d
 
 void AlignParams::validate() const
 {
-    if (!(overlap > 0.0 && overlap <= 1.0)) throw ValueError("AlignParams::overlap " + num(overlap) + ": must be in (0, 1]");
+    if (!(overlap > 0.0 && overlap <= 1.0)) throw ValueError("AlignParams::overlap " + formatNumber(overlap) + ": must be in (0, 1]");
     if (iterations < 0) throw ValueError("AlignParams::iterations " + std::to_string(iterations) + ": must be 0 or more");
     if (startIterations < 0) throw ValueError("AlignParams::startIterations " + std::to_string(startIterations) + ": must be 0 or more");
     if (startSamples < 3) throw ValueError("AlignParams::startSamples " + std::to_string(startSamples) + ": must be 3 or more");
     if (maxSamples < 3) throw ValueError("AlignParams::maxSamples " + std::to_string(maxSamples) + ": must be 3 or more");
-    if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) throw ValueError("AlignParams::tolerance " + num(tolerance) + ": must be finite and non-negative");
+    if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) throw ValueError("AlignParams::tolerance " + formatNumber(tolerance) + ": must be finite and non-negative");
     for (const Vec3d* v : {&sourceUp, &targetUp}) {
         if (!std::isfinite(v->x()) || !std::isfinite(v->y()) || !std::isfinite(v->z())) throw ValueError("AlignParams: an up direction is not finite");
     }
