@@ -144,8 +144,15 @@ void warnBandWithoutZero(const std::string& verb, const std::string& input, doub
 
 void printJson(const nlohmann::json& j)
 {
-    // A file name need not be UTF-8: invalid bytes print as U+FFFD instead of ending the run.
+    // A file name or a file's metadata need not be UTF-8: invalid bytes print as U+FFFD (valid
+    // JSON) instead of ending the run, and a warning says so.
     std::cout << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    try {
+        (void)j.dump();
+    } catch (const nlohmann::json::type_error&) {
+        std::cerr << "vdbhair: warning: the report holds text that is not UTF-8 (a file name or a metadata string); "
+                     "its invalid bytes are written as U+FFFD\n";
+    }
 }
 
 namespace {
