@@ -2,6 +2,7 @@
 #include "../RefineOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/StrandIO.h>
@@ -146,8 +147,18 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     StrandSet strands = loadStrands("refine", p.input, common, p.strict);
     checkStrandLengths("refine", p.input, strands, common, p.strict);
     const RefineParams rp = refineParamsFrom(p, strands, common);
-    // The input is not needed again: its storage may take the output (refineStrands(StrandSet&&)).
+    // Without --measure the input is not needed again: its storage may take the output
+    // (refineStrands(StrandSet&&)); with it, the output is compared with it (`vdbhair compare`).
+    StrandSet input;
+    if (rp.measure) input = strands;
     const RefineResult r = refineStrands(std::move(strands), rp, true, common.interrupter);
+    HairComparison comparison;
+    if (rp.measure) {
+        const Stage stage(common, "comparing with the input");
+        CompareParams cp;
+        cp.metersPerUnit = input.metersPerUnit;
+        comparison = compareHairstyles(input, r.strands, cp, r.head.unset() || r.head.empty() ? nullptr : &r.head);
+    }
     // Write the field first: if the strands' write fails, nothing half-done is claimed.
     {
         const Stage stage(common, "writing " + p.output);
@@ -157,9 +168,16 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     if (common.json) {
         nlohmann::json j = refineReportJson(r, rp);
         j["output"] = p.output;
+        if (rp.measure) j["compare"] = toJson(comparison);
         printJson(j);
     } else if (!common.quiet) {
         printRefineReport(r, rp);
+        if (rp.measure) {
+            std::cout << "compared with the input (vdbhair compare): Chamfer " << comparison.chamfer.mean << ", position error "
+                      << comparison.perm.meanPosition << ", Frechet / length mean " << comparison.frechetMean;
+            if (!comparison.oriented.empty()) std::cout << ", F1 at 2 mm / 20 deg " << comparison.oriented.front().f1;
+            std::cout << "\n";
+        }
         if (!p.saveField.empty()) std::cout << "wrote " << p.saveField << "\n";
         std::cout << "wrote " << p.output << "\n";
     }
@@ -204,7 +222,8 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
     addRefineOptions(sub, *params);
     sub->add_flag("--measure", params->refine.measure,
                   "Also measure the output against the input at every level: full length, hair volume, head, curvature, "
-                  "tips, displacement, coherence (an extra field estimate per level: about a fifth of the run)");
+                  "tips, displacement, coherence (an extra field estimate per level: about a fifth of the run); and compare "
+                  "the output with the input as `vdbhair compare` does (the report's \"compare\")");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --measure --json");

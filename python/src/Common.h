@@ -10,6 +10,7 @@
 #include <vdbhair/Progress.h>
 #include <vdbhair/Types.h>
 
+#include <nlohmann/json.hpp>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -27,6 +28,13 @@
 #include <vector>
 
 namespace vdbhair::py {
+
+/// @brief A JSON value as a Python object, through Python's json module (reports and scenes are
+/// small): the library's JSON reports reach Python with the command line's keys and values.
+inline pybind11::object toPython(const nlohmann::json& j)
+{
+    return pybind11::module_::import("json").attr("loads")(j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
 
 namespace pyb = pybind11;
 

@@ -3,6 +3,7 @@
 #include "Common.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/DenseArray.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/ScalpSpace.h>
@@ -670,9 +671,18 @@ Raises:
                 if (!scalpHead) p.head = headArg.get("refine");
                 return refineStrands(*strands, p, true, interrupter);
             });
+            pyb::object comparison = pyb::none();  // the output against the input, as `vdbhair compare` (refine --measure --json's "compare")
+            if (measure && returnReport) {
+                CompareParams cp;
+                cp.metersPerUnit = strands->metersPerUnit;
+                const HeadObstacle* h = result.head.unset() || result.head.empty() ? nullptr : &result.head;
+                const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return compareHairstyles(*strands, result.strands, cp, h); });
+                comparison = toPython(toJson(c));
+            }
             auto out = std::make_shared<StrandSet>(std::move(result.strands));
             if (!returnReport) return pyb::cast(out);
             pyb::dict report = measure ? measuresDict(result.levels.front().measures) : pyb::dict();
+            if (measure) report["compare"] = comparison;
             report["mode"] = refineModeName(rp.mode);
             report["voxel_size"] = result.voxelSize;
             report["head"] = result.head.describe();
@@ -726,7 +736,8 @@ Args:
     integrator: "euler", "rk2", "rk3" or "rk4", for each step of either mode.
     margin: field mode: voxels a strand may continue past the field's active region.
     max_voxels: refuse voxel sizes whose voxel visits could exceed this.
-    measure: measure each level against the input (the report's numbers; costs a field a level).
+    measure: measure each level against the input (the report's numbers; costs a field a level),
+        and compare the output with the input as ``compare()`` does (the report's ``compare``).
     space, scalp, up: the fields' space, as estimate_tangent_field() (``--space``, ``--scalp``,
         ``--up``); a scalp given (a sphere or a head) is also the head strands keep out of
         unless head= says otherwise.

@@ -34,12 +34,6 @@ namespace {
 
 using StrandsPtr = std::shared_ptr<StrandSet>;
 
-/// A JSON value as a Python object, through Python's json module (scenes are small).
-pyb::object toPython(const nlohmann::json& j)
-{
-    return pyb::module_::import("json").attr("loads")(j.dump());
-}
-
 /// A scene argument: a path to a scene .json, or the scene itself as a dict.
 Scene sceneArgument(const pyb::handle& scene, const std::string& where = "grow")
 {
@@ -967,7 +961,7 @@ dict), point_count for points grids, and explanation (the metadata in words).)do
                 return compareHairstyles(*a, *b, p, head.unset() || head.empty() ? nullptr : &head, true);
             });
             // The report's keys and values are the command line's (toJson()), as Python objects.
-            pyb::dict report = pyb::module_::import("json").attr("loads")(toJson(c).dump());
+            pyb::dict report = toPython(toJson(c));
             pyb::dict perStrand;
             perStrand["chamfer"] = pyb::array_t<double>(c.chamfer.perStrandA.size(), c.chamfer.perStrandA.data());
             if (c.paired) {

@@ -103,9 +103,17 @@ def test_refine_report(wavy):
     assert report["mode"] == "consistent" and len(report["per_level"]) == 2
     assert [f.voxel_size for f in report["fields"]] == pytest.approx([0.15, 0.3])
     assert 0.0 <= report["coherence_after"] <= 1.0
+    # And the output against the input, as compare() reports it (the same function, the same keys).
+    assert report["compare"]["paired"] and report["compare"]["strands"] == {"a": len(wavy), "b": len(out)}
+    direct = vdbhair.compare(wavy, out)
+    del direct["per_strand"]
+    # refine's head (a sphere fitted to the roots) is compare's too: the shares passing into it are
+    # measured there, not here.
+    assert report["compare"].pop("entering_head") is not None and direct.pop("entering_head") is None
+    assert report["compare"] == direct
     # The measures are opt-in (as `refine --measure`): without them the report has none.
     _, plain = vdbhair.refine(wavy, voxel_size=0.15, levels=2, return_report=True)
-    assert "coherence_after" not in plain and plain["mode"] == "consistent"
+    assert "coherence_after" not in plain and "compare" not in plain and plain["mode"] == "consistent"
     field_mode = vdbhair.refine(wavy, voxel_size=0.15, mode="field", head="none")
     assert not np.array_equal(field_mode.positions, out.positions)
     with pytest.raises(ValueError, match="mode"):
