@@ -1,6 +1,7 @@
 #include "Compare.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Memory.h>
 #include <vdbhair/Parallel.h>
 #include <vdbhair/strands/Resample.h>
 
@@ -17,6 +18,8 @@ namespace vdbhair {
 StrandIndex::StrandIndex(const StrandSet& strands, bool threaded) : mStrands(&strands), mGrid(strands.positions, threaded)
 {
     const std::size_t V = strands.numVertices(), S = strands.numStrands();
+    reserveHugePages(mDirection, V);  // a fresh page costs a fault (Memory.h)
+    reserveHugePages(mStrandOf, V);
     mDirection.assign(V, Vec3f(0.f));
     mStrandOf.resize(V);
     forEachIndex(S, threaded, [&](std::size_t s) {
@@ -184,7 +187,9 @@ void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vecto
     if (T == 0) return;
     const StrandSet& fs = from.strands();
     const std::size_t S = fs.numStrands();
-    std::vector<std::uint32_t> matched(fs.numVertices(), 0);  // per oriented point: a bit per threshold
+    std::vector<std::uint32_t> matched;  // per oriented point: a bit per threshold
+    reserveHugePages(matched, fs.numVertices());
+    matched.assign(fs.numVertices(), 0);
     std::vector<double> strandConsistency(consistency ? S * T : 0);
     const std::vector<Vec3f>& xf = fs.positions;
 
@@ -401,7 +406,9 @@ std::vector<double> nearestVertexDistances(const StrandIndex& from, const Strand
 {
     const StrandSet& fs = from.strands();
     const std::vector<Vec3f>& xt = to.strands().positions;
-    std::vector<double> out(fs.numVertices());
+    std::vector<double> out;
+    reserveHugePages(out, fs.numVertices());
+    out.resize(fs.numVertices());
     forEachRange(fs.numStrands(), threaded, 16, [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t o = range.begin(); o != range.end(); ++o) {
             const std::size_t s = from.spatialOrder()[o];

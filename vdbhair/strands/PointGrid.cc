@@ -1,6 +1,7 @@
 #include "PointGrid.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Memory.h>
 #include <vdbhair/Parallel.h>
 
 #include <algorithm>
@@ -44,16 +45,22 @@ PointGrid::PointGrid(const std::vector<Vec3f>& points, bool threaded)
         mCell *= 1.25;
     }
     const std::size_t cells = std::size_t(mDims[0]) * std::size_t(mDims[1]) * std::size_t(mDims[2]);
-    std::vector<std::uint32_t> key(n);
+    // The large arrays ask for huge pages: a fresh page costs a fault (Memory.h).
+    std::vector<std::uint32_t> key;
+    reserveHugePages(key, n);
+    key.resize(n);
     forEachIndex(n, threaded, [&](std::size_t i) {
         std::size_t c[3];
         for (int a = 0; a < 3; ++a) c[a] = std::min(std::size_t((double(points[i][a]) - mOrigin[a]) / mCell), std::size_t(mDims[a] - 1));
         key[i] = std::uint32_t(c[0] + std::size_t(mDims[0]) * (c[1] + std::size_t(mDims[1]) * c[2]));
     }, 4096);
     // A counting sort, stable: within a cell, points keep their order.
+    reserveHugePages(mStart, cells + 1);
     mStart.assign(cells + 1, 0);
     for (const std::uint32_t k : key) ++mStart[k + 1];
     for (std::size_t c = 0; c < cells; ++c) mStart[c + 1] += mStart[c];
+    reserveHugePages(mPoints, n);
+    reserveHugePages(mIndex, n);
     mPoints.resize(n);
     mIndex.resize(n);
     std::vector<std::uint32_t> next(mStart.begin(), mStart.end() - 1);
