@@ -61,6 +61,25 @@ void bruteForce(const StrandSet& from, const StrandSet& to, const OrientedThresh
     consistency = sum / double(strands);
 }
 
+/// @a m (matchOrientedPoints(@a predicted, @a reference, @a th)) against the brute force, threshold
+/// by threshold; F1 too with @a withF1.
+void checkAgainstBruteForce(const StrandSet& predicted, const StrandSet& reference, const std::vector<OrientedThreshold>& th,
+                            const std::vector<OrientedMatch>& m, bool withF1)
+{
+    for (std::size_t t = 0; t < th.size(); ++t) {
+        CAPTURE(t);
+        double precision, recall, consistency, unused;
+        bruteForce(predicted, reference, th[t], precision, unused);
+        bruteForce(reference, predicted, th[t], recall, consistency);
+        CHECK(m[t].precision == Approx(precision).margin(1e-12));
+        CHECK(m[t].recall == Approx(recall).margin(1e-12));
+        CHECK(m[t].strandConsistency == Approx(consistency).margin(1e-12));
+        if (!withF1) continue;
+        const double f1 = precision + recall > 0.0 ? 2.0 * precision * recall / (precision + recall) : 0.0;
+        CHECK(m[t].f1 == Approx(f1).margin(1e-12));
+    }
+}
+
 } // namespace
 
 TEST_CASE("matchOrientedPoints: HairGS's precision, recall, F1 and strand consistency, against brute force", "[strands]")
@@ -71,17 +90,8 @@ TEST_CASE("matchOrientedPoints: HairGS's precision, recall, F1 and strand consis
         const std::vector<OrientedThreshold> th{{0.05, 20.0}, {0.1, 30.0}, {0.15, 90.0}, {0.2, 180.0}};
         const std::vector<OrientedMatch> m = matchOrientedPoints(a, b, th);
         REQUIRE(m.size() == th.size());
-        for (std::size_t t = 0; t < th.size(); ++t) {
-            CAPTURE(round, t);
-            double precision, recall, consistency, unused;
-            bruteForce(a, b, th[t], precision, unused);
-            bruteForce(b, a, th[t], recall, consistency);
-            CHECK(m[t].precision == Approx(precision).margin(1e-12));
-            CHECK(m[t].recall == Approx(recall).margin(1e-12));
-            CHECK(m[t].strandConsistency == Approx(consistency).margin(1e-12));
-            const double f1 = precision + recall > 0.0 ? 2.0 * precision * recall / (precision + recall) : 0.0;
-            CHECK(m[t].f1 == Approx(f1).margin(1e-12));
-        }
+        CAPTURE(round);
+        checkAgainstBruteForce(a, b, th, m, /*withF1=*/true);
         CHECK(m[3].precision > 0.0);
     }
 }
@@ -112,15 +122,8 @@ TEST_CASE("matchOrientedPoints: near copies (the likely strand, the listing and 
         const std::vector<OrientedThreshold> th{{0.01, 20.0}, {0.02, 30.0}, {0.03, 90.0}};
         for (const bool threaded : {false, true}) {
             const std::vector<OrientedMatch> m = matchOrientedPoints(b, a, th, false, threaded);
-            for (std::size_t t = 0; t < th.size(); ++t) {
-                CAPTURE(jitter, threaded, t);
-                double precision, recall, consistency, unused;
-                bruteForce(b, a, th[t], precision, unused);
-                bruteForce(a, b, th[t], recall, consistency);
-                CHECK(m[t].precision == Approx(precision).margin(1e-12));
-                CHECK(m[t].recall == Approx(recall).margin(1e-12));
-                CHECK(m[t].strandConsistency == Approx(consistency).margin(1e-12));
-            }
+            CAPTURE(jitter, threaded);
+            checkAgainstBruteForce(b, a, th, m, /*withF1=*/false);
         }
     }
 }

@@ -89,8 +89,6 @@ StrandIndex::StrandIndex(const StrandSet& strands, bool threaded) : mStrands(&st
 
 namespace {
 
-Vec3d toDouble(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
-
 /// The thresholds as the tests use them: squared distances, cosines, the largest distance.
 struct Thresholds
 {
@@ -138,7 +136,7 @@ std::uint32_t matchStrand(const StrandIndex& to, const Thresholds& th, const Vec
     std::uint32_t bits = 0;
     auto test = [&](std::size_t v) {
         if (!to.oriented(v)) return false;
-        const double d2 = (p - toDouble(x[v])).lengthSqr();
+        const double d2 = (p - Vec3d(x[v])).lengthSqr();
         if (d2 > maxD2) return false;
         const std::uint32_t b = th.bits(d2, u, to.direction(v)) & want;
         if (!(b & ~bits)) return false;
@@ -197,7 +195,7 @@ void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vecto
     // the point before first (a strand's neighbours run beside it), then the grid out to the
     // largest distance of the thresholds still unmatched, until every threshold matches.
     auto matchAny = [&](std::size_t v, std::uint32_t& lastStrand, std::size_t& hint) {
-        const Vec3d p = toDouble(xf[v]), u = toDouble(from.direction(v));
+        const Vec3d p = Vec3d(xf[v]), u = Vec3d(from.direction(v));
         std::uint32_t bits = lastStrand != ~0u ? matchStrand(to, th, p, u, lastStrand, hint, th.all) : 0u;
         if (bits == th.all) return bits;
         double radius2 = 0.0;
@@ -252,7 +250,7 @@ void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vecto
                     const std::size_t v = points[k];
                     const std::uint32_t here = matched[v] & want;
                     if (!here) continue;
-                    const std::uint32_t b = matchStrand(to, th, toDouble(xf[v]), toDouble(from.direction(v)), q, h, here);
+                    const std::uint32_t b = matchStrand(to, th, Vec3d(xf[v]), Vec3d(from.direction(v)), q, h, here);
                     for (std::uint32_t t = 0, m = here; m; ++t, m >>= 1) {
                         if (!(m & 1u)) continue;
                         count[t] += (b >> t) & 1u;
@@ -271,7 +269,7 @@ void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vecto
                 for (std::size_t t = 0; t < T; ++t) want |= settled(t) ? 0u : 1u << t;
                 if (!want) break;
                 double d2 = std::numeric_limits<double>::infinity();
-                const std::uint32_t w = to.grid().nearest(toDouble(xf[points[k]]), d2);
+                const std::uint32_t w = to.grid().nearest(Vec3d(xf[points[k]]), d2);
                 if (w == ~0u) break;
                 const std::uint32_t q = to.strandOf(w);
                 if (std::find(likely.begin(), likely.end(), q) != likely.end()) continue;
@@ -306,9 +304,9 @@ void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vecto
                     --listing;
                 }
                 if (!active) continue;
-                const Vec3d u = toDouble(from.direction(v));
+                const Vec3d u = Vec3d(from.direction(v));
                 pointHits.clear();
-                to.grid().forEachWithin(toDouble(xf[v]), std::sqrt(radius2), [&](std::uint32_t w, double d2) {
+                to.grid().forEachWithin(Vec3d(xf[v]), std::sqrt(radius2), [&](std::uint32_t w, double d2) {
                     if (!to.oriented(w)) return true;
                     const std::uint32_t b = th.bits(d2, u, to.direction(w)) & active;
                     for (std::uint32_t t = 0, m = b; m; ++t, m >>= 1) {
@@ -414,12 +412,12 @@ std::vector<double> nearestVertexDistances(const StrandIndex& from, const Strand
             const std::size_t s = from.spatialOrder()[o];
             std::uint32_t last = ~0u;
             for (std::size_t v = fs.begin(s); v < fs.end(s); ++v) {
-                const Vec3d p = toDouble(fs.positions[v]);
+                const Vec3d p = Vec3d(fs.positions[v]);
                 double d2 = std::numeric_limits<double>::infinity();
                 if (last != ~0u) {
                     const std::uint32_t from = last;
                     for (std::uint32_t w = from; w < std::min<std::size_t>(std::size_t(from) + 2, xt.size()); ++w) {
-                        const double e2 = (p - toDouble(xt[w])).lengthSqr();
+                        const double e2 = (p - Vec3d(xt[w])).lengthSqr();
                         if (e2 < d2) {
                             d2 = e2;
                             last = w;
