@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 
+
 namespace vdbhair {
 
 std::uint64_t availableMemoryBytes(std::uint64_t maxMemory)
@@ -37,6 +38,48 @@ void checkMemory(const std::string& where, std::uint64_t estimate, const std::st
     if (estimate <= available) return;
     throw LimitError(where + ": needs about " + formatBytes(estimate) + " (" + how + "), more than the " + formatBytes(available) +
                      (maxMemory > 0 ? " of maxMemory" : " available (MemAvailable)") + (advice.empty() ? "" : "; " + advice));
+}
+
+namespace {
+thread_local AllocationBudget* tBudget = nullptr;
+}
+
+BudgetExceeded::BudgetExceeded(std::uint64_t requested, std::uint64_t live, std::uint64_t limit)
+    : mRequested(requested), mLive(live), mLimit(limit)
+{
+    std::snprintf(mWhat, sizeof mWhat, "allocation of %llu bytes with %llu live would pass the budget of %llu bytes",
+                  static_cast<unsigned long long>(requested), static_cast<unsigned long long>(live),
+                  static_cast<unsigned long long>(limit));
+}
+
+AllocationBudget::AllocationBudget(std::uint64_t limit) : mLimit(limit), mOuter(tBudget)
+{
+    if (mOuter) mLimit = std::min(mLimit, mOuter->mLimit - std::min(mOuter->mLimit, mOuter->mLive));
+    tBudget = this;
+}
+
+AllocationBudget::~AllocationBudget()
+{
+    tBudget = mOuter;
+    if (mOuter) {
+        mOuter->mPeak = std::max(mOuter->mPeak, mOuter->mLive + mPeak);
+        mOuter->mLive += mLive;
+    }
+}
+
+AllocationBudget* AllocationBudget::current() { return tBudget; }
+
+void AllocationBudget::charge(std::size_t request)
+{
+    if (request > mLimit || mLive > mLimit - request) throw BudgetExceeded(request, mLive, mLimit);
+}
+
+std::uint64_t readBudgetBytes(std::uint64_t fileBytes, std::uint64_t maxMemory)
+{
+    const std::uint64_t cap = std::numeric_limits<std::uint64_t>::max();
+    const std::uint64_t rule = fileBytes > (cap - kReadBudgetFloor) / kReadBudgetPerFileByte ? cap
+                                                                                             : kReadBudgetFloor + kReadBudgetPerFileByte * fileBytes;
+    return std::min(rule, availableMemoryBytes(maxMemory));
 }
 
 } // namespace vdbhair

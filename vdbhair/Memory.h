@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <string>
 
 #if defined(__linux__)
@@ -39,6 +40,66 @@ std::string formatBytes(std::uint64_t bytes);
 /// @param advice what to change, e.g. "fewer vertices per strand"
 void checkMemory(const std::string& where, std::uint64_t estimate, const std::string& how, const std::string& advice,
                  std::uint64_t maxMemory = 0);
+
+/// @brief What an AllocationBudget throws from operator new: the request that would have taken
+/// the calling thread's live bytes past the budget. A std::bad_alloc, so code that copes with an
+/// allocation failing copes with this one (nothrow new returns null).
+class BudgetExceeded : public std::bad_alloc
+{
+public:
+    BudgetExceeded(std::uint64_t requested, std::uint64_t live, std::uint64_t limit);
+    const char* what() const noexcept override { return mWhat; }
+    std::uint64_t requested() const { return mRequested; }
+    std::uint64_t live() const { return mLive; }
+    std::uint64_t limit() const { return mLimit; }
+
+private:
+    std::uint64_t mRequested, mLive, mLimit;
+    char mWhat[160];  // built without allocating: it is made inside operator new
+};
+
+/// @brief While alive, every `operator new` of the calling thread is counted against @a limit
+/// bytes: the live bytes (malloc_usable_size of each block, less each block freed) may not pass
+/// it, and a request that would throws BudgetExceeded before anything is allocated. Other
+/// threads are not counted. The library replaces the global operator new and delete to do this
+/// (Memory.cc); with no budget alive they cost one thread-local load.
+///
+/// Readers of files whose contents another library allocates (OpenVDB's tree reader) open one
+/// with readBudgetBytes() of the file's size: a size field the file states beyond what its bytes
+/// can hold then fails as a typed error instead of exhausting memory. Budgets nest: an inner one
+/// is held to what its outer one has left, and its live bytes count in the outer one when it ends.
+class AllocationBudget
+{
+public:
+    explicit AllocationBudget(std::uint64_t limit);
+    ~AllocationBudget();
+    AllocationBudget(const AllocationBudget&) = delete;
+    AllocationBudget& operator=(const AllocationBudget&) = delete;
+
+    std::uint64_t limit() const { return mLimit; }
+    std::uint64_t live() const { return mLive; }
+    std::uint64_t peak() const { return mPeak; }  ///< the most live bytes at any time
+
+    // For operator new and delete (Memory.cc).
+    void charge(std::size_t request);
+    void add(std::size_t usable) { mLive += usable; mPeak = std::max(mPeak, mLive); }
+    void release(std::size_t usable) { mLive -= std::min<std::uint64_t>(mLive, usable); }
+    static AllocationBudget* current();
+
+private:
+    std::uint64_t mLimit, mLive = 0, mPeak = 0;
+    AllocationBudget* mOuter;
+};
+
+/// @brief The budget for reading a file of @a fileBytes whose reader allocates what the file
+/// declares: kReadBudgetPerFileByte times its size plus kReadBudgetFloor, and never more than
+/// availableMemoryBytes(@a maxMemory). The factor is 2.5 times the densest legitimate expansion of
+/// a `.vdb` found (TestVdbBudget.cc): one Vec3d voxel alone in its branch of internal nodes holds
+/// 103 bytes per byte of file (tables of 32^3 and 16^3 values written as masks), fully active
+/// leaves of equal Vec3d 49, a strands grid 33, a level set 6.
+constexpr std::uint64_t kReadBudgetPerFileByte = 256;
+constexpr std::uint64_t kReadBudgetFloor = std::uint64_t(64) << 20;
+std::uint64_t readBudgetBytes(std::uint64_t fileBytes, std::uint64_t maxMemory = 0);
 
 /// @brief Ask for transparent huge pages over the 2 MiB-aligned part of [p, p + bytes); a hint
 /// that changes no contents (nothing happens below 4 MiB, or where the kernel declines).

@@ -74,7 +74,15 @@ void readOnce(const std::string& path)
         samples.curveSamples = 5;
         readAbc(path, samples, &report);
     }
-    else if (sReader == "vdb") readVdbStrands(path, opts, &report);
+    else if (sReader == "vdb") {
+        // Every grid of any type (fields, level sets, points), as `info`, `inspect` and the field
+        // verbs read them, then the strands reader on the same bytes.
+        try {
+            readVdbGrids(path, path);
+        } catch (const vdbhair::Error&) {
+        }
+        readVdbStrands(path, opts, &report);
+    }
     else if (sReader == "mesh") readTriangleMesh(path);
     else if (sReader == "scene") readScene(path);
 }

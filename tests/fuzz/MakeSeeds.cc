@@ -11,6 +11,10 @@
 #include <vdbhair/io/AbcFile.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrands.h>
+#include <vdbhair/io/VdbPrescan.h>
+
+#include <openvdb/io/File.h>
+#include <openvdb/tools/LevelSetSphere.h>
 
 #include <cmath>
 #include <cstdint>
@@ -99,6 +103,50 @@ int main(int argc, char** argv)
     VdbPointsOptions fixed;
     fixed.codec = PositionCodec::Fixed16;
     writeVdbStrands((out / "vdb/fixed16_colour.vdb").string(), s, fixed);
+    {
+        // Fields, a level set and a file of several grids (issue 51), each under 64 KiB.
+        auto tangent = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+        auto density = openvdb::FloatGrid::create(0.f);
+        for (int i = 0; i < 40; ++i) {
+            const openvdb::Coord c(i, (i * 7) % 13, (i * 3) % 17);
+            tangent->tree().setValue(c, openvdb::Vec3s(0.f, 1.f, 0.1f * float(i % 5)));
+            density->tree().setValue(c, 0.025f * float(i));
+        }
+        tangent->setName("tangent");
+        tangent->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+        density->setName("density");
+        density->setGridClass(openvdb::GRID_FOG_VOLUME);
+        auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(3.f, openvdb::Vec3f(8.f), 1.f, 2.f);
+        sphere->setName("surface");
+        auto wide = openvdb::Vec3DGrid::create();
+        wide->tree().setValue(openvdb::Coord(4096, 0, 0), openvdb::Vec3d(1.0, 2.0, 3.0));
+        auto flags = openvdb::BoolGrid::create();
+        flags->denseFill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(9)), true);
+        writeVdbGrids((out / "vdb/field.vdb").string(), {tangent, density}, "seeds");
+        writeVdbGrids((out / "vdb/level_set.vdb").string(), {sphere}, "seeds");
+        openvdb::GridCPtrVec many{density, sphere, wide, flags};
+        for (const auto& g : readVdbGrids((out / "vdb/float.vdb").string(), "seeds")) many.push_back(g);
+        writeVdbGrids((out / "vdb/several.vdb").string(), many, "seeds");
+        // The overflow of Debian's OpenVDB 10.0.1 (fixed in 11.0, PR #1701): a leaf chunk of -1000
+        // bytes is read uncompressed into its smaller buffer. Also tests/io/data/fuzz_vdb_negative_chunk.vdb.
+        std::vector<VdbPrescanField> fields;
+        prescanVdbFile((out / "vdb/field.vdb").string(), "seeds", nullptr, &fields);
+        for (auto it = fields.rbegin(); it != fields.rend(); ++it) {  // the last: a leaf's buffer
+            const VdbPrescanField& f = *it;
+            if ((f.kind != "chunk64blosc" && f.kind != "chunk64zip") || f.destination == 0) continue;
+            std::ifstream in(out / "vdb/field.vdb", std::ios::binary);
+            std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+            const std::int64_t negative = -1000;
+            bytes.replace(f.offset, 8, reinterpret_cast<const char*>(&negative), 8);
+            writeRaw(out / "vdb/negative_chunk.vdb", bytes);
+            break;
+        }
+        auto zip = sphere->deepCopy();
+        openvdb::io::File file((out / "vdb/level_set_zip.vdb").string());
+        file.setCompression(openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK);
+        file.write({zip});
+        file.close();
+    }
 
     // CT2Hair .bin: int32 strands; per strand int32 count and 7 floats per vertex.
     std::string bin;

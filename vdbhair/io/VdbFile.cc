@@ -2,6 +2,7 @@
 #include "VdbPrescan.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Memory.h>
 #include <vdbhair/io/FileUtil.h>
 
 #include <openvdb/io/DelayedLoadMetadata.h>
@@ -300,14 +301,42 @@ const char* const kTreeSizes =
 /// Open @a path, turning OpenVDB's errors into ours.
 void openFile(openvdb::io::File& file, const std::string& path, const std::string& where)
 {
-    requireRegularFile(path, where);
     checkVdbFileLayout(path, where);
     prescanVdbFile(path, where);  // every chunk, count and string bounded before OpenVDB reads it (VdbPrescan.h)
     try {
-
         file.open(/*delayLoad=*/false);
     } catch (const openvdb::Exception& e) {
         throw FormatError(where + ": not a readable VDB file (" + std::string(e.what()) + ")");
+    }
+}
+
+/// Run @a read (which opens and reads @a path with OpenVDB) under the file's allocation budget
+/// (readBudgetBytes(), Memory.h): the second line behind the pre-scan, for what it does not walk
+/// (formats before 222) and anything it misses. A request past the budget, or one memory cannot
+/// meet, is one line naming the file.
+template<typename ReadT>
+auto budgetedRead(const std::string& path, const std::string& where, ReadT&& read)
+{
+    requireRegularFile(path, where);
+    std::error_code ec;
+    const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+    const std::uint64_t rule = readBudgetBytes(ec ? 0 : bytes, std::numeric_limits<std::uint64_t>::max());
+    try {
+        AllocationBudget budget(readBudgetBytes(ec ? 0 : bytes));
+        return read();
+    } catch (const BudgetExceeded& e) {
+        const std::string asked = where + ": reading it asks for " + formatBytes(e.requested()) + " with " + formatBytes(e.live()) + " held";
+        if (e.limit() == rule)
+            throw LimitError(asked + ", past the budget of " + formatBytes(rule) + " (" + std::to_string(kReadBudgetPerFileByte) + " x its " +
+                             formatBytes(bytes) + " + " + formatBytes(kReadBudgetFloor) +
+                             "): the file declares more data than it can hold (damaged, or not what it claims)");
+        throw LimitError(asked + ", more than the " + formatBytes(e.limit()) +
+                         (e.limit() == availableMemoryBytes() ? " available (MemAvailable)" : " left to this read") +
+                         "; free memory or read it on a larger machine");
+    } catch (const std::bad_alloc&) {
+        throw FormatError(where + ": " + kTreeSizes);
+    } catch (const std::length_error&) {
+        throw FormatError(where + ": " + kTreeSizes);
     }
 }
 
@@ -324,55 +353,53 @@ std::string listNames(const std::vector<std::string>& names)
 openvdb::GridPtrVec readVdbGrids(const std::string& path, const std::string& where)
 {
     initializeOpenVdb();
-    openvdb::io::File file(path);
-    openFile(file, path, where);
-    try {
-        openvdb::GridPtrVecPtr grids = file.getGrids();
-        file.close();
-        return grids ? *grids : openvdb::GridPtrVec{};
-    } catch (const openvdb::Exception& e) {
-        throw FormatError(where + ": cannot read the grids (" + std::string(e.what()) + ")");
-    } catch (const std::bad_alloc&) {
-        throw FormatError(where + ": " + kTreeSizes);
-    } catch (const std::length_error&) {
-        throw FormatError(where + ": " + kTreeSizes);
-    }
+    return budgetedRead(path, where, [&] {
+        openvdb::io::File file(path);
+        openFile(file, path, where);
+        try {
+            openvdb::GridPtrVecPtr grids = file.getGrids();
+            file.close();
+            return grids ? *grids : openvdb::GridPtrVec{};
+        } catch (const openvdb::Exception& e) {
+            throw FormatError(where + ": cannot read the grids (" + std::string(e.what()) + ")");
+        }
+    });
 }
 
 std::vector<std::string> vdbGridNames(const std::string& path, const std::string& where)
 {
     initializeOpenVdb();
-    openvdb::io::File file(path);
-    openFile(file, path, where);
-    std::vector<std::string> names;
-    for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(it.gridName());
-    file.close();
-    return names;
+    return budgetedRead(path, where, [&] {
+        openvdb::io::File file(path);
+        openFile(file, path, where);
+        std::vector<std::string> names;
+        for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(it.gridName());
+        file.close();
+        return names;
+    });
 }
 
 openvdb::GridBase::Ptr readVdbGrid(const std::string& path, const std::string& name,
                                    const std::string& where)
 {
     initializeOpenVdb();
-    openvdb::io::File file(path);
-    openFile(file, path, where);
-    std::vector<std::string> names;
-    for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(it.gridName());
-    if (!file.hasGrid(name)) {
-        file.close();
-        throw LookupError(where + ": no grid named '" + name + "'; " + listNames(names));
-    }
-    try {
-        openvdb::GridBase::Ptr grid = file.readGrid(name);
-        file.close();
-        return grid;
-    } catch (const openvdb::Exception& e) {
-        throw FormatError(where + ": cannot read grid '" + name + "' (" + std::string(e.what()) + ")");
-    } catch (const std::bad_alloc&) {
-        throw FormatError(where + ": grid '" + name + "': " + kTreeSizes);
-    } catch (const std::length_error&) {
-        throw FormatError(where + ": grid '" + name + "': " + kTreeSizes);
-    }
+    return budgetedRead(path, where, [&] {
+        openvdb::io::File file(path);
+        openFile(file, path, where);
+        std::vector<std::string> names;
+        for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(it.gridName());
+        if (!file.hasGrid(name)) {
+            file.close();
+            throw LookupError(where + ": no grid named '" + name + "'; " + listNames(names));
+        }
+        try {
+            openvdb::GridBase::Ptr grid = file.readGrid(name);
+            file.close();
+            return grid;
+        } catch (const openvdb::Exception& e) {
+            throw FormatError(where + ": cannot read grid '" + name + "' (" + std::string(e.what()) + ")");
+        }
+    });
 }
 
 void writeVdbGrids(const std::string& path, const openvdb::GridCPtrVec& grids, const std::string& where)

@@ -294,7 +294,9 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
         populateDirect<float>(tree, index->tree(), "Alpha", [&](std::size_t v) { return 1.f - strands.transparency[v]; });
     }
 
-    for (const auto& [name, values] : opts.strandAttributes) {
+    for (const auto& attribute : opts.strandAttributes) {
+        const std::string& name = attribute.first;
+        const auto& values = attribute.second;  // a plain reference: lambdas may not capture structured bindings (C++17)
         const bool nameOk = !name.empty() && !std::isdigit(static_cast<unsigned char>(name[0])) &&
                             std::all_of(name.begin(), name.end(), [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; });
         if (!nameOk || name == "P" || name == "strand" || name == "vertex" || name == "Cd" || name == "width" || name == "Alpha")

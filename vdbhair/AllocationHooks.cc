@@ -1,0 +1,49 @@
+/// @file AllocationHooks.cc
+/// @brief The replaceable global allocation functions ([new.delete]), counting against the
+/// calling thread's AllocationBudget (Memory.h) when one is alive.
+///
+/// In the library archive, so every program linking it gets them; a program exports them, so
+/// OpenVDB's allocations come here too. The Python module compiles this file into itself (its
+/// link keeps the archive's symbols inside), which exports them to the libraries it loads.
+#include <vdbhair/Memory.h>
+
+#include <cstdlib>
+#include <new>
+
+#include <malloc.h>
+
+#define VDBHAIR_HOOK __attribute__((visibility("default")))
+
+// The replaceable global allocation functions ([new.delete]), counting against the calling
+// thread's AllocationBudget when one is alive. The plain, array and sized forms are written here;
+// the standard library's nothrow forms call them. The aligned forms are left to it: they
+// allocate with aligned_alloc and free on their own, outside any budget.
+VDBHAIR_HOOK void* operator new(std::size_t n)
+{
+    vdbhair::AllocationBudget* budget = vdbhair::AllocationBudget::current();
+    if (budget) budget->charge(n);
+    for (;;) {
+        if (void* p = std::malloc(n ? n : 1)) {
+            if (budget) budget->add(malloc_usable_size(p));
+            return p;
+        }
+        std::new_handler handler = std::get_new_handler();
+        if (!handler) throw std::bad_alloc();
+        handler();
+    }
+}
+
+VDBHAIR_HOOK void operator delete(void* p) noexcept
+{
+    if (!p) return;
+    if (vdbhair::AllocationBudget* budget = vdbhair::AllocationBudget::current()) budget->release(malloc_usable_size(p));
+    std::free(p);
+}
+
+VDBHAIR_HOOK void operator delete(void* p, std::size_t) noexcept { ::operator delete(p); }
+
+VDBHAIR_HOOK void* operator new[](std::size_t n) { return ::operator new(n); }
+
+VDBHAIR_HOOK void operator delete[](void* p) noexcept { ::operator delete(p); }
+
+VDBHAIR_HOOK void operator delete[](void* p, std::size_t) noexcept { ::operator delete(p); }
