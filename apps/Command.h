@@ -229,6 +229,7 @@ void writeSynthStrands(const std::string& path, const StrandSet& strands,
 struct TransferJob
 {
     std::string verb, details, base, output, scalp, detailsLabel = "DETAILS", baseLabel = "BASE";
+    bool measure = false;  ///< also compare the output with BASE (`vdbhair compare`)
 };
 int runTransferJob(const TransferJob& job, TransferParams params, const CommonOptions& common);
 

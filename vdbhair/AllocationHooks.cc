@@ -2,9 +2,8 @@
 /// @brief The replaceable global allocation functions ([new.delete]), counting against the
 /// calling thread's AllocationBudget (Memory.h) when one is alive.
 ///
-/// In the library archive, so every program linking it gets them; a program exports them, so
-/// OpenVDB's allocations come here too. The Python module compiles this file into itself (its
-/// link keeps the archive's symbols inside), which exports them to the libraries it loads.
+/// Linked as an object into every program and module that links the library (CMakeLists.txt);
+/// they export them, so OpenVDB's allocations come here too.
 #include <vdbhair/Memory.h>
 
 #include <cstdlib>

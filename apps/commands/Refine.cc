@@ -155,9 +155,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     HairComparison comparison;
     if (rp.measure) {
         const Stage stage(common, "comparing with the input");
-        CompareParams cp;
-        cp.metersPerUnit = input.metersPerUnit;
-        comparison = compareHairstyles(input, r.strands, cp, r.head.unset() || r.head.empty() ? nullptr : &r.head);
+        comparison = measureAgainst(input, r.strands, &r.head);
     }
     // Write the field first: if the strands' write fails, nothing half-done is claimed.
     {
@@ -173,10 +171,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     } else if (!common.quiet) {
         printRefineReport(r, rp);
         if (rp.measure) {
-            std::cout << "compared with the input (vdbhair compare): Chamfer " << comparison.chamfer.mean << ", position error "
-                      << comparison.perm.meanPosition << ", Frechet / length mean " << comparison.frechetMean;
-            if (!comparison.oriented.empty()) std::cout << ", F1 at 2 mm / 20 deg " << comparison.oriented.front().f1;
-            std::cout << "\n";
+            std::cout << "compared with the input (vdbhair compare): " << summaryLine(comparison) << "\n";
         }
         if (!p.saveField.empty()) std::cout << "wrote " << p.saveField << "\n";
         std::cout << "wrote " << p.output << "\n";

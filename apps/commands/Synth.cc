@@ -4,6 +4,7 @@
 #include "../Command.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/RefineReport.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/FileUtil.h>
@@ -36,7 +37,7 @@ struct SynthCmdParams
     SynthOptionText text;
     std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;
-    bool coarseGuides = false;
+    bool coarseGuides = false, measure = false;
     std::string coarse;
     const CLI::Option* detailScaleOption = nullptr;     ///< (given or not: --coarse takes transfer's defaults)
     const CLI::Option* matchCandidatesOption = nullptr;
@@ -168,7 +169,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
             if (!p.coarseGuides) throw ValueError("--strands: with --coarse the output has BASE's strands; --strands needs --coarse-guides");
             tp.strands = std::size_t(p.strands);
         }
-        TransferJob job{"synth", p.input, p.coarse, p.output, p.scalp, "EXAMPLE", "--coarse"};
+        TransferJob job{"synth", p.input, p.coarse, p.output, p.scalp, "EXAMPLE", "--coarse", p.measure};
         return runTransferJob(job, tp, common);
     }
     const StrandSet example = loadStrands("synth", p.input, common);
@@ -248,6 +249,11 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     StrandSet movedBack;
     if (outputMap) movedBack = moveToScalp(r.strands, *outputMap, *r.map, -p.synth.outputTurn);
     const nlohmann::json stats = statsJson(example, r, outputMap ? movedBack : r.strands, finestVoxel, checks);
+    HairComparison comparison;
+    if (p.measure) {
+        const Stage stage(common, "comparing with the example");
+        comparison = measureAgainst(example, outputMap ? movedBack : r.strands, outputMap ? nullptr : &p.synth.head);
+    }
     if (common.json) {
         nlohmann::json levels = nlohmann::json::array();
         for (std::size_t l = 0; l < r.output.size(); ++l)
@@ -269,7 +275,8 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
                    {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
                              {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
                                            {"example", outputMap ? nlohmann::json(nullptr) : nlohmann::json(double(r.exampleEnteringHead) / double(example.numStrands()))}}}}},
-                   {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}});
+                   {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks},
+                   {"compare", p.measure ? toJson(comparison) : nlohmann::json(nullptr)}});
     } else if (!common.quiet) {
         std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
         for (const SynthStage& s : r.stages) std::cout << "  " << s.name << ": " << s.seconds << " s\n";
@@ -288,6 +295,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
             }
             std::cout << "\n";
         }
+        if (p.measure) std::cout << "  compared with the example (vdbhair compare): " << summaryLine(comparison) << "\n";
         std::cout << "wrote " << p.output << "\n";
     }
     return 0;
@@ -368,6 +376,8 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     params->matchCandidatesOption = sub->get_option("--match-candidates");
     sub->add_option("--coarse", params->coarse, "Impose a coarsest level instead of synthesizing one (Wang et al. §6): BASE's own coarsest level (a hairstyle, or a scene grown first); the example's finer levels are transferred onto it, on BASE's scalp, with BASE's roots (as vdbhair transfer EXAMPLE BASE)");
     sub->add_flag("--coarse-guides", params->coarseGuides, "With --coarse: BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over the guides' region (--strands sets the output count)");
+    sub->add_flag("--measure", params->measure, "Also compare the output with the example as `vdbhair compare` does (the report's \"compare\"; on another head, "
+                                                "the output moved back onto the example's scalp): about 1-3 s more at 100,000 strands");
     sub->add_option("--save-maps", params->saveMaps, "Write input_map.png, output_map.png (first three PCA channels as RGB) and clusters.png to this folder");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);

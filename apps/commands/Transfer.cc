@@ -3,6 +3,7 @@
 #include "../Command.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/strands/Measures.h>
@@ -88,6 +89,11 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
     const double rd = tr.detailsMap->radius(), rb = r.map->radius();
     const nlohmann::json checks = {{"detail", std::abs(turnOut * rb - turnDetails * rd) <= 0.1 * turnDetails * rd},
                                    {"coarse_shape", mean(dev) <= 0.1}};
+    HairComparison comparison;
+    if (job.measure) {
+        const Stage stage(common, "comparing with the base");
+        comparison = measureAgainst(base, r.strands);
+    }
     if (common.json) {
         nlohmann::json levels = nlohmann::json::array();
         for (std::size_t l = 0; l < r.output.size(); ++l)
@@ -109,7 +115,8 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                    {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
                              {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
                                            {"base", double(r.exampleEnteringHead) / double(base.numStrands())}}}}},
-                   {"stages", stages}, {"seconds", seconds}, {"checks", checks}});
+                   {"stages", stages}, {"seconds", seconds}, {"checks", checks},
+                   {"compare", job.measure ? toJson(comparison) : nlohmann::json(nullptr)}});
     } else if (!common.quiet) {
         std::cout << "transferred the detail of " << job.details << " (" << details.numStrands() << " strands) onto "
                   << job.base << " (" << base.numStrands() << "): " << r.strands.numStrands() << " strands in " << seconds << " s\n"
@@ -122,6 +129,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                           100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())), 100.0 * double(r.exampleEnteringHead) / double(base.numStrands()));
             std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares << "\n";
         }
+        if (job.measure) std::cout << "  compared with " << job.baseLabel << " (vdbhair compare): " << summaryLine(comparison) << "\n";
         std::cout << "wrote " << job.output << "\n";
     }
     return 0;
@@ -140,6 +148,7 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag_function("--keep-base-detail", [p](std::int64_t) { p->params.smoothBase = false; }, "Keep BASE's coarsest level unsmoothed (the paper's rule: BASE's own wisp-level waves stay, under DETAILS')");
     sub->add_flag("--guides", p->params.guides, "BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over their region");
     sub->add_option("--strands", p->strands, "With --guides: strands in the output (default: DETAILS' strands per coarsest strand, times the guides)");
+    sub->add_flag("--measure", p->job.measure, "Also compare the output with BASE as `vdbhair compare` does (the report's \"compare\"; BASE is the reference)");
     addSynthHierarchyOptions(sub, s, p->text);
     addSynthTransferOptions(sub, s, p->text);
     addCommonOptions(sub, common);

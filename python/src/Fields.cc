@@ -673,10 +673,7 @@ Raises:
             });
             pyb::object comparison = pyb::none();  // the output against the input, as `vdbhair compare` (refine --measure --json's "compare")
             if (measure && returnReport) {
-                CompareParams cp;
-                cp.metersPerUnit = strands->metersPerUnit;
-                const HeadObstacle* h = result.head.unset() || result.head.empty() ? nullptr : &result.head;
-                const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return compareHairstyles(*strands, result.strands, cp, h); });
+                const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureAgainst(*strands, result.strands, &result.head); });
                 comparison = toPython(toJson(c));
             }
             auto out = std::make_shared<StrandSet>(std::move(result.strands));

@@ -176,7 +176,7 @@ Returns:
            double nearby, bool refine, std::optional<std::string> refineMode,
            double voxelSize, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp,
            std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region,
-           std::optional<PathArg> outputScalp, double outputTurn, bool returnReport, int threads,
+           std::optional<PathArg> outputScalp, double outputTurn, bool measure, bool returnReport, int threads,
            const pyb::object& progress) -> pyb::object {
             SynthParams p;
             std::vector<Vec3d> regionPoints;
@@ -209,9 +209,9 @@ Returns:
             if (outputTurn != 0.0 && !outputScalp) throw ValueError("synth: output_turn needs output_scalp");
             p.outputTurn = outputTurn * M_PI / 180.0;
             if (outputScalp && !region) throw ValueError("synth: output_scalp needs region=, the points where the hair grows on that head");
+            std::shared_ptr<const ScalpMap> other;
             SynthResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
                 openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
-                std::shared_ptr<const ScalpMap> other;
                 if (outputScalp) {
                     std::vector<Vec3f> pts(regionPoints.begin(), regionPoints.end());
                     const openvdb::FloatGrid::Ptr otherGrid = readScalp(*outputScalp, interrupter);
@@ -220,9 +220,18 @@ Returns:
                 }
                 return synthesizeHair(*example, p, grid, true, interrupter, region ? &regionPoints : nullptr, other);
             });
+            pyb::object comparison = pyb::none();  // as synth --measure --json's "compare"
+            if (measure && returnReport) {
+                const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) {
+                    return other ? measureAgainst(*example, moveToScalp(r.strands, *other, *r.map, -p.outputTurn))
+                                 : measureAgainst(*example, r.strands, &p.head);
+                });
+                comparison = toPython(toJson(c));
+            }
             auto out = std::make_shared<StrandSet>(std::move(r.strands));
             if (!returnReport) return pyb::cast(out);
             pyb::dict report;
+            report["compare"] = comparison;
             pyb::list levelsList, stages, clusters;
             for (std::size_t l = 0; l < r.output.size(); ++l) {
                 pyb::dict d;
@@ -254,7 +263,7 @@ Returns:
         pyb::arg("nearby") = synthDefaults.texture.nearbyRadius, pyb::arg("refine") = synthDefaults.refine,
         pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(),
         pyb::arg("scalp") = pyb::none(), pyb::arg("region") = pyb::none(), pyb::arg("output_scalp") = pyb::none(),
-        pyb::arg("output_turn") = 0.0, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
+        pyb::arg("output_turn") = 0.0, pyb::arg("measure") = false, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(A new hairstyle in the style of an example (Wang et al. 2009, §3-5): ``vdbhair synth``.
 
@@ -289,6 +298,8 @@ Args:
     output_scalp: a path to another head (scalp .vdb or mesh) that region= lies on: the hairstyle
         is made at the region's (u, v) and moved onto it through scalp space.
     output_turn: degrees about the up axis the layout turns on output_scalp (heads facing different ways).
+    measure: with return_report, the report's "compare" holds the output against the example, as
+        ``vdbhair.compare(example, output)`` (on output_scalp, the output moved back onto the example's scalp).
     return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up, output_area,
         head: the head new hair is kept out of, the strands pushed out, the output's and the example's strands passing into it).
     threads: worker threads, 0 for all cores.
@@ -304,7 +315,7 @@ Returns:
            bool smoothBase, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters, int components,
            const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, bool refine,
            std::optional<std::string> refineMode,
-           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp, bool returnReport,
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp, bool measure, bool returnReport,
            int threads, const pyb::object& progress) -> pyb::object {
             TransferParams p;
             p.guides = guides;
@@ -330,9 +341,13 @@ Returns:
                 openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
                 return transferHairstyle(*details, *base, p, grid, true, interrupter);
             });
+            pyb::object comparison = pyb::none();  // as transfer --measure --json's "compare"
+            if (measure && returnReport)
+                comparison = toPython(toJson(runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureAgainst(*base, r.result.strands); })));
             auto out = std::make_shared<StrandSet>(std::move(r.result.strands));
             if (!returnReport) return pyb::cast(out);
             pyb::dict report;
+            report["compare"] = comparison;
             pyb::list clusters;
             for (const std::vector<std::int32_t>& c : r.result.clusterOf)
                 clusters.append(pyb::array_t<std::int32_t>(pyb::ssize_t(c.size()), c.data()));
@@ -351,7 +366,7 @@ Returns:
         pyb::arg("detail") = detailBlendName(transferDefaults.synth.detailBlend), pyb::arg("detail_scale") = detailScaleName(transferDefaults.synth.detailScale),
         pyb::arg("match_balance") = transferDefaults.synth.match.balance, pyb::arg("match_candidates") = transferDefaults.synth.match.candidates,
         pyb::arg("refine") = transferDefaults.synth.refine, pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = transferDefaults.synth.voxelSize,
-        pyb::arg("up") = pyb::none(), pyb::arg("scalp") = pyb::none(), pyb::arg("return_report") = false, pyb::arg("threads") = 0,
+        pyb::arg("up") = pyb::none(), pyb::arg("scalp") = pyb::none(), pyb::arg("measure") = false, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(The base's global flow with the details' wisps and waves (Wang et al. 2009, §6): ``vdbhair transfer``.
 
@@ -367,6 +382,8 @@ Args:
     detail_scale: "arc-length" (curls keep their size, the strand runs the base's wisp), "index"
         (the paper's, vertex by vertex) or "strand".
     match_candidates: as synth's, 64 here (the two hairstyles' wisps differ more).
+    measure: with return_report, the report's "compare" holds the output against the base, as
+        ``vdbhair.compare(base, output)``.
     Other options as synth.
 
 Returns:

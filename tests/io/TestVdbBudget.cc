@@ -93,3 +93,14 @@ TEST_CASE("readVdbGrids: the leaf chunk of -1000 bytes that overflows OpenVDB 10
     REQUIRE_THROWS_WITH(readVdbGrids(path, path), Contains(path) && Contains("leaf values: uncompressed chunk of 1000 bytes for a destination of 8"));
     REQUIRE_THROWS_AS(readVdbGrid(path, "tangent", path), FormatError);
 }
+
+TEST_CASE("readVdbStrands: a points grid whose uniform arrays claim 268 million points in an 11 KB file ends at the read budget", "[io][vdb][fuzz]")
+{
+    // Found by fuzz_vdb: a leaf's offsets say 268,435,456 points, and its arrays are uniform (one
+    // value stands for every point), so the file is valid to OpenVDB and small; expanding it to
+    // strands asked for 3 GiB. The expansion runs in the file's read budget (withinReadBudget).
+    const std::string path = test::regressionInput("fuzz_vdb_uniform_points.vdb");
+    REQUIRE_THROWS_AS(readVdbStrands(path), LimitError);
+    REQUIRE_THROWS_WITH(readVdbStrands(path), Contains(path) && Contains("past the budget of") && Contains("the file declares more data than it can hold"));
+    CHECK(AllocationBudget::current() == nullptr);
+}

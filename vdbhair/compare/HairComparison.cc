@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace vdbhair {
@@ -117,6 +118,34 @@ nlohmann::json toJson(const std::vector<OrientedMatch>& matches, double metersPe
         oriented.push_back(t);
     }
     return oriented;
+}
+
+HairComparison measureAgainst(const StrandSet& reference, const StrandSet& output, const HeadObstacle* head)
+{
+    CompareParams cp;
+    cp.metersPerUnit = reference.metersPerUnit;
+    return compareHairstyles(reference, output, cp, head && !head->unset() && !head->empty() ? head : nullptr);
+}
+
+std::string summaryLine(const HairComparison& c)
+{
+    char buf[320];
+    std::string s;
+    std::snprintf(buf, sizeof buf, "Chamfer %.4g", c.chamfer.mean);
+    s += buf;
+    if (!c.oriented.empty()) {
+        const OrientedMatch& m = c.oriented.front();
+        if (c.metersPerUnit > 0.0) std::snprintf(buf, sizeof buf, ", F1 %.3f at %.3g mm / %.3g deg", m.f1, m.threshold.distance * c.metersPerUnit * 1000.0, m.threshold.angleDegrees);
+        else std::snprintf(buf, sizeof buf, ", F1 %.3f at %.3g / %.3g deg", m.f1, m.threshold.distance, m.threshold.angleDegrees);
+        s += buf;
+    }
+    if (c.paired) {
+        std::snprintf(buf, sizeof buf, ", position error %.4g, Frechet / length mean %.3g", c.perm.meanPosition, c.frechetMean);
+        s += buf;
+    }
+    std::snprintf(buf, sizeof buf, ", %.1f %% of strands leave its volume", 100.0 * c.leavingVolume);
+    s += buf;
+    return s;
 }
 
 nlohmann::json toJson(const HairComparison& c)

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace vdbhair {
@@ -66,6 +67,15 @@ struct HairComparison
 /// @throw ValueError for bad @a params or a hairstyle without segments.
 HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const CompareParams& params,
                                  const HeadObstacle* head = nullptr, bool threaded = true);
+
+/// @brief How a verb measures its output against the hairstyle it started from (refine --measure,
+/// synth and transfer --measure): compareHairstyles() at @a reference's unit and HairGS's
+/// thresholds, with @a head when it is set and not empty.
+HairComparison measureAgainst(const StrandSet& reference, const StrandSet& output, const HeadObstacle* head = nullptr);
+
+/// @brief The comparison in one line for a verb's text report: Chamfer, F1 at the first threshold,
+/// the paired errors when the strands pair up, the share leaving the reference's volume.
+std::string summaryLine(const HairComparison& c);
 
 /// @brief Oriented-point matches as JSON, one object per threshold: distance (file units),
 /// angle_degrees, precision, recall, f1, strand_consistency and, with @a metersPerUnit > 0,

@@ -310,34 +310,17 @@ void openFile(openvdb::io::File& file, const std::string& path, const std::strin
     }
 }
 
-/// Run @a read (which opens and reads @a path with OpenVDB) under the file's allocation budget
-/// (readBudgetBytes(), Memory.h): the second line behind the pre-scan, for what it does not walk
-/// (formats before 222) and anything it misses. A request past the budget, or one memory cannot
-/// meet, is one line naming the file.
+/// The path whose read budget this thread is in (withinReadBudget()), or null.
+thread_local const std::string* tBudgetedPath = nullptr;
+
+/// withinReadBudget() for a read that returns its result.
 template<typename ReadT>
-auto budgetedRead(const std::string& path, const std::string& where, ReadT&& read)
+auto budgetedRead(const std::string& path, const std::string& where, ReadT&& read) -> decltype(read())
 {
-    requireRegularFile(path, where);
-    std::error_code ec;
-    const std::uint64_t bytes = std::filesystem::file_size(path, ec);
-    const std::uint64_t rule = readBudgetBytes(ec ? 0 : bytes, std::numeric_limits<std::uint64_t>::max());
-    try {
-        AllocationBudget budget(readBudgetBytes(ec ? 0 : bytes));
-        return read();
-    } catch (const BudgetExceeded& e) {
-        const std::string asked = where + ": reading it asks for " + formatBytes(e.requested()) + " with " + formatBytes(e.live()) + " held";
-        if (e.limit() == rule)
-            throw LimitError(asked + ", past the budget of " + formatBytes(rule) + " (" + std::to_string(kReadBudgetPerFileByte) + " x its " +
-                             formatBytes(bytes) + " + " + formatBytes(kReadBudgetFloor) +
-                             "): the file declares more data than it can hold (damaged, or not what it claims)");
-        throw LimitError(asked + ", more than the " + formatBytes(e.limit()) +
-                         (e.limit() == availableMemoryBytes() ? " available (MemAvailable)" : " left to this read") +
-                         "; free memory or read it on a larger machine");
-    } catch (const std::bad_alloc&) {
-        throw FormatError(where + ": " + kTreeSizes);
-    } catch (const std::length_error&) {
-        throw FormatError(where + ": " + kTreeSizes);
-    }
+    if (tBudgetedPath && *tBudgetedPath == path) return read();
+    decltype(read()) result;
+    withinReadBudget(path, where, [&] { result = read(); });
+    return result;
 }
 
 std::string listNames(const std::vector<std::string>& names)
@@ -349,6 +332,41 @@ std::string listNames(const std::vector<std::string>& names)
 }
 
 } // namespace
+
+void withinReadBudget(const std::string& path, const std::string& where, const std::function<void()>& read)
+{
+    requireRegularFile(path, where);
+    if (tBudgetedPath && *tBudgetedPath == path) return read();
+    std::error_code ec;
+    const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+    const std::uint64_t rule = readBudgetBytes(ec ? 0 : bytes, std::numeric_limits<std::uint64_t>::max());
+    const std::string* outerPath = tBudgetedPath;
+    try {
+        AllocationBudget budget(readBudgetBytes(ec ? 0 : bytes));
+        tBudgetedPath = &path;
+        read();
+        tBudgetedPath = outerPath;
+    } catch (const BudgetExceeded& e) {
+        tBudgetedPath = outerPath;
+        const std::string asked = where + ": reading it asks for " + formatBytes(e.requested()) + " with " + formatBytes(e.live()) + " held";
+        if (e.limit() == rule)
+            throw LimitError(asked + ", past the budget of " + formatBytes(rule) + " (" + std::to_string(kReadBudgetPerFileByte) + " x its " +
+                             formatBytes(bytes) + " + " + formatBytes(kReadBudgetFloor) +
+                             "): the file declares more data than it can hold (damaged, or not what it claims)");
+        throw LimitError(asked + ", more than the " + formatBytes(e.limit()) +
+                         (e.limit() == availableMemoryBytes() ? " available (MemAvailable)" : " left to this read") +
+                         "; free memory or read it on a larger machine");
+    } catch (const std::bad_alloc&) {
+        tBudgetedPath = outerPath;
+        throw FormatError(where + ": " + kTreeSizes);
+    } catch (const std::length_error&) {
+        tBudgetedPath = outerPath;
+        throw FormatError(where + ": " + kTreeSizes);
+    } catch (...) {
+        tBudgetedPath = outerPath;
+        throw;
+    }
+}
 
 openvdb::GridPtrVec readVdbGrids(const std::string& path, const std::string& where)
 {

@@ -5,6 +5,7 @@
 
 #include <openvdb/Grid.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,14 @@ void initializeOpenVdb();
 /// transform (it follows the tree there).
 /// @throw IoError if the file cannot be read; FormatError naming the byte and the rule.
 void checkVdbFileLayout(const std::string& path, const std::string& where);
+
+/// @brief Run @a read under the allocation budget of reading @a path: readBudgetBytes() of its size
+/// (Memory.h), the second line behind the pre-scan. A request past it, or one memory cannot meet,
+/// is one LimitError or FormatError naming @a where. The readers below run in it; a reader that
+/// goes on to expand what OpenVDB read (strands from a points grid, whose uniform arrays hold any
+/// number of points in one value) runs the expansion in it too. Within it, the readers below
+/// reading the same @a path add no budget of their own.
+void withinReadBudget(const std::string& path, const std::string& where, const std::function<void()>& read);
 
 /// @throw IoError (cannot open), FormatError (not a valid VDB file).
 openvdb::GridPtrVec readVdbGrids(const std::string& path, const std::string& where);

@@ -560,12 +560,16 @@ StrandSet readVdbStrands(const std::string& path, const ReadOptions& opts, ReadR
                          const std::string& gridName)
 {
     const std::string where = "readVdbStrands(" + path + ")";
-    const openvdb::GridBase::Ptr base = readVdbGrid(path, gridName, where);
-    const auto grid = openvdb::GridBase::grid<pts::PointDataGrid>(base);
-    if (!grid) {
-        throw TypeError(where + ": grid '" + gridName + "' is a " + base->type() + ", not a PointDataGrid of strands");
-    }
-    return strandsFromGrid(*grid, where, opts, report);
+    StrandSet strands;
+    withinReadBudget(path, where, [&] {  // the expansion too: a uniform array holds any number of points in one value
+        const openvdb::GridBase::Ptr base = readVdbGrid(path, gridName, where);
+        const auto grid = openvdb::GridBase::grid<pts::PointDataGrid>(base);
+        if (!grid) {
+            throw TypeError(where + ": grid '" + gridName + "' is a " + base->type() + ", not a PointDataGrid of strands");
+        }
+        strands = strandsFromGrid(*grid, where, opts, report);
+    });
+    return strands;
 }
 
 } // namespace vdbhair
