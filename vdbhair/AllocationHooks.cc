@@ -14,9 +14,9 @@
 #define VDBHAIR_HOOK __attribute__((visibility("default")))
 
 // The replaceable global allocation functions ([new.delete]), counting against the calling
-// thread's AllocationBudget when one is alive. The plain, array and sized forms are written here;
-// the standard library's nothrow forms call them. The aligned forms are left to it: they
-// allocate with aligned_alloc and free on their own, outside any budget.
+// thread's AllocationBudget when one is alive: every form but the aligned ones, which are left to
+// the standard library (or a sanitizer's runtime) whole: they allocate and free on their own,
+// outside any budget. A runtime's nothrow new must not pair with this delete.
 VDBHAIR_HOOK void* operator new(std::size_t n)
 {
     vdbhair::AllocationBudget* budget = vdbhair::AllocationBudget::current();
@@ -46,3 +46,18 @@ VDBHAIR_HOOK void* operator new[](std::size_t n) { return ::operator new(n); }
 VDBHAIR_HOOK void operator delete[](void* p) noexcept { ::operator delete(p); }
 
 VDBHAIR_HOOK void operator delete[](void* p, std::size_t) noexcept { ::operator delete(p); }
+
+VDBHAIR_HOOK void* operator new(std::size_t n, const std::nothrow_t&) noexcept
+{
+    try {
+        return ::operator new(n);
+    } catch (...) {
+        return nullptr;
+    }
+}
+
+VDBHAIR_HOOK void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return ::operator new(n, std::nothrow); }
+
+VDBHAIR_HOOK void operator delete(void* p, const std::nothrow_t&) noexcept { ::operator delete(p); }
+
+VDBHAIR_HOOK void operator delete[](void* p, const std::nothrow_t&) noexcept { ::operator delete(p); }
