@@ -133,6 +133,8 @@ Command addCompareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--threshold", params->thresholds, "An oriented-point threshold DISTANCE:ANGLE (millimetres with --unit, else file units; "
                                                        "repeat for more; default with --unit: HairGS's 2:20 3:30 4:40 4:90)");
     sub->add_flag("--bidirectional", params->params.bidirectional, "Oriented points match whichever way round their directions point");
+    sub->add_flag_function("--unpaired", [params](std::int64_t) { params->params.pairStrands = false; },
+                           "Do not pair strand i of A with strand i of B even when the counts agree (hairstyles whose strands do not correspond, such as a synthesis)");
     sub->add_option("--samples", params->params.samples, "Points per strand for the strand-pair measures (Perm: 100)")->capture_default_str();
     sub->add_option("--head", params->head, "A head (mesh or .vdb level set): the shares of A's and B's strands passing into it");
     sub->add_option("--per-strand", params->perStrand, "Write each strand of A's values as CSV: chamfer, and with equal strand counts position, curvature, frechet");

@@ -252,7 +252,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     HairComparison comparison;
     if (p.measure) {
         const Stage stage(common, "comparing with the example");
-        comparison = measureAgainst(example, outputMap ? movedBack : r.strands, outputMap ? nullptr : &p.synth.head);
+        comparison = measureAgainst(example, outputMap ? movedBack : r.strands, outputMap ? nullptr : &p.synth.head, /*corresponding=*/false);
     }
     if (common.json) {
         nlohmann::json levels = nlohmann::json::array();

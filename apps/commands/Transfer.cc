@@ -129,7 +129,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                           100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())), 100.0 * double(r.exampleEnteringHead) / double(base.numStrands()));
             std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares << "\n";
         }
-        if (job.measure) std::cout << "  compared with " << job.baseLabel << " (vdbhair compare): " << summaryLine(comparison) << "\n";
+        if (job.measure) std::cout << "  compared with " << job.base << " (vdbhair compare): " << summaryLine(comparison) << "\n";
         std::cout << "wrote " << job.output << "\n";
     }
     return 0;

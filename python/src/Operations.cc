@@ -223,8 +223,8 @@ Returns:
             pyb::object comparison = pyb::none();  // as synth --measure --json's "compare"
             if (measure && returnReport) {
                 const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) {
-                    return other ? measureAgainst(*example, moveToScalp(r.strands, *other, *r.map, -p.outputTurn))
-                                 : measureAgainst(*example, r.strands, &p.head);
+                    return other ? measureAgainst(*example, moveToScalp(r.strands, *other, *r.map, -p.outputTurn), nullptr, false)
+                                 : measureAgainst(*example, r.strands, &p.head, false);
                 });
                 comparison = toPython(toJson(c));
             }
@@ -961,9 +961,10 @@ dict), point_count for points grids, and explanation (the metadata in words).)do
     m.def(
         "compare",
         [](const StrandsPtr& a, const StrandsPtr& b, double metersPerUnit, const std::vector<std::pair<double, double>>& thresholds,
-           bool bidirectional, std::size_t samples, const pyb::object& headArg, int threads) {
+           bool bidirectional, std::size_t samples, bool pairStrands, const pyb::object& headArg, int threads) {
             CompareParams p;
             p.metersPerUnit = metersPerUnit;
+            p.pairStrands = pairStrands;
             for (const auto& [d, angle] : thresholds) p.thresholds.push_back({d, angle});
             p.bidirectional = bidirectional;
             p.samples = samples;
@@ -991,7 +992,8 @@ dict), point_count for points grids, and explanation (the metadata in words).)do
         },
         pyb::arg("a"), pyb::arg("b"), pyb::kw_only(), pyb::arg("meters_per_unit") = compareDefaults.metersPerUnit,
         pyb::arg("thresholds") = std::vector<std::pair<double, double>>(), pyb::arg("bidirectional") = compareDefaults.bidirectional,
-        pyb::arg("samples") = compareDefaults.samples, pyb::arg("head") = pyb::none(), pyb::arg("threads") = 0,
+        pyb::arg("samples") = compareDefaults.samples, pyb::arg("pair_strands") = compareDefaults.pairStrands, pyb::arg("head") = pyb::none(),
+        pyb::arg("threads") = 0,
         R"doc(Compare a hairstyle ``b`` with a reference ``a`` (``vdbhair compare A B --json``): HairGS's
 oriented-point precision, recall, F1 and strand consistency, the Chamfer distance, Perm's
 root-aligned position and curvature errors and the discrete Frechet distance over length of the
@@ -1007,6 +1009,8 @@ Args:
         4 / 90) when meters_per_unit is given, else no oriented-point measure.
     bidirectional: directions match whichever way round they point.
     samples: points per strand for the strand-pair measures (Perm: 100), at least 3.
+    pair_strands: pair strand i of a with strand i of b when the counts agree (False for
+        hairstyles whose strands do not correspond, such as a synthesis).
     head: None, a path (a mesh or a .vdb level set) or (x, y, z, r), a sphere.
     threads: worker threads, 0 for all cores (results do not depend on it).
 

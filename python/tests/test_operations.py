@@ -129,8 +129,12 @@ def test_synth(tmp_path):
     full = vdbhair.read(str(SOURCE_DIR / "scenes" / "default" / "ponytail.hair"))
     kept = [full.positions[full.offsets[i]:full.offsets[i + 1]] for i in range(0, len(full), 2)]
     example = vdbhair.Strands(np.concatenate(kept), np.concatenate([[0], np.cumsum([len(k) for k in kept])]))
-    out, report = vdbhair.synth(example, strands=800, seed=3, return_report=True)
+    out, report = vdbhair.synth(example, strands=800, seed=3, measure=True, return_report=True)
     assert len(out) == 800
+    # measure=True: the output against the example, vdbhair.compare's report (strands not paired).
+    measured = vdbhair.compare(example, out, pair_strands=False)
+    del measured["per_strand"]
+    assert report["compare"] == measured and measured["paired"] is False and measured["chamfer"]["mean"] > 0.0
     assert [lv["output"] for lv in report["levels"]][0] == 800
     assert [name for name, _ in report["stages"]][:3] == ["scalp", "clustering", "feature maps"]
     assert len(report["cluster_of"]) == 2 and report["cluster_of"][0].shape == (800,)
@@ -173,11 +177,15 @@ def test_synth(tmp_path):
 def test_transfer_and_comb():
     pony = vdbhair.read(str(SOURCE_DIR / "scenes" / "default" / "ponytail.hair"))
     # A hairstyle onto itself keeps its strands' roots, in order.
-    out, report = vdbhair.transfer(pony, pony, refine=False, return_report=True)
+    out, report = vdbhair.transfer(pony, pony, refine=False, measure=True, return_report=True)
     assert len(out) == len(pony)
+    measured = vdbhair.compare(pony, out)  # measure=True: the output against the base, strands paired
+    del measured["per_strand"]
+    assert report["compare"] == measured and measured["paired"] is True
     roots = pony.positions[pony.offsets[:-1]]
     assert np.allclose(out.positions[out.offsets[:-1]], roots, atol=1e-3)
     assert report["detail_scale"] == pytest.approx(1.0)
+    assert vdbhair.transfer(pony, pony, refine=False, return_report=True)[1]["compare"] is None
     with pytest.raises(ValueError, match="strands needs guides=True"):
         vdbhair.transfer(pony, pony, strands=10)
     # Zero strength changes nothing; a stroke keeps every segment's length.

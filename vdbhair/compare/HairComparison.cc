@@ -78,7 +78,7 @@ HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const C
 
     c.chamfer = chamferDistances(ia, ib, threaded);
 
-    c.paired = a.numStrands() == b.numStrands();
+    c.paired = params.pairStrands && a.numStrands() == b.numStrands();
     if (c.paired) {
         c.perm = strandPairErrors(a, b, params.samples, threaded);
         c.frechet = relativeFrechetPairs(a, b, params.samples, threaded);
@@ -120,10 +120,11 @@ nlohmann::json toJson(const std::vector<OrientedMatch>& matches, double metersPe
     return oriented;
 }
 
-HairComparison measureAgainst(const StrandSet& reference, const StrandSet& output, const HeadObstacle* head)
+HairComparison measureAgainst(const StrandSet& reference, const StrandSet& output, const HeadObstacle* head, bool corresponding)
 {
     CompareParams cp;
     cp.metersPerUnit = reference.metersPerUnit;
+    cp.pairStrands = corresponding;
     return compareHairstyles(reference, output, cp, head && !head->unset() && !head->empty() ? head : nullptr);
 }
 
@@ -138,6 +139,8 @@ std::string summaryLine(const HairComparison& c)
         if (c.metersPerUnit > 0.0) std::snprintf(buf, sizeof buf, ", F1 %.3f at %.3g mm / %.3g deg", m.f1, m.threshold.distance * c.metersPerUnit * 1000.0, m.threshold.angleDegrees);
         else std::snprintf(buf, sizeof buf, ", F1 %.3f at %.3g / %.3g deg", m.f1, m.threshold.distance, m.threshold.angleDegrees);
         s += buf;
+    } else if (c.metersPerUnit <= 0.0) {
+        s += ", no F1 (the file carries no unit; vdbhair compare --unit)";
     }
     if (c.paired) {
         std::snprintf(buf, sizeof buf, ", position error %.4g, Frechet / length mean %.3g", c.perm.meanPosition, c.frechetMean);

@@ -35,6 +35,9 @@ struct CompareParams
     bool bidirectional = false;
     /// Points per strand for the strand-pair measures (Perm: 100), at least 3.
     std::size_t samples = 100;
+    /// Pair strand i of A with strand i of B when the counts agree (a retrace, a reconstruction,
+    /// an edit); false for hairstyles whose strands do not correspond (a synthesis).
+    bool pairStrands = true;
 
     /// @throw ValueError naming the parameter, its value and the rule.
     void validate() const;
@@ -70,11 +73,14 @@ HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const C
 
 /// @brief How a verb measures its output against the hairstyle it started from (refine --measure,
 /// synth and transfer --measure): compareHairstyles() at @a reference's unit and HairGS's
-/// thresholds, with @a head when it is set and not empty.
-HairComparison measureAgainst(const StrandSet& reference, const StrandSet& output, const HeadObstacle* head = nullptr);
+/// thresholds, with @a head when it is set and not empty; strands paired by index only when
+/// @a corresponding (the output is the reference's strands, moved).
+HairComparison measureAgainst(const StrandSet& reference, const StrandSet& output, const HeadObstacle* head = nullptr,
+                              bool corresponding = true);
 
 /// @brief The comparison in one line for a verb's text report: Chamfer, F1 at the first threshold,
-/// the paired errors when the strands pair up, the share leaving the reference's volume.
+/// the paired errors when the strands pair up, the share leaving the reference's volume; what was
+/// left out for want of a unit is said.
 std::string summaryLine(const HairComparison& c);
 
 /// @brief Oriented-point matches as JSON, one object per threshold: distance (file units),
