@@ -113,7 +113,8 @@ int runCompare(CompareCmdParams p, const CommonOptions& common)
                     c.perm.meanCurvature);
         std::printf("discrete Frechet / length: mean %g, 95th percentile %g, max %g\n", c.frechetMean, c.frechetP95, c.frechetMax);
     } else {
-        std::printf("strand pairs: not measured (%zu strands against %zu: the counts differ)\n", c.strandsA, c.strandsB);
+        if (c.strandsA == c.strandsB) std::printf("strand pairs: not measured (--unpaired)\n");
+        else std::printf("strand pairs: not measured (%zu strands against %zu: the counts differ)\n", c.strandsA, c.strandsB);
     }
     std::printf("B leaving A's hair volume: %.2f %% of its strands (voxel %g)\n", 100.0 * c.leavingVolume, c.volumeVoxel);
     if (c.headMeasured) std::printf("passing into the head:     A %.2f %%, B %.2f %% of the strands\n", 100.0 * c.enteringHeadA, 100.0 * c.enteringHeadB);
