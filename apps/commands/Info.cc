@@ -83,6 +83,8 @@ int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadRe
                    {"strands", s.strands},
                    {"vertices", s.vertices},
                    {"bbox", {vec3Json(bmin), vec3Json(bmax)}},
+                   {"meters_per_unit", s.metersPerUnit > 0.0 ? nlohmann::json(s.metersPerUnit) : nlohmann::json(nullptr)},
+                   {"up_axis", s.upAxis ? nlohmann::json(std::string(1, s.upAxis)) : nlohmann::json(nullptr)},
                    {"length", {{"min", s.length.min}, {"mean", s.length.mean}, {"max", s.length.max}}},
                    {"vertices_per_strand",
                     {{"min", s.verticesPerStrand.min}, {"mean", s.verticesPerStrand.mean}, {"max", s.verticesPerStrand.max}}},
@@ -98,7 +100,9 @@ int printStrandSummary(const InfoParams& p, const StrandSummary& s, const ReadRe
               << fmt(s.verticesPerStrand.mean) << ", max " << fmt(s.verticesPerStrand.max) << "\n"
               << "  strand length:       min " << fmt(s.length.min) << ", mean " << fmt(s.length.mean)
               << ", max " << fmt(s.length.max) << "\n"
-              << "  bounding box:        " << fmtVec(bmin) << " .. " << fmtVec(bmax) << "\n";
+              << "  bounding box:        " << fmtVec(bmin) << " .. " << fmtVec(bmax) << "\n"
+              << "  unit:                " << (s.metersPerUnit > 0.0 ? fmt(s.metersPerUnit) + " m (declared by the file)" : std::string("not declared by the file")) << "\n"
+              << "  up axis:             " << (s.upAxis ? std::string("+") + s.upAxis + " (declared by the file)" : std::string("not declared by the file")) << "\n";
     if (report.droppedStrands) std::cout << "  dropped strands:     " << report.droppedStrands << " (fewer than 2 vertices)\n";
     if (stats) {
         std::cout << "  turning per strand:  min " << fmt(stats->turning.min) << ", mean " << fmt(stats->turning.mean) << ", max "

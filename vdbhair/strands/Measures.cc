@@ -166,7 +166,10 @@ StrandSummary summarizeStrands(const StrandSet& strands)
 {
     std::vector<std::uint32_t> counts(strands.numStrands());
     for (std::size_t i = 0; i < counts.size(); ++i) counts[i] = std::uint32_t(strands.size(i));
-    return summarizeStrands(strands.numVertices(), computeBBox(strands), strandLengths(strands), counts);
+    StrandSummary s = summarizeStrands(strands.numVertices(), computeBBox(strands), strandLengths(strands), counts);
+    s.metersPerUnit = strands.metersPerUnit;
+    s.upAxis = strands.upAxis;
+    return s;
 }
 
 StrandSummary summarizeStrands(std::size_t vertices, const BBox& bbox, const std::vector<float>& lengths,

@@ -59,6 +59,8 @@ struct StrandSummary
     BBox bbox;
     RangeStats length;             ///< world units
     RangeStats verticesPerStrand;
+    double metersPerUnit = 0.0;    ///< the unit the file declared (StrandSet::metersPerUnit), 0: none
+    char upAxis = 0;               ///< the up axis the file declared (StrandSet::upAxis), 0: none
 };
 
 /// @brief Counts, bounding box and the ranges of strand length and vertices per strand.
