@@ -625,3 +625,12 @@ TEST_CASE("prescanVdbFile: every chunk size and array size of a strands .vdb set
     CHECK(mutated >= 8);
 }
 
+
+TEST_CASE("readVdbStrands: a whole-number vertex index beyond any integer type is named as it is (fuzz_vdb, UBSan)", "[io][vdb][fuzz]")
+{
+    // A float 'vertex' attribute of 6.04e23: a whole number, out of range. The error message
+    // converted it to int64 (undefined behaviour; UBSan stopped fuzz_vdb at 1.93 M executions).
+    const std::string path = test::regressionInput("fuzz_vdb_huge_strand_index.vdb");
+    REQUIRE_THROWS_AS(readVdbStrands(path), FormatError);
+    REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("has strand 0 and vertex 6.04462909807314") && Contains("vertex in [0, 10)"));
+}

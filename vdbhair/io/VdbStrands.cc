@@ -477,8 +477,10 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
                 if (hasW) width[k] = hW->get(*it);
                 if (hasA) alpha[k] = hA->get(*it);
                 if (sid[k] < 0 || sid[k] >= strandLimit || vid[k] < 0 || std::uint64_t(vid[k]) >= nPoints) {
-                    pointError[l] = where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + std::to_string(std::int64_t(sv)) +
-                                    " and vertex " + std::to_string(std::int64_t(vv)) + "; strand must be in [0, " +
+                    // Whole numbers, possibly beyond any integer type: written as doubles.
+                    const auto whole = [](double x) { std::ostringstream o; o.precision(17); o << x; return o.str(); };
+                    pointError[l] = where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + whole(sv) +
+                                    " and vertex " + whole(vv) + "; strand must be in [0, " +
                                     std::to_string(strandLimit) + ") and vertex in [0, " + std::to_string(nPoints) + ")";
                     break;
                 }
