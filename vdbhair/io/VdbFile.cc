@@ -317,7 +317,6 @@ thread_local const std::string* tBudgetedPath = nullptr;
 template<typename ReadT>
 auto budgetedRead(const std::string& path, const std::string& where, ReadT&& read) -> decltype(read())
 {
-    if (tBudgetedPath && *tBudgetedPath == path) return read();
     decltype(read()) result;
     withinReadBudget(path, where, [&] { result = read(); });
     return result;
@@ -338,16 +337,20 @@ void withinReadBudget(const std::string& path, const std::string& where, const s
     requireRegularFile(path, where);
     if (tBudgetedPath && *tBudgetedPath == path) return read();
     std::error_code ec;
-    const std::uint64_t bytes = std::filesystem::file_size(path, ec);
-    const std::uint64_t rule = readBudgetBytes(ec ? 0 : bytes, std::numeric_limits<std::uint64_t>::max());
-    const std::string* outerPath = tBudgetedPath;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    const std::uint64_t bytes = ec ? 0 : std::uint64_t(size);
+    const std::uint64_t rule = readBudgetBytes(bytes, std::numeric_limits<std::uint64_t>::max());
+    struct PathScope  // this thread reads @a path until the scope ends, however it ends
+    {
+        const std::string* outer = tBudgetedPath;
+        explicit PathScope(const std::string& p) { tBudgetedPath = &p; }
+        ~PathScope() { tBudgetedPath = outer; }
+    };
     try {
-        AllocationBudget budget(readBudgetBytes(ec ? 0 : bytes));
-        tBudgetedPath = &path;
+        const PathScope scope(path);
+        AllocationBudget budget(readBudgetBytes(bytes));
         read();
-        tBudgetedPath = outerPath;
     } catch (const BudgetExceeded& e) {
-        tBudgetedPath = outerPath;
         const std::string asked = where + ": reading it asks for " + formatBytes(e.requested()) + " with " + formatBytes(e.live()) + " held";
         if (e.limit() == rule)
             throw LimitError(asked + ", past the budget of " + formatBytes(rule) + " (" + std::to_string(kReadBudgetPerFileByte) + " x its " +
@@ -357,14 +360,9 @@ void withinReadBudget(const std::string& path, const std::string& where, const s
                          (e.limit() == availableMemoryBytes() ? " available (MemAvailable)" : " left to this read") +
                          "; free memory or read it on a larger machine");
     } catch (const std::bad_alloc&) {
-        tBudgetedPath = outerPath;
         throw FormatError(where + ": " + kTreeSizes);
     } catch (const std::length_error&) {
-        tBudgetedPath = outerPath;
         throw FormatError(where + ": " + kTreeSizes);
-    } catch (...) {
-        tBudgetedPath = outerPath;
-        throw;
     }
 }
 
