@@ -77,7 +77,7 @@ void addReadOptions(CLI::App* sub, CommonOptions& common)
     sub->add_option("--points-per-strand", common.pointsPerStrand,
                     "For a .ply of points only (NeuralHaircut, GaussianHaircut: 100): each run of N consecutive points is one strand");
     sub->add_option("--curve-samples", common.curveSamples,
-                    "For .obj curves (curv): points per curve, evenly in its parameter (0: automatic, within 1 % of the curve's length)");
+                    "For .obj curves (curv) and cubic .usda/.abc curves: points per curve, evenly in its parameter (0: automatic, within 1 % of the curve's length)");
     CLI::Option* head = sub->get_option_no_throw("--head");
     // interpolate's --roots names its root positions: there the option is only --root-end.
     const bool rootsTaken = sub->get_option_no_throw("--roots") != nullptr;

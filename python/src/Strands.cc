@@ -404,7 +404,7 @@ Args:
         instead of its end with the lower vertex index (and for a .ply line set).
     points_per_strand: for a .ply of points only (NeuralHaircut, GaussianHaircut write 100), each
         run of this many consecutive points is one strand (the CLI's ``--points-per-strand``).
-    curve_samples: for .obj free-form curves, the points each curve is evaluated at, evenly in its
+    curve_samples: for .obj free-form curves and cubic .usda and .abc curves, the points each curve is evaluated at, evenly in its
         parameter; 0 chooses them so that the polyline keeps the curve within 1 % of its length
         (the CLI's ``--curve-samples``).
     roots: which end of each stored strand is its root (the CLI's ``--roots``): "first" (the

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs tinyusdz from the npm registry into SCRATCH (once) and reads FILE.usda with it:
 #   check_tinyusdz.sh SCRATCH FILE.usda STRANDS VERTICES [WANT...]
+#   check_tinyusdz.sh SCRATCH FILE.usda world VDBHAIR.obj   (check_tinyusdz_world.mjs)
 # Each WANT (mpu=1, up=Z, widths=constant, color=constant, width=0.5) is checked against what
 # tinyusdz parsed.
 # Skips (prints SKIPPED: and exits 0) when node or npm is missing or the registry is unreachable.
@@ -19,4 +20,5 @@ if [ ! -f "$pkg/tinyusdz.wasm" ]; then
     exit 0
   fi
 fi
+[ "$strands" = world ] && exec node "$here/check_tinyusdz_world.mjs" "$pkg" "$file" "$vertices"
 exec node "$here/check_tinyusdz.mjs" "$pkg" "$file" "$strands" "$vertices" "$@"

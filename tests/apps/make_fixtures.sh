@@ -86,3 +86,48 @@ printf '{"strokes": [{"points": [[0, 2, 1e999], [9, -10, -15]], "radius": 4}]}\n
 printf '{"strokes": [{"points": [[0, 60, 0], [20, 40, 0]], "radius": 30}]}\n' > stroke_pony.json
 # Down and back into the ponytail's head (the sphere fitted to its roots: centre (0.3, 87.9, 7.3), radius 32).
 printf '{"strokes": [{"points": [[0, 150, 40], [0, 100, 15]], "radius": 35}]}\n' > stroke_into_head.json
+# USD prims under transforms (translate, rotateXYZ, scale, a pivot with !invert!,
+# !resetXformStack!, orient, a matrix), three levels deep: vdbhair's points against tinyusdz's
+# world matrices (check_tinyusdz_world.mjs).
+cat > transformed.usda <<'USDA'
+#usda 1.0
+def Xform "root"
+{
+    double3 xformOp:translate = (10, 0, 0)
+    float3 xformOp:rotateXYZ = (30, 0, 90)
+    float3 xformOp:scale = (2, 2, 2)
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ", "xformOp:scale"]
+    def BasisCurves "hair"
+    {
+        double3 xformOp:translate = (0, 1, 0)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+        uniform token type = "linear"
+        int[] curveVertexCounts = [2, 3]
+        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 0, 1), (0, 1, 1), (1, 1, 1)]
+    }
+    def Xform "pivoted"
+    {
+        double3 xformOp:translate = (100, 0, 0)
+        float xformOp:rotateY = 45
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateY"]
+        def BasisCurves "reset"
+        {
+            uniform token[] xformOpOrder = ["!resetXformStack!", "xformOp:translate:pivot", "xformOp:rotateY", "!invert!xformOp:translate:pivot"]
+            double3 xformOp:translate:pivot = (1, 0, 0)
+            float xformOp:rotateY = 180
+            uniform token type = "linear"
+            int[] curveVertexCounts = [2]
+            point3f[] points = [(1, 0, 0), (2, 0, 3)]
+        }
+        def BasisCurves "oriented"
+        {
+            quatf xformOp:orient = (0.8660254, 0.5, 0, 0)
+            matrix4d xformOp:transform = ( (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 5, 1) )
+            uniform token[] xformOpOrder = ["xformOp:transform", "xformOp:orient"]
+            uniform token type = "linear"
+            int[] curveVertexCounts = [2]
+            point3f[] points = [(0, 1, 0), (0, 2, 3)]
+        }
+    }
+}
+USDA

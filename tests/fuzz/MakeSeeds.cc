@@ -97,6 +97,19 @@ int main(int argc, char** argv)
         writeRaw(out / "ply/lineset_binary.ply", lines);
     }
     writeUsda((out / "usda/tiny.usda").string(), s);
+    // Cubic curves of each basis and wrap under nested transforms, and time samples.
+    writeRaw(out / "usda/cubic_xform.usda",
+             "#usda 1.0\ndef Xform \"r\"\n{\n    double3 xformOp:translate = (1, 0, 0)\n    float3 xformOp:rotateXYZ = (30, 0, 90)\n"
+             "    uniform token[] xformOpOrder = [\"xformOp:translate\", \"!invert!xformOp:rotateXYZ\"]\n"
+             "    def BasisCurves \"b\"\n    {\n        quatf xformOp:orient = (0.8660254, 0.5, 0, 0)\n"
+             "        uniform token[] xformOpOrder = [\"!resetXformStack!\", \"xformOp:orient\"]\n"
+             "        uniform token type = \"cubic\"\n        uniform token basis = \"bspline\"\n        uniform token wrap = \"pinned\"\n"
+             "        int[] curveVertexCounts = [4, 5]\n"
+             "        point3f[] points = [(0,0,0), (1,0,0), (1,1,0), (2,1,0), (0,0,1), (0,1,1), (1,1,1), (1,2,1), (2,2,2)]\n"
+             "        float[] widths = [1, 2, 3, 4, 5, 6, 7, 8, 9] (interpolation = \"vertex\")\n    }\n"
+             "    def BasisCurves \"z\"\n    {\n        uniform token type = \"cubic\"\n        uniform token basis = \"bezier\"\n"
+             "        int[] curveVertexCounts = [4]\n        point3f[] points.timeSamples = { 1: [(0,0,0), (1,0,0), (1,1,0), (2,1,0)], 0: [(0,0,0), (1,0,0), (1,1,0), (2,1,0)] }\n"
+             "        float[] widths = [1, 2] (interpolation = \"varying\")\n    }\n}\n");
     writeAbc((out / "abc/tiny.abc").string(), s);
     writeAbc((out / "abc/plain.abc").string(), plain);
     writeVdbStrands((out / "vdb/float.vdb").string(), plain);

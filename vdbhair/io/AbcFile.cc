@@ -4,7 +4,7 @@
 #include "AbcFile.h"
 
 #include <vdbhair/Exceptions.h>
-#include <vdbhair/io/AbcXform.h>
+#include <vdbhair/io/Xform.h>
 #include <vdbhair/io/FreeFormCurve.h>
 #include <vdbhair/io/MappedFile.h>
 #include <vdbhair/io/Ogawa.h>
@@ -20,14 +20,17 @@ namespace vdbhair {
 namespace {
 
 using namespace abc;
+using namespace xform;
 
-/// Values of "varying" scope on a curve of @a n control points: one per segment end (AbcGeom's
-/// ICurves: linear curves have n, Bezier ones (n - 1) / 3 + 1, B-spline and Catmull-Rom n - 2).
-std::size_t varyingCount(std::uint32_t n, bool linear, unsigned basis)
+/// Alembic's basis (1 Bezier, 2 B-spline, 3 Catmull-Rom) and wrap (0 nonperiodic, 1 periodic).
+CubicBasis cubicBasis(unsigned basis) { return basis == 1 ? CubicBasis::Bezier : basis == 2 ? CubicBasis::BSpline : CubicBasis::CatmullRom; }
+CurveWrap curveWrap(unsigned wrap) { return wrap == 1 ? CurveWrap::Periodic : CurveWrap::Nonperiodic; }
+
+/// Values of "varying" scope on a curve of @a n control points: one per segment end (linear
+/// curves: one per point).
+std::size_t varyingCount(std::uint32_t n, bool linear, unsigned basis, unsigned wrap)
 {
-    if (linear) return n;
-    if (n < 4) return 0;
-    return basis == 1 ? (n - 1) / 3 + 1 : n - 2;
+    return linear ? n : cubicVaryingCount(cubicBasis(basis), curveWrap(wrap), n);
 }
 
 struct PropertyIn
@@ -395,7 +398,7 @@ Matrix AbcReader::readXform(const ogawa::Reader::Group& object, const std::strin
         }
     }
     Matrix m = kIdentity;
-    const std::string rule = composeXformOps(ops, vals, m);
+    const std::string rule = composeAbcOps(ops, vals, m);
     if (!rule.empty()) throw FormatError(mWhere + ": " + what + ": " + rule);
     return m;
 }
@@ -510,8 +513,12 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
     std::string widthScope, uvScope;
     if (const PropertyIn* pW = find("width")) widths = floatParam(geom, *pW, 1, what + "/width", widthScope);
     if (const PropertyIn* pU = find("uv")) uvs = floatParam(geom, *pU, 2, what + "/uv", uvScope);
+    if (world != kIdentity) {  // widths scale with the transform, as the points do
+        const float scale = float(lengthScale(world));
+        for (float& w : widths) w *= scale;
+    }
     std::size_t numVarying = 0;  // per segment end: one per control point of linear curves
-    for (std::uint32_t c : counts) numVarying += varyingCount(c, linear, basis);
+    for (std::uint32_t c : counts) numVarying += varyingCount(c, linear, basis, wrap);
     auto widthCount = [&](const std::string& s) -> std::uint64_t {
         if (s == "con") return 1;
         if (s == "uni") return numCurves;
@@ -541,7 +548,7 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
             if (widths.size() == 1) return widths[0];
             if (widthScope == "uni") return widths[i];
             if (widthScope == "var") {
-                const std::size_t nv = varyingCount(n, linear, basis);
+                const std::size_t nv = varyingCount(n, linear, basis, wrap);
                 return nv ? widths[firstVarying + std::min<std::size_t>(nv - 1, k * nv / std::max<std::size_t>(m, 1))] : 1.f;
             }
             return widths[first + std::min<std::size_t>(k, n - 1)];
@@ -553,40 +560,17 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
             for (std::uint32_t k = 0; k < n; ++k) polyWidth.push_back(widths.empty() ? 0.f : widthOf(k, n));
             if (wrap == 1 && n >= 2) { poly.push_back(cp[0]); polyWidth.push_back(polyWidth.front()); }
         } else if (n >= 4) {
-            FreeFormCurve curve;
-            curve.degree = 3;
-            for (std::uint32_t k = 0; k < n; ++k) curve.points.push_back(Vec3d(cp[k]));
-            if (wrap == 1) {  // periodic: the first points again close the loop
-                const std::uint32_t extra = basis == 1 ? 1 : 3;
-                for (std::uint32_t k = 0; k < extra; ++k) curve.points.push_back(Vec3d(cp[k]));
-            }
-            const std::size_t m = curve.points.size();
-            curve.weights.assign(m, 1.0);
-            if (basis == 1) {
-                curve.basis = CurveBasis::Bezier;
-                curve.u1 = double((m - 1) / 3);
-            } else if (basis == 2) {  // uniform, unclamped: spans between knots 3 and m
-                curve.basis = CurveBasis::BSpline;
-                for (std::size_t k = 0; k < m + 4; ++k) curve.parms.push_back(double(k));
-                curve.u0 = 3.0;
-                curve.u1 = double(m);
-            } else {
-                curve.basis = CurveBasis::Cardinal;
-                curve.u1 = double(m - 3);
-            }
+            const FreeFormCurve curve = cubicCurve(cubicBasis(basis), curveWrap(wrap), cp, n);
             const std::string rule = flattenCurve(curve, mOpts.curveSamples, poly);
             if (!rule.empty()) throw FormatError(mWhere + ": " + what + ": curve " + std::to_string(i) + ": " + rule);
             if (!widths.empty()) {
                 for (std::size_t k = 0; k < poly.size(); ++k) {
-                    // Width along the curve, interpolated between the controls as evenly spaced.
-                    const double t = poly.size() > 1 ? double(k) / double(poly.size() - 1) * double(n - 1) : 0.0;
-                    const std::size_t k0 = std::min<std::size_t>(std::size_t(t), n - 1), k1 = std::min<std::size_t>(k0 + 1, n - 1);
-                    const float f = float(t - double(k0));
-                    polyWidth.push_back((1.f - f) * widthOf(k0, n) + f * widthOf(k1, n));
+                    const CurvePosition at = positionAlong(k, poly.size(), n);
+                    polyWidth.push_back((1.f - at.f) * widthOf(at.i0, n) + at.f * widthOf(at.i1, n));
                 }
             }
         }
-        firstVarying += varyingCount(n, linear, basis);
+        firstVarying += varyingCount(n, linear, basis, wrap);
         first += n;
         if (!filter.keep(std::size_t(i), poly.size(), "at byte " + std::to_string(dN.pos + 24 + 4 * i))) continue;
         set.addStrand(poly);

@@ -264,4 +264,58 @@ std::string flattenCurve(const FreeFormCurve& curve, std::size_t samples, std::v
     return {};
 }
 
+FreeFormCurve cubicCurve(CubicBasis basis, CurveWrap wrap, const Vec3f* points, std::size_t n)
+{
+    FreeFormCurve curve;
+    curve.degree = 3;
+    const bool phantoms = wrap == CurveWrap::Pinned && basis != CubicBasis::Bezier && n >= 2;
+    if (phantoms) curve.points.push_back(2.0 * Vec3d(points[0]) - Vec3d(points[1]));
+    for (std::size_t k = 0; k < n; ++k) curve.points.push_back(Vec3d(points[k]));
+    if (phantoms) curve.points.push_back(2.0 * Vec3d(points[n - 1]) - Vec3d(points[n - 2]));
+    if (wrap == CurveWrap::Periodic) {  // the first points again close the loop
+        const std::size_t extra = std::min<std::size_t>(n, basis == CubicBasis::Bezier ? 1 : 3);
+        for (std::size_t k = 0; k < extra; ++k) curve.points.push_back(Vec3d(points[k]));
+    }
+    const std::size_t m = curve.points.size();
+    curve.weights.assign(m, 1.0);
+    switch (basis) {
+    case CubicBasis::Bezier:
+        curve.basis = CurveBasis::Bezier;
+        curve.u1 = double(std::max<std::size_t>((m - std::min<std::size_t>(m, 1)) / 3, 1));
+        break;
+    case CubicBasis::BSpline:  // uniform and unclamped: the spans between knots 3 and m
+        curve.basis = CurveBasis::BSpline;
+        for (std::size_t k = 0; k < m + 4; ++k) curve.parms.push_back(double(k));
+        curve.u0 = 3.0;
+        curve.u1 = double(std::max<std::size_t>(m, 4));
+        break;
+    case CubicBasis::CatmullRom:
+        curve.basis = CurveBasis::Cardinal;
+        curve.u1 = double(std::max<std::size_t>(m, 4) - 3);
+        break;
+    }
+    return curve;
+}
+
+std::size_t cubicVaryingCount(CubicBasis basis, CurveWrap wrap, std::size_t n)
+{
+    if (basis == CubicBasis::Bezier) {
+        if (wrap == CurveWrap::Periodic) return n >= 3 ? n / 3 : 0;
+        return n >= 4 ? (n - 1) / 3 + 1 : 0;
+    }
+    if (wrap == CurveWrap::Nonperiodic) return n >= 4 ? n - 2 : 0;
+    return n >= 2 ? n : 0;  // pinned: n - 1 segments; periodic: n
+}
+
+CurvePosition positionAlong(std::size_t k, std::size_t count, std::size_t m)
+{
+    CurvePosition p;
+    if (m <= 1 || count <= 1) return p;
+    const double t = double(k) / double(count - 1) * double(m - 1);
+    p.i0 = std::min<std::size_t>(std::size_t(t), m - 1);
+    p.i1 = std::min<std::size_t>(p.i0 + 1, m - 1);
+    p.f = float(t - double(p.i0));
+    return p;
+}
+
 } // namespace vdbhair

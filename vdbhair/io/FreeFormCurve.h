@@ -53,4 +53,32 @@ constexpr int kMaxCurveDegree = 31;
 /// points, got 2"), for the reader to put after the file and line.
 std::string flattenCurve(const FreeFormCurve& curve, std::size_t samples, std::vector<Vec3f>& out);
 
+/// The cubic bases of USD's `BasisCurves` and Alembic's `Curves` (RenderMan's curves: uniform
+/// parametrization, a step of 3 control points per Bezier segment and 1 for the others).
+enum class CubicBasis { Bezier, BSpline, CatmullRom };
+
+/// How a cubic curve's ends are treated: `nonperiodic` (a B-spline and a Catmull-Rom curve start
+/// near their second point and end near their last but one), `periodic` (closed: the first points
+/// follow the last), `pinned` (USD: a B-spline and a Catmull-Rom curve reach their end points, by a
+/// phantom point 2 P0 - P1 before the first and one after the last; a Bezier curve is unchanged).
+enum class CurveWrap { Nonperiodic, Periodic, Pinned };
+
+/// @brief The FreeFormCurve of a cubic curve of @a n control points, for flattenCurve() (which
+/// states the rule when @a n does not make a curve, e.g. a Bezier curve of 5 points).
+FreeFormCurve cubicCurve(CubicBasis basis, CurveWrap wrap, const Vec3f* points, std::size_t n);
+
+/// @brief The values of "varying" interpolation on a cubic curve of @a n control points: one per
+/// segment end (USD's UsdGeomBasisCurves and RenderMan's rule); 0 when @a n makes no segment.
+std::size_t cubicVaryingCount(CubicBasis basis, CurveWrap wrap, std::size_t n);
+
+/// Where point @a k of @a count points of a polyline evaluated from a curve lies among @a m values
+/// given along the curve (per control point or per segment end, taken as evenly spaced): between
+/// value i0 and i1, at fraction f.
+struct CurvePosition
+{
+    std::size_t i0 = 0, i1 = 0;
+    float f = 0.f;
+};
+CurvePosition positionAlong(std::size_t k, std::size_t count, std::size_t m);
+
 } // namespace vdbhair

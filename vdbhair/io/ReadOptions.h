@@ -43,7 +43,7 @@ struct ReadOptions
     /// write): each run of this many consecutive vertices is one strand (they write 100). 0: not
     /// set, and such a file is an error that says to set it. Ignored when the file has topology.
     std::size_t pointsPerStrand = 0;
-    /// `.obj` free-form curves (`curv`): the points each curve is evaluated at, evenly in its
+    /// `.obj` free-form curves (`curv`) and cubic USD and Alembic curves: the points each curve is evaluated at, evenly in its
     /// parameter. 0: chosen per curve so that the polyline keeps the curve's shape within 1 % of
     /// its length (FreeFormCurve.h explains the rule).
     std::size_t curveSamples = 0;

@@ -4,6 +4,8 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Version.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/io/FreeFormCurve.h>
+#include <vdbhair/io/Xform.h>
 
 #include <algorithm>
 #include <cctype>
@@ -11,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <functional>
 #include <map>
 
 namespace vdbhair {
@@ -262,33 +265,80 @@ std::map<std::string, FlatValue> parseMetadata(UsdLexer& lex)
 }
 
 // ---------------------------------------------------------------------------------------------
-// A BasisCurves prim's properties.
+// Prims: the tree's transforms, and every BasisCurves prim's properties.
 
 struct Property
 {
     FlatValue value;
     std::string interpolation;
     bool hasValue = false;
+    bool sampled = false;  ///< the value is the first of its time samples
+};
+
+constexpr std::size_t kNoParent = std::numeric_limits<std::size_t>::max();
+
+/// A prim of the tree, for its transform: its parent and its `xformOpOrder` and `xformOp:*`.
+struct PrimNode
+{
+    std::size_t parent = kNoParent;
+    std::string name;
+    std::size_t line = 0;
+    std::map<std::string, Property> xformProps;
 };
 
 struct CurvesPrim
 {
     std::string name;
     std::size_t line = 0;
+    std::size_t node = 0;  ///< its PrimNode
     std::map<std::string, Property> props;
 };
 
 struct UsdDocument
 {
+    std::vector<PrimNode> nodes;
     std::vector<CurvesPrim> curves;
     std::string upAxis;
     double metersPerUnit = 0.0;  ///< 0: not in the stage's metadata
-    std::size_t xformOps = 0, timeSamples = 0;
+    std::size_t timeSampled = 0;  ///< properties read at their first time sample
 };
 
-void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, int depth);
+/// A property's value: its default, or the first of its time samples, which win (USD resolves a
+/// sampled attribute to its samples at any time; a file's first frame is what it shows first).
+void store(std::map<std::string, Property>& props, const std::string& name, Property prop)
+{
+    Property& to = props[name];
+    if (to.sampled && !prop.sampled && prop.hasValue) return;
+    if (!prop.hasValue && to.hasValue) {  // a declaration without a value keeps the value
+        if (!prop.interpolation.empty()) to.interpolation = prop.interpolation;
+        return;
+    }
+    if (to.hasValue && prop.interpolation.empty()) prop.interpolation = to.interpolation;
+    to = std::move(prop);
+}
 
-void parsePrim(UsdLexer& lex, UsdDocument& doc, int depth)
+/// `{ TIME: VALUE, ... }`: the value at the earliest time.
+FlatValue parseFirstSample(UsdLexer& lex)
+{
+    lex.expect('{', "to open time samples");
+    FlatValue first;
+    double firstTime = std::numeric_limits<double>::infinity();
+    while (!lex.isPunct('}')) {
+        if (lex.peek().kind != Tok::Number) lex.fail("expected a time in time samples, found " + UsdLexer::describe(lex.peek()));
+        const double t = lex.next().number;
+        lex.expect(':', "after a time sample's time");
+        FlatValue v = parseValue(lex);
+        if (t < firstTime) { firstTime = t; first = std::move(v); }
+        if (lex.isPunct(',')) lex.next();
+        else if (!lex.isPunct('}')) lex.fail("expected ',' or '}' in time samples, found " + UsdLexer::describe(lex.peek()));
+    }
+    lex.next();
+    return first;
+}
+
+void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, std::size_t node, int depth);
+
+void parsePrim(UsdLexer& lex, UsdDocument& doc, std::size_t parent, int depth)
 {
     checkNesting(lex, depth, "prims");
     const Token spec = lex.next();  // def, over, class
@@ -298,24 +348,27 @@ void parsePrim(UsdLexer& lex, UsdDocument& doc, int depth)
     const Token name = lex.next();
     if (lex.isPunct('(')) parseMetadata(lex);
     lex.expect('{', "to open the body of prim \"" + std::string(name.text) + "\"");
+    const std::size_t node = doc.nodes.size();
+    doc.nodes.push_back(PrimNode{parent, std::string(name.text), name.line, {}});
     if (spec.text == "def" && type == "BasisCurves") {
         CurvesPrim prim;
         prim.name = std::string(name.text);
         prim.line = name.line;
-        parsePrimBody(lex, doc, &prim, depth);
+        prim.node = node;
+        parsePrimBody(lex, doc, &prim, node, depth);
         doc.curves.push_back(std::move(prim));
     } else {
-        parsePrimBody(lex, doc, nullptr, depth);
+        parsePrimBody(lex, doc, nullptr, node, depth);
     }
 }
 
-void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, int depth)
+void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, std::size_t node, int depth)
 {
     while (!lex.isPunct('}')) {
         const Token& t = lex.peek();
         if (t.kind == Tok::End) lex.fail("a prim's body is not closed with '}'");
         if (t.kind == Tok::Punct && t.text[0] == ';') { lex.next(); continue; }
-        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) { parsePrim(lex, doc, depth + 1); continue; }
+        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) { parsePrim(lex, doc, node, depth + 1); continue; }
         if (lex.isWord("variantSet")) {  // variantSet "name" = { "a" { ... } }
             lex.next();
             lex.next();
@@ -327,7 +380,7 @@ void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, int dept
                 if (lex.isPunct('(')) parseMetadata(lex);
                 lex.expect('{', "to open a variant");
                 checkNesting(lex, depth + 1, "prims");
-                parsePrimBody(lex, doc, nullptr, depth + 1);
+                parsePrimBody(lex, doc, nullptr, node, depth + 1);
             }
             lex.next();
             continue;
@@ -344,21 +397,28 @@ void parsePrimBody(UsdLexer& lex, UsdDocument& doc, CurvesPrim* curves, int dept
         }
         if (lex.peek().kind != Tok::Word) lex.fail("expected a property name, found " + UsdLexer::describe(lex.peek()));
         name = std::string(lex.next().text);
+        const auto suffix = [&](const char* s) { return name.size() > std::strlen(s) && name.compare(name.size() - std::strlen(s), std::string::npos, s) == 0; };
+        const bool samples = suffix(".timeSamples");
+        if (samples) name.resize(name.size() - std::strlen(".timeSamples"));
         Property prop;
         if (lex.isPunct('=')) {
             lex.next();
-            prop.value = parseValue(lex);
+            if (samples) {
+                prop.value = parseFirstSample(lex);
+                prop.sampled = true;
+                ++doc.timeSampled;
+            } else {
+                prop.value = parseValue(lex);
+            }
             prop.hasValue = true;
         }
         if (lex.isPunct('(')) {
             const auto meta = parseMetadata(lex);
             if (const auto it = meta.find("interpolation"); it != meta.end() && !it->second.words.empty()) prop.interpolation = it->second.words[0];
         }
-        const auto suffix = [&](const char* s) { return name.size() > std::strlen(s) && name.compare(name.size() - std::strlen(s), std::string::npos, s) == 0; };
-        if (suffix(".timeSamples")) { ++doc.timeSamples; continue; }
         if (suffix(".connect")) continue;
-        if (name.rfind("xformOp:", 0) == 0) ++doc.xformOps;
-        if (curves) curves->props[name] = std::move(prop);
+        if (name.rfind("xformOp", 0) == 0) store(doc.nodes[node].xformProps, name, prop);
+        if (curves) store(curves->props, name, std::move(prop));
     }
     lex.next();
 }
@@ -379,11 +439,65 @@ UsdDocument parseUsda(const std::vector<char>& bytes, const std::string& where)
         }
     }
     while (lex.peek().kind != Tok::End) {
-        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) parsePrim(lex, doc, 1);
+        if (lex.isWord("def") || lex.isWord("over") || lex.isWord("class")) parsePrim(lex, doc, kNoParent, 1);
         else lex.fail("expected a prim (def, over or class), found " + UsdLexer::describe(lex.peek()));
     }
     return doc;
 }
+
+/// A prim's own transform: its `xformOpOrder`'s ops, the last applied first (`!invert!` inverts
+/// one; `!resetXformStack!` sets @a reset: the parents' transforms do not apply).
+xform::Matrix localTransform(const PrimNode& node, bool& reset, const std::string& where, const std::function<void(const std::string&)>& warn)
+{
+    reset = false;
+    xform::Matrix local = xform::kIdentity;
+    const auto order = node.xformProps.find("xformOpOrder");
+    if (order == node.xformProps.end() || !order->second.hasValue) return local;  // USD applies only ordered ops
+    const std::string at = "prim \"" + node.name + "\" (line " + std::to_string(order->second.value.line) + ")";
+    for (const std::string& entry : order->second.value.words) {
+        if (entry == "!resetXformStack!") { reset = true; continue; }
+        const bool inverse = entry.rfind("!invert!", 0) == 0;
+        const std::string name = inverse ? entry.substr(8) : entry;
+        const auto op = node.xformProps.find(name);
+        if (op == node.xformProps.end() || !op->second.hasValue) {
+            warn(at + ": xformOpOrder names \"" + name + "\", which has no value; that op is not applied");
+            continue;
+        }
+        const std::size_t colon = name.find(':', 8);
+        const std::string type = name.size() > 8 ? name.substr(8, colon == std::string::npos ? std::string::npos : colon - 8) : std::string();
+        xform::Matrix m;
+        if (std::string rule = xform::usdOp(type, op->second.value.numbers, m); !rule.empty()) {
+            throw FormatError(where + ": line " + std::to_string(op->second.value.line) + ": " + at + ": " + name + ": " + rule);
+        }
+        if (inverse && !xform::invert(m, m)) {
+            throw FormatError(where + ": line " + std::to_string(op->second.value.line) + ": " + at + ": !invert!" + name + " is not invertible");
+        }
+        local = xform::multiply(m, local);
+    }
+    return local;
+}
+
+/// The transform from a prim's space to the stage's: its own, then its parents' up the tree.
+xform::Matrix worldTransform(const UsdDocument& doc, std::size_t node, const std::string& where, const std::function<void(const std::string&)>& warn)
+{
+    xform::Matrix world = xform::kIdentity;
+    for (std::size_t n = node; n != kNoParent; n = doc.nodes[n].parent) {
+        bool reset = false;
+        world = xform::multiply(world, localTransform(doc.nodes[n], reset, where, warn));
+        if (reset) break;
+    }
+    return world;
+}
+
+/// A primvar's values as stored: per curve, per control point, or per segment end (varying).
+enum class Interp { Constant, Uniform, Vertex, Varying };
+
+struct Primvar
+{
+    Interp interp = Interp::Constant;
+    std::size_t arity = 1;
+    std::vector<float> values;
+};
 
 } // namespace
 
@@ -395,10 +509,9 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
     if (doc.curves.empty()) {
         throw FormatError(where + ": no strands: the file has no 'def BasisCurves' prim");
     }
-    auto warn = [&](const std::string& w) { if (report) report->warnings.push_back(where + ": " + w); };
+    const std::function<void(const std::string&)> warn = [&](const std::string& w) { if (report) report->warnings.push_back(where + ": " + w); };
     if (doc.upAxis == "Z") warn("the stage's upAxis is Z; coordinates are kept as they are (render with RenderParams::up set to z)");
-    if (doc.xformOps) warn(std::to_string(doc.xformOps) + " xformOp(s) of BasisCurves prims were not applied: points are read in the prim's own space");
-    if (doc.timeSamples) warn(std::to_string(doc.timeSamples) + " time-sampled attribute(s) were ignored; only default values are read");
+    if (doc.timeSampled) warn(std::to_string(doc.timeSampled) + " time-sampled attribute(s) were read at their first sample (an animation's first frame)");
 
     StrandSet out;
     ShortStrandFilter filter(opts, report, where);
@@ -412,9 +525,26 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
             const auto it = prim.props.find(name);
             return it != prim.props.end() && it->second.hasValue ? &it->second : nullptr;
         };
-        const Property* type = find("type");
-        if (type && !type->value.words.empty() && type->value.words[0] != "linear") {
-            warn(at + ": type \"" + type->value.words[0] + "\": its control points are read as a linear polyline");
+        auto token = [&](const char* name, const char* fallback) {
+            const Property* t = find(name);
+            return t && !t->value.words.empty() ? t->value.words[0] : std::string(fallback);
+        };
+        // USD's fallbacks: cubic Bezier curves, not periodic.
+        const std::string type = token("type", "cubic"), basisName = token("basis", "bezier"), wrapName = token("wrap", "nonperiodic");
+        if (type != "linear" && type != "cubic") throw FormatError(where + ": " + at + ": type \"" + type + "\"; BasisCurves are linear or cubic");
+        if (wrapName != "nonperiodic" && wrapName != "periodic" && wrapName != "pinned") {
+            throw FormatError(where + ": " + at + ": wrap \"" + wrapName + "\"; expected nonperiodic, periodic or pinned");
+        }
+        const CurveWrap wrap = wrapName == "periodic" ? CurveWrap::Periodic : wrapName == "pinned" ? CurveWrap::Pinned : CurveWrap::Nonperiodic;
+        bool linear = type == "linear";
+        CubicBasis basis = CubicBasis::Bezier;
+        if (!linear) {
+            if (basisName == "bspline") basis = CubicBasis::BSpline;
+            else if (basisName == "catmullRom") basis = CubicBasis::CatmullRom;
+            else if (basisName != "bezier") {
+                warn(at + ": cubic basis \"" + basisName + "\" (deprecated in USD) is not evaluated; its control points are read as a polyline");
+                linear = true;
+            }
         }
         const Property* counts = find("curveVertexCounts");
         const Property* points = find("points");
@@ -426,7 +556,7 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
             throw FormatError(where + ": line " + std::to_string(points->value.line) + ": " + at + ": points must be (x, y, z) triples");
         }
         const std::size_t nP = p.size() / 3, nC = n.size();
-        std::uint64_t sum = 0;
+        std::uint64_t sum = 0, numVarying = 0;
         for (std::size_t i = 0; i < nC; ++i) {
             poll();
             if (!(n[i] >= 0.0) || n[i] != std::floor(n[i]) || n[i] > 4294967295.0) {
@@ -434,47 +564,62 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
                                   std::to_string(i) + "] is " + std::to_string(n[i]) + "; counts must be whole numbers of at least 0");
             }
             sum += std::uint64_t(n[i]);
+            numVarying += linear ? std::uint64_t(n[i]) : cubicVaryingCount(basis, wrap, std::size_t(n[i]));
         }
         if (sum != nP) {
             throw FormatError(where + ": line " + std::to_string(counts->value.line) + ": " + at + ": curveVertexCounts add up to " +
                               std::to_string(sum) + " but there are " + std::to_string(nP) + " points");
         }
-        // A primvar as per-vertex values of @a arity components (empty: constant, into @a constant).
-        auto perVertex = [&](const char* name, std::size_t arity, std::vector<float>& values, float* constant) {
-            values.clear();
+        if (!find("type") && !find("basis")) {
+            // USD's fallback is cubic Bezier; curves whose counts cannot be Bezier curves were meant
+            // as polylines (a writer that left the type out).
+            bool bezier = true;
+            for (std::size_t i = 0; i < nC && bezier; ++i) bezier = std::size_t(n[i]) >= 4 && (std::size_t(n[i]) - 1) % 3 == 0;
+            if (!bezier) {
+                warn(at + ": type is not authored and its curves do not fit USD's fallback (cubic Bezier: 3 k + 1 points); read as linear");
+                linear = true;
+                numVarying = sum;
+            }
+        }
+        // A primvar's values with their interpolation (none: false; constant: into @a constant).
+        auto readPrimvar = [&](const char* name, std::size_t arity, Primvar& pv, float* constant) {
+            pv = Primvar{};
+            pv.arity = arity;
             const Property* prop = find(name);
             if (!prop) return false;
             const std::vector<double>& v = prop->value.numbers;
-            const std::string interp = prop->interpolation.empty() ? (std::strcmp(name, "widths") == 0 ? "vertex" : "constant") : prop->interpolation;
+            // The interpolation: the metadata, else an attribute NAME:interpolation (older writers),
+            // else USD's fallback (vertex for widths; constant for primvars and for one width).
+            std::string interp = prop->interpolation;
+            if (const Property* i = interp.empty() ? find((std::string(name) + ":interpolation").c_str()) : nullptr; i && !i->value.words.empty()) {
+                interp = i->value.words[0];
+            }
+            if (interp.empty()) interp = std::strcmp(name, "widths") == 0 && v.size() != 1 ? "vertex" : "constant";
             const std::string line = "line " + std::to_string(prop->value.line);
+            auto need = [&](std::uint64_t count, const char* per) {
+                if (v.size() != arity * count) {
+                    throw FormatError(where + ": " + line + ": " + at + ": " + interp + " " + name + " needs one value per " + per + " (" +
+                                      std::to_string(count) + "), got " + std::to_string(v.size() / arity));
+                }
+            };
             if (interp == "constant") {
                 if (v.size() != arity) throw FormatError(where + ": " + line + ": " + at + ": constant " + name + " needs " + std::to_string(arity) + " number(s), got " + std::to_string(v.size()));
                 for (std::size_t c = 0; c < arity; ++c) constant[c] = float(v[c]);
                 return true;
             }
-            if (interp == "uniform") {
-                if (v.size() != arity * nC) throw FormatError(where + ": " + line + ": " + at + ": uniform " + name + " needs one value per curve (" + std::to_string(nC) + "), got " + std::to_string(v.size() / arity));
-                values.resize(arity * nP);
-                std::size_t k = 0;
-                for (std::size_t i = 0; i < nC; ++i)
-                    for (std::size_t j = 0; j < std::size_t(n[i]); ++j, ++k)
-                        for (std::size_t c = 0; c < arity; ++c) values[arity * k + c] = float(v[arity * i + c]);
-                return true;
-            }
-            if (interp == "vertex" || interp == "varying") {
-                if (v.size() != arity * nP) throw FormatError(where + ": " + line + ": " + at + ": " + interp + " " + name + " needs one value per point (" + std::to_string(nP) + "), got " + std::to_string(v.size() / arity));
-                values.resize(v.size());
-                for (std::size_t k = 0; k < v.size(); ++k) values[k] = float(v[k]);
-                return true;
-            }
-            throw FormatError(where + ": " + line + ": " + at + ": " + name + " has interpolation \"" + interp + "\"; expected constant, uniform, vertex or varying");
+            if (interp == "uniform") { need(nC, "curve"); pv.interp = Interp::Uniform; }
+            else if (interp == "vertex") { need(nP, "point"); pv.interp = Interp::Vertex; }
+            else if (interp == "varying") { need(numVarying, linear ? "point" : "segment end"); pv.interp = Interp::Varying; }
+            else throw FormatError(where + ": " + line + ": " + at + ": " + name + " has interpolation \"" + interp + "\"; expected constant, uniform, vertex or varying");
+            pv.values.assign(v.begin(), v.end());
+            return true;
         };
         StrandDefaults defaults = out.defaults;
-        std::vector<float> widths, colors, opacity;
+        Primvar widths, colors, opacity;
         float opacityConstant = 1.f - defaults.transparency;
-        const bool constantWidth = perVertex("widths", 1, widths, &defaults.thickness) && widths.empty();
-        const bool constantColor = perVertex("primvars:displayColor", 3, colors, &defaults.color[0]) && colors.empty();
-        const bool constantOpacity = perVertex("primvars:displayOpacity", 1, opacity, &opacityConstant) && opacity.empty();
+        const bool constantWidth = readPrimvar("widths", 1, widths, &defaults.thickness) && widths.values.empty();
+        const bool constantColor = readPrimvar("primvars:displayColor", 3, colors, &defaults.color[0]) && colors.values.empty();
+        const bool constantOpacity = readPrimvar("primvars:displayOpacity", 1, opacity, &opacityConstant) && opacity.values.empty();
         if (constantOpacity) defaults.transparency = 1.f - opacityConstant;
         // A per-vertex array of one value that writeUsda() wrote once (vdbhair_uniform_*): the
         // array again, so .hair -> .usda -> .hair keeps it.
@@ -486,12 +631,14 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         const bool displayWidth = constantWidth && uniform("vdbhair_display_width");
         const bool uniformColor = constantColor && uniform("vdbhair_uniform_color");
         const bool uniformOpacity = constantOpacity && uniform("vdbhair_uniform_transparency");
-        if (uniformWidth) widths.assign(nP, defaults.thickness);
-        if (uniformColor) {
-            colors.resize(3 * nP);
-            for (std::size_t k = 0; k < nP; ++k) for (int c = 0; c < 3; ++c) colors[3 * k + c] = defaults.color[c];
-        }
-        if (uniformOpacity) opacity.assign(nP, opacityConstant);
+        auto asUniform = [&](Primvar& pv, const float* value) {  // one value for every curve
+            pv.interp = Interp::Uniform;
+            pv.values.resize(pv.arity * nC);
+            for (std::size_t i = 0; i < nC; ++i) std::copy(value, value + pv.arity, pv.values.begin() + std::ptrdiff_t(pv.arity * i));
+        };
+        if (uniformWidth) asUniform(widths, &defaults.thickness);
+        if (uniformColor) asUniform(colors, &defaults.color[0]);
+        if (uniformOpacity) asUniform(opacity, &opacityConstant);
         // vdbhair's own record of the defaults (exact, and kept when the arrays are per vertex); a
         // constant primvar that is not such an array is what the file says for every vertex, and
         // wins (a width given to the writer).
@@ -506,29 +653,63 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         if (const Property* d = find("vdbhair_default_color"); d && d->value.numbers.size() == 3 && (!constantColor || uniformColor)) {
             defaults.color = Vec3f(float(d->value.numbers[0]), float(d->value.numbers[1]), float(d->value.numbers[2]));
         }
+        // The prim's transform to the stage's space (its xformOps and its parents'); widths scale
+        // with it.
+        const xform::Matrix world = worldTransform(doc, prim.node, where, warn);
+        const bool transformed = world != xform::kIdentity;
+        const float widthScale = transformed ? float(xform::lengthScale(world)) : 1.f;
+        if (transformed) defaults.thickness *= widthScale;
         if (first) out.defaults = defaults;
         first = false;
 
         // Strands, with the attributes where this prim has them (defaults elsewhere).
         StrandSet part;
         part.defaults = out.defaults;
-        std::size_t v0 = 0;
+        std::vector<Vec3f> controls, poly;
+        std::size_t v0 = 0, vv0 = 0;
         for (std::size_t i = 0; i < nC; ++i) {
             const std::size_t cnt = std::size_t(n[i]);
+            controls.clear();
             for (std::size_t k = v0; k < v0 + cnt; ++k) {
                 const Vec3f q(static_cast<float>(p[3 * k]), static_cast<float>(p[3 * k + 1]), static_cast<float>(p[3 * k + 2]));
                 checkFinite(q, k, where, at);
+                controls.push_back(q);
+                if (transformed) {
+                    controls.back() = xform::transformPoint(world, q);
+                    checkFinite(controls.back(), k, where, at + " after its transform");
+                }
             }
-            if (filter.keep(strandIndex++, cnt, at + ", curve " + std::to_string(i))) {
-                for (std::size_t k = v0; k < v0 + cnt; ++k) {
-                    part.positions.emplace_back(float(p[3 * k]), float(p[3 * k + 1]), float(p[3 * k + 2]));
-                    if (!widths.empty()) part.thickness.push_back(widths[k]);
-                    if (!colors.empty()) part.color.emplace_back(colors[3 * k], colors[3 * k + 1], colors[3 * k + 2]);
-                    if (!opacity.empty()) part.transparency.push_back(1.f - opacity[k]);
+            if (linear) {
+                poly = controls;
+                if (wrap == CurveWrap::Periodic && cnt >= 2) poly.push_back(controls.front());
+            } else {
+                poly.clear();
+                const FreeFormCurve curve = cubicCurve(basis, wrap, controls.data(), cnt);
+                if (std::string rule = flattenCurve(curve, opts.curveSamples, poly); !rule.empty()) {
+                    throw FormatError(where + ": " + at + ": curve " + std::to_string(i) + " (cubic " + basisName + ", " + wrapName + "): " + rule);
+                }
+            }
+            const std::size_t nv = linear ? cnt : cubicVaryingCount(basis, wrap, cnt);
+            // A primvar at polyline point k: per curve, or between the values along the curve.
+            auto valueAt = [&](const Primvar& pv, std::size_t k, std::size_t c) -> float {
+                const std::size_t at0 = pv.interp == Interp::Uniform ? i : pv.interp == Interp::Vertex ? v0 : vv0;
+                const std::size_t m = pv.interp == Interp::Uniform ? 1 : pv.interp == Interp::Vertex ? cnt : nv;
+                if (m == 0) return 0.f;
+                if (linear && m > 1) return pv.values[pv.arity * (at0 + (k < m ? k : 0)) + c];
+                const CurvePosition pos = positionAlong(k, poly.size(), m);
+                return (1.f - pos.f) * pv.values[pv.arity * (at0 + pos.i0) + c] + pos.f * pv.values[pv.arity * (at0 + pos.i1) + c];
+            };
+            if (filter.keep(strandIndex++, poly.size(), at + ", curve " + std::to_string(i))) {
+                for (std::size_t k = 0; k < poly.size(); ++k) {
+                    part.positions.push_back(poly[k]);
+                    if (!widths.values.empty()) part.thickness.push_back(valueAt(widths, k, 0) * widthScale);
+                    if (!colors.values.empty()) part.color.emplace_back(valueAt(colors, k, 0), valueAt(colors, k, 1), valueAt(colors, k, 2));
+                    if (!opacity.values.empty()) part.transparency.push_back(1.f - valueAt(opacity, k, 0));
                 }
                 part.offsets.push_back(std::uint32_t(part.positions.size()));
             }
             v0 += cnt;
+            vv0 += nv;
         }
         if (out.empty()) {
             out = std::move(part);

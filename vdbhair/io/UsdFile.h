@@ -38,9 +38,14 @@
 ///
 /// Reading accepts every `def BasisCurves` prim of the file (concatenated in file order), nested
 /// in any `def` prims; `uniform`, `constant`, `vertex` and `varying` interpolation; comments,
-/// prim and property metadata, and other prims and properties (ignored). Transforms
-/// (`xformOp`s) are not applied and time samples are not read (a warning says so). A `cubic`
-/// curve's control points are read as a polyline, with a warning. `upAxis` and `metersPerUnit`
+/// prim and property metadata, and other prims and properties (ignored). Points are read into the
+/// stage's space: the `xformOp`s that a prim and each of its parents list in `xformOpOrder` are
+/// composed as `UsdGeomXformable` does (Xform.h; widths scale with the transform). Cubic curves
+/// (bezier, bspline, catmullRom; nonperiodic, periodic, pinned) are evaluated to polylines by
+/// FreeFormCurve.h (ReadOptions::curveSamples), their vertex and varying primvars interpolated
+/// along them; USD's fallback type, cubic Bezier, applies when `type` is not authored unless the
+/// counts cannot be Bezier curves (read as linear, with a warning). An attribute with time
+/// samples is read at its first (a warning says so). `upAxis` and `metersPerUnit`
 /// are carried in StrandSet::upAxis and StrandSet::metersPerUnit (USD's fallbacks, Y and 0.01,
 /// when the stage has none), never applied (no rotation or scaling; a "Z" up axis is reported in a
 /// warning: render such hair with `--up z`), and written again by writeUsda() unless told
