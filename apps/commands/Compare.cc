@@ -22,22 +22,6 @@ struct CompareCmdParams
     CompareParams params;
 };
 
-/// "mm", "cm", "dm", "m", "in" or a positive number: the files' unit in metres.
-double parseUnit(const std::string& text)
-{
-    if (text == "mm") return 0.001;
-    if (text == "cm") return 0.01;
-    if (text == "dm") return 0.1;
-    if (text == "m") return 1.0;
-    if (text == "in") return 0.0254;
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
-        throw ValueError("--unit '" + text + "': expected mm, cm, dm, m, in or the unit's length in metres (0.01 for centimetres)");
-    }
-    return v;
-}
-
 /// "D:ANGLE": a distance (millimetres with --unit, else file units) and an angle in degrees.
 OrientedThreshold parseThreshold(const std::string& text, bool millimetres)
 {
@@ -56,7 +40,7 @@ OrientedThreshold parseThreshold(const std::string& text, bool millimetres)
 
 int runCompare(CompareCmdParams p, const CommonOptions& common)
 {
-    if (!p.unit.empty()) p.params.metersPerUnit = parseUnit(p.unit);
+    if (!p.unit.empty()) p.params.metersPerUnit = metersPerUnitFromName(p.unit, "--unit");
     for (const std::string& t : p.thresholds) p.params.thresholds.push_back(parseThreshold(t, p.params.metersPerUnit > 0.0));
     p.params.validate();
     if (!p.perStrand.empty() && fileExtension(p.perStrand) != ".csv") {

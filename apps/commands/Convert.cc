@@ -36,6 +36,8 @@ struct ConvertParams
     float width = WriteOptions{}.usd.width;
     std::string format;  ///< the format of `-` (standard input or output), e.g. "obj"
     std::string up = "y";  ///< the input's up axis; rotated onto +Y
+    std::string units;       ///< convert to this unit (mm, cm, m, ... or metres); empty: keep
+    std::string inputUnits;  ///< the inputs' unit, declared or overriding the files'; empty: theirs
 };
 
 /// @brief Rotate @a strands so that the axis @a up (a unit axis, possibly negative) becomes +Y,
@@ -139,6 +141,30 @@ int runConvert(ConvertParams p, const CommonOptions& common)
         std::string what = inputs.size() == 1 ? inputs[0] + ": the file has no strands" : "the " + std::to_string(inputs.size()) + " inputs have no strands";
         throw FormatError(what + "; nothing to write to " + p.output);
     }
+    // Units: declared (--input-units) and converted (--units) only when asked.
+    if (!p.inputUnits.empty()) {
+        const double declared = metersPerUnitFromName(p.inputUnits, "--input-units");
+        if (strands.metersPerUnit > 0.0 && strands.metersPerUnit != declared && !common.quiet) {
+            std::cerr << "vdbhair convert: warning: the input declares " << formatValue(strands.metersPerUnit) << " m per unit; --input-units "
+                      << p.inputUnits << " overrides it (nothing is scaled by that)\n";
+        }
+        strands.metersPerUnit = declared;
+    }
+    if (!p.units.empty()) {
+        const double target = metersPerUnitFromName(p.units, "--units");
+        if (p.metersPerUnit > 0.0 && p.metersPerUnit != target) {
+            throw ValueError("--units " + p.units + " and --meters-per-unit " + formatValue(p.metersPerUnit) + " disagree; give one");
+        }
+        if (!(strands.metersPerUnit > 0.0)) {
+            throw ValueError("--units " + p.units + ": " + (inputs.size() == 1 ? inputs[0] : std::string("the inputs")) +
+                             " declare(s) no unit to convert from; give it with --input-units (e.g. --input-units cm)");
+        }
+        convertUnits(strands, target);
+    }
+    if (!common.quiet && !(strands.metersPerUnit > 0.0) && p.metersPerUnit == 0.0 && strandFormatFromPath(p.output, true) == StrandFormat::Usda) {
+        std::cerr << "vdbhair convert: warning: " << p.output << ": the input declares no unit; the stage says metersPerUnit = 0.01 "
+                     "(centimetres, USD's fallback): give the input's unit with --input-units UNIT if it is not centimetres\n";
+    }
     if (p.scale != 1.0) scaleStrands(strands, float(p.scale));
     rotateUpToY(strands, axisFromName(p.up, "--up"));
     if (p.resample >= 2) {
@@ -192,6 +218,11 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--meters-per-unit", params->metersPerUnit,
                     "USD output: the stage's metersPerUnit (0: the input's own, from a USD stage, else 0.01: centimetres); nothing is scaled")
         ->capture_default_str();
+    sub->add_option("--units", params->units,
+                    "Convert to this unit (mm, cm, dm, m, in, or its length in metres): positions and thickness scaled from the input's "
+                    "declared unit (a USD stage's metersPerUnit, or --input-units), which outputs with a unit (USD) then declare");
+    sub->add_option("--input-units", params->inputUnits,
+                    "The inputs' unit (mm, cm, dm, m, in, or metres), for files that declare none or declare it wrongly; nothing is scaled by it");
     sub->add_option("--width", params->width,
                     "USD output: the widths (world units) of strands without thickness (default: the file's own default thickness, else 1/1000 of the bounding box's diagonal)");
     sub->add_option("--up", params->up,

@@ -335,6 +335,32 @@ Raises:
             return d;
         },
         "The per-vertex defaults used where an attribute array is None (cyHair's header): a dict.");
+    cls.def_property(
+        "meters_per_unit", [](const StrandSet& s) -> pyb::object { return s.metersPerUnit > 0.0 ? pyb::cast(s.metersPerUnit) : pyb::none(); },
+        [](StrandSet& s, const pyb::object& v) {
+            const double m = v.is_none() ? 0.0 : v.cast<double>();
+            if (!(m >= 0.0) || !std::isfinite(m)) {
+                throw ValueError("meters_per_unit=" + std::to_string(m) + ": must be a positive length in metres, or None (not declared)");
+            }
+            s.metersPerUnit = m;
+        },
+        "The unit the file declared (a USD stage's metersPerUnit), in metres, or None when it declared none. Setting it declares "
+        "a unit (nothing is scaled); convert_units() scales.");
+    cls.def_property_readonly(
+        "up_axis", [](const StrandSet& s) -> pyb::object { return s.upAxis ? pyb::cast(std::string(1, s.upAxis)) : pyb::none(); },
+        "The up axis the file declared, \"Y\" or \"Z\", or None.");
+    cls.def(
+        "convert_units",
+        [](StrandSet& s, const pyb::object& unit) {
+            const double target = pyb::isinstance<pyb::str>(unit) ? metersPerUnitFromName(unit.cast<std::string>(), "unit") : unit.cast<double>();
+            if (!(s.metersPerUnit > 0.0)) {
+                throw ValueError("convert_units: the strands declare no unit to convert from; set meters_per_unit first (e.g. 0.01 for centimetres)");
+            }
+            convertUnits(s, target);
+        },
+        pyb::arg("unit"),
+        "Express the strands in ``unit`` (\"mm\", \"cm\", \"dm\", \"m\", \"in\" or metres as a float), in place: positions and thickness "
+        "scaled from meters_per_unit, which becomes ``unit`` (the CLI's ``convert --units``).");
     cls.def_property_readonly("num_strands", &StrandSet::numStrands, "S, the number of strands.");
     cls.def_property_readonly("num_vertices", &StrandSet::numVertices, "V, the number of vertices.");
     cls.def("__len__", &StrandSet::numStrands, "The number of strands S.");

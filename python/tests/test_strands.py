@@ -255,3 +255,26 @@ def test_write_takes_the_cli_write_options(tmp_path):
         vdbhair.write(hair, out, usd_up="x")
     with pytest.raises(vdbhair.ArgumentError, match="meters_per_unit=-1.000000: must be a positive length"):
         vdbhair.write(hair, out, meters_per_unit=-1)
+
+
+def test_units_declared_and_converted(tmp_path):
+    positions, offsets = two_strands()
+    s = vdbhair.Strands(positions, offsets)
+    assert s.meters_per_unit is None and s.up_axis is None
+    with pytest.raises(ValueError, match="declare no unit to convert from"):
+        s.convert_units("m")
+    s.meters_per_unit = 0.01  # declares centimetres; nothing moves
+    np.testing.assert_array_equal(s.positions, positions)
+    s.convert_units("mm")
+    assert s.meters_per_unit == 0.001
+    np.testing.assert_allclose(s.positions, positions * 10.0, rtol=1e-6)
+    s.convert_units(1.0)  # metres, as a number
+    np.testing.assert_allclose(s.positions, positions * 0.01, rtol=1e-6)
+    s.write(tmp_path / "m.usda")
+    again = vdbhair.read(tmp_path / "m.usda")
+    assert again.meters_per_unit == 1.0 and again.up_axis == "Y"
+    with pytest.raises(ValueError, match="'furlong': expected mm, cm, dm, m, in"):
+        s.convert_units("furlong")
+    with pytest.raises(ValueError, match="meters_per_unit=-1"):
+        s.meters_per_unit = -1.0
+    assert s.meters_per_unit == 1.0  # a refused value changes nothing

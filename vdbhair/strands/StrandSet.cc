@@ -4,6 +4,7 @@
 #include <vdbhair/Memory.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 namespace vdbhair {
@@ -158,6 +159,35 @@ void scaleStrands(StrandSet& strands, float factor)
     const float a = std::abs(factor);
     for (float& t : strands.thickness) t *= a;
     strands.defaults.thickness *= a;
+}
+
+double metersPerUnitFromName(const std::string& text, const std::string& what)
+{
+    if (text == "mm") return 0.001;
+    if (text == "cm") return 0.01;
+    if (text == "dm") return 0.1;
+    if (text == "m") return 1.0;
+    if (text == "in") return 0.0254;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
+        throw ValueError(what + " '" + text + "': expected mm, cm, dm, m, in or the unit's length in metres (0.01 for centimetres)");
+    }
+    return v;
+}
+
+void convertUnits(StrandSet& strands, double metersPerUnit)
+{
+    if (!(metersPerUnit > 0.0) || !std::isfinite(metersPerUnit)) {
+        throw ValueError("convertUnits: metersPerUnit " + std::to_string(metersPerUnit) + " must be a positive length in metres");
+    }
+    if (!(strands.metersPerUnit > 0.0)) {
+        throw ValueError("convertUnits: the strands declare no unit, so there is nothing to convert from; give their unit first "
+                         "(StrandSet::metersPerUnit)");
+    }
+    const double factor = strands.metersPerUnit / metersPerUnit;
+    if (factor != 1.0) scaleStrands(strands, float(factor));
+    strands.metersPerUnit = metersPerUnit;
 }
 
 } // namespace vdbhair

@@ -39,7 +39,7 @@ struct StrandSet
     std::vector<std::int32_t> strandId;  ///< #S or empty (ids of an upstream source)
     StrandDefaults defaults;
     /// The unit the source file declared (USD's `metersPerUnit`), 0 when it declared none: carried
-    /// so that a writer with a unit (USD) keeps it; nothing is ever scaled by it.
+    /// so that a writer with a unit (USD) keeps it; nothing is scaled by it except convertUnits().
     double metersPerUnit = 0.0;
     /// The up axis the source declared or the data was turned to: 'Y', 'Z', or 0 when unknown
     /// (USD's `upAxis`; `convert --up` makes it 'Y'); OBJ's header comment says it.
@@ -96,5 +96,14 @@ StrandSet selectStrands(const StrandSet& strands, const std::vector<char>& keep)
 
 /// @brief Scale every position by @a factor about the origin (thickness scales too).
 void scaleStrands(StrandSet& strands, float factor);
+
+/// @brief A unit's length in metres from its name: "mm", "cm", "dm", "m", "in", or a positive
+/// number of metres ("0.01"). Throws ValueError naming @a what (e.g. "--units") and the choices.
+double metersPerUnitFromName(const std::string& text, const std::string& what);
+
+/// @brief Express @a strands in the unit of @a metersPerUnit: positions and thickness scaled by
+/// their declared unit over it (StrandSet::metersPerUnit), which becomes @a metersPerUnit.
+/// Throws ValueError when the strands declare no unit (give it first: set metersPerUnit).
+void convertUnits(StrandSet& strands, double metersPerUnit);
 
 } // namespace vdbhair
