@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Install what vdbhair needs to build and test, from Debian's packages. Quiet and fast when
-# everything is already there (one dpkg query); uses sudo when not run as root.
+# Install what vdbhair needs to build, from Debian's packages; with --tests also what the tests
+# run (Blender, for the interop tests and the add-on's). Quiet and fast when everything is already
+# there (one dpkg query); uses sudo when not run as root.
 set -euo pipefail
 
 PACKAGES=(
@@ -10,6 +11,8 @@ PACKAGES=(
   libopenvdb-tools python3-openvdb python3-numpy fonts-dejavu-core
   pybind11-dev python3-pybind11 python3-dev python3-pytest
 )
+# Debian's Blender 3.4 runs the system Python, so it loads the vdbhair module the build makes.
+[ "${1:-}" = --tests ] && PACKAGES+=(blender)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

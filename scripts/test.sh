@@ -5,6 +5,7 @@
 # Arguments go to both ctest runs (e.g. -R TestRefine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+./scripts/setup.sh --tests
 ./scripts/build.sh -DVDBHAIR_CHECK_HEADERS=ON
 (cd build && ctest --output-on-failure -j 2 "$@")
 if [ "${VDBHAIR_SKIP_SANITIZERS:-0}" = 1 ]; then
