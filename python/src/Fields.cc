@@ -10,6 +10,7 @@
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbPoints.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 
 #include <openvdb/openvdb.h>
@@ -408,6 +409,45 @@ are shared, not copied: a Grid taken from a field sees the same voxels.)doc");
                                "The grid's metadata as a dict (vdbhair records the parameters that made it, e.g. vdbhair_voxel_size).");
     addArrayMethods(grid, [](const PyGrid& g) -> const openvdb::GridBase& { return *g.grid; }, "the grid");
     grid.def(
+        "point_attributes",
+        [](const PyGrid& g) {
+            std::vector<PointColumn> columns;
+            std::vector<std::string> skipped;
+            try {
+                pyb::gil_scoped_release release;
+                columns = pointColumns(*g.grid, &skipped);
+            } catch (const TypeError& e) {
+                throw TypeError(std::string("Grid.point_attributes: ") + e.what());
+            }
+            pyb::dict d;
+            for (const PointColumn& c : columns) {
+                const std::size_t n = c.values.size() / c.components;
+                std::vector<pyb::ssize_t> shape{pyb::ssize_t(n)};
+                if (c.components > 1) shape.push_back(pyb::ssize_t(c.components));
+                if (c.type == "group") {
+                    pyb::array_t<bool> a(shape);
+                    for (std::size_t i = 0; i < c.values.size(); ++i) a.mutable_data()[i] = c.values[i] != 0.0;
+                    d[pyb::str(c.name)] = a;
+                } else if (c.integer) {
+                    pyb::array_t<std::int64_t> a(shape);
+                    for (std::size_t i = 0; i < c.values.size(); ++i) a.mutable_data()[i] = std::int64_t(c.values[i]);
+                    d[pyb::str(c.name)] = a;
+                } else {
+                    pyb::array_t<double> a(shape);
+                    std::copy(c.values.begin(), c.values.end(), a.mutable_data());
+                    d[pyb::str(c.name)] = a;
+                }
+            }
+            return d;
+        },
+        R"doc(Every attribute of every point of a points grid, in the grid's own order (leaf by leaf, voxel
+by voxel: the order Houdini's Convert VDB Points gives), as a dict name -> NumPy array: ``P`` the
+world positions (N, 3) float64; integer attributes int64, real ones float64, vectors (N, 3); each
+point group as a bool array by its name. Attributes of other types (strings) are left out.
+
+Raises:
+    vdbhair.GridTypeError when the grid holds voxels, not points.)doc");
+    grid.def(
         "write",
         [](const PyGrid& g, const PathArg& path) {
             pyb::gil_scoped_release release;
@@ -491,7 +531,7 @@ Raises:
             return d;
         },
         pyb::arg("path"), "Every grid of a .vdb file as a dict name -> Grid, in file order (points grids included as Grids "
-                          "without array access; read strands with vdbhair.read).");
+                          "without array access: their points through Grid.point_attributes(); strands with vdbhair.read).");
     m.def(
         "write_grids",
         [](const PathArg& path, const std::vector<pyb::object>& items) {

@@ -1,0 +1,114 @@
+#include "VdbPoints.h"
+
+#include <vdbhair/Exceptions.h>
+
+#include <openvdb/points/AttributeArray.h>
+#include <openvdb/points/AttributeGroup.h>
+#include <openvdb/points/PointCount.h>
+#include <openvdb/points/PointDataGrid.h>
+
+#include <algorithm>
+#include <cstdint>
+
+namespace vdbhair {
+
+namespace {
+
+namespace pts = openvdb::points;
+
+/// Copy attribute @a index of every leaf into @a col (T scalar or a 3-vector of it).
+template<typename T>
+void copyColumn(const std::vector<const pts::PointDataTree::LeafNodeType*>& leaves, std::size_t index, PointColumn& col)
+{
+    std::size_t k = 0;
+    for (const auto* leaf : leaves) {
+        pts::AttributeHandle<T> h(leaf->constAttributeArray(index));
+        for (auto it = leaf->beginIndexOn(); it; ++it, ++k) {
+            const T v = h.get(*it);
+            if constexpr (openvdb::VecTraits<T>::IsVec) {
+                for (int c = 0; c < 3; ++c) col.values[3 * k + std::size_t(c)] = double(v[c]);
+            } else {
+                col.values[k] = double(v);
+            }
+        }
+    }
+}
+
+/// The copy for OpenVDB's type name @a type, or null when it is not a numeric type read here.
+using CopyFn = void (*)(const std::vector<const pts::PointDataTree::LeafNodeType*>&, std::size_t, PointColumn&);
+CopyFn copierFor(const std::string& type, std::size_t& components, bool& integer)
+{
+    struct Entry { const char* name; CopyFn fn; std::size_t components; bool integer; };
+    static const Entry kTypes[] = {
+        {"int16", &copyColumn<std::int16_t>, 1, true},   {"int32", &copyColumn<std::int32_t>, 1, true},
+        {"int64", &copyColumn<std::int64_t>, 1, true},   {"bool", &copyColumn<bool>, 1, true},
+        {"uint8", &copyColumn<std::uint8_t>, 1, true},   {"float", &copyColumn<float>, 1, false},
+        {"double", &copyColumn<double>, 1, false},       {"vec3s", &copyColumn<openvdb::Vec3f>, 3, false},
+        {"vec3d", &copyColumn<openvdb::Vec3d>, 3, false}, {"vec3i", &copyColumn<openvdb::Vec3i>, 3, true},
+    };
+    for (const Entry& e : kTypes) {
+        if (type == e.name) {
+            components = e.components;
+            integer = e.integer;
+            return e.fn;
+        }
+    }
+    return nullptr;
+}
+
+} // namespace
+
+std::vector<PointColumn> pointColumns(const openvdb::GridBase& base, std::vector<std::string>* skipped)
+{
+    const auto* points = dynamic_cast<const pts::PointDataGrid*>(&base);
+    if (!points) throw TypeError("grid '" + base.getName() + "' holds " + base.valueType() + " voxels, not points");
+    const pts::PointDataGrid& grid = *points;
+    std::vector<const pts::PointDataTree::LeafNodeType*> leaves;
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(&*leaf);
+    std::vector<PointColumn> out;
+    if (leaves.empty()) return out;
+    const std::size_t n = std::size_t(pts::pointCount(grid.tree()));
+    const pts::AttributeSet::Descriptor& desc = leaves.front()->attributeSet().descriptor();
+    const std::size_t iP = desc.find("P");
+    if (iP != pts::AttributeSet::INVALID_POS) {
+        PointColumn p{"P", desc.valueType(iP), 3, false, std::vector<double>(3 * n)};
+        std::size_t k = 0;
+        for (const auto* leaf : leaves) {
+            pts::AttributeHandle<openvdb::Vec3f> h(leaf->constAttributeArray(iP));
+            for (auto it = leaf->beginIndexOn(); it; ++it, ++k) {
+                const openvdb::Vec3d world = grid.transform().indexToWorld(it.getCoord().asVec3d() + h.get(*it));
+                for (int c = 0; c < 3; ++c) p.values[3 * k + std::size_t(c)] = world[c];
+            }
+        }
+        out.push_back(std::move(p));
+    }
+    // The other attributes in the descriptor's order (the group arrays hold the groups below).
+    std::vector<std::pair<std::size_t, std::string>> byPosition;
+    for (const auto& [name, index] : desc.map()) byPosition.emplace_back(index, name);
+    std::sort(byPosition.begin(), byPosition.end());
+    for (const auto& [index, name] : byPosition) {
+        if (index == iP || desc.type(index) == pts::GroupAttributeArray::attributeType()) continue;
+        PointColumn col{name, desc.valueType(index), 1, false, {}};
+        const CopyFn copy = copierFor(col.type, col.components, col.integer);
+        if (!copy) {
+            if (skipped) skipped->push_back(name + " (" + col.type + ")");
+            continue;
+        }
+        col.values.resize(n * col.components);
+        copy(leaves, index, col);
+        out.push_back(std::move(col));
+    }
+    for (const auto& [group, offset] : desc.groupMap()) {
+        (void)offset;
+        PointColumn col{group, "group", 1, true, std::vector<double>(n)};
+        std::size_t k = 0;
+        for (const auto* leaf : leaves) {
+            const pts::GroupHandle h = leaf->groupHandle(group);
+            for (auto it = leaf->beginIndexOn(); it; ++it, ++k) col.values[k] = h.get(*it) ? 1.0 : 0.0;
+        }
+        out.push_back(std::move(col));
+    }
+    return out;
+}
+
+} // namespace vdbhair
