@@ -14,6 +14,8 @@
 #             curveBasisAndType and width, with P's and nVertices' sizes equal to vdbhair's counts
 #   abcls -l -v  every point the reference library reads equals vdbhair's (to the 6 significant digits
 #             abcls prints), every curve count too, and the basis is kLinear
+#   .arbGeomParams (when INPUT has colours and thicknesses): Cd and groom_width per vertex, and
+#             every colour abcls reads equals vdbhair's
 # and that vdbhair reads its own .abc back to the same .hair bytes.
 set -eu
 ABC=${1:?usage: $0 ALEMBIC_BIN [VDBHAIR] [INPUT]}
@@ -77,3 +79,30 @@ assert basis[0] == 1 and basis[1] == 0, 'not linear, non-periodic: %s' % basis
 print('ok: abcls -v reads all %d points and %d curve counts as vdbhair wrote them (worst relative '
       'difference %.2g, within abcls\'s 6 printed digits)' % (len(P), len(n), worst))
 EOF
+
+# Colours and Unreal's groom attributes (.arbGeomParams), when INPUT has colours and thicknesses:
+# the reference library lists them with one value per vertex, and reads Cd as vdbhair wrote it.
+if grep -q "ArrayProperty name=Cd;" "$OUT/echo.txt"; then
+    grep -q "CompoundProperty name=.arbGeomParams" "$OUT/echo.txt"
+    grep -q "ArrayProperty name=Cd;interpretation=rgb;datatype=float32_t\[3\];arraysize=$vertices;numsamps=1" "$OUT/echo.txt"
+    grep -q "ArrayProperty name=groom_width;interpretation=;datatype=float32_t;arraysize=$vertices;numsamps=1" "$OUT/echo.txt"
+    "$ABC/abcls" -l -v "$OUT/a.abc/hair/.geom/.arbGeomParams" | sed 's/\x1b\[[0-9;]*m//g' > "$OUT/arb.txt"
+    python3 - "$OUT/arb.txt" "$OUT/a.hair" <<'PY'
+import struct, sys
+lines = open(sys.argv[1]).read().split('\n')
+start = next(i for i, l in enumerate(lines) if l.split() and l.split()[-1] == 'Cd[1]')
+cd = []
+for v in lines[start + 1:]:
+    if not v.strip() or 'Property' in v:
+        break
+    cd.append([float(x) for x in v.split(',')])
+# cyHair: the colour array is the last array of the file, 3 floats a vertex.
+data = open(sys.argv[2], 'rb').read()
+n = len(cd)
+hair = struct.unpack('<%df' % (3 * n), data[len(data) - 12 * n:])
+worst = max(abs(a - b) for i, c in enumerate(cd) for a, b in zip(c, hair[3 * i:3 * i + 3]))
+assert worst < 1e-5, 'a colour differs by %g' % worst
+print('ok: abcecho lists .arbGeomParams Cd and groom_width per vertex; abcls reads all %d colours as vdbhair wrote them '
+      '(worst difference %.2g)' % (n, worst))
+PY
+fi

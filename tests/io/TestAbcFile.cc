@@ -169,10 +169,12 @@ TEST_CASE("murmur3x64_128: the digests the reference Alembic library stored", "[
     REQUIRE(std::string(hex) == "2b062640406f998d7f6e446a12199c6c");
 }
 
-TEST_CASE("writeAbc/readAbc: positions, widths and root UVs round-trip exactly", "[io][abc]")
+TEST_CASE("writeAbc/readAbc: positions, widths, colours, root UVs and ids round-trip exactly", "[io][abc]")
 {
     StrandSet s = test::sampleStrands(true);
+    REQUIRE(!s.color.empty());
     for (std::size_t i = 0; i < s.numStrands(); ++i) s.rootUV.emplace_back(0.25f * float(i), 1.f - 0.125f * float(i));
+    for (std::size_t i = 0; i < s.numStrands(); ++i) s.strandId.push_back(std::int32_t(100 + 7 * i));
     const std::string path = test::tempPath("rt.abc");
     writeAbc(path, s);
     ReadReport report;
@@ -181,7 +183,13 @@ TEST_CASE("writeAbc/readAbc: positions, widths and root UVs round-trip exactly",
     REQUIRE(r.positions == s.positions);
     REQUIRE(r.thickness == s.thickness);
     REQUIRE(r.rootUV == s.rootUV);
+    REQUIRE(r.color == s.color);        // .arbGeomParams/Cd
+    REQUIRE(r.strandId == s.strandId);  // .arbGeomParams/groom_id
     REQUIRE(report.warnings.empty());
+    // Unreal's groom attributes are written beside width and uv.
+    const std::string bytes = test::readBytes(path);
+    REQUIRE(bytes.find("groom_root_uv") != std::string::npos);
+    REQUIRE(bytes.find("groom_width") != std::string::npos);
     // Through the format table too, and the same bytes every time (no date, no pointers).
     writeStrands(test::tempPath("rt2.abc"), s);
     REQUIRE(test::readBytes(test::tempPath("rt2.abc")) == test::readBytes(path));
@@ -264,11 +272,12 @@ TEST_CASE("writeAbc: the layout of the reference library's Curves", "[io][abc]")
     const auto hair = r.group(r.childGroup(top, 1, "hair"), "hair");
     const auto props = r.group(r.childGroup(hair, 0, "props"), "props");
     const auto geom = r.group(r.childGroup(props, 0, ".geom"), ".geom");
-    REQUIRE(geom.children.size() == 5 + 1);  // .selfBnds P nVertices curveBasisAndType width, headers
-    const auto h = r.childData(geom, 5, "geom headers");
+    // .selfBnds P nVertices curveBasisAndType width .arbGeomParams (Cd, groom_width), headers
+    REQUIRE(geom.children.size() == 6 + 1);
+    const auto h = r.childData(geom, 6, "geom headers");
     const std::string text(h.bytes, h.size);
     std::size_t at = 0;
-    for (const char* name : {".selfBnds", "P", "nVertices", "curveBasisAndType", "width"}) {
+    for (const char* name : {".selfBnds", "P", "nVertices", "curveBasisAndType", "width", ".arbGeomParams"}) {
         const std::size_t found = text.find(name, at);
         CAPTURE(name);
         REQUIRE(found != std::string::npos);

@@ -121,6 +121,9 @@ private:
     /// Sample 0 of an array property: its bytes, checked to be whole elements of pod x extent.
     ogawa::Reader::Data arraySample(const ogawa::Reader::Group& compound, const PropertyIn& p,
                                     const std::string& what, std::uint64_t& count);
+    struct ArbParams;
+    ArbParams readArbGeomParams(const ogawa::Reader::Group& geom, const PropertyIn& arb, const std::string& what,
+                                std::uint64_t numPoints, std::uint64_t numCurves);
     std::vector<float> floatParam(const ogawa::Reader::Group& compound, const PropertyIn& p,
                                   unsigned extent, const std::string& what, std::string& scope);
     void warn(const std::string& msg)
@@ -403,6 +406,51 @@ Matrix AbcReader::readXform(const ogawa::Reader::Group& object, const std::strin
     return m;
 }
 
+/// What readCurves() takes from `.arbGeomParams`: Cd (colour; per control point, or one value
+/// for the curve or the object), Unreal's groom_root_uv and groom_id (per curve) and groom_width
+/// (per control point; used where `width` is absent).
+struct AbcReader::ArbParams
+{
+    std::vector<float> cd, rootUV, groomWidth;
+    std::string cdScope;
+    std::vector<std::int32_t> ids;
+};
+
+AbcReader::ArbParams AbcReader::readArbGeomParams(const ogawa::Reader::Group& geom, const PropertyIn& arb, const std::string& what,
+                                                  std::uint64_t numPoints, std::uint64_t numCurves)
+{
+    ArbParams out;
+    const std::string here = what + "/.geom/.arbGeomParams";
+    const std::uint64_t pos = mOgawa.childGroup(geom, arb.child, here);
+    enterGroup(pos, here);
+    const ogawa::Reader::Group g = mOgawa.group(pos, here);
+    std::string scope;
+    for (const PropertyIn& p : readPropertyHeaders(g, here)) {
+        if (p.name == "Cd" && p.pod == kFloat32 && p.extent == 3) {
+            out.cd = floatParam(g, p, 3, here + "/Cd", out.cdScope);
+            const std::uint64_t need = out.cdScope == "con" ? 1 : out.cdScope == "uni" ? numCurves : numPoints;
+            if (out.cd.size() != 3 * need) {
+                warn(here + "/Cd has " + std::to_string(out.cd.size() / 3) + " values but scope '" + out.cdScope + "' needs " + std::to_string(need) + "; ignored");
+                out.cd.clear();
+            }
+        } else if (p.name == "groom_root_uv" && p.pod == kFloat32 && p.extent == 2) {
+            out.rootUV = floatParam(g, p, 2, here + "/groom_root_uv", scope);
+            if (out.rootUV.size() != 2 * numCurves) out.rootUV.clear();
+        } else if (p.name == "groom_width" && p.pod == kFloat32 && p.extent == 1) {
+            out.groomWidth = floatParam(g, p, 1, here + "/groom_width", scope);
+            if (out.groomWidth.size() != numPoints) out.groomWidth.clear();
+        } else if (p.name == "groom_id" && p.type == kArray && p.pod == kInt32 && p.extent == 1) {
+            std::uint64_t n = 0;
+            const ogawa::Reader::Data d = arraySample(g, p, here + "/groom_id", n);
+            if (n == numCurves) {
+                out.ids.resize(std::size_t(n));
+                if (n) std::memcpy(out.ids.data(), d.bytes, std::size_t(4 * n));
+            }
+        }
+    }
+    return out;
+}
+
 void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out)
 {
     const std::string what = name;
@@ -513,6 +561,10 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
     std::string widthScope, uvScope;
     if (const PropertyIn* pW = find("width")) widths = floatParam(geom, *pW, 1, what + "/width", widthScope);
     if (const PropertyIn* pU = find("uv")) uvs = floatParam(geom, *pU, 2, what + "/uv", uvScope);
+    ArbParams arb;
+    if (const PropertyIn* pA = find(".arbGeomParams"); pA && pA->type == kCompound) arb = readArbGeomParams(geom, *pA, what, numPoints, numCurves);
+    if (widths.empty() && !arb.groomWidth.empty()) { widths = std::move(arb.groomWidth); widthScope = "vtx"; }
+    if (uvs.empty() && !arb.rootUV.empty()) { uvs = std::move(arb.rootUV); uvScope = "uni"; }
     if (world != kIdentity) {  // widths scale with the transform, as the points do
         const float scale = float(lengthScale(world));
         for (float& w : widths) w *= scale;
@@ -540,6 +592,9 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
     std::vector<Vec3f> poly;
     std::vector<float> polyWidth, keptWidths;
     std::vector<Vec2f> keptUV;
+    std::vector<Vec3f> polyColor, keptColor;
+    std::vector<std::int32_t> keptIds;
+    const bool perVertexColor = !arb.cd.empty() && arb.cdScope != "con";
     std::uint64_t first = 0, firstVarying = 0;
     for (std::uint64_t i = 0; i < numCurves; ++i) {
         const std::uint32_t n = counts[i];
@@ -553,12 +608,22 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
             }
             return widths[first + std::min<std::size_t>(k, n - 1)];
         };
+        auto colorOf = [&](std::size_t k) {  // control k
+            const std::size_t at = arb.cdScope == "uni" ? std::size_t(i) : std::size_t(first) + std::min<std::size_t>(k, n - 1);
+            return Vec3f(arb.cd[3 * at], arb.cd[3 * at + 1], arb.cd[3 * at + 2]);
+        };
         poly.clear();
         polyWidth.clear();
+        polyColor.clear();
         if (linear) {
             poly.assign(cp, cp + n);
             for (std::uint32_t k = 0; k < n; ++k) polyWidth.push_back(widths.empty() ? 0.f : widthOf(k, n));
-            if (wrap == 1 && n >= 2) { poly.push_back(cp[0]); polyWidth.push_back(polyWidth.front()); }
+            if (perVertexColor) for (std::uint32_t k = 0; k < n; ++k) polyColor.push_back(colorOf(k));
+            if (wrap == 1 && n >= 2) {
+                poly.push_back(cp[0]);
+                polyWidth.push_back(polyWidth.front());
+                if (perVertexColor) polyColor.push_back(polyColor.front());
+            }
         } else if (n >= 4) {
             const FreeFormCurve curve = cubicCurve(cubicBasis(basis), curveWrap(wrap), cp, n);
             const std::string rule = flattenCurve(curve, mOpts.curveSamples, poly);
@@ -569,6 +634,10 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
                     polyWidth.push_back((1.f - at.f) * widthOf(at.i0, n) + at.f * widthOf(at.i1, n));
                 }
             }
+            for (std::size_t k = 0; perVertexColor && k < poly.size(); ++k) {
+                const CurvePosition at = positionAlong(k, poly.size(), n);
+                polyColor.push_back((1.f - at.f) * colorOf(at.i0) + at.f * colorOf(at.i1));
+            }
         }
         firstVarying += varyingCount(n, linear, basis, wrap);
         first += n;
@@ -576,8 +645,13 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
         set.addStrand(poly);
         if (perVertexWidth) keptWidths.insert(keptWidths.end(), polyWidth.begin(), polyWidth.end());
         if (uvPerCurve) keptUV.emplace_back(uvs[2 * i], uvs[2 * i + 1]);
+        if (perVertexColor) keptColor.insert(keptColor.end(), polyColor.begin(), polyColor.end());
+        if (!arb.ids.empty()) keptIds.push_back(arb.ids[i]);
     }
     filter.finish();
+    if (!arb.cd.empty() && !perVertexColor) set.defaults.color = Vec3f(arb.cd[0], arb.cd[1], arb.cd[2]);
+    if (perVertexColor) set.color = std::move(keptColor);
+    if (!arb.ids.empty()) set.strandId = std::move(keptIds);
     if (widths.size() == 1) set.defaults.thickness = widths[0];
     if (perVertexWidth) set.thickness = std::move(keptWidths);
     if (uvPerCurve) set.rootUV = std::move(keptUV);

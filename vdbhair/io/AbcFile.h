@@ -22,9 +22,15 @@
 ///       width              float32 array, arrayExtent=1;geoScope=vtx (per vertex) or geoScope=con
 ///                          (one value: the default thickness);isGeomParam=true;podExtent=1;
 ///                          podName=float32_t
+///       .arbGeomParams     compound, when the set has any of these (geometry parameters as
+///                          AbcGeom writes them):
+///         Cd               float32[3] array, geoScope=vtx;interpretation=rgb (the colours)
+///         groom_root_uv    float32[2] array, geoScope=uni (the root UVs, again: Unreal's name)
+///         groom_id         int32 array, geoScope=uni (StrandSet::strandId)
+///         groom_width      float32 array, geoScope=vtx (the thickness, again: Unreal's name)
 /// ```
 ///
-/// Widths are vdbhair's thickness (a diameter in world units, as Alembic's and USD's widths).
+/// The groom_* attributes follow Unreal's "Alembic for Grooms" specification. Widths are vdbhair's thickness (a diameter in world units, as Alembic's and USD's widths).
 ///
 /// Reading takes every object whose schema is `AbcGeom_Curve_v*`, in hierarchy order (depth
 /// first, children in file order), concatenated. Linear curves are read as they are (periodic ones
@@ -32,10 +38,12 @@
 /// evaluated into polylines by FreeFormCurve.h (ReadOptions::curveSamples points per curve, or its
 /// adaptive 1 % rule when 0), with per-vertex widths interpolated along the polyline. Widths of
 /// any scope (constant, uniform, varying, vertex), indexed or not, and a uniform or indexed root
-/// `uv` are read. Animated properties are read at their first sample, with a warning; the
+/// `uv` are read; from `.arbGeomParams`, `Cd` (per vertex, interpolated along cubic curves, per
+/// curve, or one colour), `groom_id`, and `groom_width` and `groom_root_uv` where `width` and `uv`
+/// are absent. Animated properties are read at their first sample, with a warning; the
 /// transforms of parent Xform objects are applied to the points (their `.ops` and `.vals`
-/// composed as AbcGeom's XformSample::getMatrix does, `.inherits` honoured; widths are not
-/// scaled); NURBS (`kVariableOrder`) curves other
+/// composed as AbcGeom's XformSample::getMatrix does, `.inherits` honoured; widths scale with
+/// them); NURBS (`kVariableOrder`) curves other
 /// than order 2, Hermite and power bases are refused (UnsupportedError).
 ///
 /// Every offset and count in the file is checked against the file size before it is used, and

@@ -118,11 +118,11 @@ void writeAbc(const std::string& path, const StrandSet& strands)
     const std::uint8_t basisAndType[4] = {1, 0, 0, 0};  // kLinear, kNonPeriodic, kNoBasis, kNoBasis
     const float constantWidth = strands.defaults.thickness;
 
-    std::vector<PropertyOut> props;
+    std::vector<PropertyOut> props, arbProps;
     std::vector<Sample> samples;  // kept alive until write: the digests are borrowed
-    samples.reserve(6);
-    auto arrayProperty = [&](const char* name, const char* md, unsigned pod, unsigned extent,
-                             const void* data, std::uint64_t bytes, std::uint64_t count) {
+    samples.reserve(10);
+    auto arrayPropertyIn = [&](std::vector<PropertyOut>& to, const char* name, const std::string& md, unsigned pod, unsigned extent,
+                               const void* data, std::uint64_t bytes, std::uint64_t count) {
         samples.push_back(makeSample(data, bytes));
         const Sample& s = samples.back();
         PropertyOut p{name, md, kArray, pod, extent, count == 1, {}};
@@ -130,7 +130,14 @@ void writeAbc(const std::string& path, const StrandSet& strands)
         const auto data0 = w.addData(ogawa::Writer::Pieces{{s.digest, 16}, {s.data, s.size}});
         const auto dims = w.addData(ogawa::Writer::Pieces{});
         p.group = w.addGroup({data0, dims});
-        props.push_back(std::move(p));
+        to.push_back(std::move(p));
+    };
+    auto arrayProperty = [&](const char* name, const std::string& md, unsigned pod, unsigned extent, const void* data, std::uint64_t bytes,
+                             std::uint64_t count) { arrayPropertyIn(props, name, md, pod, extent, data, bytes, count); };
+    // A geometry parameter's metadata, as AbcGeom's OTypedGeomParam writes it.
+    auto geomParam = [](const char* scope, const char* interpretation, unsigned extent, const char* podName) {
+        return std::string("arrayExtent=1;geoScope=") + scope + (*interpretation ? std::string(";interpretation=") + interpretation : std::string()) +
+               ";isGeomParam=true;podExtent=" + std::to_string(extent) + ";podName=" + podName;
     };
     auto scalarProperty = [&](const char* name, const char* md, unsigned pod, unsigned extent,
                               const void* data, std::uint64_t bytes) {
@@ -156,6 +163,25 @@ void writeAbc(const std::string& path, const StrandSet& strands)
         arrayProperty("width", "arrayExtent=1;geoScope=con;isGeomParam=true;podExtent=1;podName=float32_t", kFloat32, 1,
                       &constantWidth, 4, 1);
     }
+    // .arbGeomParams: colour as Cd (Houdini's, Maya's and Blender's name) and Unreal's groom
+    // attributes (its "Alembic for Grooms" specification): groom_root_uv and groom_id per curve,
+    // groom_width per vertex.
+    if (!strands.color.empty()) {
+        arrayPropertyIn(arbProps, "Cd", geomParam("vtx", "rgb", 3, "float32_t"), kFloat32, 3, strands.color.data(),
+                        12 * std::uint64_t(strands.color.size()), strands.color.size());
+    }
+    if (!strands.rootUV.empty()) {
+        arrayPropertyIn(arbProps, "groom_root_uv", geomParam("uni", "vector", 2, "float32_t"), kFloat32, 2, strands.rootUV.data(),
+                        8 * std::uint64_t(strands.rootUV.size()), strands.rootUV.size());
+    }
+    if (!strands.strandId.empty()) {
+        arrayPropertyIn(arbProps, "groom_id", geomParam("uni", "", 1, "int32_t"), kInt32, 1, strands.strandId.data(),
+                        4 * std::uint64_t(strands.strandId.size()), strands.strandId.size());
+    }
+    if (!strands.thickness.empty()) {
+        arrayPropertyIn(arbProps, "groom_width", geomParam("vtx", "", 1, "float32_t"), kFloat32, 1, strands.thickness.data(),
+                        4 * std::uint64_t(strands.thickness.size()), strands.thickness.size());
+    }
 
     // Header blocks: properties of .geom, the object's compound, the objects.
     const std::string curvesSchema = "schema=AbcGeom_Curve_v2;schemaBaseType=AbcGeom_GeomBase_v1";
@@ -168,6 +194,12 @@ void writeAbc(const std::string& path, const StrandSet& strands)
     // readers only compare them, so any content hash keeps their meaning: equal content, equal hash).
     auto contentHash = [](const std::string& bytes, std::uint64_t out[2]) { ogawa::murmur3x64_128(bytes.data(), bytes.size(), out); };
 
+    if (!arbProps.empty()) {
+        std::vector<ogawa::Writer::Node> arbChildren;
+        for (const PropertyOut& p : arbProps) arbChildren.push_back(p.group);
+        arbChildren.push_back(w.addData(headers(arbProps)));
+        props.push_back(PropertyOut{".arbGeomParams", "", kCompound, 0, 0, false, w.addGroup(arbChildren)});
+    }
     std::vector<ogawa::Writer::Node> geomChildren;
     for (const PropertyOut& p : props) geomChildren.push_back(p.group);
     const std::string geomHeaders = headers(props);
