@@ -3,6 +3,8 @@
 // detail transfer, vector-field refinement per level).
 #include "../Command.h"
 
+#include <vdbhair/synth/StyleRegions.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/RefineReport.h>
@@ -249,6 +251,12 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     StrandSet movedBack;
     if (outputMap) movedBack = moveToScalp(r.strands, *outputMap, *r.map, -p.synth.outputTurn);
     const nlohmann::json stats = statsJson(example, r, outputMap ? movedBack : r.strands, finestVoxel, checks);
+    // The style region by region, output beside example, in the example's head frame (on another
+    // head, the output moved back; the head then is not the example's, so no inside-head figure).
+    std::string regionText;
+    const ScalpSphere& sphere = r.map->sphere();
+    const nlohmann::json regions = compareStyleRegions(example, outputMap ? movedBack : r.strands, sphere.center, sphere.up, sphere.radius,
+                                                       outputMap || r.head == "none" ? nullptr : &p.synth.head, &regionText);
     HairComparison comparison;
     if (p.measure) {
         const Stage stage(common, "comparing with the example");
@@ -275,7 +283,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
                    {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
                              {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
                                            {"example", outputMap ? nlohmann::json(nullptr) : nlohmann::json(double(r.exampleEnteringHead) / double(example.numStrands()))}}}}},
-                   {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks},
+                   {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}, {"regions", regions},
                    {"compare", p.measure ? toJson(comparison) : nlohmann::json(nullptr)}});
     } else if (!common.quiet) {
         std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
@@ -295,6 +303,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
             }
             std::cout << "\n";
         }
+        std::cout << "  by region, output (example):\n" << regionText;
         if (p.measure) std::cout << "  compared with the example (vdbhair compare): " << summaryLine(comparison) << "\n";
         std::cout << "wrote " << p.output << "\n";
     }

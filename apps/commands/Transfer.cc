@@ -2,6 +2,9 @@
 // al. 2009, §6), and `synth EXAMPLE --coarse BASE`, which is the same operation.
 #include "../Command.h"
 
+#include <vdbhair/Quantile.h>
+#include <vdbhair/synth/StyleRegions.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/io/StrandIO.h>
@@ -23,13 +26,6 @@ double mean(const std::vector<double>& v)
     double s = 0.0;
     for (double x : v) s += x;
     return v.empty() ? 0.0 : s / double(v.size());
-}
-
-double percentile(std::vector<double> v, double q)
-{
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v[std::min(v.size() - 1, std::size_t(q * double(v.size() - 1) + 0.5))];
 }
 
 struct TransferCmdParams
@@ -89,6 +85,11 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
     const double rd = tr.detailsMap->radius(), rb = r.map->radius();
     const nlohmann::json checks = {{"detail", std::abs(turnOut * rb - turnDetails * rd) <= 0.1 * turnDetails * rd},
                                    {"coarse_shape", mean(dev) <= 0.1}};
+    // BASE's regions kept: the output against BASE, region by region, in BASE's head frame.
+    std::string regionText;
+    const ScalpSphere& sphere = r.map->sphere();
+    const nlohmann::json regions =
+        compareStyleRegions(base, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &params.synth.head, &regionText);
     HairComparison comparison;
     if (job.measure) {
         const Stage stage(common, "comparing with the base");
@@ -111,11 +112,11 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                    {"turning_per_length", {{"details", turnDetails}, {"base", turnBase}, {"output", turnOut}, {"spacing_head_radii", spacing}}},
                    {"output_vertices", tr.outputVertices}, {"details_smoothing", tr.detailsSmoothing},
                    {"turning_per_head_radius", {{"details", turnDetails * rd}, {"base", turnBase * rb}, {"output", turnOut * rb}}},
-                   {"coarse_deviation", {{"mean", mean(dev)}, {"p90", percentile(dev, 0.9)}, {"clusters", dev.size()}}},
+                   {"coarse_deviation", {{"mean", mean(dev)}, {"p90", quantile(dev, 0.9)}, {"clusters", dev.size()}}},
                    {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
                              {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
                                            {"base", double(r.exampleEnteringHead) / double(base.numStrands())}}}}},
-                   {"stages", stages}, {"seconds", seconds}, {"checks", checks},
+                   {"stages", stages}, {"seconds", seconds}, {"checks", checks}, {"regions", regions},
                    {"compare", job.measure ? toJson(comparison) : nlohmann::json(nullptr)}});
     } else if (!common.quiet) {
         std::cout << "transferred the detail of " << job.details << " (" << details.numStrands() << " strands) onto "
@@ -129,6 +130,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                           100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())), 100.0 * double(r.exampleEnteringHead) / double(base.numStrands()));
             std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares << "\n";
         }
+        std::cout << "  by region, output (base):\n" << regionText;
         if (job.measure) std::cout << "  compared with " << job.base << " (vdbhair compare): " << summaryLine(comparison) << "\n";
         std::cout << "wrote " << job.output << "\n";
     }

@@ -18,6 +18,7 @@
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/synth/Comb.h>
 #include <vdbhair/synth/HairTransfer.h>
+#include <vdbhair/synth/StyleRegions.h>
 #include <vdbhair/synth/Synthesis.h>
 
 #include <nlohmann/json.hpp>
@@ -228,10 +229,20 @@ Returns:
                 });
                 comparison = toPython(toJson(c));
             }
+            pyb::object regions = pyb::none();  // as synth --json's "regions"
+            if (returnReport) {
+                const ScalpSphere& sphere = r.map->sphere();
+                regions = toPython(runLong(threads, pyb::none(), [&](WorkInterrupter*) {
+                    return other ? compareStyleRegions(*example, moveToScalp(r.strands, *other, *r.map, -p.outputTurn), sphere.center, sphere.up,
+                                                       sphere.radius, nullptr)
+                                 : compareStyleRegions(*example, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &p.head);
+                }));
+            }
             auto out = std::make_shared<StrandSet>(std::move(r.strands));
             if (!returnReport) return pyb::cast(out);
             pyb::dict report;
             report["compare"] = comparison;
+            report["regions"] = regions;
             pyb::list levelsList, stages, clusters;
             for (std::size_t l = 0; l < r.output.size(); ++l) {
                 pyb::dict d;
@@ -301,7 +312,8 @@ Args:
     measure: with return_report, the report's "compare" holds the output against the example, as
         ``vdbhair.compare(example, output)`` (on output_scalp, the output moved back onto the example's scalp).
     return_report: also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up, output_area,
-        head: the head new hair is kept out of, the strands pushed out, the output's and the example's strands passing into it).
+        head: the head new hair is kept out of, the strands pushed out, the output's and the example's strands passing into it,
+        regions: the style region by region, output beside example, as synth --json's "regions", StyleRegions.h).
     threads: worker threads, 0 for all cores.
     progress: optional callable ``progress(stage, done, total, unit)``.
 
@@ -344,10 +356,19 @@ Returns:
             pyb::object comparison = pyb::none();  // as transfer --measure --json's "compare"
             if (measure && returnReport)
                 comparison = toPython(toJson(runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureAgainst(*base, r.result.strands); })));
+            pyb::object regions = pyb::none();  // as transfer --json's "regions"
+            if (returnReport) {
+                const ScalpSphere& sphere = r.result.map->sphere();
+                regions = toPython(runLong(threads, pyb::none(), [&](WorkInterrupter*) {
+                    return compareStyleRegions(*base, r.result.strands, sphere.center, sphere.up, sphere.radius,
+                                               r.result.head == "none" ? nullptr : &p.synth.head);
+                }));
+            }
             auto out = std::make_shared<StrandSet>(std::move(r.result.strands));
             if (!returnReport) return pyb::cast(out);
             pyb::dict report;
             report["compare"] = comparison;
+            report["regions"] = regions;
             pyb::list clusters;
             for (const std::vector<std::int32_t>& c : r.result.clusterOf)
                 clusters.append(pyb::array_t<std::int32_t>(pyb::ssize_t(c.size()), c.data()));
@@ -384,7 +405,7 @@ Args:
     match_candidates: as synth's, 64 here (the two hairstyles' wisps differ more).
     measure: with return_report, the report's "compare" holds the output against the base, as
         ``vdbhair.compare(base, output)``.
-    Other options as synth.
+    Other options as synth. The report's "regions" set the output beside the base, region by region.
 
 Returns:
     Strands, or (Strands, report) with return_report.)doc");

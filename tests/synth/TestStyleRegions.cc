@@ -1,0 +1,107 @@
+#include "../TestUtil.h"
+
+#include <vdbhair/Quantile.h>
+#include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/synth/StyleRegions.h>
+
+#include <cmath>
+
+using namespace vdbhair;
+
+namespace {
+
+/// A root on the unit sphere at @a elevation above the horizon and @a azimuth from +Z towards +X (degrees).
+Vec3d rootAt(double elevationDeg, double azimuthDeg)
+{
+    const double e = elevationDeg * M_PI / 180.0, a = azimuthDeg * M_PI / 180.0;
+    return Vec3d(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
+}
+
+void addLine(StrandSet& s, const Vec3d& root, const Vec3d& direction, double length, int vertices = 33)
+{
+    std::vector<Vec3f> pts;
+    for (int k = 0; k < vertices; ++k) pts.emplace_back(root + direction * (length * double(k) / double(vertices - 1)));
+    s.addStrand(pts);
+}
+
+} // namespace
+
+TEST_CASE("quantile: linear between order statistics, as NumPy's default", "[core]")
+{
+    REQUIRE(quantile({}, 0.5) == 0.0);
+    REQUIRE(quantile({5.0}, 0.9) == 5.0);
+    REQUIRE(quantile({5.0, 1.0, 4.0, 2.0, 3.0}, 0.25) == 2.0);
+    REQUIRE(quantile({5.0, 1.0, 4.0, 2.0, 3.0}, 0.5) == 3.0);
+    REQUIRE(quantile({1.0, 2.0, 3.0, 4.0}, 0.5) == Approx(2.5));   // numpy.quantile([1,2,3,4], .5)
+    REQUIRE(quantile({1.0, 2.0, 3.0, 4.0}, 0.9) == Approx(3.7));   // numpy.quantile([1,2,3,4], .9)
+    REQUIRE(quantile({3.0, 1.0, 2.0}, 1.0) == 3.0);
+}
+
+TEST_CASE("measureStyleRegions: regions, front, lengths, lift, turning, curl and the head on a sphere", "[synth][regions]")
+{
+    StrandSet s;
+    // Crown: 4 strands straight up from 70 degrees (they lift), length 0.5.
+    for (int i = 0; i < 4; ++i) addLine(s, rootAt(70.0, 90.0 * i), Vec3d(0, 1, 0), 0.5);
+    // The hairline below the crown, highest at the forehead (+Z) and lowest at the nape: short
+    // strands rooted at 15 + 20 cos(azimuth) degrees, two in each region.
+    for (int a : {30, 330, 75, 285, 150, 210}) addLine(s, rootAt(15.0 + 20.0 * std::cos(a * M_PI / 180.0), double(a)), Vec3d(0, -1, 0), 0.1);
+    // Fringe: 2 strands from the forehead, hanging down, lengths 0.2 and 0.4.
+    addLine(s, rootAt(35.0, -10.0), Vec3d(0, -1, 0), 0.2);
+    addLine(s, rootAt(35.0, 10.0), Vec3d(0, -1, 0), 0.4);
+    // Back: 5 strands hanging from behind (-Z), lengths 1..5: p25/p50/p75 = 2, 3, 4.
+    for (int i = 0; i < 5; ++i) addLine(s, rootAt(10.0, 180.0 + 10.0 * (i - 2)), Vec3d(0, -1, 0), double(i + 1));
+    // Sides: 2 strands, one of them waving across its length with amplitude A (8 waves) and one
+    // going straight into the head through its centre (half its vertices inside).
+    const double A = 0.005;  // gentle (slopes under 0.25): sampling by arc length barely weights the crossings
+    {
+        const Vec3d root = rootAt(0.0, 90.0);
+        std::vector<Vec3f> pts;
+        for (int k = 0; k < 257; ++k) {
+            const double t = double(k) / 256.0;
+            pts.emplace_back(root + Vec3d(0.0, -t, A * std::sin(2.0 * M_PI * 8.0 * t)));
+        }
+        s.addStrand(pts);
+    }
+    addLine(s, rootAt(0.0, -90.0), Vec3d(1, 0, 0), 1.0, 101);
+
+    const RegionFrame frame = regionFrameFromRoots(s, Vec3d(0.0), Vec3d(0, 1, 0), 1.0);
+    REQUIRE(frame.front.z() > 0.99);  // where the hairline is highest (within the 15-degree sectors)
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    const StyleRegions r = measureStyleRegions(s, frame, &head);
+    const auto& crown = r.regions[int(StyleRegion::Crown)];
+    const auto& fringe = r.regions[int(StyleRegion::Fringe)];
+    const auto& back = r.regions[int(StyleRegion::Back)];
+    const auto& sides = r.regions[int(StyleRegion::Sides)];
+    REQUIRE(crown.strands == 4);
+    REQUIRE(fringe.strands == 2 + 2);
+    REQUIRE(back.strands == 5 + 2);
+    REQUIRE(sides.strands == 2 + 2);
+    REQUIRE(crown.share == Approx(4.0 / 19.0));
+    REQUIRE(crown.lift == 1.0);
+    REQUIRE(back.lift == 0.0);
+    REQUIRE(fringe.lift == 0.0);
+    // Back lengths 0.1, 0.1, 1, 2, 3, 4, 5: quartiles at positions 1.5, 3, 4.5 of the sorted seven.
+    REQUIRE(back.lengthP25 == Approx(0.55));
+    REQUIRE(back.lengthP50 == Approx(2.0));
+    REQUIRE(back.lengthP75 == Approx(3.5));
+    REQUIRE(fringe.lengthP50 == Approx(0.15));  // 0.1, 0.1, 0.2, 0.4
+    REQUIRE(crown.turning == Approx(0.0).margin(1e-6));
+    REQUIRE(crown.curlAmplitude == Approx(0.0).margin(1e-9));
+    // The waving strand's amplitude: its RMS offset A / sqrt(2), over the four side strands (the
+    // others are straight); the waves are far shorter than the smoothing, so it keeps all of it.
+    REQUIRE(sides.curlAmplitude == Approx(A / std::sqrt(2.0) / 4.0).epsilon(0.03));
+    REQUIRE(sides.turning > 1.0);
+    // Inside the head: all but the root of the strand going through the centre, and of the two
+    // hairline strands hanging straight down from above the equator (32 each); the crown's point up.
+    REQUIRE(sides.insideHead == Approx((100.0 + 2 * 32.0) / (257.0 + 101.0 + 2 * 33.0)));
+    REQUIRE(crown.insideHead == 0.0);
+    // Without a head, no figure; the report sets example and output side by side.
+    const StyleRegions noHead = measureStyleRegions(s, frame, nullptr, /*threaded=*/false);
+    REQUIRE(noHead.regions[0].insideHead == -1.0);
+    REQUIRE(noHead.regions[int(StyleRegion::Back)].lengthP50 == r.regions[int(StyleRegion::Back)].lengthP50);
+    const nlohmann::json j = toJson(r, noHead);
+    REQUIRE(j["crown"]["lift"]["example"] == 1.0);
+    REQUIRE(j["sides"]["inside_head"]["output"].is_null());
+    REQUIRE(j["back"]["strands"]["output"] == 7);
+    REQUIRE(summaryLines(r, noHead).find("fringe") != std::string::npos);
+}

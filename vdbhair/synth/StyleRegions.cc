@@ -1,0 +1,267 @@
+#include "StyleRegions.h"
+
+#include <vdbhair/Parallel.h>
+#include <vdbhair/Quantile.h>
+#include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/strands/Resample.h>
+
+#include <openvdb/math/Mat3.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <vector>
+
+namespace vdbhair {
+
+namespace {
+
+constexpr double kCrownElevationDeg = 50.0;
+constexpr double kFringeAngleDeg = 60.0, kBackAngleDeg = 120.0;
+constexpr double kLiftHeight = 0.1;     ///< head radii above the root
+constexpr int kCurlVertices = 64;
+constexpr double kCurlSigma = 6.0;      ///< vertices of kCurlVertices
+
+/// Per strand: length, lift, turning per length, curl amplitude (head radii), vertices inside.
+struct StrandFigures
+{
+    double length = 0.0, turning = 0.0, curl = 0.0;
+    bool lifts = false;
+    std::size_t inside = 0;
+};
+
+StrandFigures strandFigures(const StrandSet& s, std::size_t i, const RegionFrame& f, HeadObstacle::Probe* head, double tolerance,
+                            std::vector<Vec3d>& pts, std::vector<Vec3d>& smooth)
+{
+    StrandFigures out;
+    const std::size_t b = s.offsets[i], e = s.offsets[i + 1];
+    const Vec3d root(s.positions[b]);
+    double highest = 0.0, length = 0.0, turning = 0.0;
+    for (std::size_t k = b; k < e; ++k) {
+        const Vec3d p(s.positions[k]);
+        highest = std::max(highest, (p - root).dot(f.up));
+        if (head && head->distance(p) < -tolerance) ++out.inside;
+        if (k + 1 < e) length += (Vec3d(s.positions[k + 1]) - p).length();
+        if (k > b && k + 1 < e) {
+            Vec3d a = p - Vec3d(s.positions[k - 1]), c = Vec3d(s.positions[k + 1]) - p;
+            const double la = a.length(), lc = c.length();
+            if (la > 0.0 && lc > 0.0) turning += std::acos(std::clamp(a.dot(c) / (la * lc), -1.0, 1.0));
+        }
+    }
+    out.length = length / f.radius;
+    out.lifts = highest > kLiftHeight * f.radius;
+    out.turning = length > 0.0 ? turning / out.length : 0.0;
+    // Curl amplitude: RMS distance from the strand's own smoothed centre line, at a fixed resolution.
+    if (length > 0.0) {
+        pts.assign(kCurlVertices, Vec3d(0.0));
+        const double step = length / double(kCurlVertices - 1);
+        std::size_t k = b;
+        double walked = 0.0;
+        for (int j = 0; j < kCurlVertices; ++j) {
+            const double target = std::min(length, step * double(j));
+            while (k + 2 < e && walked + (Vec3d(s.positions[k + 1]) - Vec3d(s.positions[k])).length() < target) {
+                walked += (Vec3d(s.positions[k + 1]) - Vec3d(s.positions[k])).length();
+                ++k;
+            }
+            const Vec3d p0(s.positions[k]), p1(s.positions[k + 1]);
+            const double seg = (p1 - p0).length();
+            const double t = seg > 0.0 ? std::clamp((target - walked) / seg, 0.0, 1.0) : 0.0;
+            pts[std::size_t(j)] = p0 + t * (p1 - p0);
+        }
+        smooth.resize(pts.size());
+        smoothPolyline(pts.data(), pts.size(), kCurlSigma, smooth.data());
+        double sum = 0.0;
+        for (std::size_t j = 0; j < pts.size(); ++j) sum += (pts[j] - smooth[j]).lengthSqr();
+        out.curl = std::sqrt(sum / double(pts.size())) / f.radius;
+    }
+    return out;
+}
+
+} // namespace
+
+const char* styleRegionName(StyleRegion r)
+{
+    switch (r) {
+    case StyleRegion::Crown: return "crown";
+    case StyleRegion::Fringe: return "fringe";
+    case StyleRegion::Sides: return "sides";
+    case StyleRegion::Back: return "back";
+    }
+    return "?";
+}
+
+RegionFrame regionFrameFromRoots(const StrandSet& strands, const Vec3d& center, const Vec3d& up, double radius)
+{
+    RegionFrame f;
+    f.center = center;
+    f.up = up.length() > 0.0 ? up.unit() : Vec3d(0.0, 1.0, 0.0);
+    f.radius = radius > 0.0 ? radius : 1.0;
+    // Two axes perpendicular to up: azimuth 0 along e1.
+    Vec3d e1 = std::abs(f.up.z()) < 0.9 ? Vec3d(0.0, 0.0, 1.0) : Vec3d(0.0, -1.0, 0.0);
+    e1 = (e1 - e1.dot(f.up) * f.up).unit();
+    const Vec3d e2 = f.up.cross(e1);
+    // The hairline's height per azimuth: the lowest root elevation below the crown in each of kBins sectors (a
+    // sector without roots says nothing). The forehead's is the highest of a head (the nape's the
+    // lowest, the ears' between), whatever the parting or the sweep.
+    constexpr int kBins = 24;
+    std::array<double, kBins> lowest;
+    lowest.fill(std::numeric_limits<double>::infinity());  // no root in the sector: no evidence
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
+        const Vec3d d = Vec3d(strands.root(i)) - center;
+        const double len = d.length();
+        if (!(len > 0.0)) continue;
+        const double elevation = std::asin(std::clamp(d.dot(f.up) / len, -1.0, 1.0)) * 180.0 / M_PI;
+        if (elevation > kCrownElevationDeg) continue;  // the crown says nothing of the hairline
+        const double azimuth = std::atan2(d.dot(e2), d.dot(e1));
+        const int bin = (int(std::floor((azimuth + M_PI) / (2.0 * M_PI) * kBins)) % kBins + kBins) % kBins;
+        lowest[std::size_t(bin)] = std::min(lowest[std::size_t(bin)], elevation);
+    }
+    // h(a) ~ c0 + c1 cos a + s1 sin a by least squares over the sectors with roots: the front is
+    // where the first harmonic peaks, atan2(s1, c1).
+    openvdb::math::Mat3d normal = openvdb::math::Mat3d::zero();
+    openvdb::math::Vec3d rhs(0.0);
+    int sectors = 0;
+    for (int b = 0; b < kBins; ++b) {
+        if (!std::isfinite(lowest[std::size_t(b)])) continue;
+        const double a = (double(b) + 0.5) / kBins * 2.0 * M_PI - M_PI;
+        const openvdb::math::Vec3d row(1.0, std::cos(a), std::sin(a));
+        for (int i = 0; i < 3; ++i) {
+            rhs[i] += row[i] * lowest[std::size_t(b)];
+            for (int j = 0; j < 3; ++j) normal(i, j) += row[i] * row[j];
+        }
+        ++sectors;
+    }
+    double azimuth = 0.0;  // too few sectors to tell: azimuth 0 (e1)
+    if (sectors >= 3 && std::abs(normal.det()) > 1e-9) {
+        const openvdb::math::Vec3d c = normal.inverse() * rhs;
+        if (std::hypot(c[1], c[2]) > 0.0) azimuth = std::atan2(c[2], c[1]);
+    }
+    f.front = (std::cos(azimuth) * e1 + std::sin(azimuth) * e2).unit();
+    return f;
+}
+
+StyleRegion regionOf(const RegionFrame& f, const Vec3d& root)
+{
+    const Vec3d d = root - f.center;
+    const double len = d.length();
+    if (!(len > 0.0)) return StyleRegion::Crown;
+    const double elevation = std::asin(std::clamp(d.dot(f.up) / len, -1.0, 1.0)) * 180.0 / M_PI;
+    if (elevation > kCrownElevationDeg) return StyleRegion::Crown;
+    Vec3d h = d - d.dot(f.up) * f.up;
+    if (!(h.length() > 0.0)) return StyleRegion::Sides;
+    const double angle = std::acos(std::clamp(h.unit().dot(f.front), -1.0, 1.0)) * 180.0 / M_PI;
+    if (angle < kFringeAngleDeg) return StyleRegion::Fringe;
+    if (angle > kBackAngleDeg) return StyleRegion::Back;
+    return StyleRegion::Sides;
+}
+
+StyleRegions measureStyleRegions(const StrandSet& strands, const RegionFrame& frame, const HeadObstacle* head, bool threaded)
+{
+    const std::size_t nS = strands.numStrands();
+    std::vector<StrandFigures> per(nS);
+    std::vector<StyleRegion> region(nS);
+    const bool withHead = head && !head->empty();
+    // Inside: deeper than a level set's half voxel (refine --head's rule), or than rounding on a sphere.
+    const double tolerance = withHead ? std::max(headTolerance(*head), 1e-6 * frame.radius) : 0.0;
+    forEachRange(nS, threaded, 256, [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<Vec3d> pts, smooth;
+        std::optional<HeadObstacle::Probe> probe;
+        if (withHead) probe.emplace(*head);
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            region[i] = regionOf(frame, Vec3d(strands.root(i)));
+            per[i] = strandFigures(strands, i, frame, probe ? &*probe : nullptr, tolerance, pts, smooth);
+        }
+    });
+    StyleRegions out;
+    out.frame = frame;
+    for (int r = 0; r < kStyleRegions; ++r) {
+        RegionFigures& g = out.regions[std::size_t(r)];
+        std::vector<double> lengths;
+        std::size_t lifts = 0, inside = 0, vertices = 0;
+        double turning = 0.0, curl = 0.0;
+        for (std::size_t i = 0; i < nS; ++i) {
+            if (int(region[i]) != r) continue;
+            lengths.push_back(per[i].length);
+            lifts += per[i].lifts;
+            turning += per[i].turning;
+            curl += per[i].curl;
+            inside += per[i].inside;
+            vertices += strands.size(i);
+        }
+        g.strands = lengths.size();
+        g.share = nS ? double(g.strands) / double(nS) : 0.0;
+        if (g.strands == 0) continue;
+        g.lengthP25 = quantile(lengths, 0.25);
+        g.lengthP50 = quantile(lengths, 0.5);
+        g.lengthP75 = quantile(lengths, 0.75);
+        g.lift = double(lifts) / double(g.strands);
+        g.turning = turning / double(g.strands);
+        g.curlAmplitude = curl / double(g.strands);
+        g.insideHead = withHead ? double(inside) / double(vertices) : -1.0;
+    }
+    return out;
+}
+
+nlohmann::json toJson(const StyleRegions& example, const StyleRegions& output)
+{
+    const RegionFrame& f = example.frame;
+    nlohmann::json j;
+    j["frame"] = {{"center", {f.center.x(), f.center.y(), f.center.z()}}, {"up", {f.up.x(), f.up.y(), f.up.z()}},
+                  {"front", {f.front.x(), f.front.y(), f.front.z()}}, {"radius", f.radius}};
+    for (int r = 0; r < kStyleRegions; ++r) {
+        const RegionFigures &a = example.regions[std::size_t(r)], &b = output.regions[std::size_t(r)];
+        auto pair = [&](double x, double y, bool hasX, bool hasY) {
+            return nlohmann::json{{"example", hasX ? nlohmann::json(x) : nlohmann::json(nullptr)},
+                                  {"output", hasY ? nlohmann::json(y) : nlohmann::json(nullptr)}};
+        };
+        const bool ha = a.strands > 0, hb = b.strands > 0;
+        nlohmann::json g;
+        g["strands"] = {{"example", a.strands}, {"output", b.strands}};
+        g["share"] = pair(a.share, b.share, true, true);
+        g["length_p25"] = pair(a.lengthP25, b.lengthP25, ha, hb);
+        g["length_p50"] = pair(a.lengthP50, b.lengthP50, ha, hb);
+        g["length_p75"] = pair(a.lengthP75, b.lengthP75, ha, hb);
+        g["lift"] = pair(a.lift, b.lift, ha, hb);
+        g["turning"] = pair(a.turning, b.turning, ha, hb);
+        g["curl_amplitude"] = pair(a.curlAmplitude, b.curlAmplitude, ha, hb);
+        g["inside_head"] = pair(a.insideHead, b.insideHead, ha && a.insideHead >= 0.0, hb && b.insideHead >= 0.0);
+        j[styleRegionName(StyleRegion(r))] = g;
+    }
+    return j;
+}
+
+std::string summaryLines(const StyleRegions& example, const StyleRegions& output, const std::string& indent)
+{
+    std::string out;
+    char buf[512];
+    for (int r = 0; r < kStyleRegions; ++r) {
+        const RegionFigures &a = example.regions[std::size_t(r)], &b = output.regions[std::size_t(r)];
+        std::snprintf(buf, sizeof buf,
+                      "%s%-6s %4.1f %% of strands (example %4.1f %%), length p25/p50/p75 %.2f/%.2f/%.2f (%.2f/%.2f/%.2f), "
+                      "lift %.0f %% (%.0f %%), turning %.2f (%.2f), curl %.3f (%.3f)",
+                      indent.c_str(), styleRegionName(StyleRegion(r)), 100.0 * b.share, 100.0 * a.share, b.lengthP25, b.lengthP50, b.lengthP75,
+                      a.lengthP25, a.lengthP50, a.lengthP75, 100.0 * b.lift, 100.0 * a.lift, b.turning, a.turning, b.curlAmplitude, a.curlAmplitude);
+        out += buf;
+        if (a.insideHead >= 0.0 && b.insideHead >= 0.0) {
+            std::snprintf(buf, sizeof buf, ", inside the head %.1f %% (%.1f %%)", 100.0 * b.insideHead, 100.0 * a.insideHead);
+            out += buf;
+        }
+        out += "\n";
+    }
+    return out;
+}
+
+nlohmann::json compareStyleRegions(const StrandSet& example, const StrandSet& output, const Vec3d& center, const Vec3d& up, double radius,
+                                   const HeadObstacle* head, std::string* text)
+{
+    const RegionFrame frame = regionFrameFromRoots(example, center, up, radius);
+    const StyleRegions a = measureStyleRegions(example, frame, head), b = measureStyleRegions(output, frame, head);
+    if (text) *text = summaryLines(a, b, "    ");
+    return toJson(a, b);
+}
+
+} // namespace vdbhair
