@@ -26,7 +26,8 @@ PROP_UP = "vdbhair_up_axis"            # "Y" or "Z": the file's up axis as impor
 PROP_SCALE = "vdbhair_scale"           # Blender units per file unit applied by the import
 PROP_UNIT = "vdbhair_meters_per_unit"  # the file's unit in metres, when known
 PROP_SOURCE = "vdbhair_source"         # the imported file
-RECORDED = (PROP_UP, PROP_SCALE, PROP_UNIT, PROP_SOURCE)
+PROP_DEFAULTS = "vdbhair_defaults"     # the file's per-vertex defaults (a cyHair header's), file units
+RECORDED = (PROP_UP, PROP_SCALE, PROP_UNIT, PROP_SOURCE, PROP_DEFAULTS)
 
 HAIR_TYPES = {'CURVES', 'CURVE'}
 
@@ -262,7 +263,7 @@ def _convert_legacy(context, legacy):
     temp = bpy.data.objects.new(legacy.name, legacy)
     context.scene.collection.objects.link(temp)
     view_layer = context.view_layer
-    active, selected = view_layer.objects.active, [o for o in context.selected_objects]
+    active, selected = view_layer.objects.active, list(view_layer.objects.selected)
     try:
         for o in selected:
             o.select_set(False)
@@ -316,22 +317,46 @@ def copy_recorded(source, target):
 
 
 def replace_geometry(context, obj, hair):
-    """Give `obj` the strands `hair` (local coordinates). Positions are written in place when the
-    topology is the same (attributes, selection and everything else kept); otherwise a new datablock
-    replaces the old one, keeping materials, the surface and the import's record."""
+    """Give `obj` the strands `hair` (local coordinates), in Object Mode (the mode is restored).
+    Positions are written in place when the topology is the same (attributes, selection, spline
+    settings and everything else kept); otherwise a new datablock replaces the old one, keeping
+    materials, the surface and the import's record."""
+    with object_mode(context):
+        if not _write_in_place(obj.data, hair):
+            _replace_data(context, obj, hair)
+
+
+def _write_in_place(data, hair):
+    """Write the positions into `data` if it has the topology of `hair` (poly splines only for a
+    legacy curve); return whether it did."""
+    counts = hair.counts
+    if isinstance(data, bpy.types.Curves):
+        if len(data.points) != len(hair.positions) or len(data.curves) != len(counts):
+            return False
+        offsets = np.empty(len(data.curves) + 1, dtype=np.int32)
+        data.curve_offset_data.foreach_get("value", offsets)
+        if not np.array_equal(offsets, hair.offsets):
+            return False
+        data.position_data.foreach_set("vector", hair.positions.ravel())
+        data.update_tag()
+        return True
+    splines = data.splines
+    if len(splines) != len(counts) or any(s.type != 'POLY' or len(s.points) != n for s, n in zip(splines, counts)):
+        return False
+    for i, spline in enumerate(splines):
+        co = np.empty(len(spline.points) * 4, dtype=np.float32)
+        spline.points.foreach_get("co", co)  # (x, y, z, w): each point's weight w is kept
+        co = co.reshape(-1, 4)
+        co[:, :3] = hair.positions[hair.offsets[i]:hair.offsets[i + 1]]
+        spline.points.foreach_set("co", co.ravel())
+    data.update_tag()
+    return True
+
+
+def _replace_data(context, obj, hair):
     old = obj.data
     if obj.type == 'CURVES':
-        same = len(old.points) == len(hair.positions) and len(old.curves) == len(hair.counts)
-        if same:
-            offsets = np.empty(len(old.curves) + 1, dtype=np.int32)
-            old.curve_offset_data.foreach_get("value", offsets)
-            same = np.array_equal(offsets, hair.offsets)
-        if same:
-            old.position_data.foreach_set("vector", hair.positions.ravel())
-            old.update_tag()
-            return
-        with object_mode(context):
-            new = build_curves(context, old.name, hair)
+        new = build_curves(context, old.name, hair)
         new.surface, new.surface_uv_map = old.surface, old.surface_uv_map
     else:
         new = build_legacy_curve(old.name, hair)

@@ -144,7 +144,7 @@ def write_ply(path, vertices, triangles):
 
 def other_selected_hair(context, obj, kind):
     """The selected objects of the given types other than the active one, by name."""
-    return sorted((o for o in context.selected_objects if o != obj and o.type in kind), key=lambda o: o.name)
+    return sorted((o for o in context.view_layer.objects.selected if o != obj and o.type in kind), key=lambda o: o.name)
 
 
 # Operators --------------------------------------------------------------------------------------

@@ -100,11 +100,12 @@ def import_strands(context, strands, name, source, object_type, up_choice, unit,
     else:
         data = convert.build_legacy_curve(stem, hair)
     data[convert.PROP_UP], data[convert.PROP_SCALE], data[convert.PROP_SOURCE] = up, scale, source
+    data[convert.PROP_DEFAULTS] = strands.defaults  # written back by the export (.hair headers keep them)
     if meters_per_unit is not None:
         data[convert.PROP_UNIT] = meters_per_unit
     obj = bpy.data.objects.new(data.name, data)
     context.collection.objects.link(obj)
-    for o in context.selected_objects:
+    for o in list(context.view_layer.objects.selected):
         o.select_set(False)
     obj.select_set(True)
     context.view_layer.objects.active = obj
@@ -154,7 +155,7 @@ class EXPORT_SCENE_OT_vdbhair(bpy.types.Operator, ExportHelper):
             path += dict((k, e) for k, e, _ in WRITE_FORMATS)[self.file_format]
         try:
             vdbhair = loader.module()
-            objects = sorted((o for o in (context.selected_objects if self.use_selection else context.view_layer.objects)
+            objects = sorted((o for o in (context.view_layer.objects.selected if self.use_selection else context.view_layer.objects)
                               if o.type in convert.HAIR_TYPES), key=lambda o: o.name)
             if not objects:
                 raise ValueError("no hair object to export (select a Curves or Curve object)")
@@ -182,7 +183,7 @@ def export_strands(context, vdbhair, objects, apply_transform, use_modifiers, up
         declared = first.get(convert.PROP_UNIT) if convert.PROP_SCALE in first else scene_unit
     else:
         declared = UNITS[unit]
-    parts, notes = [], []
+    parts, scales, notes = [], [], []
     for obj in objects:
         hair, warned = convert.read_object(obj, depsgraph)
         convert.check_strands(hair, obj.name)
@@ -197,9 +198,17 @@ def export_strands(context, vdbhair, objects, apply_transform, use_modifiers, up
                                                ).astype(np.float32)
         scale = obj.data.get(convert.PROP_SCALE, 1.0) if unit == 'AUTO' else UNITS[unit] / scene_unit
         parts.append(convert.to_strands(vdbhair, hair, _up(up_choice, obj.data.get(convert.PROP_UP)), scale))
+        scales.append(scale)
     strands = parts[0] if len(parts) == 1 else concatenate(vdbhair, parts, notes)
     if declared is not None:
         strands.meters_per_unit = declared
+    if convert.PROP_DEFAULTS in first:  # the first object's file defaults, its thickness in the output's unit
+        defaults = first[convert.PROP_DEFAULTS].to_dict()
+        defaults["color"] = tuple(defaults["color"])
+        factor = first.get(convert.PROP_SCALE, 1.0) / scales[0]
+        if factor != 1.0:
+            defaults["thickness"] *= factor
+        strands.defaults = defaults
     return strands, up, notes
 
 

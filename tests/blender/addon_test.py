@@ -40,13 +40,14 @@ def cli(*arguments):
         fail("vdbhair %s: exit %d: %s" % (" ".join(arguments), run.returncode, run.stderr.strip()))
 
 
-def enable_addon():
+def enable_addon(empty=True):
     """Register the build tree's add-on (its folder on sys.path, as Blender's add-on folder would
-    be) in a factory-fresh, empty scene; return the add-on package."""
+    be); return the add-on package. empty: in a factory-fresh, empty scene (else the scene as it is)."""
     import addon_utils
     if ADDON_PARENT not in sys.path:
         sys.path.insert(0, ADDON_PARENT)
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    if empty:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
     module = addon_utils.enable("vdbhair_addon", default_set=True, handle_error=lambda e: fail("enable: %s" % e))
     if module is None:
         fail("the add-on did not enable")

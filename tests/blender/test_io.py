@@ -8,7 +8,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from addon_test import (PONYTAIL, blender_to_y_up, check, cli, enable_addon, expect_error, fail,  # noqa: E402
+from addon_test import (PONYTAIL, check, cli, enable_addon, expect_error,  # noqa: E402
                         new_scene, object_arrays, out, run_operator, same_strands, y_up_to_blender)
 
 enable_addon()
@@ -72,6 +72,16 @@ for fmt in ("hair", "usda"):
     run_operator(export_op, filepath=out("rich_blender.%s" % fmt))
     cli("convert", out("rich.hair"), out("rich_cli.%s" % fmt))
     same_file(out("rich_blender.%s" % fmt), out("rich_cli.%s" % fmt))
+
+# A cyHair header's defaults (no per-vertex arrays) are kept: .hair and .usda (widths) as convert writes them.
+plain = vdbhair.Strands(truth.positions, truth.offsets)
+plain.defaults = {"thickness": 0.1, "transparency": 0.25, "color": (1.0, 0.9, 0.5)}
+plain.write(out("defaults.hair"))
+import_file(out("defaults.hair"))
+for fmt in ("hair", "usda"):
+    run_operator(export_op, filepath=out("defaults_blender.%s" % fmt))
+    cli("convert", out("defaults.hair"), out("defaults_cli.%s" % fmt))
+    same_file(out("defaults_blender.%s" % fmt), out("defaults_cli.%s" % fmt))
 
 # A USD stage that declares +Z up and metres comes in unturned, and goes out so declared.
 cli("convert", PONYTAIL, out("z.usda"), "--usd-up", "z", "--meters-per-unit", "1")

@@ -44,6 +44,14 @@ for options, flags in (({"levels": 2}, ["--levels", "2"]), ({"mode": 'field'}, [
     cli("refine", PONYTAIL, "-o", out("refined.hair"), *flags)
     same_as_cli("refine %s against vdbhair refine %s" % (options, " ".join(flags)), obj, out("refined.hair"))
 
+# A legacy curve object is refined in place, as the hair object is.
+new_scene()
+bpy.ops.import_scene.vdbhair(filepath=PONYTAIL, object_type='CURVE')
+legacy = bpy.context.active_object
+run_operator(bpy.ops.vdbhair.refine, levels=2)
+cli("refine", PONYTAIL, "-o", out("refined.hair"), "--levels", "2")
+same_as_cli("refine of a legacy curve object against vdbhair refine --levels 2", legacy, out("refined.hair"))
+
 # The hair's surface mesh as the head: an icosphere inside the ponytail, written for the command as a PLY.
 obj = import_ponytail()
 bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=3, radius=10.0, location=(0.0, 0.0, 60.0))
@@ -106,8 +114,11 @@ def subset(strands, indices):
 
 subset(truth, guides).write(out("guides.hair"))
 subset(truth, rest).write(out("rest.hair"))
+bpy.ops.object.mode_set(mode='SCULPT_CURVES')  # where curves are selected; the new datablock needs Object Mode
 result, seconds = run_operator(bpy.ops.vdbhair.interpolate)
 check(result == {'FINISHED'}, "interpolate finished (%.3f s)" % seconds)
+check(obj.mode == 'SCULPT_CURVES' and bpy.context.view_layer.objects.active == obj,
+      "the object is active and in Sculpt Mode again")
 cli("interpolate", out("guides.hair"), "--roots", out("rest.hair"), "-o", out("interpolated.hair"))
 p, o = object_strands(obj)
 got = vdbhair.Strands(p, o)
