@@ -11,8 +11,9 @@ PACKAGES=(
   libopenvdb-tools python3-openvdb python3-numpy fonts-dejavu-core
   pybind11-dev python3-pybind11 python3-dev python3-pytest
 )
-# Debian's Blender 3.4 runs the system Python, so it loads the vdbhair module the build makes.
-[ "${1:-}" = --tests ] && PACKAGES+=(blender)
+# Debian's Blender 3.4 runs the system Python, so it loads the vdbhair module the build makes;
+# xvfb gives it a window for the add-on's modal test (tests/blender/test_modal.py: progress, Esc).
+[ "${1:-}" = --tests ] && PACKAGES+=(blender xvfb xauth)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -325,7 +325,7 @@ Raises:
         auto [f, d] = optionalView(&StrandSet::strandId, 0, "(S,) int32 ids of an upstream source, or None: a view.");
         cls.def_property_readonly("strand_id", f, d);
     }
-    cls.def_property_readonly(
+    cls.def_property(
         "defaults",
         [](const StrandSet& s) {
             pyb::dict d;
@@ -334,7 +334,30 @@ Raises:
             d["color"] = pyb::make_tuple(s.defaults.color.x(), s.defaults.color.y(), s.defaults.color.z());
             return d;
         },
-        "The per-vertex defaults used where an attribute array is None (cyHair's header): a dict.");
+        [](StrandSet& s, const pyb::dict& d) {
+            // Checked whole before anything is set: a bad key or value leaves the defaults as they were.
+            StrandDefaults next = s.defaults;
+            auto finite = [](const char* key, const pyb::handle& v) {
+                const float x = v.cast<float>();
+                if (!std::isfinite(x)) throw ValueError(std::string("Strands.defaults: ") + key + " = " + std::string(pyb::str(v)) + "; must be a finite number");
+                return x;
+            };
+            for (const auto& [key, value] : d) {
+                const std::string k = key.cast<std::string>();
+                if (k == "thickness") next.thickness = finite("thickness", value);
+                else if (k == "transparency") next.transparency = finite("transparency", value);
+                else if (k == "color") {
+                    const auto c = value.cast<std::vector<pyb::handle>>();
+                    if (c.size() != 3) throw ValueError("Strands.defaults: color has " + std::to_string(c.size()) + " values; must be (r, g, b)");
+                    for (int i = 0; i < 3; ++i) next.color[i] = finite("color", c[i]);
+                } else {
+                    throw ValueError("Strands.defaults: unknown key '" + k + "'; the keys are thickness, transparency, color");
+                }
+            }
+            s.defaults = next;
+        },
+        "The per-vertex defaults used where an attribute array is None (cyHair's header): a dict. Setting it (a dict "
+        "of some or all of its keys) changes those defaults, as a .hair file's header writes them.");
     cls.def_property(
         "meters_per_unit", [](const StrandSet& s) -> pyb::object { return s.metersPerUnit > 0.0 ? pyb::cast(s.metersPerUnit) : pyb::none(); },
         [](StrandSet& s, const pyb::object& v) {

@@ -278,3 +278,21 @@ def test_units_declared_and_converted(tmp_path):
     with pytest.raises(ValueError, match="meters_per_unit=-1"):
         s.meters_per_unit = -1.0
     assert s.meters_per_unit == 1.0  # a refused value changes nothing
+
+
+def test_defaults_settable_and_written_to_hair(tmp_path):
+    # A cyHair header's defaults carried by strands built from arrays (the Blender add-on's export).
+    positions, offsets = two_strands()
+    s = vdbhair.Strands(positions, offsets)
+    assert s.defaults == {"thickness": 1.0, "transparency": 0.0, "color": (0.5, 0.5, 0.5)}
+    s.defaults = {"thickness": 0.25, "color": (1.0, 0.5, 0.0)}  # some keys: the others kept
+    assert s.defaults == {"thickness": 0.25, "transparency": 0.0, "color": (1.0, 0.5, 0.0)}
+    s.write(tmp_path / "d.hair")
+    assert vdbhair.read(tmp_path / "d.hair").defaults == s.defaults
+    with pytest.raises(ValueError, match="unknown key 'width'; the keys are thickness, transparency, color"):
+        s.defaults = {"thickness": 2.0, "width": 1.0}
+    with pytest.raises(ValueError, match="transparency = nan; must be a finite number"):
+        s.defaults = {"transparency": float("nan")}
+    with pytest.raises(ValueError, match="color has 2 values; must be"):
+        s.defaults = {"color": (1.0, 0.0)}
+    assert s.defaults["thickness"] == 0.25  # a refused dict changes nothing

@@ -19,11 +19,13 @@ cmake --build "$work/consumer" > "$work/build.log"
 "$work/consumer/consumer"
 # The Python module, when it was built: installed into the prefix's site-packages, it imports
 # from there and works (the interpreter is the one it was built for, from the build's cache).
-python=$(sed -n 's/^Python_EXECUTABLE:FILEPATH=//p' "$build/CMakeCache.txt")
+python=$(sed -n 's/^Python_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt")
 if grep -q '^VDBHAIR_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then
   module=$(find "$work/prefix" -name 'vdbhair.cpython-*.so' | head -n 1)
   test -n "$module"
   (cd "$work" && PYTHONPATH=$(dirname "$module") "$python" -c \
     "import vdbhair, numpy; s = vdbhair.Strands(numpy.zeros((2, 3)) + [[0, 0, 0], [1, 0, 0]], [0, 2]); assert len(s) == 1 and vdbhair.__file__.startswith('$work/prefix')")
+  # The Blender add-on, installed with it, names that module's directory (docs/blender.md).
+  grep -qx "MODULE_DIR = \"$(dirname "$module")\"" "$work/prefix/share/vdbhair/blender/vdbhair_addon/_build_info.py"
 fi
 echo "ok: an installed vdbhair builds and runs a find_package(vdbhair) project"
