@@ -204,7 +204,7 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common);
 /// @brief The options of `synth`, `transfer` and `comb` that are not plain SynthParams fields.
 struct SynthOptionText
 {
-    std::string up = "auto", refineMode, detail, detailScale;
+    std::string up = "auto", front = "auto", refineMode, detail, detailScale;
     bool noRefine = false;
 };
 /// @brief The hierarchy's options (--levels, --seed, --vertices, --threshold, --initial-clusters, --up).

@@ -256,7 +256,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     std::string regionText;
     const ScalpSphere& sphere = r.map->sphere();
     const nlohmann::json regions = compareStyleRegions(example, outputMap ? movedBack : r.strands, sphere.center, sphere.up, sphere.radius,
-                                                       outputMap || r.head == "none" ? nullptr : &p.synth.head, &regionText);
+                                                       outputMap || r.head == "none" ? nullptr : &p.synth.head, &regionText, p.synth.front);
     HairComparison comparison;
     if (p.measure) {
         const Stage stage(common, "comparing with the example");
@@ -326,6 +326,7 @@ void addSynthHierarchyOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
 void addSynthTransferOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
 {
     t.detail = detailBlendName(s.detailBlend);
+    sub->add_option("--front", t.front, "The head's front for the report by region: auto (where the example's hairline is highest), x, y, z, -x, -y or -z")->capture_default_str();
     sub->add_option("--components", s.components, "PCA components of the feature maps and of cluster matching, n_f")->capture_default_str();
     sub->add_option("--detail", t.detail, "Detail transfer: edges (each strand's own edges re-laid along the output centre: curls keep their turning), root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
     t.detailScale = detailScaleName(s.detailScale);
@@ -342,6 +343,7 @@ void addSynthTransferOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
 void applySynthOptionText(const SynthOptionText& t, SynthParams& s)
 {
     if (t.up != "auto") s.up = axisFromName(t.up, "--up");
+    if (t.front != "auto") s.front = axisFromName(t.front, "--front");
     s.refine = !t.noRefine;
     if (!t.refineMode.empty()) s.refineMode = refineModeFromName(t.refineMode);
     if (!t.detail.empty()) s.detailBlend = detailBlendFromName(t.detail);

@@ -89,7 +89,8 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
     std::string regionText;
     const ScalpSphere& sphere = r.map->sphere();
     const nlohmann::json regions =
-        compareStyleRegions(base, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &params.synth.head, &regionText);
+        compareStyleRegions(base, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &params.synth.head, &regionText,
+                            params.synth.front);
     HairComparison comparison;
     if (job.measure) {
         const Stage stage(common, "comparing with the base");

@@ -175,7 +175,7 @@ Returns:
            double threshold, int initialClusters, int components, double mapSpacing, const std::string& layout,
            const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, double placeWeight,
            double nearby, bool refine, std::optional<std::string> refineMode,
-           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp,
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::array<double, 3>> front, std::optional<PathArg> scalp,
            std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region,
            std::optional<PathArg> outputScalp, double outputTurn, bool measure, bool returnReport, int threads,
            const pyb::object& progress) -> pyb::object {
@@ -188,6 +188,7 @@ Returns:
                 for (pyb::ssize_t i = 0; i < r.shape(0); ++i) regionPoints.emplace_back(r(i, 0), r(i, 1), r(i, 2));
             }
             setHierarchy(p, levels, seed, vertices, threshold, initialClusters, up);
+            if (front) p.front = Vec3d((*front)[0], (*front)[1], (*front)[2]);
             p.components = components;
             p.mapSpacing = mapSpacing;
             p.layout = synthLayoutFromName(layout);
@@ -234,8 +235,9 @@ Returns:
                 const ScalpSphere& sphere = r.map->sphere();
                 regions = toPython(runLong(threads, pyb::none(), [&](WorkInterrupter*) {
                     return other ? compareStyleRegions(*example, moveToScalp(r.strands, *other, *r.map, -p.outputTurn), sphere.center, sphere.up,
-                                                       sphere.radius, nullptr)
-                                 : compareStyleRegions(*example, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &p.head);
+                                                       sphere.radius, nullptr, nullptr, p.front)
+                                 : compareStyleRegions(*example, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &p.head,
+                                                       nullptr, p.front);
                 }));
             }
             auto out = std::make_shared<StrandSet>(std::move(r.strands));
@@ -272,7 +274,7 @@ Returns:
         pyb::arg("detail_scale") = detailScaleName(synthDefaults.detailScale), pyb::arg("match_balance") = synthDefaults.match.balance,
         pyb::arg("match_candidates") = synthDefaults.match.candidates, pyb::arg("place_weight") = synthDefaults.placeWeight,
         pyb::arg("nearby") = synthDefaults.texture.nearbyRadius, pyb::arg("refine") = synthDefaults.refine,
-        pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(),
+        pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(), pyb::arg("front") = pyb::none(),
         pyb::arg("scalp") = pyb::none(), pyb::arg("region") = pyb::none(), pyb::arg("output_scalp") = pyb::none(),
         pyb::arg("output_turn") = 0.0, pyb::arg("measure") = false, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
@@ -303,6 +305,7 @@ Args:
     refine_mode: None (refine's default, "consistent") or "field".
     voxel_size: refinement voxel of the finest level, world units (0: refine's suggestion).
     up: the scalp's up axis (None: the roots' mean direction from the head's centre).
+    front: the head's front for the report's "regions" (None: where the example's hairline is highest).
     scalp: a path to a scalp: .vdb with a level set 'surface', or a head mesh (.ply, .obj).
     region: where the new hair grows, an (N, 3) array of points on the scalp (roots() positions,
         another hairstyle's roots); None: the example's region. The count scales with the area.
@@ -327,8 +330,8 @@ Returns:
            bool smoothBase, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters, int components,
            const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, bool refine,
            std::optional<std::string> refineMode,
-           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<PathArg> scalp, bool measure, bool returnReport,
-           int threads, const pyb::object& progress) -> pyb::object {
+           double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::array<double, 3>> front, std::optional<PathArg> scalp,
+           bool measure, bool returnReport, int threads, const pyb::object& progress) -> pyb::object {
             TransferParams p;
             p.guides = guides;
             if (strands) {
@@ -340,6 +343,7 @@ Returns:
             p.smoothBase = smoothBase;
             SynthParams& s = p.synth;
             setHierarchy(s, levels, seed, vertices, threshold, initialClusters, up);
+            if (front) s.front = Vec3d((*front)[0], (*front)[1], (*front)[2]);
             s.components = components;
             s.detailBlend = detailBlendFromName(detail);
             s.detailScale = detailScaleFromName(detailScale);
@@ -361,7 +365,7 @@ Returns:
                 const ScalpSphere& sphere = r.result.map->sphere();
                 regions = toPython(runLong(threads, pyb::none(), [&](WorkInterrupter*) {
                     return compareStyleRegions(*base, r.result.strands, sphere.center, sphere.up, sphere.radius,
-                                               r.result.head == "none" ? nullptr : &p.synth.head);
+                                               r.result.head == "none" ? nullptr : &p.synth.head, nullptr, p.synth.front);
                 }));
             }
             auto out = std::make_shared<StrandSet>(std::move(r.result.strands));
@@ -387,7 +391,8 @@ Returns:
         pyb::arg("detail") = detailBlendName(transferDefaults.synth.detailBlend), pyb::arg("detail_scale") = detailScaleName(transferDefaults.synth.detailScale),
         pyb::arg("match_balance") = transferDefaults.synth.match.balance, pyb::arg("match_candidates") = transferDefaults.synth.match.candidates,
         pyb::arg("refine") = transferDefaults.synth.refine, pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = transferDefaults.synth.voxelSize,
-        pyb::arg("up") = pyb::none(), pyb::arg("scalp") = pyb::none(), pyb::arg("measure") = false, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
+        pyb::arg("up") = pyb::none(), pyb::arg("front") = pyb::none(), pyb::arg("scalp") = pyb::none(), pyb::arg("measure") = false,
+        pyb::arg("return_report") = false, pyb::arg("threads") = 0,
         pyb::arg("progress") = pyb::none(),
         R"doc(The base's global flow with the details' wisps and waves (Wang et al. 2009, §6): ``vdbhair transfer``.
 
@@ -405,7 +410,8 @@ Args:
     match_candidates: as synth's, 64 here (the two hairstyles' wisps differ more).
     measure: with return_report, the report's "compare" holds the output against the base, as
         ``vdbhair.compare(base, output)``.
-    Other options as synth. The report's "regions" set the output beside the base, region by region.
+    Other options as synth (front: the head's front for the report's "regions", which set the output
+    beside the base, region by region).
 
 Returns:
     Strands, or (Strands, report) with return_report.)doc");

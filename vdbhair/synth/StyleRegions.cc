@@ -256,9 +256,11 @@ std::string summaryLines(const StyleRegions& example, const StyleRegions& output
 }
 
 nlohmann::json compareStyleRegions(const StrandSet& example, const StrandSet& output, const Vec3d& center, const Vec3d& up, double radius,
-                                   const HeadObstacle* head, std::string* text)
+                                   const HeadObstacle* head, std::string* text, const Vec3d& front)
 {
-    const RegionFrame frame = regionFrameFromRoots(example, center, up, radius);
+    RegionFrame frame = regionFrameFromRoots(example, center, up, radius);
+    const Vec3d given = front - front.dot(frame.up) * frame.up;
+    if (given.length() > 1e-9) frame.front = given.unit();
     const StyleRegions a = measureStyleRegions(example, frame, head), b = measureStyleRegions(output, frame, head);
     if (text) *text = summaryLines(a, b, "    ");
     return toJson(a, b);

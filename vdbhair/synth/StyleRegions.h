@@ -84,8 +84,9 @@ nlohmann::json toJson(const StyleRegions& example, const StyleRegions& output);
 /// @brief The report of synth and transfer: @a example and @a output measured in one frame (the
 /// head's @a center, @a up and @a radius, the example's front), as toJson() sets them side by
 /// side; @a text, if given, receives summaryLines().
+/// @param front the head's front, or (0, 0, 0) to find it from @a example's hairline
 nlohmann::json compareStyleRegions(const StrandSet& example, const StrandSet& output, const Vec3d& center, const Vec3d& up, double radius,
-                                   const HeadObstacle* head, std::string* text = nullptr);
+                                   const HeadObstacle* head, std::string* text = nullptr, const Vec3d& front = Vec3d(0.0));
 
 /// @brief One line per region for a text report ("crown: 31 % of strands (example 28 %), length
 /// p50 1.2 (1.3), lift 40 % (45 %), ...").

@@ -109,6 +109,9 @@ struct SynthParams
     /// direction from the fitted sphere's centre to the roots, so the hair sits on the upper
     /// hemisphere of scalp space whatever the file's axes (cyHair files are z-up, USC's y-up).
     Vec3d up{0.0, 0.0, 0.0};
+    /// The head's front, for the report by region (StyleRegions.h); (0, 0, 0): found from the
+    /// example's hairline.
+    Vec3d front{0.0, 0.0, 0.0};
     std::uint64_t seed = 0;
     /// Refuse outputs above this many vertices (16 bytes each with the samples, before refinement).
     std::uint64_t maxVertices = std::uint64_t(1) << 28;
