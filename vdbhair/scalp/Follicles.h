@@ -12,7 +12,7 @@
 ///    a nearest-neighbour spacing s gives d = s / 0.90 (relaxed roots sit 10 % closer than the
 ///    ideal lattice: kRelaxedNearestPerSpacing) and N = 2 A / (sqrt(3) d^2).
 /// 3. Contour: with a region, fixed particles on its rim (where the region ends on the surface),
-///    about 0.90 d apart along it (contourParticles in Follicles.cc). They repel the others and
+///    about 0.90 d apart along it (contourParticles, SurfaceCells.h). They repel the others and
 ///    never move, so the region's edge is lined with roots (a hairline) instead of left to
 ///    whichever free particles reach it. The rim is found at the level set's resolution: where the
 ///    spacing is below a voxel, contour roots are about a voxel apart and free roots fill between.

@@ -204,162 +204,197 @@ bool combPolyline(const std::vector<Vec3d>& p, const std::vector<std::vector<Vec
     return touched;
 }
 
-CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& strokes, const CombParams& params,
-                    openvdb::FloatGrid::ConstPtr scalp, bool threaded, openvdb::util::NullInterrupter* interrupter)
+namespace {
+
+/// One combHair() call: its inputs, the hierarchy, and what each step leaves for the next.
+struct CombRun
 {
-    params.validate("combHair");
-    for (std::size_t i = 0; i < strokes.size(); ++i) validateStroke(strokes[i], i, "combHair");
-    if (strokes.empty()) throw ValueError("combHair: no strokes");
-    if (strands.numStrands() == 0) throw ValueError("combHair: no strands to comb");
-    const auto forEach = [&](std::size_t count, auto&& fn) { forEachIndex(count, threaded, fn, 16); };
-    CombResult res;
-    const std::size_t n = strands.numStrands();
-    // The hierarchy, as synthesis builds it.
+    CombRun(const StrandSet& input, const std::vector<CombStroke>& combStrokes, const CombParams& p, bool runThreaded)
+        : strands(input), strokes(combStrokes), params(p), threaded(runThreaded), n(input.numStrands())
+    {
+    }
+
+    const StrandSet& strands;
+    const std::vector<CombStroke>& strokes;
+    const CombParams& params;
+    const bool threaded;
+    const std::size_t n;  ///< strands
+    // clusterHair()
     std::shared_ptr<ScalpMap> map;
     ClusterHierarchy h;
-    std::vector<std::uint32_t> order;
+    std::vector<std::uint32_t> order;  ///< the input strand of each of level 0's rows
+    // deformCoarsest()
+    std::size_t K = 0, ns = 0;                                           ///< coarsest strands; their vertices
+    std::vector<std::vector<Vec3d>> centre;                              ///< the coarsest strands combed (world)
+    std::vector<std::vector<Quat, Eigen::aligned_allocator<Quat>>> rot;  ///< per coarsest strand, its edges' rotations
+    std::vector<std::uint8_t> touched;                                   ///< coarsest strands some stroke reached
+
+    template<typename BodyT>
+    void forEach(std::size_t count, BodyT&& fn) const
+    {
+        forEachIndex(count, threaded, fn, 16);
+    }
+};
+
+/// The hierarchy, as synthesis builds it, and each strand's coarsest cluster (CombResult::cluster).
+void clusterHair(CombRun& run, openvdb::FloatGrid::ConstPtr scalp, openvdb::util::NullInterrupter* interrupter, CombResult& res)
+{
     {
         SynthStageTimer t{res.stages, "clustering"};
-        map = hairScalpMap(strands, params.synth.up, scalp);
-        h = hairHierarchy(strands, *map, params.synth, threaded, interrupter, &order);
+        run.map = hairScalpMap(run.strands, run.params.synth.up, scalp);
+        run.h = hairHierarchy(run.strands, *run.map, run.params.synth, run.threaded, interrupter, &run.order);
     }
-    res.cluster.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
+    res.cluster.assign(run.n, 0);
+    for (std::size_t i = 0; i < run.n; ++i) {
         std::uint32_t c = std::uint32_t(i);
-        for (const Clustering& cl : h.clusterings) c = cl.label[c];
-        res.cluster[order[i]] = std::int32_t(c);
+        for (const Clustering& cl : run.h.clusterings) c = cl.label[c];
+        res.cluster[run.order[i]] = std::int32_t(c);
     }
-    // 1. The coarsest strands, deformed stroke after stroke; their rotations composed per edge.
-    const StrandSamples& coarse = h.levels.back();
-    const std::size_t K = coarse.count(), ns = std::size_t(coarse.vertices);
-    const double sigma = params.smoothing * double(ns);
-    std::vector<std::vector<Vec3d>> centre(K);
-    std::vector<std::vector<Quat, Eigen::aligned_allocator<Quat>>> rot(K);
-    std::vector<std::uint8_t> touched(K, 0);
-    {
-        SynthStageTimer t{res.stages, "coarsest deformation"};
-        // The members of every coarsest cluster, as level 0's samples (rows in spatial order).
-        std::vector<std::vector<std::uint32_t>> members(K);
-        for (std::size_t i = 0; i < n; ++i) members[std::size_t(res.cluster[order[i]])].push_back(std::uint32_t(i));
-        const StrandSamples& fine = h.levels.front();
-        forEach(K, [&](std::size_t c) {
-            const auto world = [&](const StrandSamples& set, std::size_t i) {
-                std::vector<Vec3f> w(ns);
-                sampleToWorld(set.row(i), set.vertices, set.roots[i], set.frames[i], map->radius(), w.data());
-                return std::vector<Vec3d>(w.begin(), w.end());
-            };
-            std::vector<Vec3d> p = world(coarse, c), q;
-            std::vector<std::vector<Vec3d>> wisp;
-            for (std::uint32_t m : members[c]) wisp.push_back(world(fine, m));
-            rot[c].assign(ns - 1, Quat::Identity());
-            std::vector<std::array<double, 4>> r;
-            for (const CombStroke& s : strokes) {
-                if (!combPolyline(p, wisp, s, sigma, q, r)) continue;
-                touched[c] = 1;
-                for (std::size_t i = 0; i + 1 < ns; ++i) rot[c][i] = (toQuat(r[i]) * rot[c][i]).normalized();
-                // The members as the stroke left them: their edges turned by the same rotations.
-                for (std::vector<Vec3d>& m : wisp) {
-                    Vec3d at = m[0];
-                    for (std::size_t i = 0; i + 1 < ns; ++i) {
-                        const Vec3d e = m[i + 1] - m[i];
-                        m[i] = at;
-                        at += fromE(toQuat(r[i]) * toE(e));
-                    }
-                    m[ns - 1] = at;
-                }
-                p.swap(q);
-            }
-            centre[c] = std::move(p);
-        });
-    }
-    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("combing interrupted");
-    // 2. Every strand of a combed cluster: its edges turned by its centre's rotations at its arc
-    // length; then the head (below).
-    const HeadObstacle head = !params.head.unset() ? params.head
-                              : scalp             ? HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper)
-                                                  : headFromRoots(strands);
-    const bool relative = head.policy() == HeadPolicy::NoDeeper;
-    res.strands = strands;
-    {
-        SynthStageTimer t{res.stages, "detail re-transfer"};
-        // Arc length of every centre edge's midpoint (the original centre's).
-        std::vector<std::vector<double>> mids(K);
-        forEach(K, [&](std::size_t c) {
-            if (!touched[c]) return;
+}
+
+/// Step 1, the coarsest strands deformed stroke after stroke; their rotations composed per edge.
+void deformCoarsest(CombRun& run, CombResult& res)
+{
+    const StrandSamples& coarse = run.h.levels.back();
+    const std::size_t K = run.K = coarse.count(), ns = run.ns = std::size_t(coarse.vertices);
+    const double sigma = run.params.smoothing * double(ns);
+    run.centre.resize(K);
+    run.rot.resize(K);
+    run.touched.assign(K, 0);
+    SynthStageTimer t{res.stages, "coarsest deformation"};
+    // The members of every coarsest cluster, as level 0's samples (rows in spatial order).
+    std::vector<std::vector<std::uint32_t>> members(K);
+    for (std::size_t i = 0; i < run.n; ++i) members[std::size_t(res.cluster[run.order[i]])].push_back(std::uint32_t(i));
+    const StrandSamples& fine = run.h.levels.front();
+    run.forEach(K, [&](std::size_t c) {
+        const auto world = [&](const StrandSamples& set, std::size_t i) {
             std::vector<Vec3f> w(ns);
-            sampleToWorld(coarse.row(c), coarse.vertices, coarse.roots[c], coarse.frames[c], map->radius(), w.data());
-            mids[c].resize(ns - 1);
-            double a = 0.0;
-            for (std::size_t i = 0; i + 1 < ns; ++i) {
-                const double len = (Vec3d(w[i + 1]) - Vec3d(w[i])).length();
-                mids[c][i] = a + 0.5 * len;
-                a += len;
+            sampleToWorld(set.row(i), set.vertices, set.roots[i], set.frames[i], run.map->radius(), w.data());
+            return std::vector<Vec3d>(w.begin(), w.end());
+        };
+        std::vector<Vec3d> p = world(coarse, c), q;
+        std::vector<std::vector<Vec3d>> wisp;
+        for (std::uint32_t m : members[c]) wisp.push_back(world(fine, m));
+        run.rot[c].assign(ns - 1, Quat::Identity());
+        std::vector<std::array<double, 4>> r;
+        for (const CombStroke& s : run.strokes) {
+            if (!combPolyline(p, wisp, s, sigma, q, r)) continue;
+            run.touched[c] = 1;
+            for (std::size_t i = 0; i + 1 < ns; ++i) run.rot[c][i] = (toQuat(r[i]) * run.rot[c][i]).normalized();
+            // The members as the stroke left them: their edges turned by the same rotations.
+            for (std::vector<Vec3d>& m : wisp) {
+                Vec3d at = m[0];
+                for (std::size_t i = 0; i + 1 < ns; ++i) {
+                    const Vec3d e = m[i + 1] - m[i];
+                    m[i] = at;
+                    at += fromE(toQuat(r[i]) * toE(e));
+                }
+                m[ns - 1] = at;
             }
-        });
-        forEach(n, [&](std::size_t s) {
-            const std::size_t c = std::size_t(res.cluster[s]);
-            if (!touched[c]) return;
-            const Vec3f* in = strands.data(s);
-            Vec3f* out = res.strands.data(s);
-            const std::vector<double>& m = mids[c];
-            const auto& R = rot[c];
-            EVec q = toE(Vec3d(in[0]));
-            double a = 0.0;
-            std::size_t k = 0;
-            for (std::size_t v = 0; v + 1 < strands.size(s); ++v) {
-                const EVec e = toE(Vec3d(in[v + 1]) - Vec3d(in[v]));
-                const double mid = a + 0.5 * e.norm();
-                a += e.norm();
-                while (k + 1 < m.size() && m[k + 1] <= mid) ++k;
-                Quat Q;
-                if (mid <= m.front()) Q = R.front();
-                else if (k + 1 >= m.size()) Q = R.back();
-                else Q = R[k].slerp((mid - m[k]) / std::max(1e-300, m[k + 1] - m[k]), R[k + 1]);
-                const EVec step = Q * e;
-                q += step;
-                out[v + 1] = Vec3f(fromE(q));
-            }
-        });
-    }
-    // The head: the combed strands swept out of it along their length, no vertex deeper inside it
-    // than the input's (NoDeeper) or none inside (KeepOutside) (HeadCollision.h: a strand that
-    // meets the head follows it over a length instead of bending at one vertex).
-    if (!head.empty()) {
-        std::vector<char> touchedStrand(n, 0);
-        for (std::size_t s = 0; s < n; ++s) touchedStrand[s] = char(touched[std::size_t(res.cluster[s])]);
-        StrandSet combed = selectStrands(res.strands, touchedStrand);
-        std::vector<float> allowed(combed.numVertices(), 0.f);
-        if (relative) {
-            std::size_t w = 0;
-            HeadObstacle::Probe probe(head);
-            for (std::size_t s = 0; s < n; ++s) {
-                if (!touchedStrand[s]) continue;
-                for (std::size_t v = 0; v < strands.size(s); ++v, ++w) allowed[w] = float(std::max(0.0, -probe.distance(Vec3d(strands.data(s)[v]))));
-            }
+            p.swap(q);
         }
-        const HeadCollisionStats hc = resolveHeadCollisions(combed, head, allowed, {}, threaded);
-        std::size_t t = 0;
+        run.centre[c] = std::move(p);
+    });
+}
+
+/// Step 2, every strand of a combed cluster: its edges turned by its centre's rotations at its
+/// arc length, into CombResult::strands (a copy of the input).
+void retransferDetail(const CombRun& run, CombResult& res)
+{
+    const StrandSet& strands = run.strands;
+    const StrandSamples& coarse = run.h.levels.back();
+    const std::size_t K = run.K, ns = run.ns;
+    res.strands = strands;
+    SynthStageTimer t{res.stages, "detail re-transfer"};
+    // Arc length of every centre edge's midpoint (the original centre's).
+    std::vector<std::vector<double>> mids(K);
+    run.forEach(K, [&](std::size_t c) {
+        if (!run.touched[c]) return;
+        std::vector<Vec3f> w(ns);
+        sampleToWorld(coarse.row(c), coarse.vertices, coarse.roots[c], coarse.frames[c], run.map->radius(), w.data());
+        mids[c].resize(ns - 1);
+        double a = 0.0;
+        for (std::size_t i = 0; i + 1 < ns; ++i) {
+            const double len = (Vec3d(w[i + 1]) - Vec3d(w[i])).length();
+            mids[c][i] = a + 0.5 * len;
+            a += len;
+        }
+    });
+    run.forEach(run.n, [&](std::size_t s) {
+        const std::size_t c = std::size_t(res.cluster[s]);
+        if (!run.touched[c]) return;
+        const Vec3f* in = strands.data(s);
+        Vec3f* out = res.strands.data(s);
+        const std::vector<double>& m = mids[c];
+        const auto& R = run.rot[c];
+        EVec q = toE(Vec3d(in[0]));
+        double a = 0.0;
+        std::size_t k = 0;
+        for (std::size_t v = 0; v + 1 < strands.size(s); ++v) {
+            const EVec e = toE(Vec3d(in[v + 1]) - Vec3d(in[v]));
+            const double mid = a + 0.5 * e.norm();
+            a += e.norm();
+            while (k + 1 < m.size() && m[k + 1] <= mid) ++k;
+            Quat Q;
+            if (mid <= m.front()) Q = R.front();
+            else if (k + 1 >= m.size()) Q = R.back();
+            else Q = R[k].slerp((mid - m[k]) / std::max(1e-300, m[k + 1] - m[k]), R[k + 1]);
+            const EVec step = Q * e;
+            q += step;
+            out[v + 1] = Vec3f(fromE(q));
+        }
+    });
+}
+
+/// The head: the combed strands swept out of @a head along their length, no vertex deeper inside
+/// it than the input's (NoDeeper) or none inside (KeepOutside) (HeadCollision.h: a strand that
+/// meets the head follows it over a length instead of bending at one vertex).
+void keepOutOfHead(const CombRun& run, const HeadObstacle& head, CombResult& res)
+{
+    const StrandSet& strands = run.strands;
+    const std::size_t n = run.n;
+    const bool relative = head.policy() == HeadPolicy::NoDeeper;
+    std::vector<char> touchedStrand(n, 0);
+    for (std::size_t s = 0; s < n; ++s) touchedStrand[s] = char(run.touched[std::size_t(res.cluster[s])]);
+    StrandSet combed = selectStrands(res.strands, touchedStrand);
+    std::vector<float> allowed(combed.numVertices(), 0.f);
+    if (relative) {
+        std::size_t w = 0;
+        HeadObstacle::Probe probe(head);
         for (std::size_t s = 0; s < n; ++s) {
             if (!touchedStrand[s]) continue;
-            std::copy(combed.data(t), combed.data(t) + combed.size(t), res.strands.data(s));
-            ++t;
+            for (std::size_t v = 0; v < strands.size(s); ++v, ++w) allowed[w] = float(std::max(0.0, -probe.distance(Vec3d(strands.data(s)[v]))));
         }
-        res.stats.headDeflected = hc.strandsMoved;
     }
-    // 3. What the strokes did.
+    const HeadCollisionStats hc = resolveHeadCollisions(combed, head, allowed, {}, run.threaded);
+    std::size_t t = 0;
+    for (std::size_t s = 0; s < n; ++s) {
+        if (!touchedStrand[s]) continue;
+        std::copy(combed.data(t), combed.data(t) + combed.size(t), res.strands.data(s));
+        ++t;
+    }
+    res.stats.headDeflected = hc.strandsMoved;
+}
+
+/// Step 3, what the strokes did (CombStats), from the input and the combed strands.
+void measureComb(const CombRun& run, const HeadObstacle& head, CombResult& res)
+{
+    const StrandSet& strands = run.strands;
+    const std::vector<CombStroke>& strokes = run.strokes;
+    const std::size_t n = run.n;
     CombStats& st = res.stats;
-    st.clusters = K;
+    st.clusters = run.K;
     st.head = head.empty() ? std::string("none") : head.describe();
-    for (std::uint8_t u : touched) st.combedClusters += u;
+    for (std::uint8_t u : run.touched) st.combedClusters += u;
     std::vector<std::uint8_t> moved(n, 0);
-    for (std::size_t s = 0; s < n; ++s) moved[s] = touched[std::size_t(res.cluster[s])];
+    for (std::size_t s = 0; s < n; ++s) moved[s] = run.touched[std::size_t(res.cluster[s])];
     for (std::uint8_t u : moved) st.movedStrands += u;
     {
         // Per strand partial sums, added in strand order (the same on any thread count).
         std::vector<double> before(n, 0.0), after(n, 0.0);
         std::vector<std::size_t> count(n, 0), insideBefore(n, 0), insideAfter(n, 0);
         std::vector<std::uint8_t> kinked(n, 0);
-        forEach(n, [&](std::size_t s) {
+        run.forEach(n, [&](std::size_t s) {
             const Vec3f* a = strands.data(s);
             const Vec3f* b = res.strands.data(s);
             const std::size_t m = strands.size(s);
@@ -411,6 +446,29 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
         st.turningBefore /= double(ta.size());
         st.turningAfter /= double(tb.size());
     }
+}
+
+} // namespace
+
+CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& strokes, const CombParams& params,
+                    openvdb::FloatGrid::ConstPtr scalp, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    params.validate("combHair");
+    for (std::size_t i = 0; i < strokes.size(); ++i) validateStroke(strokes[i], i, "combHair");
+    if (strokes.empty()) throw ValueError("combHair: no strokes");
+    if (strands.numStrands() == 0) throw ValueError("combHair: no strands to comb");
+    CombRun run(strands, strokes, params, threaded);
+    CombResult res;
+    clusterHair(run, scalp, interrupter, res);
+    deformCoarsest(run, res);
+    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("combing interrupted");
+    // The head the combed strands are kept out of (keepOutOfHead()).
+    const HeadObstacle head = !params.head.unset() ? params.head
+                              : scalp             ? HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper)
+                                                  : headFromRoots(strands);
+    retransferDetail(run, res);
+    if (!head.empty()) keepOutOfHead(run, head, res);
+    measureComb(run, head, res);
     return res;
 }
 

@@ -8,6 +8,7 @@
 #include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/synth/impl/BalancedMatch.h>
+#include <vdbhair/synth/impl/DetailEdges.h>
 
 #include <vdbhair/Parallel.h>
 
@@ -140,245 +141,82 @@ double polylineLengthOf(const std::vector<Vec3d>& p)
 /// the three, not an optimum of any.
 constexpr double kStrandCarrierSmoothing = 3.0 / 16.0;
 constexpr double kCentreCarrierSmoothing = 0.5;
-/// Edges whose angle has a cosine within this of 1 (about 0.06 degrees) are collinear (strandEdges()):
-/// a coarse polyline resampled to n_s (Curly_100 has 15-19 vertices a strand) is a run of collinear
-/// edges between its corners. Each edge held in the carrier's frame at its own middle, a run came
-/// out bent wherever the output carrier turned otherwise than the strand's own, every edge by a
-/// little, and the bends added up: Curly_100 synthesized had strands with 2.6 times the turning of
-/// the strand they copied (7.2 rad against 2.7).
-constexpr double kCollinearCos = 5e-7;
 
-/// A polyline's low-passed self (smoothPolyline(), σ in vertices) with its rotation-minimizing
-/// frames (started from @a reference) and arc lengths: what detail is laid along.
-struct Carrier
+/// One transferDetail() call: its inputs and their sizes, and what each step below leaves for the
+/// steps after it.
+struct DetailTransferRun
 {
-    std::vector<Vec3f> points;
-    std::vector<Frame> frames;
-    std::vector<double> arc;
-    double length() const { return arc.empty() ? 0.0 : arc.back(); }
-
-    Carrier() = default;
-    Carrier(const std::vector<Vec3d>& p, double sigma, const Vec3f& reference)
+    DetailTransferRun(const TransferSource& src, const StrandSamples& centres, const std::vector<Vec3d>& newRoots, const ScalpMap& scalpMap,
+                      DetailBlend detailBlend, DetailScale detailScale, int outVertices, const DetailMatchParams& matchParams, bool runThreaded)
+        : source(src), inS(*src.strands), inC(*src.centers), outCenters(centres), roots(newRoots), map(scalpMap), blend(detailBlend),
+          scale(detailScale), matching(matchParams), threaded(runThreaded), ns(inS.vertices), nc(centres.vertices),
+          no(outVertices > 0 ? outVertices : nc), dim(inS.dim()), nIn(inC.count()), nOut(centres.count()), n(newRoots.size()),
+          radius(scalpMap.radius()), balanced(matchParams.balance > 0.0), edges(detailBlend == DetailBlend::Edges),
+          sigmaCentre(kCentreCarrierSmoothing * double(ns)), sigmaStrand(kStrandCarrierSmoothing * double(ns))
     {
-        std::vector<Vec3d> smooth(p.size());
-        smoothPolyline(p.data(), p.size(), sigma, smooth.data());
-        points.resize(p.size());
-        for (std::size_t k = 0; k < p.size(); ++k) points[k] = Vec3f(smooth[k]);
-        frames.resize(p.size());
-        parallelTransportFrames(points.data(), points.size(), reference, frames.data());
-        arc.assign(p.size(), 0.0);
-        for (std::size_t k = 1; k < p.size(); ++k) arc[k] = arc[k - 1] + (smooth[k] - smooth[k - 1]).length();
     }
 
-    /// The frame at arc length @a s (clamped to the carrier), between vertices by normalized
-    /// interpolation; as three world axes (t, n, b).
-    void frameAt(double s, Vec3d axes[3]) const
+    const TransferSource& source;
+    const StrandSamples& inS;         ///< the input's strands
+    const StrandSamples& inC;         ///< the input's centres
+    const StrandSamples& outCenters;  ///< the coarser output strands
+    const std::vector<Vec3d>& roots;  ///< the new strands' roots
+    const ScalpMap& map;
+    const DetailBlend blend;
+    const DetailScale scale;
+    const DetailMatchParams& matching;
+    const bool threaded;
+    const int ns, nc, no;                 ///< vertices of an input strand, of an output centre, of a new strand
+    const std::size_t dim, nIn, nOut, n;  ///< floats in an input row; input centres, output centres, new strands
+    const double radius;
+    const bool balanced, edges;           ///< DetailMatchParams::balance on; DetailBlend::Edges
+    const double sigmaCentre, sigmaStrand;  ///< carrier smoothing of centres and of strands, in vertices
+    // clusterRoots()
+    std::vector<std::uint32_t> label;  ///< #n: each new strand's output centre
+    // alignCentres()
+    std::vector<ScalpFrame> inAligned, outAligned;
+    std::vector<float> rows;  ///< input then output centres in their aligned frames, n_s vertices each
+    // matchClusters()
+    std::vector<std::uint32_t> match;  ///< #nOut: each output centre's input centre
+    // matchStrands()
+    std::vector<std::uint32_t> pickOf;  ///< #n: each new strand's input strand
+    // centreGeometry()
+    std::vector<std::vector<Vec3f>> outWorld, inWorld;
+    std::vector<std::vector<Frame>> outRmf, inRmf;
+    std::vector<std::uint8_t> inUsed, outUsed;
+    // centreCarriers()
+    std::vector<double> inCarrierLength;
+    std::vector<detail::Carrier> inCarrier, outCarrier;
+    // readPositions()
+    std::vector<std::vector<double>> atOf;  ///< per output centre used, where each output vertex reads
+
+    template<typename BodyT>
+    void forEach(std::size_t count, BodyT&& fn) const
     {
-        std::size_t j = 0;
-        double u = 0.0;
-        if (s >= arc.back()) {
-            j = arc.size() - 1;
-        } else if (s > 0.0) {
-            j = std::size_t(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()) - 1;
-            const double span = arc[j + 1] - arc[j];
-            u = span > 0.0 ? (s - arc[j]) / span : 0.0;
-        }
-        Vec3d t = Vec3d(frames[j].t), n = Vec3d(frames[j].n);
-        if (u > 0.0 && j + 1 < frames.size()) {
-            t = t * (1.0 - u) + Vec3d(frames[j + 1].t) * u;
-            n = n * (1.0 - u) + Vec3d(frames[j + 1].n) * u;
-        }
-        t = t.unitSafe();
-        n = (n - t * n.dot(t)).unitSafe();
-        axes[0] = t;
-        axes[1] = n;
-        axes[2] = t.cross(n);
+        forEachIndex(count, threaded, fn, 64);
     }
 };
 
-/// The rotation that takes unit @a from to unit @a to by the shortest arc, applied to @a v.
-Vec3d rotateOnto(const Vec3d& from, const Vec3d& to, const Vec3d& v)
-{
-    const Vec3d axis = from.cross(to);
-    const double s = axis.length(), c = from.dot(to);
-    if (s < 1e-12) {
-        if (c >= 0.0) return v;
-        const Vec3d k = Vec3d(perpendicularTo(Vec3f(from))).unitSafe();  // half a turn about any perpendicular
-        return k * (2.0 * k.dot(v)) - v;
-    }
-    const Vec3d k = axis / s;
-    return v * c + k.cross(v) * s + k * (k.dot(v) * (1.0 - c));
-}
-
-/// One strand's detail as edges (DetailBlend::Edges): every edge in the frame of the strand's
-/// carrier at the edge's middle; @a advance receives how far along the carrier each edge goes
-/// (where the edge is laid along the output's carrier). (Turning each edge so that the edges'
-/// local mean points along the carrier was tried: the ponytail onto the default head drifted
-/// 0.082 of its length from BASE's wisps with it, 0.076 without.)
-std::vector<Vec3d> strandEdges(const std::vector<Vec3d>& strand, double sigma, const Vec3f& reference, std::vector<Vec3f>* carrierPoints,
-                               std::vector<double>* advance, std::vector<double>* frameShift)
-{
-    const Carrier c(strand, sigma, reference);
-    if (carrierPoints) *carrierPoints = c.points;
-    if (advance) {
-        advance->resize(strand.size() - 1);
-        for (std::size_t k = 0; k + 1 < strand.size(); ++k) (*advance)[k] = c.arc[k + 1] - c.arc[k];
-    }
-    const std::size_t K = strand.size() - 1;
-    // Runs of collinear edges (a straight piece of a coarse polyline, resampled) share one frame,
-    // the carrier's at the run's middle, so that they stay collinear wherever the output carrier
-    // turns otherwise; every other edge takes the frame at its own middle (NaN in frameShift).
-    std::vector<double> shift(K, std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t a = 0; a < K;) {
-        std::size_t b = a + 1;
-        while (b < K) {
-            const Vec3d e0 = strand[b] - strand[b - 1], e1 = strand[b + 1] - strand[b];
-            const double l0 = e0.length(), l1 = e1.length();
-            if (!(l0 > 0.0 && l1 > 0.0) || e0.dot(e1) < (1.0 - kCollinearCos) * l0 * l1) break;
-            ++b;
-        }
-        if (b - a > 1) {
-            const double mid = 0.5 * (c.arc[a] + c.arc[b]);
-            for (std::size_t k = a; k < b; ++k) shift[k] = mid - c.arc[k];
-        }
-        a = b;
-    }
-    std::vector<Vec3d> d(K);
-    for (std::size_t k = 0; k < K; ++k) {
-        Vec3d axes[3];
-        c.frameAt(std::isnan(shift[k]) ? 0.5 * (c.arc[k] + c.arc[k + 1]) : c.arc[k] + shift[k], axes);
-        const Vec3d e = strand[k + 1] - strand[k];
-        d[k] = Vec3d(axes[0].dot(e), axes[1].dot(e), axes[2].dot(e));
-    }
-    if (frameShift) *frameShift = std::move(shift);
-    return d;
-}
-
-/// The loop that repeats past a strand's end (DetailScale::ArcLength): edges [a, K) of @a d,
-/// where the window of edges before a is most like the window ending the strand (so the repeat
-/// joins as the strand itself continues: a period of a curl), at least a quarter of the strand
-/// long. Turned as a whole: first so that its net step points along the carrier (a loop that
-/// leans would step sideways at every repeat), then about the carrier by the angle that best
-/// joins its start to the strand's end; @a twist receives that angle (each repeat turns by it).
-std::vector<Vec3d> strandLoop(const std::vector<Vec3d>& d, double& twist)
-{
-    const std::size_t K = d.size();
-    const std::size_t minLoop = std::max<std::size_t>(1, K / 4), window = std::max<std::size_t>(1, std::min<std::size_t>(4, K / 8));
-    std::size_t a = 0;
-    double best = std::numeric_limits<double>::max();
-    for (std::size_t start = 1; start + minLoop <= K; ++start) {
-        double e = 0.0;
-        std::size_t w = 0;
-        for (; w < window && w < start; ++w) e += (d[start - 1 - w] - d[K - 1 - w]).lengthSqr();
-        e /= double(w);
-        if (e < best) {
-            best = e;
-            a = start;
-        }
-    }
-    std::vector<Vec3d> loop(d.begin() + std::ptrdiff_t(a), d.end());
-    Vec3d net(0.0);
-    for (const Vec3d& e : loop) net += e;
-    if (net.length() > 1e-30)
-        for (Vec3d& e : loop) e = rotateOnto(net.unitSafe(), Vec3d(1.0, 0.0, 0.0), e);
-    // The twist about x̂ that takes the edges before the loop's start (as turned) onto the strand's last edges.
-    double sn = 0.0, cs = 0.0;
-    if (a > 0) {
-        const Vec3d before = net.length() > 1e-30 ? rotateOnto(net.unitSafe(), Vec3d(1.0, 0.0, 0.0), d[a - 1]) : d[a - 1];
-        const Vec3d& last = d[K - 1];
-        sn = before.y() * last.z() - before.z() * last.y();
-        cs = before.y() * last.y() + before.z() * last.z();
-    }
-    twist = (sn != 0.0 || cs != 0.0) ? std::atan2(sn, cs) : 0.0;
-    return loop;
-}
-
-/// The strand of DetailBlend::Edges: @a d (strandEdges()) scaled by @a lambda, laid from
-/// @a root in the frames of @a carrier at the place each edge reaches along it (its running
-/// progress along x̂), until the progress reaches @a target: the strand's last edge is cut
-/// there, or the strand's loop (strandLoop()) repeats after it, turned by one more twist each time.
-std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<double>& advance, const std::vector<double>& frameShift,
-                            double lambda, const Carrier& carrier, const Vec3d& root, double target)
-{
-    std::vector<Vec3d> out{root};
-    out.reserve(d.size() + 1);
-    double progress = 0.0;
-    const auto lay = [&](const Vec3d& local, double step, double shift) {
-        Vec3d e = local * lambda;
-        step *= lambda;
-        bool last = false;
-        // (Within rounding of the target: a strand laid to its own length ends on its last edge.)
-        if (progress + step >= target * (1.0 - 1e-9) && step > 0.0) {
-            e *= (target - progress) / step;
-            step = target - progress;
-            last = true;
-        }
-        Vec3d axes[3];
-        carrier.frameAt(std::isnan(shift) ? progress + 0.5 * step : progress + shift * lambda, axes);
-        out.push_back(out.back() + axes[0] * e.x() + axes[1] * e.y() + axes[2] * e.z());
-        progress += step;
-        return last;
-    };
-    for (std::size_t k = 0; k < d.size(); ++k)
-        if (lay(d[k], advance[k], frameShift[k])) return out;
-    if (progress >= target * (1.0 - 1e-9)) return out;
-    double twist = 0.0;
-    std::vector<Vec3d> loop = strandLoop(d, twist);
-    const auto stepOf = [](const std::vector<Vec3d>& l, double& arc) {
-        double step = 0.0;
-        arc = 0.0;
-        for (const Vec3d& e : l) {
-            step += e.x();
-            arc += e.length();
-        }
-        return step;
-    };
-    double arc = 0.0, loopStep = stepOf(loop, arc);
-    if (!(loopStep > 0.1 * arc)) {
-        // A loop that hardly moves on (a closed curl): the whole strand repeats instead.
-        loop = d;
-        Vec3d net(0.0);
-        for (const Vec3d& e : loop) net += e;
-        if (net.length() > 1e-30)
-            for (Vec3d& e : loop) e = rotateOnto(net.unitSafe(), Vec3d(1.0, 0.0, 0.0), e);
-        twist = 0.0;
-        loopStep = stepOf(loop, arc);
-        if (!(loopStep > 0.0)) return out;
-    }
-    // (A cap on the repeats: targets are at most a few dozen strand lengths, kMaxOutputVertices.)
-    constexpr std::size_t kMaxLaid = std::size_t(1) << 16;
-    for (int r = 1; progress < target && out.size() < kMaxLaid; ++r) {
-        const double c = std::cos(twist * r), sn = std::sin(twist * r);
-        for (const Vec3d& e : loop)
-            if (lay(Vec3d(e.x(), c * e.y() - sn * e.z(), sn * e.y() + c * e.z()), std::max(0.0, e.x()), std::numeric_limits<double>::quiet_NaN())) return out;
-    }
-    return out;
-}
-} // namespace
-
-StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
-                             const std::vector<Vec3d>& roots, const ScalpMap& map, int components,
-                             std::vector<std::uint32_t>* outLabel, TransferStats* stats, DetailBlend blend, bool threaded,
-                             openvdb::util::NullInterrupter* interrupter, const std::vector<std::uint32_t>* givenLabel,
-                             DetailScale scale, int outVertices, const DetailMatchParams& matching)
+/// The checks of transferDetail()'s arguments, before any work.
+void checkTransferInputs(const TransferSource& source, const StrandSamples& outCenters, int outVertices, const DetailMatchParams& matching)
 {
     matching.validate("transferDetail");
     if (!source.strands || !source.centers || !source.label || source.strands->count() == 0 ||
         source.centers->count() == 0 || source.label->size() != source.strands->count())
         throw ValueError("transferDetail: the input level is incomplete or empty");
     if (outCenters.count() == 0) throw ValueError("transferDetail: no coarser output strands to transfer onto");
-    const StrandSamples& inS = *source.strands;
-    const StrandSamples& inC = *source.centers;
-    const int ns = inS.vertices, nc = outCenters.vertices, no = outVertices > 0 ? outVertices : nc;
-    if (inC.vertices != ns)
+    const int ns = source.strands->vertices, nc = outCenters.vertices, no = outVertices > 0 ? outVertices : nc;
+    if (source.centers->vertices != ns)
         throw ValueError("transferDetail: the input levels have different vertex counts per strand");
     if (ns < 2 || nc < 2 || no < 2) throw ValueError("transferDetail: strands need at least 2 vertices");
-    const std::size_t dim = inS.dim(), nIn = inC.count(), nOut = outCenters.count(), n = roots.size();
-    const double radius = map.radius();
-    const auto forEach = [&](std::size_t count, auto&& fn) { forEachIndex(count, threaded, fn, 64); };
+}
 
-    // 1. Output clusters: each new root joins the nearest coarser output root (or its given centre).
-    std::vector<std::uint32_t> label(n, 0);
+/// Step 1, output clusters: each new root joins the nearest coarser output root (or its given centre).
+void clusterRoots(DetailTransferRun& run, const std::vector<std::uint32_t>* givenLabel)
+{
+    const std::size_t n = run.n, nOut = run.nOut;
+    std::vector<std::uint32_t>& label = run.label;
+    label.assign(n, 0);
     if (givenLabel) {
         if (givenLabel->size() != n)
             throw ValueError("transferDetail: " + std::to_string(givenLabel->size()) + " given centres for " + std::to_string(n) + " roots");
@@ -386,10 +224,11 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             if (c >= nOut) throw ValueError("transferDetail: given centre " + std::to_string(c) + " of " + std::to_string(nOut));
         label = *givenLabel;
     } else {
-        PointCloud cloud{&outCenters.roots};
+        PointCloud cloud{&run.outCenters.roots};
         PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
         tree.buildIndex();
-        forEach(n, [&](std::size_t i) {
+        const std::vector<Vec3d>& roots = run.roots;
+        run.forEach(n, [&](std::size_t i) {
             std::uint32_t idx;
             double d2;
             const double q[3] = {roots[i].x(), roots[i].y(), roots[i].z()};
@@ -397,56 +236,76 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             label[i] = idx;
         });
     }
-    // 2. Aligned frames of every centre and their rows in them.
-    std::vector<ScalpFrame> inAligned(nIn), outAligned(nOut);
-    std::vector<float> rows((nIn + nOut) * dim);
-    forEach(nIn, [&](std::size_t c) {
+}
+
+/// Step 2: the aligned frame of every centre and its row in it, input and output centres both at
+/// the input's n_s vertices; balanced, each set's rows over its median centre length.
+void alignCentres(DetailTransferRun& run)
+{
+    const StrandSamples& inC = run.inC;
+    const StrandSamples& outCenters = run.outCenters;
+    const int ns = run.ns, nc = run.nc;
+    const std::size_t dim = run.dim, nIn = run.nIn, nOut = run.nOut;
+    std::vector<ScalpFrame>& inAligned = run.inAligned;
+    std::vector<ScalpFrame>& outAligned = run.outAligned;
+    std::vector<float>& rows = run.rows;
+    inAligned.resize(nIn);
+    outAligned.resize(nOut);
+    rows.resize((nIn + nOut) * dim);
+    run.forEach(nIn, [&](std::size_t c) {
         inAligned[c] = alignedFrame(inC.row(c), ns, inC.frames[c]);
         reexpress(inC.row(c), ns, inC.frames[c], inAligned[c], rows.data() + c * dim);
     });
-    forEach(nOut, [&](std::size_t c) {
+    run.forEach(nOut, [&](std::size_t c) {
         // Compared at the input's n_s vertices (the same row when the counts agree).
         std::vector<float> row(dim);
         resampleRow(outCenters.row(c), nc, ns, row.data());
         outAligned[c] = alignedFrame(row.data(), ns, outCenters.frames[c]);
         reexpress(row.data(), ns, outCenters.frames[c], outAligned[c], rows.data() + (nIn + c) * dim);
     });
+    if (!run.balanced) return;
+    // One scale: each set's rows over its median centre length (DetailMatchParams).
+    const auto rowLength = [&](std::size_t r) {
+        const float* q = rows.data() + r * dim;
+        double len = 0.0;
+        for (int l = 1; l < ns; ++l)
+            len += std::sqrt(double(q[3 * l] - q[3 * l - 3]) * (q[3 * l] - q[3 * l - 3]) + double(q[3 * l + 1] - q[3 * l - 2]) * (q[3 * l + 1] - q[3 * l - 2]) +
+                             double(q[3 * l + 2] - q[3 * l - 1]) * (q[3 * l + 2] - q[3 * l - 1]));
+        return len;
+    };
+    const auto medianOf = [&](std::size_t from, std::size_t count) {
+        std::vector<double> v(count);
+        for (std::size_t r = 0; r < count; ++r) v[r] = rowLength(from + r);
+        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(count / 2), v.end());
+        return v[count / 2];
+    };
+    const double mIn = medianOf(0, nIn), mOut = medianOf(nIn, nOut);
+    for (std::size_t r = 0; r < nIn + nOut; ++r) {
+        const double m = r < nIn ? mIn : mOut;
+        if (m > 1e-30)
+            for (std::size_t k = 0; k < dim; ++k) rows[r * dim + k] = float(rows[r * dim + k] / m);
+    }
+}
+
+/// Step 3, matching clusters through PCA features of both sets of centres: each output centre
+/// takes the nearest input centre or, balanced, the nearest with room among its candidates.
+void matchClusters(DetailTransferRun& run, int components)
+{
+    const std::size_t dim = run.dim, nIn = run.nIn, nOut = run.nOut, n = run.n;
+    const std::vector<float>& rows = run.rows;
+    const bool balanced = run.balanced;
     // Each output centre's strands (the load it puts on the input centre it takes).
     std::vector<std::size_t> load(nOut, 0);
-    for (std::uint32_t l : label) ++load[l];
-    const bool balanced = matching.balance > 0.0;
-    if (balanced) {
-        // One scale: each set's rows over its median centre length (DetailMatchParams).
-        const auto rowLength = [&](std::size_t r) {
-            const float* q = rows.data() + r * dim;
-            double len = 0.0;
-            for (int l = 1; l < ns; ++l)
-                len += std::sqrt(double(q[3 * l] - q[3 * l - 3]) * (q[3 * l] - q[3 * l - 3]) + double(q[3 * l + 1] - q[3 * l - 2]) * (q[3 * l + 1] - q[3 * l - 2]) +
-                                 double(q[3 * l + 2] - q[3 * l - 1]) * (q[3 * l + 2] - q[3 * l - 1]));
-            return len;
-        };
-        const auto medianOf = [&](std::size_t from, std::size_t count) {
-            std::vector<double> v(count);
-            for (std::size_t r = 0; r < count; ++r) v[r] = rowLength(from + r);
-            std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(count / 2), v.end());
-            return v[count / 2];
-        };
-        const double mIn = medianOf(0, nIn), mOut = medianOf(nIn, nOut);
-        for (std::size_t r = 0; r < nIn + nOut; ++r) {
-            const double m = r < nIn ? mIn : mOut;
-            if (m > 1e-30)
-                for (std::size_t k = 0; k < dim; ++k) rows[r * dim + k] = float(rows[r * dim + k] / m);
-        }
-    }
-    // 3. Matching clusters through PCA features of both sets of centres.
+    for (std::uint32_t l : run.label) ++load[l];
     const Pca pca = fitPca(rows.data(), nIn + nOut, dim, components);
     const int nf = pca.components;
     std::vector<float> feat((nIn + nOut) * std::size_t(nf));
-    forEach(nIn + nOut, [&](std::size_t r) { pca.project(rows.data() + r * dim, feat.data() + r * std::size_t(nf)); });
-    std::vector<std::uint32_t> match(nOut, 0);
-    const std::size_t K = balanced ? std::min<std::size_t>(nIn, std::size_t(matching.candidates)) : 1;
+    run.forEach(nIn + nOut, [&](std::size_t r) { pca.project(rows.data() + r * dim, feat.data() + r * std::size_t(nf)); });
+    std::vector<std::uint32_t>& match = run.match;
+    match.assign(nOut, 0);
+    const std::size_t K = balanced ? std::min<std::size_t>(nIn, std::size_t(run.matching.candidates)) : 1;
     std::vector<std::pair<double, std::uint32_t>> nearest(nOut * K);  // per output centre, its K nearest (distance, input)
-    forEach(nOut, [&](std::size_t c) {
+    run.forEach(nOut, [&](std::size_t c) {
         const float* f = feat.data() + (nIn + c) * std::size_t(nf);
         std::vector<std::pair<double, std::uint32_t>> all(nIn);
         for (std::size_t j = 0; j < nIn; ++j) all[j] = {sampleDistance2(f, feat.data() + j * std::size_t(nf), std::size_t(nf)), std::uint32_t(j)};
@@ -454,49 +313,58 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
         std::copy_n(all.begin(), K, nearest.begin() + std::ptrdiff_t(c * K));
         match[c] = all[0].second;
     });
-    if (balanced) {
-        // Pairs by increasing distance; an input centre serves at most balance × its even share
-        // of the output's strands; an output wisp that fits no candidate keeps its nearest.
-        std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> pairs;
-        for (std::size_t c = 0; c < nOut; ++c)
-            if (load[c])
-                for (std::size_t k = 0; k < K; ++k) pairs.emplace_back(nearest[c * K + k].first, std::uint32_t(c), nearest[c * K + k].second);
-        std::sort(pairs.begin(), pairs.end());
-        // An input wisp's share is its own part of the input's strands, so that the output's
-        // wisps take detail in the proportions the input has it (and a hairstyle onto itself
-        // takes every wisp from itself: an even share turned wisps larger than the mean away
-        // from their own detail).
-        std::vector<double> share(nIn, 0.0);
-        for (std::uint32_t c : *source.label) share[c] += matching.balance * double(n) / double(inS.count());
-        std::vector<double> used(nIn, 0.0);
-        std::vector<std::uint8_t> done(nOut, 0);
-        for (const auto& [d, c, j] : pairs) {
-            if (done[c] || used[j] + double(load[c]) > share[j]) continue;
-            done[c] = 1;
-            used[j] += double(load[c]);
-            match[c] = j;
-        }
+    if (!balanced) return;
+    // Pairs by increasing distance; an input centre serves at most balance × its even share
+    // of the output's strands; an output wisp that fits no candidate keeps its nearest.
+    std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t c = 0; c < nOut; ++c)
+        if (load[c])
+            for (std::size_t k = 0; k < K; ++k) pairs.emplace_back(nearest[c * K + k].first, std::uint32_t(c), nearest[c * K + k].second);
+    std::sort(pairs.begin(), pairs.end());
+    // An input wisp's share is its own part of the input's strands, so that the output's
+    // wisps take detail in the proportions the input has it (and a hairstyle onto itself
+    // takes every wisp from itself: an even share turned wisps larger than the mean away
+    // from their own detail).
+    std::vector<double> share(nIn, 0.0);
+    for (std::uint32_t c : *run.source.label) share[c] += run.matching.balance * double(n) / double(run.inS.count());
+    std::vector<double> used(nIn, 0.0);
+    std::vector<std::uint8_t> done(nOut, 0);
+    for (const auto& [d, c, j] : pairs) {
+        if (done[c] || used[j] + double(load[c]) > share[j]) continue;
+        done[c] = 1;
+        used[j] += double(load[c]);
+        match[c] = j;
     }
-    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("detail transfer interrupted");
+}
+
+/// Step 4, matching strands: each output strand takes a member of its matched input wisp by root
+/// offset from the centre (aligned frames). Balanced, pairs are taken by increasing offset
+/// distance and a member serves at most balance × its even share of the output wisp's strands
+/// (so the output's strands take the input wisp's lengths and curls in its proportions: picked
+/// by nearest offset alone, 100 strands of Curly_100 took a few members many times); the
+/// paper's rule (balance 0) takes the nearest.
+void matchStrands(DetailTransferRun& run)
+{
+    const StrandSamples& inS = run.inS;
+    const StrandSamples& inC = run.inC;
+    const StrandSamples& outCenters = run.outCenters;
+    const std::vector<Vec3d>& roots = run.roots;
+    const std::size_t nIn = run.nIn, nOut = run.nOut, n = run.n;
+    const bool balanced = run.balanced;
     // Members of each input cluster.
     std::vector<std::vector<std::uint32_t>> members(nIn);
-    for (std::uint32_t s = 0; s < inS.count(); ++s) members[(*source.label)[s]].push_back(s);
-    // 4. Matching strands: each output strand takes a member of its matched input wisp by root
-    // offset from the centre (aligned frames). Balanced, pairs are taken by increasing offset
-    // distance and a member serves at most balance × its even share of the output wisp's strands
-    // (so the output's strands take the input wisp's lengths and curls in its proportions: picked
-    // by nearest offset alone, 100 strands of Curly_100 took a few members many times); the
-    // paper's rule (balance 0) takes the nearest.
+    for (std::uint32_t s = 0; s < inS.count(); ++s) members[(*run.source.label)[s]].push_back(s);
     std::vector<std::vector<std::uint32_t>> strandsOf(nOut);
-    for (std::size_t i = 0; i < n; ++i) strandsOf[label[i]].push_back(std::uint32_t(i));
-    std::vector<std::uint32_t> pickOf(n, 0);
-    forEach(nOut, [&](std::size_t oc) {
+    for (std::size_t i = 0; i < n; ++i) strandsOf[run.label[i]].push_back(std::uint32_t(i));
+    std::vector<std::uint32_t>& pickOf = run.pickOf;
+    pickOf.assign(n, 0);
+    run.forEach(nOut, [&](std::size_t oc) {
         const std::vector<std::uint32_t>& mine = strandsOf[oc];
-        const std::uint32_t ic = match[oc];
+        const std::uint32_t ic = run.match[oc];
         const std::vector<std::uint32_t>& mem = members[ic];
         if (mine.empty() || mem.empty()) return;
-        const ScalpFrame& mo = outAligned[oc];
-        const ScalpFrame& mi = inAligned[ic];
+        const ScalpFrame& mo = run.outAligned[oc];
+        const ScalpFrame& mi = run.inAligned[ic];
         std::vector<Vec3d> offIn(mem.size());
         for (std::size_t k = 0; k < mem.size(); ++k) offIn[k] = mi.toLocal(inS.roots[mem[k]] - inC.roots[ic]);
         // Balanced: the greedy over every (distance², strand, member) pair by increasing distance
@@ -524,67 +392,84 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             if (balanced) nearest[a] = std::uint32_t(nearestK);
         }
         if (!balanced) return;
-        const double cap = std::ceil(matching.balance * double(mine.size()) / double(mem.size()));
+        const double cap = std::ceil(run.matching.balance * double(mine.size()) / double(mem.size()));
         detail::balancedMatch(cand, mine.size(), mem.size(), nearest, cap,
                               [&](std::uint32_t a, std::uint32_t k) { pickOf[mine[a]] = mem[k]; });
     });
-    // World geometry and rotation-minimizing frames of the centres used, computed once each.
-    std::vector<std::vector<Vec3f>> outWorld(nOut), inWorld(nIn);
-    std::vector<std::vector<Frame>> outRmf(nOut), inRmf(nIn);
-    std::vector<std::uint8_t> inUsed(nIn, 0), outUsed(nOut, 0);
-    for (std::uint32_t l : label) outUsed[l] = 1;
+}
+
+/// World geometry and rotation-minimizing frames of the centres used, computed once each (the
+/// output centres at the output's vertex count).
+void centreGeometry(DetailTransferRun& run)
+{
+    const std::size_t nIn = run.nIn, nOut = run.nOut;
+    run.outWorld.resize(nOut);
+    run.inWorld.resize(nIn);
+    run.outRmf.resize(nOut);
+    run.inRmf.resize(nIn);
+    run.inUsed.assign(nIn, 0);
+    run.outUsed.assign(nOut, 0);
+    for (std::uint32_t l : run.label) run.outUsed[l] = 1;
     for (std::size_t c = 0; c < nOut; ++c)
-        if (outUsed[c]) inUsed[match[c]] = 1;
-    // (The output centres at the output's vertex count.)
+        if (run.outUsed[c]) run.inUsed[run.match[c]] = 1;
     const auto prepare = [&](const StrandSamples& s, std::size_t i, const ScalpFrame& aligned, int vertices,
                              std::vector<Vec3f>& world, std::vector<Frame>& rmf) {
         std::vector<float> row(std::size_t(3 * vertices));
         resampleRow(s.row(i), s.vertices, vertices, row.data());
         world.resize(std::size_t(vertices));
-        sampleToWorld(row.data(), vertices, s.roots[i], s.frames[i], radius, world.data());
+        sampleToWorld(row.data(), vertices, s.roots[i], s.frames[i], run.radius, world.data());
         rmf.resize(std::size_t(vertices));
         parallelTransportFrames(world.data(), world.size(), Vec3f(aligned.t), rmf.data());
     };
-    forEach(nIn, [&](std::size_t c) { if (inUsed[c]) prepare(inC, c, inAligned[c], ns, inWorld[c], inRmf[c]); });
-    forEach(nOut, [&](std::size_t c) { if (outUsed[c]) prepare(outCenters, c, outAligned[c], no, outWorld[c], outRmf[c]); });
-    // DetailBlend::Edges: each used input centre's carrier and each used output centre's, at one
-    // σ in world units (kCentreCarrierSmoothing of the matched input centre's vertices) so that a
-    // centre onto itself gives its own carrier; strands' carriers at kStrandCarrierSmoothing of
-    // their vertices (below, "Carrier smoothing").
-    const bool edges = blend == DetailBlend::Edges;
-    const double sigmaCentre = kCentreCarrierSmoothing * double(ns), sigmaStrand = kStrandCarrierSmoothing * double(ns);
-    std::vector<double> inCarrierLength(nIn, 0.0);
-    std::vector<Carrier> inCarrier(edges ? nIn : 0), outCarrier(edges ? nOut : 0);
-    if (edges) {
-        const auto toD = [](const std::vector<Vec3f>& p) {
-            std::vector<Vec3d> q(p.size());
-            for (std::size_t k = 0; k < p.size(); ++k) q[k] = Vec3d(p[k]);
-            return q;
-        };
-        forEach(nIn, [&](std::size_t c) {
-            if (!inUsed[c]) return;
-            inCarrier[c] = Carrier(toD(inWorld[c]), sigmaCentre, Vec3f(inAligned[c].t));
-            inCarrierLength[c] = inCarrier[c].length();
-        });
-        forEach(nOut, [&](std::size_t c) {
-            if (!outUsed[c]) return;
-            const std::vector<Vec3d> p = toD(outWorld[c]);
-            const double spacingIn = polylineLengthOf(toD(inWorld[match[c]])) / double(ns - 1);
-            const double spacingOut = polylineLengthOf(p) / double(no - 1);
-            outCarrier[c] = Carrier(p, spacingOut > 0.0 ? sigmaCentre * spacingIn / spacingOut : sigmaCentre, Vec3f(outAligned[c].t));
-        });
-    }
+    run.forEach(nIn, [&](std::size_t c) { if (run.inUsed[c]) prepare(run.inC, c, run.inAligned[c], run.ns, run.inWorld[c], run.inRmf[c]); });
+    run.forEach(nOut, [&](std::size_t c) { if (run.outUsed[c]) prepare(run.outCenters, c, run.outAligned[c], run.no, run.outWorld[c], run.outRmf[c]); });
+}
 
-    // Where each output vertex reads the input's displacement, a fractional input vertex: the
-    // same for every strand of an output centre (computed once per centre used).
-    std::vector<std::vector<double>> atOf(nOut);
-    forEach(nOut, [&](std::size_t oc) {
-        if (!outUsed[oc]) return;
-        const std::vector<Vec3f>& cin = inWorld[match[oc]];
-        const std::vector<Vec3f>& cout = outWorld[oc];
-        std::vector<double>& at = atOf[oc];
+/// DetailBlend::Edges: each used input centre's carrier and each used output centre's, at one
+/// σ in world units (kCentreCarrierSmoothing of the matched input centre's vertices) so that a
+/// centre onto itself gives its own carrier; strands' carriers at kStrandCarrierSmoothing of
+/// their vertices (layStrand(), "Carrier smoothing"). Empty for the other blends.
+void centreCarriers(DetailTransferRun& run)
+{
+    const std::size_t nIn = run.nIn, nOut = run.nOut;
+    const int ns = run.ns, no = run.no;
+    const double sigmaCentre = run.sigmaCentre;
+    run.inCarrierLength.assign(nIn, 0.0);
+    run.inCarrier.resize(run.edges ? nIn : 0);
+    run.outCarrier.resize(run.edges ? nOut : 0);
+    if (!run.edges) return;
+    const auto toD = [](const std::vector<Vec3f>& p) {
+        std::vector<Vec3d> q(p.size());
+        for (std::size_t k = 0; k < p.size(); ++k) q[k] = Vec3d(p[k]);
+        return q;
+    };
+    run.forEach(nIn, [&](std::size_t c) {
+        if (!run.inUsed[c]) return;
+        run.inCarrier[c] = detail::Carrier(toD(run.inWorld[c]), sigmaCentre, Vec3f(run.inAligned[c].t));
+        run.inCarrierLength[c] = run.inCarrier[c].length();
+    });
+    run.forEach(nOut, [&](std::size_t c) {
+        if (!run.outUsed[c]) return;
+        const std::vector<Vec3d> p = toD(run.outWorld[c]);
+        const double spacingIn = polylineLengthOf(toD(run.inWorld[run.match[c]])) / double(ns - 1);
+        const double spacingOut = polylineLengthOf(p) / double(no - 1);
+        run.outCarrier[c] = detail::Carrier(p, spacingOut > 0.0 ? sigmaCentre * spacingIn / spacingOut : sigmaCentre, Vec3f(run.outAligned[c].t));
+    });
+}
+
+/// Where each output vertex reads the input's displacement, a fractional input vertex: the
+/// same for every strand of an output centre (computed once per centre used).
+void readPositions(DetailTransferRun& run)
+{
+    const int ns = run.ns, no = run.no;
+    run.atOf.resize(run.nOut);
+    run.forEach(run.nOut, [&](std::size_t oc) {
+        if (!run.outUsed[oc]) return;
+        const std::vector<Vec3f>& cin = run.inWorld[run.match[oc]];
+        const std::vector<Vec3f>& cout = run.outWorld[oc];
+        std::vector<double>& at = run.atOf[oc];
         at.resize(static_cast<std::size_t>(no));
-        if (scale != DetailScale::Index) {  // (Strand reads as ArcLength here)
+        if (run.scale != DetailScale::Index) {  // (Strand reads as ArcLength here)
             // At the output centre's arc length along the input centre, mirrored back and forth
             // beyond the input centre's end (DetailTransfer.h; DetailBlend::Edges: held at the end).
             const auto arcs = [&](const std::vector<Vec3f>& c) {
@@ -596,7 +481,7 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             const double Li = ai.back();
             for (std::size_t k = 0; k < at.size(); ++k) {
                 double a = ao[k];
-                if (Li > 0.0 && !edges) {
+                if (Li > 0.0 && !run.edges) {
                     a = std::fmod(a, 2.0 * Li);
                     if (a > Li) a = 2.0 * Li - a;
                 }
@@ -610,136 +495,171 @@ StrandSamples transferDetail(const TransferSource& source, const StrandSamples& 
             for (std::size_t k = 0; k < at.size(); ++k) at[k] = double(k) * double(ns - 1) / double(no - 1);
         }
     });
+}
 
-    // 4-5. Every new strand.
+/// Step 5, DetailBlend::Edges: new strand @a i as the edges of its input strand (@a gin, world)
+/// laid along the output centre's carrier (DetailTransfer.h, "Edges"); writes its row in its root
+/// frame @a rf and returns its length.
+double layStrand(const DetailTransferRun& run, std::size_t i, const std::vector<Vec3f>& gin, const ScalpFrame& rf, float* row)
+{
+    const std::uint32_t oc = run.label[i], ic = run.match[oc];
+    const ScalpFrame& mo = run.outAligned[oc];
+    const ScalpFrame& mi = run.inAligned[ic];
+    const std::vector<double>& at = run.atOf[oc];  // where each output vertex reads
+    const std::vector<Vec3d>& roots = run.roots;
+    const int ns = run.ns, no = run.no;
+    const DetailScale scale = run.scale;
+    std::vector<Vec3d> strand(gin.size());
+    for (std::size_t k = 0; k < gin.size(); ++k) strand[k] = Vec3d(gin[k]);
+    std::vector<Vec3f> cg;
+    std::vector<double> advance, frameShift;
+    const std::vector<Vec3d> d = detail::strandEdges(strand, run.sigmaStrand, Vec3f(mi.t), &cg, &advance, &frameShift);
+    double progress = 0.0;
+    for (std::size_t k = 0; k < d.size(); ++k) progress += advance[k];
+    // The output carrier: the output centre's, plus the strand's smooth offset from its
+    // centre (carrier minus centre carrier, less the root offset) in the aligned root
+    // frames, read where the output vertex reads (so a wisp gathers and parts as the input's).
+    const detail::Carrier& centreCarrier = run.outCarrier[oc];
+    const std::vector<Vec3f>& ci = run.inCarrier[ic].points;
+    std::vector<Vec3d> q(static_cast<std::size_t>(no));
+    const Vec3d off0 = Vec3d(cg[0]) - Vec3d(ci[0]);
+    for (std::size_t l = 0; l < q.size(); ++l) {
+        const std::size_t j = std::min(std::size_t(at[l]), std::size_t(ns - 1));
+        const double t = at[l] - double(j);
+        Vec3d off = Vec3d(cg[j]) - Vec3d(ci[j]);
+        if (t > 0.0 && j + 1 < std::size_t(ns)) off = off * (1.0 - t) + (Vec3d(cg[j + 1]) - Vec3d(ci[j + 1])) * t;
+        q[l] = roots[i] + (Vec3d(centreCarrier.points[l]) - Vec3d(centreCarrier.points[0])) + mo.toWorld(mi.toLocal(off - off0));
+    }
+    const detail::Carrier carrier(q, 0.0, Vec3f(mo.t));
+    const double li = run.inCarrierLength[ic], lo = centreCarrier.length();
+    double lambda = 1.0, target = progress;  // Strand: its own length
+    if (scale == DetailScale::Index) {
+        lambda = li > 0.0 ? lo / li : 1.0;
+        target = lambda * progress;
+    } else if (scale == DetailScale::ArcLength) {
+        // The output centre's length, as the other blends (each strand's own share of it,
+        // its length over its input centre's, moved the ponytail's wisps onto the default
+        // head 0.27 of their length from BASE's, against 0.08).
+        target = std::max(progress + lo - li, progress * std::min(1.0, li > 0.0 ? lo / li : 1.0));
+    }
+    const std::vector<Vec3d> laid = detail::layEdges(d, advance, frameShift, lambda, carrier, roots[i], target);
+    std::vector<Vec3f> lf(laid.size()), rs(static_cast<std::size_t>(no));
+    for (std::size_t k = 0; k < laid.size(); ++k) lf[k] = Vec3f(laid[k]);
+    if (lf.size() < 2) lf.push_back(lf.back());
+    // Laid whole at the output's vertex count, the strand's own vertices stay (resampling by
+    // arc would cut its corners: samples even along the input, not along their chords).
+    if (lf.size() == std::size_t(no)) rs = lf;
+    else resamplePolyline(lf.data(), lf.size(), std::size_t(no), rs.data());
+    double len = 0.0;
+    for (int l = 0; l < no; ++l) {
+        const Vec3d p = l == 0 ? roots[i] : Vec3d(rs[std::size_t(l)]);
+        const Vec3d q = rf.toLocal((p - roots[i]) / run.radius);
+        row[3 * l] = float(q.x());
+        row[3 * l + 1] = float(q.y());
+        row[3 * l + 2] = float(q.z());
+        if (l > 0) len += (Vec3d(rs[std::size_t(l)]) - Vec3d(rs[std::size_t(l - 1)])).length();
+    }
+    return len;
+}
+
+/// Step 5, DetailBlend::RootFrame and Paper (Eq. 5-8): new strand @a i as the displacements of its
+/// input strand (@a gin, world) from its input centre, added to the output centre; writes its row
+/// in its root frame @a rf and returns its length.
+double blendStrand(const DetailTransferRun& run, std::size_t i, const std::vector<Vec3f>& gin, const ScalpFrame& rf, float* row)
+{
+    const std::uint32_t oc = run.label[i], ic = run.match[oc];
+    const ScalpFrame& mo = run.outAligned[oc];
+    const ScalpFrame& mi = run.inAligned[ic];
+    const std::vector<Vec3f>& cin = run.inWorld[ic];
+    const std::vector<Vec3f>& cout = run.outWorld[oc];
+    const std::vector<double>& at = run.atOf[oc];  // where each output vertex reads
+    const std::vector<Frame>& fin = run.inRmf[ic];
+    const std::vector<Frame>& fout = run.outRmf[oc];
+    const std::vector<Vec3d>& roots = run.roots;
+    const int ns = run.ns, no = run.no;
+    const auto inFrame = [&](const Frame& f, const Vec3d& w) { return Vec3d(f.t.dot(Vec3f(w)), f.n.dot(Vec3f(w)), f.b.dot(Vec3f(w))); };
+    const auto outOf = [&](const Frame& f, const Vec3d& d) { return Vec3d(f.t) * d.x() + Vec3d(f.n) * d.y() + Vec3d(f.b) * d.z(); };
+    const Vec3d rootIn = Vec3d(gin[0]) - Vec3d(cin[0]);
+    const Vec3d betaShift = roots[i] - Vec3d(cout[0]) - outOf(fout[0], inFrame(fin[0], rootIn));
+    // Eq. 5-6 per vertex of the input pair.
+    std::vector<Vec3d> dA(static_cast<std::size_t>(ns)), dB(static_cast<std::size_t>(ns));
+    for (int l = 0; l < ns; ++l) {
+        const Vec3d dIn = Vec3d(gin[std::size_t(l)]) - Vec3d(cin[std::size_t(l)]);
+        dA[std::size_t(l)] = mi.toLocal(dIn - rootIn);                          // Eq. 5
+        dB[std::size_t(l)] = inFrame(fin[std::size_t(l)], dIn);                 // Eq. 6
+    }
+    const auto read = [&](const std::vector<Vec3d>& d) {
+        std::vector<Vec3d> r(at.size());
+        for (std::size_t k = 0; k < at.size(); ++k) {
+            const std::size_t j = std::min(std::size_t(at[k]), std::size_t(ns - 1));
+            const double t = at[k] - double(j);
+            r[k] = j + 1 < std::size_t(ns) && t > 0.0 ? d[j] * (1.0 - t) + d[j + 1] * t : d[j];
+        }
+        return r;
+    };
+    dA = read(dA);
+    dB = read(dB);
+    double len = 0.0;
+    Vec3d prev = roots[i];
+    for (int l = 0; l < no; ++l) {
+        const Vec3d& dAlpha = dA[std::size_t(l)];
+        const Vec3d& dBeta = dB[std::size_t(l)];
+        const Vec3d a = roots[i] + (Vec3d(cout[std::size_t(l)]) - Vec3d(cout[0])) + mo.toWorld(dAlpha);  // Eq. 8
+        const Vec3d b = Vec3d(cout[std::size_t(l)]) + outOf(fout[std::size_t(l)], dBeta) + betaShift;
+        const double s = run.blend == DetailBlend::RootFrame ? 0.0 : double(l) / double(no - 1);
+        const Vec3d p = l == 0 ? roots[i] : a * (1.0 - s) + b * s;             // Eq. 7
+        const Vec3d q = rf.toLocal((p - roots[i]) / run.radius);
+        row[3 * l] = float(q.x());
+        row[3 * l + 1] = float(q.y());
+        row[3 * l + 2] = float(q.z());
+        len += (p - prev).length();
+        prev = p;
+    }
+    return len;
+}
+} // namespace
+
+StrandSamples transferDetail(const TransferSource& source, const StrandSamples& outCenters,
+                             const std::vector<Vec3d>& roots, const ScalpMap& map, int components,
+                             std::vector<std::uint32_t>* outLabel, TransferStats* stats, DetailBlend blend, bool threaded,
+                             openvdb::util::NullInterrupter* interrupter, const std::vector<std::uint32_t>* givenLabel,
+                             DetailScale scale, int outVertices, const DetailMatchParams& matching)
+{
+    checkTransferInputs(source, outCenters, outVertices, matching);
+    DetailTransferRun run(source, outCenters, roots, map, blend, scale, outVertices, matching, threaded);
+    clusterRoots(run, givenLabel);
+    alignCentres(run);
+    matchClusters(run, components);
+    if (interrupter && interrupter->wasInterrupted()) throw InterruptedError("detail transfer interrupted");
+    matchStrands(run);
+    centreGeometry(run);
+    centreCarriers(run);
+    readPositions(run);
+
+    // 5. Every new strand.
     StrandSamples out;
-    out.vertices = no;
-    reserveHugePages(out.local, n * out.dim());  // fresh pages 2 MiB at a time (Memory.h)
-    out.local.assign(n * out.dim(), 0.0f);
+    out.vertices = run.no;
+    reserveHugePages(out.local, run.n * out.dim());  // fresh pages 2 MiB at a time (Memory.h)
+    out.local.assign(run.n * out.dim(), 0.0f);
     out.roots = roots;
-    out.scalp.resize(n);
-    out.frames.resize(n);
-    out.lengths.resize(n);
-    forEach(n, [&](std::size_t i) {
-        const std::uint32_t oc = label[i], ic = match[oc];
-        const ScalpFrame& mo = outAligned[oc];
-        const ScalpFrame& mi = inAligned[ic];
-        const std::uint32_t pick = pickOf[i];  // step 4
-        const std::vector<Vec3f> gin = worldOf(inS, pick, radius);
+    out.scalp.resize(run.n);
+    out.frames.resize(run.n);
+    out.lengths.resize(run.n);
+    run.forEach(run.n, [&](std::size_t i) {
+        const std::vector<Vec3f> gin = worldOf(run.inS, run.pickOf[i], run.radius);  // its input strand (step 4)
         const Vec3d sc = map.toScalp(roots[i]);
         const ScalpFrame rf = map.frame(sc.x(), sc.y());
-        float* row = out.row(i);
-        const std::vector<Vec3f>& cin = inWorld[ic];
-        const std::vector<Vec3f>& cout = outWorld[oc];
-        const std::vector<double>& at = atOf[oc];  // where each output vertex reads
-        if (edges) {
-            // The strand's own edges laid along the output centre's carrier (DetailTransfer.h, "Edges").
-            std::vector<Vec3d> strand(gin.size());
-            for (std::size_t k = 0; k < gin.size(); ++k) strand[k] = Vec3d(gin[k]);
-            std::vector<Vec3f> cg;
-            std::vector<double> advance, frameShift;
-            const std::vector<Vec3d> d = strandEdges(strand, sigmaStrand, Vec3f(mi.t), &cg, &advance, &frameShift);
-            double progress = 0.0;
-            for (std::size_t k = 0; k < d.size(); ++k) progress += advance[k];
-            // The output carrier: the output centre's, plus the strand's smooth offset from its
-            // centre (carrier minus centre carrier, less the root offset) in the aligned root
-            // frames, read where the output vertex reads (so a wisp gathers and parts as the input's).
-            const Carrier& centreCarrier = outCarrier[oc];
-            const std::vector<Vec3f>& ci = inCarrier[ic].points;
-            std::vector<Vec3d> q(static_cast<std::size_t>(no));
-            const Vec3d off0 = Vec3d(cg[0]) - Vec3d(ci[0]);
-            for (std::size_t l = 0; l < q.size(); ++l) {
-                const std::size_t j = std::min(std::size_t(at[l]), std::size_t(ns - 1));
-                const double t = at[l] - double(j);
-                Vec3d off = Vec3d(cg[j]) - Vec3d(ci[j]);
-                if (t > 0.0 && j + 1 < std::size_t(ns)) off = off * (1.0 - t) + (Vec3d(cg[j + 1]) - Vec3d(ci[j + 1])) * t;
-                q[l] = roots[i] + (Vec3d(centreCarrier.points[l]) - Vec3d(centreCarrier.points[0])) + mo.toWorld(mi.toLocal(off - off0));
-            }
-            const Carrier carrier(q, 0.0, Vec3f(mo.t));
-            const double li = inCarrierLength[ic], lo = centreCarrier.length();
-            double lambda = 1.0, target = progress;  // Strand: its own length
-            if (scale == DetailScale::Index) {
-                lambda = li > 0.0 ? lo / li : 1.0;
-                target = lambda * progress;
-            } else if (scale == DetailScale::ArcLength) {
-                // The output centre's length, as the other blends (each strand's own share of it,
-                // its length over its input centre's, moved the ponytail's wisps onto the default
-                // head 0.27 of their length from BASE's, against 0.08).
-                target = std::max(progress + lo - li, progress * std::min(1.0, li > 0.0 ? lo / li : 1.0));
-            }
-            const std::vector<Vec3d> laid = layEdges(d, advance, frameShift, lambda, carrier, roots[i], target);
-            std::vector<Vec3f> lf(laid.size()), rs(static_cast<std::size_t>(no));
-            for (std::size_t k = 0; k < laid.size(); ++k) lf[k] = Vec3f(laid[k]);
-            if (lf.size() < 2) lf.push_back(lf.back());
-            // Laid whole at the output's vertex count, the strand's own vertices stay (resampling by
-            // arc would cut its corners: samples even along the input, not along their chords).
-            if (lf.size() == std::size_t(no)) rs = lf;
-            else resamplePolyline(lf.data(), lf.size(), std::size_t(no), rs.data());
-            double len = 0.0;
-            for (int l = 0; l < no; ++l) {
-                const Vec3d p = l == 0 ? roots[i] : Vec3d(rs[std::size_t(l)]);
-                const Vec3d q = rf.toLocal((p - roots[i]) / radius);
-                row[3 * l] = float(q.x());
-                row[3 * l + 1] = float(q.y());
-                row[3 * l + 2] = float(q.z());
-                if (l > 0) len += (Vec3d(rs[std::size_t(l)]) - Vec3d(rs[std::size_t(l - 1)])).length();
-            }
-            out.scalp[i] = sc;
-            out.frames[i] = rf;
-            out.lengths[i] = float(len);
-            return;
-        }
-        const std::vector<Frame>& fin = inRmf[ic];
-        const std::vector<Frame>& fout = outRmf[oc];
-        // 5. Eq. 5-8.
-        const auto inFrame = [&](const Frame& f, const Vec3d& w) { return Vec3d(f.t.dot(Vec3f(w)), f.n.dot(Vec3f(w)), f.b.dot(Vec3f(w))); };
-        const auto outOf = [&](const Frame& f, const Vec3d& d) { return Vec3d(f.t) * d.x() + Vec3d(f.n) * d.y() + Vec3d(f.b) * d.z(); };
-        const Vec3d rootIn = Vec3d(gin[0]) - Vec3d(cin[0]);
-        const Vec3d betaShift = roots[i] - Vec3d(cout[0]) - outOf(fout[0], inFrame(fin[0], rootIn));
-        // Eq. 5-6 per vertex of the input pair.
-        std::vector<Vec3d> dA(static_cast<std::size_t>(ns)), dB(static_cast<std::size_t>(ns));
-        for (int l = 0; l < ns; ++l) {
-            const Vec3d dIn = Vec3d(gin[std::size_t(l)]) - Vec3d(cin[std::size_t(l)]);
-            dA[std::size_t(l)] = mi.toLocal(dIn - rootIn);                          // Eq. 5
-            dB[std::size_t(l)] = inFrame(fin[std::size_t(l)], dIn);                 // Eq. 6
-        }
-        const auto read = [&](const std::vector<Vec3d>& d) {
-            std::vector<Vec3d> r(at.size());
-            for (std::size_t k = 0; k < at.size(); ++k) {
-                const std::size_t j = std::min(std::size_t(at[k]), std::size_t(ns - 1));
-                const double t = at[k] - double(j);
-                r[k] = j + 1 < std::size_t(ns) && t > 0.0 ? d[j] * (1.0 - t) + d[j + 1] * t : d[j];
-            }
-            return r;
-        };
-        dA = read(dA);
-        dB = read(dB);
-        double len = 0.0;
-        Vec3d prev = roots[i];
-        for (int l = 0; l < no; ++l) {
-            const Vec3d& dAlpha = dA[std::size_t(l)];
-            const Vec3d& dBeta = dB[std::size_t(l)];
-            const Vec3d a = roots[i] + (Vec3d(cout[std::size_t(l)]) - Vec3d(cout[0])) + mo.toWorld(dAlpha);  // Eq. 8
-            const Vec3d b = Vec3d(cout[std::size_t(l)]) + outOf(fout[std::size_t(l)], dBeta) + betaShift;
-            const double s = blend == DetailBlend::RootFrame ? 0.0 : double(l) / double(no - 1);
-            const Vec3d p = l == 0 ? roots[i] : a * (1.0 - s) + b * s;             // Eq. 7
-            const Vec3d q = rf.toLocal((p - roots[i]) / radius);
-            row[3 * l] = float(q.x());
-            row[3 * l + 1] = float(q.y());
-            row[3 * l + 2] = float(q.z());
-            len += (p - prev).length();
-            prev = p;
-        }
+        const double len = run.edges ? layStrand(run, i, gin, rf, out.row(i)) : blendStrand(run, i, gin, rf, out.row(i));
         out.scalp[i] = sc;
         out.frames[i] = rf;
         out.lengths[i] = float(len);
     });
-    if (outLabel) *outLabel = label;
+    if (outLabel) *outLabel = run.label;
     if (stats) {
         stats->clusters = 0;
-        for (std::uint8_t u : outUsed) stats->clusters += u;
+        for (std::uint8_t u : run.outUsed) stats->clusters += u;
         stats->distinctSources = 0;
-        for (std::uint8_t u : inUsed) stats->distinctSources += u;
+        for (std::uint8_t u : run.inUsed) stats->distinctSources += u;
     }
     return out;
 }

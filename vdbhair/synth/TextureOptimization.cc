@@ -4,19 +4,15 @@
 #include <vdbhair/Format.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/Random.h>
+#include <vdbhair/synth/impl/TextureSourceIndex.h>
 
-#include <Eigen/Dense>
-#include <nanoflann.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <limits>
-#include <memory>
-#include <numeric>
 #include <string>
 
 namespace vdbhair {
@@ -61,14 +57,6 @@ constexpr const char* kWhere = "synthesizeTexture";
 constexpr int kMaxOutputSide = 16384;
 /// Window distances are clamped below at this fraction of w sigma in the IRLS weights (step 7).
 constexpr double kMinDistanceFraction = 1e-3;
-/// Rows of keys the PCA is computed from (evenly spread over the sources).
-constexpr int kPcaSamples = 1024;
-/// Key dimensions up to which the PCA diagonalizes the covariance directly; above, randomized
-/// subspace iteration (Halko, Martinsson & Tropp 2011, Alg. 4.4) with this oversampling and
-/// power iteration count.
-constexpr int kDirectPcaDims = 256;
-constexpr int kPcaOversampling = 8;
-constexpr int kPcaPowerIterations = 2;
 
 template<typename Fn>
 void forRange(std::size_t n, std::size_t grain, bool threaded, const Fn& fn)
@@ -134,31 +122,6 @@ FeatureImage upsample(const FeatureImage& coarse, int width, int height)
     return fine;
 }
 
-/// Per-channel summed-area table: box sums of any rectangle in O(C).
-struct Integral
-{
-    int width = 0, height = 0, channels = 0;
-    std::vector<double> sum;  ///< (height+1) x (width+1) x channels
-
-    explicit Integral(const FeatureImage& img) : width(img.width), height(img.height), channels(img.channels)
-    {
-        const std::size_t stride = std::size_t(width + 1) * channels;
-        sum.assign(stride * (height + 1), 0.0);
-        std::vector<double> row(stride, 0.0);
-        for (int y = 0; y < height; ++y) {
-            std::fill(row.begin(), row.end(), 0.0);
-            for (int x = 0; x < width; ++x) {
-                const float* p = img.pixel(x, y);
-                for (int c = 0; c < channels; ++c) row[std::size_t(x + 1) * channels + c] = row[std::size_t(x) * channels + c] + p[c];
-            }
-            const double* above = &sum[std::size_t(y) * stride];
-            double* here = &sum[std::size_t(y + 1) * stride];
-            for (std::size_t i = 0; i < stride; ++i) here[i] = above[i] + row[i];
-        }
-    }
-    const double* at(int x, int y) const { return &sum[(std::size_t(y) * (width + 1) + x) * channels]; }
-};
-
 /// Side of the largest square of valid pixels (dynamic programming over the mask).
 int largestValidSquare(const FeatureImage& img)
 {
@@ -198,162 +161,6 @@ void coverage(const std::vector<int>& origins, int w, int n, std::vector<int>& l
     }
 }
 
-/// The search key of a window: its w x w x C values averaged over taps x taps cells, each cell's
-/// mean times sqrt(its pixel count), so that key distances never exceed window distances.
-struct KeyLayout
-{
-    int width = 0, taps = 0, channels = 0;
-    std::vector<int> edges;  ///< taps + 1 cell boundaries along an axis, 0 to width
-
-    KeyLayout(int w, int maxTaps, int c) : width(w), taps(std::min(w, maxTaps)), channels(c), edges(taps + 1)
-    {
-        for (int i = 0; i <= taps; ++i) edges[i] = int((std::int64_t(i) * w) / taps);
-    }
-    int dim() const { return taps * taps * channels; }
-
-    void compute(const Integral& I, int ox, int oy, float* out) const
-    {
-        for (int j = 0; j < taps; ++j) {
-            const int y0 = oy + edges[j], y1 = oy + edges[j + 1];
-            for (int i = 0; i < taps; ++i) {
-                const int x0 = ox + edges[i], x1 = ox + edges[i + 1];
-                const double norm = 1.0 / std::sqrt(double((y1 - y0) * (x1 - x0)));
-                const double *a = I.at(x0, y0), *b = I.at(x1, y0), *c = I.at(x0, y1), *d = I.at(x1, y1);
-                for (int k = 0; k < channels; ++k) *out++ = float((d[k] - b[k] - c[k] + a[k]) * norm);
-            }
-        }
-    }
-};
-
-/// Orthonormal basis of the columns of @a m.
-Eigen::MatrixXf orthonormalize(const Eigen::MatrixXf& m)
-{
-    Eigen::HouseholderQR<Eigen::MatrixXf> qr(m);
-    return qr.householderQ() * Eigen::MatrixXf::Identity(m.rows(), m.cols());
-}
-
-/// Keys minus their mean, projected onto the leading principal axes.
-struct Projection
-{
-    int inDim = 0, outDim = 0;
-    std::vector<float> mean;   ///< inDim
-    std::vector<float> basis;  ///< inDim x paddedDim, row-major; empty: no reduction (outDim == inDim)
-
-    /// @a out = basis^T (key - mean); @a scratch holds inDim floats.
-    void apply(const float* key, float* out, float* scratch) const
-    {
-        for (int d = 0; d < inDim; ++d) scratch[d] = key[d] - mean[d];
-        if (basis.empty()) {
-            std::copy_n(scratch, inDim, out);
-            return;
-        }
-        // Blocks of 8 outputs, accumulated in registers over the key (the basis is padded to a
-        // multiple of 8 columns).
-        for (int j0 = 0; j0 < outDim; j0 += 8) {
-            float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-            for (int d = 0; d < inDim; ++d) {
-                const float v = scratch[d];
-                const float* row = &basis[std::size_t(d) * paddedDim + j0];
-                for (int k = 0; k < 8; ++k) acc[k] += v * row[k];
-            }
-            for (int k = 0; k < 8 && j0 + k < outDim; ++k) out[j0 + k] = acc[k];
-        }
-    }
-    int paddedDim = 0;  ///< columns of basis: outDim rounded up to a multiple of 8
-};
-
-/// PCA of the rows of @a samples (keys): the @a dims leading axes.
-Projection fitProjection(Eigen::MatrixXf samples, int dims)
-{
-    Projection p;
-    p.inDim = int(samples.cols());
-    const Eigen::RowVectorXf mean = samples.colwise().mean();
-    p.mean.assign(mean.data(), mean.data() + p.inDim);
-    if (dims >= p.inDim) {
-        p.outDim = p.inDim;
-        return p;
-    }
-    p.outDim = dims;
-    samples.rowwise() -= mean;
-    Eigen::MatrixXf axes;  // inDim x dims, leading first
-    auto leading = [&](const Eigen::MatrixXf& vectors, const Eigen::VectorXf& /*ascending values*/) {
-        axes = vectors.rightCols(dims).rowwise().reverse();
-    };
-    if (p.inDim <= kDirectPcaDims) {
-        const Eigen::MatrixXf cov = samples.transpose() * samples;
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXf> eig(cov);
-        leading(eig.eigenvectors(), eig.eigenvalues());
-    } else {
-        // Randomized subspace iteration, then Rayleigh-Ritz in the subspace found.
-        const int l = std::min(dims + kPcaOversampling, p.inDim);
-        Eigen::MatrixXf omega(p.inDim, l);
-        Rng rng(0x7e47u, std::uint64_t(p.inDim), std::uint64_t(l));
-        for (Eigen::Index i = 0; i < omega.size(); i += 2) {
-            double a, b;
-            rng.normalPair(a, b);
-            omega.data()[i] = float(a);
-            if (i + 1 < omega.size()) omega.data()[i + 1] = float(b);
-        }
-        Eigen::MatrixXf z = orthonormalize(omega);
-        for (int q = 0; q < kPcaPowerIterations; ++q) z = orthonormalize(samples.transpose() * (samples * z));
-        const Eigen::MatrixXf y = samples * z;
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXf> eig(y.transpose() * y);
-        axes = z * eig.eigenvectors().rightCols(dims).rowwise().reverse();
-    }
-    p.paddedDim = (dims + 7) / 8 * 8;
-    p.basis.assign(std::size_t(p.inDim) * p.paddedDim, 0.0f);
-    for (int d = 0; d < p.inDim; ++d) {
-        for (int j = 0; j < dims; ++j) p.basis[std::size_t(d) * p.paddedDim + j] = axes(d, j);
-    }
-    return p;
-}
-
-/// nanoflann's view of the projected keys (row-major, dim floats each).
-struct KeyCloud
-{
-    const float* pts = nullptr;
-    std::size_t count = 0;
-    int dim = 0;
-    std::size_t kdtree_get_point_count() const { return count; }
-    float kdtree_get_pt(std::size_t i, std::size_t d) const { return pts[i * std::size_t(dim) + d]; }
-    template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
-};
-/// nanoflann result set: the k nearest points whose squared distance is below a bound (the
-/// search prunes every cell beyond the bound from the start).
-class BoundedKnn
-{
-public:
-    BoundedKnn(std::size_t capacity, float bound, std::uint32_t* idx, float* dist)
-        : mCapacity(capacity), mBound(bound), mIdx(idx), mDist(dist) {}
-    std::size_t size() const { return mCount; }
-    bool full() const { return mCount == mCapacity; }
-    float worstDist() const { return mCount == mCapacity ? mDist[mCapacity - 1] : mBound; }
-    bool addPoint(float dist, std::uint32_t index)
-    {
-        std::size_t i = mCount;
-        for (; i > 0 && mDist[i - 1] > dist; --i) {
-            if (i < mCapacity) {
-                mDist[i] = mDist[i - 1];
-                mIdx[i] = mIdx[i - 1];
-            }
-        }
-        if (i < mCapacity) {
-            mDist[i] = dist;
-            mIdx[i] = index;
-        }
-        if (mCount < mCapacity) ++mCount;
-        return true;
-    }
-
-private:
-    std::size_t mCapacity, mCount = 0;
-    float mBound;
-    std::uint32_t* mIdx;
-    float* mDist;
-};
-
-using KeyTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Adaptor<float, KeyCloud, float>, KeyCloud, -1, std::uint32_t>;
-
 /// Squared distance between the w x w windows of @a a at (ax, ay) and @a b at (bx, by), every
 /// channel; stops as soon as the sum exceeds @a bound (then returns a value above it).
 double windowDistance2(const FeatureImage& a, int ax, int ay, const FeatureImage& b, int bx, int by, int w, double bound)
@@ -387,128 +194,6 @@ struct ExampleLevel
 {
     FeatureImage image;    ///< invalid pixels hold 0
     int largestSquare = 0;  ///< side of the largest square of valid pixels
-};
-
-/// Origins (y * width + x) of the windows of width @a w lying wholly in valid pixels, row-major.
-std::vector<std::uint32_t> validWindows(const FeatureImage& img, int w)
-{
-    // Invalid-pixel counts by summed-area table.
-    const int W = img.width, H = img.height;
-    std::vector<int> s(std::size_t(W + 1) * (H + 1), 0);
-    for (int y = 0; y < H; ++y) {
-        int row = 0;
-        for (int x = 0; x < W; ++x) {
-            row += img.isValid(x, y) ? 0 : 1;
-            s[std::size_t(y + 1) * (W + 1) + x + 1] = s[std::size_t(y) * (W + 1) + x + 1] + row;
-        }
-    }
-    std::vector<std::uint32_t> out;
-    for (int y = 0; y + w <= H; ++y) {
-        for (int x = 0; x + w <= W; ++x) {
-            const int bad = s[std::size_t(y + w) * (W + 1) + x + w] - s[std::size_t(y) * (W + 1) + x + w] -
-                            s[std::size_t(y + w) * (W + 1) + x] + s[std::size_t(y) * (W + 1) + x];
-            if (bad == 0) out.push_back(std::uint32_t(y) * std::uint32_t(W) + std::uint32_t(x));
-        }
-    }
-    return out;
-}
-
-/// Everything one (level, width) stage needs about the example: sources, keys, the k-d tree.
-class SourceIndex
-{
-public:
-    SourceIndex(const FeatureImage& ex, int w, const TextureParams& params, bool threaded)
-        : mLayout(w, params.keyTaps, ex.channels)
-    {
-        mOrigins = validWindows(ex, w);
-        const std::size_t n = mOrigins.size();
-        mWidth = ex.width;
-        mHeight = ex.height;
-        mSourceAt.assign(ex.pixelCount(), -1);
-        for (std::size_t i = 0; i < n; ++i) mSourceAt[mOrigins[i]] = std::int64_t(i);
-        const Integral integral(ex);
-        const int D = mLayout.dim();
-
-        // PCA of up to kPcaSamples keys, evenly spread over the sources.
-        const std::size_t m = std::min<std::size_t>(n, kPcaSamples);
-        Eigen::MatrixXf samples(Eigen::Index(m), D);
-        {
-            std::vector<float> key(D);
-            for (std::size_t i = 0; i < m; ++i) {
-                const std::uint32_t o = mOrigins[i * n / m];
-                mLayout.compute(integral, int(o % std::uint32_t(ex.width)), int(o / std::uint32_t(ex.width)), key.data());
-                for (int d = 0; d < D; ++d) samples(Eigen::Index(i), d) = key[d];
-            }
-        }
-        mProjection = fitProjection(std::move(samples), params.pcaDims);
-        const int k = mProjection.outDim;
-
-        // Projected keys of all sources.
-        std::vector<float> keys(n * std::size_t(k));
-        forRange(n, 64, threaded, [&](const tbb::blocked_range<std::size_t>& r) {
-            std::vector<float> key(D), scratch(D);
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const std::uint32_t o = mOrigins[i];
-                mLayout.compute(integral, int(o % std::uint32_t(ex.width)), int(o / std::uint32_t(ex.width)), key.data());
-                mProjection.apply(key.data(), &keys[i * k], scratch.data());
-            }
-        });
-
-        // One tree point per distinct key (identical keys, e.g. in constant regions, would make
-        // every search visit all of them); the first source of each key represents it.
-        std::vector<std::uint32_t> order(n);
-        std::iota(order.begin(), order.end(), 0u);
-        auto keyOf = [&](std::uint32_t i) { return &keys[std::size_t(i) * k]; };
-        std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-            const int c = std::memcmp(keyOf(a), keyOf(b), sizeof(float) * k);
-            return c != 0 ? c < 0 : a < b;
-        });
-        std::vector<std::uint32_t> reps;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (i == 0 || std::memcmp(keyOf(order[i]), keyOf(order[i - 1]), sizeof(float) * k) != 0) reps.push_back(order[i]);
-        }
-        std::sort(reps.begin(), reps.end());
-        mTreeSources = reps;
-        mTreeKeys.resize(reps.size() * std::size_t(k));
-        for (std::size_t i = 0; i < reps.size(); ++i) std::copy_n(keyOf(reps[i]), k, &mTreeKeys[i * k]);
-        mCloud = KeyCloud{mTreeKeys.data(), reps.size(), k};
-        mTree = std::make_unique<KeyTree>(k, mCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    }
-
-    SourceIndex(const SourceIndex&) = delete;  // the tree refers to mCloud
-    SourceIndex& operator=(const SourceIndex&) = delete;
-
-    const KeyLayout& layout() const { return mLayout; }
-    const Projection& projection() const { return mProjection; }
-    std::size_t size() const { return mOrigins.size(); }
-    std::uint32_t origin(std::size_t i) const { return mOrigins[i]; }
-    /// The source whose window has its origin at example pixel (x, y), or -1 (none there).
-    std::int64_t sourceAt(int x, int y) const
-    {
-        if (x < 0 || y < 0 || x >= mWidth || y >= mHeight) return -1;
-        return mSourceAt[std::size_t(y) * mWidth + x];
-    }
-    /// Up to @a k sources whose projected keys are nearest @a query with squared key distance
-    /// below @a bound (source indices, nearest first).
-    std::size_t nearest(const float* query, std::size_t k, float bound, float eps, std::uint32_t* idx, float* dist2) const
-    {
-        BoundedKnn result(k, bound, idx, dist2);
-        mTree->findNeighbors(result, query, nanoflann::SearchParams(32, eps));
-        const std::size_t found = result.size();
-        for (std::size_t i = 0; i < found; ++i) idx[i] = mTreeSources[idx[i]];
-        return found;
-    }
-
-private:
-    KeyLayout mLayout;
-    std::vector<std::uint32_t> mOrigins;
-    Projection mProjection;
-    std::vector<std::uint32_t> mTreeSources;
-    std::vector<float> mTreeKeys;
-    KeyCloud mCloud;
-    std::unique_ptr<KeyTree> mTree;
-    int mWidth = 0, mHeight = 0;
-    std::vector<std::int64_t> mSourceAt;
 };
 
 void checkExample(const FeatureImage& ex)
@@ -547,24 +232,36 @@ struct StagePlan
     int level = 0, width = 0;
 };
 
-} // namespace
-
-FeatureImage synthesizeTexture(const FeatureImage& example, int width, int height, const TextureParams& params,
-                               TextureStats* stats, bool threaded, openvdb::util::NullInterrupter* interrupter)
+/// One synthesizeTexture() call: the pyramids, the stages, and the output being synthesized.
+struct TextureRun
 {
-    const auto start = std::chrono::steady_clock::now();
-    params.validate(kWhere);
-    if (width < 1 || height < 1 || width > kMaxOutputSide || height > kMaxOutputSide) {
-        throw ValueError(std::string(kWhere) + ": output size " + std::to_string(width) + " x " + std::to_string(height) +
-                         ": width and height must be between 1 and " + std::to_string(kMaxOutputSide) + " pixels");
-    }
-    checkExample(example);
-    const int C = example.channels;
-    const double r = params.robustExponent;
+    TextureRun(const TextureParams& p, bool runThreaded, int channels) : params(p), threaded(runThreaded), C(channels), r(p.robustExponent) {}
 
-    // 1. Pyramids: the example (invalid pixels zeroed) and the output sizes, level 0 the finest.
-    std::vector<ExampleLevel> ex(params.levels);
-    std::vector<int> outW(params.levels), outH(params.levels);
+    const TextureParams& params;
+    const bool threaded;
+    const int C;     ///< channels
+    const double r;  ///< the robust exponent
+    std::vector<ExampleLevel> ex;   ///< the example's pyramid, level 0 the finest
+    std::vector<int> outW, outH;    ///< the output's size at each level
+    double sigma = 0.0;             ///< the example's spread (exampleSpread())
+    std::vector<StagePlan> plan;
+    FeatureImage x;                 ///< the output at the current level
+    /// For each output pixel, the example pixel (y * width + x at the current level) its value came
+    /// from: in the M-step, the one of the covering window of largest weight (first on a tie).
+    std::vector<std::int64_t> from;
+    int currentLevel = 0;
+};
+
+/// Step 1, pyramids: the example (invalid pixels zeroed) and the output sizes, level 0 the finest.
+void buildPyramids(TextureRun& t, const FeatureImage& example, int width, int height)
+{
+    const TextureParams& params = t.params;
+    const int C = t.C;
+    std::vector<ExampleLevel>& ex = t.ex;
+    std::vector<int>&outW = t.outW, &outH = t.outH;
+    ex.resize(params.levels);
+    outW.resize(params.levels);
+    outH.resize(params.levels);
     ex[0].image = FeatureImage(example.width, example.height, C);
     for (int y = 0; y < example.height; ++y) {
         for (int x = 0; x < example.width; ++x) {
@@ -591,38 +288,44 @@ FeatureImage synthesizeTexture(const FeatureImage& example, int width, int heigh
                          " pixels are valid, the largest valid square is " + std::to_string(ex[0].largestSquare) + " x " +
                          std::to_string(ex[0].largestSquare));
     }
+}
 
-    // The example's spread, for the IRLS distance floor: sigma^2 = total variance of valid pixels.
+/// The example's spread, for the IRLS distance floor: sigma^2 = total variance of the valid pixels
+/// of @a e0 (1 for a constant example: every distance is 0, any floor works).
+double exampleSpread(const FeatureImage& e0, int C)
+{
     double sigma = 0.0;
-    {
-        std::vector<double> mean(C, 0.0), sq(C, 0.0);
-        std::size_t n = 0;
-        const FeatureImage& e0 = ex[0].image;
-        for (int y = 0; y < e0.height; ++y) {
-            for (int x = 0; x < e0.width; ++x) {
-                if (!e0.isValid(x, y)) continue;
-                const float* p = e0.pixel(x, y);
-                for (int c = 0; c < C; ++c) mean[c] += p[c];
-                ++n;
-            }
+    std::vector<double> mean(C, 0.0), sq(C, 0.0);
+    std::size_t n = 0;
+    for (int y = 0; y < e0.height; ++y) {
+        for (int x = 0; x < e0.width; ++x) {
+            if (!e0.isValid(x, y)) continue;
+            const float* p = e0.pixel(x, y);
+            for (int c = 0; c < C; ++c) mean[c] += p[c];
+            ++n;
         }
-        for (int c = 0; c < C; ++c) mean[c] /= double(n);
-        for (int y = 0; y < e0.height; ++y) {
-            for (int x = 0; x < e0.width; ++x) {
-                if (!e0.isValid(x, y)) continue;
-                const float* p = e0.pixel(x, y);
-                for (int c = 0; c < C; ++c) sq[c] += (p[c] - mean[c]) * (p[c] - mean[c]);
-            }
-        }
-        for (int c = 0; c < C; ++c) sigma += sq[c] / double(n);
-        sigma = std::sqrt(sigma);
-        if (!(sigma > 0.0)) sigma = 1.0;  // a constant example: every distance is 0, any floor works
     }
+    for (int c = 0; c < C; ++c) mean[c] /= double(n);
+    for (int y = 0; y < e0.height; ++y) {
+        for (int x = 0; x < e0.width; ++x) {
+            if (!e0.isValid(x, y)) continue;
+            const float* p = e0.pixel(x, y);
+            for (int c = 0; c < C; ++c) sq[c] += (p[c] - mean[c]) * (p[c] - mean[c]);
+        }
+    }
+    for (int c = 0; c < C; ++c) sigma += sq[c] / double(n);
+    sigma = std::sqrt(sigma);
+    if (!(sigma > 0.0)) sigma = 1.0;
+    return sigma;
+}
 
-    // 2. Stages: widths per level, coarse to fine and large to small.
+/// Step 2, stages: widths per level, coarse to fine and large to small.
+std::vector<StagePlan> planStages(const TextureRun& t)
+{
+    const TextureParams& params = t.params;
     std::vector<StagePlan> plan;
     for (int l = params.levels - 1; l >= 0; --l) {
-        const int limit = std::min({ex[l].largestSquare, outW[l], outH[l]});
+        const int limit = std::min({t.ex[l].largestSquare, t.outW[l], t.outH[l]});
         if (l > 0 && limit < params.minNeighbourhood) continue;
         std::vector<int> widths;
         for (int s : params.neighbourhoodSizes) {
@@ -633,217 +336,285 @@ FeatureImage synthesizeTexture(const FeatureImage& example, int width, int heigh
         }
         for (int w : widths) plan.push_back({l, w});
     }
+    return plan;
+}
+
+/// Step 3, initialization at the coarsest level used: random example patches of the first width.
+void initializeOutput(TextureRun& t)
+{
+    const TextureParams& params = t.params;
+    FeatureImage& x = t.x;
+    std::vector<std::int64_t>& from = t.from;
+    const int C = t.C;
+    const int l = t.plan.front().level, w = t.plan.front().width;
+    const FeatureImage& e = t.ex[l].image;
+    const std::vector<std::uint32_t> sources = detail::validWindows(e, w);
+    x = FeatureImage(t.outW[l], t.outH[l], C);
+    from.assign(x.pixelCount(), -1);
+    const int bx = (x.width + w - 1) / w, by = (x.height + w - 1) / w;
+    for (int j = 0; j < by; ++j) {
+        for (int i = 0; i < bx; ++i) {
+            Rng rng(params.seed, std::uint64_t(j) * bx + i, 0x7e47u);
+            std::uint32_t o = sources[std::min(sources.size() - 1, std::size_t(rng.uniform() * double(sources.size())))];
+            if (params.init == TextureInit::Nearby) {
+                // The patch's own place in the example, moved by a random offset; then the
+                // nearest valid window (first on a tie).
+                const double r = params.nearbyRadius * double(std::max(e.width, e.height));
+                const double tx = double(i * w) * double(e.width) / double(x.width) + (2.0 * rng.uniform() - 1.0) * r;
+                const double ty = double(j * w) * double(e.height) / double(x.height) + (2.0 * rng.uniform() - 1.0) * r;
+                double best = std::numeric_limits<double>::max();
+                for (std::uint32_t cand : sources) {
+                    const double dx = double(cand % std::uint32_t(e.width)) - tx, dy = double(cand / std::uint32_t(e.width)) - ty;
+                    if (dx * dx + dy * dy < best) {
+                        best = dx * dx + dy * dy;
+                        o = cand;
+                    }
+                }
+            }
+            const int sx = int(o % std::uint32_t(e.width)), sy = int(o / std::uint32_t(e.width));
+            for (int y = j * w; y < std::min((j + 1) * w, x.height); ++y) {
+                std::copy_n(e.pixel(sx, sy + y - j * w), std::size_t(std::min(w, x.width - i * w)) * C, x.pixel(i * w, y));
+                for (int px = i * w; px < std::min((i + 1) * w, x.width); ++px) {
+                    from[std::size_t(y) * x.width + px] = std::int64_t(sy + y - j * w) * e.width + (sx + px - i * w);
+                }
+            }
+        }
+    }
+    t.currentLevel = l;
+}
+
+/// The output, and the sources of its pixels, upsampled to level @a l (each later level starts
+/// from the coarser output).
+void upsampleTo(TextureRun& t, int l)
+{
+    FeatureImage& x = t.x;
+    std::vector<std::int64_t>& from = t.from;
+    int& currentLevel = t.currentLevel;
+    while (currentLevel > l) {
+        --currentLevel;
+        x = upsample(x, t.outW[currentLevel], t.outH[currentLevel]);
+        // Sources follow: the fine pixel under coarse source (sx, sy) is (2 sx, 2 sy) plus its
+        // own parity.
+        const int cw = t.outW[currentLevel + 1], ecw = t.ex[currentLevel + 1].image.width;
+        const int efw = t.ex[currentLevel].image.width, efh = t.ex[currentLevel].image.height;
+        std::vector<std::int64_t> fine(x.pixelCount(), -1);
+        for (int y = 0; y < x.height; ++y) {
+            for (int px = 0; px < x.width; ++px) {
+                const std::int64_t c = from[std::size_t(y / 2) * cw + px / 2];
+                if (c < 0) continue;
+                const int sx = std::min(int(c % ecw) * 2 + (px & 1), efw - 1), sy = std::min(int(c / ecw) * 2 + (y & 1), efh - 1);
+                fine[std::size_t(y) * x.width + px] = std::int64_t(sy) * efw + sx;
+            }
+        }
+        from.swap(fine);
+    }
+}
+
+/// Step 4, one stage's sources and output windows, and the windows' matches.
+struct Stage
+{
+    Stage(const TextureRun& t, int level, int width)
+        : l(level), w(width), e(t.ex[level].image), sources(e, w, t.params, t.threaded), s(std::max(1, int(std::lround(t.params.spacing * w)))),
+          ox(windowOrigins(t.x.width, w, s)), oy(windowOrigins(t.x.height, w, s)), nx(ox.size()), ny(oy.size()), q(nx * ny),
+          k(sources.projection().outDim), D(sources.layout().dim()), cand(std::min<std::size_t>(std::size_t(t.params.candidates), sources.size())),
+          minDistance(kMinDistanceFraction * w * t.sigma), match(q, -1), next(q, -1), dist2(q, 0.0), weight(q, 0.0)
+    {
+        coverage(ox, w, t.x.width, colLo, colHi);
+        coverage(oy, w, t.x.height, rowLo, rowHi);
+    }
+
+    const int l, w;          ///< level; window width
+    const FeatureImage& e;   ///< the example at this level
+    const detail::SourceIndex sources;
+    const int s;             ///< spacing of the output windows
+    const std::vector<int> ox, oy;  ///< the output windows' origins along x and y
+    const std::size_t nx, ny, q;    ///< windows along x, along y, in all
+    std::vector<int> colLo, colHi, rowLo, rowHi;  ///< the windows covering each column and row (coverage())
+    const int k, D;          ///< projected and full key dimensions
+    const std::size_t cand;  ///< tree candidates per window
+    const double minDistance;
+    std::vector<std::int64_t> match, next;  ///< each window's source, and this iteration's
+    std::vector<double> dist2, weight;
+};
+
+/// Step 5, the E-step: each window's best source among candidates (the previous match, coherent
+/// windows, the k-d tree), ranked by full distance, into Stage::next and Stage::dist2.
+void matchWindows(const TextureRun& t, Stage& g)
+{
+    const FeatureImage& x = t.x;
+    const FeatureImage& e = g.e;
+    const detail::SourceIndex& sources = g.sources;
+    const std::vector<int>&ox = g.ox, &oy = g.oy;
+    const std::size_t nx = g.nx, ny = g.ny, cand = g.cand;
+    const int w = g.w, k = g.k, D = g.D;
+    const detail::Integral integral(x);
+    forRange(g.q, 16, t.threaded, [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<float> key(D), scratch(D), projected(k), d2(cand);
+        std::vector<std::uint32_t> idx(cand);
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const int wx = ox[i % nx], wy = oy[i / nx];
+            sources.layout().compute(integral, wx, wy, key.data());
+            sources.projection().apply(key.data(), projected.data(), scratch.data());
+            const std::int64_t prev = g.match[i];
+            std::int64_t best = -1;
+            double bestD2 = std::numeric_limits<double>::infinity();
+            auto consider = [&](std::int64_t src) {
+                const std::uint32_t o = sources.origin(std::size_t(src));
+                const double d = windowDistance2(x, wx, wy, e, int(o % std::uint32_t(e.width)), int(o / std::uint32_t(e.width)), w, bestD2);
+                if (d < bestD2 || (d == bestD2 && best != prev && src < best)) {
+                    best = src;
+                    bestD2 = d;
+                }
+            };
+            // The previous match, the window the centre pixel's source implies, the grid
+            // neighbours' matches shifted by the neighbours' offsets (coherence, as
+            // Ashikhmin 2001 proposes), then the tree's candidates among keys no farther
+            // than the best so far (key distances never exceed window distances, so no
+            // source beyond is better; the bound has a 1e-5 margin for float rounding).
+            if (prev >= 0) consider(prev);
+            {
+                // The window placed where the source of its centre pixel says.
+                const std::int64_t c = t.from[std::size_t(wy + w / 2) * x.width + (wx + w / 2)];
+                if (c >= 0) {
+                    const std::int64_t src = sources.sourceAt(int(c % e.width) - w / 2, int(c / e.width) - w / 2);
+                    if (src >= 0 && src != best) consider(src);
+                }
+            }
+            const std::size_t ix = i % nx, iy = i / nx;
+            const std::size_t nbs[4] = {ix > 0 ? i - 1 : i, ix + 1 < nx ? i + 1 : i, iy > 0 ? i - nx : i, iy + 1 < ny ? i + nx : i};
+            for (std::size_t nb : nbs) {
+                if (nb == i || g.match[nb] < 0) continue;
+                const std::uint32_t o = sources.origin(std::size_t(g.match[nb]));
+                const std::int64_t src = sources.sourceAt(int(o % std::uint32_t(e.width)) + wx - ox[nb % nx],
+                                                           int(o / std::uint32_t(e.width)) + wy - oy[nb / nx]);
+                if (src >= 0 && src != best) consider(src);
+            }
+            const float bound = bestD2 < std::numeric_limits<double>::infinity() ? float(bestD2 * (1.0 + 1e-5))
+                                                                                : std::numeric_limits<float>::max();
+            const std::size_t found = sources.nearest(projected.data(), cand, bound, float(t.params.searchEpsilon), idx.data(), d2.data());
+            for (std::size_t c = 0; c < found; ++c) {
+                if (std::int64_t(idx[c]) != best) consider(idx[c]);
+            }
+            g.next[i] = best;
+            g.dist2[i] = bestD2;
+        }
+    });
+}
+
+/// Step 7, the M-step: each pixel is the IRLS-weighted mean of the matched windows covering it;
+/// the output's pixel sources become those of the covering window of largest weight.
+FeatureImage blendWindows(TextureRun& t, Stage& g)
+{
+    const FeatureImage& x = t.x;
+    const FeatureImage& e = g.e;
+    const int C = t.C;
+    const std::size_t nx = g.nx;
+    for (std::size_t i = 0; i < g.q; ++i) g.weight[i] = std::pow(std::max(std::sqrt(g.dist2[i]), g.minDistance), t.r - 2.0);
+    FeatureImage updated(x.width, x.height, C);
+    forRange(std::size_t(x.height), 4, t.threaded, [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<double> acc(C);
+        for (std::size_t yy = range.begin(); yy != range.end(); ++yy) {
+            const int y = int(yy);
+            for (int px = 0; px < x.width; ++px) {
+                std::fill(acc.begin(), acc.end(), 0.0);
+                double total = 0.0, top = -1.0;
+                std::int64_t topFrom = -1;
+                for (int j = g.rowLo[y]; j < g.rowHi[y]; ++j) {
+                    for (int i = g.colLo[px]; i < g.colHi[px]; ++i) {
+                        const std::size_t win = std::size_t(j) * nx + std::size_t(i);
+                        const std::uint32_t o = g.sources.origin(std::size_t(g.match[win]));
+                        const int fx = int(o % std::uint32_t(e.width)) + px - g.ox[i], fy = int(o / std::uint32_t(e.width)) + y - g.oy[j];
+                        const float* z = e.pixel(fx, fy);
+                        const double wt = g.weight[win];
+                        for (int c = 0; c < C; ++c) acc[c] += wt * z[c];
+                        total += wt;
+                        if (wt > top) {
+                            top = wt;
+                            topFrom = std::int64_t(fy) * e.width + fx;
+                        }
+                    }
+                }
+                float* dst = updated.pixel(px, y);
+                for (int c = 0; c < C; ++c) dst[c] = float(acc[c] / total);
+                t.from[std::size_t(y) * x.width + px] = topFrom;
+            }
+        }
+    });
+    return updated;
+}
+
+/// Steps 4-7 for one stage: E- and M-steps until no window changes its match or maxIterations.
+TextureStage runStage(TextureRun& t, const StagePlan& stage, TextureStats& st, ProgressCounter& progress)
+{
+    const TextureParams& params = t.params;
+    const auto stageStart = std::chrono::steady_clock::now();
+    Stage g(t, stage.level, stage.width);
+    TextureStage record;
+    record.level = g.l;
+    record.width = g.w;
+    record.spacing = g.s;
+    record.firstIteration = int(st.energy.size());
+
+    for (int it = 0; it < params.maxIterations; ++it) {
+        if (progress.add(1)) throw InterruptedError(std::string(kWhere) + ": interrupted");
+
+        matchWindows(t, g);
+        std::size_t changed = 0;
+        double energy = 0.0;
+        for (std::size_t i = 0; i < g.q; ++i) {
+            changed += g.next[i] != g.match[i] ? 1 : 0;
+            energy += std::pow(std::sqrt(g.dist2[i]), t.r);
+        }
+        g.match.swap(g.next);
+        st.energy.push_back(energy);
+        ++record.iterations;
+        ++st.iterations;
+
+        // 6. Convergence: no window changed its match.
+        if (it > 0 && changed == 0) {
+            record.converged = true;
+            break;
+        }
+
+        t.x = blendWindows(t, g);
+    }
+    // Unused iterations of a converged stage count as done for the progress display.
+    if (record.iterations < params.maxIterations && progress.add(std::uint64_t(params.maxIterations - record.iterations))) {
+        throw InterruptedError(std::string(kWhere) + ": interrupted");
+    }
+    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - stageStart).count();
+    return record;
+}
+} // namespace
+
+FeatureImage synthesizeTexture(const FeatureImage& example, int width, int height, const TextureParams& params,
+                               TextureStats* stats, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    const auto start = std::chrono::steady_clock::now();
+    params.validate(kWhere);
+    if (width < 1 || height < 1 || width > kMaxOutputSide || height > kMaxOutputSide) {
+        throw ValueError(std::string(kWhere) + ": output size " + std::to_string(width) + " x " + std::to_string(height) +
+                         ": width and height must be between 1 and " + std::to_string(kMaxOutputSide) + " pixels");
+    }
+    checkExample(example);
+    TextureRun t(params, threaded, example.channels);
+    buildPyramids(t, example, width, height);
+    t.sigma = exampleSpread(t.ex[0].image, t.C);
+    t.plan = planStages(t);
 
     TextureStats localStats;
     TextureStats& st = stats ? *stats : localStats;
     st = TextureStats();
-    ProgressCounter progress(interrupter, "synthesizing texture", std::uint64_t(plan.size()) * std::uint64_t(params.maxIterations),
+    ProgressCounter progress(interrupter, "synthesizing texture", std::uint64_t(t.plan.size()) * std::uint64_t(params.maxIterations),
                              "iterations");
-
-    // 3. Initialization at the coarsest level used: random example patches of the first width.
-    FeatureImage x;
-    // For each output pixel, the example pixel (y * width + x at the current level) its value came
-    // from: in the M-step, the one of the covering window of largest weight (first on a tie).
-    std::vector<std::int64_t> from;
-    {
-        const int l = plan.front().level, w = plan.front().width;
-        const FeatureImage& e = ex[l].image;
-        const std::vector<std::uint32_t> sources = validWindows(e, w);
-        x = FeatureImage(outW[l], outH[l], C);
-        from.assign(x.pixelCount(), -1);
-        const int bx = (x.width + w - 1) / w, by = (x.height + w - 1) / w;
-        for (int j = 0; j < by; ++j) {
-            for (int i = 0; i < bx; ++i) {
-                Rng rng(params.seed, std::uint64_t(j) * bx + i, 0x7e47u);
-                std::uint32_t o = sources[std::min(sources.size() - 1, std::size_t(rng.uniform() * double(sources.size())))];
-                if (params.init == TextureInit::Nearby) {
-                    // The patch's own place in the example, moved by a random offset; then the
-                    // nearest valid window (first on a tie).
-                    const double r = params.nearbyRadius * double(std::max(e.width, e.height));
-                    const double tx = double(i * w) * double(e.width) / double(x.width) + (2.0 * rng.uniform() - 1.0) * r;
-                    const double ty = double(j * w) * double(e.height) / double(x.height) + (2.0 * rng.uniform() - 1.0) * r;
-                    double best = std::numeric_limits<double>::max();
-                    for (std::uint32_t cand : sources) {
-                        const double dx = double(cand % std::uint32_t(e.width)) - tx, dy = double(cand / std::uint32_t(e.width)) - ty;
-                        if (dx * dx + dy * dy < best) {
-                            best = dx * dx + dy * dy;
-                            o = cand;
-                        }
-                    }
-                }
-                const int sx = int(o % std::uint32_t(e.width)), sy = int(o / std::uint32_t(e.width));
-                for (int y = j * w; y < std::min((j + 1) * w, x.height); ++y) {
-                    std::copy_n(e.pixel(sx, sy + y - j * w), std::size_t(std::min(w, x.width - i * w)) * C, x.pixel(i * w, y));
-                    for (int px = i * w; px < std::min((i + 1) * w, x.width); ++px) {
-                        from[std::size_t(y) * x.width + px] = std::int64_t(sy + y - j * w) * e.width + (sx + px - i * w);
-                    }
-                }
-            }
-        }
-    }
-
-    int currentLevel = plan.front().level;
-    for (const StagePlan& stage : plan) {
-        const int l = stage.level, w = stage.width;
-        // Each later level starts from the coarser output, upsampled.
-        while (currentLevel > l) {
-            --currentLevel;
-            x = upsample(x, outW[currentLevel], outH[currentLevel]);
-            // Sources follow: the fine pixel under coarse source (sx, sy) is (2 sx, 2 sy) plus its
-            // own parity.
-            const int cw = outW[currentLevel + 1], ecw = ex[currentLevel + 1].image.width;
-            const int efw = ex[currentLevel].image.width, efh = ex[currentLevel].image.height;
-            std::vector<std::int64_t> fine(x.pixelCount(), -1);
-            for (int y = 0; y < x.height; ++y) {
-                for (int px = 0; px < x.width; ++px) {
-                    const std::int64_t c = from[std::size_t(y / 2) * cw + px / 2];
-                    if (c < 0) continue;
-                    const int sx = std::min(int(c % ecw) * 2 + (px & 1), efw - 1), sy = std::min(int(c / ecw) * 2 + (y & 1), efh - 1);
-                    fine[std::size_t(y) * x.width + px] = std::int64_t(sy) * efw + sx;
-                }
-            }
-            from.swap(fine);
-        }
-        const FeatureImage& e = ex[l].image;
-
-        // 4. Sources and output windows.
-        const auto stageStart = std::chrono::steady_clock::now();
-        const SourceIndex sources(e, w, params, threaded);
-        const int s = std::max(1, int(std::lround(params.spacing * w)));
-        const std::vector<int> ox = windowOrigins(x.width, w, s), oy = windowOrigins(x.height, w, s);
-        const std::size_t nx = ox.size(), ny = oy.size(), q = nx * ny;
-        std::vector<int> colLo, colHi, rowLo, rowHi;
-        coverage(ox, w, x.width, colLo, colHi);
-        coverage(oy, w, x.height, rowLo, rowHi);
-        const int k = sources.projection().outDim, D = sources.layout().dim();
-        const std::size_t cand = std::min<std::size_t>(std::size_t(params.candidates), sources.size());
-        const double minDistance = kMinDistanceFraction * w * sigma;
-
-        std::vector<std::int64_t> match(q, -1), next(q, -1);
-        std::vector<double> dist2(q, 0.0), weight(q, 0.0);
-        TextureStage record;
-        record.level = l;
-        record.width = w;
-        record.spacing = s;
-        record.firstIteration = int(st.energy.size());
-
-        for (int it = 0; it < params.maxIterations; ++it) {
-            if (progress.add(1)) throw InterruptedError(std::string(kWhere) + ": interrupted");
-
-            // 5. E-step: candidates (previous match, coherent windows, k-d tree), ranked by full distance.
-            const Integral integral(x);
-            forRange(q, 16, threaded, [&](const tbb::blocked_range<std::size_t>& range) {
-                std::vector<float> key(D), scratch(D), projected(k), d2(cand);
-                std::vector<std::uint32_t> idx(cand);
-                for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                    const int wx = ox[i % nx], wy = oy[i / nx];
-                    sources.layout().compute(integral, wx, wy, key.data());
-                    sources.projection().apply(key.data(), projected.data(), scratch.data());
-                    const std::int64_t prev = match[i];
-                    std::int64_t best = -1;
-                    double bestD2 = std::numeric_limits<double>::infinity();
-                    auto consider = [&](std::int64_t src) {
-                        const std::uint32_t o = sources.origin(std::size_t(src));
-                        const double d = windowDistance2(x, wx, wy, e, int(o % std::uint32_t(e.width)), int(o / std::uint32_t(e.width)), w, bestD2);
-                        if (d < bestD2 || (d == bestD2 && best != prev && src < best)) {
-                            best = src;
-                            bestD2 = d;
-                        }
-                    };
-                    // The previous match, the window the centre pixel's source implies, the grid
-                    // neighbours' matches shifted by the neighbours' offsets (coherence, as
-                    // Ashikhmin 2001 proposes), then the tree's candidates among keys no farther
-                    // than the best so far (key distances never exceed window distances, so no
-                    // source beyond is better; the bound has a 1e-5 margin for float rounding).
-                    if (prev >= 0) consider(prev);
-                    {
-                        // The window placed where the source of its centre pixel says.
-                        const std::int64_t c = from[std::size_t(wy + w / 2) * x.width + (wx + w / 2)];
-                        if (c >= 0) {
-                            const std::int64_t src = sources.sourceAt(int(c % e.width) - w / 2, int(c / e.width) - w / 2);
-                            if (src >= 0 && src != best) consider(src);
-                        }
-                    }
-                    const std::size_t ix = i % nx, iy = i / nx;
-                    const std::size_t nbs[4] = {ix > 0 ? i - 1 : i, ix + 1 < nx ? i + 1 : i, iy > 0 ? i - nx : i, iy + 1 < ny ? i + nx : i};
-                    for (std::size_t nb : nbs) {
-                        if (nb == i || match[nb] < 0) continue;
-                        const std::uint32_t o = sources.origin(std::size_t(match[nb]));
-                        const std::int64_t src = sources.sourceAt(int(o % std::uint32_t(e.width)) + wx - ox[nb % nx],
-                                                                   int(o / std::uint32_t(e.width)) + wy - oy[nb / nx]);
-                        if (src >= 0 && src != best) consider(src);
-                    }
-                    const float bound = bestD2 < std::numeric_limits<double>::infinity() ? float(bestD2 * (1.0 + 1e-5))
-                                                                                        : std::numeric_limits<float>::max();
-                    const std::size_t found = sources.nearest(projected.data(), cand, bound, float(params.searchEpsilon), idx.data(), d2.data());
-                    for (std::size_t c = 0; c < found; ++c) {
-                        if (std::int64_t(idx[c]) != best) consider(idx[c]);
-                    }
-                    next[i] = best;
-                    dist2[i] = bestD2;
-                }
-            });
-            std::size_t changed = 0;
-            double energy = 0.0;
-            for (std::size_t i = 0; i < q; ++i) {
-                changed += next[i] != match[i] ? 1 : 0;
-                energy += std::pow(std::sqrt(dist2[i]), r);
-            }
-            match.swap(next);
-            st.energy.push_back(energy);
-            ++record.iterations;
-            ++st.iterations;
-
-            // 6. Convergence: no window changed its match.
-            if (it > 0 && changed == 0) {
-                record.converged = true;
-                break;
-            }
-
-            // 7. M-step: each pixel is the IRLS-weighted mean of the matched windows covering it.
-            for (std::size_t i = 0; i < q; ++i) weight[i] = std::pow(std::max(std::sqrt(dist2[i]), minDistance), r - 2.0);
-            FeatureImage updated(x.width, x.height, C);
-            forRange(std::size_t(x.height), 4, threaded, [&](const tbb::blocked_range<std::size_t>& range) {
-                std::vector<double> acc(C);
-                for (std::size_t yy = range.begin(); yy != range.end(); ++yy) {
-                    const int y = int(yy);
-                    for (int px = 0; px < x.width; ++px) {
-                        std::fill(acc.begin(), acc.end(), 0.0);
-                        double total = 0.0, top = -1.0;
-                        std::int64_t topFrom = -1;
-                        for (int j = rowLo[y]; j < rowHi[y]; ++j) {
-                            for (int i = colLo[px]; i < colHi[px]; ++i) {
-                                const std::size_t win = std::size_t(j) * nx + std::size_t(i);
-                                const std::uint32_t o = sources.origin(std::size_t(match[win]));
-                                const int fx = int(o % std::uint32_t(e.width)) + px - ox[i], fy = int(o / std::uint32_t(e.width)) + y - oy[j];
-                                const float* z = e.pixel(fx, fy);
-                                const double wt = weight[win];
-                                for (int c = 0; c < C; ++c) acc[c] += wt * z[c];
-                                total += wt;
-                                if (wt > top) {
-                                    top = wt;
-                                    topFrom = std::int64_t(fy) * e.width + fx;
-                                }
-                            }
-                        }
-                        float* dst = updated.pixel(px, y);
-                        for (int c = 0; c < C; ++c) dst[c] = float(acc[c] / total);
-                        from[std::size_t(y) * x.width + px] = topFrom;
-                    }
-                }
-            });
-            x = std::move(updated);
-        }
-        // Unused iterations of a converged stage count as done for the progress display.
-        if (record.iterations < params.maxIterations && progress.add(std::uint64_t(params.maxIterations - record.iterations))) {
-            throw InterruptedError(std::string(kWhere) + ": interrupted");
-        }
-        record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - stageStart).count();
-        st.stages.push_back(record);
+    initializeOutput(t);
+    for (const StagePlan& stage : t.plan) {
+        upsampleTo(t, stage.level);
+        st.stages.push_back(runStage(t, stage, st, progress));
     }
     progress.finish();
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return x;
+    return std::move(t.x);
 }
 
 } // namespace vdbhair
