@@ -136,7 +136,9 @@ def main():
         ("reconstruct", ["reconstruct", "head.hair", "-o", "o_rec.hair", "--guides", "10%"]),
         ("synth", ["synth", pony, "-o", "o_synth.hair"]),
         ("transfer", ["transfer", pony, pony, "-o", "o_transfer.hair"]),
-        ("comb", ["comb", pony, "--stroke", os.path.join(SCENES, "comb", "sweep_ponytail.json"), "-o", "o_comb.hair"]),
+        # The stroke is in the default head scene's frame (head.hair is grown from it); on
+        # ponytail.hair it reaches no wisp and the comb does nothing.
+        ("comb", ["comb", "head.hair", "--stroke", os.path.join(SCENES, "comb", "sweep_ponytail.json"), "-o", "o_comb.hair"]),
         ("inspect", ["inspect", "field.vdb"]),
         ("render", ["render", pony, "-o", "o_render.png"]),
         ("demo", ["demo", head, "-o", "o_demo"]),

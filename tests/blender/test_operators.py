@@ -131,10 +131,19 @@ kept = np.empty(n, np.float32)
 obj.data.attributes[".selection_curve_float"].data.foreach_get("value", kept)
 check(np.array_equal(kept, selection), "the guides stay selected")
 
-# Comb along a curve object made from the stroke file's points (+Y up turned to Blender's +Z).
+# Comb along a curve object made from a stroke's points (+Y up turned to Blender's +Z). The stroke
+# runs along the longest strand (its vertices at 20, 50 and 80 % of its length), sweeping toward
+# +x; it is written as a stroke file for the command too.
 obj = import_ponytail()
-stroke_file = os.path.join(SOURCE_DIR, "scenes", "comb", "sweep_ponytail.json")
-stroke = json.load(open(stroke_file))["strokes"][0]
+longest = truth[int(np.argmax(np.diff(truth.offsets)))]
+mid = np.array([longest[int(f * (len(longest) - 1))] for f in (0.2, 0.5, 0.8)], dtype=np.float64)
+mid[:, 0] += np.array([0.0, 6.0, 15.0])
+# Multiples of 1/64 and a strength of 0.75: exact in float32 (the curve object's points and the
+# operator's properties) and in the JSON (the command's); 0.8 differs by 1.2e-8 as a float32.
+stroke = {"points": (np.round(mid * 64.0) / 64.0).tolist(), "radius": 12.0, "strength": 0.75}
+stroke_file = out("stroke.json")
+with open(stroke_file, "w") as f:
+    json.dump({"vdbhair": "strokes/1", "strokes": [stroke]}, f)
 curve = bpy.data.curves.new("stroke", 'CURVE')
 spline = curve.splines.new('POLY')
 spline.points.add(len(stroke["points"]) - 1)
@@ -149,6 +158,8 @@ obj.select_set(True)
 result, seconds = run_operator(bpy.ops.vdbhair.comb, radius=stroke["radius"], strength=stroke["strength"])
 check(result == {'FINISHED'}, "comb finished (%.3f s)" % seconds)
 cli("comb", PONYTAIL, "--stroke", stroke_file, "-o", out("combed.hair"))
+moved = np.linalg.norm(object_strands(obj)[0] - truth.positions, axis=1)
+check(np.count_nonzero(moved > 1e-3) > 0.05 * len(moved), "the stroke moved %d of %d vertices" % (np.count_nonzero(moved > 1e-3), len(moved)))
 same_as_cli("comb along the curve object against vdbhair comb --stroke", obj, out("combed.hair"))
 
 # Synth: a new object in the active one's style; the example is left as it was.
