@@ -281,7 +281,7 @@ FreeFormCurve cubicCurve(CubicBasis basis, CurveWrap wrap, const Vec3f* points, 
     switch (basis) {
     case CubicBasis::Bezier:
         curve.basis = CurveBasis::Bezier;
-        curve.u1 = double(std::max<std::size_t>((m - std::min<std::size_t>(m, 1)) / 3, 1));
+        curve.u1 = double(m >= 4 ? (m - 1) / 3 : 1);  // segments (flattenCurve() refuses fewer than 4 points)
         break;
     case CubicBasis::BSpline:  // uniform and unclamped: the spans between knots 3 and m
         curve.basis = CurveBasis::BSpline;
