@@ -5,6 +5,7 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/VdbInfo.h>
+#include <vdbhair/io/VdbPoints.h>
 #include <vdbhair/io/VdbPrescan.h>
 #include <vdbhair/io/VdbStrandGrid.h>
 
@@ -633,4 +634,17 @@ TEST_CASE("readVdbStrands: a whole-number vertex index beyond any integer type i
     const std::string path = test::regressionInput("fuzz_vdb_huge_strand_index.vdb");
     REQUIRE_THROWS_AS(readVdbStrands(path), FormatError);
     REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("has strand 0 and vertex 6.04462909807314") && Contains("vertex in [0, 10)"));
+}
+
+TEST_CASE("readVdbStrands and pointColumns: an array shorter than its leaf's points is refused (fuzz_vdb)", "[io][vdb][fuzz]")
+{
+    // A 'width' array of varying stride whose total size is 1 in a leaf of 10 points: OpenVDB's
+    // handle indexes it by point (its size), past its one value (an assertion in Debian's
+    // libopenvdb, an out-of-bounds read without one). Found by fuzz_vdb at 80 thousand executions.
+    const std::string path = test::regressionInput("fuzz_vdb_short_array.vdb");
+    REQUIRE_THROWS_AS(readVdbStrands(path), FormatError);
+    REQUIRE_THROWS_WITH(readVdbStrands(path), Contains("has 10 points but its 'width' array holds 1"));
+    const openvdb::GridPtrVec grids = readVdbGrids(path, "test");
+    REQUIRE(grids.size() == 1);
+    REQUIRE_THROWS_WITH(pointColumns(*grids.front()), Contains("grid 'strands'") && Contains("'width' array holds 1"));
 }

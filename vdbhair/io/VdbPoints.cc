@@ -56,7 +56,52 @@ CopyFn copierFor(const std::string& type, std::size_t& components, bool& integer
     return nullptr;
 }
 
+/// The name of array @a index of @a desc (an attribute's, or the groups' array).
+std::string arrayName(const pts::AttributeSet::Descriptor& desc, std::size_t index)
+{
+    for (const auto& [name, i] : desc.map())
+        if (i == index) return name;
+    return "#" + std::to_string(index);
+}
+
+/// @throw FormatError naming @a grid when a leaf would make a handle read outside its arrays:
+/// a layout other than the first leaf's, point offsets that decrease, or an array shorter than
+/// the leaf's points (the rules strandsFromGrid() reads strands by, VdbStrands.cc).
+void checkLeaves(const pts::PointDataGrid& grid, const std::vector<const pts::PointDataTree::LeafNodeType*>& leaves)
+{
+    const pts::AttributeSet::Descriptor& desc = leaves.front()->attributeSet().descriptor();
+    for (const auto* leaf : leaves) {
+        const std::string where = "grid '" + grid.getName() + "': the leaf at voxel " + coordText(leaf->origin());
+        if (!(leaf->attributeSet().descriptor() == desc))
+            throw FormatError(where + " has other attributes than the first leaf; every leaf of a points grid shares one layout");
+        openvdb::Index32 previous = 0;
+        for (openvdb::Index i = 0; i < pts::PointDataTree::LeafNodeType::SIZE; ++i) {
+            const openvdb::Index32 offset = leaf->getValue(i);
+            if (offset < previous)
+                throw FormatError(where + " has point offset " + std::to_string(offset) + " after " + std::to_string(previous) +
+                                  "; a leaf's point offsets never decrease");
+            previous = offset;
+        }
+        for (std::size_t a = 0; a < leaf->attributeSet().size(); ++a) {
+            const std::uint64_t length = pointArrayLength(*leaf->attributeSet().getConst(a));
+            if (length < previous)
+                throw FormatError(where + " has " + std::to_string(previous) + " points but its '" + arrayName(desc, a) + "' array holds " +
+                                  std::to_string(length) + "; each array holds one value per point");
+        }
+    }
+}
+
 } // namespace
+
+std::string coordText(const openvdb::Coord& c)
+{
+    return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ")";
+}
+
+std::uint64_t pointArrayLength(const openvdb::points::AttributeArray& array)
+{
+    return array.hasConstantStride() ? std::uint64_t(array.size()) : std::uint64_t(array.dataSize());
+}
 
 std::vector<PointColumn> pointColumns(const openvdb::GridBase& base, std::vector<std::string>* skipped)
 {
@@ -67,6 +112,7 @@ std::vector<PointColumn> pointColumns(const openvdb::GridBase& base, std::vector
     for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(&*leaf);
     std::vector<PointColumn> out;
     if (leaves.empty()) return out;
+    checkLeaves(grid, leaves);
     const std::size_t n = std::size_t(pts::pointCount(grid.tree()));
     const pts::AttributeSet::Descriptor& desc = leaves.front()->attributeSet().descriptor();
     const std::size_t iP = desc.find("P");

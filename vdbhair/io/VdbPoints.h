@@ -6,8 +6,12 @@
 
 #include <openvdb/Grid.h>
 
+#include <cstdint>
+
 #include <string>
 #include <vector>
+
+namespace openvdb { OPENVDB_USE_VERSION_NAMESPACE namespace OPENVDB_VERSION_NAME { namespace points { class AttributeArray; } } }
 
 namespace vdbhair {
 
@@ -28,5 +32,14 @@ struct PointColumn
 /// outside the library, such as the Python module, instantiates none of OpenVDB's point templates.)
 /// @throw TypeError when @a grid is not a points grid, naming it and what it holds.
 std::vector<PointColumn> pointColumns(const openvdb::GridBase& grid, std::vector<std::string>* skipped = nullptr);
+
+/// @brief The points an AttributeHandle on @a array may index: its size, or for an array of
+/// varying stride its total size (as the handle counts). A file states both apart from the leaf's
+/// point offsets: a leaf whose last offset exceeds this for any array it reads is refused, else a
+/// handle reads past the array (OpenVDB checks only with assertions).
+std::uint64_t pointArrayLength(const openvdb::points::AttributeArray& array);
+
+/// @brief A voxel as error messages name it: "(x, y, z)".
+std::string coordText(const openvdb::Coord& c);
 
 } // namespace vdbhair

@@ -5,6 +5,7 @@
 #include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbPoints.h>
 
 #include <openvdb/points/PointAttribute.h>
 #include <openvdb/points/PointConversion.h>
@@ -30,10 +31,6 @@ namespace vdbhair {
 namespace pts = openvdb::points;
 
 namespace {
-std::string toString(const openvdb::Coord& c)
-{
-    return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ")";
-}
 /// A topology attribute (`strand`, `vertex`) of any integer or floating type, read as a whole
 /// number: Houdini writes int64 for `i@strand` set in VEX and float for a bare `@strand`.
 class WholeNumberAttribute
@@ -381,7 +378,7 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
         for (std::size_t l = r.begin(); l != r.end(); ++l) {
             const auto& leaf = *leaves[l];
             if (!(leaf.attributeSet().descriptor() == desc)) {
-                leafError[l] = where + ": the leaf at voxel " + toString(leaf.origin()) +
+                leafError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) +
                                " has other attributes than the first leaf; every leaf of a points grid shares one layout";
                 continue;
             }
@@ -390,7 +387,7 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
             for (openvdb::Index i = 0; i < pts::PointDataTree::LeafNodeType::SIZE; ++i) {
                 const openvdb::Index32 offset = leaf.getValue(i);
                 if (offset < previous) {
-                    leafError[l] = where + ": the leaf at voxel " + toString(leaf.origin()) + " has point offset " +
+                    leafError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) + " has point offset " +
                                    std::to_string(offset) + " after " + std::to_string(previous) + " (voxel " + std::to_string(i) +
                                    "); a leaf's point offsets never decrease";
                     break;
@@ -404,9 +401,9 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
             for (const auto& [name, index] : used) {
                 if (index == pts::AttributeSet::INVALID_POS) continue;
                 const pts::AttributeArray& array = leaf.constAttributeArray(index);
-                if (!array.isUniform() && array.size() < previous) {
-                    arrayError[l] = where + ": the leaf at voxel " + toString(leaf.origin()) + " has " + std::to_string(previous) +
-                                    " points but its '" + std::string(name) + "' array holds " + std::to_string(array.size()) +
+                if (pointArrayLength(array) < previous) {
+                    arrayError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) + " has " + std::to_string(previous) +
+                                    " points but its '" + std::string(name) + "' array holds " + std::to_string(pointArrayLength(array)) +
                                     "; each array holds one value per point";
                     break;
                 }
@@ -421,7 +418,7 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
         if (!leafError[l].empty()) {
             firstLeafError = leafError[l];
         } else if (std::uint64_t(last[l]) > nPoints - base[l]) {
-            firstLeafError = where + ": the leaf at voxel " + toString(leaves[l]->origin()) + " holds " + std::to_string(last[l]) +
+            firstLeafError = where + ": the leaf at voxel " + coordText(leaves[l]->origin()) + " holds " + std::to_string(last[l]) +
                              " points, more than the " + std::to_string(nPoints) + " the tree counts";
         } else if (!arrayError[l].empty()) {
             firstLeafError = arrayError[l];
@@ -465,7 +462,7 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
                         std::ostringstream v;
                         v.precision(9);
                         v << value;
-                        pointError[l] = where + ": a point in voxel " + toString(it.getCoord()) + " has " + name + " " + v.str() +
+                        pointError[l] = where + ": a point in voxel " + coordText(it.getCoord()) + " has " + name + " " + v.str() +
                                         "; strand and vertex must hold whole numbers";
                         break;
                     }
@@ -479,7 +476,7 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
                 if (sid[k] < 0 || sid[k] >= strandLimit || vid[k] < 0 || std::uint64_t(vid[k]) >= nPoints) {
                     // Whole numbers, possibly beyond any integer type: written as doubles.
                     const auto whole = [](double x) { std::ostringstream o; o.precision(17); o << x; return o.str(); };
-                    pointError[l] = where + ": a point in voxel " + toString(it.getCoord()) + " has strand " + whole(sv) +
+                    pointError[l] = where + ": a point in voxel " + coordText(it.getCoord()) + " has strand " + whole(sv) +
                                     " and vertex " + whole(vv) + "; strand must be in [0, " +
                                     std::to_string(strandLimit) + ") and vertex in [0, " + std::to_string(nPoints) + ")";
                     break;
