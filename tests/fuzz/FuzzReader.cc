@@ -19,6 +19,7 @@
 #include <vdbhair/io/TfxFile.h>
 #include <vdbhair/io/UsdFile.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/io/VdbPoints.h>
 #include <vdbhair/io/VdbStrands.h>
 
 #include <cstdint>
@@ -76,9 +77,15 @@ void readOnce(const std::string& path)
     }
     else if (sReader == "vdb") {
         // Every grid of any type (fields, level sets, points), as `info`, `inspect` and the field
-        // verbs read them, then the strands reader on the same bytes.
+        // verbs read them, and the points' columns as Python's Grid.point_attributes() reads them;
+        // then the strands reader on the same bytes.
         try {
-            readVdbGrids(path, path);
+            for (const openvdb::GridBase::Ptr& grid : readVdbGrids(path, path)) {
+                try {
+                    pointColumns(*grid);
+                } catch (const vdbhair::Error&) {
+                }
+            }
         } catch (const vdbhair::Error&) {
         }
         readVdbStrands(path, opts, &report);
