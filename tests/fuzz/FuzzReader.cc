@@ -77,12 +77,14 @@ void readOnce(const std::string& path)
     }
     else if (sReader == "vdb") {
         // Every grid of any type (fields, level sets, points), as `info`, `inspect` and the field
-        // verbs read them, and the points' columns as Python's Grid.point_attributes() reads them;
+        // verbs read them, and the points' columns as Python's Grid.point_attributes() reads them
+        // (within the file's read budget: uniform arrays may stand for more points than memory
+        // holds, which the function checks against the machine's memory, not libFuzzer's limit);
         // then the strands reader on the same bytes.
         try {
             for (const openvdb::GridBase::Ptr& grid : readVdbGrids(path, path)) {
                 try {
-                    pointColumns(*grid);
+                    withinReadBudget(path, path, [&] { pointColumns(*grid); });
                 } catch (const vdbhair::Error&) {
                 }
             }

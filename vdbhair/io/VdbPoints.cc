@@ -1,6 +1,7 @@
 #include "VdbPoints.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Memory.h>
 
 #include <openvdb/points/AttributeArray.h>
 #include <openvdb/points/AttributeGroup.h>
@@ -115,6 +116,12 @@ std::vector<PointColumn> pointColumns(const openvdb::GridBase& base, std::vector
     checkLeaves(grid, leaves);
     const std::size_t n = std::size_t(pts::pointCount(grid.tree()));
     const pts::AttributeSet::Descriptor& desc = leaves.front()->attributeSet().descriptor();
+    // Uniform arrays hold any number of points in one value: the columns may need far more memory
+    // than the grid. At most 3 components of 8 bytes per attribute or group.
+    const std::uint64_t columns = desc.size() + desc.groupMap().size();
+    checkMemory("grid '" + grid.getName() + "'", std::uint64_t(n) * columns * 24,
+                std::to_string(n) + " points x " + std::to_string(columns) + " columns of up to 3 doubles",
+                "read the strands instead (vdbhair.read) or fewer points");
     const std::size_t iP = desc.find("P");
     if (iP != pts::AttributeSet::INVALID_POS) {
         PointColumn p{"P", desc.valueType(iP), 3, false, std::vector<double>(3 * n)};
