@@ -16,7 +16,8 @@
 #             abcls prints), every curve count too, and the basis is kLinear
 #   .arbGeomParams (when INPUT has colours and thicknesses): Cd and groom_width per vertex, and
 #             every colour abcls reads equals vdbhair's
-# and that vdbhair reads its own .abc back to the same .hair bytes.
+# and that vdbhair reads its own .abc back to the same .hair bytes; and, for `interpolate`'s groom
+# (INPUT as guides and roots), the objects /guides and /hair with Unreal's groom attributes.
 set -eu
 ABC=${1:?usage: $0 ALEMBIC_BIN [VDBHAIR] [INPUT]}
 VDBHAIR=${2:-build/bin/vdbhair}
@@ -31,12 +32,14 @@ trap 'rm -rf "$OUT"' EXIT
 "$VDBHAIR" convert "$INPUT" "$OUT/a.hair" --quiet
 "$VDBHAIR" convert "$OUT/a.hair" "$OUT/a.abc" --quiet
 "$VDBHAIR" convert "$OUT/a.abc" "$OUT/b.hair" --quiet
-cmp "$OUT/a.hair" "$OUT/b.hair" && echo "ok: vdbhair reads its .abc back to the same .hair bytes"
+cmp "$OUT/a.hair" "$OUT/b.hair" || { echo "alembic_oracle: the .abc reads back differently" >&2; exit 1; }
+echo "ok: vdbhair reads its .abc back to the same .hair bytes"
 "$VDBHAIR" convert "$OUT/a.hair" "$OUT/a.obj" --obj-lines polylines --quiet
 strands=$("$VDBHAIR" info "$OUT/a.abc" | awk '$1 == "strands:" {print $2}')
 vertices=$("$VDBHAIR" info "$OUT/a.abc" | awk '$1 == "vertices:" {print $2}')
 
-"$ABC/abctree" "$OUT/a.abc" | grep -q -- '`--hair' && echo "ok: abctree shows ABC -> hair"
+"$ABC/abctree" "$OUT/a.abc" | grep -q -- '`--hair' || { echo "alembic_oracle: abctree does not show ABC -> hair" >&2; exit 1; }
+echo "ok: abctree shows ABC -> hair"
 "$ABC/abcecho" "$OUT/a.abc" > "$OUT/echo.txt"
 grep -q "CompoundProperty name=.geom;schema=AbcGeom_Curve_v2" "$OUT/echo.txt"
 grep -q "ScalarProperty name=.selfBnds;interpretation=box;datatype=float64_t\[6\]" "$OUT/echo.txt"
@@ -106,3 +109,43 @@ print('ok: abcecho lists .arbGeomParams Cd and groom_width per vertex; abcls rea
       '(worst difference %.2g)' % (n, worst))
 PY
 fi
+
+# Unreal's groom from `interpolate` (INPUT's strands as guides, new hair at their roots): the guides
+# and the hair as sibling objects, groom_guide 1 and 0, ids 0..G-1 and G.., each hair's three guides
+# among the guides' ids with weights summing to 1; vdbhair reads the hair back (guides left out).
+"$VDBHAIR" interpolate "$OUT/a.hair" --roots "$OUT/a.hair" --head none -o "$OUT/groom.abc" --quiet
+"$VDBHAIR" interpolate "$OUT/a.hair" --roots "$OUT/a.hair" --head none -o "$OUT/groom.hair" --quiet
+"$VDBHAIR" convert "$OUT/groom.abc" "$OUT/groom_back.hair" --quiet
+cmp "$OUT/groom.hair" "$OUT/groom_back.hair" || { echo "alembic_oracle: the groom's hair reads back differently" >&2; exit 1; }
+echo "ok: vdbhair reads the groom's hair back to the bytes interpolate writes as .hair"
+"$ABC/abctree" "$OUT/groom.abc" | tr -d '|`\r-' | awk 'NF' | tr '\n' ' ' | grep -Eq "^ABC +guides +hair *$" ||
+    { echo "alembic_oracle: abctree does not show ABC -> guides, hair" >&2; exit 1; }
+echo "ok: abctree shows ABC -> guides, hair"
+for obj in guides hair; do
+    "$ABC/abcls" -l -v "$OUT/groom.abc/$obj/.geom/.arbGeomParams" | sed 's/\x1b\[[0-9;]*m//g' > "$OUT/$obj.txt"
+done
+python3 - "$OUT/guides.txt" "$OUT/hair.txt" "$strands" <<'PY'
+import sys
+def blocks(path):
+    lines, out, name = open(path).read().split('\n'), {}, None
+    for l in lines:
+        w = l.split()
+        if w and w[0].endswith('Property'):
+            name = w[-1].replace('[1]', '')
+            out[name] = []
+        elif name and l.strip() and '=' not in l and l.strip() not in ('{', '}'):
+            out[name].append([float(x) for x in l.split(',')])
+    return out
+g, h, n = blocks(sys.argv[1]), blocks(sys.argv[2]), int(sys.argv[3])
+for b in (g, h):
+    assert b['groom_version_major'] == [[1]] and b['groom_version_minor'] == [[5]], 'groom schema version is not 1.5'
+assert g['groom_guide'] == [[1]] and h['groom_guide'] == [[0]], 'groom_guide is not 1 on /guides and 0 on /hair'
+assert [int(v[0]) for v in g['groom_id']] == list(range(n)), 'guide ids are not 0..G-1'
+assert [int(v[0]) for v in h['groom_id']] == list(range(n, 2 * n)), 'hair ids are not G..G+S-1'
+cg, w = h['groom_closest_guides'], h['groom_guide_weights']
+assert len(cg) == n and len(w) == n and all(len(r) == 3 for r in cg + w), 'not three guides and weights per curve'
+assert all(0 <= x < n for r in cg for x in r), 'a closest guide is not a guide id'
+assert all(abs(sum(r) - 1) < 1e-5 and min(r) >= 0 for r in w), 'weights do not sum to 1'
+print('ok: abcls reads /guides (groom_guide 1, ids 0..%d) and /hair (groom_guide 0, %d curves, each with three '
+      'guides among them and weights summing to 1), groom schema 1.5' % (n - 1, n))
+PY

@@ -173,8 +173,14 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
     const InterpolateResult r = interpolateGuides(guides, roots, head, op, true, common.interrupter);
     {
         const Stage stage(common, "writing " + p.output);
-        if (op.returnScene) writeScene(p.output, r.scene);
-        else writeStrands(p.output, r.strands);
+        if (op.returnScene) {
+            writeScene(p.output, r.scene);
+        } else if (fileExtension(p.output) == ".abc" && points) {
+            // Unreal's groom: the guides beside the new hair, each strand bound to its guides.
+            writeGroomAbc(p.output, guides.scene ? growGuides(scene, true, common.interrupter) : guideStrands, guides.groups, r);
+        } else {
+            writeStrands(p.output, r.strands);
+        }
     }
     const std::size_t count = r.strands.numStrands() > 0 ? r.strands.numStrands() : r.scene.guides.size();
     const double enteringShare = double(r.enteringHead) / double(count);

@@ -112,6 +112,19 @@ int main(int argc, char** argv)
              "        float[] widths = [1, 2] (interpolation = \"varying\")\n    }\n}\n");
     writeAbc((out / "abc/tiny.abc").string(), s);
     writeAbc((out / "abc/plain.abc").string(), plain);
+    {
+        // Unreal's groom as interpolate writes it: guides and hair, groups, closest guides and weights.
+        AbcCurves guides, hair;
+        guides.name = "guides";
+        guides.strands = &plain;
+        guides.guides = true;
+        guides.groupId.assign(plain.numStrands(), 3);
+        hair.strands = &s;
+        hair.groupId.assign(s.numStrands(), 3);
+        hair.closestGuides.assign(3 * s.numStrands(), 0);
+        hair.guideWeights.assign(3 * s.numStrands(), 0.5f);
+        writeAbc((out / "abc/groom.abc").string(), {guides, hair});
+    }
     writeVdbStrands((out / "vdb/float.vdb").string(), plain);
     VdbPointsOptions fixed;
     fixed.codec = PositionCodec::Fixed16;

@@ -584,3 +584,39 @@ TEST_CASE("interpolateGuides: new hair is kept out of the head, both methods", "
         CHECK(kept.guidesEnteringHead == 0);
     }
 }
+
+TEST_CASE("interpolatePoints: each new strand's binding is its three guides of largest weight, summing to 1", "[helicoid][interp]")
+{
+    // Five straight guides on a line; a root on a guide's root is that guide alone, a root between
+    // two blends them most, and the binding lists guides by weight (largest first).
+    StrandSet guides;
+    for (int g = 0; g < 5; ++g) guides.addStrand({Vec3f(float(g), 0, 0), Vec3f(float(g), 1, 0)});
+    InterpolationRoots roots;
+    roots.positions = {Vec3d(2, 0, 0), Vec3d(0.5, 0, 0), Vec3d(3.25, 0, 0)};
+    PointInterpolationParams params;
+    params.grouping = GuideGrouping::None;
+    GuideBinding b;
+    interpolatePoints(guides, roots, params, {}, true, nullptr, nullptr, nullptr, &b);
+    REQUIRE(b.guides.size() == 9);
+    REQUIRE(b.weights.size() == 9);
+    CHECK(b.guides[0] == 2);
+    CHECK(b.weights[0] == 1.0f);
+    CHECK(b.weights[1] == 0.0f);
+    for (std::size_t i = 0; i < 3; ++i) {
+        CHECK(b.weights[3 * i] + b.weights[3 * i + 1] + b.weights[3 * i + 2] == Approx(1.0).epsilon(1e-6));
+        CHECK(b.weights[3 * i] >= b.weights[3 * i + 1]);
+        CHECK(b.weights[3 * i + 1] >= b.weights[3 * i + 2]);
+    }
+    CHECK(((b.guides[3] == 0 && b.guides[4] == 1) || (b.guides[3] == 1 && b.guides[4] == 0)));
+    CHECK(b.weights[3] == Approx(b.weights[4]).epsilon(1e-6));  // midway: the two alike
+    CHECK(b.guides[6] == 3);  // nearer 3 than 4
+    CHECK(b.guides[7] == 4);
+    // The same for one thread.
+    GuideBinding one;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        interpolatePoints(guides, roots, params, {}, true, nullptr, nullptr, nullptr, &one);
+    }
+    CHECK(one.guides == b.guides);
+    CHECK(one.weights == b.weights);
+}

@@ -453,3 +453,52 @@ TEST_CASE("readAbc: NURBS and Hermite curves are refused by name", "[io][abc]")
     bad.basisAndType = {7, 0, 0, 0};
     REQUIRE_THROWS_WITH(readAbc(test::writeBytes("badtype.abc", buildArchive({bad}, false))), Contains("type 0-2"));
 }
+
+TEST_CASE("writeAbc: several objects; reading leaves simulation guides out when there is hair", "[io][abc]")
+{
+    StrandSet hair = test::sampleStrands(true), guides;
+    guides.addStrand({Vec3f(0, 0, 0), Vec3f(0, 1, 0)});
+    guides.addStrand({Vec3f(1, 0, 0), Vec3f(1, 1, 0)});
+    AbcCurves g, h;
+    g.name = "guides";
+    g.strands = &guides;
+    g.guides = true;
+    g.groupId = {7, 8};
+    h.strands = &hair;
+    h.closestGuides.assign(3 * hair.numStrands(), 1);
+    h.guideWeights.assign(3 * hair.numStrands(), 1.0f / 3.0f);
+    const std::string path = test::tempPath("groom.abc");
+    writeAbc(path, {g, h});
+    ReadReport report;
+    const StrandSet r = readAbc(path, {}, &report);
+    REQUIRE(r.positions == hair.positions);
+    REQUIRE(r.thickness == hair.thickness);
+    REQUIRE(r.color == hair.color);
+    REQUIRE(report.warnings.size() == 1);
+    CHECK_THAT(report.warnings[0], Contains("2 guide curves (groom_guide = 1) left out"));
+    // Hair first and guides after: the same.
+    writeAbc(path, {h, g});
+    REQUIRE(readAbc(path).positions == hair.positions);
+    // Guides only: read whole, silently.
+    writeAbc(path, {g});
+    ReadReport only;
+    REQUIRE(readAbc(path, {}, &only).positions == guides.positions);
+    CHECK(only.warnings.empty());
+    // Two hair objects: concatenated in order.
+    AbcCurves h2 = h;
+    h2.name = "more";
+    writeAbc(path, {h, h2});
+    REQUIRE(readAbc(path).numStrands() == 2 * hair.numStrands());
+    // Refused: a repeated or empty name, a '/', sizes that do not fit the strands.
+    REQUIRE_THROWS_WITH(writeAbc(path, {h, h}), Contains("two objects of one name"));
+    AbcCurves bad = h;
+    bad.name = "a/b";
+    REQUIRE_THROWS_WITH(writeAbc(path, {bad}), Contains("has no '/'"));
+    bad = h;
+    bad.groupId = {1};
+    REQUIRE_THROWS_WITH(writeAbc(path, {bad}), Contains("1 group ids for " + std::to_string(hair.numStrands()) + " strands"));
+    bad = h;
+    bad.guideWeights.pop_back();
+    REQUIRE_THROWS_WITH(writeAbc(path, {bad}), Contains("three of each per strand"));
+    REQUIRE_THROWS_AS(writeAbc(path, std::vector<AbcCurves>{}), ValueError);
+}

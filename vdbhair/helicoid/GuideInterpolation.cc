@@ -1,5 +1,7 @@
 #include "GuideInterpolation.h"
 
+#include <vdbhair/io/AbcFile.h>
+
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/HeadCollision.h>
@@ -101,7 +103,7 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
         context.groups = guides.groups;
         context.frames = params.frames;
         if (guides.scene && params.frames == FrameRule::Surface) context.normals = sceneGuideNormals(*guides.scene);
-        res.strands = interpolatePoints(g, roots, params.points, context, threaded, interrupter, &res.groups, &rootGroups);
+        res.strands = interpolatePoints(g, roots, params.points, context, threaded, interrupter, &res.groups, &rootGroups, &res.binding);
         res.guides = g.numStrands();
         res.guidesEnteringHead = countStrandsEnteringHead(g, head, headTolerance(head), threaded);
     } else {
@@ -171,6 +173,38 @@ InterpolateResult interpolateGuides(const InterpolationGuides& guides, const Int
     }
     res.seconds = secondsSince(t0) - res.fitSeconds;
     return res;
+}
+
+void writeGroomAbc(const std::string& path, const StrandSet& guides, const std::vector<std::int32_t>& guideGroups,
+                   const InterpolateResult& result)
+{
+    const std::size_t G = guides.numStrands(), S = result.strands.numStrands();
+    const std::string where = "writeGroomAbc(" + path + ")";
+    if (result.binding.guides.size() != 3 * S || result.binding.weights.size() != 3 * S)
+        throw ValueError(where + ": the result has no guide binding for its " + std::to_string(S) + " strands (points interpolation makes one)");
+    if (!guideGroups.empty() && guideGroups.size() != G)
+        throw ValueError(where + ": " + std::to_string(guideGroups.size()) + " guide groups for " + std::to_string(G) + " guides: one per guide");
+    for (const std::int32_t g : result.binding.guides)
+        if (g < 0 || std::size_t(g) >= G) throw ValueError(where + ": guide " + std::to_string(g) + " bound, of " + std::to_string(G) + " guides");
+    StrandSet guideCopy = guides, hair = result.strands;
+    guideCopy.strandId.resize(G);
+    for (std::size_t i = 0; i < G; ++i) guideCopy.strandId[i] = std::int32_t(i);
+    hair.strandId.resize(S);
+    for (std::size_t i = 0; i < S; ++i) hair.strandId[i] = std::int32_t(G + i);
+    AbcCurves g, h;
+    g.name = "guides";
+    g.strands = &guideCopy;
+    g.guides = true;
+    g.groupId = guideGroups;
+    h.name = "hair";
+    h.strands = &hair;
+    h.closestGuides = result.binding.guides;  // guide i has groom_id i
+    h.guideWeights = result.binding.weights;
+    if (!guideGroups.empty()) {
+        h.groupId.resize(S);
+        for (std::size_t i = 0; i < S; ++i) h.groupId[i] = guideGroups[std::size_t(result.binding.guides[3 * i])];
+    }
+    writeAbc(path, {std::move(g), std::move(h)});
 }
 
 } // namespace vdbhair

@@ -78,6 +78,9 @@ struct InterpolateResult
     std::size_t rootsDropped = 0;   ///< of them, left bare by density or a length of 0
     std::size_t cut = 0;            ///< new hairs cut to a length under 1
     GroomStats groom;               ///< curl, clumps, frizz
+    /// Points: each new strand's three guides of largest weight (indices into the guides) and
+    /// their weights (GuideBinding), for Unreal's groom attributes; empty for Helicoid.
+    GuideBinding binding;
     std::size_t pushedOut = 0;         ///< new strands the head pushed out (swept, before curl, clumps and frizz)
     std::size_t groomPushedOut = 0;    ///< strands with vertices that curl, clumps or frizz moved into the head, pushed back out one by one
     std::size_t verticesTooDeep = 0;   ///< vertices the push could not bring out (HeadCollision.h)
@@ -100,5 +103,16 @@ struct InterpolateResult
 InterpolateResult interpolateGuides(const InterpolationGuides& guides, const InterpolationRoots& roots, const HeadObstacle& head,
                                     const InterpolateParams& params, bool threaded = true,
                                     openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// @brief Write the groom of an interpolation as Unreal's groom importer takes it (AbcFile.h): the
+/// guides as the Curves object `guides` (groom_guide 1, groom_id 0 .. G-1, their groom_group_id
+/// when @a guideGroups is given) and the new hair as `hair` (groom_guide 0, groom_id G .. G+S-1,
+/// and per strand the groom_closest_guides and groom_guide_weights of @a result's binding, and
+/// the group of its first guide). Reading the file back gives the new hair (the guides are left
+/// out with a warning).
+/// @param guides the guide strands @a result was made from (a scene's: growGuides())
+/// @throw ValueError when @a result has no binding (Helicoid) or sizes disagree; IoError.
+void writeGroomAbc(const std::string& path, const StrandSet& guides, const std::vector<std::int32_t>& guideGroups,
+                   const InterpolateResult& result);
 
 } // namespace vdbhair

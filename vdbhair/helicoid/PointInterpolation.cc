@@ -78,7 +78,7 @@ double likenessDistance(const Vec3f* a, std::size_t na, const Vec3f* b, std::siz
 
 StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& roots, const PointInterpolationParams& params,
                             const GuideContext& context, bool threaded, openvdb::util::NullInterrupter* interrupter,
-                            std::size_t* groupsOut, std::vector<std::uint32_t>* rootGroupsOut)
+                            std::size_t* groupsOut, std::vector<std::uint32_t>* rootGroupsOut, GuideBinding* bindingOut)
 {
     // Arguments, before any work.
     const std::size_t G = guides.numStrands(), R = roots.positions.size();
@@ -259,6 +259,25 @@ StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& r
     else blend(tbb::blocked_range<std::size_t>(0, R));
     if (progress.stopped()) throw InterruptedError("interpolatePoints: interrupted");
 
+    if (bindingOut) {
+        bindingOut->guides.assign(3 * R, 0);
+        bindingOut->weights.assign(3 * R, 0.0f);
+        std::vector<GuideWeight> top;
+        for (std::size_t i = 0; i < R; ++i) {
+            top = weights[i];
+            std::sort(top.begin(), top.end(), [](const GuideWeight& a, const GuideWeight& b) {
+                return a.weight > b.weight || (a.weight == b.weight && a.guide < b.guide);
+            });
+            top.resize(std::min<std::size_t>(top.size(), 3));
+            double sum = 0.0;
+            for (const GuideWeight& w : top) sum += w.weight;
+            for (std::size_t k = 0; k < 3; ++k) {
+                const bool has = k < top.size();
+                bindingOut->guides[3 * i + k] = std::int32_t(has ? top[k].guide : top.front().guide);
+                bindingOut->weights[3 * i + k] = has && sum > 0.0 ? float(top[k].weight / sum) : 0.0f;
+            }
+        }
+    }
     if (groupsOut) *groupsOut = M;
     if (rootGroupsOut) *rootGroupsOut = std::move(rootGroup);
     return out;

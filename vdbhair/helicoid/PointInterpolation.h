@@ -79,6 +79,16 @@ struct GuideContext
     FrameRule frames = FrameRule::World;
 };
 
+/// @brief What each new strand was blended from, as Unreal's groom importer takes it
+/// (`groom_closest_guides`, `groom_guide_weights`: three per strand): the three guides of largest
+/// weight (guide indices; ties to the lower index) and their weights over the three's sum. A
+/// strand of fewer guides repeats its first guide with weight 0.
+struct GuideBinding
+{
+    std::vector<std::int32_t> guides;  ///< 3 #R
+    std::vector<float> weights;        ///< 3 #R
+};
+
 /// @brief New strands at every root by blending the points of @a guides (see above). In parallel,
 /// identical for any thread count.
 /// @param context with FrameRule::Surface, the roots need normals; with root normals and no guide
@@ -89,10 +99,11 @@ struct GuideContext
 /// @param[out] groups optional: the number of distinct guide groups
 /// @param[out] rootGroups optional: #R, the group each new hair blended (0 .. groups - 1, ids in
 /// ascending order), so that later steps (clumps) keep groups apart too
+/// @param[out] binding optional: the guides and weights of each new strand (see GuideBinding)
 StrandSet interpolatePoints(const StrandSet& guides, const InterpolationRoots& roots, const PointInterpolationParams& params,
                             const GuideContext& context = {}, bool threaded = true,
                             openvdb::util::NullInterrupter* interrupter = nullptr, std::size_t* groups = nullptr,
-                            std::vector<std::uint32_t>* rootGroups = nullptr);
+                            std::vector<std::uint32_t>* rootGroups = nullptr, GuideBinding* binding = nullptr);
 
 /// @brief The likeness distance u of two strands (step 3): the mean distance between their
 /// root-relative points at 16 equal fractions of their lengths, over the longer length (0 for two

@@ -138,6 +138,7 @@ private:
     ReadReport* mReport;
     std::vector<std::string> mIndexedMetaData;
     std::unordered_set<std::uint64_t> mVisited;
+    StrandSet mGuides;  ///< the curves whose groom_guide is not 0
     bool mWarnedAnimated = false;
 };
 
@@ -337,6 +338,12 @@ StrandSet AbcReader::read()
     if (curveObjects == 0) {
         throw FormatError(mWhere + ": no Curves object (schema AbcGeom_Curve_v2) in the archive");
     }
+    // Simulation guides beside the hair (Unreal's groom_guide): the hair is what is read.
+    if (mGuides.numStrands() > 0) {
+        if (out.numStrands() == 0) return std::move(mGuides);
+        warn(std::to_string(mGuides.numStrands()) + " guide curves (groom_guide = 1) left out; the " + std::to_string(out.numStrands()) +
+             " other curves are the hair read");
+    }
     return out;
 }
 
@@ -414,6 +421,7 @@ struct AbcReader::ArbParams
     std::vector<float> cd, rootUV, groomWidth;
     std::string cdScope;
     std::vector<std::int32_t> ids;
+    std::vector<std::int32_t> guide;  ///< groom_guide: one value (the object) or one per curve
 };
 
 AbcReader::ArbParams AbcReader::readArbGeomParams(const ogawa::Reader::Group& geom, const PropertyIn& arb, const std::string& what,
@@ -439,6 +447,21 @@ AbcReader::ArbParams AbcReader::readArbGeomParams(const ogawa::Reader::Group& ge
         } else if (p.name == "groom_width" && p.pod == kFloat32 && p.extent == 1) {
             out.groomWidth = floatParam(g, p, 1, here + "/groom_width", scope);
             if (out.groomWidth.size() != numPoints) out.groomWidth.clear();
+        } else if (p.name == "groom_guide" && p.type != kCompound && (p.pod == kInt8 || p.pod == kInt16 || p.pod == kInt32) && p.extent == 1) {
+            std::uint64_t n = 1;
+            const ogawa::Reader::Data d = p.type == kArray ? arraySample(g, p, here + "/groom_guide", n) : scalarSample(g, p, here + "/groom_guide");
+            const unsigned size = kPodBytes[p.pod];
+            if ((n == 1 || n == numCurves) && d.size == n * size) {
+                for (std::uint64_t i = 0; i < n; ++i) {
+                    std::int32_t v = 0;
+                    if (size == 1) v = std::int8_t(d.bytes[i]);
+                    else if (size == 2) { std::int16_t x; std::memcpy(&x, d.bytes + 2 * i, 2); v = x; }
+                    else std::memcpy(&v, d.bytes + 4 * i, 4);
+                    out.guide.push_back(v);
+                }
+            } else {
+                warn(here + "/groom_guide has " + std::to_string(n) + " values for " + std::to_string(numCurves) + " curves; one, or one per curve, is read; ignored");
+            }
         } else if (p.name == "groom_id" && p.type == kArray && p.pod == kInt32 && p.extent == 1) {
             std::uint64_t n = 0;
             const ogawa::Reader::Data d = arraySample(g, p, here + "/groom_id", n);
@@ -594,6 +617,7 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
     std::vector<Vec2f> keptUV;
     std::vector<Vec3f> polyColor, keptColor;
     std::vector<std::int32_t> keptIds;
+    std::vector<char> isGuide;  // per kept curve
     const bool perVertexColor = !arb.cd.empty() && arb.cdScope != "con";
     std::uint64_t first = 0, firstVarying = 0;
     for (std::uint64_t i = 0; i < numCurves; ++i) {
@@ -647,6 +671,7 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
         if (uvPerCurve) keptUV.emplace_back(uvs[2 * i], uvs[2 * i + 1]);
         if (perVertexColor) keptColor.insert(keptColor.end(), polyColor.begin(), polyColor.end());
         if (!arb.ids.empty()) keptIds.push_back(arb.ids[i]);
+        isGuide.push_back(!arb.guide.empty() && arb.guide[arb.guide.size() == 1 ? 0 : std::size_t(i)] != 0);
     }
     filter.finish();
     if (!arb.cd.empty() && !perVertexColor) set.defaults.color = Vec3f(arb.cd[0], arb.cd[1], arb.cd[2]);
@@ -655,10 +680,20 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
     if (widths.size() == 1) set.defaults.thickness = widths[0];
     if (perVertexWidth) set.thickness = std::move(keptWidths);
     if (uvPerCurve) set.rootUV = std::move(keptUV);
-    if (out.empty() && out.positions.empty()) {
-        out = std::move(set);
+    // Guides apart from the hair (read() chooses).
+    auto add = [](StrandSet& to, StrandSet&& from) {
+        if (to.empty() && to.positions.empty()) to = std::move(from);
+        else to.append(std::move(from));
+    };
+    const std::size_t guides = std::size_t(std::count(isGuide.begin(), isGuide.end(), char(1)));
+    if (guides == 0) {
+        add(out, std::move(set));
+    } else if (guides == set.numStrands()) {
+        add(mGuides, std::move(set));
     } else {
-        out.append(std::move(set));
+        add(mGuides, selectStrands(set, isGuide));
+        for (char& g : isGuide) g = !g;
+        add(out, selectStrands(set, isGuide));
     }
 }
 

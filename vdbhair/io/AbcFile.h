@@ -22,15 +22,22 @@
 ///       width              float32 array, arrayExtent=1;geoScope=vtx (per vertex) or geoScope=con
 ///                          (one value: the default thickness);isGeomParam=true;podExtent=1;
 ///                          podName=float32_t
-///       .arbGeomParams     compound, when the set has any of these (geometry parameters as
-///                          AbcGeom writes them):
-///         Cd               float32[3] array, geoScope=vtx;interpretation=rgb (the colours)
+///       .arbGeomParams     compound (geometry parameters as AbcGeom writes them):
+///         groom_version_major, groom_version_minor   int16, geoScope=con: 1 and 5
+///         groom_guide      int32, geoScope=con: 1 for an object of guides (AbcCurves::guides), else 0
+///         Cd               float32[3] array, geoScope=vtx;interpretation=rgb (the colours, if any)
 ///         groom_root_uv    float32[2] array, geoScope=uni (the root UVs, again: Unreal's name)
-///         groom_id         int32 array, geoScope=uni (StrandSet::strandId)
+///         groom_id         int32 array, geoScope=uni (StrandSet::strandId, if any)
 ///         groom_width      float32 array, geoScope=vtx (the thickness, again: Unreal's name)
+///         groom_group_id   int32 array, geoScope=uni (AbcCurves::groupId, if any)
+///         groom_closest_guides  int32[3] array, geoScope=uni  } the guides (their groom_id) and
+///         groom_guide_weights   float32[3] array, geoScope=uni } weights of each curve, if any
 /// ```
 ///
-/// The groom_* attributes follow Unreal's "Alembic for Grooms" specification. Widths are vdbhair's thickness (a diameter in world units, as Alembic's and USD's widths).
+/// Several objects are siblings under the archive's top object, in the order given (`interpolate`
+/// writes its guides as `/guides` and the new hair as `/hair`). The groom_* attributes follow
+/// Unreal's "Alembic for Grooms" specification (schema version 1.5). Widths are vdbhair's thickness
+/// (a diameter in world units, as Alembic's and USD's widths).
 ///
 /// Reading takes every object whose schema is `AbcGeom_Curve_v*`, in hierarchy order (depth
 /// first, children in file order), concatenated. Linear curves are read as they are (periodic ones
@@ -44,7 +51,10 @@
 /// transforms of parent Xform objects are applied to the points (their `.ops` and `.vals`
 /// composed as AbcGeom's XformSample::getMatrix does, `.inherits` honoured; widths scale with
 /// them); NURBS (`kVariableOrder`) curves other
-/// than order 2, Hermite and power bases are refused (UnsupportedError).
+/// than order 2, Hermite and power bases are refused (UnsupportedError). Unreal's `groom_guide`
+/// (int8, int16 or int32; per object or per curve) marks simulation guides: when an archive holds
+/// both guides and other curves, the other curves (the hair) are read, with a warning naming the
+/// guides left out; an archive of guides only is read whole.
 ///
 /// Every offset and count in the file is checked against the file size before it is used, and
 /// the object tree is walked with an explicit stack (no recursion on the file's depth); a group
@@ -54,7 +64,9 @@
 #include <vdbhair/io/ReadOptions.h>
 #include <vdbhair/strands/StrandSet.h>
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace vdbhair {
 
@@ -63,8 +75,24 @@ namespace vdbhair {
 /// UnsupportedError (an HDF5 archive, NURBS, Hermite or power curves).
 StrandSet readAbc(const std::string& path, const ReadOptions& opts = {}, ReadReport* report = nullptr);
 
+/// One Curves object to write: strands, and Unreal's per-curve groom attributes beside them.
+struct AbcCurves
+{
+    std::string name = "hair";
+    const StrandSet* strands = nullptr;
+    bool guides = false;                      ///< simulation guides (groom_guide = 1), not rendered hair
+    std::vector<std::int32_t> groupId;        ///< #S or empty: groom_group_id
+    std::vector<std::int32_t> closestGuides;  ///< 3 #S or empty: groom_closest_guides, the groom_id of guide curves
+    std::vector<float> guideWeights;          ///< 3 #S (with closestGuides) or empty: groom_guide_weights
+};
+
 /// @brief Write the strands as one linear Curves object `/hair` (layout above), atomically.
 /// @throw ValueError (empty set), IoError.
 void writeAbc(const std::string& path, const StrandSet& strands);
+
+/// @brief Write @a objects as sibling Curves objects, in order, atomically.
+/// @throw ValueError (no objects, an empty set, a name that is empty, has '/' or repeats, groom
+/// attributes of the wrong size), IoError.
+void writeAbc(const std::string& path, const std::vector<AbcCurves>& objects);
 
 } // namespace vdbhair

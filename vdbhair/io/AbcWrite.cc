@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <deque>
 #include <map>
 
 namespace vdbhair {
@@ -103,136 +104,236 @@ Sample makeSample(const void* data, std::uint64_t size)
 
 } // namespace
 
-void writeAbc(const std::string& path, const StrandSet& strands)
+namespace {
+
+/// One archive being written: the container, its indexed metadata, and the sample digests the
+/// container borrows until it is written (a deque: they never move).
+struct ArchiveOut
 {
-    const std::string where = "writeAbc(" + path + ")";
-    if (strands.empty()) throw ValueError(where + ": no strands to write; an Alembic Curves object needs at least one");
     ogawa::Writer w;
     MetaDataIndex mdIndex;
+    std::deque<Sample> samples;
+    std::deque<std::string> owned;  // bytes of values made while writing (the container borrows them)
+};
 
-    // Arrays: points, counts, bounds, basis and type, widths, root UVs.
+/// A geometry parameter's metadata, as AbcGeom's OTypedGeomParam writes it.
+std::string geomParam(const char* scope, const char* interpretation, unsigned extent, const char* podName)
+{
+    return std::string("arrayExtent=1;geoScope=") + scope + (*interpretation ? std::string(";interpretation=") + interpretation : std::string()) +
+           ";isGeomParam=true;podExtent=" + std::to_string(extent) + ";podName=" + podName;
+}
+
+/// The properties of one object's compound, collected and encoded.
+class PropertyList
+{
+public:
+    explicit PropertyList(ArchiveOut& a) : mA(a) {}
+
+    /// An array property of @a count elements; @a data must stay valid until the archive is written.
+    void array(const std::string& name, const std::string& md, unsigned pod, unsigned extent, const void* data, std::uint64_t bytes,
+               std::uint64_t count)
+    {
+        const Sample& s = mA.samples.emplace_back(makeSample(data, bytes));
+        PropertyOut p{name, md, kArray, pod, extent, count == 1, {}};
+        // Sample 0: its digest and bytes, then its dimensions (empty: rank 1, count from the size).
+        const auto data0 = mA.w.addData(ogawa::Writer::Pieces{{s.digest, 16}, {s.data, s.size}});
+        const auto dims = mA.w.addData(ogawa::Writer::Pieces{});
+        p.group = mA.w.addGroup({data0, dims});
+        mList.push_back(std::move(p));
+    }
+    /// As array(), the bytes copied (for values made here).
+    void ownedArray(const std::string& name, const std::string& md, unsigned pod, unsigned extent, std::string bytes, std::uint64_t count)
+    {
+        const std::string& b = mA.owned.emplace_back(std::move(bytes));
+        array(name, md, pod, extent, b.data(), b.size(), count);
+    }
+    void scalar(const std::string& name, const std::string& md, unsigned pod, unsigned extent, std::string bytes)
+    {
+        const std::string& b = mA.owned.emplace_back(std::move(bytes));
+        const Sample& s = mA.samples.emplace_back(makeSample(b.data(), b.size()));
+        PropertyOut p{name, md, kScalar, pod, extent, true, {}};
+        p.group = mA.w.addGroup({mA.w.addData(ogawa::Writer::Pieces{{s.digest, 16}, {s.data, s.size}})});
+        mList.push_back(std::move(p));
+    }
+    void compound(const std::string& name, const std::string& md, ogawa::Writer::Node group)
+    {
+        mList.push_back(PropertyOut{name, md, kCompound, 0, 0, false, group});
+    }
+    bool empty() const { return mList.empty(); }
+    /// The compound's group: every property's group, then their headers. @a headers gets the headers.
+    ogawa::Writer::Node group(std::string* headers = nullptr)
+    {
+        std::vector<ogawa::Writer::Node> children;
+        for (const PropertyOut& p : mList) children.push_back(p.group);
+        std::string h;
+        for (const PropertyOut& p : mList) encodeProperty(h, p, mA.mdIndex);
+        children.push_back(mA.w.addData(h));
+        if (headers) *headers = std::move(h);
+        return mA.w.addGroup(children);
+    }
+
+private:
+    ArchiveOut& mA;
+    std::vector<PropertyOut> mList;
+};
+
+template<typename T>
+std::string bytesOf(const T* data, std::size_t count)
+{
+    return std::string(reinterpret_cast<const char*>(data), sizeof(T) * count);
+}
+
+/// Hashes of content (the reference library's are SpookyHash V2 of the same inputs; readers only
+/// compare them, so any content hash keeps their meaning: equal content, equal hash).
+void contentHash(const std::string& bytes, std::uint64_t out[2])
+{
+    ogawa::murmur3x64_128(bytes.data(), bytes.size(), out);
+}
+
+const std::string kCurvesSchema = "schema=AbcGeom_Curve_v2;schemaBaseType=AbcGeom_GeomBase_v1";
+
+/// One written object: its group and the 16 bytes of its properties' hash.
+struct ObjectOut
+{
+    ogawa::Writer::Node group;
+    std::uint64_t hash[2];
+};
+
+/// The Curves object of @a c (AbcFile.h's layout).
+ObjectOut writeCurvesObject(ArchiveOut& a, const AbcCurves& c)
+{
+    const StrandSet& strands = *c.strands;
     std::vector<std::int32_t> counts(strands.numStrands());
     for (std::size_t i = 0; i < counts.size(); ++i) counts[i] = std::int32_t(strands.size(i));
     const BBox box = computeBBox(strands);
     const double bounds[6] = {box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z()};
     const std::uint8_t basisAndType[4] = {1, 0, 0, 0};  // kLinear, kNonPeriodic, kNoBasis, kNoBasis
     const float constantWidth = strands.defaults.thickness;
+    const std::size_t firstSample = a.samples.size();
 
-    std::vector<PropertyOut> props, arbProps;
-    std::vector<Sample> samples;  // kept alive until write: the digests are borrowed
-    samples.reserve(10);
-    auto arrayPropertyIn = [&](std::vector<PropertyOut>& to, const char* name, const std::string& md, unsigned pod, unsigned extent,
-                               const void* data, std::uint64_t bytes, std::uint64_t count) {
-        samples.push_back(makeSample(data, bytes));
-        const Sample& s = samples.back();
-        PropertyOut p{name, md, kArray, pod, extent, count == 1, {}};
-        // Sample 0: its digest and bytes, then its dimensions (empty: rank 1, count from the size).
-        const auto data0 = w.addData(ogawa::Writer::Pieces{{s.digest, 16}, {s.data, s.size}});
-        const auto dims = w.addData(ogawa::Writer::Pieces{});
-        p.group = w.addGroup({data0, dims});
-        to.push_back(std::move(p));
-    };
-    auto arrayProperty = [&](const char* name, const std::string& md, unsigned pod, unsigned extent, const void* data, std::uint64_t bytes,
-                             std::uint64_t count) { arrayPropertyIn(props, name, md, pod, extent, data, bytes, count); };
-    // A geometry parameter's metadata, as AbcGeom's OTypedGeomParam writes it.
-    auto geomParam = [](const char* scope, const char* interpretation, unsigned extent, const char* podName) {
-        return std::string("arrayExtent=1;geoScope=") + scope + (*interpretation ? std::string(";interpretation=") + interpretation : std::string()) +
-               ";isGeomParam=true;podExtent=" + std::to_string(extent) + ";podName=" + podName;
-    };
-    auto scalarProperty = [&](const char* name, const char* md, unsigned pod, unsigned extent,
-                              const void* data, std::uint64_t bytes) {
-        samples.push_back(makeSample(data, bytes));
-        const Sample& s = samples.back();
-        PropertyOut p{name, md, kScalar, pod, extent, true, {}};
-        p.group = w.addGroup({w.addData(ogawa::Writer::Pieces{{s.digest, 16}, {s.data, s.size}})});
-        props.push_back(std::move(p));
-    };
-    scalarProperty(".selfBnds", "interpretation=box", kFloat64, 6, bounds, sizeof(bounds));
-    arrayProperty("P", "geoScope=vtx;interpretation=point", kFloat32, 3, strands.positions.data(),
-                  12 * std::uint64_t(strands.numVertices()), strands.numVertices());
-    arrayProperty("nVertices", "", kInt32, 1, counts.data(), 4 * std::uint64_t(counts.size()), counts.size());
-    scalarProperty("curveBasisAndType", "", kUint8, 4, basisAndType, 4);
+    PropertyList geom(a), arb(a);
+    geom.scalar(".selfBnds", "interpretation=box", kFloat64, 6, bytesOf(bounds, 6));
+    geom.array("P", "geoScope=vtx;interpretation=point", kFloat32, 3, strands.positions.data(), 12 * std::uint64_t(strands.numVertices()),
+               strands.numVertices());
+    geom.ownedArray("nVertices", "", kInt32, 1, bytesOf(counts.data(), counts.size()), counts.size());
+    geom.scalar("curveBasisAndType", "", kUint8, 4, bytesOf(basisAndType, 4));
     if (!strands.rootUV.empty()) {
-        arrayProperty("uv", "arrayExtent=1;geoScope=uni;interpretation=vector;isGeomParam=true;podExtent=2;podName=float32_t", kFloat32, 2,
-                      strands.rootUV.data(), 8 * std::uint64_t(strands.rootUV.size()), strands.rootUV.size());
+        geom.array("uv", geomParam("uni", "vector", 2, "float32_t"), kFloat32, 2, strands.rootUV.data(), 8 * std::uint64_t(strands.rootUV.size()),
+                   strands.rootUV.size());
     }
     if (!strands.thickness.empty()) {
-        arrayProperty("width", "arrayExtent=1;geoScope=vtx;isGeomParam=true;podExtent=1;podName=float32_t", kFloat32, 1,
-                      strands.thickness.data(), 4 * std::uint64_t(strands.thickness.size()), strands.thickness.size());
+        geom.array("width", geomParam("vtx", "", 1, "float32_t"), kFloat32, 1, strands.thickness.data(),
+                   4 * std::uint64_t(strands.thickness.size()), strands.thickness.size());
     } else {
-        arrayProperty("width", "arrayExtent=1;geoScope=con;isGeomParam=true;podExtent=1;podName=float32_t", kFloat32, 1,
-                      &constantWidth, 4, 1);
+        geom.ownedArray("width", geomParam("con", "", 1, "float32_t"), kFloat32, 1, bytesOf(&constantWidth, 1), 1);
     }
     // .arbGeomParams: colour as Cd (Houdini's, Maya's and Blender's name) and Unreal's groom
-    // attributes (its "Alembic for Grooms" specification): groom_root_uv and groom_id per curve,
-    // groom_width per vertex.
+    // attributes (its "Alembic for Grooms" specification, schema version 1.5).
+    const std::int16_t versionMajor = 1, versionMinor = 5;
+    arb.ownedArray("groom_version_major", geomParam("con", "", 1, "int16_t"), kInt16, 1, bytesOf(&versionMajor, 1), 1);
+    arb.ownedArray("groom_version_minor", geomParam("con", "", 1, "int16_t"), kInt16, 1, bytesOf(&versionMinor, 1), 1);
+    const std::int32_t guideFlag = c.guides ? 1 : 0;
+    arb.ownedArray("groom_guide", geomParam("con", "", 1, "int32_t"), kInt32, 1, bytesOf(&guideFlag, 1), 1);
     if (!strands.color.empty()) {
-        arrayPropertyIn(arbProps, "Cd", geomParam("vtx", "rgb", 3, "float32_t"), kFloat32, 3, strands.color.data(),
-                        12 * std::uint64_t(strands.color.size()), strands.color.size());
+        arb.array("Cd", geomParam("vtx", "rgb", 3, "float32_t"), kFloat32, 3, strands.color.data(), 12 * std::uint64_t(strands.color.size()),
+                  strands.color.size());
     }
     if (!strands.rootUV.empty()) {
-        arrayPropertyIn(arbProps, "groom_root_uv", geomParam("uni", "vector", 2, "float32_t"), kFloat32, 2, strands.rootUV.data(),
-                        8 * std::uint64_t(strands.rootUV.size()), strands.rootUV.size());
+        arb.array("groom_root_uv", geomParam("uni", "vector", 2, "float32_t"), kFloat32, 2, strands.rootUV.data(),
+                  8 * std::uint64_t(strands.rootUV.size()), strands.rootUV.size());
     }
     if (!strands.strandId.empty()) {
-        arrayPropertyIn(arbProps, "groom_id", geomParam("uni", "", 1, "int32_t"), kInt32, 1, strands.strandId.data(),
-                        4 * std::uint64_t(strands.strandId.size()), strands.strandId.size());
+        arb.array("groom_id", geomParam("uni", "", 1, "int32_t"), kInt32, 1, strands.strandId.data(), 4 * std::uint64_t(strands.strandId.size()),
+                  strands.strandId.size());
     }
     if (!strands.thickness.empty()) {
-        arrayPropertyIn(arbProps, "groom_width", geomParam("vtx", "", 1, "float32_t"), kFloat32, 1, strands.thickness.data(),
-                        4 * std::uint64_t(strands.thickness.size()), strands.thickness.size());
+        arb.array("groom_width", geomParam("vtx", "", 1, "float32_t"), kFloat32, 1, strands.thickness.data(),
+                  4 * std::uint64_t(strands.thickness.size()), strands.thickness.size());
     }
-
-    // Header blocks: properties of .geom, the object's compound, the objects.
-    const std::string curvesSchema = "schema=AbcGeom_Curve_v2;schemaBaseType=AbcGeom_GeomBase_v1";
-    auto headers = [&](const std::vector<PropertyOut>& list) {
-        std::string out;
-        for (const PropertyOut& p : list) encodeProperty(out, p, mdIndex);
-        return out;
-    };
-    // Hashes of the content (the reference library's are SpookyHash V2 of the same inputs;
-    // readers only compare them, so any content hash keeps their meaning: equal content, equal hash).
-    auto contentHash = [](const std::string& bytes, std::uint64_t out[2]) { ogawa::murmur3x64_128(bytes.data(), bytes.size(), out); };
-
-    if (!arbProps.empty()) {
-        std::vector<ogawa::Writer::Node> arbChildren;
-        for (const PropertyOut& p : arbProps) arbChildren.push_back(p.group);
-        arbChildren.push_back(w.addData(headers(arbProps)));
-        props.push_back(PropertyOut{".arbGeomParams", "", kCompound, 0, 0, false, w.addGroup(arbChildren)});
+    if (!c.groupId.empty()) {
+        arb.array("groom_group_id", geomParam("uni", "", 1, "int32_t"), kInt32, 1, c.groupId.data(), 4 * std::uint64_t(c.groupId.size()),
+                  c.groupId.size());
     }
-    std::vector<ogawa::Writer::Node> geomChildren;
-    for (const PropertyOut& p : props) geomChildren.push_back(p.group);
-    const std::string geomHeaders = headers(props);
-    geomChildren.push_back(w.addData(geomHeaders));
-    PropertyOut geom{".geom", curvesSchema, kCompound, 0, 0, false, w.addGroup(geomChildren)};
-    const std::string objPropHeaders = headers({geom});
-    const auto objProps = w.addGroup({geom.group, w.addData(objPropHeaders)});
+    if (!c.closestGuides.empty()) {
+        arb.array("groom_closest_guides", geomParam("uni", "", 3, "int32_t"), kInt32, 3, c.closestGuides.data(),
+                  4 * std::uint64_t(c.closestGuides.size()), c.closestGuides.size() / 3);
+        arb.array("groom_guide_weights", geomParam("uni", "", 3, "float32_t"), kFloat32, 3, c.guideWeights.data(),
+                  4 * std::uint64_t(c.guideWeights.size()), c.guideWeights.size() / 3);
+    }
+    geom.compound(".arbGeomParams", "", arb.group());
 
+    std::string geomHeaders;
+    const ogawa::Writer::Node geomGroup = geom.group(&geomHeaders);
+    PropertyList objectProps(a);
+    objectProps.compound(".geom", kCurvesSchema, geomGroup);
+    const ogawa::Writer::Node props = objectProps.group();
+
+    ObjectOut out{};
     std::uint64_t hashes[4];
     std::string digestInput = geomHeaders;
-    for (const Sample& s : samples) digestInput.append(reinterpret_cast<const char*>(s.digest), 16);
+    for (std::size_t k = firstSample; k < a.samples.size(); ++k) digestInput.append(reinterpret_cast<const char*>(a.samples[k].digest), 16);
     contentHash(digestInput, hashes);  // properties
     hashes[2] = hashes[3] = 0;         // no children
-    const auto hairObject = w.addGroup({objProps, w.addData(std::string(reinterpret_cast<const char*>(hashes), 32))});
+    out.group = a.w.addGroup({props, a.w.addData(std::string(reinterpret_cast<const char*>(hashes), 32))});
+    out.hash[0] = hashes[0];
+    out.hash[1] = hashes[1];
+    return out;
+}
 
-    std::string topHeaders;
-    const std::string hairMd = curvesSchema + ";schemaObjTitle=AbcGeom_Curve_v2:.geom";
-    pushU32(topHeaders, 4, 2);
-    topHeaders += "hair";
-    const std::uint32_t hairMdi = mdIndex.index(hairMd);
-    pushU32(topHeaders, hairMdi, 0);
-    if (hairMdi == 255) { pushU32(topHeaders, std::uint32_t(hairMd.size()), 2); topHeaders += hairMd; }
+} // namespace
+
+void writeAbc(const std::string& path, const StrandSet& strands)
+{
+    AbcCurves hair;
+    hair.strands = &strands;
+    writeAbc(path, std::vector<AbcCurves>{std::move(hair)});
+}
+
+void writeAbc(const std::string& path, const std::vector<AbcCurves>& objects)
+{
+    const std::string where = "writeAbc(" + path + ")";
+    if (objects.empty()) throw ValueError(where + ": no objects to write");
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const AbcCurves& c = objects[i];
+        const std::string what = where + ": object '" + c.name + "'";
+        if (!c.strands || c.strands->empty()) throw ValueError(what + ": no strands to write; an Alembic Curves object needs at least one");
+        if (c.name.empty() || c.name.find('/') != std::string::npos) throw ValueError(what + ": a name is not empty and has no '/'");
+        for (std::size_t j = 0; j < i; ++j)
+            if (objects[j].name == c.name) throw ValueError(what + ": two objects of one name; names are unique among siblings");
+        const std::size_t S = c.strands->numStrands();
+        if (!c.groupId.empty() && c.groupId.size() != S)
+            throw ValueError(what + ": " + std::to_string(c.groupId.size()) + " group ids for " + std::to_string(S) + " strands: one per strand");
+        if (c.closestGuides.size() != c.guideWeights.size() || (!c.closestGuides.empty() && c.closestGuides.size() != 3 * S))
+            throw ValueError(what + ": " + std::to_string(c.closestGuides.size()) + " closest guides and " + std::to_string(c.guideWeights.size()) +
+                             " weights for " + std::to_string(S) + " strands: three of each per strand");
+    }
+    ArchiveOut a;
+    // The top object's children: each object, then their headers (name, metadata) and hashes.
+    std::vector<ogawa::Writer::Node> topChildren{a.w.addGroup({})};
+    std::string topHeaders, childDigest;
+    const std::string curvesMd = kCurvesSchema + ";schemaObjTitle=AbcGeom_Curve_v2:.geom";
+    for (const AbcCurves& c : objects) {
+        const ObjectOut o = writeCurvesObject(a, c);
+        topChildren.push_back(o.group);
+        pushU32(topHeaders, std::uint32_t(c.name.size()), 2);
+        topHeaders += c.name;
+        const std::uint32_t mdi = a.mdIndex.index(curvesMd);
+        pushU32(topHeaders, mdi, 0);
+        if (mdi == 255) { pushU32(topHeaders, std::uint32_t(curvesMd.size()), 2); topHeaders += curvesMd; }
+        childDigest += std::string(reinterpret_cast<const char*>(o.hash), 16) + curvesMd + c.name;
+    }
     std::uint64_t topHashes[4] = {0, 0, 0, 0};
-    contentHash(std::string(reinterpret_cast<const char*>(hashes), 16) + hairMd + "hair", topHashes + 2);
+    contentHash(childDigest, topHashes + 2);
     topHeaders.append(reinterpret_cast<const char*>(topHashes), 32);
-    const auto topObject = w.addGroup({w.addGroup({}), hairObject, w.addData(topHeaders)});
+    topChildren.push_back(a.w.addData(topHeaders));
+    const auto topObject = a.w.addGroup(topChildren);
 
     // The archive: versions, top object, metadata, time samplings, indexed metadata.
     std::string versionBytes(4, '\0'), libraryBytes(4, '\0');
     std::memcpy(&versionBytes[0], &kOgawaFileVersion, 4);
     std::memcpy(&libraryBytes[0], &kLibraryVersion, 4);
-    const auto v0 = w.addData(versionBytes);
-    const auto v1 = w.addData(libraryBytes);
+    const auto v0 = a.w.addData(versionBytes);
+    const auto v1 = a.w.addData(libraryBytes);
     const std::string archiveMd = std::string("_ai_AlembicVersion=Alembic 1.8.12 (written by ") + creatorString() +
                                   ");_ai_Application=" + creatorString();
     std::string timeSamplings;
@@ -241,13 +342,13 @@ void writeAbc(const std::string& path, const StrandSet& strands)
     timeSamplings.append(reinterpret_cast<const char*>(&timePerCycle), 8);
     pushU32(timeSamplings, 1, 2);  // one stored time
     timeSamplings.append(reinterpret_cast<const char*>(&time0), 8);
-    const auto md = w.addData(archiveMd);
-    const auto ts = w.addData(timeSamplings);
-    const auto indexed = w.addData(mdIndex.serialize());
-    w.addGroup({v0, v1, topObject, md, ts, indexed});
+    const auto md = a.w.addData(archiveMd);
+    const auto ts = a.w.addData(timeSamplings);
+    const auto indexed = a.w.addData(a.mdIndex.serialize());
+    a.w.addGroup({v0, v1, topObject, md, ts, indexed});
 
     AtomicFileWriter file(path, where);
-    w.write([&](const void* data, std::uint64_t n) { file.append(data, std::size_t(n)); });
+    a.w.write([&](const void* data, std::uint64_t n) { file.append(data, std::size_t(n)); });
     file.commit();
 }
 

@@ -167,7 +167,7 @@ void Writer::write(AppendT&& append) const
 /// AbcCoreOgawa's encoding on top of the container (AbcFile.cc reads it, AbcWrite.cc writes it).
 namespace abc {
 /// Alembic's plain-old-data types (Util/PlainOldDataType.h) used here, and their sizes in bytes.
-enum Pod : unsigned { kUint8 = 1, kUint32 = 5, kInt32 = 6, kFloat32 = 10, kFloat64 = 11, kNumPods = 14 };
+enum Pod : unsigned { kUint8 = 1, kInt8 = 2, kInt16 = 4, kUint32 = 5, kInt32 = 6, kFloat32 = 10, kFloat64 = 11, kNumPods = 14 };
 constexpr unsigned kPodBytes[kNumPods] = {1, 1, 1, 2, 2, 4, 4, 8, 8, 2, 4, 8, 0, 0};
 constexpr std::int32_t kOgawaFileVersion = 0;    ///< AbcCoreOgawa's ALEMBIC_OGAWA_FILE_VERSION
 constexpr std::int32_t kLibraryVersion = 10812;  ///< the layout of Alembic 1.8.12
