@@ -20,17 +20,14 @@ namespace vdbhair::app {
 struct RefineCmdParams
 {
     std::string input, output, saveField;
-    RefineParams refine;
-    CLI::Option* voxelOpt = nullptr;  ///< whether --voxel-size was given
-    CLI::Option* stepOpt = nullptr;   ///< whether --step was given
-    std::string mode = "consistent";
-    std::string integrator = "euler";
+    RefineParams refine;  ///< its declared parameters (refineParameters()) are options
     HeadOptions head;
     bool strict = false;
     ScalpOptions scalp;
 };
 
-void addRefineOptions(CLI::App* sub, RefineCmdParams& p);
+/// @brief refine's declared parameters but those in @a skip, the head and scalp options, --strict.
+void addRefineOptions(CLI::App* sub, RefineCmdParams& p, const std::vector<std::string>& skip = {});
 /// @throw ValueError for out-of-range options, IoError/FormatError for an unreadable --head.
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands, const CommonOptions& common);
 /// The field grids of @a r, each tagged `vdbhair_source` = @a source (the input file).

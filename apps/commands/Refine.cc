@@ -1,4 +1,5 @@
 // vdbhair refine IN -o OUT: Wang et al.'s vector-field refinement, coarse level to fine.
+#include "../ParamOptions.h"
 #include "../RefineOptions.h"
 
 #include <vdbhair/Exceptions.h>
@@ -15,22 +16,8 @@ namespace vdbhair::app {
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands, const CommonOptions& common)
 {
     RefineParams rp = p.refine;
-    const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0, stepGiven = p.stepOpt && p.stepOpt->count() > 0;
-    const double voxel = rp.field.voxelSize;
-    if (voxelGiven && (!(voxel > 0.0) || !std::isfinite(voxel))) {
-        throw ValueError("--voxel-size " + formatValue(voxel) + ": must be a positive finite length");
-    }
-    if (!voxelGiven) rp.field.voxelSize = 0.0;
-    if (stepGiven && (!(rp.trace.step > 0.0) || !std::isfinite(rp.trace.step))) {
-        throw ValueError("--step " + formatValue(rp.trace.step) + ": must be a positive finite length");
-    }
-    rp.setStep(rp.trace.step, integratorFromName(p.integrator));  // one --step and --integrator for both modes
-    if (rp.field.iterations < 1) throw ValueError("--iterations " + std::to_string(rp.field.iterations) + ": must be at least 1");
-    if (rp.trace.margin < 0 || rp.trace.margin > TraceParams::kMaxMargin) {
-        throw ValueError("--margin " + std::to_string(rp.trace.margin) + ": must be between 0 and " + std::to_string(TraceParams::kMaxMargin) + " voxels");
-    }
-    rp.validate("option");  // the library's ranges, its field names spelled as flags (addRefineCommand)
-    rp.mode = refineModeFromName(p.mode);
+    checkParamOptions(refineParameters(), rp);
+    rp.validate("option");  // the library's rules across parameters, its field names spelled as flags (addRefineCommand)
     // A scalp given as a sphere or a level set is also the head the strands keep out of, unless
     // --head says otherwise.
     const openvdb::FloatGrid::Ptr surface = applyScalpOptions(p.scalp, strands, rp.field, common);
@@ -181,28 +168,10 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
 
 } // namespace
 
-void addRefineOptions(CLI::App* sub, RefineCmdParams& p)
+void addRefineOptions(CLI::App* sub, RefineCmdParams& p, const std::vector<std::string>& skip)
 {
-    RefineParams& rp = p.refine;
-    p.voxelOpt = sub->add_option("--voxel-size", rp.field.voxelSize,
-                                 "Finest voxel size in world units (default: " + kSuggestedVoxelSizeHelp + ")");
-    sub->add_option("--levels", rp.levels, "Levels, coarse (h*2^(n-1)) to fine (h)")->capture_default_str();
-    sub->add_option("--mode", p.mode, "consistent: fix only strands that stray from the flow, keep every strand's detail; "
-                                      "field: replace every strand by the field's streamline (Wang et al.)")->capture_default_str();
-    sub->add_option("--iterations", rp.field.iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
-    p.stepOpt = sub->add_option("--step", rp.trace.step, "Integration step in world units (default: " + formatValue(kDefaultStepVoxels) + " of each level's voxel size)");
-    sub->add_option("--outlier-start", rp.consistency.zStart,
-                    "consistent mode: outlier score (deviation over the voxel's spread) where the field starts to take over")->capture_default_str();
-    sub->add_option("--outlier-full", rp.consistency.zFull,
-                    "consistent mode: outlier score from which the field's direction is followed")->capture_default_str();
-    sub->add_option("--min-spread", rp.consistency.minSpreadDeg,
-                    "consistent mode: deviations below this many degrees are never outliers")->capture_default_str();
+    addParamOptions(sub, p.refine, refineParameters(), skip);
     addHeadOptions(sub, p.head, "--scalp's sphere if given, else a sphere fitted to the roots");
-    sub->add_option("--integrator", p.integrator, "euler (the papers' choice), rk2, rk3 or rk4: each step of either mode")->capture_default_str();
-    sub->add_option("--margin", rp.trace.margin, "field mode: voxels a strand may continue straight past the field's active region")->capture_default_str();
-    sub->add_option("--max-voxels", rp.field.maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
-    sub->add_option("--max-memory", rp.field.maxMemory, "Refuse work whose memory estimate exceeds this many bytes (suffixes k, M, G: 16G); 0: the memory available (MemAvailable)")
-        ->transform(CLI::AsSizeValue(false))->capture_default_str();
     sub->add_flag("--strict", p.strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addScalpOptions(sub, p.scalp);
 }
@@ -215,10 +184,6 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
     sub->add_option("--save-field", params->saveField, "Also write the fields used (tangent[_level_l], density[_level_l]) to this .vdb");
     addRefineOptions(sub, *params);
-    sub->add_flag("--measure", params->refine.measure,
-                  "Also measure the output against the input at every level: full length, hair volume, head, curvature, "
-                  "tips, displacement, coherence (an extra field estimate per level: about a fifth of the run); and compare "
-                  "the output with the input as `vdbhair compare` does (the report's \"compare\")");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --measure --json");

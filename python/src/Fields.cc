@@ -1,6 +1,7 @@
 // vdbhair.Grid, vdbhair.TangentField and the field operations: estimate_tangent_field, retrace,
 // refine, read_grid, read_grids, write_grids, suggest_voxel_size.
 #include "Common.h"
+#include "Params.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
@@ -678,113 +679,83 @@ Raises:
     KeyboardInterrupt on Ctrl-C.)doc");
 
     const RefineParams refineDefaults;
-    m.def(
-        "refine",
-        [](const StrandsPtr& strands, double voxelSize, int levels, const std::string& mode, int iterations, double step,
-           double outlierStart, double outlierFull, double minSpread, const pyb::object& head, const std::string& headPolicy,
-           const std::string& integrator, int margin, std::uint64_t maxVoxels, bool measure, const std::string& space,
-           const ScalpArgument& scalp, std::array<double, 3> up, bool returnReport, int threads, const pyb::object& progress) -> pyb::object {
-            RefineParams rp;
-            rp.field.voxelSize = voxelSize;
-            rp.levels = levels;
-            rp.mode = refineModeFromName(mode);
-            rp.field.iterations = iterations;
-            rp.setStep(step, integratorFromName(integrator));  // one step and integrator for both modes, as the CLI's
-            rp.consistency.zStart = outlierStart;
-            rp.consistency.zFull = outlierFull;
-            rp.consistency.minSpreadDeg = minSpread;
-            rp.trace.margin = margin;
-            rp.field.maxVoxels = maxVoxels;
-            rp.measure = measure;
-            const HeadArgument headArg(head, headPolicy);
-            rp.head = headArg.head;
-            // A scalp given as a sphere or a head is also the head strands keep out of, unless head= says (as the CLI).
-            const openvdb::FloatGrid::Ptr scalpSurface = applyScalpArgument(rp.field, *strands, space, scalp, up, "refine");
-            const bool scalpHead = head.is_none() && scalp.has_value();
-            if (scalpHead) {
-                rp.head = scalpSurface ? HeadObstacle::levelSet(scalpSurface, headArg.policy)
-                                       : HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, headArg.policy);
+    auto refineImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
+        RefineParams rp;
+        applyKeywords(refineParameters(), kw, rp, "refine");
+        const pyb::object head = kw["head"];
+        const HeadArgument headArg(head, kw["head_policy"].cast<std::string>());
+        rp.head = headArg.head;
+        // A scalp given as a sphere or a head is also the head strands keep out of, unless head= says (as the CLI).
+        const ScalpArgument scalp = kw["scalp"].cast<ScalpArgument>();
+        const openvdb::FloatGrid::Ptr scalpSurface = applyScalpArgument(rp.field, *strands, kw["space"].cast<std::string>(), scalp,
+                                                                        kw["up"].cast<std::array<double, 3>>(), "refine");
+        const bool scalpHead = head.is_none() && scalp.has_value();
+        if (scalpHead) {
+            rp.head = scalpSurface ? HeadObstacle::levelSet(scalpSurface, headArg.policy)
+                                   : HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, headArg.policy);
+        }
+        rp.validate("refine");
+        const int threads = kw["threads"].cast<int>();
+        const bool returnReport = kw["return_report"].cast<bool>();
+        RefineResult result = runLong(threads, kw["progress"], [&](WorkInterrupter* interrupter) {
+            RefineParams p = rp;
+            if (!scalpHead) p.head = headArg.get("refine");
+            return refineStrands(*strands, p, true, interrupter);
+        });
+        pyb::object comparison = pyb::none();  // the output against the input, as `vdbhair compare` (refine --measure --json's "compare")
+        if (rp.measure && returnReport) {
+            const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureAgainst(*strands, result.strands, &result.head); });
+            comparison = toPython(toJson(c));
+        }
+        auto out = std::make_shared<StrandSet>(std::move(result.strands));
+        if (!returnReport) return pyb::cast(out);
+        pyb::dict report = rp.measure ? measuresDict(result.levels.front().measures) : pyb::dict();
+        if (rp.measure) report["compare"] = comparison;
+        report["mode"] = refineModeName(rp.mode);
+        report["voxel_size"] = result.voxelSize;
+        report["head"] = result.head.describe();
+        pyb::list perLevel, fields;
+        for (std::size_t l = 0; l < result.levels.size(); ++l) {
+            const RefineLevel& lv = result.levels[l];
+            pyb::dict e = rp.measure ? measuresDict(lv.measures) : pyb::dict();
+            e["level"] = l;
+            e["voxel_size"] = lv.voxelSize;
+            if (rp.mode == RefineMode::Consistent) {
+                e["corrected_strands"] = lv.consistency.corrected;
+                e["reverted_strands"] = lv.consistency.reverted;
+            } else {
+                e["trace"] = traceStatsDict(lv.trace);
             }
-            rp.validate("refine");
-            RefineResult result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                RefineParams p = rp;
-                if (!scalpHead) p.head = headArg.get("refine");
-                return refineStrands(*strands, p, true, interrupter);
-            });
-            pyb::object comparison = pyb::none();  // the output against the input, as `vdbhair compare` (refine --measure --json's "compare")
-            if (measure && returnReport) {
-                const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureAgainst(*strands, result.strands, &result.head); });
-                comparison = toPython(toJson(c));
-            }
-            auto out = std::make_shared<StrandSet>(std::move(result.strands));
-            if (!returnReport) return pyb::cast(out);
-            pyb::dict report = measure ? measuresDict(result.levels.front().measures) : pyb::dict();
-            if (measure) report["compare"] = comparison;
-            report["mode"] = refineModeName(rp.mode);
-            report["voxel_size"] = result.voxelSize;
-            report["head"] = result.head.describe();
-            pyb::list perLevel, fields;
-            for (std::size_t l = 0; l < result.levels.size(); ++l) {
-                const RefineLevel& lv = result.levels[l];
-                pyb::dict e = measure ? measuresDict(lv.measures) : pyb::dict();
-                e["level"] = l;
-                e["voxel_size"] = lv.voxelSize;
-                if (rp.mode == RefineMode::Consistent) {
-                    e["corrected_strands"] = lv.consistency.corrected;
-                    e["reverted_strands"] = lv.consistency.reverted;
-                } else {
-                    e["trace"] = traceStatsDict(lv.trace);
-                }
-                perLevel.append(e);
-            }
-            for (TangentField& f : result.fields) fields.append(PyField{std::move(f)});
-            report["per_level"] = perLevel;
-            report["fields"] = fields;
-            return pyb::make_tuple(out, report);
-        },
-        pyb::arg("strands"), pyb::kw_only(), pyb::arg("voxel_size") = refineDefaults.field.voxelSize,
-        pyb::arg("levels") = refineDefaults.levels, pyb::arg("mode") = refineModeName(refineDefaults.mode),
-        pyb::arg("iterations") = refineDefaults.field.iterations, pyb::arg("step") = refineDefaults.trace.step,
-        pyb::arg("outlier_start") = refineDefaults.consistency.zStart, pyb::arg("outlier_full") = refineDefaults.consistency.zFull,
-        pyb::arg("min_spread") = refineDefaults.consistency.minSpreadDeg, pyb::arg("head") = pyb::none(),
-        pyb::arg("head_policy") = headPolicyName(kDefaultHeadPolicy), pyb::arg("integrator") = integratorName(refineDefaults.trace.integrator),
-        pyb::arg("margin") = refineDefaults.trace.margin, pyb::arg("max_voxels") = refineDefaults.field.maxVoxels,
-        pyb::arg("measure") = refineDefaults.measure, pyb::arg("space") = fieldSpaceName(refineDefaults.field.space),
-        pyb::arg("scalp") = pyb::none(),
-        pyb::arg("up") = std::array<double, 3>{refineDefaults.field.scalp.up.x(), refineDefaults.field.scalp.up.y(), refineDefaults.field.scalp.up.z()},
-        pyb::arg("return_report") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(Vector-field refinement (Wang et al. 2009, Sec. 5.3): estimate, retrace, repeat from the
-coarsest level to the finest: ``vdbhair refine``.
-
-Args:
-    strands: a Strands.
-    voxel_size: the finest level's voxel size in world units; 0 picks suggest_voxel_size().
-    levels: levels, coarse (voxel_size * 2**(levels-1)) to fine.
-    mode: "consistent" (fix only strands that stray from the flow) or "field" (the paper's rule:
-        every strand replaced by its streamline).
-    iterations: Eq. 9 iterations of each field.
-    step: integration step in world units; 0 is half of each level's voxel.
-    outlier_start, outlier_full: consistent mode: outlier scores where the field starts to take
-        over and from which it is followed.
-    min_spread: consistent mode: floor on a voxel's angular spread, degrees.
-    head: None (a sphere fitted to the roots), "none" (no head), a path to a mesh (.ply, .obj)
-        or a .vdb level set, or a sphere (cx, cy, cz, r) in world units.
-    head_policy: "no-deeper" (no vertex enters the head that was outside it) or "outside".
-    integrator: "euler", "rk2", "rk3" or "rk4", for each step of either mode.
-    margin: field mode: voxels a strand may continue past the field's active region.
-    max_voxels: refuse voxel sizes whose voxel visits could exceed this.
-    measure: measure each level against the input (the report's numbers; costs a field a level),
-        and compare the output with the input as ``compare()`` does (the report's ``compare``).
-    space, scalp, up: the fields' space, as estimate_tangent_field() (``--space``, ``--scalp``,
-        ``--up``); a scalp given (a sphere or a head) is also the head strands keep out of
-        unless head= says otherwise.
-    return_report: also return a dict: the finest level's measures, mode, voxel_size, head,
-        per_level (a dict a level) and fields (the TangentField of each level, 0 the finest).
-    threads: worker threads, 0 for all cores (results do not depend on it).
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    Strands, or (Strands, report) with return_report.)doc");
+            perLevel.append(e);
+        }
+        for (TangentField& f : result.fields) fields.append(PyField{std::move(f)});
+        report["per_level"] = perLevel;
+        report["fields"] = fields;
+        return pyb::make_tuple(out, report);
+    };
+    defineVerb(m, "refine", {"strands"}, refineParameters(),
+               {{"head", "", pyb::none(),
+                 "None (a sphere fitted to the roots), \"none\" (no head), a path to a mesh (.ply, .obj) or a .vdb level set, "
+                 "or a sphere (cx, cy, cz, r) in world units."},
+                {"head_policy", "str", pyb::str(headPolicyName(kDefaultHeadPolicy)),
+                 "\"no-deeper\" (no vertex enters the head that was outside it) or \"outside\"."},
+                {"space", "str", pyb::str(fieldSpaceName(refineDefaults.field.space)),
+                 "the fields' space, as estimate_tangent_field() (``--space``)."},
+                {"scalp", "", pyb::none(),
+                 "space='scalp': a sphere (cx, cy, cz, r) or a head (a scalp .vdb or a mesh); None fits a sphere to the roots. "
+                 "A scalp given is also the head strands keep out of unless head= says otherwise."},
+                {"up", "Tuple[float, float, float]",
+                 pyb::make_tuple(refineDefaults.field.scalp.up.x(), refineDefaults.field.scalp.up.y(), refineDefaults.field.scalp.up.z()),
+                 "the scalp's up axis (``--up``)."},
+                {"return_report", "bool", pyb::bool_(false),
+                 "also return a dict: the finest level's measures, mode, voxel_size, head, per_level (a dict a level) and "
+                 "fields (the TangentField of each level, 0 the finest)."},
+                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
+                {"progress", "Optional[Callable]", pyb::none(), "optional callable ``progress(stage, done, total, unit)``."}},
+               "Vector-field refinement (Wang et al. 2009, Sec. 5.3): estimate, retrace, repeat from the\n"
+               "coarsest level to the finest: ``vdbhair refine``.",
+               "    strands: a Strands.\n", "Strands, or (Strands, report) with return_report.",
+               pyb::cpp_function(refineImpl, pyb::arg("strands"), pyb::arg("keywords")));
 }
 
 } // namespace vdbhair::py

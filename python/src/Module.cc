@@ -95,6 +95,10 @@ def _explain(name, params, args, kwargs):
             return "%s: %s must be %s, got %s" % (name, pname, _expected(ann), type(v).__name__)
     return None
 
+def _check_keywords(name, checks):
+    for k, ann, v in checks:
+        if not _accepts(ann, v):
+            raise ArgumentTypeError("%s: %s must be %s, got %s" % (name, k, _expected(ann), type(v).__name__))
 def _wrap(qualname, f):
     sig, params = _signature(f.__name__, f.__doc__)
     if params is None: return f

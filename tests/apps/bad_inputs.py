@@ -178,7 +178,7 @@ CASES = [
     ("field --strict: one strand of zero length", ["field", path("somezero.hair"), "-o", "{out}.vdb", "--strict"], ["somezero.hair", "1 of 3 strands have zero length (strand 2", "--strict rejects them"]),
     ("retrace --strict: one strand of zero length", ["retrace", path("somezero.hair"), "--field", path("field.vdb"), "-o", "{out}.hair", "--strict"], ["somezero.hair", "zero length", "--strict"]),
     ("field: negative voxel size", ["field", good_hair, "-o", "{out}.vdb", "--voxel-size", "-1"], ["voxel", "-1"]),
-    ("refine: zero step", ["refine", good_hair, "-o", "{out}.hair", "--step", "0"], ["step", "0"]),
+    ("refine: negative step", ["refine", good_hair, "-o", "{out}.hair", "--step", "-0.5"], ["--step -0.5", "must be at least 0 world units"]),
     # Paths and the command line
     ("info: a directory", ["info", path("folder")], ["folder", "is a directory, not a regular file"]),
     ("info: a directory with a strand extension", ["info", path("folder.hair")], ["folder.hair", "is a directory"]),

@@ -38,6 +38,75 @@ void RefineParams::setStep(double step, Integrator integrator)
     trace.integrator = consistency.integrator = integrator;
 }
 
+const ParamTable<RefineParams>& refineParameters()
+{
+    using P = RefineParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto add = [&](Param<P> p) { t.push_back(std::move(p)); };
+        auto voxel = makeParam<P>("voxel-size", "The finest level's voxel size", "world units", member<P>([](P& p) -> double& { return p.field.voxelSize; }));
+        voxel.min = 0.0;
+        voxel.zeroMeans = "3 x the median root spacing, within 1/64..1/4 of the head radius";
+        add(voxel);
+        auto levels = makeParam<P>("levels", "Levels, coarse (voxel size x 2^(levels-1)) to fine", "", member<P>([](P& p) -> int& { return p.levels; }));
+        levels.min = 1;
+        levels.max = P::kMaxLevels;
+        add(levels);
+        auto mode = makeParam<P>("mode", "consistent: fix only strands that stray from the flow, keep every strand's detail; field: replace "
+                              "every strand by the field's streamline (Wang et al.)", "",
+                      named<P>([](P& p) -> RefineMode& { return p.mode; }, refineModeName, refineModeFromName));
+        mode.choices = {"consistent", "field"};
+        add(mode);
+        auto iterations = makeParam<P>("iterations", "Reweighting iterations of Eq. 9", "", member<P>([](P& p) -> int& { return p.field.iterations; }));
+        iterations.min = 1;
+        add(iterations);
+        // One step and one integrator for both modes (setStep()).
+        auto step = makeParam<P>("step", "Integration step", "world units",
+                      ParamAccess<P, double>{[](const P& p) { return p.trace.step; }, [](P& p, double v) { p.setStep(v, p.trace.integrator); }});
+        step.min = 0.0;
+        step.zeroMeans = "half of each level's voxel size";
+        add(step);
+        auto integrator = makeParam<P>("integrator", "The integrator of each step of either mode (euler: the papers' choice)", "",
+                            ParamAccess<P, std::string>{[](const P& p) { return std::string(integratorName(p.trace.integrator)); },
+                                                        [](P& p, std::string v) { p.setStep(p.trace.step, integratorFromName(v)); }});
+        integrator.choices = {"euler", "rk2", "rk3", "rk4"};
+        add(integrator);
+        auto zStart = makeParam<P>("outlier-start", "consistent mode: the outlier score (deviation over the voxel's spread) where the field starts to take over",
+                        "", member<P>([](P& p) -> double& { return p.consistency.zStart; }));
+        zStart.min = 0.0;
+        add(zStart);
+        auto zFull = makeParam<P>("outlier-full", "consistent mode: the outlier score from which the field's direction is followed (above the outlier start)", "",
+                       member<P>([](P& p) -> double& { return p.consistency.zFull; }));
+        zFull.min = 0.0;
+        add(zFull);
+        auto spread = makeParam<P>("min-spread", "consistent mode: deviations below this are never outliers", "degrees",
+                        member<P>([](P& p) -> double& { return p.consistency.minSpreadDeg; }));
+        spread.min = 0.0;
+        spread.max = 90.0;
+        add(spread);
+        auto margin = makeParam<P>("margin", "field mode: voxels a strand may continue straight past the field's active region", "voxels",
+                        member<P>([](P& p) -> int& { return p.trace.margin; }));
+        margin.min = 0;
+        margin.max = TraceParams::kMaxMargin;
+        add(margin);
+        auto maxVoxels = makeParam<P>("max-voxels", "Refuse voxel sizes whose voxel visits could exceed this", "",
+                           member<P>([](P& p) -> std::uint64_t& { return p.field.maxVoxels; }));
+        maxVoxels.min = 1;
+        add(maxVoxels);
+        auto maxMemory = makeParam<P>("max-memory", "Refuse work whose memory estimate exceeds this (suffixes k, M, G on the command line: 16G)", "bytes",
+                           member<P>([](P& p) -> std::uint64_t& { return p.field.maxMemory; }));
+        maxMemory.min = 0;
+        maxMemory.zeroMeans = "the memory available (MemAvailable)";
+        add(maxMemory);
+        add(makeParam<P>("measure", "Also measure the output against the input at every level: full length, hair volume, head, curvature, "
+                                "tips, displacement, coherence (an extra field estimate per level: about a fifth of the run), and compare "
+                                "the output with the input as `vdbhair compare` does (the report's \"compare\")", "",
+                     member<P>([](P& p) -> bool& { return p.measure; })));
+        return t;
+    }();
+    return table;
+}
+
 namespace {
 
 /// The roots as a nanoflann point cloud, copied together: a strand's root is a strand's length away

@@ -18,6 +18,8 @@
 /// The default voxel size follows the hair's own scale (suggestVoxelSize(), TangentField.h).
 #pragma once
 
+#include <vdbhair/Parameters.h>
+
 #include <vdbhair/field/ConsistentRetrace.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/field/RefineReport.h>
@@ -64,6 +66,10 @@ struct RefineParams
     /// @throw ValueError naming the parameter for values out of range.
     void validate(const char* where) const;
 };
+
+/// @brief refine's parameters (Parameters.h): the one declaration the command line, Python and
+/// docs/cli.md are made from. Defaults are RefineParams{}'s.
+const ParamTable<RefineParams>& refineParameters();
 
 /// @brief What happened at one level.
 struct RefineLevel

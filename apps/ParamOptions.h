@@ -1,0 +1,49 @@
+/// @file ParamOptions.h
+/// @brief A verb's declared parameters (vdbhair/Parameters.h) as command-line options: one
+/// `--name` each, its help, default and unit from the declaration, set on the verb's parameter
+/// struct as it is parsed; checkParamOptions() then checks their ranges.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <vdbhair/Parameters.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace vdbhair::app {
+
+/// @brief Add an option for every parameter of @a table but those named in @a skip, each writing
+/// into @a target (which must outlive parsing).
+template<typename P>
+void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const std::vector<std::string>& skip = {})
+{
+    for (const Param<P>& param : table) {
+        if (std::find(skip.begin(), skip.end(), param.name) != skip.end()) continue;
+        const std::string flag = "--" + param.name, help = paramHelp(param);
+        std::visit([&](const auto& a) {
+            using T = std::decay_t<decltype(a.get(target))>;
+            if constexpr (std::is_same_v<T, bool>) {
+                sub->add_flag_callback(flag, [&target, a] { a.set(target, true); }, help);
+            } else {
+                CLI::Option* o = sub->add_option_function<T>(flag, [&target, a](const T& v) { a.set(target, v); }, help);
+                o->default_str(param.defaultText());
+                if constexpr (std::is_same_v<T, std::string>) {
+                    if (!param.choices.empty()) o->check(CLI::IsMember(param.choices));
+                } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+                    if (param.unit == "bytes") o->transform(CLI::AsSizeValue(false));
+                }
+            }
+        }, param.access);
+    }
+}
+
+/// @brief Check the declared ranges of @a p, errors naming the flags ("--levels 9: must be ...").
+template<typename P>
+void checkParamOptions(const ParamTable<P>& table, const P& p)
+{
+    checkParams(table, p, ParamSpelling::Flag, "");
+}
+
+} // namespace vdbhair::app

@@ -1,0 +1,130 @@
+/// @file Params.h
+/// @brief Python functions made from a verb's declared parameters (vdbhair/Parameters.h): their
+/// keywords, defaults, annotations and the docstring's Args come from the declaration, so the
+/// signature agrees with the command line's options by construction.
+///
+/// defineVerb() writes a small Python function with the real signature (as `dataclasses` writes
+/// `__init__`), which checks the arguments' types (ArgumentTypeError, Module.cc) and hands them as
+/// one dict to the C++ implementation; applyKeywords() sets the declared ones on the parameter
+/// struct and checks their ranges.
+#pragma once
+
+#include "Common.h"
+
+#include <vdbhair/Parameters.h>
+
+#include <pybind11/eval.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace vdbhair::py {
+
+/// A keyword of a verb that is not one of its declared parameters (a head, a scalp, threads).
+struct PyKeyword
+{
+    std::string name;
+    std::string annotation;  ///< as Module.cc's checks read it ("int", "Optional[str]", ...); "" for any
+    pyb::object defaultValue;
+    std::string doc;  ///< its line in Args (without the name)
+};
+
+/// The annotation a declared parameter is checked by.
+template<typename P>
+std::string pythonAnnotation(const Param<P>& param)
+{
+    return std::visit([](const auto& a) -> std::string {
+        using T = std::decay_t<decltype(a.get(std::declval<const P&>()))>;
+        if constexpr (std::is_same_v<T, std::string>) return "str";
+        else if constexpr (std::is_same_v<T, bool>) return "bool";
+        else if constexpr (std::is_same_v<T, double>) return "float";
+        else return "int";
+    }, param.access);
+}
+
+/// The default of a declared parameter as a Python object.
+template<typename P>
+pyb::object pythonDefault(const Param<P>& param)
+{
+    const P defaults{};
+    return std::visit([&](const auto& a) -> pyb::object { return pyb::cast(a.get(defaults)); }, param.access);
+}
+
+/// @brief Set the declared parameters given in @a kw on @a p, then check their ranges.
+/// @throw ValueError "<verb>: <keyword> <value>: <rule>".
+template<typename P>
+void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const std::string& verb)
+{
+    for (const Param<P>& param : table) {
+        const std::string key = param.pythonName();
+        if (!kw.contains(key)) continue;
+        const pyb::object v = kw[key.c_str()];
+        std::visit([&](const auto& a) {
+            using T = std::decay_t<decltype(a.get(p))>;
+            if constexpr (std::is_same_v<T, std::string>) {
+                const std::string text = v.cast<std::string>();
+                if (!param.choices.empty() && std::find(param.choices.begin(), param.choices.end(), text) == param.choices.end()) {
+                    std::string list;
+                    for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
+                    throw ValueError(verb + ": " + key + " '" + text + "': must be one of " + list);
+                }
+                a.set(p, text);
+            } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+                const long long n = v.cast<long long>();
+                if (n < 0) throw ValueError(verb + ": " + key + " " + std::to_string(n) + ": must be at least " + formatNumber(param.min));
+                a.set(p, std::uint64_t(n));
+            } else {
+                a.set(p, v.cast<T>());
+            }
+        }, param.access);
+    }
+    checkParams(table, p, ParamSpelling::Keyword, verb);
+}
+
+/// @brief Define @a verb on @a m: `verb(positional..., *, <declared keywords>, <extra keywords>)`
+/// calling @a impl(positional..., kwargs) with every keyword in one dict.
+/// @param summary the docstring's first paragraphs; @a positionalDoc and @a returns its other parts
+template<typename P>
+void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std::string>& positional, const ParamTable<P>& table,
+                const std::vector<PyKeyword>& extras, const std::string& summary, const std::string& positionalDoc,
+                const std::string& returns, const pyb::cpp_function& impl)
+{
+    struct Keyword { std::string name, annotation; pyb::object value; std::string doc; };
+    std::vector<Keyword> keywords;
+    for (const Param<P>& p : table) keywords.push_back({p.pythonName(), pythonAnnotation(p), pythonDefault(p), paramHelp(p)});
+    for (const PyKeyword& k : extras) keywords.push_back({k.name, k.annotation, k.defaultValue, k.doc});
+
+    std::string doc = summary + "\n\nArgs:\n" + positionalDoc;
+    for (const Keyword& k : keywords) doc += "    " + k.name + ": " + k.doc + "\n";
+    doc += "\nReturns:\n    " + returns;
+
+    pyb::dict scope;
+    std::string args, checks, dict, head;
+    for (const std::string& p : positional) head += p + ", ";
+    for (std::size_t i = 0; i < keywords.size(); ++i) {
+        const Keyword& k = keywords[i];
+        const std::string d = "_d" + std::to_string(i);
+        scope[d.c_str()] = k.value;
+        args += ", " + k.name + "=" + d;
+        if (!k.annotation.empty()) checks += "(\"" + k.name + "\", \"" + k.annotation + "\", " + k.name + "), ";
+        dict += "\"" + k.name + "\": " + k.name + ", ";
+    }
+    scope["_impl"] = impl;
+    scope["_doc"] = doc;
+    scope["_module"] = m;
+    const std::string source = "def _make():\n"
+                               "    _g = vars(_module)\n"
+                               "    def " + verb + "(" + head + "*" + args + "):\n"
+                               "        _g['_check_keywords'](\"" + verb + "\", (" + checks + "))\n"
+                               "        return _impl(" + head + "{" + dict + "})\n"
+                               "    " + verb + ".__doc__ = _doc\n"
+                               "    " + verb + ".__module__ = 'vdbhair'\n"
+                               "    " + verb + ".__qualname__ = '" + verb + "'\n"
+                               "    return " + verb + "\n"
+                               "_result = _make()\n";
+    pyb::exec(source, scope);
+    m.attr(verb.c_str()) = scope["_result"];
+}
+
+} // namespace vdbhair::py

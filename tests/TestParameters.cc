@@ -1,0 +1,98 @@
+#include "TestUtil.h"
+
+#include <vdbhair/Parameters.h>
+#include <vdbhair/field/Refine.h>
+
+#include <fstream>
+#include <sstream>
+
+using namespace vdbhair;
+using Catch::Matchers::Contains;
+
+namespace {
+
+struct Toy
+{
+    int count = 3;
+    double size = 0.5;
+    bool on = false;
+    std::string kind = "a";
+};
+
+ParamTable<Toy> toyTable()
+{
+    ParamTable<Toy> t;
+    auto count = makeParam<Toy>("count", "How many", "", member<Toy>([](Toy& p) -> int& { return p.count; }));
+    count.min = 1;
+    count.max = 8;
+    t.push_back(count);
+    auto size = makeParam<Toy>("voxel-size", "How big", "world units", member<Toy>([](Toy& p) -> double& { return p.size; }));
+    size.min = 0;
+    size.zeroMeans = "pick one";
+    t.push_back(size);
+    t.push_back(makeParam<Toy>("on", "Whether", "", member<Toy>([](Toy& p) -> bool& { return p.on; })));
+    auto kind = makeParam<Toy>("kind", "Which", "", member<Toy>([](Toy& p) -> std::string& { return p.kind; }));
+    kind.choices = {"a", "b"};
+    t.push_back(kind);
+    return t;
+}
+
+} // namespace
+
+TEST_CASE("Parameters: defaults come from the struct, ranges and choices are checked, names spelled per front end", "[params]")
+{
+    const ParamTable<Toy> t = toyTable();
+    CHECK(t[0].defaultText() == "3");
+    CHECK(t[1].defaultText() == "0.5");
+    CHECK(t[2].defaultText() == "false");
+    CHECK(t[3].defaultText() == "a");
+    CHECK(t[1].pythonName() == "voxel_size");
+    CHECK(paramHelp(t[1]) == "How big (world units; at least 0; 0: pick one)");
+    CHECK(paramHelp(t[0]) == "How many (1 to 8)");
+    Toy p;
+    REQUIRE_NOTHROW(checkParams(t, p, ParamSpelling::Flag, ""));
+    p.count = 9;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--count 9: must be between 1 and 8");
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "toy"), "toy: count 9: must be between 1 and 8");
+    p = Toy{};
+    p.size = -1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "toy"), "toy: voxel_size -1: must be at least 0 world units");
+    p.size = std::numeric_limits<double>::quiet_NaN();
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), Contains("--voxel-size nan: must be at least 0"));
+    p = Toy{};
+    p.kind = "c";
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--kind 'c': must be one of a, b");
+    // Setters write the struct's members.
+    std::get<ParamAccess<Toy, int>>(t[0].access).set(p, 5);
+    CHECK(p.count == 5);
+    CHECK(parameterMarkdown(t) ==
+          "| option | Python | default | what it does |\n| --- | --- | --- | --- |\n"
+          "| `--count` | `count` | 3 | How many (1 to 8) |\n"
+          "| `--voxel-size` | `voxel_size` | 0.5 | How big (world units; at least 0; 0: pick one) |\n"
+          "| `--on` | `on` | false | Whether |\n"
+          "| `--kind` | `kind` | a | Which (one of a, b) |\n");
+}
+
+TEST_CASE("Parameters: refine's declaration sets what the library reads, and docs/cli.md shows it", "[params]")
+{
+    const ParamTable<RefineParams>& t = refineParameters();
+    RefineParams p;
+    // step and integrator set both modes' (setStep()).
+    std::get<ParamAccess<RefineParams, double>>(findParam(t, "step")->access).set(p, 0.25);
+    std::get<ParamAccess<RefineParams, std::string>>(findParam(t, "integrator")->access).set(p, "rk4");
+    CHECK(p.trace.step == 0.25);
+    CHECK(p.consistency.step == 0.25);
+    CHECK(p.trace.integrator == Integrator::RK4);
+    CHECK(p.consistency.integrator == Integrator::RK4);
+    std::get<ParamAccess<RefineParams, std::string>>(findParam(t, "mode")->access).set(p, "field");
+    CHECK(p.mode == RefineMode::Field);
+    // Every default passes its own range.
+    REQUIRE_NOTHROW(checkParams(t, RefineParams{}, ParamSpelling::Flag, ""));
+    // The page's table is the declaration's (regenerate it from parameterMarkdown() when this fails).
+    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
+    REQUIRE(in);
+    std::stringstream page;
+    page << in.rdbuf();
+    INFO("docs/cli.md's refine table should read:\n" << parameterMarkdown(t));
+    CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
+}

@@ -1,0 +1,188 @@
+/// @file Parameters.h
+/// @brief A verb's parameters declared once: name, type, default, unit, range and help, and how
+/// each reads and writes its value in the verb's parameter struct. The command line's options,
+/// `--help`, Python's keywords and signature, and docs/cli.md's option tables are all made from
+/// one declaration (apps/ParamOptions.h, python/src/Params.h, parameterMarkdown()), as vdb_tool's
+/// action table and Blender's node declarations are, so they agree by construction.
+///
+/// A parameter's name is words joined by '-': the command line's `--outlier-start`, Python's
+/// `outlier_start`. Its default is whatever the struct's own initializers give (P{}): a default
+/// is never restated here.
+#pragma once
+
+#include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace vdbhair {
+
+/// Reads and writes one value of type T in a parameter struct P.
+template<typename P, typename T>
+struct ParamAccess
+{
+    std::function<T(const P&)> get;
+    std::function<void(P&, T)> set;
+};
+
+/// One parameter of a verb whose parameters are a struct P.
+template<typename P>
+struct Param
+{
+    std::string name;  ///< words joined by '-' (see the file comment)
+    std::string help;  ///< what it does, one sentence without its unit, range or default
+    std::string unit;  ///< "world units", "degrees", "voxels", "bytes", or "" for a pure number
+    /// int, uint64 (counts and byte sizes), double, bool (a flag) or string (one of @c choices)
+    std::variant<ParamAccess<P, int>, ParamAccess<P, std::uint64_t>, ParamAccess<P, double>, ParamAccess<P, bool>,
+                 ParamAccess<P, std::string>>
+        access;
+    double min = -std::numeric_limits<double>::infinity();  ///< inclusive bounds of a number
+    double max = std::numeric_limits<double>::infinity();
+    std::vector<std::string> choices;  ///< the names a string parameter takes
+    std::string zeroMeans;             ///< what 0 stands for when it picks a value ("suggestVoxelSize()")
+
+    /// The keyword Python spells it as.
+    std::string pythonName() const
+    {
+        std::string s = name;
+        for (char& c : s) if (c == '-') c = '_';
+        return s;
+    }
+    /// The default, as a person types it: 0.5, 3, true, consistent.
+    std::string defaultText() const { return valueText(P{}); }
+    /// The value of @a p as a person types it.
+    std::string valueText(const P& p) const
+    {
+        return std::visit([&](const auto& a) -> std::string {
+            using T = std::decay_t<decltype(a.get(p))>;
+            if constexpr (std::is_same_v<T, std::string>) return a.get(p);
+            else if constexpr (std::is_same_v<T, bool>) return a.get(p) ? "true" : "false";
+            else if constexpr (std::is_same_v<T, double>) return formatNumber(a.get(p));
+            else return std::to_string(a.get(p));
+        }, access);
+    }
+};
+
+template<typename P>
+using ParamTable = std::vector<Param<P>>;
+
+/// @brief A parameter with its name, help, unit and accessors; range and choices are set after.
+template<typename P, typename A>
+Param<P> makeParam(std::string name, std::string help, std::string unit, A access)
+{
+    Param<P> p;
+    p.name = std::move(name);
+    p.help = std::move(help);
+    p.unit = std::move(unit);
+    p.access = std::move(access);
+    return p;
+}
+
+/// @brief Accessors of the member that @a field returns a reference to (a lambda P& -> T&).
+template<typename P, typename F>
+auto member(F field)
+{
+    using T = std::remove_reference_t<decltype(field(std::declval<P&>()))>;
+    return ParamAccess<P, T>{[field](const P& p) { return field(const_cast<P&>(p)); }, [field](P& p, T v) { field(p) = v; }};
+}
+
+/// @brief Accessors of an enumeration through its name functions (refineModeName(), ...).
+template<typename P, typename F, typename NameFn, typename FromNameFn>
+ParamAccess<P, std::string> named(F field, NameFn name, FromNameFn fromName)
+{
+    return {[field, name](const P& p) { return std::string(name(field(const_cast<P&>(p)))); },
+            [field, fromName](P& p, std::string v) { field(p) = fromName(v); }};
+}
+
+/// How an error names a parameter: the command line's flag or Python's keyword.
+enum class ParamSpelling { Flag, Keyword };
+
+template<typename P>
+std::string spelled(const Param<P>& param, ParamSpelling spelling)
+{
+    return spelling == ParamSpelling::Flag ? "--" + param.name : param.pythonName();
+}
+
+/// @brief The parameter of @a table called @a name, or null.
+template<typename P>
+const Param<P>* findParam(const ParamTable<P>& table, const std::string& name)
+{
+    for (const Param<P>& p : table) if (p.name == name) return &p;
+    return nullptr;
+}
+
+/// @brief Check every number of @a p against its declared range (and finiteness) and every
+/// string against its choices.
+/// @throw ValueError "<where>: <--flag|keyword> <value>: must be between <min> and <max> <unit>".
+template<typename P>
+void checkParams(const ParamTable<P>& table, const P& p, ParamSpelling spelling, const std::string& where)
+{
+    for (const Param<P>& param : table) {
+        std::visit([&](const auto& a) {
+            using T = std::decay_t<decltype(a.get(p))>;
+            const std::string who = (where.empty() ? std::string() : where + ": ") + spelled(param, spelling);
+            if constexpr (std::is_same_v<T, std::string>) {
+                const std::string v = a.get(p);
+                if (param.choices.empty()) return;
+                for (const std::string& c : param.choices) if (c == v) return;
+                std::string list;
+                for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
+                throw ValueError(who + " '" + v + "': must be one of " + list);
+            } else if constexpr (!std::is_same_v<T, bool>) {
+                const double v = double(a.get(p));
+                if (std::isfinite(v) && v >= param.min && v <= param.max) return;
+                std::string rule = "must be ";
+                if (std::isfinite(param.min) && std::isfinite(param.max)) rule += "between " + formatNumber(param.min) + " and " + formatNumber(param.max);
+                else if (std::isfinite(param.min)) rule += "at least " + formatNumber(param.min);
+                else if (std::isfinite(param.max)) rule += "at most " + formatNumber(param.max);
+                else rule += "finite";
+                if (!param.unit.empty()) rule += " " + param.unit;
+                throw ValueError(who + " " + param.valueText(p) + ": " + rule);
+            }
+        }, param.access);
+    }
+}
+
+/// @brief The help line of a parameter: its help, then its unit, range, choices and what 0 means.
+template<typename P>
+std::string paramHelp(const Param<P>& param)
+{
+    std::string h = param.help;
+    std::vector<std::string> notes;
+    if (!param.unit.empty()) notes.push_back(param.unit);
+    if (std::isfinite(param.min) && std::isfinite(param.max)) notes.push_back(formatNumber(param.min) + " to " + formatNumber(param.max));
+    else if (std::isfinite(param.min)) notes.push_back("at least " + formatNumber(param.min));
+    if (!param.choices.empty()) {
+        std::string list;
+        for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
+        notes.push_back("one of " + list);
+    }
+    if (!param.zeroMeans.empty()) notes.push_back("0: " + param.zeroMeans);
+    if (!notes.empty()) {
+        h += " (";
+        for (std::size_t i = 0; i < notes.size(); ++i) h += (i ? "; " : "") + notes[i];
+        h += ")";
+    }
+    return h;
+}
+
+/// @brief docs/cli.md's table of @a table: option, Python keyword, default, what it does.
+template<typename P>
+std::string parameterMarkdown(const ParamTable<P>& table)
+{
+    std::string out = "| option | Python | default | what it does |\n| --- | --- | --- | --- |\n";
+    for (const Param<P>& p : table) {
+        out += "| `--" + p.name + "` | `" + p.pythonName() + "` | " + p.defaultText() + " | " + paramHelp(p) + " |\n";
+    }
+    return out;
+}
+
+} // namespace vdbhair
