@@ -2,6 +2,7 @@
 
 #include <vdbhair/Parameters.h>
 #include <vdbhair/field/Refine.h>
+#include <vdbhair/field/Streamline.h>
 
 #include <fstream>
 #include <sstream>
@@ -94,5 +95,21 @@ TEST_CASE("Parameters: refine's declaration sets what the library reads, and doc
     std::stringstream page;
     page << in.rdbuf();
     INFO("docs/cli.md's refine table should read:\n" << parameterMarkdown(t));
+    CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
+}
+
+TEST_CASE("Parameters: retrace's declaration sets what the library reads, and docs/cli.md shows it", "[params]")
+{
+    const ParamTable<TraceParams>& t = traceParameters();
+    TraceParams p;
+    std::get<ParamAccess<TraceParams, std::string>>(findParam(t, "vertices")->access).set(p, "steps");
+    std::get<ParamAccess<TraceParams, std::uint64_t>>(findParam(t, "max-steps")->access).set(p, 7);
+    CHECK(p.vertices == RetraceVertices::Steps);
+    CHECK(p.maxSteps == 7);
+    REQUIRE_NOTHROW(checkParams(t, TraceParams{}, ParamSpelling::Flag, ""));
+    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
+    std::stringstream page;
+    page << in.rdbuf();
+    INFO("docs/cli.md's retrace table should read:\n" << parameterMarkdown(t));
     CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
 }

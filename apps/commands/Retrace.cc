@@ -1,4 +1,5 @@
 // vdbhair retrace IN --field F.vdb -o OUT: every strand restarts at its root and follows the field.
+#include "../ParamOptions.h"
 #include "../RefineOptions.h"
 
 #include <vdbhair/Exceptions.h>
@@ -58,16 +59,12 @@ void printTraceReport(const TraceStats& s, const std::optional<TangentAngles>& a
 
 namespace {
 
-/// The command line of retrace: the numeric options bind to the library's TraceParams fields,
-/// the named ones start from its defaults, so `--help` shows the library's defaults.
+/// The command line of retrace: its declared parameters (traceParameters()) set TraceParams.
 struct RetraceParams
 {
     std::string input, output, field, grid = "tangent";
     TraceParams trace;
-    CLI::Option* stepOpt = nullptr;
-    CLI::Option* integratorOpt = nullptr;
-    std::string integrator = integratorName(TraceParams{}.integrator);
-    std::string vertices = TraceParams{}.vertices == RetraceVertices::Input ? "input" : "steps";
+    const CLI::Option* integratorOpt = nullptr;  ///< whether --integrator was given (--helicoid's default differs)
     bool helicoid = false;
     bool strict = false;
     bool measure = false;  ///< the tangent angles: the field sampled at every input and output vertex
@@ -76,19 +73,9 @@ struct RetraceParams
 int runRetrace(const RetraceParams& p, const CommonOptions& common)
 {
     TraceParams tp = p.trace;
-    tp.integrator = integratorFromName(p.integrator);
-    if (p.helicoid && !(p.integratorOpt && p.integratorOpt->count() > 0)) tp.integrator = kHelicoidRetraceIntegrator;
-    const bool stepGiven = p.stepOpt && p.stepOpt->count() > 0;
-    if (stepGiven && (!(tp.step > 0.0) || !std::isfinite(tp.step))) {
-        throw ValueError("--step " + formatValue(tp.step) + ": must be a positive finite length");
-    }
-    if (!(tp.vanishThreshold >= 0.0 && tp.vanishThreshold < 1.0)) throw ValueError("--vanish " + formatValue(tp.vanishThreshold) + ": must be in [0, 1)");
-    if (tp.margin < 0 || tp.margin > TraceParams::kMaxMargin) {
-        throw ValueError("--margin " + std::to_string(tp.margin) + ": must be between 0 and " + std::to_string(TraceParams::kMaxMargin) + " voxels");
-    }
-    if (p.vertices == "input") tp.vertices = RetraceVertices::Input;
-    else if (p.vertices == "steps") tp.vertices = RetraceVertices::Steps;
-    else throw ValueError("--vertices '" + p.vertices + "' is not one of input, steps");
+    checkParamOptions(traceParameters(), tp);
+    if (p.helicoid && p.integratorOpt->count() == 0) tp.integrator = kHelicoidRetraceIntegrator;
+    tp.validate("option");
     strandFormatFromPath(p.output, /*forWriting=*/true);
 
     if (p.helicoid) {
@@ -158,14 +145,11 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--field", params->field, "A .vdb file holding the field")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
-    params->stepOpt = sub->add_option("--step", params->trace.step, "Integration step in world units (default: " + formatValue(kDefaultStepVoxels) + " of the field's voxel size)");
-    params->integratorOpt = sub->add_option("--integrator", params->integrator,
-                                            std::string("euler (the papers' choice), rk2, rk3 or rk4; with --helicoid the default is ") +
-                                                integratorName(kHelicoidRetraceIntegrator))->capture_default_str();
-    sub->add_option("--vanish", params->trace.vanishThreshold, "Stop where the blended direction's length falls below this fraction")->capture_default_str();
-    sub->add_option("--max-steps", params->trace.maxSteps, "Stop a strand after this many steps (0: no limit)")->capture_default_str();
-    sub->add_option("--margin", params->trace.margin, "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)")->capture_default_str();
-    sub->add_option("--vertices", params->vertices, "input: the input's vertex count and arc lengths; steps: every step")->capture_default_str();
+    addParamOptions(sub, params->trace, traceParameters());
+    CLI::Option* integrator = sub->get_option("--integrator");
+    params->integratorOpt = integrator;
+    integrator->description(paramHelp(*findParam(traceParameters(), "integrator")) + "; with --helicoid the default is " +
+                                       integratorName(kHelicoidRetraceIntegrator));
     sub->add_flag("--helicoid", params->helicoid, "Trace through the file's helicoid field (vdbhair field --helicoid) instead of the tangent grid");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_flag("--measure", params->measure,

@@ -266,13 +266,6 @@ pyb::dict traceStatsDict(const TraceStats& s)
     return d;
 }
 
-RetraceVertices verticesFromName(const std::string& name)
-{
-    if (name == "input") return RetraceVertices::Input;
-    if (name == "steps") return RetraceVertices::Steps;
-    throw ValueError("vertices='" + name + "' is not one of input, steps");
-}
-const char* verticesName(RetraceVertices v) { return v == RetraceVertices::Input ? "input" : "steps"; }
 
 pyb::dict measuresDict(const RefineMeasures& m)
 {
@@ -622,61 +615,31 @@ Returns:
 Raises:
     vdbhair.ArgumentError / LimitError (ValueErrors), KeyboardInterrupt on Ctrl-C.)doc");
 
-    const TraceParams traceDefaults;
-    m.def(
-        "retrace",
-        [](const StrandsPtr& strands, const pyb::object& fieldArg, double step, const std::string& integrator, double vanish,
-           std::size_t maxSteps, int margin, const std::string& vertices, bool returnStats, int threads,
-           const pyb::object& progress) -> pyb::object {
-            const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");
-            TraceParams tp;
-            tp.step = step;
-            tp.integrator = integratorFromName(integrator);
-            tp.vanishThreshold = vanish;
-            tp.maxSteps = maxSteps;
-            if (margin < 0 || margin > TraceParams::kMaxMargin) {
-                throw ValueError("retrace: margin=" + std::to_string(margin) + ": must be between 0 and " +
-                                 std::to_string(TraceParams::kMaxMargin) + " voxels");
-            }
-            tp.margin = margin;
-            tp.vertices = verticesFromName(vertices);
-            TraceStats stats;
-            auto out = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                return std::make_shared<StrandSet>(retraceStrands(*strands, *grid, tp, &stats, nullptr, true, interrupter));
-            });
-            if (!returnStats) return pyb::cast(out);
-            return pyb::make_tuple(out, traceStatsDict(stats));
-        },
-        pyb::arg("strands"), pyb::arg("field"), pyb::kw_only(), pyb::arg("step") = traceDefaults.step,
-        pyb::arg("integrator") = integratorName(traceDefaults.integrator), pyb::arg("vanish") = traceDefaults.vanishThreshold,
-        pyb::arg("max_steps") = traceDefaults.maxSteps, pyb::arg("margin") = traceDefaults.margin,
-        pyb::arg("vertices") = verticesName(traceDefaults.vertices), pyb::arg("return_stats") = false, pyb::arg("threads") = 0,
-        pyb::arg("progress") = pyb::none(),
-        R"doc(Retrace every strand through a vector field from its own root, for its own length
-(Wang et al. 2009, Sec. 5.3): ``vdbhair retrace``.
-
-Args:
-    strands: a Strands (roots, lengths and vertex spacing to follow).
-    field: a TangentField (its tangent grid is followed) or a vector Grid (vec3s), e.g. read with
-        read_grid from any OpenVDB writer.
-    step: integration step in world units; 0 picks half the field's voxel size.
-    integrator: "euler" (the papers' choice), "rk2", "rk3" or "rk4".
-    vanish: stop where the blended direction's length falls below this fraction, in [0, 1).
-    max_steps: stop a strand after this many steps (0: no limit).
-    margin: voxels (0-16) a strand may continue straight past the field's active region
-        (0: stop there, the papers' rule).
-    vertices: "input" (the input's vertex count at its arc lengths) or "steps" (every step).
-    return_stats: also return a dict of stop reasons (strands, full_length, vanished,
-        left_field, max_steps, steps).
-    threads: worker threads, 0 for all cores (results do not depend on it).
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    Strands, or (Strands, stats) with return_stats.
-
-Raises:
-    vdbhair.GridTypeError (a TypeError) for a non-vector grid, vdbhair.ArgumentError,
-    KeyboardInterrupt on Ctrl-C.)doc");
+    auto retraceImpl = [](const StrandsPtr& strands, const pyb::object& fieldArg, const pyb::dict& kw) -> pyb::object {
+        const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");
+        TraceParams tp;
+        applyKeywords(traceParameters(), kw, tp, "retrace");
+        TraceStats stats;
+        auto out = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            return std::make_shared<StrandSet>(retraceStrands(*strands, *grid, tp, &stats, nullptr, true, interrupter));
+        });
+        if (!kw["return_stats"].cast<bool>()) return pyb::cast(out);
+        return pyb::make_tuple(out, traceStatsDict(stats));
+    };
+    defineVerb(m, "retrace", {"strands", "field"}, traceParameters(),
+               {{"return_stats", "bool", pyb::bool_(false),
+                 "also return a dict of stop reasons (strands, full_length, vanished, left_field, max_steps, steps)."},
+                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
+                {"progress", "Optional[Callable]", pyb::none(), "optional callable ``progress(stage, done, total, unit)``."}},
+               "Retrace every strand through a vector field from its own root, for its own length\n"
+               "(Wang et al. 2009, Sec. 5.3): ``vdbhair retrace``.\n\n"
+               "Raises vdbhair.GridTypeError (a TypeError) for a non-vector grid, vdbhair.ArgumentError,\n"
+               "KeyboardInterrupt on Ctrl-C.",
+               "    strands: a Strands (roots, lengths and vertex spacing to follow).\n"
+               "    field: a TangentField (its tangent grid is followed) or a vector Grid (vec3s), e.g. read with\n"
+               "        read_grid from any OpenVDB writer.\n",
+               "Strands, or (Strands, stats) with return_stats.",
+               pyb::cpp_function(retraceImpl, pyb::arg("strands"), pyb::arg("field"), pyb::arg("keywords")));
 
     const RefineParams refineDefaults;
     auto refineImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {

@@ -72,7 +72,7 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
                 a.set(p, text);
             } else if constexpr (std::is_same_v<T, std::uint64_t>) {
                 const long long n = v.cast<long long>();
-                if (n < 0) throw ValueError(verb + ": " + key + " " + std::to_string(n) + ": must be at least " + formatNumber(param.min));
+                if (n < 0) throw ValueError(verb + ": " + key + " " + std::to_string(n) + ": must be at least " + formatNumber(std::max(0.0, param.min)));
                 a.set(p, std::uint64_t(n));
             } else {
                 a.set(p, v.cast<T>());

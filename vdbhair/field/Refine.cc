@@ -64,7 +64,7 @@ const ParamTable<RefineParams>& refineParameters()
         auto step = makeParam<P>("step", "Integration step", "world units",
                       ParamAccess<P, double>{[](const P& p) { return p.trace.step; }, [](P& p, double v) { p.setStep(v, p.trace.integrator); }});
         step.min = 0.0;
-        step.zeroMeans = "half of each level's voxel size";
+        step.zeroMeans = formatNumber(kDefaultStepVoxels) + " of each level's voxel size";
         add(step);
         auto integrator = makeParam<P>("integrator", "The integrator of each step of either mode (euler: the papers' choice)", "",
                             ParamAccess<P, std::string>{[](const P& p) { return std::string(integratorName(p.trace.integrator)); },
@@ -95,7 +95,6 @@ const ParamTable<RefineParams>& refineParameters()
         add(maxVoxels);
         auto maxMemory = makeParam<P>("max-memory", "Refuse work whose memory estimate exceeds this (suffixes k, M, G on the command line: 16G)", "bytes",
                            member<P>([](P& p) -> std::uint64_t& { return p.field.maxMemory; }));
-        maxMemory.min = 0;
         maxMemory.zeroMeans = "the memory available (MemAvailable)";
         add(maxMemory);
         add(makeParam<P>("measure", "Also measure the output against the input at every level: full length, hair volume, head, curvature, "

@@ -16,6 +16,53 @@ Integrator integratorFromName(const std::string& name)
     throw ValueError("integrator '" + name + "' is not one of euler, rk2, rk3, rk4");
 }
 
+const char* retraceVerticesName(RetraceVertices vertices)
+{
+    return vertices == RetraceVertices::Input ? "input" : "steps";
+}
+
+RetraceVertices retraceVerticesFromName(const std::string& name)
+{
+    if (name == "input") return RetraceVertices::Input;
+    if (name == "steps") return RetraceVertices::Steps;
+    throw ValueError("vertices '" + name + "' is not one of input, steps");
+}
+
+const ParamTable<TraceParams>& traceParameters()
+{
+    using P = TraceParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto step = makeParam<P>("step", "Integration step", "world units", member<P>([](P& p) -> double& { return p.step; }));
+        step.min = 0.0;
+        step.zeroMeans = formatNumber(kDefaultStepVoxels) + " of the field's voxel size";
+        t.push_back(step);
+        auto integrator = makeParam<P>("integrator", "The integrator of each step (euler: the papers' choice)", "",
+                                       named<P>([](P& p) -> Integrator& { return p.integrator; }, integratorName, integratorFromName));
+        integrator.choices = {"euler", "rk2", "rk3", "rk4"};
+        t.push_back(integrator);
+        auto vanish = makeParam<P>("vanish", "Stop where the blended direction's length falls below this fraction", "",
+                                   member<P>([](P& p) -> double& { return p.vanishThreshold; }));
+        vanish.min = 0.0;
+        vanish.max = 1.0;
+        t.push_back(vanish);
+        auto maxSteps = makeParam<P>("max-steps", "Stop a strand after this many steps", "", member<P>([](P& p) -> std::size_t& { return p.maxSteps; }));
+        maxSteps.zeroMeans = "no limit";
+        t.push_back(maxSteps);
+        auto margin = makeParam<P>("margin", "Voxels a strand may continue straight past the field's active region (0: stop there, the papers' rule)",
+                                   "voxels", member<P>([](P& p) -> int& { return p.margin; }));
+        margin.min = 0;
+        margin.max = P::kMaxMargin;
+        t.push_back(margin);
+        auto vertices = makeParam<P>("vertices", "input: the input's vertex count and arc lengths; steps: every step", "",
+                                     named<P>([](P& p) -> RetraceVertices& { return p.vertices; }, retraceVerticesName, retraceVerticesFromName));
+        vertices.choices = {"input", "steps"};
+        t.push_back(vertices);
+        return t;
+    }();
+    return table;
+}
+
 const char* integratorName(Integrator integrator)
 {
     switch (integrator) {

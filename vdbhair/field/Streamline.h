@@ -50,6 +50,7 @@
 /// the general path (TraceParams::kernel forces either).
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/Types.h>
 
 #include <algorithm>
@@ -141,6 +142,15 @@ struct TraceParams
     /// [0, kMaxMargin], a vanish threshold outside [0, 1).
     void validate(const std::string& where) const;
 };
+
+/// @brief "input" or "steps".
+const char* retraceVerticesName(RetraceVertices vertices);
+/// @throw ValueError naming @a name and the choices.
+RetraceVertices retraceVerticesFromName(const std::string& name);
+
+/// @brief retrace's parameters (Parameters.h): the one declaration the command line, Python and
+/// docs/cli.md are made from. Defaults are TraceParams{}'s.
+const ParamTable<TraceParams>& traceParameters();
 
 /// @brief What happened to every streamline of a retrace.
 struct TraceStats
