@@ -24,6 +24,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <type_traits>
 
 namespace vdbhair {
 
