@@ -115,127 +115,35 @@ private:
         const std::size_t n = mS.in.size(i);
         const Vec3f* c = mS.in.data(i);
         const bool haveHead = !mS.head.empty();
-        const bool relative = haveHead && mS.head.policy() == HeadPolicy::NoDeeper;
+        const HeadRule head{haveHead, haveHead && mS.head.policy() == HeadPolicy::NoDeeper};
         Vec3d p(c[0]);
         // KeepOutside holds for the root too: a root inside the head starts on its surface.
-        if (haveHead && !relative && mHead.pushOut(p, 0.0)) ++counts.pushedOut;
+        if (head.keepOutside() && mHead.pushOut(p, 0.0)) ++counts.pushedOut;
         o[0] = Vec3f(float(p.x()), float(p.y()), float(p.z()));
         bool corrected = false;
         for (std::size_t j = 0; j + 1 < n; ++j) {
-            const Vec3d a(c[j]), b(c[j + 1]);
-            const Vec3d seg = b - a;
-            const double len = seg.length();
-            if (len > 0.0) {
-                const Vec3d t = seg / len;
-                const std::size_t m = std::max<std::size_t>(1, std::size_t(std::ceil(len / mS.step)));
-                const double h = len / double(m);
+            const InputSegment s(c[j], c[j + 1], mS.step);
+            if (s.len > 0.0) {
                 // On the input strand (a vertex that rounds to the input's is the input's, below), a
                 // segment whose retrace is the segment itself is not traced (keepsOwnDirection()).
-                if (euler && p.x() == a.x() && p.y() == a.y() && p.z() == a.z() && keepsOwnDirection(a, seg, b, t, m, h, haveHead && !relative, counts)) {
+                if (euler && p.x() == s.a.x() && p.y() == s.a.y() && p.z() == s.a.z() &&
+                    keepsOwnDirection(s.a, s.seg, s.b, s.t, s.m, s.h, head.keepOutside(), counts)) {
                     o[j + 1] = c[j + 1];
-                    p = b;
+                    p = s.b;
                     continue;
                 }
-                bool pushed = false;
                 const Vec3d start = p;
-                for (std::size_t k = 0; k < m; ++k) {
-                    // The strand's own direction, steered back toward the input strand at this
-                    // arc length when an earlier correction moved it away: a corrected kink
-                    // stays local, the rest of the strand stays where it was.
-                    const Vec3d off = a + seg * (double(k) / double(m)) - p;
-                    Vec3d own = t + off * mS.invReturn;
-                    const double ol = own.length();
-                    own = ol > 1e-12 ? own / ol : t;
-                    // A step of the engine through the blended direction (with Euler, the default,
-                    // q = p + h d); d is the step's direction for the constraints below.
-                    blend.own = own;
-                    Vec3d q, k1;
-                    blend.startDirection(p, k1);
-                    integrator.template advanceFrom<I>(p, k1, h, q);  // never fails: without a field the strand keeps its own direction
-                    if (blend.w >= 0.5) corrected = true;
-                    Vec3d d = k1;
-                    if constexpr (!euler) {
-                        const Vec3d e = q - p;
-                        const double el = e.length();
-                        if (el > 1e-12) d = e / el;
-                    }
-                    if (!insideField(q)) {
-                        // The step would leave the hair: head for the input strand's own point
-                        // at the step's end instead (the input lies inside the hair by definition).
-                        const Vec3d back = a + seg * (double(k + 1) / double(m)) - p;
-                        const double bl = back.length();
-                        if (bl > 1e-12) {
-                            d = back / bl;
-                            q = p + h * d;
-                            ++counts.heldIn;
-                        }
-                    }
-                    // Outside the head, or for a guessed head no deeper inside than the input
-                    // strand at this arc length (HeadPolicy). The floor is never positive, so a
-                    // step that ends outside the head needs neither it nor anything below.
-                    const double dq = haveHead ? mHead.distance(q) : 0.0;
-                    if (dq < 0.0) {
-                        const double floor = relative ? depthFloor(a + seg * (double(k + 1) / double(m))) : 0.0;
-                        if (dq < floor) {
-                            // Slide along the head: drop the step's inward component (the step
-                            // keeps its length), then move out what the surface's curvature left in.
-                            const Vec3d nrm = mHead.normal(p);
-                            const double dn = d.dot(nrm);
-                            if (dn < 0.0) {
-                                const Vec3d slide = d - dn * nrm;
-                                const double sl = slide.length();
-                                if (sl > 1e-12) d = slide / sl;
-                                q = p + h * d;
-                            }
-                            // Out of the head at the step's own length: push out and pull the
-                            // step back to length h, a few times (a fixed point on the surface
-                            // for steps much shorter than the head's radius), then make sure.
-                            for (int it = 0; it < 3 && mHead.pushOut(q, floor); ++it) {
-                                pushed = true;
-                                const Vec3d e = q - p;
-                                const double el = e.length();
-                                if (el > 1e-12) q = p + e * (h / el);
-                            }
-                            pushed |= mHead.pushOut(q, floor);
-                        }
-                    }
-                    p = q;
-                }
-                counts.steps += m;
-                // The output segment is the chord of the sub-steps at the input segment's own
-                // length: a path that bends inside a segment would otherwise shorten the
-                // polyline (its chord is shorter than its arc), and the strand with it.
-                const Vec3d chord = p - start;
-                const double cl = chord.length();
-                if (cl > 1e-12) {
-                    const Vec3d scaled = start + chord * (len / cl);
-                    if (insideField(scaled) || !insideField(p)) {
-                        p = scaled;
-                    } else {
-                        // The chord at full length would leave the hair: aim at the input vertex.
-                        const Vec3d toB = b - start;
-                        const double tl = toB.length();
-                        p = tl > 1e-12 ? start + toB * (len / tl) : scaled;
-                    }
-                }
+                bool pushed = traceSegment<I>(integrator, blend, s, head, p, corrected, counts);
+                counts.steps += s.m;
+                p = chordAtInputLength(start, p, s);
                 // pushOut() moves only a point inside the head (the floor is never positive).
-                if (haveHead && mHead.distance(p) < 0.0) pushed |= mHead.pushOut(p, relative ? depthFloor(b) : 0.0);
+                if (head.have && mHead.distance(p) < 0.0) pushed |= mHead.pushOut(p, head.relative ? depthFloor(s.b) : 0.0);
                 if (pushed) ++counts.pushedOut;
             }
             o[j + 1] = Vec3f(float(p.x()), float(p.y()), float(p.z()));
-            if (o[j + 1] == c[j + 1]) p = b;  // back on the input strand, to the last bit
+            if (o[j + 1] == c[j + 1]) p = s.b;  // back on the input strand, to the last bit
         }
-        // Only where the output differs from the input can it have left the volume on its own
-        // (containsChanged()): most strands come out unchanged, bit for bit (57-68 % of them on
-        // the benchmark's set and on real hair), and their test costs one comparison.
-        if (!mDilated.containsChanged(o, c, n) && mDilated.containsPolyline(c, n)) {
-            // The corrections took the strand out of the hair volume (chords across a gap, a
-            // slide along the head): leave the strand as it was, out of the head if it must be.
-            for (std::size_t j = 0; j < n; ++j) {
-                Vec3d q(c[j]);
-                if (haveHead && !relative) mHead.pushOut(q, 0.0);
-                o[j] = Vec3f(float(q.x()), float(q.y()), float(q.z()));
-            }
+        if (revertIfOutOfVolume(o, c, n, head.keepOutside())) {
             ++counts.reverted;
             return;
         }
@@ -266,6 +174,151 @@ private:
             return SampleStatus::Ok;
         }
     };
+
+    /// The head's rule for one retrace: whether there is a head, and whether its policy is
+    /// NoDeeper (relative to the input strand's depth) rather than KeepOutside.
+    struct HeadRule
+    {
+        bool have, relative;
+        bool keepOutside() const { return have && !relative; }
+    };
+
+    /// One segment of the input strand, from @a a to @a b, and its sub-steps: m of length h,
+    /// at most the step (set only for a segment of positive length).
+    struct InputSegment
+    {
+        Vec3d a, b, seg, t;
+        double len, h = 0.0;
+        std::size_t m = 0;
+
+        InputSegment(const Vec3f& a_, const Vec3f& b_, double step) : a(a_), b(b_), seg(b - a), len(seg.length())
+        {
+            if (!(len > 0.0)) return;
+            t = seg / len;
+            m = std::max<std::size_t>(1, std::size_t(std::ceil(len / step)));
+            h = len / double(m);
+        }
+        /// The input strand's point at sub-step @a k of m.
+        Vec3d at(std::size_t k) const { return a + seg * (double(k) / double(m)); }
+    };
+
+    /// The sub-steps of input segment @a s from @a p: each the strand's own direction steered
+    /// back toward the input strand, blended with the field, held in the hair and out of the
+    /// head. Sets @a corrected when the field took over a sub-step; returns whether the head
+    /// pushed a sub-step out.
+    template<Integrator I>
+    bool traceSegment(StreamlineIntegrator<BlendSampler>& integrator, BlendSampler& blend, const InputSegment& s, const HeadRule& head,
+                      Vec3d& p, bool& corrected, Counts& counts)
+    {
+        constexpr bool euler = I == Integrator::Euler;
+        bool pushed = false;
+        for (std::size_t k = 0; k < s.m; ++k) {
+            // The strand's own direction, steered back toward the input strand at this
+            // arc length when an earlier correction moved it away: a corrected kink
+            // stays local, the rest of the strand stays where it was.
+            const Vec3d off = s.at(k) - p;
+            Vec3d own = s.t + off * mS.invReturn;
+            const double ol = own.length();
+            own = ol > 1e-12 ? own / ol : s.t;
+            // A step of the engine through the blended direction (with Euler, the default,
+            // q = p + h d); d is the step's direction for the constraints below.
+            blend.own = own;
+            Vec3d q, k1;
+            blend.startDirection(p, k1);
+            integrator.template advanceFrom<I>(p, k1, s.h, q);  // never fails: without a field the strand keeps its own direction
+            if (blend.w >= 0.5) corrected = true;
+            Vec3d d = k1;
+            if constexpr (!euler) {
+                const Vec3d e = q - p;
+                const double el = e.length();
+                if (el > 1e-12) d = e / el;
+            }
+            if (!insideField(q)) holdInHair(s, k, p, d, q, counts);
+            // Outside the head, or for a guessed head no deeper inside than the input
+            // strand at this arc length (HeadPolicy). The floor is never positive, so a
+            // step that ends outside the head needs neither it nor anything below.
+            const double dq = head.have ? mHead.distance(q) : 0.0;
+            if (dq < 0.0) {
+                const double floor = head.relative ? depthFloor(s.at(k + 1)) : 0.0;
+                if (dq < floor) pushed |= slideAlongHead(p, s.h, floor, d, q);
+            }
+            p = q;
+        }
+        return pushed;
+    }
+
+    /// The step from @a p to @a q (direction @a d) would leave the hair: head for the input
+    /// strand's own point at the step's end instead (the input lies inside the hair by definition).
+    void holdInHair(const InputSegment& s, std::size_t k, const Vec3d& p, Vec3d& d, Vec3d& q, Counts& counts)
+    {
+        const Vec3d back = s.at(k + 1) - p;
+        const double bl = back.length();
+        if (bl > 1e-12) {
+            d = back / bl;
+            q = p + s.h * d;
+            ++counts.heldIn;
+        }
+    }
+
+    /// The step from @a p to @a q (direction @a d, length @a h) ends deeper in the head than
+    /// @a floor: slide along the head, dropping the step's inward component (the step keeps its
+    /// length), then move out what the surface's curvature left in. Returns whether q was pushed out.
+    bool slideAlongHead(const Vec3d& p, double h, double floor, Vec3d& d, Vec3d& q)
+    {
+        bool pushed = false;
+        const Vec3d nrm = mHead.normal(p);
+        const double dn = d.dot(nrm);
+        if (dn < 0.0) {
+            const Vec3d slide = d - dn * nrm;
+            const double sl = slide.length();
+            if (sl > 1e-12) d = slide / sl;
+            q = p + h * d;
+        }
+        // Out of the head at the step's own length: push out and pull the step back to length
+        // h, a few times (a fixed point on the surface for steps much shorter than the head's
+        // radius), then make sure.
+        for (int it = 0; it < 3 && mHead.pushOut(q, floor); ++it) {
+            pushed = true;
+            const Vec3d e = q - p;
+            const double el = e.length();
+            if (el > 1e-12) q = p + e * (h / el);
+        }
+        pushed |= mHead.pushOut(q, floor);
+        return pushed;
+    }
+
+    /// The output segment from @a start: the chord of the sub-steps (ending at @a p) at the input
+    /// segment's own length. A path that bends inside a segment would otherwise shorten the
+    /// polyline (its chord is shorter than its arc), and the strand with it.
+    Vec3d chordAtInputLength(const Vec3d& start, const Vec3d& p, const InputSegment& s)
+    {
+        const Vec3d chord = p - start;
+        const double cl = chord.length();
+        if (!(cl > 1e-12)) return p;
+        const Vec3d scaled = start + chord * (s.len / cl);
+        if (insideField(scaled) || !insideField(p)) return scaled;
+        // The chord at full length would leave the hair: aim at the input vertex.
+        const Vec3d toB = s.b - start;
+        const double tl = toB.length();
+        return tl > 1e-12 ? start + toB * (s.len / tl) : scaled;
+    }
+
+    /// Only where the output @a o differs from the input @a c can it have left the volume on its
+    /// own (containsChanged()): most strands come out unchanged, bit for bit (57-68 % of them on
+    /// the benchmark's set and on real hair), and their test costs one comparison. When the
+    /// corrections took the strand out of the hair volume (chords across a gap, a slide along
+    /// the head), the strand is left as it was, out of the head if it must be (@a keepOutside);
+    /// returns whether it was.
+    bool revertIfOutOfVolume(Vec3f* o, const Vec3f* c, std::size_t n, bool keepOutside)
+    {
+        if (mDilated.containsChanged(o, c, n) || !mDilated.containsPolyline(c, n)) return false;
+        for (std::size_t j = 0; j < n; ++j) {
+            Vec3d q(c[j]);
+            if (keepOutside) mHead.pushOut(q, 0.0);
+            o[j] = Vec3f(float(q.x()), float(q.y()), float(q.z()));
+        }
+        return true;
+    }
 
     /// How deep (a negative distance) a retraced vertex may be inside a NoDeeper head where the
     /// input vertex at the same arc length is at @a input: on or outside the surface where the

@@ -6,6 +6,7 @@
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/field/Simd.h>
+#include <vdbhair/field/impl/FieldMoments.h>
 #include <vdbhair/strands/Measures.h>
 
 #include <openvdb/tree/LeafManager.h>
@@ -23,9 +24,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
-#include <new>
 #include <type_traits>
-#include <unordered_map>
 
 namespace vdbhair {
 
@@ -33,269 +32,13 @@ namespace {
 
 using openvdb::Coord;
 using openvdb::Vec3d;
-
-/// @brief First and second moments of the contributions to one voxel: s = Σ ℓ T and
-/// M = Σ ℓ T Tᵀ, as three SIMD quadruples a = (s_x, s_y, s_z, M_xx), b = (M_yy, M_zz, M_xy,
-/// M_xz), c = (M_yz, 0, 0, 0), so that adding a contribution is three multiply-adds.
-/// trace(M) = Σ ℓ is the density.
-struct Moments
-{
-    Float4 a = {0.f, 0.f, 0.f, 0.f}, b = {0.f, 0.f, 0.f, 0.f}, c = {0.f, 0.f, 0.f, 0.f};
-
-    /// @brief The moments of a whole segment d (world, length len > 0): ℓ T = d and
-    /// ℓ T Tᵀ = d dᵀ / len. A piece of it, fraction f of its length, contributes f times these.
-    static Moments ofSegment(const Float4& d, float len)
-    {
-        const Float4 e = d * (1.f / len);
-        Moments m;
-        m.a = Float4{d[0], d[1], d[2], d[0] * e[0]};
-        m.b = Float4{d[1] * e[1], d[2] * e[2], d[0] * e[1], d[0] * e[2]};
-        m.c = Float4{d[1] * e[2], 0.f, 0.f, 0.f};
-        return m;
-    }
-    void add(const Moments& o)
-    {
-        a += o.a;
-        b += o.b;
-        c += o.c;
-    }
-    void addScaled(const Moments& o, float f)
-    {
-        a += o.a * f;
-        b += o.b * f;
-        c += o.c * f;
-    }
-    float xx() const { return a[3]; }
-    float yy() const { return b[0]; }
-    float zz() const { return b[1]; }
-    float xy() const { return b[2]; }
-    float xz() const { return b[3]; }
-    float yz() const { return c[0]; }
-    float density() const { return xx() + yy() + zz(); }
-    bool empty() const { return xx() == 0.f && yy() == 0.f && zz() == 0.f; }
-};
-
-/// Eq. 9 from the moments: v_t = normalize(s + M v_{t-1}), v_0 = 0.
-openvdb::Vec3f robustDirection(const Moments& mo, int iterations)
-{
-    const Vec3d s(mo.a[0], mo.a[1], mo.a[2]);
-    Vec3d v(0.0);
-    for (int t = 0; t < iterations; ++t) {
-        const Vec3d w = s + Vec3d(mo.xx() * v.x() + mo.xy() * v.y() + mo.xz() * v.z(),
-                                  mo.xy() * v.x() + mo.yy() * v.y() + mo.yz() * v.z(),
-                                  mo.xz() * v.x() + mo.yz() * v.y() + mo.zz() * v.z());
-        const double len = w.length();
-        if (!(len > 1e-30)) return openvdb::Vec3f(0.f);
-        v = w / len;
-    }
-    return openvdb::Vec3f(float(v.x()), float(v.y()), float(v.z()));
-}
-
-/// |s| / Σ ℓ: 1 for parallel contributions, 0 where they cancel.
-float coherenceOf(const Moments& mo)
-{
-    const double d = mo.density();
-    if (!(d > 0.0)) return 0.f;
-    const double s = std::sqrt(double(mo.a[0]) * mo.a[0] + double(mo.a[1]) * mo.a[1] + double(mo.a[2]) * mo.a[2]);
-    return float(std::min(1.0, s / d));
-}
-
-/// 1 − vᵀ M v / Σ ℓ: the contributions' mean squared sine of their angle to v (1 if v is zero).
-float spreadOf(const Moments& mo, const openvdb::Vec3f& v)
-{
-    const double d = mo.density();
-    if (!(d > 0.0) || v.lengthSqr() == 0.f) return 1.f;
-    const double x = v.x(), y = v.y(), z = v.z();
-    const double vmv = mo.xx() * x * x + mo.yy() * y * y + mo.zz() * z * z +
-                       2.0 * (mo.xy() * x * y + mo.xz() * x * z + mo.yz() * y * z);
-    return float(std::min(1.0, std::max(0.0, 1.0 - vmv / d)));
-}
-
-/// @brief An array that grows by whole pages and never moves what it holds: a chunk's moments and
-/// blocks. A std::vector that doubles copied its contents into fresh memory at every growth,
-/// which the kernel had to clear first (clearing pages was a fifth of `field`'s CPU, these copies
-/// part of it); here each element is written once, into the page it stays in. For trivially
-/// copyable T.
-template<typename T, unsigned kPageBits>
-class PagedArray
-{
-    static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
-    static constexpr std::size_t kPage = std::size_t(1) << kPageBits;
-
-    struct Free
-    {
-        void operator()(T* p) const { ::operator delete(p, std::align_val_t(alignof(T))); }
-    };
-
-public:
-    std::size_t size() const { return mSize; }
-    T& operator[](std::size_t i) { return mPages[i >> kPageBits].get()[i & (kPage - 1)]; }
-    const T& operator[](std::size_t i) const { return mPages[i >> kPageBits].get()[i & (kPage - 1)]; }
-
-    /// The new last element, uninitialized.
-    T& grow()
-    {
-        if ((mSize & (kPage - 1)) == 0) {
-            mPages.emplace_back(static_cast<T*>(::operator new(sizeof(T) * kPage, std::align_val_t(alignof(T)))));
-        }
-        return (*this)[mSize++];
-    }
-
-private:
-    std::vector<std::unique_ptr<T, Free>> mPages;
-    std::size_t mSize = 0;
-};
-
-/// The accumulation of one chunk of strands. Moments live in one array; each touched leaf-sized
-/// block (8³ voxels) maps its voxels to slots in it. Consecutive flushes of a strand mostly hit
-/// the same block, which is cached, so a flush costs a compare, an index and three SIMD adds.
-struct Chunk
-{
-    static constexpr std::uint32_t kEmpty = 0xffffffffu;
-    struct Block
-    {
-        std::uint32_t slot[512];
-    };
-    std::unordered_map<Coord, std::uint32_t> blockOf;  // block origin -> block index
-    PagedArray<Block, 9> blocks;                       // 1 MiB pages
-    std::vector<Coord> origins;
-    PagedArray<Moments, 15> moments;                   // 1.5 MiB pages
-
-    /// The block of @a origin, or nullptr.
-    const Block* find(const Coord& origin) const
-    {
-        const auto it = blockOf.find(origin);
-        return it == blockOf.end() ? nullptr : &blocks[it->second];
-    }
-};
-
-/// Adds moments to a chunk, caching the block of the last voxel.
-class ChunkWriter
-{
-public:
-    explicit ChunkWriter(Chunk& c) : mChunk(c) {}
-
-    /// Add @a m to voxel @a ijk (inlined: called for every voxel a strand enters).
-    void add(const Coord& ijk, const Moments& m)
-    {
-        const Coord origin(ijk.x() & ~7, ijk.y() & ~7, ijk.z() & ~7);
-        if (mSlots == nullptr || !sameCoord(origin, mOrigin)) selectBlock(origin);
-        std::uint32_t& slot = mSlots[((ijk.x() & 7) << 6) | ((ijk.y() & 7) << 3) | (ijk.z() & 7)];
-        if (slot == Chunk::kEmpty) {
-            newSlot(slot, m);
-        } else {
-            mChunk.moments[slot].add(m);
-        }
-    }
-
-    /// Whether a == b, without the branches of Coord::operator== (voxels change unpredictably).
-    static bool sameCoord(const Coord& a, const Coord& b)
-    {
-        return ((a.x() ^ b.x()) | (a.y() ^ b.y()) | (a.z() ^ b.z())) == 0;
-    }
-
-private:
-    __attribute__((noinline)) void selectBlock(const Coord& origin)
-    {
-        mOrigin = origin;
-        const auto [it, inserted] = mChunk.blockOf.try_emplace(origin, std::uint32_t(mChunk.blocks.size()));
-        if (inserted) {
-            Chunk::Block& block = mChunk.blocks.grow();
-            std::fill(std::begin(block.slot), std::end(block.slot), Chunk::kEmpty);
-            mChunk.origins.push_back(origin);
-        }
-        mSlots = mChunk.blocks[it->second].slot;
-    }
-
-    __attribute__((noinline)) void newSlot(std::uint32_t& slot, const Moments& m)
-    {
-        slot = std::uint32_t(mChunk.moments.size());
-        mChunk.moments.grow() = m;
-    }
-
-    Chunk& mChunk;
-    Coord mOrigin;
-    /// The cached block's slots (blocks never move); a chunk has one writer.
-    std::uint32_t* mSlots = nullptr;
-};
-
-/// @brief Walks one chunk's strands through the voxels and adds their moments to the chunk.
-///
-/// Consecutive pieces in the same voxel (strands often take several segments per voxel) are summed
-/// in registers and written to the chunk when the walk moves on. Per segment: the world segment
-/// gives the moments of the whole segment once (Moments::ofSegment); the index-space segment
-/// gives the voxels and the fraction of its length in each, by walkSegment() (SegmentWalk.h: a 3D
-/// DDA that takes exactly |Δ| steps per axis and ends in the end vertex's voxel).
-template<typename ToIndex>
-class SegmentAccumulator
-{
-public:
-    SegmentAccumulator(Chunk& chunk, const ToIndex& toIndex) : mWriter(chunk), mToIndex(toIndex) {}
-
-    /// Add the n vertices at @a v (one strand, root first).
-    void addStrand(const Vec3f* v, std::size_t n)
-    {
-        Vec3d ia = mToIndex(v[0]);
-        Coord va = voxelOf(ia);
-        Float4 pa = loadFloat3(v[0].asPointer());
-        for (std::size_t j = 1; j < n; ++j) {
-            const Vec3d ib = mToIndex(v[j]);
-            const Coord vb = voxelOf(ib);
-            const Float4 pb = loadFloat3(v[j].asPointer());
-            const Float4 d = pb - pa;
-            const float len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            if (len2 > 0.f) {
-                const Moments u = Moments::ofSegment(d, std::sqrt(len2));
-                if (ChunkWriter::sameCoord(va, vb)) {
-                    add(va, u);  // the common case: the whole segment in one voxel
-                } else {
-                    walk(ia, ib, va, vb, u);
-                }
-            }
-            ia = ib;
-            va = vb;
-            pa = pb;
-        }
-    }
-
-    /// Write the pending moments out (at the end of the chunk).
-    void flush()
-    {
-        if (!mPending.empty()) mWriter.add(mCurrent, mPending);
-        mPending = Moments();
-    }
-
-private:
-    void add(const Coord& ijk, const Moments& u)
-    {
-        if (!ChunkWriter::sameCoord(ijk, mCurrent)) {
-            flush();
-            mCurrent = ijk;
-        }
-        mPending.add(u);
-    }
-
-    void add(const Coord& ijk, const Moments& u, float f)
-    {
-        if (!ChunkWriter::sameCoord(ijk, mCurrent)) {
-            flush();
-            mCurrent = ijk;
-        }
-        mPending.addScaled(u, f);
-    }
-
-    /// The segment from @a a (voxel @a va) to @a b (voxel @a vb != va), index space, through
-    /// every voxel it passes (SegmentWalk.h).
-    void walk(const Vec3d& a, const Vec3d& b, const Coord& va, const Coord& vb, const Moments& u)
-    {
-        walkSegment(a, b, va, vb, [&](const Coord& c, double t0, double t1) { add(c, u, float(t1 - t0)); });
-    }
-
-    ChunkWriter mWriter;
-    const ToIndex& mToIndex;
-    Coord mCurrent{std::numeric_limits<int>::max()};
-    Moments mPending;
-};
+using field_moments::Chunk;
+using field_moments::ChunkWriter;
+using field_moments::Moments;
+using field_moments::SegmentAccumulator;
+using field_moments::coherenceOf;
+using field_moments::robustDirection;
+using field_moments::spreadOf;
 
 /// Strands are split into this many chunks whatever the thread count (determinism).
 std::size_t chunkCount(std::size_t strands) { return std::min<std::size_t>(16, std::max<std::size_t>(1, strands / 256)); }
@@ -530,19 +273,12 @@ std::uint64_t visitBound(const StrandSet& strands, const FieldMapping& map)
     return std::min(measure(strands, map, true).visits, kSaturated);
 }
 
-/// @param measured measure()'s extent of @a strands at @a voxelSize when the memory check took it
-/// already (checkFieldMemory()), or null
-TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, double voxelSize, int level, int levels,
-                           bool threaded, openvdb::util::NullInterrupter* interrupter, const Extent* measured = nullptr)
+/// The strands' extent at a level and their spatial order: chunks of neighbouring strands share
+/// voxels, so a chunk's moments stay small and in cache. @a measured is the extent when the
+/// memory check took it already.
+void measureAndOrder(const StrandSet& strands, const FieldMapping& map, bool threaded, const Extent* measured, Extent& extent,
+                     std::vector<std::uint32_t>& order)
 {
-    const FieldMapping map = mappingFor(p, voxelSize);
-    const std::size_t nS = strands.numStrands(), nChunks = chunkCount(nS);
-
-    // Bounds before any allocation: index coordinates must fit OpenVDB's int32 Coord, and the
-    // voxel visits the cap. Meanwhile, the strands in spatial order: chunks of neighbouring
-    // strands share voxels, so a chunk's moments stay small and in cache.
-    Extent extent;
-    std::vector<std::uint32_t> order;
     if (measured) {
         extent = *measured;
         order = spatialOrder(strands);
@@ -552,12 +288,13 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
         extent = measure(strands, map, false);
         order = spatialOrder(strands);
     }
-    checkIndexRange(extent, map, voxelSize);
-    checkVisits(std::min(extent.visits, kSaturated), p, voxelSize);
+}
 
-    // Accumulate the moments, chunk by chunk (each chunk in strand order).
-    const std::string stage = levels > 1 ? "estimating level " + std::to_string(level) + " of " + std::to_string(levels)
-                                         : std::string("estimating the tangent field");
+/// The moments of every voxel the strands cross, chunk by chunk (each chunk in strand order).
+std::vector<Chunk> accumulateChunks(const StrandSet& strands, const std::vector<std::uint32_t>& order, const FieldMapping& map,
+                                    bool threaded, openvdb::util::NullInterrupter* interrupter, const std::string& stage)
+{
+    const std::size_t nS = strands.numStrands(), nChunks = chunkCount(nS);
     std::vector<Chunk> chunks(nChunks);
     ProgressCounter progress(interrupter, stage.c_str(), nS, "strands");
     withToIndex(map, [&](const auto& toIndex) {
@@ -588,12 +325,24 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
     });
     progress.finish();
     if (progress.stopped()) throw InterruptedError("estimateTangentField: interrupted");
+    return chunks;
+}
 
-    // Topology: every block any chunk touched, as leaves of the output trees.
-    // The other trees copy the tangent tree's topology, in parallel (OpenVDB's topology copy).
-    // The leaves are made in parallel (each fills its buffer: fresh pages, which the threads then
-    // fault in together) and then linked into the tree, which is what touchLeaf() would make.
-    openvdb::Vec3STree::Ptr tangentTree(new openvdb::Vec3STree(openvdb::Vec3f(0.f)));
+/// The trees of one level: the tangent tree's leaves are every block any chunk touched; the
+/// scalar trees copy its topology.
+struct LevelTrees
+{
+    openvdb::Vec3STree::Ptr tangent;
+    openvdb::FloatTree::Ptr density, coherence, spread;  ///< coherence and spread when asked for
+};
+
+/// The topology of a level. The leaves are made in parallel (each fills its buffer: fresh pages,
+/// which the threads then fault in together) and then linked into the tree, which is what
+/// touchLeaf() would make; the other trees copy it in parallel (OpenVDB's topology copy).
+LevelTrees makeLevelTopology(const std::vector<Chunk>& chunks, bool extra, bool threaded)
+{
+    LevelTrees trees;
+    trees.tangent.reset(new openvdb::Vec3STree(openvdb::Vec3f(0.f)));
     {
         using LeafT = openvdb::Vec3STree::LeafNodeType;
         std::vector<Coord> origins;
@@ -603,24 +352,28 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
         std::vector<std::unique_ptr<LeafT>> made(origins.size());
         const auto make = [&](std::size_t i) { made[i].reset(new LeafT(origins[i], openvdb::Vec3f(0.f), false)); };
         forEachIndex(origins.size(), threaded, make);
-        for (std::unique_ptr<LeafT>& leaf : made) tangentTree->addLeaf(leaf.release());  // the tree owns it from here
+        for (std::unique_ptr<LeafT>& leaf : made) trees.tangent->addLeaf(leaf.release());  // the tree owns it from here
     }
-    openvdb::FloatTree::Ptr densityTree, coherenceTree, spreadTree;
     const auto copyTopology = [&](openvdb::FloatTree::Ptr& tree) {
-        tree.reset(new openvdb::FloatTree(*tangentTree, 0.f, openvdb::TopologyCopy()));
+        tree.reset(new openvdb::FloatTree(*trees.tangent, 0.f, openvdb::TopologyCopy()));
     };
-    const bool extra = p.coherenceAndSpread;
     if (threaded && extra) {
-        tbb::parallel_invoke([&] { copyTopology(densityTree); }, [&] { copyTopology(coherenceTree); },
-                             [&] { copyTopology(spreadTree); });
+        tbb::parallel_invoke([&] { copyTopology(trees.density); }, [&] { copyTopology(trees.coherence); },
+                             [&] { copyTopology(trees.spread); });
     } else {
-        copyTopology(densityTree);
-        if (extra) copyTopology(coherenceTree);
-        if (extra) copyTopology(spreadTree);
+        copyTopology(trees.density);
+        if (extra) copyTopology(trees.coherence);
+        if (extra) copyTopology(trees.spread);
     }
+    return trees;
+}
 
-    // Per leaf: merge the chunks in order, then Eq. 9 and the density.
-    openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(*tangentTree);
+/// Per leaf: merge the chunks' moments in chunk order, then Eq. 9's direction, the raw density
+/// (hair length) and, when asked for, coherence and spread.
+void solveDirections(LevelTrees& trees, const std::vector<Chunk>& chunks, int iterations, bool extra, bool threaded,
+                     openvdb::util::NullInterrupter* interrupter, const std::string& stage)
+{
+    openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(*trees.tangent);
     ProgressCounter directions(interrupter, (stage + ": robust directions (Eq. 9)").c_str(), leaves.leafCount(), "blocks");
     leaves.foreach([&](openvdb::Vec3STree::LeafNodeType& leaf, std::size_t) {
         if (directions.active() && (directions.stopped() || directions.add(1))) return;
@@ -639,13 +392,13 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
                 }
             }
         }
-        auto* dl = densityTree->probeLeaf(leaf.origin());
-        auto* cl = extra ? coherenceTree->probeLeaf(leaf.origin()) : nullptr;
-        auto* sl = extra ? spreadTree->probeLeaf(leaf.origin()) : nullptr;
+        auto* dl = trees.density->probeLeaf(leaf.origin());
+        auto* cl = extra ? trees.coherence->probeLeaf(leaf.origin()) : nullptr;
+        auto* sl = extra ? trees.spread->probeLeaf(leaf.origin()) : nullptr;
         for (openvdb::Index k = 0; k < 512; ++k) {
             if (!hit[k]) continue;
             const Moments& mo = sum[k];
-            const openvdb::Vec3f v = robustDirection(mo, p.iterations);
+            const openvdb::Vec3f v = robustDirection(mo, iterations);
             leaf.setValueOn(k, v);
             dl->setValueOn(k, mo.density());
             if (!extra) continue;
@@ -654,45 +407,54 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
         }
     }, threaded);
     if (directions.stopped()) throw InterruptedError("estimateTangentField: interrupted");
+}
 
-    // The raw sums as hair_length; density normalized to a fog volume (TangentField.h states the rule).
-    TangentField out;
-    out.hairLength = openvdb::FloatGrid::create(openvdb::FloatTree::Ptr(new openvdb::FloatTree(*densityTree)));
-    const double voxelVolume = voxelSize * voxelSize * voxelSize;
-    double reference = p.densityReference;
-    if (!(reference > 0.0)) {
-        // The active values (all in leaves: the trees are built leaf by leaf), gathered leaf by
-        // leaf in parallel; the percentile does not depend on their order.
-        openvdb::tree::LeafManager<const openvdb::FloatTree> dleaves(*densityTree);
-        std::vector<std::size_t> start(dleaves.leafCount() + 1, 0);
-        for (std::size_t i = 0; i < dleaves.leafCount(); ++i) start[i + 1] = start[i] + dleaves.leaf(i).onVoxelCount();
-        std::vector<float> values(start.back());
-        forEachIndex(dleaves.leafCount(), threaded, [&](std::size_t i) {
-            std::size_t k = start[i];
-            for (auto it = dleaves.leaf(i).cbeginValueOn(); it; ++it) values[k++] = *it;
-        });
-        if (!values.empty()) {
-            const std::size_t k = std::min(values.size() - 1, std::size_t(0.95 * double(values.size())));
-            std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
-            reference = double(values[k]) / voxelVolume;
-        }
-        if (!(reference > 0.0)) reference = 1.0 / voxelVolume;
+/// The density reference (hair length per unit volume): @a given when positive, else the 95th
+/// percentile of the raw density over the voxel volume.
+double densityReferenceOf(const openvdb::FloatTree& density, double given, double voxelVolume, bool threaded)
+{
+    double reference = given;
+    if (reference > 0.0) return reference;
+    // The active values (all in leaves: the trees are built leaf by leaf), gathered leaf by
+    // leaf in parallel; the percentile does not depend on their order.
+    openvdb::tree::LeafManager<const openvdb::FloatTree> dleaves(density);
+    std::vector<std::size_t> start(dleaves.leafCount() + 1, 0);
+    for (std::size_t i = 0; i < dleaves.leafCount(); ++i) start[i + 1] = start[i] + dleaves.leaf(i).onVoxelCount();
+    std::vector<float> values(start.back());
+    forEachIndex(dleaves.leafCount(), threaded, [&](std::size_t i) {
+        std::size_t k = start[i];
+        for (auto it = dleaves.leaf(i).cbeginValueOn(); it; ++it) values[k++] = *it;
+    });
+    if (!values.empty()) {
+        const std::size_t k = std::min(values.size() - 1, std::size_t(0.95 * double(values.size())));
+        std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
+        reference = double(values[k]) / voxelVolume;
     }
-    out.densityReference = reference;
-    {
-        const float scale = float(1.0 / (voxelVolume * reference));
-        openvdb::tree::LeafManager<openvdb::FloatTree> dleaves(*densityTree);
-        dleaves.foreach([scale](openvdb::FloatTree::LeafNodeType& leaf, std::size_t) {
-            for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(std::min(1.f, *it * scale));
-        }, threaded);
-    }
-    out.tangent = openvdb::Vec3SGrid::create(tangentTree);
-    out.density = openvdb::FloatGrid::create(densityTree);
+    if (!(reference > 0.0)) reference = 1.0 / voxelVolume;
+    return reference;
+}
+
+/// Density as a fog volume: min(1, raw / (voxel volume × reference)) (TangentField.h states the rule).
+void normalizeDensity(openvdb::FloatTree& density, double voxelVolume, double reference, bool threaded)
+{
+    const float scale = float(1.0 / (voxelVolume * reference));
+    openvdb::tree::LeafManager<openvdb::FloatTree> dleaves(density);
+    dleaves.foreach([scale](openvdb::FloatTree::LeafNodeType& leaf, std::size_t) {
+        for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(std::min(1.f, *it * scale));
+    }, threaded);
+}
+
+/// The level's grids from its trees: names, classes, vector type, transform and metadata.
+void nameAndDescribeGrids(TangentField& out, const LevelTrees& trees, const FieldParams& p, const FieldMapping& map,
+                          double voxelSize, int level, int levels, std::size_t numStrands)
+{
+    out.tangent = openvdb::Vec3SGrid::create(trees.tangent);
+    out.density = openvdb::FloatGrid::create(trees.density);
     out.tangent->setName(tangentGridName(level, levels));
     out.density->setName(densityGridName(level, levels));
-    if (extra) {
-        out.coherence = openvdb::FloatGrid::create(coherenceTree);
-        out.spread = openvdb::FloatGrid::create(spreadTree);
+    if (trees.coherence) {
+        out.coherence = openvdb::FloatGrid::create(trees.coherence);
+        out.spread = openvdb::FloatGrid::create(trees.spread);
         out.coherence->setName(coherenceGridName(level, levels));
         out.spread->setName(spreadGridName(level, levels));
     }
@@ -709,11 +471,41 @@ TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, doubl
                                  static_cast<openvdb::GridBase*>(out.spread.get())}) {
         if (!g) continue;  // coherence and spread when not asked for
         g->setTransform(map.transform().copy());
-        setFieldMetadata(*g, voxelSize, p.iterations, p.space, map.scalp(), level, levels, strands.numStrands(), map.scalpSurface().get());
+        setFieldMetadata(*g, voxelSize, p.iterations, p.space, map.scalp(), level, levels, numStrands, map.scalpSurface().get());
     }
-    out.density->insertMeta("vdbhair_density_reference", openvdb::DoubleMetadata(reference));
+    out.density->insertMeta("vdbhair_density_reference", openvdb::DoubleMetadata(out.densityReference));
     out.density->insertMeta("vdbhair_density_rule", openvdb::StringMetadata(
         "min(1, hair_length / (voxel_size^3 * vdbhair_density_reference)): hair length per unit volume over the reference"));
+}
+
+/// @param measured measure()'s extent of @a strands at @a voxelSize when the memory check took it
+/// already (checkFieldMemory()), or null
+TangentField estimateLevel(const StrandSet& strands, const FieldParams& p, double voxelSize, int level, int levels,
+                           bool threaded, openvdb::util::NullInterrupter* interrupter, const Extent* measured = nullptr)
+{
+    const FieldMapping map = mappingFor(p, voxelSize);
+
+    // Bounds before any allocation: index coordinates must fit OpenVDB's int32 Coord, and the
+    // voxel visits the cap.
+    Extent extent;
+    std::vector<std::uint32_t> order;
+    measureAndOrder(strands, map, threaded, measured, extent, order);
+    checkIndexRange(extent, map, voxelSize);
+    checkVisits(std::min(extent.visits, kSaturated), p, voxelSize);
+
+    const std::string stage = levels > 1 ? "estimating level " + std::to_string(level) + " of " + std::to_string(levels)
+                                         : std::string("estimating the tangent field");
+    const std::vector<Chunk> chunks = accumulateChunks(strands, order, map, threaded, interrupter, stage);
+    LevelTrees trees = makeLevelTopology(chunks, p.coherenceAndSpread, threaded);
+    solveDirections(trees, chunks, p.iterations, p.coherenceAndSpread, threaded, interrupter, stage);
+
+    // The raw sums as hair_length; density normalized to a fog volume.
+    TangentField out;
+    out.hairLength = openvdb::FloatGrid::create(openvdb::FloatTree::Ptr(new openvdb::FloatTree(*trees.density)));
+    const double voxelVolume = voxelSize * voxelSize * voxelSize;
+    out.densityReference = densityReferenceOf(*trees.density, p.densityReference, voxelVolume, threaded);
+    normalizeDensity(*trees.density, voxelVolume, out.densityReference, threaded);
+    nameAndDescribeGrids(out, trees, p, map, voxelSize, level, levels, strands.numStrands());
     return out;
 }
 

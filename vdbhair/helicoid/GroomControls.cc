@@ -217,6 +217,138 @@ std::vector<std::uint32_t> clumpCentres(const std::vector<Vec3d>& roots, double 
     return centre;
 }
 
+namespace {
+
+/// Curl (Eq. 4 about each hair's rotation-minimizing frame), each hair resampled to
+/// kCurlVerticesPerTurn; hairs of one clump (@a centre, empty without clumps: all hairs) curl in
+/// step. Returns the vertices added.
+std::size_t curlStrands(StrandSet& strands, const GroomParams& params, const std::vector<std::uint32_t>& centre, bool threaded,
+                        openvdb::util::NullInterrupter* interrupter)
+{
+    const CurlParams& kp = params.curl;
+    const std::size_t S = strands.numStrands();
+    const double wavelength = 2.0 * M_PI / kp.frequency;
+    std::vector<std::uint32_t> counts(S);
+    forEachIndex(S, threaded, [&](std::size_t i) {
+        const std::size_t n = strands.size(i);
+        const double turns = polylineLength(strands.data(i), n) / wavelength;
+        counts[i] = std::uint32_t(std::max<double>(double(n), std::min(std::ceil(turns * kCurlVerticesPerTurn) + 1.0, 1e9)));
+    }, 1024);
+    StrandSet out = withCounts(counts, params.maxVertices, "curl (" + std::to_string(int(kCurlVerticesPerTurn)) + " vertices a turn)");
+    ProgressCounter progress(interrupter, "curling", S, "strands");
+    forEachRange(S, threaded, 256, [&](const tbb::blocked_range<std::size_t>& r) {
+        if (progress.stopped()) return;
+        std::vector<Vec3f> pts;
+        std::vector<Frame> frames;
+        HelicoidTrace trace;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const std::size_t m = out.size(i);
+            pts.resize(m);
+            if (m == strands.size(i)) std::copy(strands.data(i), strands.data(i) + m, pts.begin());
+            else resamplePolyline(strands.data(i), strands.size(i), m, pts.data());
+            // A frame that starts alike on every hair (world x, else y, across the root
+            // tangent), so hairs of one clump curl in step.
+            frames.resize(m);
+            const Vec3f t0 = (pts[1] - pts[0]).unitSafe();
+            const Vec3f ref = std::abs(t0.x()) < 0.9f ? Vec3f(1.f, 0.f, 0.f) : Vec3f(0.f, 1.f, 0.f);
+            parallelTransportFrames(pts.data(), m, ref, frames.data());
+            trace.points.resize(m);
+            trace.frames.resize(m);
+            trace.arc.resize(m);
+            arcLengths(pts.data(), m, trace.arc.data());
+            for (std::size_t k = 0; k < m; ++k) {
+                trace.points[k] = toD(pts[k]);
+                trace.frames[k] = FrameD{toD(frames[k].t), toD(frames[k].n), toD(frames[k].b)};
+            }
+            WavinessParams w;
+            w.amplitude = kp.amplitude;
+            w.frequency = kp.frequency;
+            // One phase for every hair of a clump (ringlets), or for all hairs without clumps (waves in step).
+            w.phase = 2.0 * M_PI * Rng(params.seed, centre.empty() ? 0 : centre[i], kCurlStream).uniform();
+            w.ramp = wavelength;
+            Rng unused(0);
+            applyWaviness(trace, w, unused, out.data(i));
+        }
+        progress.add(r.size());
+    });
+    if (progress.stopped()) throw InterruptedError("curl: interrupted");
+    const std::size_t added = out.numVertices() - strands.numVertices();
+    // Per-vertex attributes do not survive resampling; interpolated hair has none.
+    out.rootUV = std::move(strands.rootUV);
+    out.strandId = std::move(strands.strandId);
+    out.defaults = strands.defaults;
+    strands = std::move(out);
+    return added;
+}
+
+/// Clumps: each member towards its centre's hair at the same arc length (centres stay as they
+/// are). Returns the hairs that joined their clump.
+std::size_t clumpStrands(StrandSet& strands, const ClumpParams& cp, const std::vector<std::uint32_t>& centre, bool threaded,
+                         openvdb::util::NullInterrupter* interrupter)
+{
+    const std::size_t S = strands.numStrands();
+    std::vector<char> joined(S, 0);
+    ProgressCounter progress(interrupter, "clumping", S, "strands");
+    forEachRange(S, threaded, 256, [&](const tbb::blocked_range<std::size_t>& r) {
+        if (progress.stopped()) return;
+        std::vector<double> ap, aq;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const std::uint32_t c = centre[i];
+            if (c == i || cp.tightness <= 0.0) continue;
+            Vec3f* p = strands.data(i);
+            const Vec3f* q = strands.data(c);
+            const std::size_t n = strands.size(i), m = strands.size(c);
+            if (cp.likeness > 0.0 && likenessDistance(p, n, q, m) > cp.likeness) continue;
+            arcOf(p, n, ap);
+            arcOf(q, m, aq);
+            const double lp = ap.back(), lq = aq.back();
+            if (!(lp > 0.0)) continue;
+            const Vec3d qEnd = toD(q[m - 1]), pAtEnd = pointAt(p, ap, lq);
+            for (std::size_t k = 1; k < n; ++k) {
+                const double s = ap[k];
+                const double t = s / lp;
+                const double pull = cp.tightness * (cp.profile == 1.0 ? t : std::pow(t, cp.profile));
+                const Vec3d own = toD(p[k]);
+                // Beyond the centre's tip a longer hair keeps its own shape from there on.
+                const Vec3d target = s <= lq ? pointAt(q, aq, s) : qEnd + (own - pAtEnd);
+                p[k] = toF(own + (target - own) * pull);
+            }
+            joined[i] = 1;
+        }
+        progress.add(r.size());
+    });
+    if (progress.stopped()) throw InterruptedError("clumping: interrupted");
+    std::size_t clumped = 0;
+    for (char j : joined) clumped += std::size_t(j);
+    return clumped;
+}
+
+/// Frizz: a random offset across the hair, its deviation growing from 0 at the root to
+/// @a frizz at the tip.
+void frizzStrands(StrandSet& strands, double frizz, std::uint64_t seed, bool threaded)
+{
+    const std::size_t S = strands.numStrands();
+    forEachIndex(S, threaded, [&](std::size_t i) {
+        Vec3f* p = strands.data(i);
+        const std::size_t n = strands.size(i);
+        std::vector<double> arc;
+        arcOf(p, n, arc);
+        if (!(arc.back() > 0.0)) return;  // a strand of zero length has no across
+        const std::vector<Vec3f> before(p, p + n);
+        Rng rng(seed, i, kFrizzStream);
+        for (std::size_t k = 1; k < n; ++k) {
+            const Vec3f t = (before[std::min(k + 1, n - 1)] - before[k - 1]).unitSafe();
+            const Vec3f a = perpendicularTo(t), b = t.cross(a);
+            double g1, g2;
+            rng.normalPair(g1, g2);
+            const double sd = frizz * arc[k] / arc.back();
+            p[k] = before[k] + a * float(sd * g1) + b * float(sd * g2);
+        }
+    }, 256);
+}
+
+} // namespace
+
 GroomStats applyGroomControls(StrandSet& strands, const GroomParams& params, const std::vector<std::uint32_t>& groups, bool threaded,
                               openvdb::util::NullInterrupter* interrupter)
 {
@@ -225,130 +357,21 @@ GroomStats applyGroomControls(StrandSet& strands, const GroomParams& params, con
     if (!groups.empty() && groups.size() != S) throw ValueError(std::to_string(groups.size()) + " group ids for " + std::to_string(S) + " strands: one per strand");
     GroomStats stats;
     if (S == 0) return stats;
-    const ClumpParams& cp = params.clump;
-    const CurlParams& kp = params.curl;
     std::vector<Vec3d> roots(S);
     for (std::size_t i = 0; i < S; ++i) roots[i] = toD(strands.root(i));
 
     // Clump centres first (the curl's phase is the clump's).
     std::vector<std::uint32_t> centre;  // #S: the centre each root joins (itself for a centre)
-    if (cp.radius > 0.0) {
-        centre = clumpCentres(roots, cp.radius, groups, params.seed, threaded);
+    if (params.clump.radius > 0.0) {
+        centre = clumpCentres(roots, params.clump.radius, groups, params.seed, threaded);
         for (std::size_t i = 0; i < S; ++i) stats.clumps += centre[i] == i ? 1 : 0;
     }
-
-    // Curl (Eq. 4 about each hair's rotation-minimizing frame), resampled to kCurlVerticesPerTurn.
-    if (kp.amplitude > 0.0) {
-        const double wavelength = 2.0 * M_PI / kp.frequency;
-        std::vector<std::uint32_t> counts(S);
-        forEachIndex(S, threaded, [&](std::size_t i) {
-            const std::size_t n = strands.size(i);
-            const double turns = polylineLength(strands.data(i), n) / wavelength;
-            counts[i] = std::uint32_t(std::max<double>(double(n), std::min(std::ceil(turns * kCurlVerticesPerTurn) + 1.0, 1e9)));
-        }, 1024);
-        StrandSet out = withCounts(counts, params.maxVertices, "curl (" + std::to_string(int(kCurlVerticesPerTurn)) + " vertices a turn)");
-        ProgressCounter progress(interrupter, "curling", S, "strands");
-        forEachRange(S, threaded, 256, [&](const tbb::blocked_range<std::size_t>& r) {
-            if (progress.stopped()) return;
-            std::vector<Vec3f> pts;
-            std::vector<Frame> frames;
-            HelicoidTrace trace;
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const std::size_t m = out.size(i);
-                pts.resize(m);
-                if (m == strands.size(i)) std::copy(strands.data(i), strands.data(i) + m, pts.begin());
-                else resamplePolyline(strands.data(i), strands.size(i), m, pts.data());
-                // A frame that starts alike on every hair (world x, else y, across the root
-                // tangent), so hairs of one clump curl in step.
-                frames.resize(m);
-                const Vec3f t0 = (pts[1] - pts[0]).unitSafe();
-                const Vec3f ref = std::abs(t0.x()) < 0.9f ? Vec3f(1.f, 0.f, 0.f) : Vec3f(0.f, 1.f, 0.f);
-                parallelTransportFrames(pts.data(), m, ref, frames.data());
-                trace.points.resize(m);
-                trace.frames.resize(m);
-                trace.arc.resize(m);
-                arcLengths(pts.data(), m, trace.arc.data());
-                for (std::size_t k = 0; k < m; ++k) {
-                    trace.points[k] = toD(pts[k]);
-                    trace.frames[k] = FrameD{toD(frames[k].t), toD(frames[k].n), toD(frames[k].b)};
-                }
-                WavinessParams w;
-                w.amplitude = kp.amplitude;
-                w.frequency = kp.frequency;
-                // One phase for every hair of a clump (ringlets), or for all hairs without clumps (waves in step).
-                w.phase = 2.0 * M_PI * Rng(params.seed, centre.empty() ? 0 : centre[i], kCurlStream).uniform();
-                w.ramp = wavelength;
-                Rng unused(0);
-                applyWaviness(trace, w, unused, out.data(i));
-            }
-            progress.add(r.size());
-        });
-        if (progress.stopped()) throw InterruptedError("curl: interrupted");
+    if (params.curl.amplitude > 0.0) {
+        stats.addedVertices = curlStrands(strands, params, centre, threaded, interrupter);
         stats.curled = S;
-        stats.addedVertices = out.numVertices() - strands.numVertices();
-        // Per-vertex attributes do not survive resampling; interpolated hair has none.
-        out.rootUV = std::move(strands.rootUV);
-        out.strandId = std::move(strands.strandId);
-        out.defaults = strands.defaults;
-        strands = std::move(out);
     }
-
-    // Clumps: each member towards its centre's hair at the same arc length (centres stay as they are).
-    if (!centre.empty()) {
-        std::vector<char> joined(S, 0);
-        ProgressCounter progress(interrupter, "clumping", S, "strands");
-        forEachRange(S, threaded, 256, [&](const tbb::blocked_range<std::size_t>& r) {
-            if (progress.stopped()) return;
-            std::vector<double> ap, aq;
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const std::uint32_t c = centre[i];
-                if (c == i || cp.tightness <= 0.0) continue;
-                Vec3f* p = strands.data(i);
-                const Vec3f* q = strands.data(c);
-                const std::size_t n = strands.size(i), m = strands.size(c);
-                if (cp.likeness > 0.0 && likenessDistance(p, n, q, m) > cp.likeness) continue;
-                arcOf(p, n, ap);
-                arcOf(q, m, aq);
-                const double lp = ap.back(), lq = aq.back();
-                if (!(lp > 0.0)) continue;
-                const Vec3d qEnd = toD(q[m - 1]), pAtEnd = pointAt(p, ap, lq);
-                for (std::size_t k = 1; k < n; ++k) {
-                    const double s = ap[k];
-                    const double t = s / lp;
-                    const double pull = cp.tightness * (cp.profile == 1.0 ? t : std::pow(t, cp.profile));
-                    const Vec3d own = toD(p[k]);
-                    // Beyond the centre's tip a longer hair keeps its own shape from there on.
-                    const Vec3d target = s <= lq ? pointAt(q, aq, s) : qEnd + (own - pAtEnd);
-                    p[k] = toF(own + (target - own) * pull);
-                }
-                joined[i] = 1;
-            }
-            progress.add(r.size());
-        });
-        if (progress.stopped()) throw InterruptedError("clumping: interrupted");
-        for (char j : joined) stats.clumped += std::size_t(j);
-    }
-
-    // Frizz: a random offset across the hair, its deviation growing from 0 at the root to frizz at the tip.
-    if (kp.frizz > 0.0) {
-        forEachIndex(S, threaded, [&](std::size_t i) {
-            Vec3f* p = strands.data(i);
-            const std::size_t n = strands.size(i);
-            std::vector<double> arc;
-            arcOf(p, n, arc);
-            if (!(arc.back() > 0.0)) return;  // a strand of zero length has no across
-            const std::vector<Vec3f> before(p, p + n);
-            Rng rng(params.seed, i, kFrizzStream);
-            for (std::size_t k = 1; k < n; ++k) {
-                const Vec3f t = (before[std::min(k + 1, n - 1)] - before[k - 1]).unitSafe();
-                const Vec3f a = perpendicularTo(t), b = t.cross(a);
-                double g1, g2;
-                rng.normalPair(g1, g2);
-                const double sd = kp.frizz * arc[k] / arc.back();
-                p[k] = before[k] + a * float(sd * g1) + b * float(sd * g2);
-            }
-        }, 256);
-    }
+    if (!centre.empty()) stats.clumped = clumpStrands(strands, params.clump, centre, threaded, interrupter);
+    if (params.curl.frizz > 0.0) frizzStrands(strands, params.curl.frizz, params.seed, threaded);
     return stats;
 }
 

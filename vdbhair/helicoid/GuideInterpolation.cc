@@ -22,6 +22,168 @@ double secondsSince(std::chrono::steady_clock::time_point t0)
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// Whether any groom control that moves hair (clumps, curl, frizz) is asked for.
+bool groomsHair(const GroomParams& groom)
+{
+    return groom.clump.radius > 0.0 || groom.curl.amplitude > 0.0 || groom.curl.frizz > 0.0;
+}
+
+/// The arguments, before any work: the guides given one way, the method's options, the roots'
+/// per-root arrays one per root.
+void checkArguments(const InterpolationGuides& guides, const InterpolationRoots& rootsIn, const InterpolateParams& params)
+{
+    if ((guides.strands == nullptr) == (guides.scene == nullptr)) throw ValueError("interpolateGuides: give the guides as strands or as a scene (one of them)");
+    const bool points = params.method == InterpolationMethod::Points;
+    if (params.returnScene && points) throw ValueError("a scene of new hairs needs the helicoid method (points make strands)");
+    if (!points && !guides.groups.empty()) throw ValueError("guide groups need the points method; helicoid interpolation blends every guide");
+    if (params.frames == FrameRule::Surface && rootsIn.normals.empty()) throw ValueError("surface frames need root normals; the roots have none");
+    if (rootsIn.positions.empty()) throw ValueError("no roots: interpolation needs at least one root");
+    if (params.returnScene && (groomsHair(params.groom) || !rootsIn.density.empty() || !rootsIn.length.empty())) {
+        throw ValueError("a scene of new hairs takes no groom controls (density, length, clumps, curl, frizz): grow it first");
+    }
+    validateGroomParams(params.groom);
+    const std::size_t R0 = rootsIn.positions.size();
+    if (!rootsIn.normals.empty() && rootsIn.normals.size() != R0) {
+        throw ValueError(std::to_string(rootsIn.normals.size()) + " root normals for " + std::to_string(R0) + " roots: one per root");
+    }
+    if (!rootsIn.groups.empty() && rootsIn.groups.size() != R0) {
+        throw ValueError(std::to_string(rootsIn.groups.size()) + " root group ids for " + std::to_string(R0) + " roots: one per root");
+    }
+}
+
+/// The roots that grow hair: density (and a length of 0) leave roots bare before any hair is
+/// made. World frames need no normals.
+InterpolationRoots keptRoots(const InterpolationRoots& rootsIn, const InterpolateParams& params)
+{
+    const std::size_t R0 = rootsIn.positions.size();
+    const std::vector<char> keep = rootsKept(R0, rootsIn.density, rootsIn.length, params.seed);
+    InterpolationRoots roots;
+    for (std::size_t i = 0; i < R0; ++i) {
+        if (!keep[i]) continue;
+        roots.positions.push_back(rootsIn.positions[i]);
+        if (!rootsIn.normals.empty()) roots.normals.push_back(rootsIn.normals[i]);
+        if (!rootsIn.groups.empty()) roots.groups.push_back(rootsIn.groups[i]);
+        if (!rootsIn.length.empty()) roots.length.push_back(rootsIn.length[i]);
+    }
+    if (roots.positions.empty()) throw ValueError("the density and length leave none of the " + std::to_string(R0) + " roots to grow hair: no hair would be made");
+    if (params.frames == FrameRule::World) roots.normals.clear();
+    return roots;
+}
+
+/// The points method: the guides' own points (a scene's guides grown, without wisps, into
+/// @a grownGuides), blended by interpolatePoints(). Returns the guides as strands.
+const StrandSet* interpolateByPoints(const InterpolationGuides& guides, const InterpolationRoots& roots, const HeadObstacle& head,
+                                     const InterpolateParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter,
+                                     InterpolateResult& res, std::vector<std::uint32_t>& rootGroups, StrandSet& grownGuides)
+{
+    const StrandSet* guidePoints = guides.strands;
+    if (guides.scene) {
+        validateGuideScene(*guides.scene);
+        grownGuides = growGuides(*guides.scene, threaded, interrupter);
+        guidePoints = &grownGuides;
+    }
+    const StrandSet& g = *guidePoints;
+    if (g.empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
+    for (std::size_t i = 0; i < g.numStrands(); ++i) {
+        const std::size_t n = g.size(i);
+        if (n < 2) throw ValueError(guides.where + ": guide strand " + std::to_string(i) + ": " + std::to_string(n) + " vertex; a guide needs at least 2");
+        if (!(polylineLength(g.positions.data() + g.begin(i), n) > 0.0)) {
+            throw ValueError(guides.where + ": guide strand " + std::to_string(i) + ": zero length; a guide must have a positive length");
+        }
+    }
+    GuideContext context;
+    context.groups = guides.groups;
+    context.frames = params.frames;
+    if (guides.scene && params.frames == FrameRule::Surface) context.normals = sceneGuideNormals(*guides.scene);
+    res.strands = interpolatePoints(g, roots, params.points, context, threaded, interrupter, &res.groups, &rootGroups, &res.binding);
+    res.guides = g.numStrands();
+    res.guidesEnteringHead = countStrandsEnteringHead(g, head, headTolerance(head), threaded);
+    return guidePoints;
+}
+
+/// The helicoid method: strand guides fitted to a scene first, the helicoids blended by
+/// interpolateHelicoids() and, unless a scene is asked for, grown (a scene's guides too, into
+/// @a grownGuides). Returns the guides as strands, or null with a scene asked for.
+const StrandSet* interpolateByHelicoids(const InterpolationGuides& guides, const InterpolationRoots& roots, const HeadObstacle& head,
+                                        const InterpolateParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter,
+                                        std::chrono::steady_clock::time_point t0, InterpolateResult& res, StrandSet& grownGuides)
+{
+    const StrandSet* guidePoints = guides.strands;
+    Scene fitted;
+    if (guides.strands) {
+        if (guides.strands->empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
+        fitted = guideSceneFromStrands(*guides.strands, FitParams{}, guides.where, threaded, interrupter);
+        res.fitSeconds = secondsSince(t0);
+    }
+    const Scene& scene = guides.strands ? fitted : *guides.scene;
+    if (scene.guides.empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
+    validateGuideScene(scene);
+    const std::vector<Vec3d> guideNormals = roots.normals.empty() ? std::vector<Vec3d>() : sceneGuideNormals(scene);
+    res.scene = interpolateHelicoids(scene, roots, params.helicoid, guideNormals, threaded, interrupter);
+    res.scene.seed = params.seed;
+    res.guides = scene.guides.size();
+    if (!params.returnScene) {
+        GrowOptions grow;
+        grow.maxVertices = params.helicoid.maxVertices;
+        res.strands = growScene(res.scene, grow, threaded, interrupter);
+        if (!guides.strands) {
+            grownGuides = growGuides(scene, threaded, interrupter);
+            guidePoints = &grownGuides;
+        }
+        res.guidesEnteringHead = countStrandsEnteringHead(*guidePoints, head, headTolerance(head), threaded);
+    }
+    return guidePoints;
+}
+
+/// Length (GroomControls.h), then the head: no new hair deeper inside it than its root, the
+/// hair swept out along its length (HeadCollision.h).
+void cutAndKeepOutOfHead(InterpolateResult& res, const std::vector<float>& length, const HeadObstacle& head, bool threaded)
+{
+    if (!length.empty()) res.cut = cutStrands(res.strands, length, threaded);
+    if (!head.empty()) {
+        const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), {}, threaded);
+        res.pushedOut = hc.strandsMoved;
+        res.verticesTooDeep = hc.verticesTooDeep;
+    }
+}
+
+/// Curl, clumps (within groups), frizz on the hair as it lies, and only the vertices they move
+/// into the head pushed out, one by one: a curl that dips into the scalp is flattened against
+/// it, not turned away with the rest of the strand (a sweep would flare curly hair out).
+void groomHair(InterpolateResult& res, const InterpolateParams& params, const std::vector<std::uint32_t>& rootGroups,
+               const HeadObstacle& head, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    const bool points = params.method == InterpolationMethod::Points;
+    GroomParams groom = params.groom;
+    groom.seed = params.seed;
+    groom.maxVertices = points ? params.points.maxVertices : params.helicoid.maxVertices;
+    res.groom = applyGroomControls(res.strands, groom, rootGroups, threaded, interrupter);
+    if (!head.empty()) {
+        HeadCollisionParams vertexOnly;
+        vertexOnly.passes = 0;
+        const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), vertexOnly, threaded);
+        res.groomPushedOut = hc.strandsMoved;
+        res.verticesTooDeep = hc.verticesTooDeep;
+    }
+}
+
+/// The share of the new hair (all of it, or kVolumeSample strands spread over it) leaving the
+/// guides' hair volume at the guides' suggested voxel size.
+void measureLeavingVolume(InterpolateResult& res, const StrandSet& guidePoints, bool threaded)
+{
+    res.volumeVoxel = suggestVoxelSize(guidePoints);
+    const std::size_t S = res.strands.numStrands();
+    if (S <= kVolumeSample) {
+        res.volumeSample = S;
+        res.leavingVolume = countStrandsLeavingVolume(res.strands, guidePoints, res.volumeVoxel, threaded);
+    } else {
+        std::vector<char> pick(S, 0);
+        for (std::size_t k = 0; k < kVolumeSample; ++k) pick[k * S / kVolumeSample] = 1;
+        res.volumeSample = kVolumeSample;
+        res.leavingVolume = countStrandsLeavingVolume(selectStrands(res.strands, pick), guidePoints, res.volumeVoxel, threaded);
+    }
+}
+
 } // namespace
 
 const char* interpolationMethodName(InterpolationMethod method) { return method == InterpolationMethod::Points ? "points" : "helicoid"; }
@@ -45,132 +207,23 @@ FrameRule frameRuleFromName(const std::string& name)
 InterpolateResult interpolateGuides(const InterpolationGuides& guides, const InterpolationRoots& rootsIn, const HeadObstacle& head,
                                     const InterpolateParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {
-    if ((guides.strands == nullptr) == (guides.scene == nullptr)) throw ValueError("interpolateGuides: give the guides as strands or as a scene (one of them)");
-    const bool points = params.method == InterpolationMethod::Points;
-    if (params.returnScene && points) throw ValueError("a scene of new hairs needs the helicoid method (points make strands)");
-    if (!points && !guides.groups.empty()) throw ValueError("guide groups need the points method; helicoid interpolation blends every guide");
-    if (params.frames == FrameRule::Surface && rootsIn.normals.empty()) throw ValueError("surface frames need root normals; the roots have none");
-    if (rootsIn.positions.empty()) throw ValueError("no roots: interpolation needs at least one root");
-    const bool groomed = params.groom.clump.radius > 0.0 || params.groom.curl.amplitude > 0.0 || params.groom.curl.frizz > 0.0;
-    if (params.returnScene && (groomed || !rootsIn.density.empty() || !rootsIn.length.empty())) {
-        throw ValueError("a scene of new hairs takes no groom controls (density, length, clumps, curl, frizz): grow it first");
-    }
-    validateGroomParams(params.groom);
-    // Density (and a length of 0) leave roots bare before any hair is made.
-    const std::size_t R0 = rootsIn.positions.size();
-    if (!rootsIn.normals.empty() && rootsIn.normals.size() != R0) {
-        throw ValueError(std::to_string(rootsIn.normals.size()) + " root normals for " + std::to_string(R0) + " roots: one per root");
-    }
-    if (!rootsIn.groups.empty() && rootsIn.groups.size() != R0) {
-        throw ValueError(std::to_string(rootsIn.groups.size()) + " root group ids for " + std::to_string(R0) + " roots: one per root");
-    }
-    const std::vector<char> keep = rootsKept(R0, rootsIn.density, rootsIn.length, params.seed);
-    InterpolationRoots roots;
-    for (std::size_t i = 0; i < R0; ++i) {
-        if (!keep[i]) continue;
-        roots.positions.push_back(rootsIn.positions[i]);
-        if (!rootsIn.normals.empty()) roots.normals.push_back(rootsIn.normals[i]);
-        if (!rootsIn.groups.empty()) roots.groups.push_back(rootsIn.groups[i]);
-        if (!rootsIn.length.empty()) roots.length.push_back(rootsIn.length[i]);
-    }
-    if (roots.positions.empty()) throw ValueError("the density and length leave none of the " + std::to_string(R0) + " roots to grow hair: no hair would be made");
-    if (params.frames == FrameRule::World) roots.normals.clear();
+    checkArguments(guides, rootsIn, params);
+    const InterpolationRoots roots = keptRoots(rootsIn, params);
 
     InterpolateResult res;
-    res.roots = R0;
-    res.rootsDropped = R0 - roots.positions.size();
+    res.roots = rootsIn.positions.size();
+    res.rootsDropped = res.roots - roots.positions.size();
     std::vector<std::uint32_t> rootGroups;
-    StrandSet grownGuides;                  // a scene's guides as strands (the volume measure, the head share)
-    const StrandSet* guidePoints = guides.strands;
+    StrandSet grownGuides;  // a scene's guides as strands (the volume measure, the head share)
     const auto t0 = std::chrono::steady_clock::now();
-    if (points) {
-        // The guides' own points (a scene's guides grown, without wisps).
-        if (guides.scene) {
-            validateGuideScene(*guides.scene);
-            grownGuides = growGuides(*guides.scene, threaded, interrupter);
-            guidePoints = &grownGuides;
-        }
-        const StrandSet& g = *guidePoints;
-        if (g.empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
-        for (std::size_t i = 0; i < g.numStrands(); ++i) {
-            const std::size_t n = g.size(i);
-            if (n < 2) throw ValueError(guides.where + ": guide strand " + std::to_string(i) + ": " + std::to_string(n) + " vertex; a guide needs at least 2");
-            if (!(polylineLength(g.positions.data() + g.begin(i), n) > 0.0)) {
-                throw ValueError(guides.where + ": guide strand " + std::to_string(i) + ": zero length; a guide must have a positive length");
-            }
-        }
-        GuideContext context;
-        context.groups = guides.groups;
-        context.frames = params.frames;
-        if (guides.scene && params.frames == FrameRule::Surface) context.normals = sceneGuideNormals(*guides.scene);
-        res.strands = interpolatePoints(g, roots, params.points, context, threaded, interrupter, &res.groups, &rootGroups, &res.binding);
-        res.guides = g.numStrands();
-        res.guidesEnteringHead = countStrandsEnteringHead(g, head, headTolerance(head), threaded);
-    } else {
-        Scene fitted;
-        if (guides.strands) {
-            if (guides.strands->empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
-            fitted = guideSceneFromStrands(*guides.strands, FitParams{}, guides.where, threaded, interrupter);
-            res.fitSeconds = secondsSince(t0);
-        }
-        const Scene& scene = guides.strands ? fitted : *guides.scene;
-        if (scene.guides.empty()) throw ValueError(guides.where + ": no guides: interpolation needs at least one");
-        validateGuideScene(scene);
-        const std::vector<Vec3d> guideNormals = roots.normals.empty() ? std::vector<Vec3d>() : sceneGuideNormals(scene);
-        res.scene = interpolateHelicoids(scene, roots, params.helicoid, guideNormals, threaded, interrupter);
-        res.scene.seed = params.seed;
-        res.guides = scene.guides.size();
-        if (!params.returnScene) {
-            GrowOptions grow;
-            grow.maxVertices = params.helicoid.maxVertices;
-            res.strands = growScene(res.scene, grow, threaded, interrupter);
-            if (!guides.strands) {
-                grownGuides = growGuides(scene, threaded, interrupter);
-                guidePoints = &grownGuides;
-            }
-            res.guidesEnteringHead = countStrandsEnteringHead(*guidePoints, head, headTolerance(head), threaded);
-        }
-    }
-    // Length (GroomControls.h), then the head: no new hair deeper inside it than its root, the
-    // hair swept out along its length (HeadCollision.h).
-    if (!params.returnScene) {
-        if (!roots.length.empty()) res.cut = cutStrands(res.strands, roots.length, threaded);
-        if (!head.empty()) {
-            const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), {}, threaded);
-            res.pushedOut = hc.strandsMoved;
-            res.verticesTooDeep = hc.verticesTooDeep;
-        }
-    }
-    // Curl, clumps (within groups), frizz on the hair as it lies, and only the vertices they move
-    // into the head pushed out, one by one: a curl that dips into the scalp is flattened against
-    // it, not turned away with the rest of the strand (a sweep would flare curly hair out).
-    if (!params.returnScene && groomed) {
-        GroomParams groom = params.groom;
-        groom.seed = params.seed;
-        groom.maxVertices = points ? params.points.maxVertices : params.helicoid.maxVertices;
-        res.groom = applyGroomControls(res.strands, groom, rootGroups, threaded, interrupter);
-        if (!head.empty()) {
-            HeadCollisionParams vertexOnly;
-            vertexOnly.passes = 0;
-            const HeadCollisionStats hc = resolveHeadCollisions(res.strands, head, rootDepthAllowance(res.strands, head, threaded), vertexOnly, threaded);
-            res.groomPushedOut = hc.strandsMoved;
-            res.verticesTooDeep = hc.verticesTooDeep;
-        }
-    }
+    const StrandSet* guidePoints =
+        params.method == InterpolationMethod::Points
+            ? interpolateByPoints(guides, roots, head, params, threaded, interrupter, res, rootGroups, grownGuides)
+            : interpolateByHelicoids(guides, roots, head, params, threaded, interrupter, t0, res, grownGuides);
+    if (!params.returnScene) cutAndKeepOutOfHead(res, roots.length, head, threaded);
+    if (!params.returnScene && groomsHair(params.groom)) groomHair(res, params, rootGroups, head, threaded, interrupter);
     res.enteringHead = countStrandsEnteringHead(res.strands, head, headTolerance(head), threaded);
-    if (!params.returnScene && guidePoints) {
-        res.volumeVoxel = suggestVoxelSize(*guidePoints);
-        const std::size_t S = res.strands.numStrands();
-        if (S <= kVolumeSample) {
-            res.volumeSample = S;
-            res.leavingVolume = countStrandsLeavingVolume(res.strands, *guidePoints, res.volumeVoxel, threaded);
-        } else {
-            std::vector<char> pick(S, 0);
-            for (std::size_t k = 0; k < kVolumeSample; ++k) pick[k * S / kVolumeSample] = 1;
-            res.volumeSample = kVolumeSample;
-            res.leavingVolume = countStrandsLeavingVolume(selectStrands(res.strands, pick), *guidePoints, res.volumeVoxel, threaded);
-        }
-    }
+    if (!params.returnScene && guidePoints) measureLeavingVolume(res, *guidePoints, threaded);
     res.seconds = secondsSince(t0) - res.fitSeconds;
     return res;
 }

@@ -15,6 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -59,6 +60,155 @@ void summarize(ReconstructErrors& e, const std::vector<char>& isGuide)
     };
     stats(all, e.mean, e.p95);
     stats(interp, e.meanInterpolated, e.p95Interpolated);
+}
+
+/// The parameters reconstructHairstyle() checks itself (the rest are checked where they are used).
+void checkParams(const ReconstructParams& params)
+{
+    validateShepardParams(params.helicoid.shepard);
+    if (!(params.metersPerUnit >= 0.0) || !std::isfinite(params.metersPerUnit)) {
+        throw ValueError("metersPerUnit " + formatNumber(params.metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
+    }
+    if (params.points.neighbors < 1) throw ValueError("neighbors " + std::to_string(params.points.neighbors) + ": must be at least 1");
+}
+
+/// Fit the selected guides (§5.2-5.3) into a scene of the fitted ones (res.guides; the others
+/// count as unfitted), and each fitted guide's step into @a fitStep.
+Scene fitGuides(const StrandSet& strands, const std::vector<std::size_t>& selected, const ReconstructParams& params, bool threaded,
+                openvdb::util::NullInterrupter* interrupter, std::chrono::steady_clock::time_point t0, ReconstructResult& res,
+                std::vector<double>& fitStep)
+{
+    const StrandSet guideStrands = subset(strands, selected);
+    std::vector<std::string> fitErrors;
+    const std::vector<StrandFit> fits = fitStrands(guideStrands, params.fit, threaded, &fitErrors, interrupter);
+    res.fitSeconds = seconds(t0);
+    res.fitSummary = summarizeFits(guideStrands, fits, fitErrors, params.fit.maxError);
+    Scene scene;
+    scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines (as `vdbhair fit` writes them)
+    std::vector<std::size_t> fittedGuides;
+    for (std::size_t g = 0; g < fits.size(); ++g) {
+        if (!fitErrors[g].empty()) {
+            ++res.unfitted;
+            continue;
+        }
+        scene.guides.push_back(guideFromFit(fits[g]));
+        fittedGuides.push_back(selected[g]);
+        fitStep[selected[g]] = fits[g].step;
+    }
+    if (scene.guides.empty()) throw ValueError("no guide strand could be fitted (all have zero length)");
+    scene.step = scene.guides.front().step;
+    res.guides = fittedGuides;
+    return scene;
+}
+
+/// #S strands: guides from @a guideSet (in guide order), the others from @a interp.
+StrandSet assemble(const std::vector<char>& isGuide, const StrandSet& guideSet, const StrandSet& interp)
+{
+    StrandSet out;
+    out.offsets.assign(1, 0);
+    std::size_t g = 0, o = 0;
+    for (std::size_t i = 0; i < isGuide.size(); ++i) {
+        const StrandSet& src = isGuide[i] ? guideSet : interp;
+        const std::size_t k = isGuide[i] ? g++ : o++;
+        out.positions.insert(out.positions.end(), src.positions.begin() + std::ptrdiff_t(src.begin(k)),
+                             src.positions.begin() + std::ptrdiff_t(src.begin(k) + src.size(k)));
+        out.offsets.push_back(std::uint32_t(out.positions.size()));
+    }
+    return out;
+}
+
+/// The baseline: each other strand the nearest guide, translated to its root (@a roots: the
+/// others' roots in strand order); guides as they are.
+StrandSet nearestGuideBaseline(const StrandSet& strands, const StrandSet& rawGuides, const std::vector<char>& isGuide,
+                               const InterpolationRoots& roots)
+{
+    std::vector<Vec3d> guideRoots;
+    for (std::size_t g = 0; g < rawGuides.numStrands(); ++g) guideRoots.push_back(toD(rawGuides.root(g)));
+    const GuideLocator locator(guideRoots);
+    StrandSet nearest;
+    nearest.offsets.assign(1, 0);
+    std::size_t o = 0;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
+        const std::size_t g = isGuide[i] ? std::size_t(-1) : locator.nearest(roots.positions[o++]);
+        const StrandSet& src = isGuide[i] ? strands : rawGuides;
+        const std::size_t k = isGuide[i] ? i : g;
+        const Vec3f shift = isGuide[i] ? Vec3f(0.f) : strands.root(i) - rawGuides.root(g);
+        for (std::size_t v = 0; v < src.size(k); ++v) nearest.positions.push_back(src.positions[src.begin(k) + v] + shift);
+        nearest.offsets.push_back(std::uint32_t(nearest.positions.size()));
+    }
+    return nearest;
+}
+
+/// Every strand's relative Fréchet error, each way, at the fits' spacing (a guide's own fit's
+/// step, else the fit step asked for, else a quarter of the strand's mean edge), then their
+/// summaries.
+void measureRelativeErrors(const StrandSet& strands, ReconstructResult& res, const StrandSet& nearest, const std::vector<double>& fitStep,
+                           const std::vector<char>& isGuide, double fitStepParam, bool threaded)
+{
+    const std::size_t S = strands.numStrands();
+    res.helicoidErrors.relative.assign(S, 0.0);
+    res.pointErrors.relative.assign(S, 0.0);
+    res.nearestErrors.relative.assign(S, 0.0);
+    auto measure = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const std::size_t n = strands.size(i);
+            const Vec3f* a = strands.positions.data() + strands.begin(i);
+            const double length = polylineLength(a, n);
+            double spacing = fitStep[i] > 0.0      ? fitStep[i]
+                             : fitStepParam > 0.0 ? fitStepParam
+                                                     : 0.25 * length / double(std::max<std::size_t>(1, n - 1));
+            if (!(spacing > 0.0)) spacing = 1.0;
+            res.helicoidErrors.relative[i] = relativeFrechet(a, n, res.helicoid.positions.data() + res.helicoid.begin(i), res.helicoid.size(i), spacing);
+            res.pointErrors.relative[i] = relativeFrechet(a, n, res.points.positions.data() + res.points.begin(i), res.points.size(i), spacing);
+            res.nearestErrors.relative[i] = relativeFrechet(a, n, nearest.positions.data() + nearest.begin(i), nearest.size(i), spacing);
+        }
+    };
+    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 16), measure);
+    else measure(tbb::blocked_range<std::size_t>(0, S));
+    summarize(res.helicoidErrors, isGuide);
+    summarize(res.pointErrors, isGuide);
+    summarize(res.nearestErrors, isGuide);
+}
+
+/// The three reconstructions with the errors they are measured into.
+using Ways = std::array<std::pair<ReconstructErrors*, const StrandSet*>, 3>;
+
+/// As hair papers measure (Compare.h): HairGS's oriented points (with a known unit) and Perm's
+/// strand-pair errors.
+void measureAsPapers(const StrandSet& strands, const Ways& ways, double metersPerUnit, bool threaded)
+{
+    std::vector<OrientedThreshold> thresholds;
+    if (metersPerUnit > 0.0) {
+        thresholds = hairGsThresholds();
+        for (OrientedThreshold& t : thresholds) t.distance /= metersPerUnit;
+    }
+    for (const auto& way : ways) {
+        if (!thresholds.empty()) way.first->oriented = matchOrientedPoints(*way.second, strands, thresholds, false, threaded);
+        const StrandPairErrors perm = strandPairErrors(strands, *way.second, 100, threaded);
+        way.first->permPosition = perm.meanPosition;
+        way.first->permCurvature = perm.meanCurvature;
+    }
+}
+
+/// Spikes, flares and the head: the interpolated strands (@a others) against the guides' hair
+/// volume, and the original strands at the same roots for comparison.
+void measureVolumeAndHead(const StrandSet& strands, const StrandSet& rawGuides, const std::vector<std::size_t>& others, const Ways& ways,
+                          const HeadObstacle* head, bool threaded, ReconstructResult& res)
+{
+    std::vector<char> interpolated(strands.numStrands(), 0);
+    for (std::size_t i : others) interpolated[i] = 1;
+    res.volumeVoxel = suggestVoxelSize(rawGuides);
+    const double n = double(others.size());
+    const bool withHead = head && !head->unset() && !head->empty();
+    res.headMeasured = withHead;
+    const double tolerance = withHead ? headTolerance(*head) : 0.0;
+    auto shares = [&](const StrandSet& set, double& leaving, double& entering) {
+        const StrandSet sub = selectStrands(set, interpolated);
+        leaving = double(countStrandsLeavingVolume(sub, rawGuides, res.volumeVoxel, threaded)) / n;
+        entering = withHead ? double(countStrandsEnteringHead(sub, *head, tolerance, threaded)) / n : 0.0;
+    };
+    shares(strands, res.originalLeavingVolume, res.originalEnteringHead);
+    for (const auto& way : ways) shares(*way.second, way.first->leavingVolume, way.first->enteringHead);
 }
 
 } // namespace
@@ -138,40 +288,16 @@ double relativeFrechet(const Vec3f* a, std::size_t na, const Vec3f* b, std::size
 ReconstructResult reconstructHairstyle(const StrandSet& strands, const ReconstructParams& params, bool threaded,
                                        openvdb::util::NullInterrupter* interrupter, const HeadObstacle* head)
 {
-    validateShepardParams(params.helicoid.shepard);
-    if (!(params.metersPerUnit >= 0.0) || !std::isfinite(params.metersPerUnit)) {
-        throw ValueError("metersPerUnit " + formatNumber(params.metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
-    }
-    if (params.points.neighbors < 1) throw ValueError("neighbors " + std::to_string(params.points.neighbors) + ": must be at least 1");
+    checkParams(params);
     const std::size_t S = strands.numStrands();
     ReconstructResult res;
     const std::vector<std::size_t> selected = selectGuides(strands, params.guideFraction, params.selection, params.seed);
 
-    // Fit the guides (§5.2-5.3).
     auto t0 = std::chrono::steady_clock::now();
-    const StrandSet guideStrands = subset(strands, selected);
-    std::vector<std::string> fitErrors;
-    const std::vector<StrandFit> fits = fitStrands(guideStrands, params.fit, threaded, &fitErrors, interrupter);
-    res.fitSeconds = seconds(t0);
-    res.fitSummary = summarizeFits(guideStrands, fits, fitErrors, params.fit.maxError);
-    Scene scene;
-    scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines (as `vdbhair fit` writes them)
-    std::vector<std::size_t> fittedGuides;
     std::vector<double> fitStep(S, 0.0);  // a guide's errors are measured at its fit's step
-    for (std::size_t g = 0; g < fits.size(); ++g) {
-        if (!fitErrors[g].empty()) {
-            ++res.unfitted;
-            continue;
-        }
-        scene.guides.push_back(guideFromFit(fits[g]));
-        fittedGuides.push_back(selected[g]);
-        fitStep[selected[g]] = fits[g].step;
-    }
-    if (scene.guides.empty()) throw ValueError("no guide strand could be fitted (all have zero length)");
-    scene.step = scene.guides.front().step;
-    res.guides = fittedGuides;
+    const Scene scene = fitGuides(strands, selected, params, threaded, interrupter, t0, res, fitStep);
     std::vector<char> isGuide(S, 0);
-    for (std::size_t i : fittedGuides) isGuide[i] = 1;
+    for (std::size_t i : res.guides) isGuide[i] = 1;
     std::vector<std::size_t> others;
     InterpolationRoots roots;
     for (std::size_t i = 0; i < S; ++i) {
@@ -179,21 +305,6 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
         others.push_back(i);
         roots.positions.push_back(toD(strands.root(i)));
     }
-
-    // Assemble #S strands: guides from @a guideSet (in guide order), the others from @a interp.
-    auto assemble = [&](const StrandSet& guideSet, const StrandSet& interp) {
-        StrandSet out;
-        out.offsets.assign(1, 0);
-        std::size_t g = 0, o = 0;
-        for (std::size_t i = 0; i < S; ++i) {
-            const StrandSet& src = isGuide[i] ? guideSet : interp;
-            const std::size_t k = isGuide[i] ? g++ : o++;
-            out.positions.insert(out.positions.end(), src.positions.begin() + std::ptrdiff_t(src.begin(k)),
-                                 src.positions.begin() + std::ptrdiff_t(src.begin(k) + src.size(k)));
-            out.offsets.push_back(std::uint32_t(out.positions.size()));
-        }
-        return out;
-    };
 
     // The helicoid way: the fits regrown, interpolated hairs at the other roots.
     const StrandSet grownGuides = growScene(scene, {}, threaded, interrupter);
@@ -204,91 +315,23 @@ ReconstructResult reconstructHairstyle(const StrandSet& strands, const Reconstru
         interpHelicoid = growScene(interpolateHelicoids(scene, roots, params.helicoid, {}, threaded, interrupter), grow, threaded, interrupter);
     }
     res.helicoidErrors.seconds = seconds(t0);
-    res.helicoid = assemble(grownGuides, interpHelicoid);
+    res.helicoid = assemble(isGuide, grownGuides, interpHelicoid);
 
     // The points way from the same guides' raw strands.
     t0 = std::chrono::steady_clock::now();
-    const StrandSet rawGuides = subset(strands, fittedGuides);
+    const StrandSet rawGuides = subset(strands, res.guides);
     if (!others.empty()) interpPoints = interpolatePoints(rawGuides, roots, params.points, {}, threaded, interrupter);
     res.pointErrors.seconds = seconds(t0);
-    res.points = assemble(rawGuides, interpPoints);
+    res.points = assemble(isGuide, rawGuides, interpPoints);
 
-    // The baseline: the nearest guide, translated to the root.
     t0 = std::chrono::steady_clock::now();
-    StrandSet nearest;
-    {
-        std::vector<Vec3d> guideRoots;
-        for (std::size_t g = 0; g < rawGuides.numStrands(); ++g) guideRoots.push_back(toD(rawGuides.root(g)));
-        const GuideLocator locator(guideRoots);
-        nearest.offsets.assign(1, 0);
-        std::size_t o = 0;
-        for (std::size_t i = 0; i < S; ++i) {
-            const std::size_t g = isGuide[i] ? std::size_t(-1) : locator.nearest(roots.positions[o++]);
-            const StrandSet& src = isGuide[i] ? strands : rawGuides;
-            const std::size_t k = isGuide[i] ? i : g;
-            const Vec3f shift = isGuide[i] ? Vec3f(0.f) : strands.root(i) - rawGuides.root(g);
-            for (std::size_t v = 0; v < src.size(k); ++v) nearest.positions.push_back(src.positions[src.begin(k) + v] + shift);
-            nearest.offsets.push_back(std::uint32_t(nearest.positions.size()));
-        }
-    }
+    const StrandSet nearest = nearestGuideBaseline(strands, rawGuides, isGuide, roots);
     res.nearestErrors.seconds = seconds(t0);
 
-    // Errors, every strand at the fits' spacing.
-    res.helicoidErrors.relative.assign(S, 0.0);
-    res.pointErrors.relative.assign(S, 0.0);
-    res.nearestErrors.relative.assign(S, 0.0);
-    auto measure = [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const std::size_t n = strands.size(i);
-            const Vec3f* a = strands.positions.data() + strands.begin(i);
-            const double length = polylineLength(a, n);
-            double spacing = fitStep[i] > 0.0      ? fitStep[i]
-                             : params.fit.step > 0.0 ? params.fit.step
-                                                     : 0.25 * length / double(std::max<std::size_t>(1, n - 1));
-            if (!(spacing > 0.0)) spacing = 1.0;
-            res.helicoidErrors.relative[i] = relativeFrechet(a, n, res.helicoid.positions.data() + res.helicoid.begin(i), res.helicoid.size(i), spacing);
-            res.pointErrors.relative[i] = relativeFrechet(a, n, res.points.positions.data() + res.points.begin(i), res.points.size(i), spacing);
-            res.nearestErrors.relative[i] = relativeFrechet(a, n, nearest.positions.data() + nearest.begin(i), nearest.size(i), spacing);
-        }
-    };
-    if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S, 16), measure);
-    else measure(tbb::blocked_range<std::size_t>(0, S));
-    summarize(res.helicoidErrors, isGuide);
-    summarize(res.pointErrors, isGuide);
-    summarize(res.nearestErrors, isGuide);
-
-    // As hair papers measure (Compare.h).
-    std::vector<OrientedThreshold> thresholds;
-    if (params.metersPerUnit > 0.0) {
-        thresholds = hairGsThresholds();
-        for (OrientedThreshold& t : thresholds) t.distance /= params.metersPerUnit;
-    }
-    const std::pair<ReconstructErrors*, const StrandSet*> ways[] = {{&res.helicoidErrors, &res.helicoid}, {&res.pointErrors, &res.points},
-                                                                     {&res.nearestErrors, &nearest}};
-    for (const auto& way : ways) {
-        if (!thresholds.empty()) way.first->oriented = matchOrientedPoints(*way.second, strands, thresholds, false, threaded);
-        const StrandPairErrors perm = strandPairErrors(strands, *way.second, 100, threaded);
-        way.first->permPosition = perm.meanPosition;
-        way.first->permCurvature = perm.meanCurvature;
-    }
-    // Spikes, flares and the head: the interpolated strands against the guides' hair volume, and
-    // the original strands at the same roots for comparison.
-    if (!others.empty()) {
-        std::vector<char> interpolated(S, 0);
-        for (std::size_t i : others) interpolated[i] = 1;
-        res.volumeVoxel = suggestVoxelSize(rawGuides);
-        const double n = double(others.size());
-        const bool withHead = head && !head->unset() && !head->empty();
-        res.headMeasured = withHead;
-        const double tolerance = withHead ? headTolerance(*head) : 0.0;
-        auto shares = [&](const StrandSet& set, double& leaving, double& entering) {
-            const StrandSet sub = selectStrands(set, interpolated);
-            leaving = double(countStrandsLeavingVolume(sub, rawGuides, res.volumeVoxel, threaded)) / n;
-            entering = withHead ? double(countStrandsEnteringHead(sub, *head, tolerance, threaded)) / n : 0.0;
-        };
-        shares(strands, res.originalLeavingVolume, res.originalEnteringHead);
-        for (const auto& way : ways) shares(*way.second, way.first->leavingVolume, way.first->enteringHead);
-    }
+    measureRelativeErrors(strands, res, nearest, fitStep, isGuide, params.fit.step, threaded);
+    const Ways ways = {{{&res.helicoidErrors, &res.helicoid}, {&res.pointErrors, &res.points}, {&res.nearestErrors, &nearest}}};
+    measureAsPapers(strands, ways, params.metersPerUnit, threaded);
+    if (!others.empty()) measureVolumeAndHead(strands, rawGuides, others, ways, head, threaded, res);
     return res;
 }
 

@@ -255,8 +255,10 @@ StrandSet growGuides(const Scene& scene, bool threaded, openvdb::util::NullInter
     return growScene(bare, {}, threaded, interrupter);
 }
 
-StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded, openvdb::util::NullInterrupter* interrupter,
-                    GrowReport* report)
+namespace {
+
+/// The scene's step, and its vertices against the cap and the memory at hand, before any work.
+void checkGrowable(const Scene& scene, const GrowOptions& options)
 {
     if (!(scene.step > 0.0) || !std::isfinite(scene.step)) {
         throw ValueError("growScene: step " + std::to_string(scene.step) + " must be a positive length");
@@ -271,127 +273,188 @@ StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threade
                          "), more than the cap of " + std::to_string(options.maxVertices) + " vertices (fewer wisps, shorter pieces or a larger step)");
     }
     checkMemory("growScene", std::uint64_t(estimate) * sizeof(Vec3f), what, "fewer wisps, shorter pieces or a larger step");
-    auto stepOf = [&](const SceneGuide& g) { return g.step > 0.0 ? g.step : scene.step; };
-    const HelicoidIntegrator integrator = options.integrator ? *options.integrator : scene.integrator;
-    // Layout: guide g, then its wisps; every strand of a guide has the guide's vertex count.
-    struct Item { std::size_t guide, wisp; };  // wisp 0: the guide itself
-    std::vector<Item> items;
-    std::vector<std::uint32_t> offsets{0};
-    for (std::size_t g = 0; g < scene.guides.size(); ++g) {
-        const SceneGuide& guide = scene.guides[g];
-        std::size_t n = 1;
-        for (const HelicoidPiece& p : guide.pieces) n += stepCount(p.length, stepOf(guide));
-        const std::size_t strands = 1 + (guide.wisp ? guide.wisp->count : 0);
-        for (std::size_t w = 0; w < strands; ++w) {
-            items.push_back({g, w});
-            offsets.push_back(std::uint32_t(offsets.back() + n));
-        }
-    }
-    StrandSet out;
-    out.offsets = offsets;
-    reserveHugePages(out.positions, offsets.back());  // fresh pages 2 MiB at a time (Memory.h)
-    out.positions.resize(offsets.back());
+}
 
-    // Guides first (wisps need their traces), then all strands in parallel.
-    std::vector<HelicoidTrace> guideTraces(scene.guides.size());
-    // Each guide's clearance from its pieces' singular axes, in steps (written once per guide).
-    std::vector<double> clearance(report ? scene.guides.size() : 0, std::numeric_limits<double>::infinity());
-    // Progress: guides traced, then strands grown (a guide's own strand copies its trace).
-    ProgressCounter progress(interrupter, "growing strands", scene.guides.size() + items.size(), "traces");
-    auto traceGuides = [&](const tbb::blocked_range<std::size_t>& r) {
+/// One strand of the scene: a guide's own (wisp 0) or one of its wisp strands.
+struct GrowItem
+{
+    std::size_t guide, wisp;
+};
+
+/// Grows a scene's strands into a laid-out StrandSet: the guides with wisps traced first (their
+/// wisps need the traces), then every strand, over ranges of items (in parallel or not).
+struct SceneGrower
+{
+    const Scene& scene;
+    HelicoidIntegrator integrator;
+    bool report;  ///< whether each guide's clearance from its pieces' singular axes is measured
+    std::vector<GrowItem> items;
+    StrandSet out;
+    std::vector<HelicoidTrace> guideTraces;
+    std::vector<double> clearance;  ///< per guide, in steps (written once per guide); with report
+    ProgressCounter progress;
+
+    SceneGrower(const Scene& scene_, HelicoidIntegrator integrator_, bool report_, openvdb::util::NullInterrupter* interrupter)
+        : scene(scene_), integrator(integrator_), report(report_), guideTraces(scene_.guides.size()),
+          clearance(report_ ? scene_.guides.size() : 0, std::numeric_limits<double>::infinity()),
+          progress(interrupter, "growing strands", scene_.guides.size() + layOut(), "traces")
+    {
+    }
+
+    double stepOf(const SceneGuide& g) const { return g.step > 0.0 ? g.step : scene.step; }
+
+    /// Layout: guide g, then its wisps; every strand of a guide has the guide's vertex count.
+    /// Returns the strand count (progress: guides traced, then strands grown).
+    std::size_t layOut()
+    {
+        std::vector<std::uint32_t> offsets{0};
+        for (std::size_t g = 0; g < scene.guides.size(); ++g) {
+            const SceneGuide& guide = scene.guides[g];
+            std::size_t n = 1;
+            for (const HelicoidPiece& p : guide.pieces) n += stepCount(p.length, stepOf(guide));
+            const std::size_t strands = 1 + (guide.wisp ? guide.wisp->count : 0);
+            for (std::size_t w = 0; w < strands; ++w) {
+                items.push_back({g, w});
+                offsets.push_back(std::uint32_t(offsets.back() + n));
+            }
+        }
+        out.offsets = offsets;
+        reserveHugePages(out.positions, offsets.back());  // fresh pages 2 MiB at a time (Memory.h)
+        out.positions.resize(offsets.back());
+        return items.size();
+    }
+
+    /// Only guides with wisps are traced ahead (their wisps need the trace); the others are
+    /// traced where their strand is written, so many wispless guides (interpolated hair) never
+    /// hold all their traces at once.
+    void traceGuides(const tbb::blocked_range<std::size_t>& r)
+    {
         for (std::size_t g = r.begin(); g != r.end(); ++g) {
             if (progress.stopped() || progress.add(1)) return;
-            // Only guides with wisps are traced ahead (their wisps need the trace); the others are
-            // traced where their strand is written, so many wispless guides (interpolated hair)
-            // never hold all their traces at once.
             if (!scene.guides[g].wisp) continue;
             tracePHelicoid(scene.guides[g].root, scene.guides[g].frame, scene.guides[g].pieces, stepOf(scene.guides[g]),
                            integrator, guideTraces[g]);
             if (report) clearance[g] = traceClearance(guideTraces[g], stepOf(scene.guides[g]));
         }
-    };
-    auto growItems = [&](const tbb::blocked_range<std::size_t>& r) {
-        // Wisp strands of one guide are traced a batch at a time (see tracePHelicoids).
-        constexpr std::size_t kBatch = 8;
+    }
+
+    /// Hairs without wisps or waviness (interpolated hair) need their points only.
+    bool pointsOnly(const GrowItem& x) const
+    {
+        const SceneGuide& g = scene.guides[x.guide];
+        return !g.wisp && !g.waviness && !report;
+    }
+
+    /// A run of points-only items from @a i (up to 64, within the range's end @a end) through the
+    /// lane kernel at once. Returns how many.
+    std::size_t growPointsRun(std::size_t i, std::size_t end)
+    {
+        constexpr std::size_t kRun = 64;
+        PHelicoidRequest run[kRun];
+        Vec3f* dst[kRun];
+        std::size_t count = 0;
+        while (count < kRun && i + count != end && pointsOnly(items[i + count])) {
+            const SceneGuide& g = scene.guides[items[i + count].guide];
+            run[count] = PHelicoidRequest{g.root, g.frame, &g.pieces, stepOf(g)};
+            dst[count] = out.positions.data() + out.offsets[i + count];
+            ++count;
+        }
+        tracePHelicoidPoints(run, count, integrator, dst);
+        return count;
+    }
+
+    /// Scratch of one range: wisp strands of one guide are traced a batch at a time (see
+    /// tracePHelicoids).
+    static constexpr std::size_t kBatch = 8;
+    struct Scratch
+    {
         HelicoidTrace traces[kBatch];
-        HelicoidTrace own;  // a wispless guide's trace
+        HelicoidTrace own;  ///< a wispless guide's trace
         std::vector<Rng> rngs;
+    };
+
+    /// Item @a i's strand, with the next wisp strands of its guide (up to kBatch, within @a end):
+    /// traced, then wavy or copied. Returns how many.
+    std::size_t growBatch(std::size_t i, std::size_t end, Scratch& s)
+    {
+        const GrowItem& it = items[i];
+        const SceneGuide& guide = scene.guides[it.guide];
+        std::size_t count = 1;
+        s.rngs.assign(1, Rng(scene.seed, it.guide, it.wisp));
+        const HelicoidTrace* batch[kBatch] = {&guideTraces[it.guide]};
+        if (!guide.wisp) {
+            tracePHelicoid(guide.root, guide.frame, guide.pieces, stepOf(guide), integrator, s.own);
+            if (report) clearance[it.guide] = traceClearance(s.own, stepOf(guide));
+            batch[0] = &s.own;
+        } else if (it.wisp > 0) {
+            while (count < kBatch && i + count != end && items[i + count].guide == it.guide) {
+                s.rngs.emplace_back(scene.seed, it.guide, items[i + count].wisp);
+                ++count;
+            }
+            traceWisps(guideTraces[it.guide], guide.pieces, *guide.wisp, stepOf(guide), integrator, s.rngs.data(), count, s.traces,
+                       guide.waviness.has_value());
+            for (std::size_t b = 0; b < count; ++b) batch[b] = &s.traces[b];
+        }
+        for (std::size_t b = 0; b < count; ++b) {
+            const HelicoidTrace& trace = *batch[b];
+            Vec3f* dst = out.positions.data() + out.offsets[i + b];
+            if (guide.waviness) {
+                applyWaviness(trace, *guide.waviness, s.rngs[b], dst);
+            } else {
+                for (std::size_t k = 0; k < trace.points.size(); ++k) {
+                    dst[k] = Vec3f(float(trace.points[k].x()), float(trace.points[k].y()), float(trace.points[k].z()));
+                }
+            }
+        }
+        return count;
+    }
+
+    void growItems(const tbb::blocked_range<std::size_t>& r)
+    {
+        Scratch scratch;
         for (std::size_t i = r.begin(); i != r.end();) {
             if (progress.stopped()) return;
-            const Item& it = items[i];
-            const SceneGuide& guide = scene.guides[it.guide];
-            // Hairs without wisps or waviness (interpolated hair) need their points only: a run of
-            // them goes through the lane kernel at once.
-            const auto pointsOnly = [&](const Item& x) {
-                const SceneGuide& g = scene.guides[x.guide];
-                return !g.wisp && !g.waviness && !report;
-            };
-            if (pointsOnly(it)) {
-                constexpr std::size_t kRun = 64;
-                PHelicoidRequest run[kRun];
-                Vec3f* dst[kRun];
-                std::size_t count = 0;
-                while (count < kRun && i + count != r.end() && pointsOnly(items[i + count])) {
-                    const SceneGuide& g = scene.guides[items[i + count].guide];
-                    run[count] = PHelicoidRequest{g.root, g.frame, &g.pieces, stepOf(g)};
-                    dst[count] = out.positions.data() + out.offsets[i + count];
-                    ++count;
-                }
-                tracePHelicoidPoints(run, count, integrator, dst);
-                i += count;
-                progress.add(count);
-                continue;
-            }
-            std::size_t count = 1;
-            rngs.assign(1, Rng(scene.seed, it.guide, it.wisp));
-            const HelicoidTrace* batch[kBatch] = {&guideTraces[it.guide]};
-            if (!guide.wisp) {
-                tracePHelicoid(guide.root, guide.frame, guide.pieces, stepOf(guide), integrator, own);
-                if (report) clearance[it.guide] = traceClearance(own, stepOf(guide));
-                batch[0] = &own;
-            } else if (it.wisp > 0) {
-                while (count < kBatch && i + count != r.end() && items[i + count].guide == it.guide) {
-                    rngs.emplace_back(scene.seed, it.guide, items[i + count].wisp);
-                    ++count;
-                }
-                traceWisps(guideTraces[it.guide], guide.pieces, *guide.wisp, stepOf(guide), integrator, rngs.data(),
-                           count, traces, guide.waviness.has_value());
-                for (std::size_t b = 0; b < count; ++b) batch[b] = &traces[b];
-            }
-            for (std::size_t b = 0; b < count; ++b) {
-                const HelicoidTrace& trace = *batch[b];
-                Vec3f* dst = out.positions.data() + out.offsets[i + b];
-                if (guide.waviness) {
-                    applyWaviness(trace, *guide.waviness, rngs[b], dst);
-                } else {
-                    for (std::size_t k = 0; k < trace.points.size(); ++k) {
-                        dst[k] = Vec3f(float(trace.points[k].x()), float(trace.points[k].y()), float(trace.points[k].z()));
-                    }
-                }
-            }
+            const std::size_t count = pointsOnly(items[i]) ? growPointsRun(i, r.end()) : growBatch(i, r.end(), scratch);
             i += count;
             progress.add(count);
         }
-    };
-    if (threaded) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.guides.size(), 1), traceGuides);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size(), 16), growItems);
-    } else {
-        traceGuides(tbb::blocked_range<std::size_t>(0, scene.guides.size()));
-        growItems(tbb::blocked_range<std::size_t>(0, items.size()));
     }
-    if (progress.stopped()) throw InterruptedError("growScene: interrupted");
-    if (report) {
-        *report = GrowReport{};
-        for (std::size_t g = 0; g < clearance.size(); ++g) {
-            if (clearance[g] < options.nearAxisSteps) ++report->nearAxis;
-            if (clearance[g] < report->nearestClearance) {
-                report->nearestClearance = clearance[g];
-                report->nearestGuide = g;
-            }
+};
+
+/// The guides nearer a singular axis than options.nearAxisSteps, and the nearest one.
+GrowReport clearanceReport(const std::vector<double>& clearance, double nearAxisSteps)
+{
+    GrowReport report;
+    for (std::size_t g = 0; g < clearance.size(); ++g) {
+        if (clearance[g] < nearAxisSteps) ++report.nearAxis;
+        if (clearance[g] < report.nearestClearance) {
+            report.nearestClearance = clearance[g];
+            report.nearestGuide = g;
         }
     }
-    return out;
+    return report;
+}
+
+} // namespace
+
+StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded, openvdb::util::NullInterrupter* interrupter,
+                    GrowReport* report)
+{
+    checkGrowable(scene, options);
+    const HelicoidIntegrator integrator = options.integrator ? *options.integrator : scene.integrator;
+    SceneGrower grower(scene, integrator, report != nullptr, interrupter);
+    const auto traceGuides = [&](const tbb::blocked_range<std::size_t>& r) { grower.traceGuides(r); };
+    const auto growItems = [&](const tbb::blocked_range<std::size_t>& r) { grower.growItems(r); };
+    if (threaded) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.guides.size(), 1), traceGuides);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grower.items.size(), 16), growItems);
+    } else {
+        traceGuides(tbb::blocked_range<std::size_t>(0, scene.guides.size()));
+        growItems(tbb::blocked_range<std::size_t>(0, grower.items.size()));
+    }
+    if (grower.progress.stopped()) throw InterruptedError("growScene: interrupted");
+    if (report) *report = clearanceReport(grower.clearance, options.nearAxisSteps);
+    return std::move(grower.out);
 }
 
 } // namespace vdbhair

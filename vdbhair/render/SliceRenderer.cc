@@ -131,6 +131,266 @@ struct InPlaneSampler
     }
 };
 
+void checkSliceParams(const SliceParams& params, const std::string& where)
+{
+    if (params.axis < 0 || params.axis > 2) throw ValueError(where + ": slice axis " + std::to_string(params.axis) + " is not 0, 1 or 2");
+    if (params.width < SliceParams::kMinWidth || params.width > SliceParams::kMaxWidth) {
+        throw ValueError(where + ": width " + std::to_string(params.width) + " must be between " + std::to_string(SliceParams::kMinWidth) +
+                         " and " + std::to_string(SliceParams::kMaxWidth) + " pixels");
+    }
+    if (params.streamlines < 0 || params.streamlines > SliceParams::kMaxStreamlines) {
+        throw ValueError(where + ": streamlines " + std::to_string(params.streamlines) + " must be between 0 and " +
+                         std::to_string(SliceParams::kMaxStreamlines));
+    }
+}
+
+/// The sampler of a voxel grid of a type slices show; @a gw names the grid in errors.
+Sampled samplerOf(const openvdb::GridBase& base, const std::string& gw)
+{
+    using namespace openvdb;
+    if (base.isType<points::PointDataGrid>()) {
+        throw ValueError(gw + " holds points; slices show voxel grids (render the strands with 'vdbhair render')");
+    }
+    Sampled s;
+    const bool vec = base.apply<TypeList<Vec3SGrid, Vec3DGrid>>([&](const auto& g) { s = makeVectorSampler(g); });
+    const bool sca = !vec && base.apply<TypeList<FloatGrid, DoubleGrid, Int32Grid, Int64Grid, BoolGrid>>(
+                                 [&](const auto& g) { s = makeScalarSampler(g); });
+    if (!vec && !sca) throw ValueError(gw + " holds " + base.valueType() + " values; slices show float, double, int, bool and vec3 grids");
+    return s;
+}
+
+/// World bounds of the active voxels (voxel extents), from the 8 corners of the index box.
+openvdb::BBoxd worldBoundsOf(const openvdb::CoordBBox& ibox, const openvdb::math::Transform& xf)
+{
+    openvdb::BBoxd wbox;
+    for (int c = 0; c < 8; ++c) {
+        const Vec3d corner((c & 1 ? ibox.max().x() + 0.5 : ibox.min().x() - 0.5), (c & 2 ? ibox.max().y() + 0.5 : ibox.min().y() - 0.5),
+                           (c & 4 ? ibox.max().z() + 0.5 : ibox.min().z() - 0.5));
+        wbox.expand(xf.indexToWorld(corner));
+    }
+    return wbox;
+}
+
+/// The plot of a slice: its world window on the plane, its size in pixels and where it sits in
+/// the image (a header above, the legend's panel to the right).
+struct SlicePlot
+{
+    static constexpr int kMargin = 12, kHeader = 34, kPanel = 190;
+    int axis;
+    double world;
+    PlaneAxes pa;
+    double uLo, uHi, vLo, vHi;
+    int plotW, plotH;
+    double scale;  ///< pixels per world unit
+    int imgW, imgH;
+    int x0 = kMargin, y0 = kHeader;
+
+    SlicePlot(int axis_, double world_, int width, const openvdb::BBoxd& wbox)
+        : axis(axis_), world(world_), pa(planeAxes(axis_))
+    {
+        uLo = pa.uSign > 0 ? wbox.min()[pa.uAxis] : -wbox.max()[pa.uAxis];
+        uHi = pa.uSign > 0 ? wbox.max()[pa.uAxis] : -wbox.min()[pa.uAxis];
+        vLo = pa.vSign > 0 ? wbox.min()[pa.vAxis] : -wbox.max()[pa.vAxis];
+        vHi = pa.vSign > 0 ? wbox.max()[pa.vAxis] : -wbox.min()[pa.vAxis];
+        plotW = width;
+        scale = double(plotW) / (uHi - uLo);
+        plotH = std::max(16, std::min(16384, int(std::lround((vHi - vLo) * scale))));
+        imgW = kMargin + plotW + kPanel;
+        imgH = kHeader + std::max(plotH, 400) + kMargin;  // room for the legend
+    }
+    /// Plot pixel coordinates (continuous) to world.
+    Vec3d worldAt(double px, double py) const
+    {
+        Vec3d w(0.0);
+        w[axis] = world;
+        w[pa.uAxis] = pa.uSign * (uLo + px / scale);
+        w[pa.vAxis] = pa.vSign * (vHi - py / scale);
+        return w;
+    }
+    void pixelAt(const Vec3d& w, double& px, double& py) const
+    {
+        px = (pa.uSign * w[pa.uAxis] - uLo) * scale;
+        py = (vHi - pa.vSign * w[pa.vAxis]) * scale;
+    }
+};
+
+/// Every plot pixel's nearest voxel, and the range of the values (vector lengths) shown.
+struct PixelSamples
+{
+    std::vector<Vec3d> values;
+    std::vector<unsigned char> active;
+    double lo = std::numeric_limits<double>::max(), hi = -std::numeric_limits<double>::max();
+};
+
+PixelSamples samplePixels(const SlicePlot& plot, const Sampled& s)
+{
+    PixelSamples ps;
+    ps.values.resize(std::size_t(plot.plotW) * std::size_t(plot.plotH));
+    ps.active.assign(ps.values.size(), 0);
+    for (int py = 0; py < plot.plotH; ++py) {
+        for (int px = 0; px < plot.plotW; ++px) {
+            const std::size_t i = std::size_t(py) * std::size_t(plot.plotW) + std::size_t(px);
+            Vec3d v;
+            if (!s.nearest(plot.worldAt(px + 0.5, py + 0.5), v)) continue;
+            ps.active[i] = 1;
+            ps.values[i] = v;
+            const double q = s.vector ? v.length() : v.x();
+            if (std::isfinite(q)) { ps.lo = std::min(ps.lo, q); ps.hi = std::max(ps.hi, q); }
+        }
+    }
+    if (!(ps.hi >= ps.lo)) { ps.lo = ps.hi = 0.0; }
+    return ps;
+}
+
+/// Active voxels of the slice's voxel layer (counted in index space, not pixels); 0 for a
+/// non-linear transform.
+std::size_t activeVoxelsOfLayer(const openvdb::GridBase& base, const openvdb::CoordBBox& ibox, int axis, int indexPlane)
+{
+    using namespace openvdb;
+    std::size_t n = 0;
+    if (base.transform().isLinear()) {
+        Coord a = ibox.min(), b = ibox.max();
+        a[axis] = b[axis] = indexPlane;
+        const CoordBBox layer(a, b);
+        base.apply<TypeList<Vec3SGrid, Vec3DGrid, FloatGrid, DoubleGrid, Int32Grid, Int64Grid, BoolGrid>>([&](const auto& g) {
+            auto acc = g.getConstAccessor();
+            for (auto ijk = layer.begin(); ijk; ++ijk) n += acc.isValueOn(*ijk) ? 1 : 0;
+        });
+    }
+    return n;
+}
+
+/// The plot's pixels: vectors by direction (RGB of |x|, |y|, |z| or HSV of the in-plane angle)
+/// and length (brightness, relative to @a ref), scalars through the colour map, inactive grey.
+void paintPixels(Image& image, const SlicePlot& plot, const PixelSamples& ps, const Sampled& s, SliceColor color, double ref)
+{
+    const Vec3f inactive(0.80f);
+    const PlaneAxes& pa = plot.pa;
+    const double lo = ps.lo, hi = ps.hi;
+    for (int py = 0; py < plot.plotH; ++py) {
+        for (int px = 0; px < plot.plotW; ++px) {
+            const std::size_t i = std::size_t(py) * std::size_t(plot.plotW) + std::size_t(px);
+            Vec3f c = inactive;
+            if (ps.active[i]) {
+                const Vec3d& v = ps.values[i];
+                if (s.vector) {
+                    const double len = v.length();
+                    const double bright = len > 0.0 ? std::min(1.0, len / ref) : 0.0;
+                    if (color == SliceColor::Rgb) {
+                        c = len > 0.0 ? fromSrgb(Vec3f(float(std::abs(v.x()) / len), float(std::abs(v.y()) / len), float(std::abs(v.z()) / len)) * float(bright))
+                                      : Vec3f(0.f);
+                    } else {
+                        const double du = pa.uSign * v[pa.uAxis], dv = pa.vSign * v[pa.vAxis];
+                        const double inPlane = std::sqrt(du * du + dv * dv);
+                        const double hue = std::atan2(dv, du) / (2.0 * M_PI);
+                        c = hsvColor(hue, len > 0.0 ? inPlane / len : 0.0, bright);
+                    }
+                } else {
+                    c = colorMap(hi > lo ? float((v.x() - lo) / (hi - lo)) : 0.5f);
+                }
+            }
+            image.set(plot.x0 + px, plot.y0 + py, c);
+        }
+    }
+}
+
+/// Streamlines of the in-plane projection, seeded evenly over the active pixels: the streamline
+/// engine's midpoint rule at its default step (of the smallest voxel side), both ways from each
+/// seed, stopping where a step's stages reverse (a sink, or a sign flip). Returns how many were drawn.
+int drawStreamlines(Image& image, const SlicePlot& plot, const PixelSamples& ps, const Sampled& s, const Vec3d& voxelSize,
+                    int count, double ref)
+{
+    std::vector<std::size_t> on;
+    for (std::size_t i = 0; i < ps.active.size(); ++i) if (ps.active[i]) on.push_back(i);
+    const Vec3d& vs = voxelSize;
+    StreamlineRules rules;
+    rules.integrator = Integrator::RK2;
+    rules.reversal = StageReversal::Stop;
+    rules.step = kDefaultStepVoxels * std::min(vs.x(), std::min(vs.y(), vs.z()));
+    rules.maxSteps = std::size_t(std::max(0.0, std::min(1e6, 4.0 * ((plot.uHi - plot.uLo) + (plot.vHi - plot.vLo)) / rules.step)));
+    const double length = double(rules.maxSteps + 1) * rules.step;  // the step cap ends every streamline
+    InPlaneSampler forward{s, plot.axis, 1e-6 * ref};
+    ReversedSampler<InPlaneSampler> backward(forward);
+    const int n = rules.maxSteps ? std::min<int>(count, int(on.size())) : 0;
+    const int x0 = plot.x0, y0 = plot.y0;
+    int drawn = 0;
+    std::vector<Vec3d> half;
+    for (int k = 0; k < n; ++k) {
+        const std::size_t i = on[std::size_t((double(k) + 0.5) * double(on.size()) / double(n))];
+        const Vec3d seed = plot.worldAt(double(i % std::size_t(plot.plotW)) + 0.5, double(i / std::size_t(plot.plotW)) + 0.5);
+        traceStreamline(backward, seed, length, rules, half);
+        std::vector<Vec3d> line(half.rbegin(), half.rend());
+        traceStreamline(forward, seed, length, rules, half);
+        line.insert(line.end(), half.begin() + 1, half.end());
+        if (line.size() < 2) continue;
+        ++drawn;
+        for (int pass = 0; pass < 2; ++pass) {
+            const double hw = pass == 0 ? 1.4 : 0.6;
+            const Vec3f col = pass == 0 ? Vec3f(0.f) : Vec3f(1.f);
+            const float alpha = pass == 0 ? 0.55f : 0.95f;
+            for (std::size_t j = 0; j + 1 < line.size(); ++j) {
+                double ax, ay, bx, by;
+                plot.pixelAt(line[j], ax, ay);
+                plot.pixelAt(line[j + 1], bx, by);
+                drawLine(image, x0 + ax, y0 + ay, x0 + bx, y0 + by, hw, col, alpha, x0, y0, x0 + plot.plotW, y0 + plot.plotH);
+            }
+        }
+    }
+    return drawn;
+}
+
+/// The title above the plot and, to its right, the axes and the legend of the colours.
+void drawTitleAndLegend(SliceResult& res, const SlicePlot& plot, const Sampled& s, SliceColor color, const std::string& gridName,
+                        const std::string& valueType)
+{
+    const PlaneAxes& pa = plot.pa;
+    const double lo = res.lo, hi = res.hi;
+    const char* uName = axisName(pa.uAxis);
+    const char* vName = axisName(pa.vAxis);
+    drawText(res.image, SlicePlot::kMargin, 22,
+             "grid '" + gridName + "'  " + axisName(plot.axis) + " = " + num(plot.world) + "  (voxel layer " + std::to_string(res.indexPlane) +
+                 ", " + std::to_string(res.activeVoxels) + " active)",
+             16, Vec3f(0.f));
+    const int lx = plot.x0 + plot.plotW + 16;
+    int ly = plot.y0 + 14;
+    drawText(res.image, lx, ly, std::string("right: ") + (pa.uSign < 0 ? "-" : "+") + uName, 13, Vec3f(0.f));
+    drawText(res.image, lx, ly + 18, std::string("up: ") + (pa.vSign < 0 ? "-" : "+") + vName, 13, Vec3f(0.f));
+    drawText(res.image, lx, ly + 36, "pixel: " + num(1.0 / plot.scale) + " units", 13, Vec3f(0.f));
+    ly += 70;
+    if (s.vector) {
+        if (color == SliceColor::Rgb) {
+            drawText(res.image, lx, ly, "colour = |direction|", 13, Vec3f(0.f));
+            const char* names[3] = {"red: |x|", "green: |y|", "blue: |z|"};
+            const Vec3f cols[3] = {Vec3f(0.8f, 0.f, 0.f), Vec3f(0.f, 0.55f, 0.f), Vec3f(0.f, 0.f, 0.9f)};
+            for (int a = 0; a < 3; ++a) drawText(res.image, lx, ly + 18 * (a + 1), names[a], 13, cols[a]);
+            ly += 90;
+        } else {
+            drawText(res.image, lx, ly, "hue = in-plane angle", 13, Vec3f(0.f));
+            drawText(res.image, lx, ly + 18, "pale = out of plane", 13, Vec3f(0.f));
+            const int r = 45, cx = lx + 60, cy = ly + 40 + r;
+            for (int y = -r; y <= r; ++y) {
+                for (int x = -r; x <= r; ++x) {
+                    const double d = std::sqrt(double(x * x + y * y));
+                    if (d > r || cx + x >= plot.imgW || cy + y >= plot.imgH) continue;
+                    res.image.set(cx + x, cy + y, hsvColor(std::atan2(-double(y), double(x)) / (2.0 * M_PI), d / r, 1.0));
+                }
+            }
+            drawText(res.image, cx + r + 4, cy + 5, std::string("+") + uName, 13, Vec3f(0.f));
+            drawText(res.image, cx - 8, cy - r - 4, std::string("+") + vName, 13, Vec3f(0.f));
+            ly += 40 + 2 * r + 24;
+        }
+        drawText(res.image, lx, ly, "dark = short: length", 13, Vec3f(0.f));
+        drawText(res.image, lx, ly + 18, num(lo) + " .. " + num(hi), 13, Vec3f(0.f));
+        drawText(res.image, lx, ly + 36, "grey = inactive", 13, Vec3f(0.f));
+        if (res.streamlinesDrawn) drawText(res.image, lx, ly + 54, std::to_string(res.streamlinesDrawn) + " streamlines", 13, Vec3f(0.f));
+    } else {
+        const int barH = std::max(60, std::min(plot.plotH - 120, 300));
+        drawColorBar(res.image, lx, ly + 20, 22, barH, lo, hi, valueType + " value");
+        drawText(res.image, lx, ly + 20 + barH + 24, "range " + num(lo) + " .. " + num(hi), 13, Vec3f(0.f));
+        drawText(res.image, lx, ly + 20 + barH + 42, "grey = inactive", 13, Vec3f(0.f));
+    }
+}
+
 } // namespace
 
 void parseSlice(const std::string& text, int& axis, double& world)
@@ -147,213 +407,33 @@ void parseSlice(const std::string& text, int& axis, double& world)
 SliceResult renderSlice(const std::string& path, const std::string& gridName, const SliceParams& params)
 {
     const std::string where = "inspect(" + path + ")";
-    if (params.axis < 0 || params.axis > 2) throw ValueError(where + ": slice axis " + std::to_string(params.axis) + " is not 0, 1 or 2");
-    if (params.width < SliceParams::kMinWidth || params.width > SliceParams::kMaxWidth) {
-        throw ValueError(where + ": width " + std::to_string(params.width) + " must be between " + std::to_string(SliceParams::kMinWidth) +
-                         " and " + std::to_string(SliceParams::kMaxWidth) + " pixels");
-    }
-    if (params.streamlines < 0 || params.streamlines > SliceParams::kMaxStreamlines) {
-        throw ValueError(where + ": streamlines " + std::to_string(params.streamlines) + " must be between 0 and " +
-                         std::to_string(SliceParams::kMaxStreamlines));
-    }
+    checkSliceParams(params, where);
     const openvdb::GridBase::Ptr base = readVdbGrid(path, gridName, where);
     const std::string gw = where + ": grid '" + gridName + "'";
-    if (base->isType<openvdb::points::PointDataGrid>()) {
-        throw ValueError(gw + " holds points; slices show voxel grids (render the strands with 'vdbhair render')");
-    }
-    Sampled s;
-    using namespace openvdb;
-    const bool vec = base->apply<TypeList<Vec3SGrid, Vec3DGrid>>([&](const auto& g) { s = makeVectorSampler(g); });
-    const bool sca = !vec && base->apply<TypeList<FloatGrid, DoubleGrid, Int32Grid, Int64Grid, BoolGrid>>(
-                                 [&](const auto& g) { s = makeScalarSampler(g); });
-    if (!vec && !sca) throw ValueError(gw + " holds " + base->valueType() + " values; slices show float, double, int, bool and vec3 grids");
-    const CoordBBox ibox = base->evalActiveVoxelBoundingBox();
+    const Sampled s = samplerOf(*base, gw);
+    const openvdb::CoordBBox ibox = base->evalActiveVoxelBoundingBox();
     if (ibox.empty()) throw ValueError(gw + " has no active voxels to slice");
-    const math::Transform& xf = base->transform();
-    // World bounds of the active voxels (voxel extents), from the 8 corners of the index box.
-    BBoxd wbox;
-    for (int c = 0; c < 8; ++c) {
-        const Vec3d corner((c & 1 ? ibox.max().x() + 0.5 : ibox.min().x() - 0.5), (c & 2 ? ibox.max().y() + 0.5 : ibox.min().y() - 0.5),
-                           (c & 4 ? ibox.max().z() + 0.5 : ibox.min().z() - 0.5));
-        wbox.expand(xf.indexToWorld(corner));
-    }
+    const openvdb::BBoxd wbox = worldBoundsOf(ibox, base->transform());
     const int axis = params.axis;
     if (!(params.world >= wbox.min()[axis] && params.world <= wbox.max()[axis])) {
         throw ValueError(gw + ": slice " + axisName(axis) + "=" + num(params.world) + " is outside its active voxels, which span " +
                          axisName(axis) + " from " + num(wbox.min()[axis]) + " to " + num(wbox.max()[axis]));
     }
-    const PlaneAxes pa = planeAxes(axis);
-    const double uLo = pa.uSign > 0 ? wbox.min()[pa.uAxis] : -wbox.max()[pa.uAxis];
-    const double uHi = pa.uSign > 0 ? wbox.max()[pa.uAxis] : -wbox.min()[pa.uAxis];
-    const double vLo = pa.vSign > 0 ? wbox.min()[pa.vAxis] : -wbox.max()[pa.vAxis];
-    const double vHi = pa.vSign > 0 ? wbox.max()[pa.vAxis] : -wbox.min()[pa.vAxis];
-    const int plotW = params.width;
-    const double scale = double(plotW) / (uHi - uLo);  // pixels per world unit
-    const int plotH = std::max(16, std::min(16384, int(std::lround((vHi - vLo) * scale))));
-    const int margin = 12, header = 34, panel = 190;
-    const int imgW = margin + plotW + panel, imgH = header + std::max(plotH, 400) + margin;  // room for the legend
+    const SlicePlot plot(axis, params.world, params.width, wbox);
     SliceResult res;
-    res.image = Image(imgW, imgH, Vec3f(1.f));
-    const int x0 = margin, y0 = header;
-    auto worldAt = [&](double px, double py) {  // plot pixel coordinates (continuous) to world
-        Vec3d w(0.0);
-        w[axis] = params.world;
-        w[pa.uAxis] = pa.uSign * (uLo + px / scale);
-        w[pa.vAxis] = pa.vSign * (vHi - py / scale);
-        return w;
-    };
-    auto pixelAt = [&](const Vec3d& w, double& px, double& py) {
-        px = (pa.uSign * w[pa.uAxis] - uLo) * scale;
-        py = (vHi - pa.vSign * w[pa.vAxis]) * scale;
-    };
-    res.indexPlane = int(std::lround(xf.worldToIndex(worldAt(0.5 * plotW, 0.5 * plotH))[axis]));
+    res.image = Image(plot.imgW, plot.imgH, Vec3f(1.f));
+    res.indexPlane = int(std::lround(base->transform().worldToIndex(plot.worldAt(0.5 * plot.plotW, 0.5 * plot.plotH))[axis]));
 
-    // Sample every pixel once (nearest voxel).
-    std::vector<Vec3d> values(std::size_t(plotW) * std::size_t(plotH));
-    std::vector<unsigned char> active(values.size(), 0);
-    double lo = std::numeric_limits<double>::max(), hi = -std::numeric_limits<double>::max();
-    for (int py = 0; py < plotH; ++py) {
-        for (int px = 0; px < plotW; ++px) {
-            const std::size_t i = std::size_t(py) * std::size_t(plotW) + std::size_t(px);
-            Vec3d v;
-            if (!s.nearest(worldAt(px + 0.5, py + 0.5), v)) continue;
-            active[i] = 1;
-            values[i] = v;
-            const double q = s.vector ? v.length() : v.x();
-            if (std::isfinite(q)) { lo = std::min(lo, q); hi = std::max(hi, q); }
-        }
-    }
-    // Active voxels of the layer (counted in index space, not pixels).
-    {
-        std::size_t n = 0;
-        CoordBBox layer = ibox;
-        if (xf.isLinear()) {
-            Coord a = layer.min(), b = layer.max();
-            a[axis] = b[axis] = res.indexPlane;
-            layer = CoordBBox(a, b);
-            base->apply<TypeList<Vec3SGrid, Vec3DGrid, FloatGrid, DoubleGrid, Int32Grid, Int64Grid, BoolGrid>>([&](const auto& g) {
-                auto acc = g.getConstAccessor();
-                for (auto ijk = layer.begin(); ijk; ++ijk) n += acc.isValueOn(*ijk) ? 1 : 0;
-            });
-        }
-        res.activeVoxels = n;
-    }
-    if (!(hi >= lo)) { lo = hi = 0.0; }
-    res.lo = lo;
-    res.hi = hi;
-    const Vec3f inactive(0.80f);
-    const double ref = s.vector ? (hi > 0.0 ? hi : 1.0) : 0.0;
-    for (int py = 0; py < plotH; ++py) {
-        for (int px = 0; px < plotW; ++px) {
-            const std::size_t i = std::size_t(py) * std::size_t(plotW) + std::size_t(px);
-            Vec3f c = inactive;
-            if (active[i]) {
-                const Vec3d& v = values[i];
-                if (s.vector) {
-                    const double len = v.length();
-                    const double bright = len > 0.0 ? std::min(1.0, len / ref) : 0.0;
-                    if (params.color == SliceColor::Rgb) {
-                        c = len > 0.0 ? fromSrgb(Vec3f(float(std::abs(v.x()) / len), float(std::abs(v.y()) / len), float(std::abs(v.z()) / len)) * float(bright))
-                                      : Vec3f(0.f);
-                    } else {
-                        const double du = pa.uSign * v[pa.uAxis], dv = pa.vSign * v[pa.vAxis];
-                        const double inPlane = std::sqrt(du * du + dv * dv);
-                        const double hue = std::atan2(dv, du) / (2.0 * M_PI);
-                        c = hsvColor(hue, len > 0.0 ? inPlane / len : 0.0, bright);
-                    }
-                } else {
-                    c = colorMap(hi > lo ? float((v.x() - lo) / (hi - lo)) : 0.5f);
-                }
-            }
-            res.image.set(x0 + px, y0 + py, c);
-        }
-    }
-
-    // Streamlines of the in-plane projection, seeded evenly over the active pixels: the
-    // streamline engine's midpoint rule at its default step (of the smallest voxel side), both
-    // ways from each seed, stopping where a step's stages reverse (a sink, or a sign flip).
+    const PixelSamples ps = samplePixels(plot, s);
+    res.activeVoxels = activeVoxelsOfLayer(*base, ibox, axis, res.indexPlane);
+    res.lo = ps.lo;
+    res.hi = ps.hi;
+    const double ref = s.vector ? (ps.hi > 0.0 ? ps.hi : 1.0) : 0.0;  // the length shown brightest
+    paintPixels(res.image, plot, ps, s, params.color, ref);
     if (params.streamlines > 0 && s.vector) {
-        std::vector<std::size_t> on;
-        for (std::size_t i = 0; i < active.size(); ++i) if (active[i]) on.push_back(i);
-        const Vec3d vs = xf.voxelSize();
-        StreamlineRules rules;
-        rules.integrator = Integrator::RK2;
-        rules.reversal = StageReversal::Stop;
-        rules.step = kDefaultStepVoxels * std::min(vs.x(), std::min(vs.y(), vs.z()));
-        rules.maxSteps = std::size_t(std::max(0.0, std::min(1e6, 4.0 * ((uHi - uLo) + (vHi - vLo)) / rules.step)));
-        const double length = double(rules.maxSteps + 1) * rules.step;  // the step cap ends every streamline
-        InPlaneSampler forward{s, axis, 1e-6 * ref};
-        ReversedSampler<InPlaneSampler> backward(forward);
-        const int n = rules.maxSteps ? std::min<int>(params.streamlines, int(on.size())) : 0;
-        std::vector<Vec3d> half;
-        for (int k = 0; k < n; ++k) {
-            const std::size_t i = on[std::size_t((double(k) + 0.5) * double(on.size()) / double(n))];
-            const Vec3d seed = worldAt(double(i % std::size_t(plotW)) + 0.5, double(i / std::size_t(plotW)) + 0.5);
-            traceStreamline(backward, seed, length, rules, half);
-            std::vector<Vec3d> line(half.rbegin(), half.rend());
-            traceStreamline(forward, seed, length, rules, half);
-            line.insert(line.end(), half.begin() + 1, half.end());
-            if (line.size() < 2) continue;
-            ++res.streamlinesDrawn;
-            for (int pass = 0; pass < 2; ++pass) {
-                const double hw = pass == 0 ? 1.4 : 0.6;
-                const Vec3f col = pass == 0 ? Vec3f(0.f) : Vec3f(1.f);
-                const float alpha = pass == 0 ? 0.55f : 0.95f;
-                for (std::size_t j = 0; j + 1 < line.size(); ++j) {
-                    double ax, ay, bx, by;
-                    pixelAt(line[j], ax, ay);
-                    pixelAt(line[j + 1], bx, by);
-                    drawLine(res.image, x0 + ax, y0 + ay, x0 + bx, y0 + by, hw, col, alpha, x0, y0, x0 + plotW, y0 + plotH);
-                }
-            }
-        }
+        res.streamlinesDrawn = drawStreamlines(res.image, plot, ps, s, base->transform().voxelSize(), params.streamlines, ref);
     }
-
-    // Title, axes and legend.
-    const char* uName = axisName(pa.uAxis);
-    const char* vName = axisName(pa.vAxis);
-    drawText(res.image, margin, 22,
-             "grid '" + gridName + "'  " + axisName(axis) + " = " + num(params.world) + "  (voxel layer " + std::to_string(res.indexPlane) +
-                 ", " + std::to_string(res.activeVoxels) + " active)",
-             16, Vec3f(0.f));
-    const int lx = x0 + plotW + 16;
-    int ly = y0 + 14;
-    drawText(res.image, lx, ly, std::string("right: ") + (pa.uSign < 0 ? "-" : "+") + uName, 13, Vec3f(0.f));
-    drawText(res.image, lx, ly + 18, std::string("up: ") + (pa.vSign < 0 ? "-" : "+") + vName, 13, Vec3f(0.f));
-    drawText(res.image, lx, ly + 36, "pixel: " + num(1.0 / scale) + " units", 13, Vec3f(0.f));
-    ly += 70;
-    if (s.vector) {
-        if (params.color == SliceColor::Rgb) {
-            drawText(res.image, lx, ly, "colour = |direction|", 13, Vec3f(0.f));
-            const char* names[3] = {"red: |x|", "green: |y|", "blue: |z|"};
-            const Vec3f cols[3] = {Vec3f(0.8f, 0.f, 0.f), Vec3f(0.f, 0.55f, 0.f), Vec3f(0.f, 0.f, 0.9f)};
-            for (int a = 0; a < 3; ++a) drawText(res.image, lx, ly + 18 * (a + 1), names[a], 13, cols[a]);
-            ly += 90;
-        } else {
-            drawText(res.image, lx, ly, "hue = in-plane angle", 13, Vec3f(0.f));
-            drawText(res.image, lx, ly + 18, "pale = out of plane", 13, Vec3f(0.f));
-            const int r = 45, cx = lx + 60, cy = ly + 40 + r;
-            for (int y = -r; y <= r; ++y) {
-                for (int x = -r; x <= r; ++x) {
-                    const double d = std::sqrt(double(x * x + y * y));
-                    if (d > r || cx + x >= imgW || cy + y >= imgH) continue;
-                    res.image.set(cx + x, cy + y, hsvColor(std::atan2(-double(y), double(x)) / (2.0 * M_PI), d / r, 1.0));
-                }
-            }
-            drawText(res.image, cx + r + 4, cy + 5, std::string("+") + uName, 13, Vec3f(0.f));
-            drawText(res.image, cx - 8, cy - r - 4, std::string("+") + vName, 13, Vec3f(0.f));
-            ly += 40 + 2 * r + 24;
-        }
-        drawText(res.image, lx, ly, "dark = short: length", 13, Vec3f(0.f));
-        drawText(res.image, lx, ly + 18, num(lo) + " .. " + num(hi), 13, Vec3f(0.f));
-        drawText(res.image, lx, ly + 36, "grey = inactive", 13, Vec3f(0.f));
-        if (res.streamlinesDrawn) drawText(res.image, lx, ly + 54, std::to_string(res.streamlinesDrawn) + " streamlines", 13, Vec3f(0.f));
-    } else {
-        const int barH = std::max(60, std::min(plotH - 120, 300));
-        drawColorBar(res.image, lx, ly + 20, 22, barH, lo, hi, base->valueType() + " value");
-        drawText(res.image, lx, ly + 20 + barH + 24, "range " + num(lo) + " .. " + num(hi), 13, Vec3f(0.f));
-        drawText(res.image, lx, ly + 20 + barH + 42, "grey = inactive", 13, Vec3f(0.f));
-    }
+    drawTitleAndLegend(res, plot, s, params.color, gridName, base->valueType());
     return res;
 }
 

@@ -62,6 +62,148 @@ bool hasInside(const openvdb::FloatGrid& grid)
     return false;
 }
 
+/// The mesh's surface area, for the band estimate (before anything is allocated).
+double meshArea(const TriangleMesh& mesh)
+{
+    double area = 0.0;
+    for (const auto& t : mesh.triangles) {
+        const Vec3d a(mesh.vertices[t[0]]), b(mesh.vertices[t[1]]), c(mesh.vertices[t[2]]);
+        area += 0.5 * (b - a).cross(c - a).length();
+    }
+    return area;
+}
+
+/// A mesh as OpenVDB's mesh-to-volume takes it.
+struct VolumeMesh
+{
+    std::vector<openvdb::Vec3s> points;
+    std::vector<openvdb::Vec3I> tris;
+};
+
+/// The mesh with vertices at identical positions welded, and the triangles that welding
+/// collapsed dropped.
+VolumeMesh weldVertices(const TriangleMesh& mesh, ScalpMeshReport& rep)
+{
+    VolumeMesh vm;
+    std::vector<std::uint32_t> remap(mesh.vertices.size());
+    {
+        std::map<std::array<float, 3>, std::uint32_t> seen;
+        for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+            const Vec3f& p = mesh.vertices[i];
+            const auto [it, inserted] = seen.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, std::uint32_t(vm.points.size()));
+            if (inserted) vm.points.push_back(p);
+            else ++rep.weldedVertices;
+            remap[i] = it->second;
+        }
+    }
+    vm.tris.reserve(mesh.triangles.size());
+    for (const auto& t : mesh.triangles) {
+        const openvdb::Vec3I w(remap[t[0]], remap[t[1]], remap[t[2]]);
+        if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;  // collapsed by welding
+        vm.tris.push_back(w);
+    }
+    return vm;
+}
+
+/// The boundary edges (of one triangle), directed as in their triangle: a -> b, and each
+/// vertex's count of boundary edges ending at it.
+struct BoundaryEdges
+{
+    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> next;
+    std::unordered_map<std::uint32_t, int> inDegree;
+};
+
+BoundaryEdges boundaryEdges(const std::vector<openvdb::Vec3I>& tris, ScalpMeshReport& rep)
+{
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> edgeUse;
+    for (const auto& t : tris) {
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+            ++edgeUse[{std::min(a, b), std::max(a, b)}];
+        }
+    }
+    BoundaryEdges be;
+    for (const auto& t : tris) {
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+            const int use = edgeUse[{std::min(a, b), std::max(a, b)}];
+            if (use == 1) {
+                be.next[a].push_back(b);
+                ++be.inDegree[b];
+            }
+        }
+    }
+    for (const auto& e : edgeUse) {
+        if (e.second == 1) ++rep.boundaryEdges;
+        if (e.second > 2) ++rep.nonManifoldEdges;
+    }
+    return be;
+}
+
+/// Cap each simple boundary loop with a fan to its centroid (in a fixed order: by start
+/// vertex), and count the edges left open: boundary edges that start on no capped loop.
+void capBoundaryLoops(VolumeMesh& vm, BoundaryEdges& be, ScalpMeshReport& rep)
+{
+    auto& next = be.next;
+    auto& inDegree = be.inDegree;
+    std::vector<std::uint32_t> starts;
+    for (const auto& kv : next) starts.push_back(kv.first);
+    std::sort(starts.begin(), starts.end());
+    std::unordered_map<std::uint32_t, bool> done;
+    std::unordered_set<std::uint32_t> cappedVertex;
+    auto simple = [&](std::uint32_t v) { return next.count(v) && next[v].size() == 1 && inDegree[v] == 1; };
+    for (std::uint32_t s : starts) {
+        if (done[s] || !simple(s)) continue;
+        std::vector<std::uint32_t> loop{s};
+        bool closed = false, ok = true;
+        std::uint32_t v = s;
+        while (true) {
+            const std::uint32_t w = next[v][0];
+            if (w == s) { closed = true; break; }
+            if (!simple(w) || done[w] || loop.size() > vm.tris.size()) { ok = false; break; }
+            loop.push_back(w);
+            v = w;
+        }
+        for (std::uint32_t u : loop) done[u] = true;
+        if (!closed || !ok || loop.size() < 3) continue;
+        Vec3d c(0.0);
+        for (std::uint32_t u : loop) c += Vec3d(vm.points[u]);
+        c /= double(loop.size());
+        const std::uint32_t ci = std::uint32_t(vm.points.size());
+        vm.points.emplace_back(float(c.x()), float(c.y()), float(c.z()));
+        for (std::size_t i = 0; i < loop.size(); ++i) {
+            // The boundary edge runs a -> b in its triangle; the cap runs b -> a.
+            vm.tris.emplace_back(loop[(i + 1) % loop.size()], loop[i], ci);
+        }
+        for (std::uint32_t u : loop) cappedVertex.insert(u);
+        ++rep.cappedLoops;
+    }
+    for (const auto& kv : next) {
+        if (!cappedVertex.count(kv.first)) rep.openEdges += kv.second.size();
+    }
+}
+
+/// OpenVDB's narrow-band level set of the mesh at voxel size @a h, checked to have an inside.
+openvdb::FloatGrid::Ptr meshLevelSet(const VolumeMesh& vm, double h, float halfWidth, const ScalpMeshReport& rep,
+                                     openvdb::util::NullInterrupter* interrupter, const std::string& where)
+{
+    const openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(h);
+    openvdb::FloatGrid::Ptr grid;
+    const std::vector<openvdb::Vec4I> quads;
+    if (interrupter) {
+        grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*interrupter, *xform, vm.points, vm.tris, quads, halfWidth);
+        if (interrupter->wasInterrupted()) throw InterruptedError(where + ": interrupted");
+    } else {
+        grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, vm.points, vm.tris, quads, halfWidth);
+    }
+    if (!hasInside(*grid)) {
+        throw FormatError(where + ": the level set has no inside: the mesh is not a closed surface (" +
+                          std::to_string(rep.boundaryEdges) + " boundary edges after welding, " + std::to_string(rep.cappedLoops) +
+                          " loops capped, " + std::to_string(rep.openEdges) + " edges on no simple loop, " +
+                          std::to_string(rep.nonManifoldEdges) + " non-manifold edges)");
+    }
+    return grid;
+}
 
 } // namespace
 
@@ -98,116 +240,13 @@ openvdb::FloatGrid::Ptr scalpFromMesh(const TriangleMesh& mesh, const ScalpParam
     const Vec3f ext = box.extent();
     if (!(std::max({ext.x(), ext.y(), ext.z()}) > 0.f)) throw ValueError(where + ": all vertices are at one position; the mesh encloses nothing");
     const double h = resolveVoxelSize(params, box, where);
-
-    // Surface area, for the band estimate (before anything is allocated).
-    double area = 0.0;
-    for (const auto& t : mesh.triangles) {
-        const Vec3d a(mesh.vertices[t[0]]), b(mesh.vertices[t[1]]), c(mesh.vertices[t[2]]);
-        area += 0.5 * (b - a).cross(c - a).length();
-    }
-    checkBandEstimate(area, h, params, where);
+    checkBandEstimate(meshArea(mesh), h, params, where);
 
     ScalpMeshReport rep;
-    // Weld vertices at identical positions.
-    std::vector<openvdb::Vec3s> points;
-    std::vector<std::uint32_t> remap(mesh.vertices.size());
-    {
-        std::map<std::array<float, 3>, std::uint32_t> seen;
-        for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-            const Vec3f& p = mesh.vertices[i];
-            const auto [it, inserted] = seen.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, std::uint32_t(points.size()));
-            if (inserted) points.push_back(p);
-            else ++rep.weldedVertices;
-            remap[i] = it->second;
-        }
-    }
-    std::vector<openvdb::Vec3I> tris;
-    tris.reserve(mesh.triangles.size());
-    for (const auto& t : mesh.triangles) {
-        const openvdb::Vec3I w(remap[t[0]], remap[t[1]], remap[t[2]]);
-        if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;  // collapsed by welding
-        tris.push_back(w);
-    }
-
-    // Boundary edges (of one triangle), directed as in their triangle.
-    std::map<std::pair<std::uint32_t, std::uint32_t>, int> edgeUse;
-    for (const auto& t : tris) {
-        for (int k = 0; k < 3; ++k) {
-            const std::uint32_t a = t[k], b = t[(k + 1) % 3];
-            ++edgeUse[{std::min(a, b), std::max(a, b)}];
-        }
-    }
-    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> next;  // boundary a -> b
-    std::unordered_map<std::uint32_t, int> inDegree;
-    for (const auto& t : tris) {
-        for (int k = 0; k < 3; ++k) {
-            const std::uint32_t a = t[k], b = t[(k + 1) % 3];
-            const int use = edgeUse[{std::min(a, b), std::max(a, b)}];
-            if (use == 1) {
-                next[a].push_back(b);
-                ++inDegree[b];
-            }
-        }
-    }
-    for (const auto& e : edgeUse) {
-        if (e.second == 1) ++rep.boundaryEdges;
-        if (e.second > 2) ++rep.nonManifoldEdges;
-    }
-
-    // Cap each simple boundary loop with a fan to its centroid (in a fixed order: by start vertex).
-    std::vector<std::uint32_t> starts;
-    for (const auto& kv : next) starts.push_back(kv.first);
-    std::sort(starts.begin(), starts.end());
-    std::unordered_map<std::uint32_t, bool> done;
-    std::unordered_set<std::uint32_t> cappedVertex;
-    auto simple = [&](std::uint32_t v) { return next.count(v) && next[v].size() == 1 && inDegree[v] == 1; };
-    for (std::uint32_t s : starts) {
-        if (done[s] || !simple(s)) continue;
-        std::vector<std::uint32_t> loop{s};
-        bool closed = false, ok = true;
-        std::uint32_t v = s;
-        while (true) {
-            const std::uint32_t w = next[v][0];
-            if (w == s) { closed = true; break; }
-            if (!simple(w) || done[w] || loop.size() > tris.size()) { ok = false; break; }
-            loop.push_back(w);
-            v = w;
-        }
-        for (std::uint32_t u : loop) done[u] = true;
-        if (!closed || !ok || loop.size() < 3) continue;
-        Vec3d c(0.0);
-        for (std::uint32_t u : loop) c += Vec3d(points[u]);
-        c /= double(loop.size());
-        const std::uint32_t ci = std::uint32_t(points.size());
-        points.emplace_back(float(c.x()), float(c.y()), float(c.z()));
-        for (std::size_t i = 0; i < loop.size(); ++i) {
-            // The boundary edge runs a -> b in its triangle; the cap runs b -> a.
-            tris.emplace_back(loop[(i + 1) % loop.size()], loop[i], ci);
-        }
-        for (std::uint32_t u : loop) cappedVertex.insert(u);
-        ++rep.cappedLoops;
-    }
-    // Edges left open: boundary edges that start on no capped loop.
-    for (const auto& kv : next) {
-        if (!cappedVertex.count(kv.first)) rep.openEdges += kv.second.size();
-    }
-
-    // The level set.
-    const openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(h);
-    openvdb::FloatGrid::Ptr grid;
-    const std::vector<openvdb::Vec4I> quads;
-    if (interrupter) {
-        grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*interrupter, *xform, points, tris, quads, params.halfWidth);
-        if (interrupter->wasInterrupted()) throw InterruptedError(where + ": interrupted");
-    } else {
-        grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, points, tris, quads, params.halfWidth);
-    }
-    if (!hasInside(*grid)) {
-        throw FormatError(where + ": the level set has no inside: the mesh is not a closed surface (" +
-                          std::to_string(rep.boundaryEdges) + " boundary edges after welding, " + std::to_string(rep.cappedLoops) +
-                          " loops capped, " + std::to_string(rep.openEdges) + " edges on no simple loop, " +
-                          std::to_string(rep.nonManifoldEdges) + " non-manifold edges)");
-    }
+    VolumeMesh vm = weldVertices(mesh, rep);
+    BoundaryEdges be = boundaryEdges(vm.tris, rep);
+    capBoundaryLoops(vm, be, rep);
+    const openvdb::FloatGrid::Ptr grid = meshLevelSet(vm, h, params.halfWidth, rep, interrupter, where);
     stampScalpGrid(*grid, "mesh", params);
     grid->insertMeta("vdbhair_capped_loops", openvdb::Int64Metadata(std::int64_t(rep.cappedLoops)));
     if (report) *report = rep;

@@ -163,6 +163,215 @@ std::uint32_t matchStrand(const StrandIndex& to, const Thresholds& th, const Vec
     return bits;
 }
 
+/// The thresholds at which any oriented point of @a to matches vertex @a v of @a from: the
+/// strand that matched the point before first (a strand's neighbours run beside it), then the
+/// grid out to the largest distance of the thresholds still unmatched, until every threshold
+/// matches. @a lastStrand and @a hint carry the last match from point to point.
+std::uint32_t matchAnyPoint(const StrandIndex& from, const StrandIndex& to, const Thresholds& th, std::size_t v,
+                            std::uint32_t& lastStrand, std::size_t& hint)
+{
+    const std::size_t T = th.distance2.size();
+    const Vec3d p = Vec3d(from.strands().positions[v]), u = Vec3d(from.direction(v));
+    std::uint32_t bits = lastStrand != ~0u ? matchStrand(to, th, p, u, lastStrand, hint, th.all) : 0u;
+    if (bits == th.all) return bits;
+    double radius2 = 0.0;
+    for (std::size_t t = 0; t < T; ++t) {
+        if (!((bits >> t) & 1u)) radius2 = std::max(radius2, th.distance2[t]);
+    }
+    to.grid().forEachWithin(p, std::sqrt(radius2), [&](std::uint32_t w, double d2) {
+        if (!to.oriented(w)) return true;
+        const std::uint32_t b = th.bits(d2, u, to.direction(w));
+        if (b & ~bits) {
+            bits |= b;
+            lastStrand = to.strandOf(w);
+            hint = w;
+        }
+        return bits != th.all;
+    });
+    return bits;
+}
+
+/// One strand's consistency at each threshold, exactly (matchShare() explains the bound): the
+/// most of its oriented points that match one and the same strand of @a to. Holds the scratch of
+/// one thread, reused from strand to strand.
+class ConsistencyCounter
+{
+public:
+    /// @param matched per vertex of @a from, the thresholds at which it matches at all
+    ConsistencyCounter(const StrandIndex& from, const StrandIndex& to, const Thresholds& th, const std::vector<std::uint32_t>& matched)
+        : mFrom(from), mTo(to), mTh(th), mMatched(matched), mXf(from.strands().positions), T(th.distance2.size()),
+          best(T), count(T), partial(T), listedAt(T), matchedAt(T), left(T)
+    {
+    }
+
+    /// Each threshold's best count of the strand whose oriented points are @a points (not empty).
+    const std::vector<std::size_t>& bestCounts(const std::vector<std::size_t>& points)
+    {
+        mPoints = &points;
+        n = points.size();
+        // M_t points match at t, and no strand can count more.
+        std::fill(matchedAt.begin(), matchedAt.end(), 0);
+        for (const std::size_t v : points) {
+            for (std::size_t t = 0; t < T; ++t) matchedAt[t] += (mMatched[v] >> t) & 1u;
+        }
+        countLikelyStrands();
+        const std::uint32_t complete = listMatches();
+        countListedStrands(complete);
+        return best;
+    }
+
+private:
+    /// Strand q's matches of this strand's points at the thresholds of @a want, counted over the
+    /// points that match at all, exactly as long as q can still beat the best count (a threshold
+    /// is dropped once it cannot); the counts raise the best.
+    void countStrand(std::uint32_t q, std::uint32_t want)
+    {
+        const std::vector<std::size_t>& points = *mPoints;
+        std::fill(count.begin(), count.end(), 0);
+        left = matchedAt;
+        std::size_t h = ~std::size_t(0);
+        for (std::size_t k = 0; k < n && want; ++k) {
+            const std::size_t v = points[k];
+            const std::uint32_t here = mMatched[v] & want;
+            if (!here) continue;
+            const std::uint32_t b = matchStrand(mTo, mTh, Vec3d(mXf[v]), Vec3d(mFrom.direction(v)), q, h, here);
+            for (std::uint32_t t = 0, m = here; m; ++t, m >>= 1) {
+                if (!(m & 1u)) continue;
+                count[t] += (b >> t) & 1u;
+                --left[t];
+                if (count[t] + left[t] <= best[t]) want &= ~(1u << t);
+            }
+        }
+        for (std::size_t t = 0; t < T; ++t) best[t] = std::max(best[t], count[t]);
+    }
+
+    /// L_t: the strands nearest the middle, the root and the tip, counted exactly.
+    void countLikelyStrands()
+    {
+        const std::vector<std::size_t>& points = *mPoints;
+        const auto settled = [&](std::size_t t) { return best[t] == matchedAt[t]; };
+        std::fill(best.begin(), best.end(), 0);
+        likely.clear();
+        for (const std::size_t k : {n / 2, std::size_t(0), n - 1}) {
+            std::uint32_t want = 0;
+            for (std::size_t t = 0; t < T; ++t) want |= settled(t) ? 0u : 1u << t;
+            if (!want) break;
+            double d2 = std::numeric_limits<double>::infinity();
+            const std::uint32_t w = mTo.grid().nearest(Vec3d(mXf[points[k]]), d2);
+            if (w == ~0u) break;
+            const std::uint32_t q = mTo.strandOf(w);
+            if (std::find(likely.begin(), likely.end(), q) != likely.end()) continue;
+            likely.push_back(q);
+            countStrand(q, want);
+        }
+    }
+
+    /// A strand that counts more than L_t at t matches one of any M_t - L_t of the points that
+    /// match at t: every match of the first M_t - L_t of them finds all such strands, listed as
+    /// strandHits. When that is half of them or more, listing all of them is cheaper than
+    /// counting the strands found, and their counts come from the listing itself: those
+    /// thresholds are the bits returned.
+    std::uint32_t listMatches()
+    {
+        const std::vector<std::size_t>& points = *mPoints;
+        std::size_t listing = 0;
+        std::uint32_t complete = 0;
+        for (std::size_t t = 0; t < T; ++t) {
+            listedAt[t] = matchedAt[t] - best[t];
+            if (listedAt[t] > 0 && 2 * listedAt[t] >= matchedAt[t]) {
+                listedAt[t] = matchedAt[t];
+                complete |= 1u << t;
+            }
+            listing += listedAt[t];
+        }
+        strandHits.clear();
+        std::fill(partial.begin(), partial.end(), 0);  // here: the points listed so far at each t
+        for (std::size_t k = 0; k < n && listing; ++k) {
+            const std::size_t v = points[k];
+            std::uint32_t active = 0;  // the thresholds still listing at this point
+            double radius2 = 0.0;
+            for (std::size_t t = 0; t < T; ++t) {
+                if (!((mMatched[v] >> t) & 1u) || partial[t] == listedAt[t]) continue;
+                active |= 1u << t;
+                radius2 = std::max(radius2, mTh.distance2[t]);
+                ++partial[t];
+                --listing;
+            }
+            if (!active) continue;
+            const Vec3d u = Vec3d(mFrom.direction(v));
+            pointHits.clear();
+            mTo.grid().forEachWithin(Vec3d(mXf[v]), std::sqrt(radius2), [&](std::uint32_t w, double d2) {
+                if (!mTo.oriented(w)) return true;
+                const std::uint32_t b = mTh.bits(d2, u, mTo.direction(w)) & active;
+                for (std::uint32_t t = 0, m = b; m; ++t, m >>= 1) {
+                    if (m & 1u) pointHits.push_back(std::uint64_t(mTo.strandOf(w)) << 32 | t);
+                }
+                return true;
+            });
+            // A point counts each strand it matches once.
+            std::sort(pointHits.begin(), pointHits.end());
+            pointHits.erase(std::unique(pointHits.begin(), pointHits.end()), pointHits.end());
+            strandHits.insert(strandHits.end(), pointHits.begin(), pointHits.end());
+        }
+        return complete;
+    }
+
+    /// Per strand found: its matches among the listed points bound what it can count; those
+    /// that can beat L are counted exactly.
+    void countListedStrands(std::uint32_t complete)
+    {
+        std::sort(strandHits.begin(), strandHits.end());
+        for (std::size_t a = 0; a < strandHits.size();) {
+            const std::uint32_t q = std::uint32_t(strandHits[a] >> 32);
+            std::fill(partial.begin(), partial.end(), 0);
+            std::size_t b = a;
+            for (; b < strandHits.size() && std::uint32_t(strandHits[b] >> 32) == q; ++b) ++partial[strandHits[b] & 0xffffffffu];
+            a = b;
+            std::uint32_t want = 0;
+            for (std::size_t t = 0; t < T; ++t) {
+                if ((complete >> t) & 1u) best[t] = std::max(best[t], partial[t]);  // the exact count
+                else want |= partial[t] + (matchedAt[t] - listedAt[t]) > best[t] ? 1u << t : 0u;
+            }
+            if (want && std::find(likely.begin(), likely.end(), q) == likely.end()) countStrand(q, want);  // else counted already
+        }
+    }
+
+    const StrandIndex& mFrom;
+    const StrandIndex& mTo;
+    const Thresholds& mTh;
+    const std::vector<std::uint32_t>& mMatched;
+    const std::vector<Vec3f>& mXf;
+    const std::size_t T;
+    const std::vector<std::size_t>* mPoints = nullptr;  ///< the strand's oriented points (vertex indices)
+    std::size_t n = 0;                                   ///< their count
+    std::vector<std::uint64_t> strandHits;  ///< strand << 32 | threshold, one per listed point that matches
+    std::vector<std::uint64_t> pointHits;   ///< the same, for one point
+    std::vector<std::uint32_t> likely;
+    std::vector<std::size_t> best, count, partial, listedAt, matchedAt, left;
+};
+
+/// The mean over the strands of @a from with an oriented point of their consistency (S x T, in
+/// strand order), per threshold.
+void meanConsistency(const StrandIndex& from, const std::vector<double>& strandConsistency, std::size_t T, std::vector<double>& consistency)
+{
+    const StrandSet& fs = from.strands();
+    const std::size_t S = fs.numStrands();
+    std::size_t strands = 0;  // with an oriented point
+    for (std::size_t s = 0; s < S; ++s) {
+        for (std::size_t v = fs.begin(s); v < fs.end(s); ++v) {
+            if (from.oriented(v)) {
+                ++strands;
+                break;
+            }
+        }
+    }
+    for (std::size_t t = 0; t < T; ++t) {
+        double sum = 0.0;
+        for (std::size_t s = 0; s < S; ++s) sum += strandConsistency[s * T + t];  // in strand order
+        consistency[t] = strands ? sum / double(strands) : 0.0;
+    }
+}
+
 /// For every oriented point of @a from, whether one of @a to matches it at each threshold (the
 /// share matched, per threshold); and with @a consistency, each strand of @a from's consistency at
 /// each threshold: the most of its points that match one and the same strand of @a to.
@@ -189,153 +398,23 @@ void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vecto
     reserveHugePages(matched, fs.numVertices());
     matched.assign(fs.numVertices(), 0);
     std::vector<double> strandConsistency(consistency ? S * T : 0);
-    const std::vector<Vec3f>& xf = fs.positions;
-
-    // The thresholds at which any oriented point of @a to matches vertex v: the strand that matched
-    // the point before first (a strand's neighbours run beside it), then the grid out to the
-    // largest distance of the thresholds still unmatched, until every threshold matches.
-    auto matchAny = [&](std::size_t v, std::uint32_t& lastStrand, std::size_t& hint) {
-        const Vec3d p = Vec3d(xf[v]), u = Vec3d(from.direction(v));
-        std::uint32_t bits = lastStrand != ~0u ? matchStrand(to, th, p, u, lastStrand, hint, th.all) : 0u;
-        if (bits == th.all) return bits;
-        double radius2 = 0.0;
-        for (std::size_t t = 0; t < T; ++t) {
-            if (!((bits >> t) & 1u)) radius2 = std::max(radius2, th.distance2[t]);
-        }
-        to.grid().forEachWithin(p, std::sqrt(radius2), [&](std::uint32_t w, double d2) {
-            if (!to.oriented(w)) return true;
-            const std::uint32_t b = th.bits(d2, u, to.direction(w));
-            if (b & ~bits) {
-                bits |= b;
-                lastStrand = to.strandOf(w);
-                hint = w;
-            }
-            return bits != th.all;
-        });
-        return bits;
-    };
 
     forEachRange(S, threaded, 16, [&](const tbb::blocked_range<std::size_t>& range) {
-        std::vector<std::size_t> points;         // the strand's oriented points (vertex indices)
-        std::vector<std::uint64_t> strandHits;  // strand << 32 | threshold, one per listed point that matches
-        std::vector<std::uint64_t> pointHits;   // the same, for one point
-        std::vector<std::uint32_t> likely;
-        std::vector<std::size_t> best(T), count(T), partial(T), listedAt(T), matchedAt(T), left(T);
+        std::vector<std::size_t> points;  // the strand's oriented points (vertex indices)
+        ConsistencyCounter counter(from, to, th, matched);
         for (std::size_t o = range.begin(); o != range.end(); ++o) {
             const std::size_t s = from.spatialOrder()[o];
             points.clear();
             for (std::size_t v = fs.begin(s); v < fs.end(s); ++v) {
                 if (from.oriented(v)) points.push_back(v);
             }
-            const std::size_t n = points.size();
-            if (n == 0) continue;
-            // Which thresholds each point matches at all: M_t points match at t, and no strand
-            // can count more.
+            if (points.empty()) continue;
             std::uint32_t lastStrand = ~0u;
             std::size_t hint = ~std::size_t(0);
-            for (const std::size_t v : points) matched[v] = matchAny(v, lastStrand, hint);
+            for (const std::size_t v : points) matched[v] = matchAnyPoint(from, to, th, v, lastStrand, hint);
             if (!consistency) continue;
-            std::fill(matchedAt.begin(), matchedAt.end(), 0);
-            for (const std::size_t v : points) {
-                for (std::size_t t = 0; t < T; ++t) matchedAt[t] += (matched[v] >> t) & 1u;
-            }
-            // Strand q's matches of this strand's points at the thresholds of @a want, counted
-            // over the points that match at all, exactly as long as q can still beat the best
-            // count (a threshold is dropped once it cannot); the counts raise the best.
-            auto countStrand = [&](std::uint32_t q, std::uint32_t want) {
-                std::fill(count.begin(), count.end(), 0);
-                left = matchedAt;
-                std::size_t h = ~std::size_t(0);
-                for (std::size_t k = 0; k < n && want; ++k) {
-                    const std::size_t v = points[k];
-                    const std::uint32_t here = matched[v] & want;
-                    if (!here) continue;
-                    const std::uint32_t b = matchStrand(to, th, Vec3d(xf[v]), Vec3d(from.direction(v)), q, h, here);
-                    for (std::uint32_t t = 0, m = here; m; ++t, m >>= 1) {
-                        if (!(m & 1u)) continue;
-                        count[t] += (b >> t) & 1u;
-                        --left[t];
-                        if (count[t] + left[t] <= best[t]) want &= ~(1u << t);
-                    }
-                }
-                for (std::size_t t = 0; t < T; ++t) best[t] = std::max(best[t], count[t]);
-            };
-            auto settled = [&](std::size_t t) { return best[t] == matchedAt[t]; };
-            // L_t: the strands nearest the middle, the root and the tip, counted exactly.
-            std::fill(best.begin(), best.end(), 0);
-            likely.clear();
-            for (const std::size_t k : {n / 2, std::size_t(0), n - 1}) {
-                std::uint32_t want = 0;
-                for (std::size_t t = 0; t < T; ++t) want |= settled(t) ? 0u : 1u << t;
-                if (!want) break;
-                double d2 = std::numeric_limits<double>::infinity();
-                const std::uint32_t w = to.grid().nearest(Vec3d(xf[points[k]]), d2);
-                if (w == ~0u) break;
-                const std::uint32_t q = to.strandOf(w);
-                if (std::find(likely.begin(), likely.end(), q) != likely.end()) continue;
-                likely.push_back(q);
-                countStrand(q, want);
-            }
-            // A strand that counts more than L_t at t matches one of any M_t - L_t of the points
-            // that match at t: every match of the first M_t - L_t of them finds all such strands.
-            // When that is half of them or more, listing all of them is cheaper than counting the
-            // strands found, and their counts come from the listing itself.
-            std::size_t listing = 0;
-            std::uint32_t complete = 0;
-            for (std::size_t t = 0; t < T; ++t) {
-                listedAt[t] = matchedAt[t] - best[t];
-                if (listedAt[t] > 0 && 2 * listedAt[t] >= matchedAt[t]) {
-                    listedAt[t] = matchedAt[t];
-                    complete |= 1u << t;
-                }
-                listing += listedAt[t];
-            }
-            strandHits.clear();
-            std::fill(partial.begin(), partial.end(), 0);  // here: the points listed so far at each t
-            for (std::size_t k = 0; k < n && listing; ++k) {
-                const std::size_t v = points[k];
-                std::uint32_t active = 0;  // the thresholds still listing at this point
-                double radius2 = 0.0;
-                for (std::size_t t = 0; t < T; ++t) {
-                    if (!((matched[v] >> t) & 1u) || partial[t] == listedAt[t]) continue;
-                    active |= 1u << t;
-                    radius2 = std::max(radius2, th.distance2[t]);
-                    ++partial[t];
-                    --listing;
-                }
-                if (!active) continue;
-                const Vec3d u = Vec3d(from.direction(v));
-                pointHits.clear();
-                to.grid().forEachWithin(Vec3d(xf[v]), std::sqrt(radius2), [&](std::uint32_t w, double d2) {
-                    if (!to.oriented(w)) return true;
-                    const std::uint32_t b = th.bits(d2, u, to.direction(w)) & active;
-                    for (std::uint32_t t = 0, m = b; m; ++t, m >>= 1) {
-                        if (m & 1u) pointHits.push_back(std::uint64_t(to.strandOf(w)) << 32 | t);
-                    }
-                    return true;
-                });
-                // A point counts each strand it matches once.
-                std::sort(pointHits.begin(), pointHits.end());
-                pointHits.erase(std::unique(pointHits.begin(), pointHits.end()), pointHits.end());
-                strandHits.insert(strandHits.end(), pointHits.begin(), pointHits.end());
-            }
-            // Per strand found: its matches among the listed points bound what it can count; those
-            // that can beat L are counted exactly.
-            std::sort(strandHits.begin(), strandHits.end());
-            for (std::size_t a = 0; a < strandHits.size();) {
-                const std::uint32_t q = std::uint32_t(strandHits[a] >> 32);
-                std::fill(partial.begin(), partial.end(), 0);
-                std::size_t b = a;
-                for (; b < strandHits.size() && std::uint32_t(strandHits[b] >> 32) == q; ++b) ++partial[strandHits[b] & 0xffffffffu];
-                a = b;
-                std::uint32_t want = 0;
-                for (std::size_t t = 0; t < T; ++t) {
-                    if ((complete >> t) & 1u) best[t] = std::max(best[t], partial[t]);  // the exact count
-                    else want |= partial[t] + (matchedAt[t] - listedAt[t]) > best[t] ? 1u << t : 0u;
-                }
-                if (want && std::find(likely.begin(), likely.end(), q) == likely.end()) countStrand(q, want);  // else counted already
-            }
-            for (std::size_t t = 0; t < T; ++t) strandConsistency[s * T + t] = double(best[t]) / double(n);
+            const std::vector<std::size_t>& best = counter.bestCounts(points);
+            for (std::size_t t = 0; t < T; ++t) strandConsistency[s * T + t] = double(best[t]) / double(points.size());
         }
     });
     const std::size_t N = from.orientedPoints();
@@ -344,21 +423,7 @@ void matchShare(const StrandIndex& from, const StrandIndex& to, const std::vecto
         for (std::size_t v = 0; v < matched.size(); ++v) c += (matched[v] >> t) & 1u;
         share[t] = N ? double(c) / double(N) : 0.0;
     }
-    if (!consistency) return;
-    std::size_t strands = 0;  // with an oriented point
-    for (std::size_t s = 0; s < S; ++s) {
-        for (std::size_t v = fs.begin(s); v < fs.end(s); ++v) {
-            if (from.oriented(v)) {
-                ++strands;
-                break;
-            }
-        }
-    }
-    for (std::size_t t = 0; t < T; ++t) {
-        double sum = 0.0;
-        for (std::size_t s = 0; s < S; ++s) sum += strandConsistency[s * T + t];  // in strand order
-        (*consistency)[t] = strands ? sum / double(strands) : 0.0;
-    }
+    if (consistency) meanConsistency(from, strandConsistency, T, *consistency);
 }
 
 } // namespace

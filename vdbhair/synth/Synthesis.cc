@@ -73,6 +73,148 @@ FeatureImage filledFeatureImage(const FeatureImage& in)
     return filled;
 }
 
+/// The output region in scalp space (empty without one). On another scalp, each point's (u, v)
+/// is turned back by @a outputTurn (moveToScalp turns the hairstyle forward at the end).
+std::vector<Vec3d> regionInScalpSpace(const std::vector<Vec3d>* outputRegion, const ScalpMap* outputScalp, const ScalpMap& map,
+                                      double outputTurn)
+{
+    std::vector<Vec3d> regionUv;
+    if (!outputRegion) return regionUv;
+    regionUv.reserve(outputRegion->size());
+    const double c = std::cos(outputTurn), sn = std::sin(outputTurn);
+    const ScalpSphere unit;
+    for (const Vec3d& p : *outputRegion) {
+        if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) throw ValueError("synthesizeHair: a point of the output region is not finite");
+        Vec3d uvw = outputScalp ? outputScalp->toScalp(p) : map.toScalp(p);
+        if (outputScalp && outputTurn != 0.0) {
+            const Vec3d d = scalpToWorld(unit, Vec3d(uvw.x(), uvw.y(), 0.0));
+            uvw = worldToScalp(unit, Vec3d(c * d.x() - sn * d.z(), d.y(), sn * d.x() + c * d.z()));
+        }
+        regionUv.push_back(uvw);
+    }
+    return regionUv;
+}
+
+/// Step 4, the feature maps: the coarsest level's PCA, the uv grid around the example (and the
+/// output region), the example's feature map and, with an output region, its mask. Returns the
+/// output region's area over the example's (1 without a region).
+double buildFeatureMaps(SynthResult& res, const SynthParams& params, const std::vector<Vec3d>& regionUv, bool hasRegion,
+                        std::vector<std::uint8_t>& outputMask)
+{
+    const StrandSamples& finest = res.example.levels.front();
+    const StrandSamples& coarsest = res.example.levels.back();
+    res.pca = fitPca(coarsest.local.data(), coarsest.count(), coarsest.dim(), params.components);
+    const int nf = res.pca.components;
+    std::vector<float> features(coarsest.count() * std::size_t(nf));
+    for (std::size_t s = 0; s < coarsest.count(); ++s) res.pca.project(coarsest.row(s), features.data() + s * std::size_t(nf));
+    std::vector<Vec3d> covered = finest.scalp;
+    covered.insert(covered.end(), regionUv.begin(), regionUv.end());
+    res.grid = uvGridAround(covered, params.mapSpacing);
+    const double maskRadius = std::max(params.mapSpacing, 2.0 * medianUvSpacing(finest.scalp));
+    res.inputMap = buildFeatureMap(res.grid, coarsest.scalp, features.data(), nf, finest.scalp, maskRadius);
+    if (!hasRegion) return 1.0;
+    outputMask = uvMask(res.grid, regionUv, std::max(params.mapSpacing, 2.0 * medianUvSpacing(regionUv)));
+    FeatureImage mask(res.grid.width, res.grid.height, 1);
+    mask.valid = outputMask;
+    const double exampleArea = regionArea(*res.map, res.grid, res.inputMap), outputArea = regionArea(*res.map, res.grid, mask);
+    if (!(outputArea > 0.0)) throw ValueError("synthesizeHair: the output region covers no pixel of the feature map");
+    res.outputArea = outputArea;
+    return exampleArea > 0.0 ? outputArea / exampleArea : 1.0;
+}
+
+/// Output strands per level (the example's density over the output region), checked against
+/// the vertex cap before any output is made.
+std::vector<std::size_t> outputCounts(const ClusterHierarchy& example, const SynthParams& params, double areaRatio)
+{
+    const int L = params.cluster.levels;
+    const double scale = params.strands > 0 ? double(params.strands) / double(example.levels.front().count()) : params.strandScale * areaRatio;
+    std::vector<std::size_t> counts(static_cast<std::size_t>(L));
+    for (int l = 0; l < L; ++l)
+        counts[std::size_t(l)] = std::max<std::size_t>(1, std::size_t(std::llround(double(example.levels[std::size_t(l)].count()) * scale)));
+    if (double(counts[0]) * params.vertices > double(params.maxVertices))
+        throw LimitError("synthesizeHair: " + std::to_string(counts[0]) + " strands of " + std::to_string(params.vertices) +
+                         " vertices exceed the cap of " + std::to_string(params.maxVertices) + " vertices");
+    return counts;
+}
+
+/// The output feature map by texture optimization of the example's, with two guidance channels
+/// holding each pixel's own place (see SynthParams::placeWeight). The output region is the
+/// example's.
+FeatureImage synthesizeFeatureMap(SynthResult& res, const SynthParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter)
+{
+    TextureParams tp = params.texture;
+    tp.seed = params.seed;
+    const FeatureImage& in = res.inputMap;
+    const int C = in.channels, G = params.placeWeight > 0.0 ? 2 : 0;
+    double variance = 0.0;
+    std::size_t valid = 0;
+    for (int y = 0; y < in.height; ++y)
+        for (int x = 0; x < in.width; ++x)
+            if (in.isValid(x, y)) {
+                ++valid;
+                for (int ch = 0; ch < C; ++ch) variance += double(in.pixel(x, y)[ch]) * in.pixel(x, y)[ch];
+            }
+    const double sigma = valid ? std::sqrt(variance / double(valid)) : 1.0;
+    const double reach = std::max(1.0, tp.nearbyRadius * double(std::max(in.width, in.height)));
+    const float scale = float(params.placeWeight * (sigma > 0.0 ? sigma : 1.0) / reach);
+    // The example's invalid pixels take the value of the nearest valid one (breadth-first
+    // from the valid pixels, 4-neighbours, in index order) and count as valid: output windows
+    // at the region's edge then match windows that continue the edge outward instead of
+    // windows from inside, which averaged the edge's extremes away.
+    const FeatureImage filled = filledFeatureImage(in);
+    FeatureImage guided(in.width, in.height, C + G);
+    for (int y = 0; y < in.height; ++y)
+        for (int x = 0; x < in.width; ++x) {
+            std::copy_n(filled.pixel(x, y), C, guided.pixel(x, y));
+            if (G) {
+                guided.pixel(x, y)[C] = float(x) * scale;
+                guided.pixel(x, y)[C + 1] = float(y) * scale;
+            }
+        }
+    const FeatureImage out = synthesizeTexture(guided, res.grid.width, res.grid.height, tp, &res.texture, threaded, interrupter);
+    FeatureImage outputMap(out.width, out.height, C);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x) std::copy_n(out.pixel(x, y), C, outputMap.pixel(x, y));
+    outputMap.valid = in.valid;
+    return outputMap;
+}
+
+/// Roots of output level @a l, scattered over the output map: its own random stream per level.
+ScatteredRoots scatterLevelRoots(const SynthResult& res, const SynthParams& params, std::size_t count, int l, bool threaded)
+{
+    RootScatterParams rp;
+    rp.count = count;
+    rp.iterations = params.rootIterations;
+    rp.seed = params.seed;
+    rp.stream = std::uint64_t(l);
+    return scatterRoots(*res.map, res.grid, res.outputMap, rp, threaded);
+}
+
+/// Step 5, the coarsest level from the synthesized map: at each root, the PCA reconstruction of
+/// the nearest feature, its root at the root.
+void synthesizeCoarsestLevel(SynthResult& res, const SynthParams& params, const ScatteredRoots& roots)
+{
+    const ScalpMap& map = *res.map;
+    const double radius = map.radius();
+    const StrandSamples& coarsest = res.example.levels.back();
+    StrandSamples& level = res.output.back();
+    level.vertices = params.vertices;
+    std::vector<float> f(std::size_t(res.pca.components)), row(coarsest.dim());
+    for (std::size_t i = 0; i < roots.positions.size(); ++i) {
+        if (!nearestFeature(res.outputMap, res.grid, roots.scalp[i].x(), roots.scalp[i].y(), f.data()))
+            throw ValueError("synthesizeHair: the output feature map has no valid pixel");
+        res.pca.reconstruct(f.data(), row.data());
+        row[0] = row[1] = row[2] = 0.0f;  // the root is the root
+        double len = 0.0;
+        for (int v = 1; v < params.vertices; ++v)
+            len += std::sqrt(double(row[3 * v] - row[3 * v - 3]) * (row[3 * v] - row[3 * v - 3]) +
+                             double(row[3 * v + 1] - row[3 * v - 2]) * (row[3 * v + 1] - row[3 * v - 2]) +
+                             double(row[3 * v + 2] - row[3 * v - 1]) * (row[3 * v + 2] - row[3 * v - 1]));
+        level.push(row.data(), roots.positions[i], roots.scalp[i], map.frame(roots.scalp[i].x(), roots.scalp[i].y()),
+                   float(len * radius));
+    }
+}
+
 } // namespace
 
 SynthStageTimer::~SynthStageTimer()
@@ -113,147 +255,44 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
         SynthStageTimer t{res.stages, "scalp"};
         res.map = hairScalpMap(example, params.up, scalp, &res.up);
     }
-    const ScalpMap& map = *res.map;
-    const double radius = map.radius();
     // 2-3. Samples and the example's hierarchy.
     {
         SynthStageTimer t{res.stages, "clustering"};
-        res.example = hairHierarchy(example, map, params, threaded, interrupter);
+        res.example = hairHierarchy(example, *res.map, params, threaded, interrupter);
     }
-    const StrandSamples& finest = res.example.levels.front();
-    const StrandSamples& coarsest = res.example.levels.back();
     // The output region in scalp space (the example's when none is given).
-    std::vector<Vec3d> regionUv;
-    if (outputRegion) {
-        regionUv.reserve(outputRegion->size());
-        // On another scalp, each point's (u, v) turned back by outputTurn (moveToScalp turns the
-        // hairstyle forward at the end).
-        const double c = std::cos(params.outputTurn), sn = std::sin(params.outputTurn);
-        const ScalpSphere unit;
-        for (const Vec3d& p : *outputRegion) {
-            if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) throw ValueError("synthesizeHair: a point of the output region is not finite");
-            Vec3d uvw = outputScalp ? outputScalp->toScalp(p) : map.toScalp(p);
-            if (outputScalp && params.outputTurn != 0.0) {
-                const Vec3d d = scalpToWorld(unit, Vec3d(uvw.x(), uvw.y(), 0.0));
-                uvw = worldToScalp(unit, Vec3d(c * d.x() - sn * d.z(), d.y(), sn * d.x() + c * d.z()));
-            }
-            regionUv.push_back(uvw);
-        }
-    }
+    const std::vector<Vec3d> regionUv = regionInScalpSpace(outputRegion, outputScalp.get(), *res.map, params.outputTurn);
     // 4. Feature maps.
     std::vector<std::uint8_t> outputMask;
     double areaRatio = 1.0;
     {
         SynthStageTimer t{res.stages, "feature maps"};
-        res.pca = fitPca(coarsest.local.data(), coarsest.count(), coarsest.dim(), params.components);
-        const int nf = res.pca.components;
-        std::vector<float> features(coarsest.count() * std::size_t(nf));
-        for (std::size_t s = 0; s < coarsest.count(); ++s) res.pca.project(coarsest.row(s), features.data() + s * std::size_t(nf));
-        std::vector<Vec3d> covered = finest.scalp;
-        covered.insert(covered.end(), regionUv.begin(), regionUv.end());
-        res.grid = uvGridAround(covered, params.mapSpacing);
-        const double maskRadius = std::max(params.mapSpacing, 2.0 * medianUvSpacing(finest.scalp));
-        res.inputMap = buildFeatureMap(res.grid, coarsest.scalp, features.data(), nf, finest.scalp, maskRadius);
-        if (outputRegion) {
-            outputMask = uvMask(res.grid, regionUv, std::max(params.mapSpacing, 2.0 * medianUvSpacing(regionUv)));
-            FeatureImage mask(res.grid.width, res.grid.height, 1);
-            mask.valid = outputMask;
-            const double exampleArea = regionArea(map, res.grid, res.inputMap), outputArea = regionArea(map, res.grid, mask);
-            if (!(outputArea > 0.0)) throw ValueError("synthesizeHair: the output region covers no pixel of the feature map");
-            areaRatio = exampleArea > 0.0 ? outputArea / exampleArea : 1.0;
-            res.outputArea = outputArea;
-        }
+        areaRatio = buildFeatureMaps(res, params, regionUv, outputRegion != nullptr, outputMask);
     }
-    // Output counts per level (the example's density over the output region) and the memory
-    // estimate, before any output is made.
-    const double scale = params.strands > 0 ? double(params.strands) / double(finest.count()) : params.strandScale * areaRatio;
-    std::vector<std::size_t> counts(static_cast<std::size_t>(L));
-    for (int l = 0; l < L; ++l)
-        counts[std::size_t(l)] = std::max<std::size_t>(1, std::size_t(std::llround(double(res.example.levels[std::size_t(l)].count()) * scale)));
-    if (double(counts[0]) * params.vertices > double(params.maxVertices))
-        throw LimitError("synthesizeHair: " + std::to_string(counts[0]) + " strands of " + std::to_string(params.vertices) +
-                         " vertices exceed the cap of " + std::to_string(params.maxVertices) + " vertices");
+    const std::vector<std::size_t> counts = outputCounts(res.example, params, areaRatio);
     {
         SynthStageTimer t{res.stages, "texture optimization"};
         if (params.layout == SynthLayout::Example) {
             res.outputMap = outputRegion ? filledFeatureImage(res.inputMap) : res.inputMap;
         } else {
-        TextureParams tp = params.texture;
-        tp.seed = params.seed;
-        // Two guidance channels hold each pixel's own place (see SynthParams::placeWeight).
-        const FeatureImage& in = res.inputMap;
-        const int C = in.channels, G = params.placeWeight > 0.0 ? 2 : 0;
-        double variance = 0.0;
-        std::size_t valid = 0;
-        for (int y = 0; y < in.height; ++y)
-            for (int x = 0; x < in.width; ++x)
-                if (in.isValid(x, y)) {
-                    ++valid;
-                    for (int ch = 0; ch < C; ++ch) variance += double(in.pixel(x, y)[ch]) * in.pixel(x, y)[ch];
-                }
-        const double sigma = valid ? std::sqrt(variance / double(valid)) : 1.0;
-        const double reach = std::max(1.0, tp.nearbyRadius * double(std::max(in.width, in.height)));
-        const float scale = float(params.placeWeight * (sigma > 0.0 ? sigma : 1.0) / reach);
-        // The example's invalid pixels take the value of the nearest valid one (breadth-first
-        // from the valid pixels, 4-neighbours, in index order) and count as valid: output windows
-        // at the region's edge then match windows that continue the edge outward instead of
-        // windows from inside, which averaged the edge's extremes away.
-        const FeatureImage filled = filledFeatureImage(in);
-        FeatureImage guided(in.width, in.height, C + G);
-        for (int y = 0; y < in.height; ++y)
-            for (int x = 0; x < in.width; ++x) {
-                std::copy_n(filled.pixel(x, y), C, guided.pixel(x, y));
-                if (G) {
-                    guided.pixel(x, y)[C] = float(x) * scale;
-                    guided.pixel(x, y)[C + 1] = float(y) * scale;
-                }
-            }
-        const FeatureImage out = synthesizeTexture(guided, res.grid.width, res.grid.height, tp, &res.texture, threaded, interrupter);
-        res.outputMap = FeatureImage(out.width, out.height, C);
-        for (int y = 0; y < out.height; ++y)
-            for (int x = 0; x < out.width; ++x) std::copy_n(out.pixel(x, y), C, res.outputMap.pixel(x, y));
-        res.outputMap.valid = in.valid;  // the output region is the example's
+            res.outputMap = synthesizeFeatureMap(res, params, threaded, interrupter);
         }
     }
     if (outputRegion) res.outputMap.valid = outputMask;
     // 5. The coarsest level from the synthesized map.
     res.output.resize(std::size_t(L));
-    const auto scatter = [&](int l) {
-        RootScatterParams rp;
-        rp.count = counts[std::size_t(l)];
-        rp.iterations = params.rootIterations;
-        rp.seed = params.seed;
-        rp.stream = std::uint64_t(l);
-        return scatterRoots(map, res.grid, res.outputMap, rp, threaded);
-    };
     {
         SynthStageTimer t{res.stages, "coarsest level"};
-        const ScatteredRoots roots = scatter(L - 1);
-        StrandSamples& level = res.output[std::size_t(L - 1)];
-        level.vertices = params.vertices;
-        std::vector<float> f(std::size_t(res.pca.components)), row(coarsest.dim());
-        for (std::size_t i = 0; i < roots.positions.size(); ++i) {
-            if (!nearestFeature(res.outputMap, res.grid, roots.scalp[i].x(), roots.scalp[i].y(), f.data()))
-                throw ValueError("synthesizeHair: the output feature map has no valid pixel");
-            res.pca.reconstruct(f.data(), row.data());
-            row[0] = row[1] = row[2] = 0.0f;  // the root is the root
-            double len = 0.0;
-            for (int v = 1; v < params.vertices; ++v)
-                len += std::sqrt(double(row[3 * v] - row[3 * v - 3]) * (row[3 * v] - row[3 * v - 3]) +
-                                 double(row[3 * v + 1] - row[3 * v - 2]) * (row[3 * v + 1] - row[3 * v - 2]) +
-                                 double(row[3 * v + 2] - row[3 * v - 1]) * (row[3 * v + 2] - row[3 * v - 1]));
-            level.push(row.data(), roots.positions[i], roots.scalp[i], map.frame(roots.scalp[i].x(), roots.scalp[i].y()),
-                       float(len * radius));
-        }
+        synthesizeCoarsestLevel(res, params, scatterLevelRoots(res, params, counts[std::size_t(L - 1)], L - 1, threaded));
     }
     // 6-7. Finer levels, refined from the coarsest on.
     const double finestVoxel = params.voxelSize > 0.0 ? params.voxelSize : suggestVoxelSize(example);
     // Refined on the example's scalp: another head's obstacle (the output's) is not the one there.
     SynthParams onExample = params;
     if (outputScalp) onExample.head = HeadObstacle();
-    synthesizeFinerLevels(res, res.example, [&](int l) { return LevelRoots{scatter(l).positions, {}}; }, onExample, finestVoxel,
-                          /*refineCoarsest=*/true, scalp, threaded, interrupter);
-    if (outputScalp) res.strands = moveToScalp(res.strands, map, *outputScalp, params.outputTurn, threaded);
+    const auto rootsOf = [&](int l) { return LevelRoots{scatterLevelRoots(res, params, counts[std::size_t(l)], l, threaded).positions, {}}; };
+    synthesizeFinerLevels(res, res.example, rootsOf, onExample, finestVoxel, /*refineCoarsest=*/true, scalp, threaded, interrupter);
+    if (outputScalp) res.strands = moveToScalp(res.strands, *res.map, *outputScalp, params.outputTurn, threaded);
     keepHairOutOfHead(res, synthesisHead(params, scalp, outputScalp != nullptr, example, res.up), outputScalp ? nullptr : &example, threaded);
     return res;
 }
