@@ -3,6 +3,7 @@
 #include <vdbhair/Parameters.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Streamline.h>
+#include <vdbhair/field/TangentField.h>
 
 #include <fstream>
 #include <sstream>
@@ -96,6 +97,26 @@ TEST_CASE("Parameters: refine's declaration sets what the library reads, and doc
     page << in.rdbuf();
     INFO("docs/cli.md's refine table should read:\n" << parameterMarkdown(t));
     CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
+}
+
+TEST_CASE("Parameters: field's declaration is refine's too (nested), and docs/cli.md shows it", "[params]")
+{
+    const ParamTable<FieldParams>& f = fieldParameters();
+    // refine offers the field's voxel size, iterations and caps from the one declaration.
+    for (const char* name : {"voxel-size", "iterations", "max-voxels", "max-memory"}) {
+        const Param<RefineParams>* r = findParam(refineParameters(), name);
+        REQUIRE(r);
+        CHECK(paramHelp(*r) == paramHelp(*findParam(f, name)));
+        CHECK(r->defaultText() == findParam(f, name)->defaultText());
+    }
+    RefineParams rp;
+    std::get<ParamAccess<RefineParams, double>>(findParam(refineParameters(), "voxel-size")->access).set(rp, 0.75);
+    CHECK(rp.field.voxelSize == 0.75);
+    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
+    std::stringstream page;
+    page << in.rdbuf();
+    INFO("docs/cli.md's field table should read:\n" << parameterMarkdown(f));
+    CHECK(page.str().find(parameterMarkdown(f)) != std::string::npos);
 }
 
 TEST_CASE("Parameters: retrace's declaration sets what the library reads, and docs/cli.md shows it", "[params]")

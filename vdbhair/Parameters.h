@@ -102,6 +102,38 @@ ParamAccess<P, std::string> named(F field, NameFn name, FromNameFn fromName)
             [field, fromName](P& p, std::string v) { field(p) = fromName(v); }};
 }
 
+/// @brief The parameters of @a inner named in @a names (all when empty), declared once for a
+/// struct Inner, as parameters of a struct Outer that holds an Inner (@a part: Outer& -> Inner&):
+/// a verb whose parameters contain another's reuses its declaration instead of restating it.
+template<typename Outer, typename Inner, typename F>
+ParamTable<Outer> nestedParams(const ParamTable<Inner>& inner, F part, const std::vector<std::string>& names = {})
+{
+    ParamTable<Outer> out;
+    auto wanted = [&](const std::string& n) {
+        if (names.empty()) return true;
+        for (const std::string& w : names) if (w == n) return true;
+        return false;
+    };
+    for (const Param<Inner>& p : inner) {
+        if (!wanted(p.name)) continue;
+        Param<Outer> q;
+        q.name = p.name;
+        q.help = p.help;
+        q.unit = p.unit;
+        q.min = p.min;
+        q.max = p.max;
+        q.choices = p.choices;
+        q.zeroMeans = p.zeroMeans;
+        std::visit([&](const auto& a) {
+            using T = std::decay_t<decltype(a.get(std::declval<const Inner&>()))>;
+            q.access = ParamAccess<Outer, T>{[a, part](const Outer& o) { return a.get(part(const_cast<Outer&>(o))); },
+                                             [a, part](Outer& o, T v) { a.set(part(o), v); }};
+        }, p.access);
+        out.push_back(std::move(q));
+    }
+    return out;
+}
+
 /// How an error names a parameter: the command line's flag or Python's keyword.
 enum class ParamSpelling { Flag, Keyword };
 

@@ -1,5 +1,6 @@
 // vdbhair field IN -o OUT.vdb: strands to the robust tangent field (Wang et al. 2009, Eq. 9).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/DenseArray.h>
@@ -23,18 +24,12 @@ namespace {
 struct FieldCmdParams
 {
     std::string input, output;
-    // Defaults from the library's FieldParams (one home for each).
-    double voxelSize = FieldParams{}.voxelSize;
-    CLI::Option* voxelOpt = nullptr;  ///< whether --voxel-size was given
-    int iterations = FieldParams{}.iterations;
+    FieldParams field;  ///< its declared parameters (fieldParameters()) are options
     int levels = 1;
-    std::uint64_t maxVoxels = FieldParams{}.maxVoxels;
-    std::uint64_t maxMemory = FieldParams{}.maxMemory;
     bool withStrands = false;
     bool helicoid = false;
     bool strict = false;
     ScalpOptions scalp;
-    double densityReference = FieldParams{}.densityReference;
     std::string vectorName = "tangent";
     std::string dense;                       ///< --dense OUT.npy: the orientation volume
     std::vector<double> denseBox;            ///< x0,y0,z0,x1,y1,z1 (world units)
@@ -66,19 +61,12 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
 {
     if (p.output.empty()) throw ValueError("needs an output: -o OUT.vdb");
     if (fileExtension(p.output) != ".vdb") throw ValueError(p.output + ": the field is written as OpenVDB; the output must end in .vdb");
-    const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0;
-    if (voxelGiven && (!(p.voxelSize > 0.0) || !std::isfinite(p.voxelSize))) {
-        throw ValueError("--voxel-size " + formatValue(p.voxelSize) + ": must be a positive finite length");
-    }
-    if (p.iterations < 1) throw ValueError("--iterations " + std::to_string(p.iterations) + ": must be at least 1");
+    checkParamOptions(fieldParameters(), p.field);
     if (p.levels < 1 || p.levels > FieldParams::kMaxLevels) {
         throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and " + std::to_string(FieldParams::kMaxLevels));
     }
     if (p.helicoid && p.levels != 1) throw ValueError("--helicoid with --levels " + std::to_string(p.levels) + ": a helicoid field has one level; use --levels 1");
     if (p.helicoid && p.scalp.space != "world") throw ValueError("--helicoid with --space " + p.scalp.space + ": helicoid fields are world-space");
-    if (p.densityReference < 0.0 || !std::isfinite(p.densityReference)) {
-        throw ValueError("--density-reference " + formatValue(p.densityReference) + ": must be a positive length per unit volume (0 chooses it)");
-    }
     if (p.vectorName.empty() || p.vectorName.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos ||
         std::isdigit(static_cast<unsigned char>(p.vectorName[0]))) {
         throw ValueError("--vector-name '" + p.vectorName + "': must be a valid attribute name (letters, digits, _; not starting with a digit)");
@@ -91,13 +79,8 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
 
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
     checkStrandLengths("field", p.input, strands, common, p.strict);
-    FieldParams fp;
-    fp.voxelSize = voxelGiven ? p.voxelSize : 0.0;
+    FieldParams fp = p.field;
     fp.voxelSize = resolveVoxelSize(strands, fp);  // 0: the library's suggestion (reported below)
-    fp.iterations = p.iterations;
-    fp.maxVoxels = p.maxVoxels;
-    fp.maxMemory = p.maxMemory;
-    fp.densityReference = p.densityReference;
     fp.coherenceAndSpread = false;  // not written (below)
     applyScalpOptions(p.scalp, strands, fp, common);
 
@@ -183,14 +166,8 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "field");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent', 'density' (fog volume in [0,1]) and 'hair_length' (or *_level_<l>)")->required();
-    params->voxelOpt = sub->add_option("--voxel-size", params->voxelSize, "Voxel size in world units (default: " + kSuggestedVoxelSizeHelp + ")");
-    sub->add_option("--iterations", params->iterations, "Reweighting iterations of Eq. 9")->capture_default_str();
+    addParamOptions(sub, params->field, fieldParameters());
     sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
-    sub->add_option("--max-voxels", params->maxVoxels, "Refuse voxel sizes whose voxel visits could exceed this")->capture_default_str();
-    sub->add_option("--max-memory", params->maxMemory, "Refuse work whose memory estimate exceeds this many bytes (suffixes k, M, G: 16G); 0: the memory available (MemAvailable)")
-        ->transform(CLI::AsSizeValue(false))->capture_default_str();
-    sub->add_option("--density-reference", params->densityReference,
-                    "Hair length per unit volume (world units^-2) that 'density' maps to 1 (default: the 95th percentile of the hairstyle's)");
     sub->add_option("--vector-name", params->vectorName,
                     "Name of the direction grid; Blender's Cycles reserves 'tangent' for UV tangents, so use e.g. hair_direction for Cycles")
         ->capture_default_str();

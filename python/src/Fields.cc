@@ -553,67 +553,49 @@ Raises:
 between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhair/field/Refine.h).)doc");
 
     const FieldParams fieldDefaults;
-    m.def(
-        "estimate_tangent_field",
-        [](const StrandsPtr& strands, double voxelSize, int iterations, std::optional<int> levels, std::uint64_t maxVoxels,
-           double densityReference, const std::string& space, const ScalpArgument& scalp, std::array<double, 3> up,
-           int threads, const pyb::object& progress) -> pyb::object {
-            FieldParams fp;
-            fp.voxelSize = voxelSize;
-            fp.iterations = iterations;
-            fp.maxVoxels = maxVoxels;
-            fp.densityReference = densityReference;
-            applyScalpArgument(fp, *strands, space, scalp, up, "estimate_tangent_field");
-            if (levels && (*levels < 1 || *levels > FieldParams::kMaxLevels)) {
-                throw ValueError("estimate_tangent_field: levels=" + std::to_string(*levels) + ": must be between 1 and " +
-                                 std::to_string(FieldParams::kMaxLevels));
-            }
-            auto fields = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                if (!levels) return std::vector<TangentField>{estimateTangentField(*strands, fp, true, interrupter)};
-                return estimateTangentFieldLevels(*strands, fp, *levels, true, interrupter);
-            });
-            if (!levels) return pyb::cast(PyField{fields.front()});
-            pyb::list out;
-            for (TangentField& f : fields) out.append(PyField{std::move(f)});
-            return out;
-        },
-        pyb::arg("strands"), pyb::arg("voxel_size") = fieldDefaults.voxelSize, pyb::kw_only(),
-        pyb::arg("iterations") = fieldDefaults.iterations, pyb::arg("levels") = pyb::none(),
-        pyb::arg("max_voxels") = fieldDefaults.maxVoxels, pyb::arg("density_reference") = fieldDefaults.densityReference,
-        pyb::arg("space") = fieldSpaceName(fieldDefaults.space), pyb::arg("scalp") = pyb::none(),
-        pyb::arg("up") = std::array<double, 3>{fieldDefaults.scalp.up.x(), fieldDefaults.scalp.up.y(), fieldDefaults.scalp.up.z()},
-        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space by default: ``vdbhair field``.
-
-Every segment contributes its unit tangent to every voxel it passes through, weighted by its
-length there; each iteration reweights contributions by 0.5 (T . v + 1) and renormalizes.
-Results are bitwise identical for any thread count.
-
-Args:
-    strands: a Strands.
-    voxel_size: world units; 0 chooses suggest_voxel_size(strands) (the CLI's default).
-    iterations: Eq. 9 iterations, at least 1 (the paper's 2).
-    levels: None for one field; N (1-16) for a list of N fields, level l of voxel size
-        voxel_size * 2**l (element 0 the finest), as ``--levels N``.
-    max_voxels: refuse voxel sizes whose voxel visits could exceed this (vdbhair.LimitError).
-    density_reference: hair length per unit volume (world units^-2) that density 1 means;
-        0 chooses the 95th percentile of the hairstyle's.
-    space: "world" (any hairstyle) or "scalp" (Wang et al.'s (u, v, w) over a scalp sphere), as
-        ``--space``.
-    scalp: with space="scalp", the sphere (cx, cy, cz, r) in world units, or a head (the path of a
-        scalp .vdb with a level set 'surface', or of a mesh): w is then the height above that
-        head, measured along rays from the sphere fitted to the roots, and the grids carry the
-        measured table (vdbhair_scalp_distance); None fits a sphere to the roots.
-    up: the scalp's up axis for space="scalp".
-    threads: worker threads, 0 for all cores (results do not depend on it).
-    progress: optional callable ``progress(stage, done, total, unit)``, called at each stage's
-        start and then at most ten times a second; raising in it stops the work.
-
-Returns:
-    TangentField, or a list of them when ``levels`` is given.
-
-Raises:
-    vdbhair.ArgumentError / LimitError (ValueErrors), KeyboardInterrupt on Ctrl-C.)doc");
+    auto fieldImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
+        FieldParams fp;
+        applyKeywords(fieldParameters(), kw, fp, "estimate_tangent_field");
+        applyScalpArgument(fp, *strands, kw["space"].cast<std::string>(), kw["scalp"].cast<ScalpArgument>(),
+                           kw["up"].cast<std::array<double, 3>>(), "estimate_tangent_field");
+        const std::optional<int> levels = kw["levels"].cast<std::optional<int>>();
+        if (levels && (*levels < 1 || *levels > FieldParams::kMaxLevels)) {
+            throw ValueError("estimate_tangent_field: levels " + std::to_string(*levels) + ": must be between 1 and " +
+                             std::to_string(FieldParams::kMaxLevels));
+        }
+        auto fields = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            if (!levels) return std::vector<TangentField>{estimateTangentField(*strands, fp, true, interrupter)};
+            return estimateTangentFieldLevels(*strands, fp, *levels, true, interrupter);
+        });
+        if (!levels) return pyb::cast(PyField{fields.front()});
+        pyb::list out;
+        for (TangentField& f : fields) out.append(PyField{std::move(f)});
+        return out;
+    };
+    defineVerb(m, "estimate_tangent_field", {"strands"}, fieldParameters(),
+               {{"levels", "Optional[int]", pyb::none(),
+                 "None for one field; N (1-16) for a list of N fields, level l of voxel size voxel_size * 2**l (element 0 the "
+                 "finest), as ``--levels N``."},
+                {"space", "str", pyb::str(fieldSpaceName(fieldDefaults.space)),
+                 "\"world\" (any hairstyle) or \"scalp\" (Wang et al.'s (u, v, w) over a scalp sphere), as ``--space``."},
+                {"scalp", "", pyb::none(),
+                 "with space=\"scalp\", the sphere (cx, cy, cz, r) in world units, or a head (the path of a scalp .vdb with a level "
+                 "set 'surface', or of a mesh): w is then the height above that head, measured along rays from the sphere fitted "
+                 "to the roots, and the grids carry the measured table (vdbhair_scalp_distance); None fits a sphere to the roots."},
+                {"up", "Tuple[float, float, float]",
+                 pyb::make_tuple(fieldDefaults.scalp.up.x(), fieldDefaults.scalp.up.y(), fieldDefaults.scalp.up.z()),
+                 "the scalp's up axis for space=\"scalp\"."},
+                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
+                {"progress", "Optional[Callable]", pyb::none(),
+                 "optional callable ``progress(stage, done, total, unit)``, called at each stage's start and then at most ten "
+                 "times a second; raising in it stops the work."}},
+               "The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space by default: ``vdbhair field``.\n\n"
+               "Every segment contributes its unit tangent to every voxel it passes through, weighted by its\n"
+               "length there; each iteration reweights contributions by 0.5 (T . v + 1) and renormalizes.\n"
+               "Results are bitwise identical for any thread count. Raises vdbhair.ArgumentError / LimitError\n"
+               "(ValueErrors), KeyboardInterrupt on Ctrl-C.",
+               "    strands: a Strands.\n", "TangentField, or a list of them when ``levels`` is given.",
+               pyb::cpp_function(fieldImpl, pyb::arg("strands"), pyb::arg("keywords")), 1);
 
     auto retraceImpl = [](const StrandsPtr& strands, const pyb::object& fieldArg, const pyb::dict& kw) -> pyb::object {
         const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");

@@ -85,10 +85,11 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
 /// @brief Define @a verb on @a m: `verb(positional..., *, <declared keywords>, <extra keywords>)`
 /// calling @a impl(positional..., kwargs) with every keyword in one dict.
 /// @param summary the docstring's first paragraphs; @a positionalDoc and @a returns its other parts
+/// @param positionalKeywords how many of the first declared parameters may also be given by position
 template<typename P>
 void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std::string>& positional, const ParamTable<P>& table,
                 const std::vector<PyKeyword>& extras, const std::string& summary, const std::string& positionalDoc,
-                const std::string& returns, const pyb::cpp_function& impl)
+                const std::string& returns, const pyb::cpp_function& impl, std::size_t positionalKeywords = 0)
 {
     struct Keyword { std::string name, annotation; pyb::object value; std::string doc; };
     std::vector<Keyword> keywords;
@@ -106,7 +107,7 @@ void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std:
         const Keyword& k = keywords[i];
         const std::string d = "_d" + std::to_string(i);
         scope[d.c_str()] = k.value;
-        args += ", " + k.name + "=" + d;
+        args += (i == positionalKeywords ? ", *, " : ", ") + k.name + "=" + d;
         if (!k.annotation.empty()) checks += "(\"" + k.name + "\", \"" + k.annotation + "\", " + k.name + "), ";
         dict += "\"" + k.name + "\": " + k.name + ", ";
     }
@@ -115,7 +116,7 @@ void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std:
     scope["_module"] = m;
     const std::string source = "def _make():\n"
                                "    _g = vars(_module)\n"
-                               "    def " + verb + "(" + head + "*" + args + "):\n"
+                               "    def " + verb + "(" + head.substr(0, head.size() - 2) + args + "):\n"
                                "        _g['_check_keywords'](\"" + verb + "\", (" + checks + "))\n"
                                "        return _impl(" + head + "{" + dict + "})\n"
                                "    " + verb + ".__doc__ = _doc\n"

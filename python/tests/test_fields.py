@@ -122,7 +122,7 @@ def test_refine_report(wavy):
 
 def test_argument_errors(bundle, tmp_path):
     field = vdbhair.estimate_tangent_field(bundle, voxel_size=0.25)
-    with pytest.raises(vdbhair.ArgumentError, match="voxel size"):
+    with pytest.raises(vdbhair.ArgumentError, match="voxel_size -1: must be at least 0"):
         vdbhair.estimate_tangent_field(bundle, voxel_size=-1.0)
     with pytest.raises(ValueError, match="integrator"):
         vdbhair.retrace(bundle, field, integrator="rk5")

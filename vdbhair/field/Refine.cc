@@ -44,10 +44,9 @@ const ParamTable<RefineParams>& refineParameters()
     static const ParamTable<P> table = [] {
         ParamTable<P> t;
         auto add = [&](Param<P> p) { t.push_back(std::move(p)); };
-        auto voxel = makeParam<P>("voxel-size", "The finest level's voxel size", "world units", member<P>([](P& p) -> double& { return p.field.voxelSize; }));
-        voxel.min = 0.0;
-        voxel.zeroMeans = "3 x the median root spacing, within 1/64..1/4 of the head radius";
-        add(voxel);
+        // The field's: voxel size first (its declaration, TangentField.cc).
+        const auto field = [](P& p) -> FieldParams& { return p.field; };
+        for (Param<P>& q : nestedParams<P>(fieldParameters(), field, {"voxel-size"})) add(std::move(q));
         auto levels = makeParam<P>("levels", "Levels, coarse (voxel size x 2^(levels-1)) to fine", "", member<P>([](P& p) -> int& { return p.levels; }));
         levels.min = 1;
         levels.max = P::kMaxLevels;
@@ -57,9 +56,7 @@ const ParamTable<RefineParams>& refineParameters()
                       named<P>([](P& p) -> RefineMode& { return p.mode; }, refineModeName, refineModeFromName));
         mode.choices = {"consistent", "field"};
         add(mode);
-        auto iterations = makeParam<P>("iterations", "Reweighting iterations of Eq. 9", "", member<P>([](P& p) -> int& { return p.field.iterations; }));
-        iterations.min = 1;
-        add(iterations);
+        for (Param<P>& q : nestedParams<P>(fieldParameters(), field, {"iterations"})) add(std::move(q));
         // One step and one integrator for both modes (setStep()).
         auto step = makeParam<P>("step", "Integration step", "world units",
                       ParamAccess<P, double>{[](const P& p) { return p.trace.step; }, [](P& p, double v) { p.setStep(v, p.trace.integrator); }});
@@ -89,14 +86,7 @@ const ParamTable<RefineParams>& refineParameters()
         margin.min = 0;
         margin.max = TraceParams::kMaxMargin;
         add(margin);
-        auto maxVoxels = makeParam<P>("max-voxels", "Refuse voxel sizes whose voxel visits could exceed this", "",
-                           member<P>([](P& p) -> std::uint64_t& { return p.field.maxVoxels; }));
-        maxVoxels.min = 1;
-        add(maxVoxels);
-        auto maxMemory = makeParam<P>("max-memory", "Refuse work whose memory estimate exceeds this (suffixes k, M, G on the command line: 16G)", "bytes",
-                           member<P>([](P& p) -> std::uint64_t& { return p.field.maxMemory; }));
-        maxMemory.zeroMeans = "the memory available (MemAvailable)";
-        add(maxMemory);
+        for (Param<P>& q : nestedParams<P>(fieldParameters(), field, {"max-voxels", "max-memory"})) add(std::move(q));
         add(makeParam<P>("measure", "Also measure the output against the input at every level: full length, hair volume, head, curvature, "
                                 "tips, displacement, coherence (an extra field estimate per level: about a fifth of the run), and compare "
                                 "the output with the input as `vdbhair compare` does (the report's \"compare\")", "",

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <vdbhair/Memory.h>
+#include <vdbhair/Parameters.h>
 #include <vdbhair/field/FieldTypes.h>
 #include <vdbhair/field/ScalpMap.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -155,6 +156,11 @@ double suggestVoxelSize(const StrandSet& strands);
 /// @brief The voxel size an estimate at @a params uses: params.voxelSize, or
 /// suggestVoxelSize(@a strands) when it is 0 (the one place that rule lives).
 double resolveVoxelSize(const StrandSet& strands, const FieldParams& params);
+
+/// @brief The field estimate's parameters (Parameters.h), declared once: `field` and
+/// estimate_tangent_field() offer them, and `refine` reuses those it shares (its fields').
+/// Defaults are FieldParams{}'s.
+const ParamTable<FieldParams>& fieldParameters();
 
 /// @brief Estimate the field of @a strands at one voxel size (params.voxelSize, 0: resolveVoxelSize()).
 /// @throw ValueError (empty hairstyle, voxel size negative or not finite, iterations < 1),
