@@ -25,8 +25,12 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(target))>;
             if constexpr (std::is_same_v<T, bool>) {
-                sub->add_flag_callback(flag, [&target, a] { a.set(target, true); }, help);
-            } else {
+                if (!param.valued) {
+                    sub->add_flag_callback(flag, [&target, a] { a.set(target, true); }, help);
+                    return;
+                }
+            }
+            {
                 CLI::Option* o = sub->add_option_function<T>(flag, [&target, a](const T& v) { a.set(target, v); }, help);
                 o->default_str(param.defaultText());
                 if constexpr (std::is_same_v<T, std::string>) {

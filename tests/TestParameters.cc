@@ -4,6 +4,7 @@
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/HelicoidFit.h>
 
 #include <fstream>
 #include <sstream>
@@ -117,6 +118,22 @@ TEST_CASE("Parameters: field's declaration is refine's too (nested), and docs/cl
     page << in.rdbuf();
     INFO("docs/cli.md's field table should read:\n" << parameterMarkdown(f));
     CHECK(page.str().find(parameterMarkdown(f)) != std::string::npos);
+}
+
+TEST_CASE("Parameters: fit's declaration, a keyword that is not its name and a valued flag, in docs/cli.md", "[params]")
+{
+    const ParamTable<FitParams>& t = fitParameters();
+    CHECK(findParam(t, "lambda")->pythonName() == "lambda_");
+    CHECK(findParam(t, "roll")->valued);
+    FitParams p;
+    p.maxError = 0.0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--max-error 0: must be above 0");
+    REQUIRE_NOTHROW(checkParams(t, FitParams{}, ParamSpelling::Flag, ""));
+    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
+    std::stringstream page;
+    page << in.rdbuf();
+    INFO("docs/cli.md's fit table should read:\n" << parameterMarkdown(t));
+    CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
 }
 
 TEST_CASE("Parameters: retrace's declaration sets what the library reads, and docs/cli.md shows it", "[params]")

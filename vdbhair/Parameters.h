@@ -46,12 +46,17 @@ struct Param
         access;
     double min = -std::numeric_limits<double>::infinity();  ///< inclusive bounds of a number
     double max = std::numeric_limits<double>::infinity();
+    bool aboveMin = false;             ///< the minimum itself is excluded (a positive number)
     std::vector<std::string> choices;  ///< the names a string parameter takes
     std::string zeroMeans;             ///< what 0 stands for when it picks a value ("suggestVoxelSize()")
+    /// A bool given as a value on the command line (`--roll false`), not a flag that turns it on.
+    bool valued = false;
+    std::string keyword;  ///< Python's keyword when the name is not one (`lambda_` for `lambda`)
 
     /// The keyword Python spells it as.
     std::string pythonName() const
     {
+        if (!keyword.empty()) return keyword;
         std::string s = name;
         for (char& c : s) if (c == '-') c = '_';
         return s;
@@ -122,8 +127,11 @@ ParamTable<Outer> nestedParams(const ParamTable<Inner>& inner, F part, const std
         q.unit = p.unit;
         q.min = p.min;
         q.max = p.max;
+        q.aboveMin = p.aboveMin;
         q.choices = p.choices;
         q.zeroMeans = p.zeroMeans;
+        q.valued = p.valued;
+        q.keyword = p.keyword;
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(std::declval<const Inner&>()))>;
             q.access = ParamAccess<Outer, T>{[a, part](const Outer& o) { return a.get(part(const_cast<Outer&>(o))); },
@@ -170,9 +178,10 @@ void checkParams(const ParamTable<P>& table, const P& p, ParamSpelling spelling,
                 throw ValueError(who + " '" + v + "': must be one of " + list);
             } else if constexpr (!std::is_same_v<T, bool>) {
                 const double v = double(a.get(p));
-                if (std::isfinite(v) && v >= param.min && v <= param.max) return;
+                if (std::isfinite(v) && (param.aboveMin ? v > param.min : v >= param.min) && v <= param.max) return;
                 std::string rule = "must be ";
-                if (std::isfinite(param.min) && std::isfinite(param.max)) rule += "between " + formatNumber(param.min) + " and " + formatNumber(param.max);
+                if (param.aboveMin) rule += "above " + formatNumber(param.min) + (std::isfinite(param.max) ? " and at most " + formatNumber(param.max) : "");
+                else if (std::isfinite(param.min) && std::isfinite(param.max)) rule += "between " + formatNumber(param.min) + " and " + formatNumber(param.max);
                 else if (std::isfinite(param.min)) rule += "at least " + formatNumber(param.min);
                 else if (std::isfinite(param.max)) rule += "at most " + formatNumber(param.max);
                 else rule += "finite";
@@ -190,7 +199,8 @@ std::string paramHelp(const Param<P>& param)
     std::string h = param.help;
     std::vector<std::string> notes;
     if (!param.unit.empty()) notes.push_back(param.unit);
-    if (std::isfinite(param.min) && std::isfinite(param.max)) notes.push_back(formatNumber(param.min) + " to " + formatNumber(param.max));
+    if (param.aboveMin) notes.push_back("above " + formatNumber(param.min));
+    else if (std::isfinite(param.min) && std::isfinite(param.max)) notes.push_back(formatNumber(param.min) + " to " + formatNumber(param.max));
     else if (std::isfinite(param.min)) notes.push_back("at least " + formatNumber(param.min));
     if (!param.choices.empty()) {
         std::string list;

@@ -1,5 +1,6 @@
 // vdbhair fit IN -o FITS.json: p-helicoids fitted to every strand (Piuze et al. 2011, §5).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
@@ -25,7 +26,8 @@ struct FitCmdParams
 int runFit(FitCmdParams p, const CommonOptions& common)
 {
     if (fileExtension(p.output) != ".json") throw ValueError(p.output + ": fits are written as a scene file; the output must end in .json");
-    p.fit.validate("option");  // the library's ranges, its field names spelled as flags (addFitCommand)
+    checkParamOptions(fitParameters(), p.fit);
+    p.fit.validate("option");  // the library's own rules, its field names spelled as flags (addFitCommand)
     const StrandSet strands = loadStrands("fit", p.input, common, p.strict);
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -87,13 +89,7 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "fit");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Scene file (.json): one guide per input strand, in input order")->required();
-    sub->add_option("--max-error", params->fit.maxError, "Accept a piece within this discrete Frechet distance, as a fraction of the strand length")->capture_default_str();
-    sub->add_option("--lambda", params->fit.lambda, "Regularization weight of Eq. 5 (dimensionless: per turn of the piece)")->capture_default_str();
-    sub->add_option("--max-pieces", params->fit.maxPieces, "Most pieces per strand, 1 to " + std::to_string(FitParams::kMaxPieces) + " (and at most (3 n - 10) / 6 for n vertices: a fit is never larger than its points)")->capture_default_str();
-    sub->add_option("--prefit-iterations", params->fit.prefitIterations, "Levenberg-Marquardt pre-fit iterations per piece and start (0: none, Nelder-Mead alone from the raw starts, the paper's method)")->capture_default_str();
-    sub->add_option("--max-evaluations", params->fit.maxEvaluations, "Nelder-Mead evaluations per piece with --prefit-iterations 0, at least " + std::to_string(FitParams::kMinEvaluations) + " (the pre-fit needs none)")->capture_default_str();
-    sub->add_option("--step", params->fit.step, "Tracing step of the fits in world units (default: a quarter of each strand's mean segment length)");
-    sub->add_option("--roll", params->fit.optimizeRoll, "Also fit a roll angle of each piece's frame about its tangent (true/false)")->capture_default_str();
+    addParamOptions(sub, params->fit, fitParameters());
     sub->add_flag("--skip-degenerate", params->skipDegenerate, "Leave out strands of zero length instead of failing");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);

@@ -572,7 +572,7 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
         for (TangentField& f : fields) out.append(PyField{std::move(f)});
         return out;
     };
-    defineVerb(m, "estimate_tangent_field", {"strands"}, fieldParameters(),
+    defineVerb(m, "estimate_tangent_field", {"strands: vdbhair.Strands"}, fieldParameters(),
                {{"levels", "Optional[int]", pyb::none(),
                  "None for one field; N (1-16) for a list of N fields, level l of voxel size voxel_size * 2**l (element 0 the "
                  "finest), as ``--levels N``."},
@@ -608,7 +608,7 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
         if (!kw["return_stats"].cast<bool>()) return pyb::cast(out);
         return pyb::make_tuple(out, traceStatsDict(stats));
     };
-    defineVerb(m, "retrace", {"strands", "field"}, traceParameters(),
+    defineVerb(m, "retrace", {"strands: vdbhair.Strands", "field"}, traceParameters(),
                {{"return_stats", "bool", pyb::bool_(false),
                  "also return a dict of stop reasons (strands, full_length, vanished, left_field, max_steps, steps)."},
                 {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
@@ -678,7 +678,7 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
         report["fields"] = fields;
         return pyb::make_tuple(out, report);
     };
-    defineVerb(m, "refine", {"strands"}, refineParameters(),
+    defineVerb(m, "refine", {"strands: vdbhair.Strands"}, refineParameters(),
                {{"head", "", pyb::none(),
                  "None (a sphere fitted to the roots), \"none\" (no head), a path to a mesh (.ply, .obj) or a .vdb level set, "
                  "or a sphere (cx, cy, cz, r) in world units."},

@@ -1,5 +1,6 @@
 // grow, fit, render and inspect.
 #include "Common.h"
+#include "Params.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
@@ -494,85 +495,59 @@ Returns:
     Strands (same vertices, attributes kept), or (Strands, report) with return_report.)doc");
 
     const FitParams fitDefaults;
-    m.def(
-        "fit",
-        [](const StrandsPtr& strands, double maxError, double lambda, int maxPieces, int prefitIterations, int maxEvaluations, double step, bool roll,
-           bool skipDegenerate, bool returnSummary, int threads, const pyb::object& progress) -> pyb::object {
-            FitParams fp;
-            fp.maxError = maxError;
-            fp.lambda = lambda;
-            fp.maxPieces = maxPieces;
-            fp.prefitIterations = prefitIterations;
-            fp.maxEvaluations = maxEvaluations;
-            fp.step = step;
-            fp.optimizeRoll = roll;
-            validateFitKeywords(fp, "fit");
-            std::vector<std::string> errors;
-            const std::vector<StrandFit> fits = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                return fitStrands(*strands, fp, true, &errors, interrupter);
-            });
-            Scene scene;
-            scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines, regrown exactly (as `vdbhair fit`)
-            for (std::size_t i = 0; i < fits.size(); ++i) {
-                if (!errors[i].empty()) {
-                    if (!skipDegenerate) throw ValueError("fit: " + errors[i] + " (skip_degenerate=True leaves such strands out)");
-                    continue;
-                }
-                SceneGuide g = guideFromFit(fits[i]);
-                g.fit = {{"frechet", fits[i].frechet}, {"coupling", fits[i].coupling}, {"pieces", fits[i].pieces.size()}, {"strand", i},
-                         {"step_deviation", fits[i].stepDeviation}};
-                scene.guides.push_back(g);
+    auto fitImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
+        FitParams fp;
+        applyKeywords(fitParameters(), kw, fp, "fit");
+        validateFitKeywords(fp, "fit");
+        const bool skipDegenerate = kw["skip_degenerate"].cast<bool>(), returnSummary = kw["return_summary"].cast<bool>();
+        std::vector<std::string> errors;
+        const std::vector<StrandFit> fits = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            return fitStrands(*strands, fp, true, &errors, interrupter);
+        });
+        Scene scene;
+        scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines, regrown exactly (as `vdbhair fit`)
+        for (std::size_t i = 0; i < fits.size(); ++i) {
+            if (!errors[i].empty()) {
+                if (!skipDegenerate) throw ValueError("fit: " + errors[i] + " (skip_degenerate=True leaves such strands out)");
+                continue;
             }
-            pyb::object sceneObj = toPython(sceneToJson(scene));
-            if (!returnSummary) return sceneObj;
-            const FitSummary s = summarizeFits(*strands, fits, errors, fp.maxError);
-            pyb::dict d;
-            d["strands"] = s.strands;
-            d["fitted"] = s.fitted;
-            d["skipped"] = s.skipped;
-            d["over_max_error"] = s.overMaxError;
-            d["frechet_relative_mean"] = s.meanRelative;
-            d["frechet_relative_p95"] = s.p95Relative;
-            d["pieces_per_strand"] = s.piecesPerStrand;
-            d["step_deviation_mean"] = s.stepDeviationMean;
-            d["step_deviation_max"] = s.stepDeviationMax;
-            d["unconverged"] = s.unconverged;
-            d["fit_bytes"] = s.fitBytes;
-            d["point_bytes"] = s.pointBytes;
-            return pyb::make_tuple(sceneObj, d);
-        },
-        pyb::arg("strands"), pyb::kw_only(), pyb::arg("max_error") = fitDefaults.maxError, pyb::arg("lambda_") = fitDefaults.lambda,
-        pyb::arg("max_pieces") = fitDefaults.maxPieces, pyb::arg("prefit_iterations") = fitDefaults.prefitIterations,
-        pyb::arg("max_evaluations") = fitDefaults.maxEvaluations,
-        pyb::arg("step") = fitDefaults.step, pyb::arg("roll") = fitDefaults.optimizeRoll, pyb::arg("skip_degenerate") = false,
-        pyb::arg("return_summary") = false, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``.
-
-Args:
-    strands: a Strands.
-    max_error: accept a piece within this discrete Frechet distance, as a fraction of the
-        strand length.
-    lambda_: regularization weight of Eq. 5 (dimensionless, per turn of the piece); the CLI's
-        ``--lambda`` (``lambda`` is a Python keyword).
-    max_pieces: most pieces per strand (1-64).
-    prefit_iterations: Levenberg-Marquardt pre-fit iterations per piece and start (0: none,
-        Nelder-Mead alone from the raw starts, the paper's method).
-    max_evaluations: Nelder-Mead evaluations per piece with prefit_iterations=0 (at least 10;
-        the pre-fit needs none).
-    step: tracing step of the fits in world units; 0 is a quarter of each strand's mean
-        segment length.
-    roll: also fit a roll angle of each piece's frame about its tangent.
-    skip_degenerate: leave out strands of zero length instead of raising.
-    return_summary: also return a dict (fitted, skipped, Frechet distance relative to length:
-        mean and 95th percentile, pieces per strand, step convergence: the largest distance
-        between each fit traced at its step and at a quarter of it relative to length, mean and
-        max, and how many fits exceed a tenth of max_error; bytes of fits and of points).
-    threads: worker threads, 0 for all cores (results do not depend on it).
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    The scene as a dict (one guide per fitted strand, in input order), which grow() regrows
-    and ``json.dump`` saves as a scene file; or (scene, summary) with return_summary.)doc");
+            SceneGuide g = guideFromFit(fits[i]);
+            g.fit = {{"frechet", fits[i].frechet}, {"coupling", fits[i].coupling}, {"pieces", fits[i].pieces.size()}, {"strand", i},
+                     {"step_deviation", fits[i].stepDeviation}};
+            scene.guides.push_back(g);
+        }
+        pyb::object sceneObj = toPython(sceneToJson(scene));
+        if (!returnSummary) return sceneObj;
+        const FitSummary s = summarizeFits(*strands, fits, errors, fp.maxError);
+        pyb::dict d;
+        d["strands"] = s.strands;
+        d["fitted"] = s.fitted;
+        d["skipped"] = s.skipped;
+        d["over_max_error"] = s.overMaxError;
+        d["frechet_relative_mean"] = s.meanRelative;
+        d["frechet_relative_p95"] = s.p95Relative;
+        d["pieces_per_strand"] = s.piecesPerStrand;
+        d["step_deviation_mean"] = s.stepDeviationMean;
+        d["step_deviation_max"] = s.stepDeviationMax;
+        d["unconverged"] = s.unconverged;
+        d["fit_bytes"] = s.fitBytes;
+        d["point_bytes"] = s.pointBytes;
+        return pyb::make_tuple(sceneObj, d);
+    };
+    defineVerb(m, "fit", {"strands: vdbhair.Strands"}, fitParameters(),
+               {{"skip_degenerate", "bool", pyb::bool_(false), "leave out strands of zero length instead of raising."},
+                {"return_summary", "bool", pyb::bool_(false),
+                 "also return a dict (fitted, skipped, Frechet distance relative to length: mean and 95th percentile, pieces per "
+                 "strand, step convergence: the largest distance between each fit traced at its step and at a quarter of it "
+                 "relative to length, mean and max, and how many fits exceed a tenth of max_error; bytes of fits and of points)."},
+                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
+                {"progress", "Optional[Callable]", pyb::none(), "optional callable ``progress(stage, done, total, unit)``."}},
+               "Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``. ``lambda_`` is the\n"
+               "command's ``--lambda`` (``lambda`` is a Python keyword).",
+               "    strands: a Strands.\n",
+               "The scene as a dict (one guide per fitted strand, in input order), which grow() regrows\n"
+               "    and ``json.dump`` saves as a scene file; or (scene, summary) with return_summary.",
+               pyb::cpp_function(fitImpl, pyb::arg("strands"), pyb::arg("keywords")));
 
     const InterpolateParams interpDefaults;
     m.def(

@@ -83,6 +83,7 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
 }
 
 /// @brief Define @a verb on @a m: `verb(positional..., *, <declared keywords>, <extra keywords>)`
+/// (a positional is "name" or "name: annotation", as Module.cc's type checks read annotations)
 /// calling @a impl(positional..., kwargs) with every keyword in one dict.
 /// @param summary the docstring's first paragraphs; @a positionalDoc and @a returns its other parts
 /// @param positionalKeywords how many of the first declared parameters may also be given by position
@@ -102,7 +103,13 @@ void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std:
 
     pyb::dict scope;
     std::string args, checks, dict, head;
-    for (const std::string& p : positional) head += p + ", ";
+    // A positional argument is "name" or "name: annotation" (checked as the keywords are).
+    for (const std::string& p : positional) {
+        const std::size_t colon = p.find(':');
+        const std::string name = p.substr(0, colon);
+        head += name + ", ";
+        if (colon != std::string::npos) checks += "(\"" + name + "\", \"" + p.substr(p.find_first_not_of(' ', colon + 1)) + "\", " + name + "), ";
+    }
     for (std::size_t i = 0; i < keywords.size(); ++i) {
         const Keyword& k = keywords[i];
         const std::string d = "_d" + std::to_string(i);

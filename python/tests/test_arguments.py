@@ -1,5 +1,6 @@
 """Every function and method names a wrong argument's type in the library's words, never with
 pybind11's generic "incompatible function arguments" (issue 50)."""
+import inspect
 import re
 
 import numpy as np
@@ -9,6 +10,14 @@ import vdbhair
 
 
 def signature(f):
+    if inspect.isfunction(f) and not hasattr(f, "__wrapped__"):  # a verb made from declared parameters
+        parts = []
+        for p in inspect.signature(f).parameters.values():
+            if p.kind == p.KEYWORD_ONLY and "*" not in parts:
+                parts.append("*")
+            annotation = ": vdbhair.Strands" if p.name == "strands" else ""
+            parts.append(p.name + annotation + ("" if p.default is p.empty else " = " + repr(p.default)))
+        return ", ".join(parts)
     for line in (f.__doc__ or "").splitlines():
         m = re.match(r"^\s*(?:\d+\.\s*)?" + re.escape(f.__name__) + r"\((.*)\)\s*(?:->.*)?$", line)
         if m and m.group(1) != "*args, **kwargs":

@@ -100,6 +100,8 @@ def flag_defaults(verb, cache={}):
 
 def same(python_value, cli_value):
     python_value = python_value.strip().strip("'")
+    if python_value in ("True", "False"):
+        return python_value.lower() == cli_value
     try:
         return float(python_value) == float(cli_value)
     except ValueError:
@@ -118,7 +120,7 @@ def test_python_defaults_are_the_commands(function, keyword, verb, flag):
 # Verbs whose parameters are declared once (vdbhair/Parameters.h): every keyword of the signature
 # that has a flag of the same name shows the same default in --help, by construction; this checks
 # the two generators.
-DECLARED = [("refine", "refine"), ("retrace", "retrace"), ("estimate_tangent_field", "field")]
+DECLARED = [("refine", "refine"), ("retrace", "retrace"), ("estimate_tangent_field", "field"), ("fit", "fit")]
 
 
 @pytest.mark.parametrize("function, verb", DECLARED)
@@ -127,7 +129,7 @@ def test_declared_verbs_generate_the_same_keywords_and_flags(function, verb):
     shown = flag_defaults(verb)
     compared = 0
     for keyword, value in python.items():
-        flag = "--" + keyword.replace("_", "-")
+        flag = "--" + keyword.rstrip("_").replace("_", "-")  # lambda_ is --lambda
         if flag in shown and not value.startswith("(") and value != "None":  # up: an axis name on the command line, a vector in Python; levels: None for one field
             assert same(value, shown[flag]), f"{function}({keyword}={value}) but vdbhair {verb} {flag} defaults to {shown[flag]}"
             compared += 1

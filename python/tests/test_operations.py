@@ -33,11 +33,11 @@ def test_fit_then_grow_regrows_the_strands(tmp_path):
 
 
 @pytest.mark.parametrize("keyword, value, message", [
-    ("max_error", 0.0, "fit: max_error=0: must be a positive fraction"),
-    ("lambda_", -1.0, "fit: lambda_=-1: must be zero or positive"),
-    ("max_pieces", 65, "fit: max_pieces=65: must be between 1 and 64"),
-    ("max_evaluations", 9, "fit: max_evaluations=9: must be at least 10"),
-    ("step", -1.0, "fit: step=-1: must be a positive finite length"),
+    ("max_error", 0.0, "fit: max_error 0: must be above 0"),
+    ("lambda_", -1.0, "fit: lambda_ -1: must be at least 0"),
+    ("max_pieces", 65, "fit: max_pieces 65: must be between 1 and 64"),
+    ("max_evaluations", 9, "fit: max_evaluations 9: must be at least 10"),
+    ("step", -1.0, "fit: step -1: must be at least 0 world units"),
 ])
 def test_fit_refuses_a_keyword_out_of_range_by_its_name(keyword, value, message):
     with pytest.raises(ValueError, match="^" + message.replace("(", r"\(")):

@@ -125,6 +125,48 @@ void FitParams::validate(const char* where) const
     if (!(stepDeviationLimit > 0.0) || !std::isfinite(stepDeviationLimit)) fail("stepDeviationLimit", formatNumber(stepDeviationLimit), "must be a positive fraction of the tolerance");
 }
 
+const ParamTable<FitParams>& fitParameters()
+{
+    using P = FitParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto maxError = makeParam<P>("max-error", "Accept a piece within this discrete Frechet distance, as a fraction of the strand length", "",
+                                     member<P>([](P& p) -> double& { return p.maxError; }));
+        maxError.min = 0.0;
+        maxError.aboveMin = true;
+        t.push_back(maxError);
+        auto lambda = makeParam<P>("lambda", "Regularization weight of Eq. 5 (dimensionless: per turn of the piece)", "",
+                                   member<P>([](P& p) -> double& { return p.lambda; }));
+        lambda.min = 0.0;
+        lambda.keyword = "lambda_";
+        t.push_back(lambda);
+        auto pieces = makeParam<P>("max-pieces", "Most pieces per strand (and at most (3 n - 10) / 6 for n vertices: a fit is never larger than its points)",
+                                   "", member<P>([](P& p) -> int& { return p.maxPieces; }));
+        pieces.min = 1;
+        pieces.max = P::kMaxPieces;
+        t.push_back(pieces);
+        auto prefit = makeParam<P>("prefit-iterations", "Levenberg-Marquardt pre-fit iterations per piece and start", "",
+                                   member<P>([](P& p) -> int& { return p.prefitIterations; }));
+        prefit.min = 0;
+        prefit.zeroMeans = "none, Nelder-Mead alone from the raw starts (the paper's method)";
+        t.push_back(prefit);
+        auto evaluations = makeParam<P>("max-evaluations", "Nelder-Mead evaluations per piece with no pre-fit (the pre-fit needs none)", "",
+                                        member<P>([](P& p) -> int& { return p.maxEvaluations; }));
+        evaluations.min = P::kMinEvaluations;
+        t.push_back(evaluations);
+        auto step = makeParam<P>("step", "Tracing step of the fits", "world units", member<P>([](P& p) -> double& { return p.step; }));
+        step.min = 0.0;
+        step.zeroMeans = "a quarter of each strand's mean segment length";
+        t.push_back(step);
+        auto roll = makeParam<P>("roll", "Also fit a roll angle of each piece's frame about its tangent (true or false)", "",
+                                 member<P>([](P& p) -> bool& { return p.optimizeRoll; }));
+        roll.valued = true;
+        t.push_back(roll);
+        return t;
+    }();
+    return table;
+}
+
 void traceFit(const StrandFit& fit, HelicoidTrace& out)
 {
     tracePHelicoid(fit.root, fit.frame, fit.pieces, fit.step, HelicoidIntegrator::RK4, out);

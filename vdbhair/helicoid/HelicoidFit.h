@@ -17,6 +17,8 @@
 /// piecewise fit of one strand (PiecewiseFit.h).
 #pragma once
 
+#include <vdbhair/Parameters.h>
+
 #include <vdbhair/helicoid/Helicoid.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -67,6 +69,10 @@ struct FitParams
     /// (fitStrand and fitStrands call it; commands call it before reading their input).
     void validate(const char* where) const;
 };
+
+/// @brief fit's parameters (Parameters.h), declared once: `fit`, Python's fit() and
+/// `reconstruct` (its --max-error) are made from them. Defaults are FitParams{}'s.
+const ParamTable<FitParams>& fitParameters();
 
 struct StrandFit
 {
