@@ -39,9 +39,9 @@ struct InterpolateCmdParams
 
 Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
 
-int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
+/// The options into @a p.op, checked before any work (the library checks them again, in its own words).
+void checkOptions(InterpolateCmdParams& p)
 {
-    // Arguments first, before any work.
     InterpolateParams& op = p.op;
     op.method = interpolationMethodFromName(p.method);
     const bool points = op.method == InterpolationMethod::Points;
@@ -73,157 +73,231 @@ int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
     }
     op.helicoid.up = axisFromName(p.up, "--up");
     validateGroomParams(op.groom);
-    if (op.returnScene && (op.groom.clump.radius > 0.0 || op.groom.curl.amplitude > 0.0 || op.groom.curl.frizz > 0.0 || !p.density.empty() || !p.length.empty())) {
+    if (op.returnScene && (groomsHair(op.groom) || !p.density.empty() || !p.length.empty())) {
         throw ValueError(p.output + ": a scene of new hairs takes no --density, --length, --clump-radius, --curl or --frizz; write strands");
     }
     op.points.maxVertices = op.helicoid.maxVertices;
+}
 
-    // The guides: a scene, or strands (blended as they are, or fitted for helicoids).
+/// The guides as read: a scene, or strands (blended as they are, or fitted for helicoids).
+/// `guides` points into the other two members, so the whole is filled in place and never copied.
+struct GuideInput
+{
     Scene scene;
-    StrandSet guideStrands;
+    StrandSet strands;
     InterpolationGuides guides;
-    guides.where = p.guides;
+
+    GuideInput() = default;
+    GuideInput(const GuideInput&) = delete;
+    GuideInput& operator=(const GuideInput&) = delete;
+
+    std::size_t count() const { return guides.scene ? scene.guides.size() : strands.numStrands(); }
+};
+
+/// Read the guides (and --guide-groups, one id per guide root) into @a in.
+void readGuides(const InterpolateCmdParams& p, const CommonOptions& common, GuideInput& in)
+{
+    in.guides.where = p.guides;
     if (fileExtension(p.guides) == ".json") {
-        scene = readScene(p.guides);
-        if (scene.guides.empty()) throw ValueError(p.guides + ": no guides: interpolation needs at least one");
-        validateGuideScene(scene);
-        guides.scene = &scene;
+        in.scene = readScene(p.guides);
+        if (in.scene.guides.empty()) throw ValueError(p.guides + ": no guides: interpolation needs at least one");
+        validateGuideScene(in.scene);
+        in.guides.scene = &in.scene;
     } else {
-        guideStrands = loadStrands("interpolate", p.guides, common);
-        if (guideStrands.empty()) throw ValueError(p.guides + ": no guides: interpolation needs at least one");
-        guides.strands = &guideStrands;
+        in.strands = loadStrands("interpolate", p.guides, common);
+        if (in.strands.empty()) throw ValueError(p.guides + ": no guides: interpolation needs at least one");
+        in.guides.strands = &in.strands;
     }
-    const std::size_t G = guides.scene ? scene.guides.size() : guideStrands.numStrands();
+    const std::size_t G = in.count();
     if (!p.guideGroups.empty()) {
         std::vector<Vec3d> guideRoots(G);
-        for (std::size_t i = 0; i < G; ++i) guideRoots[i] = guides.scene ? scene.guides[i].root : toD(guideStrands.root(i));
-        guides.groups = readRootIds(p.guideGroups, guideRoots, "--guide-groups", "guides");
+        for (std::size_t i = 0; i < G; ++i) guideRoots[i] = in.guides.scene ? in.scene.guides[i].root : toD(in.strands.root(i));
+        in.guides.groups = readRootIds(p.guideGroups, guideRoots, "--guide-groups", "guides");
     }
-    // A bound of the vertices a new hair has, for the cap before the roots are made.
+}
+
+/// A bound of the vertices a new hair has, for the cap before the roots are made.
+std::size_t verticesPerHairBound(const GuideInput& in, const InterpolateParams& op)
+{
     std::size_t perHair = 0;
-    if (guides.scene) {
-        const HelicoidInterpolator probe(scene, op.helicoid);  // checks the guides; bounds a hair's vertices
+    if (in.guides.scene) {
+        const HelicoidInterpolator probe(in.scene, op.helicoid);  // checks the guides; bounds a hair's vertices
         perHair = probe.maxVerticesPerHair();
     } else {
         // The guides' own counts: exact for points; for helicoids a first bound (fits are traced at
         // their own step), which interpolateHelicoids() checks exactly before growing anything.
-        for (std::size_t i = 0; i < G; ++i) perHair = std::max(perHair, guideStrands.size(i));
+        for (std::size_t i = 0; i < in.count(); ++i) perHair = std::max(perHair, in.strands.size(i));
     }
-    auto checkCount = [&](double count) {
-        const double estimate = count * double(perHair);
-        if (estimate > double(op.helicoid.maxVertices)) {
-            throw LimitError(formatValue(count) + " strands would grow up to " + formatValue(estimate) + " vertices, more than the cap of " +
-                             std::to_string(op.helicoid.maxVertices) + " (--max-vertices; 12 bytes a vertex): ask for fewer strands");
-        }
-    };
+    return perHair;
+}
 
-    // Roots: a root file (PLY points with optional normals, or the roots of any strand file), or follicles on a scalp.
-    InterpolationRoots roots;
-    HeadObstacle head;
-    if (!p.roots.empty()) {
-        if (fileExtension(p.roots) == ".ply" && plyElementCount(p.roots, "vertex") > 0) {
-            const Stage stage(common, "reading " + p.roots);
-            const OrientedPoints pts = readPlyPoints(p.roots);
-            checkCount(double(pts.size()));
-            for (const Vec3f& v : pts.positions) roots.positions.push_back(toD(v));
-            for (const Vec3f& v : pts.normals) roots.normals.push_back(toD(v));
-        } else {
-            const StrandSet s = loadStrands("interpolate", p.roots, common);
-            checkCount(double(s.numStrands()));
-            for (std::size_t i = 0; i < s.numStrands(); ++i) roots.positions.push_back(toD(s.root(i)));
-        }
-        if (roots.positions.empty()) throw ValueError(p.roots + ": no roots");
-    } else {
-        checkCount(double(p.count));
-        openvdb::GridBase::Ptr g = readVdbGrid(p.scalp, "surface", "interpolate(" + p.scalp + ")");
-        openvdb::FloatGrid::Ptr surface = openvdb::GridBase::grid<openvdb::FloatGrid>(g);
-        if (!surface || surface->getGridClass() != openvdb::GRID_LEVEL_SET) throw TypeError(p.scalp + ": grid 'surface' is not a float level set; vdbhair scalp makes one");
-        openvdb::BoolGrid::Ptr region;
-        const std::vector<std::string> names = vdbGridNames(p.scalp, p.scalp);
-        if (std::find(names.begin(), names.end(), "region") != names.end()) {
-            region = openvdb::GridBase::grid<openvdb::BoolGrid>(readVdbGrid(p.scalp, "region", p.scalp));
-        }
-        FollicleParams fp;
-        fp.count = std::size_t(p.count);
-        fp.seed = op.seed;
-        fp.up = op.helicoid.up;
-        const Follicles f = sampleFollicles(surface, region, fp, true, common.interrupter);
-        for (const Vec3f& v : f.positions) roots.positions.push_back(toD(v));
-        for (const Vec3f& v : f.normals) roots.normals.push_back(toD(v));
-        head = HeadObstacle::levelSet(surface);
-        head.setLabel("--scalp " + p.scalp);
+/// @throw LimitError when @a count new hairs of up to @a perHair vertices could pass --max-vertices.
+void checkStrandCount(double count, std::size_t perHair, const InterpolateParams& op)
+{
+    const double estimate = count * double(perHair);
+    if (estimate > double(op.helicoid.maxVertices)) {
+        throw LimitError(formatValue(count) + " strands would grow up to " + formatValue(estimate) + " vertices, more than the cap of " +
+                         std::to_string(op.helicoid.maxVertices) + " (--max-vertices; 12 bytes a vertex): ask for fewer strands");
     }
+}
+
+/// --roots: PLY points with optional normals, or the roots of any strand file.
+InterpolationRoots readRootsFile(const InterpolateCmdParams& p, const CommonOptions& common, std::size_t perHair)
+{
+    InterpolationRoots roots;
+    if (fileExtension(p.roots) == ".ply" && plyElementCount(p.roots, "vertex") > 0) {
+        const Stage stage(common, "reading " + p.roots);
+        const OrientedPoints pts = readPlyPoints(p.roots);
+        checkStrandCount(double(pts.size()), perHair, p.op);
+        for (const Vec3f& v : pts.positions) roots.positions.push_back(toD(v));
+        for (const Vec3f& v : pts.normals) roots.normals.push_back(toD(v));
+    } else {
+        const StrandSet s = loadStrands("interpolate", p.roots, common);
+        checkStrandCount(double(s.numStrands()), perHair, p.op);
+        for (std::size_t i = 0; i < s.numStrands(); ++i) roots.positions.push_back(toD(s.root(i)));
+    }
+    if (roots.positions.empty()) throw ValueError(p.roots + ": no roots");
+    return roots;
+}
+
+/// --scalp with --count: follicles spread over the scalp's surface (in its region, if it has one);
+/// the surface becomes @a head.
+InterpolationRoots rootsOnScalp(const InterpolateCmdParams& p, const CommonOptions& common, std::size_t perHair, HeadObstacle& head)
+{
+    checkStrandCount(double(p.count), perHair, p.op);
+    openvdb::GridBase::Ptr g = readVdbGrid(p.scalp, "surface", "interpolate(" + p.scalp + ")");
+    openvdb::FloatGrid::Ptr surface = openvdb::GridBase::grid<openvdb::FloatGrid>(g);
+    if (!surface || surface->getGridClass() != openvdb::GRID_LEVEL_SET) throw TypeError(p.scalp + ": grid 'surface' is not a float level set; vdbhair scalp makes one");
+    openvdb::BoolGrid::Ptr region;
+    const std::vector<std::string> names = vdbGridNames(p.scalp, p.scalp);
+    if (std::find(names.begin(), names.end(), "region") != names.end()) {
+        region = openvdb::GridBase::grid<openvdb::BoolGrid>(readVdbGrid(p.scalp, "region", p.scalp));
+    }
+    FollicleParams fp;
+    fp.count = std::size_t(p.count);
+    fp.seed = p.op.seed;
+    fp.up = p.op.helicoid.up;
+    const Follicles f = sampleFollicles(surface, region, fp, true, common.interrupter);
+    InterpolationRoots roots;
+    for (const Vec3f& v : f.positions) roots.positions.push_back(toD(v));
+    for (const Vec3f& v : f.normals) roots.normals.push_back(toD(v));
+    head = HeadObstacle::levelSet(surface);
+    head.setLabel("--scalp " + p.scalp);
+    return roots;
+}
+
+/// The per-root controls: --root-groups, and density and length per root (a number, a mask grid,
+/// a painted mesh property, or a list: RootValues.h); then the normals --frames surface needs.
+void readRootControls(const InterpolateCmdParams& p, InterpolationRoots& roots)
+{
     if (!p.rootGroups.empty()) roots.groups = readRootIds(p.rootGroups, roots.positions, "--root-groups", "roots");
-    // Density and length per root: a number, a mask grid, a painted mesh property, or a list (RootValues.h).
     for (auto [spec, values, option, grid] : {std::tuple{&p.density, &roots.density, "--density", "density"}, std::tuple{&p.length, &roots.length, "--length", "length"}}) {
         if (spec->empty()) continue;
         *values = readRootValues(*spec, roots.positions, option, grid);
         const bool any = std::any_of(values->begin(), values->end(), [](float v) { return v > 0.f; });
         if (!any) throw ValueError(std::string(option) + " " + *spec + ": 0 at every one of the " + std::to_string(values->size()) + " roots: no hair would grow (a mask that covers none of them?)");
     }
-    if (op.frames == FrameRule::Surface && roots.normals.empty()) {
+    if (p.op.frames == FrameRule::Surface && roots.normals.empty()) {
         throw ValueError((p.roots.empty() ? p.scalp : p.roots) + ": the roots have no normals (PLY nx ny nz); --frames surface needs them");
     }
-    // The head: --head, else --scalp's surface, else the scene's sphere, else a sphere fitted to the guide roots.
-    if (p.head == "none") head = HeadObstacle::none();
-    else if (!p.head.empty()) head = readHeadObstacle(p.head, "--head " + p.head);
-    else if (head.empty() && guides.scene && scene.head) head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
-    else if (head.empty() && guides.strands) head = headFromRoots(guideStrands, op.helicoid.up);
+}
 
-    const InterpolateResult r = interpolateGuides(guides, roots, head, op, true, common.interrupter);
-    {
-        const Stage stage(common, "writing " + p.output);
-        if (op.returnScene) {
-            writeScene(p.output, r.scene);
-        } else if (fileExtension(p.output) == ".abc" && points) {
-            // Unreal's groom: the guides beside the new hair, each strand bound to its guides.
-            writeGroomAbc(p.output, guides.scene ? growGuides(scene, true, common.interrupter) : guideStrands, guides.groups, r);
-        } else {
-            writeStrands(p.output, r.strands);
-        }
+/// The head: --head, else --scalp's surface (@a scalpHead, empty without --scalp), else the
+/// scene's sphere, else a sphere fitted to the guide roots.
+HeadObstacle chooseHead(const InterpolateCmdParams& p, const GuideInput& in, HeadObstacle scalpHead)
+{
+    if (p.head == "none") return HeadObstacle::none();
+    if (!p.head.empty()) return readHeadObstacle(p.head, "--head " + p.head);
+    if (!scalpHead.empty()) return scalpHead;
+    if (in.guides.scene && in.scene.head) return HeadObstacle::sphere(in.scene.head->center, in.scene.head->radius);
+    if (in.guides.strands) return headFromRoots(in.strands, p.op.helicoid.up);
+    return scalpHead;
+}
+
+void writeOutput(const InterpolateCmdParams& p, const CommonOptions& common, const GuideInput& in, const InterpolateResult& r)
+{
+    const Stage stage(common, "writing " + p.output);
+    if (p.op.returnScene) {
+        writeScene(p.output, r.scene);
+    } else if (fileExtension(p.output) == ".abc" && p.op.method == InterpolationMethod::Points) {
+        // Unreal's groom: the guides beside the new hair, each strand bound to its guides.
+        writeGroomAbc(p.output, in.guides.scene ? growGuides(in.scene, true, common.interrupter) : in.strands, in.guides.groups, r);
+    } else {
+        writeStrands(p.output, r.strands);
     }
-    const std::size_t count = r.strands.numStrands() > 0 ? r.strands.numStrands() : r.scene.guides.size();
+}
+
+/// The new hairs made: strands, or a scene's helicoids.
+std::size_t newHairCount(const InterpolateResult& r) { return r.strands.numStrands() > 0 ? r.strands.numStrands() : r.scene.guides.size(); }
+
+void reportJson(const InterpolateCmdParams& p, const HeadObstacle& head, const InterpolateResult& r)
+{
+    const InterpolateParams& op = p.op;
+    const bool points = op.method == InterpolationMethod::Points;
+    const std::size_t count = newHairCount(r);
     const double enteringShare = double(r.enteringHead) / double(count);
     const double guidesEnteringShare = double(r.guidesEnteringHead) / double(std::max<std::size_t>(1, r.guides));
-    if (common.json) {
-        printJson({{"output", p.output}, {"method", p.method}, {"blend", points ? nlohmann::json(nullptr) : nlohmann::json(p.blend)},
-                   {"grouping", points ? nlohmann::json(p.grouping) : nlohmann::json(nullptr)}, {"groups", r.groups},
-                   {"guides", r.guides}, {"strands", count},
-                   {"vertices", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json(r.strands.numVertices())},
-                   {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe(false))},
-                   {"roots", r.roots}, {"roots_dropped", r.rootsDropped}, {"cut", r.cut},
-                   {"clumps", r.groom.clumps}, {"clumped", r.groom.clumped}, {"curled", r.groom.curled},
-                   {"pushed_out", r.pushedOut}, {"pushed_out_after_controls", r.groomPushedOut}, {"vertices_too_deep", r.verticesTooDeep},
-                   {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
-                   {"leaving_guide_volume", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json({{"strands", double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample))}, {"sample", r.volumeSample}, {"voxel", r.volumeVoxel}})},
-                   {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
-    } else if (!common.quiet) {
-        std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << p.method << ", " << frameRuleName(op.frames) << " frames";
-        if (points) std::cout << ", " << r.groups << (r.groups == 1 ? " group" : " groups") << ", grouping " << p.grouping;
-        char seconds[32];
-        std::snprintf(seconds, sizeof seconds, "%.3f", r.seconds);
-        std::cout << ") in " << seconds << " s\n";
-        if (r.rootsDropped > 0 || r.cut > 0) {
-            std::cout << "density and length: " << r.rootsDropped << " of " << r.roots << " roots left bare, " << r.cut << " hairs cut shorter\n";
-        }
-        if (r.groom.clumps > 0) std::cout << "clumps: " << r.groom.clumps << " centres, " << r.groom.clumped << " hairs pulled in\n";
-        if (r.groom.curled > 0) std::cout << "curl: " << r.groom.curled << " hairs (" << r.groom.addedVertices << " vertices added for " << int(kCurlVerticesPerTurn) << " a turn)\n";
-        if (!head.empty() && !op.returnScene) {
-            char shares[96];
-            std::snprintf(shares, sizeof shares, "%.1f %% of the new strands, %.1f %% of the guides", 100.0 * enteringShare, 100.0 * guidesEnteringShare);
-            std::cout << "head: " << head.describe(false) << " (no new vertex deeper than its root); " << r.pushedOut << " strands pushed out";
-            if (r.groom.curled > 0 || r.groom.clumped > 0 || op.groom.curl.frizz > 0.0) std::cout << " (and " << r.groomPushedOut << " touched up after curl, clumps and frizz)";
-            std::cout << "; passing into it: " << shares << "\n";
-        }
-        if (!op.returnScene) {
-            char share[64];
-            std::snprintf(share, sizeof share, "%.1f %%", 100.0 * double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample)));
-            std::cout << "leaving the guides' hair volume (voxel " << formatValue(r.volumeVoxel) << ", dilated by one): " << share << " of the new strands";
-            if (r.volumeSample < count) std::cout << " (measured on " << r.volumeSample << " spread over them)";
-            std::cout << "\n";
-        }
-        std::cout << "wrote " << p.output << "\n";
+    printJson({{"output", p.output}, {"method", p.method}, {"blend", points ? nlohmann::json(nullptr) : nlohmann::json(p.blend)},
+               {"grouping", points ? nlohmann::json(p.grouping) : nlohmann::json(nullptr)}, {"groups", r.groups},
+               {"guides", r.guides}, {"strands", count},
+               {"vertices", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json(r.strands.numVertices())},
+               {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe(false))},
+               {"roots", r.roots}, {"roots_dropped", r.rootsDropped}, {"cut", r.cut},
+               {"clumps", r.groom.clumps}, {"clumped", r.groom.clumped}, {"curled", r.groom.curled},
+               {"pushed_out", r.pushedOut}, {"pushed_out_after_controls", r.groomPushedOut}, {"vertices_too_deep", r.verticesTooDeep},
+               {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
+               {"leaving_guide_volume", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json({{"strands", double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample))}, {"sample", r.volumeSample}, {"voxel", r.volumeVoxel}})},
+               {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
+}
+
+void reportText(const InterpolateCmdParams& p, const HeadObstacle& head, const InterpolateResult& r)
+{
+    const InterpolateParams& op = p.op;
+    const std::size_t count = newHairCount(r);
+    std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << p.method << ", " << frameRuleName(op.frames) << " frames";
+    if (op.method == InterpolationMethod::Points) std::cout << ", " << r.groups << (r.groups == 1 ? " group" : " groups") << ", grouping " << p.grouping;
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%.3f", r.seconds);
+    std::cout << ") in " << seconds << " s\n";
+    if (r.rootsDropped > 0 || r.cut > 0) {
+        std::cout << "density and length: " << r.rootsDropped << " of " << r.roots << " roots left bare, " << r.cut << " hairs cut shorter\n";
     }
+    if (r.groom.clumps > 0) std::cout << "clumps: " << r.groom.clumps << " centres, " << r.groom.clumped << " hairs pulled in\n";
+    if (r.groom.curled > 0) std::cout << "curl: " << r.groom.curled << " hairs (" << r.groom.addedVertices << " vertices added for " << int(kCurlVerticesPerTurn) << " a turn)\n";
+    if (!head.empty() && !op.returnScene) {
+        const double enteringShare = double(r.enteringHead) / double(count);
+        const double guidesEnteringShare = double(r.guidesEnteringHead) / double(std::max<std::size_t>(1, r.guides));
+        char shares[96];
+        std::snprintf(shares, sizeof shares, "%.1f %% of the new strands, %.1f %% of the guides", 100.0 * enteringShare, 100.0 * guidesEnteringShare);
+        std::cout << "head: " << head.describe(false) << " (no new vertex deeper than its root); " << r.pushedOut << " strands pushed out";
+        if (r.groom.curled > 0 || r.groom.clumped > 0 || op.groom.curl.frizz > 0.0) std::cout << " (and " << r.groomPushedOut << " touched up after curl, clumps and frizz)";
+        std::cout << "; passing into it: " << shares << "\n";
+    }
+    if (!op.returnScene) {
+        char share[64];
+        std::snprintf(share, sizeof share, "%.1f %%", 100.0 * double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample)));
+        std::cout << "leaving the guides' hair volume (voxel " << formatValue(r.volumeVoxel) << ", dilated by one): " << share << " of the new strands";
+        if (r.volumeSample < count) std::cout << " (measured on " << r.volumeSample << " spread over them)";
+        std::cout << "\n";
+    }
+    std::cout << "wrote " << p.output << "\n";
+}
+
+int runInterpolate(InterpolateCmdParams p, const CommonOptions& common)
+{
+    checkOptions(p);  // before any work
+    GuideInput in;
+    readGuides(p, common, in);
+    const std::size_t perHair = verticesPerHairBound(in, p.op);
+    HeadObstacle scalpHead;
+    InterpolationRoots roots = p.roots.empty() ? rootsOnScalp(p, common, perHair, scalpHead) : readRootsFile(p, common, perHair);
+    readRootControls(p, roots);
+    const HeadObstacle head = chooseHead(p, in, std::move(scalpHead));
+
+    const InterpolateResult r = interpolateGuides(in.guides, roots, head, p.op, true, common.interrupter);
+    writeOutput(p, common, in, r);
+    if (common.json) reportJson(p, head, r);
+    else if (!common.quiet) reportText(p, head, r);
     return 0;
 }
 

@@ -149,7 +149,8 @@ std::vector<Vec3d> readRegionPoints(const std::string& path, const CommonOptions
     return out;
 }
 
-int runSynth(SynthCmdParams p, const CommonOptions& common)
+/// The options into @a p.synth, checked before any work.
+void checkOptions(SynthCmdParams& p)
 {
     strandFormatFromPath(p.output, /*forWriting=*/true);
     if (p.coarseGuides && p.coarse.empty()) throw ValueError("--coarse-guides: needs --coarse FILE");
@@ -157,24 +158,32 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     p.synth.layout = synthLayoutFromName(p.layout);
     if (p.strands == 0) throw ValueError("--strands 0: must be at least 1");
     p.synth.validate("option");
-    if (!p.coarse.empty()) {
-        // An imposed coarsest level: the example's finer levels transferred onto it (HairTransfer.h).
-        if (p.layout != synthLayoutName(SynthParams{}.layout)) throw ValueError("--layout: has no effect with --coarse (the coarsest level is imposed)");
-        TransferParams tp;
-        // Transfer's defaults for what was not given.
-        if (p.detailScaleOption->count() == 0) p.synth.detailScale = tp.synth.detailScale;
-        if (p.matchCandidatesOption->count() == 0) p.synth.match.candidates = tp.synth.match.candidates;
-        p.synth.validate("option");
-        tp.synth = p.synth;
-        tp.guides = p.coarseGuides;
-        if (p.strands > 0) {
-            if (!p.coarseGuides) throw ValueError("--strands: with --coarse the output has BASE's strands; --strands needs --coarse-guides");
-            tp.strands = std::size_t(p.strands);
-        }
-        TransferJob job{"synth", p.input, p.coarse, p.output, p.scalp, "EXAMPLE", "--coarse", p.measure};
-        return runTransferJob(job, tp, common);
+}
+
+/// --coarse: an imposed coarsest level, the example's finer levels transferred onto it
+/// (HairTransfer.h), run as `vdbhair transfer` runs it.
+int runOnCoarse(SynthCmdParams& p, const CommonOptions& common)
+{
+    if (p.layout != synthLayoutName(SynthParams{}.layout)) throw ValueError("--layout: has no effect with --coarse (the coarsest level is imposed)");
+    TransferParams tp;
+    // Transfer's defaults for what was not given.
+    if (p.detailScaleOption->count() == 0) p.synth.detailScale = tp.synth.detailScale;
+    if (p.matchCandidatesOption->count() == 0) p.synth.match.candidates = tp.synth.match.candidates;
+    p.synth.validate("option");
+    tp.synth = p.synth;
+    tp.guides = p.coarseGuides;
+    if (p.strands > 0) {
+        if (!p.coarseGuides) throw ValueError("--strands: with --coarse the output has BASE's strands; --strands needs --coarse-guides");
+        tp.strands = std::size_t(p.strands);
     }
-    const StrandSet example = loadStrands("synth", p.input, common);
+    TransferJob job{"synth", p.input, p.coarse, p.output, p.scalp, "EXAMPLE", "--coarse", p.measure};
+    return runTransferJob(job, tp, common);
+}
+
+/// The example, and --strands checked against the vertex cap.
+StrandSet readExample(SynthCmdParams& p, const CommonOptions& common)
+{
+    StrandSet example = loadStrands("synth", p.input, common);
     if (example.numStrands() < 2) throw ValueError(p.input + ": " + std::to_string(example.numStrands()) + " strand: synthesis needs an example of many strands");
     if (p.strands > 0) {
         p.synth.strands = std::size_t(p.strands);
@@ -183,9 +192,15 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
             throw LimitError("--strands " + std::to_string(p.strands) + ": " + formatValue(estimate) + " vertices exceed the cap of " +
                              std::to_string(p.synth.maxVertices));
     }
-    const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
+    return example;
+}
+
+/// Where the new hair grows: the points of --region, else of --output-scalp's region grid; none
+/// (the example's region) without either. @a regionFrom is set to the file they came from.
+std::vector<Vec3d> readOutputRegion(const SynthCmdParams& p, const CommonOptions& common, std::string& regionFrom)
+{
     std::vector<Vec3d> region;
-    std::string regionFrom = p.region;
+    regionFrom = p.region;
     if (regionFrom.empty() && !p.outputScalp.empty()) {
         if (!readScalpRegion(p.outputScalp))
             throw ValueError("--output-scalp " + p.outputScalp + ": no grid 'region' in it: say where the hair grows on it with --region");
@@ -195,6 +210,13 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
         const Stage stage(common, "reading " + regionFrom);
         region = readRegionPoints(regionFrom, common);
     }
+    return region;
+}
+
+/// --output-scalp (and --output-turn): the scalp map of the other head at @a region's points, and
+/// that head as the one the hair grows on; null without --output-scalp.
+std::shared_ptr<const ScalpMap> outputScalpMap(SynthCmdParams& p, const CommonOptions& common, const std::vector<Vec3d>& region)
+{
     std::shared_ptr<const ScalpMap> outputMap;
     if (p.outputTurnDeg != 0.0 && p.outputScalp.empty()) throw ValueError("--output-turn: needs --output-scalp (it turns the layout on the other head)");
     if (!std::isfinite(p.outputTurnDeg)) throw ValueError("--output-turn " + formatValue(p.outputTurnDeg) + ": must be a finite angle in degrees");
@@ -208,8 +230,134 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
         p.synth.head = HeadObstacle::levelSet(other);  // the head the hair grows on
         p.synth.head.setLabel("--output-scalp " + p.outputScalp);
     }
+    return outputMap;
+}
+
+/// --save-maps: the input and output feature maps, and the output's coarsest clusters rendered a
+/// colour each.
+void saveMaps(const std::string& folder, const SynthResult& r, const CommonOptions& common)
+{
+    const Stage stage(common, "writing maps to " + folder);
+    std::error_code ec;
+    std::filesystem::create_directories(folder, ec);
+    if (ec) throw IoError(folder + ": cannot create the folder: " + ec.message());
+    const int zoom = std::max(1, 400 / std::max(1, std::max(r.grid.width, r.grid.height)));
+    writeImage(folder + "/input_map.png", mapImage(r.inputMap, r.inputMap, zoom));
+    writeImage(folder + "/output_map.png", mapImage(r.outputMap, r.inputMap, zoom));
+    // The output's clusters at the coarsest level, a colour each.
+    StrandSet coloured = r.strands;
+    coloured.color.resize(coloured.numVertices());
+    const std::vector<std::int32_t>& top = r.clusterOf.back();
+    for (std::size_t s = 0; s < coloured.numStrands(); ++s)
+        for (std::size_t v = coloured.begin(s); v < coloured.end(s); ++v) coloured.color[v] = idColor(std::uint64_t(top[s]));
+    RenderParams rp;
+    rp.width = rp.height = 800;
+    // The world axis nearest the up used (views are named for axis-aligned heads).
+    Vec3d axis(0.0);
+    const int k = std::abs(r.up.x()) >= std::max(std::abs(r.up.y()), std::abs(r.up.z())) ? 0 : (std::abs(r.up.y()) >= std::abs(r.up.z()) ? 1 : 2);
+    axis[k] = r.up[k] < 0.0 ? -1.0 : 1.0;
+    rp.up = axis;
+    rp.title = "synth: coarsest clusters";
+    writeImage(folder + "/clusters.png", renderStrands(coloured, rp));
+}
+
+/// What the report says of the output against the example.
+struct SynthMeasures
+{
+    nlohmann::json stats, checks, regions;
+    std::string regionText;  ///< the style by region, as text
+    HairComparison comparison;  ///< --measure
+};
+
+/// The output against the example for the report: statsJson()'s statistics, the style by region,
+/// and with --measure what `vdbhair compare` measures.
+SynthMeasures measureOutput(const SynthCmdParams& p, const CommonOptions& common, const StrandSet& example, const SynthResult& r,
+                            const std::shared_ptr<const ScalpMap>& outputMap)
+{
+    SynthMeasures m;
+    const double finestVoxel = r.refineVoxelSizes.front();
+    // On another head the output is measured where it was made, on the example's scalp (moved
+    // back: the same (u, v), height and local offsets), so that its figures compare with the example's.
+    StrandSet movedBack;
+    if (outputMap) movedBack = moveToScalp(r.strands, *outputMap, *r.map, -p.synth.outputTurn);
+    m.stats = statsJson(example, r, outputMap ? movedBack : r.strands, finestVoxel, m.checks);
+    // The style region by region, output beside example, in the example's head frame (on another
+    // head, the output moved back; the head then is not the example's, so no inside-head figure).
+    const ScalpSphere& sphere = r.map->sphere();
+    m.regions = compareStyleRegions(example, outputMap ? movedBack : r.strands, sphere.center, sphere.up, sphere.radius,
+                                    outputMap || r.head == "none" ? nullptr : &p.synth.head, &m.regionText, p.synth.front);
+    if (p.measure) {
+        const Stage stage(common, "comparing with the example");
+        m.comparison = measureAgainst(example, outputMap ? movedBack : r.strands, outputMap ? nullptr : &p.synth.head, /*corresponding=*/false);
+    }
+    return m;
+}
+
+void reportJson(const SynthCmdParams& p, const StrandSet& example, const SynthResult& r, const std::shared_ptr<const ScalpMap>& outputMap,
+                const std::string& regionFrom, double seconds, const SynthMeasures& m)
+{
+    nlohmann::json levels = nlohmann::json::array();
+    for (std::size_t l = 0; l < r.output.size(); ++l)
+        levels.push_back({{"level", l}, {"example", r.example.levels[l].count()}, {"output", r.output[l].count()},
+                          {"refine_corrected", r.refinedCorrected[l]}});
+    nlohmann::json energy = nlohmann::json::array();
+    for (const Clustering& c : r.example.clusterings)
+        energy.push_back({{"energy", c.energy}, {"clusters", c.clusters}, {"largest_distance", c.largestDistance}});
+    nlohmann::json stages = nlohmann::json::object();
+    for (const SynthStage& s : r.stages) stages[s.name] = s.seconds;
+    printJson({{"output", p.output}, {"example", p.input}, {"strands", r.strands.numStrands()},
+               {"vertices", r.strands.numVertices()}, {"levels", levels}, {"clustering", energy},
+               {"map", {{"width", r.grid.width}, {"height", r.grid.height}, {"components", r.pca.components},
+                        {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
+               {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
+               {"head_radius", r.map->radius()}, {"region", regionFrom.empty() ? "the example's" : regionFrom}, {"output_area", r.outputArea},
+               {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)}, {"detail_scale", detailScaleName(p.synth.detailScale)},
+               {"match", {{"balance", p.synth.match.balance}, {"candidates", p.synth.match.candidates}}},
+               {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
+                         {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
+                                       {"example", outputMap ? nlohmann::json(nullptr) : nlohmann::json(double(r.exampleEnteringHead) / double(example.numStrands()))}}}}},
+               {"stages", stages}, {"seconds", seconds}, {"statistics", m.stats}, {"checks", m.checks}, {"regions", m.regions},
+               {"compare", p.measure ? toJson(m.comparison) : nlohmann::json(nullptr)}});
+}
+
+void reportText(const SynthCmdParams& p, const StrandSet& example, const SynthResult& r, const std::shared_ptr<const ScalpMap>& outputMap,
+                double seconds, const SynthMeasures& m)
+{
+    const nlohmann::json& stats = m.stats;
+    std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
+    for (const SynthStage& s : r.stages) std::cout << "  " << s.name << ": " << s.seconds << " s\n";
+    for (std::size_t l = r.output.size(); l-- > 0;)
+        std::cout << "  level " << l << ": example " << r.example.levels[l].count() << ", output " << r.output[l].count() << "\n";
+    std::cout << "  length distance " << stats["length_distance"] << ", turning distance " << stats["turning_distance"]
+              << ", coherence " << stats["coherence"]["output"] << " (example " << stats["coherence"]["example"] << ")"
+              << ", copies " << stats["novelty"]["copies"] << "\n";
+    if (r.head != "none") {
+        char shares[128];
+        std::snprintf(shares, sizeof shares, "%.1f %% of the output", 100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())));
+        std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares;
+        if (!outputMap) {
+            std::snprintf(shares, sizeof shares, ", %.1f %% of the example", 100.0 * double(r.exampleEnteringHead) / double(example.numStrands()));
+            std::cout << shares;
+        }
+        std::cout << "\n";
+    }
+    std::cout << "  by region, output (example):\n" << m.regionText;
+    if (p.measure) std::cout << "  compared with the example (vdbhair compare): " << summaryLine(m.comparison) << "\n";
+    std::cout << "wrote " << p.output << "\n";
+}
+
+int runSynth(SynthCmdParams p, const CommonOptions& common)
+{
+    checkOptions(p);
+    if (!p.coarse.empty()) return runOnCoarse(p, common);
+    const StrandSet example = readExample(p, common);
+    const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
+    std::string regionFrom;
+    const std::vector<Vec3d> region = readOutputRegion(p, common, regionFrom);
+    const std::shared_ptr<const ScalpMap> outputMap = outputScalpMap(p, common, region);
     if (p.head == "none") p.synth.head = HeadObstacle::none();
     else if (!p.head.empty()) p.synth.head = readHeadObstacle(p.head, "--head " + p.head);
+
     const auto t0 = std::chrono::steady_clock::now();
     const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter, regionFrom.empty() ? nullptr : &region, outputMap);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -217,99 +365,15 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
         const Stage stage(common, "writing " + p.output);
         writeSynthStrands(p.output, r.strands, r.clusterOf);
     }
-    if (!p.saveMaps.empty()) {
-        const Stage stage(common, "writing maps to " + p.saveMaps);
-        std::error_code ec;
-        std::filesystem::create_directories(p.saveMaps, ec);
-        if (ec) throw IoError(p.saveMaps + ": cannot create the folder: " + ec.message());
-        const int zoom = std::max(1, 400 / std::max(1, std::max(r.grid.width, r.grid.height)));
-        writeImage(p.saveMaps + "/input_map.png", mapImage(r.inputMap, r.inputMap, zoom));
-        writeImage(p.saveMaps + "/output_map.png", mapImage(r.outputMap, r.inputMap, zoom));
-        // The output's clusters at the coarsest level, a colour each.
-        StrandSet coloured = r.strands;
-        coloured.color.resize(coloured.numVertices());
-        const std::vector<std::int32_t>& top = r.clusterOf.back();
-        for (std::size_t s = 0; s < coloured.numStrands(); ++s)
-            for (std::size_t v = coloured.begin(s); v < coloured.end(s); ++v) coloured.color[v] = idColor(std::uint64_t(top[s]));
-        RenderParams rp;
-        rp.width = rp.height = 800;
-        // The world axis nearest the up used (views are named for axis-aligned heads).
-        Vec3d axis(0.0);
-        const int k = std::abs(r.up.x()) >= std::max(std::abs(r.up.y()), std::abs(r.up.z())) ? 0 : (std::abs(r.up.y()) >= std::abs(r.up.z()) ? 1 : 2);
-        axis[k] = r.up[k] < 0.0 ? -1.0 : 1.0;
-        rp.up = axis;
-        rp.title = "synth: coarsest clusters";
-        writeImage(p.saveMaps + "/clusters.png", renderStrands(coloured, rp));
-    }
+    if (!p.saveMaps.empty()) saveMaps(p.saveMaps, r, common);
     // The statistics (two tangent fields and a nearest-strand search: a sixth of a large synthesis)
     // are only what the report prints; --quiet without --json prints nothing.
     if (common.quiet && !common.json) return 0;
-    const double finestVoxel = r.refineVoxelSizes.front();
-    nlohmann::json checks;
-    // On another head the output is measured where it was made, on the example's scalp (moved
-    // back: the same (u, v), height and local offsets), so that its figures compare with the example's.
-    StrandSet movedBack;
-    if (outputMap) movedBack = moveToScalp(r.strands, *outputMap, *r.map, -p.synth.outputTurn);
-    const nlohmann::json stats = statsJson(example, r, outputMap ? movedBack : r.strands, finestVoxel, checks);
-    // The style region by region, output beside example, in the example's head frame (on another
-    // head, the output moved back; the head then is not the example's, so no inside-head figure).
-    std::string regionText;
-    const ScalpSphere& sphere = r.map->sphere();
-    const nlohmann::json regions = compareStyleRegions(example, outputMap ? movedBack : r.strands, sphere.center, sphere.up, sphere.radius,
-                                                       outputMap || r.head == "none" ? nullptr : &p.synth.head, &regionText, p.synth.front);
-    HairComparison comparison;
-    if (p.measure) {
-        const Stage stage(common, "comparing with the example");
-        comparison = measureAgainst(example, outputMap ? movedBack : r.strands, outputMap ? nullptr : &p.synth.head, /*corresponding=*/false);
-    }
-    if (common.json) {
-        nlohmann::json levels = nlohmann::json::array();
-        for (std::size_t l = 0; l < r.output.size(); ++l)
-            levels.push_back({{"level", l}, {"example", r.example.levels[l].count()}, {"output", r.output[l].count()},
-                              {"refine_corrected", r.refinedCorrected[l]}});
-        nlohmann::json energy = nlohmann::json::array();
-        for (const Clustering& c : r.example.clusterings)
-            energy.push_back({{"energy", c.energy}, {"clusters", c.clusters}, {"largest_distance", c.largestDistance}});
-        nlohmann::json stages = nlohmann::json::object();
-        for (const SynthStage& s : r.stages) stages[s.name] = s.seconds;
-        printJson({{"output", p.output}, {"example", p.input}, {"strands", r.strands.numStrands()},
-                   {"vertices", r.strands.numVertices()}, {"levels", levels}, {"clustering", energy},
-                   {"map", {{"width", r.grid.width}, {"height", r.grid.height}, {"components", r.pca.components},
-                            {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
-                   {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
-                   {"head_radius", r.map->radius()}, {"region", regionFrom.empty() ? "the example's" : regionFrom}, {"output_area", r.outputArea},
-                   {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)}, {"detail_scale", detailScaleName(p.synth.detailScale)},
-                   {"match", {{"balance", p.synth.match.balance}, {"candidates", p.synth.match.candidates}}},
-                   {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
-                             {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
-                                           {"example", outputMap ? nlohmann::json(nullptr) : nlohmann::json(double(r.exampleEnteringHead) / double(example.numStrands()))}}}}},
-                   {"stages", stages}, {"seconds", seconds}, {"statistics", stats}, {"checks", checks}, {"regions", regions},
-                   {"compare", p.measure ? toJson(comparison) : nlohmann::json(nullptr)}});
-    } else if (!common.quiet) {
-        std::cout << "synthesized " << r.strands.numStrands() << " strands from " << example.numStrands() << " in " << seconds << " s\n";
-        for (const SynthStage& s : r.stages) std::cout << "  " << s.name << ": " << s.seconds << " s\n";
-        for (std::size_t l = r.output.size(); l-- > 0;)
-            std::cout << "  level " << l << ": example " << r.example.levels[l].count() << ", output " << r.output[l].count() << "\n";
-        std::cout << "  length distance " << stats["length_distance"] << ", turning distance " << stats["turning_distance"]
-                  << ", coherence " << stats["coherence"]["output"] << " (example " << stats["coherence"]["example"] << ")"
-                  << ", copies " << stats["novelty"]["copies"] << "\n";
-        if (r.head != "none") {
-            char shares[128];
-            std::snprintf(shares, sizeof shares, "%.1f %% of the output", 100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())));
-            std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares;
-            if (!outputMap) {
-                std::snprintf(shares, sizeof shares, ", %.1f %% of the example", 100.0 * double(r.exampleEnteringHead) / double(example.numStrands()));
-                std::cout << shares;
-            }
-            std::cout << "\n";
-        }
-        std::cout << "  by region, output (example):\n" << regionText;
-        if (p.measure) std::cout << "  compared with the example (vdbhair compare): " << summaryLine(comparison) << "\n";
-        std::cout << "wrote " << p.output << "\n";
-    }
+    const SynthMeasures m = measureOutput(p, common, example, r, outputMap);
+    if (common.json) reportJson(p, example, r, outputMap, regionFrom, seconds, m);
+    else reportText(p, example, r, outputMap, seconds, m);
     return 0;
 }
-
 
 } // namespace
 

@@ -15,17 +15,16 @@
 
 namespace vdbhair {
 
+bool groomsHair(const GroomParams& groom)
+{
+    return groom.clump.radius > 0.0 || groom.curl.amplitude > 0.0 || groom.curl.frizz > 0.0;
+}
+
 namespace {
 
 double secondsSince(std::chrono::steady_clock::time_point t0)
 {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// Whether any groom control that moves hair (clumps, curl, frizz) is asked for.
-bool groomsHair(const GroomParams& groom)
-{
-    return groom.clump.radius > 0.0 || groom.curl.amplitude > 0.0 || groom.curl.frizz > 0.0;
 }
 
 /// The arguments, before any work: the guides given one way, the method's options, the roots'

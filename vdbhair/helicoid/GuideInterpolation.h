@@ -55,6 +55,11 @@ struct InterpolateParams
     bool returnScene = false;  ///< Helicoid: keep the new hairs as a scene, not grown (no head collision, no groom controls then)
 };
 
+/// @brief Whether @a groom asks for a control that moves hair: clumps, curl or frizz (a positive
+/// clump radius, curl amplitude or frizz). interpolateGuides() applies them only then, and refuses
+/// them with InterpolateParams::returnScene (a scene of new hairs is not grown, so nothing to move).
+bool groomsHair(const GroomParams& groom);
+
 /// @brief The guides: strands (blended as they are by points; fitted first for helicoids) or a
 /// helicoid scene (grown without wisps for points). Exactly one of the two.
 struct InterpolationGuides
