@@ -9,6 +9,7 @@
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/Types.h>
+#include <vdbhair/strands/StrandSet.h>
 
 #include <nlohmann/json.hpp>
 #include <pybind11/numpy.h>
@@ -37,6 +38,9 @@ inline pybind11::object toPython(const nlohmann::json& j)
 }
 
 namespace pyb = pybind11;
+
+/// How the module holds strands (vdbhair.Strands).
+using StrandsPtr = std::shared_ptr<StrandSet>;
 
 /// @brief Register vdbhair.Error and its subclasses on @a m and translate the library's typed
 /// exceptions (vdbhair/Exceptions.h) to them; InterruptedError becomes KeyboardInterrupt.
@@ -185,6 +189,7 @@ std::string pathString(const pyb::handle& obj, const std::string& what = "path")
 void bindStrands(pyb::module_& m);
 void bindFields(pyb::module_& m);
 void bindOperations(pyb::module_& m);
+void bindSynthesis(pyb::module_& m);  ///< synth, transfer, comb (Synthesis.cc)
 void bindScalp(pyb::module_& m);
 void bindDataset(pyb::module_& m);
 

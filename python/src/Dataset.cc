@@ -17,7 +17,6 @@ namespace vdbhair::py {
 
 namespace {
 
-using StrandsPtr = std::shared_ptr<StrandSet>;
 
 /// A report's JSON as Python objects (the command line's keys and values).
 pyb::object fromJson(const nlohmann::json& j)

@@ -31,7 +31,6 @@ namespace vdbhair::py {
 namespace {
 
 using IndexBox = std::array<std::array<int, 3>, 2>;
-using StrandsPtr = std::shared_ptr<StrandSet>;
 
 /// A field of one level as Python sees it.
 struct PyField

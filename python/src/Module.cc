@@ -155,6 +155,7 @@ the library's one-line messages. Paths may be str or any os.PathLike (pathlib.Pa
     py::bindStrands(m);
     py::bindFields(m);
     py::bindOperations(m);
+    py::bindSynthesis(m);
     py::bindScalp(m);
     py::bindDataset(m);
     // Arguments of the wrong type: instead of pybind11's "incompatible function arguments" with

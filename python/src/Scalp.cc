@@ -20,7 +20,6 @@ namespace vdbhair::py {
 
 namespace {
 
-using StrandsPtr = std::shared_ptr<StrandSet>;
 
 std::vector<Vec3f> toFloat(const std::vector<Vec3d>& points)
 {

@@ -17,7 +17,6 @@ namespace vdbhair::py {
 
 namespace {
 
-using StrandsPtr = std::shared_ptr<StrandSet>;
 
 std::string shapeText(const pyb::array& a)
 {
