@@ -583,11 +583,7 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
                  "to the roots, and the grids carry the measured table (vdbhair_scalp_distance); None fits a sphere to the roots."},
                 {"up", "Tuple[float, float, float]",
                  pyb::make_tuple(fieldDefaults.scalp.up.x(), fieldDefaults.scalp.up.y(), fieldDefaults.scalp.up.z()),
-                 "the scalp's up axis for space=\"scalp\"."},
-                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
-                {"progress", "Optional[Callable]", pyb::none(),
-                 "optional callable ``progress(stage, done, total, unit)``, called at each stage's start and then at most ten "
-                 "times a second; raising in it stops the work."}},
+                 "the scalp's up axis for space=\"scalp\"."}},
                "The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space by default: ``vdbhair field``.\n\n"
                "Every segment contributes its unit tangent to every voxel it passes through, weighted by its\n"
                "length there; each iteration reweights contributions by 0.5 (T . v + 1) and renormalizes.\n"
@@ -609,9 +605,7 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
     };
     defineVerb(m, "retrace", {"strands: vdbhair.Strands", "field"}, traceParameters(),
                {{"return_stats", "bool", pyb::bool_(false),
-                 "also return a dict of stop reasons (strands, full_length, vanished, left_field, max_steps, steps)."},
-                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
-                {"progress", "Optional[Callable]", pyb::none(), "optional callable ``progress(stage, done, total, unit)``."}},
+                 "also return a dict of stop reasons (strands, full_length, vanished, left_field, max_steps, steps)."}},
                "Retrace every strand through a vector field from its own root, for its own length\n"
                "(Wang et al. 2009, Sec. 5.3): ``vdbhair retrace``.\n\n"
                "Raises vdbhair.GridTypeError (a TypeError) for a non-vector grid, vdbhair.ArgumentError,\n"
@@ -693,9 +687,7 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
                  "the scalp's up axis (``--up``)."},
                 {"return_report", "bool", pyb::bool_(false),
                  "also return a dict: the finest level's measures, mode, voxel_size, head, per_level (a dict a level) and "
-                 "fields (the TangentField of each level, 0 the finest)."},
-                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
-                {"progress", "Optional[Callable]", pyb::none(), "optional callable ``progress(stage, done, total, unit)``."}},
+                 "fields (the TangentField of each level, 0 the finest)."}},
                "Vector-field refinement (Wang et al. 2009, Sec. 5.3): estimate, retrace, repeat from the\n"
                "coarsest level to the finest: ``vdbhair refine``.",
                "    strands: a Strands.\n", "Strands, or (Strands, report) with return_report.",

@@ -200,9 +200,7 @@ Returns:
                 {"return_summary", "bool", pyb::bool_(false),
                  "also return a dict (fitted, skipped, Frechet distance relative to length: mean and 95th percentile, pieces per "
                  "strand, step convergence: the largest distance between each fit traced at its step and at a quarter of it "
-                 "relative to length, mean and max, and how many fits exceed a tenth of max_error; bytes of fits and of points)."},
-                {"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."},
-                {"progress", "Optional[Callable]", pyb::none(), "optional callable ``progress(stage, done, total, unit)``."}},
+                 "relative to length, mean and max, and how many fits exceed a tenth of max_error; bytes of fits and of points)."}},
                "Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``. ``lambda_`` is the\n"
                "command's ``--lambda`` (``lambda`` is a Python keyword).",
                "    strands: a Strands.\n",

@@ -82,7 +82,8 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
     checkParams(table, p, ParamSpelling::Keyword, verb);
 }
 
-/// @brief Define @a verb on @a m: `verb(positional..., *, <declared keywords>, <extra keywords>)`
+/// @brief Define @a verb on @a m: `verb(positional..., *, <declared keywords>, <extra keywords>,
+/// threads=0, progress=None)`
 /// (a positional is "name" or "name: annotation", as Module.cc's type checks read annotations)
 /// calling @a impl(positional..., kwargs) with every keyword in one dict.
 /// @param summary the docstring's first paragraphs; @a positionalDoc and @a returns its other parts
@@ -96,6 +97,11 @@ void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std:
     std::vector<Keyword> keywords;
     for (const Param<P>& p : table) keywords.push_back({p.pythonName(), pythonAnnotation(p), pythonDefault(p), paramHelp(p)});
     for (const PyKeyword& k : extras) keywords.push_back({k.name, k.annotation, k.defaultValue, k.doc});
+    // What every long operation takes (Common.h's runLong()).
+    keywords.push_back({"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."});
+    keywords.push_back({"progress", "Optional[Callable]", pyb::none(),
+                        "optional callable ``progress(stage, done, total, unit)``, called at each stage's start and then at most "
+                        "ten times a second; raising in it stops the work."});
 
     std::string doc = summary + "\n\nArgs:\n" + positionalDoc;
     for (const Keyword& k : keywords) doc += "    " + k.name + ": " + k.doc + "\n";
