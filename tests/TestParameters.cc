@@ -40,6 +40,16 @@ ParamTable<Toy> toyTable()
     return t;
 }
 
+/// docs/cli.md, whose option tables are generated from the declarations.
+std::string cliPage()
+{
+    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
+    REQUIRE(in);
+    std::stringstream page;
+    page << in.rdbuf();
+    return page.str();
+}
+
 } // namespace
 
 TEST_CASE("Parameters: defaults come from the struct, ranges and choices are checked, names spelled per front end", "[params]")
@@ -92,12 +102,9 @@ TEST_CASE("Parameters: refine's declaration sets what the library reads, and doc
     // Every default passes its own range.
     REQUIRE_NOTHROW(checkParams(t, RefineParams{}, ParamSpelling::Flag, ""));
     // The page's table is the declaration's (regenerate it from parameterMarkdown() when this fails).
-    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
-    REQUIRE(in);
-    std::stringstream page;
-    page << in.rdbuf();
+    const std::string page = cliPage();
     INFO("docs/cli.md's refine table should read:\n" << parameterMarkdown(t));
-    CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
+    CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
 }
 
 TEST_CASE("Parameters: field's declaration is refine's too (nested), and docs/cli.md shows it", "[params]")
@@ -113,11 +120,9 @@ TEST_CASE("Parameters: field's declaration is refine's too (nested), and docs/cl
     RefineParams rp;
     std::get<ParamAccess<RefineParams, double>>(findParam(refineParameters(), "voxel-size")->access).set(rp, 0.75);
     CHECK(rp.field.voxelSize == 0.75);
-    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
-    std::stringstream page;
-    page << in.rdbuf();
+    const std::string page = cliPage();
     INFO("docs/cli.md's field table should read:\n" << parameterMarkdown(f));
-    CHECK(page.str().find(parameterMarkdown(f)) != std::string::npos);
+    CHECK(page.find(parameterMarkdown(f)) != std::string::npos);
 }
 
 TEST_CASE("Parameters: fit's declaration, a keyword that is not its name and a valued flag, in docs/cli.md", "[params]")
@@ -129,11 +134,9 @@ TEST_CASE("Parameters: fit's declaration, a keyword that is not its name and a v
     p.maxError = 0.0;
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--max-error 0: must be above 0");
     REQUIRE_NOTHROW(checkParams(t, FitParams{}, ParamSpelling::Flag, ""));
-    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
-    std::stringstream page;
-    page << in.rdbuf();
+    const std::string page = cliPage();
     INFO("docs/cli.md's fit table should read:\n" << parameterMarkdown(t));
-    CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
+    CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
 }
 
 TEST_CASE("Parameters: retrace's declaration sets what the library reads, and docs/cli.md shows it", "[params]")
@@ -145,9 +148,7 @@ TEST_CASE("Parameters: retrace's declaration sets what the library reads, and do
     CHECK(p.vertices == RetraceVertices::Steps);
     CHECK(p.maxSteps == 7);
     REQUIRE_NOTHROW(checkParams(t, TraceParams{}, ParamSpelling::Flag, ""));
-    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
-    std::stringstream page;
-    page << in.rdbuf();
+    const std::string page = cliPage();
     INFO("docs/cli.md's retrace table should read:\n" << parameterMarkdown(t));
-    CHECK(page.str().find(parameterMarkdown(t)) != std::string::npos);
+    CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
 }
