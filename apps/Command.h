@@ -204,14 +204,14 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common);
 /// @brief The options of `synth`, `transfer` and `comb` that are not plain SynthParams fields.
 struct SynthOptionText
 {
-    std::string up = "auto", front = "auto", refineMode, detail, detailScale;
+    std::string up = "auto", front = "auto", refineMode, detail, detailScale, rootDensity;
     bool noRefine = false;
 };
 /// @brief The hierarchy's options (--levels, --seed, --vertices, --threshold, --initial-clusters, --up).
 void addSynthHierarchyOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
 /// @brief Detail transfer and refinement (--components, --detail, --detail-scale, --refine-mode, --no-refine, --voxel-size).
 void addSynthTransferOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
-/// @throw ValueError for a bad --up, --refine-mode or --detail.
+/// @throw ValueError for a bad --up, --refine-mode, --detail or --root-density.
 void applySynthOptionText(const SynthOptionText& text, SynthParams& params);
 /// @brief The flags of the detail-transfer parameters the library's errors name (synth, transfer, comb).
 FlagNames synthTransferFlags();

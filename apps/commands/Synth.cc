@@ -43,6 +43,7 @@ struct SynthCmdParams
     std::string coarse;
     const CLI::Option* detailScaleOption = nullptr;     ///< (given or not: --coarse takes transfer's defaults)
     const CLI::Option* matchCandidatesOption = nullptr;
+    const CLI::Option* matchPlaceOption = nullptr;
 };
 
 /// The first three channels of a feature map as an RGB picture (each channel scaled by the input
@@ -169,6 +170,7 @@ int runOnCoarse(SynthCmdParams& p, const CommonOptions& common)
     // Transfer's defaults for what was not given.
     if (p.detailScaleOption->count() == 0) p.synth.detailScale = tp.synth.detailScale;
     if (p.matchCandidatesOption->count() == 0) p.synth.match.candidates = tp.synth.match.candidates;
+    if (p.matchPlaceOption->count() == 0) p.synth.match.place = tp.synth.match.place;
     p.synth.validate("option");
     tp.synth = p.synth;
     tp.guides = p.coarseGuides;
@@ -399,6 +401,8 @@ void addSynthTransferOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
     sub->add_option("--match-balance", s.match.balance, "Each example wisp serves output wisps of at most this times its own share of the output's strands (its part of the example's), and each example strand at most this times its even share of its output wisp's, pairs taken by increasing distance at one scale (0: every output wisp takes its nearest, the paper's rule)")->capture_default_str();
     sub->add_option("--match-candidates", s.match.candidates, std::string("Example wisps considered per output wisp in balanced matching, nearest first") +
                                                                 (s.match.candidates == SynthParams{}.match.candidates && s.detailScale == DetailScale::Strand ? " (64 with --coarse, as transfer)" : ""))->capture_default_str();
+    sub->add_option("--match-place", s.match.place, std::string("How much an output wisp prefers example wisps near its own place on the scalp, against their shape (0: by shape alone, the paper's rule; ") +
+                                                      (s.match.place > 0.0 ? "0 with --coarse, as transfer" : "synth uses 1") + ")")->capture_default_str();
     sub->add_option("--refine-mode", t.refineMode, "Refinement after each level: consistent (default, keeps detail) or field (the paper's retrace)");
     sub->add_flag("--no-refine", t.noRefine, "Skip the vector-field refinement of every level");
     sub->add_option("--voxel-size", s.voxelSize, "Refinement voxel of the finest level, world units (0: refine's suggestion for the hairstyle; doubled per coarser level)")->capture_default_str();
@@ -412,6 +416,10 @@ void applySynthOptionText(const SynthOptionText& t, SynthParams& s)
     if (!t.refineMode.empty()) s.refineMode = refineModeFromName(t.refineMode);
     if (!t.detail.empty()) s.detailBlend = detailBlendFromName(t.detail);
     if (!t.detailScale.empty()) s.detailScale = detailScaleFromName(t.detailScale);
+    if (!t.rootDensity.empty()) {
+        if (t.rootDensity != "example" && t.rootDensity != "even") throw ValueError("--root-density " + t.rootDensity + ": must be example or even");
+        s.exampleDensity = t.rootDensity == "example";
+    }
 }
 
 void writeSynthStrands(const std::string& path, const StrandSet& strands, const std::vector<std::vector<std::int32_t>>& clusterOf)
@@ -446,9 +454,12 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--layout", params->layout, "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: a variation that keeps its global flow exactly)")->capture_default_str();
     sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();
     sub->add_option("--nearby", s.texture.nearbyRadius, "Texture synthesis: the reach of place guidance and of the initial patches' offsets, as a fraction of the map")->capture_default_str();
+    params->text.rootDensity = s.exampleDensity ? "example" : "even";
+    sub->add_option("--root-density", params->text.rootDensity, "New roots at the example's density place by place (example: a dense crown stays dense) or evenly over the region (even: the paper's)")->capture_default_str();
     addSynthTransferOptions(sub, s, params->text);
     params->detailScaleOption = sub->get_option("--detail-scale");
     params->matchCandidatesOption = sub->get_option("--match-candidates");
+    params->matchPlaceOption = sub->get_option("--match-place");
     sub->add_option("--coarse", params->coarse, "Impose a coarsest level instead of synthesizing one (Wang et al. §6): BASE's own coarsest level (a hairstyle, or a scene grown first); the example's finer levels are transferred onto it, on BASE's scalp, with BASE's roots (as vdbhair transfer EXAMPLE BASE)");
     sub->add_flag("--coarse-guides", params->coarseGuides, "With --coarse: BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over the guides' region (--strands sets the output count)");
     sub->add_flag("--measure", params->measure, "Also compare the output with the example as `vdbhair compare` does (the report's \"compare\"; on another head, "
@@ -467,7 +478,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
 
 FlagNames synthTransferFlags()
 {
-    return {{"match balance", "--match-balance"}, {"match candidates", "--match-candidates"},
+    return {{"match balance", "--match-balance"}, {"match candidates", "--match-candidates"}, {"match place", "--match-place"},
             {"detail blend", "--detail"}, {"detail scale", "--detail-scale"}};
 }
 

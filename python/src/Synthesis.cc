@@ -47,8 +47,8 @@ void bindSynthesis(pyb::module_& m)
         "synth",
         [](const StrandsPtr& example, int levels, std::optional<std::size_t> strands, std::uint64_t seed, int vertices,
            double threshold, int initialClusters, int components, double mapSpacing, const std::string& layout,
-           const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, double placeWeight,
-           double nearby, bool refine, std::optional<std::string> refineMode,
+           const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, double matchPlace, double placeWeight,
+           double nearby, const std::string& rootDensity, bool refine, std::optional<std::string> refineMode,
            double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::array<double, 3>> front, std::optional<PathArg> scalp,
            std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>> region,
            std::optional<PathArg> outputScalp, double outputTurn, bool measure, bool returnReport, int threads,
@@ -70,7 +70,10 @@ void bindSynthesis(pyb::module_& m)
             p.detailScale = detailScaleFromName(detailScale);
             p.match.balance = matchBalance;
             p.match.candidates = matchCandidates;
+            p.match.place = matchPlace;
             p.placeWeight = placeWeight;
+            if (rootDensity != "example" && rootDensity != "even") throw ValueError("synth: root_density '" + rootDensity + "': must be example or even");
+            p.exampleDensity = rootDensity == "example";
             p.texture.nearbyRadius = nearby;
             p.refine = refine;
             if (refineMode) p.refineMode = refineModeFromName(*refineMode);
@@ -146,8 +149,9 @@ void bindSynthesis(pyb::module_& m)
         pyb::arg("components") = synthDefaults.components, pyb::arg("map_spacing") = synthDefaults.mapSpacing,
         pyb::arg("layout") = synthLayoutName(synthDefaults.layout), pyb::arg("detail") = detailBlendName(synthDefaults.detailBlend),
         pyb::arg("detail_scale") = detailScaleName(synthDefaults.detailScale), pyb::arg("match_balance") = synthDefaults.match.balance,
-        pyb::arg("match_candidates") = synthDefaults.match.candidates, pyb::arg("place_weight") = synthDefaults.placeWeight,
-        pyb::arg("nearby") = synthDefaults.texture.nearbyRadius, pyb::arg("refine") = synthDefaults.refine,
+        pyb::arg("match_candidates") = synthDefaults.match.candidates, pyb::arg("match_place") = synthDefaults.match.place,
+        pyb::arg("place_weight") = synthDefaults.placeWeight, pyb::arg("nearby") = synthDefaults.texture.nearbyRadius,
+        pyb::arg("root_density") = synthDefaults.exampleDensity ? "example" : "even", pyb::arg("refine") = synthDefaults.refine,
         pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = synthDefaults.voxelSize, pyb::arg("up") = pyb::none(), pyb::arg("front") = pyb::none(),
         pyb::arg("scalp") = pyb::none(), pyb::arg("region") = pyb::none(), pyb::arg("output_scalp") = pyb::none(),
         pyb::arg("output_turn") = 0.0, pyb::arg("measure") = false, pyb::arg("return_report") = false, pyb::arg("threads") = 0,
@@ -173,8 +177,10 @@ Args:
     detail_scale: "strand" (each strand at its own length and pitch), "index" (vertex by vertex) or "arc-length".
     match_balance: each example wisp serves at most this times its own share of the output (its part of the example's strands), each of its strands at most this times its even share of an output wisp (0: nearest wisp and strand).
     match_candidates: example wisps considered per output wisp in balanced matching.
+    match_place: how much an output wisp prefers example wisps near its own place, against their shape (0: by shape alone).
     place_weight: texture synthesis place guidance (0: none).
     nearby: reach of place guidance and initial patch offsets, a fraction of the map.
+    root_density: "example" (new roots at the example's density, place by place) or "even" (evenly over the region).
     refine: refine every level (Wang et al. §5.3).
     refine_mode: None (refine's default, "consistent") or "field".
     voxel_size: refinement voxel of the finest level, world units (0: refine's suggestion).
@@ -202,7 +208,7 @@ Returns:
         "transfer",
         [](const StrandsPtr& details, const StrandsPtr& base, bool guides, std::optional<std::size_t> strands, double smoothing,
            bool smoothBase, int levels, std::uint64_t seed, int vertices, double threshold, int initialClusters, int components,
-           const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, bool refine,
+           const std::string& detail, const std::string& detailScale, double matchBalance, int matchCandidates, double matchPlace, bool refine,
            std::optional<std::string> refineMode,
            double voxelSize, std::optional<std::array<double, 3>> up, std::optional<std::array<double, 3>> front, std::optional<PathArg> scalp,
            bool measure, bool returnReport, int threads, const pyb::object& progress) -> pyb::object {
@@ -223,6 +229,7 @@ Returns:
             s.detailScale = detailScaleFromName(detailScale);
             s.match.balance = matchBalance;
             s.match.candidates = matchCandidates;
+            s.match.place = matchPlace;
             s.refine = refine;
             if (refineMode) s.refineMode = refineModeFromName(*refineMode);
             s.voxelSize = voxelSize;
@@ -264,6 +271,7 @@ Returns:
         pyb::arg("initial_clusters") = transferDefaults.synth.cluster.initialClusters, pyb::arg("components") = transferDefaults.synth.components,
         pyb::arg("detail") = detailBlendName(transferDefaults.synth.detailBlend), pyb::arg("detail_scale") = detailScaleName(transferDefaults.synth.detailScale),
         pyb::arg("match_balance") = transferDefaults.synth.match.balance, pyb::arg("match_candidates") = transferDefaults.synth.match.candidates,
+        pyb::arg("match_place") = transferDefaults.synth.match.place,
         pyb::arg("refine") = transferDefaults.synth.refine, pyb::arg("refine_mode") = pyb::none(), pyb::arg("voxel_size") = transferDefaults.synth.voxelSize,
         pyb::arg("up") = pyb::none(), pyb::arg("front") = pyb::none(), pyb::arg("scalp") = pyb::none(), pyb::arg("measure") = false,
         pyb::arg("return_report") = false, pyb::arg("threads") = 0,
@@ -282,6 +290,7 @@ Args:
     detail_scale: "arc-length" (curls keep their size, the strand runs the base's wisp), "index"
         (the paper's, vertex by vertex) or "strand".
     match_candidates: as synth's, 64 here (the two hairstyles' wisps differ more).
+    match_place: as synth's, 0 here (two hairstyles' places are not one another's).
     measure: with return_report, the report's "compare" holds the output against the base, as
         ``vdbhair.compare(base, output)``.
     Other options as synth (front: the head's front for the report's "regions", which set the output

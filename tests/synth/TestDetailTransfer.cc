@@ -281,3 +281,64 @@ TEST_CASE("transferDetail: edges keep a helix's turning per length on a longer s
         CHECK((end - want).length() < 3.0 * r);
     }
 }
+
+namespace {
+
+/// Straight strands along the normal of the unit sphere, rooted in a small cap around @a at.
+StrandSet radialStrands(const Vec3d& at, std::size_t count, double length, std::uint64_t seed)
+{
+    StrandSet out;
+    Rng rng(seed, 0x9a1u, 0);
+    const Vec3d c = at.unitSafe();
+    for (std::size_t s = 0; s < count; ++s) {
+        const Vec3d n = (c + Vec3d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 0.1).unitSafe();
+        std::vector<Vec3f> p;
+        for (int l = 0; l < 8; ++l) p.emplace_back(n * (1.0 + length * double(l) / 7.0));
+        out.addStrand(p);
+    }
+    return out;
+}
+
+double meanLength(const StrandSamples& s, std::size_t from, std::size_t to)
+{
+    double sum = 0.0;
+    for (std::size_t i = from; i < to; ++i) sum += s.lengths[i];
+    return sum / double(to - from);
+}
+
+} // namespace
+
+TEST_CASE("transferDetail: match place takes the wisps near an output wisp's place over those of its shape", "[synth]")
+{
+    // Input: short strands (0.3) around P, long ones (0.6) around Q, one wisp each. Output
+    // centres: a long one at P and a short one at Q, and the output roots are the input's. By
+    // shape each output wisp takes the input wisp of its length (the other place); with place
+    // weight enough, the one at its own place, so each place keeps its lengths.
+    const Vec3d P(0.6, 0.8, 0.0), Q(-0.6, 0.8, 0.0);
+    StrandSet in = radialStrands(P, 100, 0.3, 1);
+    in.append(radialStrands(Q, 100, 0.6, 2));
+    const StrandSamples strands = sampleStrands(in, unitMap(), 16);
+    ClusterParams params;
+    const Clustering c = clusterSamples(strands, unitMap(), 2, false, params);
+    REQUIRE(c.centers.count() == 2);
+    StrandSet centres = radialStrands(P, 1, 0.6, 3);
+    centres.append(radialStrands(Q, 1, 0.3, 4));
+    const StrandSamples outC = sampleStrands(centres, unitMap(), 16);
+    const TransferSource src{&strands, &c.centers, &c.label};
+    for (double place : {0.0, 10.0})
+        for (bool threaded : {true, false}) {
+            DetailMatchParams match;
+            match.place = place;
+            const StrandSamples out = transferDetail(src, outC, strands.roots, unitMap(), 16, nullptr, nullptr, DetailBlend::Edges, threaded,
+                                                     nullptr, nullptr, DetailScale::Strand, 0, match);
+            REQUIRE(out.count() == 200);
+            CAPTURE(place, threaded);
+            // Strands 0-99 are rooted at P, 100-199 at Q.
+            const double atP = meanLength(out, 0, 100), atQ = meanLength(out, 100, 200);
+            CHECK(atP == Approx(place > 0.0 ? 0.3 : 0.6).epsilon(0.05));
+            CHECK(atQ == Approx(place > 0.0 ? 0.6 : 0.3).epsilon(0.05));
+        }
+    DetailMatchParams bad;
+    bad.place = -1.0;
+    CHECK_THROWS_WITH(bad.validate("test"), Catch::Contains("match place -1"));
+}

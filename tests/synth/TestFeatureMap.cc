@@ -83,3 +83,68 @@ TEST_CASE("scatterRoots: roots on the scalp, in the region, more even after rela
     params.count = 0;
     CHECK_THROWS_WITH(scatterRoots(unitMap(), grid, mask, params), Catch::Contains("count of 0"));
 }
+
+TEST_CASE("rootDensity and scatterRoots: new roots at the example's density, place by place", "[synth]")
+{
+    // An example four times as dense on one side of the cap (u below the split) as on the other.
+    const std::vector<Vec3d> all = capCoords(4000);
+    std::vector<double> us;
+    for (const Vec3d& c : all) us.push_back(c.x());
+    std::nth_element(us.begin(), us.begin() + std::ptrdiff_t(us.size() / 2), us.end());
+    const double split = us[us.size() / 2];
+    std::vector<Vec3d> coords;
+    for (std::size_t i = 0; i < all.size(); ++i)
+        if (all[i].x() < split || i % 4 == 0) coords.push_back(all[i]);
+    const UvGrid grid = uvGridAround(all, 0.02);
+    std::vector<float> f(all.size(), 0.0f);
+    const FeatureImage mask = buildFeatureMap(grid, all, f.data(), 1, all, 2.0 * medianUvSpacing(all));
+    const FeatureImage density = rootDensity(grid, coords, mask);
+    REQUIRE(density.channels == 1);
+    // Away from the split, the densities stand as the example's (4 : 1).
+    double dense = 0.0, sparse = 0.0;
+    std::size_t nd = 0, ns = 0;
+    for (int y = 0; y < grid.height; ++y)
+        for (int x = 0; x < grid.width; ++x) {
+            if (!mask.isValid(x, y)) {
+                CHECK_FALSE(density.isValid(x, y));
+                continue;
+            }
+            const double u = grid.u(x);
+            if (u < split - 0.2) dense += density.pixel(x, y)[0], ++nd;
+            if (u > split + 0.2) sparse += density.pixel(x, y)[0], ++ns;
+        }
+    REQUIRE(nd > 50);
+    REQUIRE(ns > 50);
+    CHECK(dense / double(nd) / (sparse / double(ns)) == Approx(4.0).epsilon(0.2));
+    // The new roots keep the sides' shares, relaxed or not, and the dense side's spacing is half
+    // the sparse side's; the result does not depend on threads.
+    RootScatterParams params;
+    params.count = 1500;
+    params.seed = 5;
+    const auto share = [&](const ScatteredRoots& r) {
+        std::size_t left = 0;
+        for (const Vec3d& s : r.scalp) left += s.x() < split;
+        return double(left) / double(r.scalp.size());
+    };
+    const double exampleShare = double(std::count_if(coords.begin(), coords.end(), [&](const Vec3d& c) { return c.x() < split; })) / double(coords.size());
+    const ScatteredRoots even = scatterRoots(unitMap(), grid, mask, params);
+    const ScatteredRoots relaxed = scatterRoots(unitMap(), grid, mask, params, true, &density);
+    CAPTURE(exampleShare, share(even), share(relaxed));
+    CHECK(share(even) == Approx(0.5).margin(0.08));
+    CHECK(share(relaxed) == Approx(exampleShare).margin(0.05));
+    CHECK(scatterRoots(unitMap(), grid, mask, params, false, &density).positions == relaxed.positions);
+    std::vector<Vec3f> left, right;
+    for (std::size_t i = 0; i < relaxed.scalp.size(); ++i) {
+        const double u = relaxed.scalp[i].x();
+        if (u < split - 0.2) left.emplace_back(relaxed.positions[i]);
+        if (u > split + 0.2) right.emplace_back(relaxed.positions[i]);
+    }
+    const FollicleStats sl = measureFollicles(left), sr = measureFollicles(right);
+    CAPTURE(sl.nnMean, sr.nnMean, sl.nnCV, sr.nnCV);
+    CHECK(sr.nnMean / sl.nnMean == Approx(2.0).epsilon(0.25));
+    CHECK(sl.nnCV < 0.35);
+    CHECK(sr.nnCV < 0.35);
+    params.iterations = 0;
+    CHECK(share(scatterRoots(unitMap(), grid, mask, params, true, &density)) == Approx(exampleShare).margin(0.05));
+    CHECK_THROWS_WITH(rootDensity(grid, {}, mask), Catch::Contains("no coordinates"));
+}

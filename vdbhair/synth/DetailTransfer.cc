@@ -7,6 +7,7 @@
 #include <vdbhair/strands/Resample.h>
 #include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
+#include <vdbhair/synth/FeatureMap.h>
 #include <vdbhair/synth/impl/BalancedMatch.h>
 #include <vdbhair/synth/impl/DetailEdges.h>
 
@@ -59,6 +60,7 @@ void DetailMatchParams::validate(const char* where) const
     if (!(balance == 0.0 || (balance >= 1.0 && std::isfinite(balance))))
         throw ValueError(std::string(where) + ": match balance " + formatNumber(balance) + ": 0 (off) or a finite factor of at least 1");
     if (candidates < 1) throw ValueError(std::string(where) + ": match candidates " + std::to_string(candidates) + ": must be at least 1");
+    if (!(place >= 0.0) || !std::isfinite(place)) throw ValueError(std::string(where) + ": match place " + formatNumber(place) + ": must be 0 (off) or a positive finite weight");
 }
 
 ScalpFrame alignedFrame(const float* row, int vertices, const ScalpFrame& f)
@@ -287,6 +289,19 @@ void alignCentres(DetailTransferRun& run)
     }
 }
 
+/// DetailMatchParams::place as a factor of squared (u, v) distances: place × the input centres'
+/// RMS feature norm per two of their median (u, v) spacings (0 when off or without places).
+double matchPlaceScale2(const DetailTransferRun& run, const std::vector<float>& feat, int nf)
+{
+    const double place = run.matching.place;
+    if (!(place > 0.0) || run.inC.scalp.size() != run.nIn || run.outCenters.scalp.size() != run.nOut || run.nIn < 2) return 0.0;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < run.nIn * std::size_t(nf); ++k) sum += double(feat[k]) * feat[k];
+    const double spacing = medianUvSpacing(run.inC.scalp);
+    if (!(spacing > 0.0)) return 0.0;
+    return place * place * (sum / double(run.nIn)) / (4.0 * spacing * spacing);
+}
+
 /// Step 3, matching clusters through PCA features of both sets of centres: each output centre
 /// takes the nearest input centre or, balanced, the nearest with room among its candidates.
 void matchClusters(DetailTransferRun& run, int components)
@@ -305,10 +320,18 @@ void matchClusters(DetailTransferRun& run, int components)
     match.assign(nOut, 0);
     const std::size_t K = balanced ? std::min<std::size_t>(nIn, std::size_t(run.matching.candidates)) : 1;
     std::vector<std::pair<double, std::uint32_t>> nearest(nOut * K);  // per output centre, its K nearest (distance, input)
+    const double placeScale2 = matchPlaceScale2(run, feat, nf);
     run.forEach(nOut, [&](std::size_t c) {
         const float* f = feat.data() + (nIn + c) * std::size_t(nf);
         std::vector<std::pair<double, std::uint32_t>> all(nIn);
         for (std::size_t j = 0; j < nIn; ++j) all[j] = {sampleDistance2(f, feat.data() + j * std::size_t(nf), std::size_t(nf)), std::uint32_t(j)};
+        if (placeScale2 > 0.0) {
+            const Vec3d& uv = run.outCenters.scalp[c];
+            for (std::size_t j = 0; j < nIn; ++j) {
+                const Vec3d& in = run.inC.scalp[j];
+                all[j].first += placeScale2 * ((uv.x() - in.x()) * (uv.x() - in.x()) + (uv.y() - in.y()) * (uv.y() - in.y()));
+            }
+        }
         std::partial_sort(all.begin(), all.begin() + std::ptrdiff_t(K), all.end());  // ties to the lower index
         std::copy_n(all.begin(), K, nearest.begin() + std::ptrdiff_t(c * K));
         match[c] = all[0].second;

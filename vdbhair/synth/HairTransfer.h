@@ -58,6 +58,7 @@ struct TransferParams
         // DETAILS' wisps differ from BASE's in length and shape more than an example's from its
         // synthesis: balanced matching looks further for a wisp with share left.
         p.match.candidates = 64;
+        p.match.place = 0.0;  // two hairstyles' places are not one another's
         return p;
     }();
     /// σ of the smoothing of the coarsest strands, as a fraction of BASE's vertices (DETAILS': of

@@ -187,7 +187,11 @@ ScatteredRoots scatterLevelRoots(const SynthResult& res, const SynthParams& para
     rp.iterations = params.rootIterations;
     rp.seed = params.seed;
     rp.stream = std::uint64_t(l);
-    return scatterRoots(*res.map, res.grid, res.outputMap, rp, threaded);
+    if (!params.exampleDensity) return scatterRoots(*res.map, res.grid, res.outputMap, rp, threaded);
+    // The example's own roots of this level, per pixel of its region; pixels of another output
+    // region take the nearest region pixel's density.
+    const FeatureImage density = filledFeatureImage(rootDensity(res.grid, res.example.levels[std::size_t(l)].scalp, res.inputMap));
+    return scatterRoots(*res.map, res.grid, res.outputMap, rp, threaded, &density);
 }
 
 /// Step 5, the coarsest level from the synthesized map: at each root, the PCA reconstruction of

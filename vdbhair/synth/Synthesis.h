@@ -69,7 +69,12 @@ struct SynthParams
     /// its lengths (transfer between hairstyles lays detail by arc length, HairTransfer.h).
     /// Measured on Curly_100 (--json, seeds 0-6): see the docs/synthesis.md.
     DetailScale detailScale = DetailScale::Strand;
-    DetailMatchParams match;  ///< how output wisps choose the example's (balanced, DetailTransfer.h)
+    /// How output wisps choose the example's (balanced, DetailTransfer.h), near their own place
+    DetailMatchParams match = [] {
+        DetailMatchParams m;
+        m.place = 1.0;
+        return m;
+    }();
     int vertices = StrandSamples::kDefaultVertices;  ///< n_s (Table 1)
     int components = Pca::kDefaultComponents;        ///< n_f (§5.1)
     ClusterParams cluster;                           ///< includes the level count and the seed
@@ -102,6 +107,10 @@ struct SynthParams
     /// by against the example's (moveToScalp()), for heads that face different ways
     double outputTurn = 0.0;
     int rootIterations = 10;   ///< RootScatter.h relaxation rounds
+    /// Output roots at the example's density, place by place (rootDensity() of each level's roots,
+    /// RootScatter.h): a dense short crown stays dense. false: evenly over the region (the paper's
+    /// "randomly generate hair roots" and Turk's relaxation)
+    bool exampleDensity = true;
     bool refine = true;        ///< §5.3 after every level
     double voxelSize = 0.0;    ///< the finest level's refinement voxel, world units (0: suggestVoxelSize(example))
     RefineMode refineMode = RefineMode::Consistent;
