@@ -1,5 +1,6 @@
 /// @file RefineOptions.h
-/// @brief What `refine` and `demo` share: the refinement options and their reports
+/// @brief What `refine` and `demo` share: the refinement options and the prose report (the JSON
+/// report is the library's, RefineJson.h)
 /// (defined in commands/Refine.cc; the trace report in commands/Retrace.cc).
 #pragma once
 
@@ -7,6 +8,7 @@
 #include "HeadOptions.h"
 
 #include <vdbhair/field/Refine.h>
+#include <vdbhair/field/RefineJson.h>
 #include <vdbhair/field/TangentAngles.h>
 
 #include <openvdb/Grid.h>
@@ -32,9 +34,6 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p, const std::vector<std::
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands, const CommonOptions& common);
 /// The field grids of @a r, each tagged `vdbhair_source` = @a source (the input file).
 openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source);
-/// The refine report: settings, then what an artist sees (RefineMeasures), for the finest level
-/// and for every level.
-nlohmann::json refineReportJson(const RefineResult& r, const RefineParams& rp);
 void printRefineReport(const RefineResult& r, const RefineParams& rp);
 
 /// The report of retrace: {"strands","full_length","stopped":{...},"mean_displacement"}, and

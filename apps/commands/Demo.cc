@@ -90,7 +90,7 @@ int runDemo(const DemoParams& p, const CommonOptions& common)
         writeImage(previewPath, sheet);
     }
     const StrandSummary s = summarizeStrands(strands);
-    nlohmann::json report = refineReportJson(r, rp);
+    nlohmann::json report = refineReport(r, rp);
     report["scene"] = p.refine.input;
     report["vertices"] = s.vertices;
     report["seconds"] = seconds;

@@ -7,6 +7,7 @@
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/DenseArray.h>
 #include <vdbhair/field/Refine.h>
+#include <vdbhair/field/RefineJson.h>
 #include <vdbhair/field/ScalpSpace.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
@@ -265,24 +266,6 @@ pyb::dict traceStatsDict(const TraceStats& s)
     return d;
 }
 
-
-pyb::dict measuresDict(const RefineMeasures& m)
-{
-    pyb::dict d;
-    d["strands"] = m.strands;
-    d["full_length"] = m.fullLength;
-    d["left_hair_volume"] = m.leftVolume;
-    d["inside_head_before"] = m.insideHeadBefore;
-    d["inside_head_after"] = m.insideHeadAfter;
-    d["curvature_kept_vertex"] = m.curvatureKeptVertex;
-    d["curvature_kept_8"] = m.curvatureKept8;
-    d["tip_occupancy"] = m.tipOccupancy;
-    d["displacement_mean_voxels"] = m.displacementMean;
-    d["displacement_p95_voxels"] = m.displacementP95;
-    d["coherence_before"] = m.coherenceBefore;
-    d["coherence_after"] = m.coherenceAfter;
-    return d;
-}
 
 /// The array methods Grid and TangentField share (TangentField's act on its tangent grid).
 template <typename ClassT, typename GetT>
@@ -645,29 +628,15 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
             const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureAgainst(*strands, result.strands, &result.head); });
             comparison = toPython(toJson(c));
         }
+        // refine --json's report (RefineJson.h), with the output compared to the input and each
+        // level's TangentField (0 the finest).
+        const nlohmann::json json = returnReport ? refineReport(result, rp) : nlohmann::json();
         auto out = std::make_shared<StrandSet>(std::move(result.strands));
         if (!returnReport) return pyb::cast(out);
-        pyb::dict report = rp.measure ? measuresDict(result.levels.front().measures) : pyb::dict();
+        pyb::dict report = toPython(json);
         if (rp.measure) report["compare"] = comparison;
-        report["mode"] = refineModeName(rp.mode);
-        report["voxel_size"] = result.voxelSize;
-        report["head"] = result.head.describe();
-        pyb::list perLevel, fields;
-        for (std::size_t l = 0; l < result.levels.size(); ++l) {
-            const RefineLevel& lv = result.levels[l];
-            pyb::dict e = rp.measure ? measuresDict(lv.measures) : pyb::dict();
-            e["level"] = l;
-            e["voxel_size"] = lv.voxelSize;
-            if (rp.mode == RefineMode::Consistent) {
-                e["corrected_strands"] = lv.consistency.corrected;
-                e["reverted_strands"] = lv.consistency.reverted;
-            } else {
-                e["trace"] = traceStatsDict(lv.trace);
-            }
-            perLevel.append(e);
-        }
+        pyb::list fields;
         for (TangentField& f : result.fields) fields.append(PyField{std::move(f)});
-        report["per_level"] = perLevel;
         report["fields"] = fields;
         return pyb::make_tuple(out, report);
     };
@@ -686,8 +655,8 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
                  pyb::make_tuple(refineDefaults.field.scalp.up.x(), refineDefaults.field.scalp.up.y(), refineDefaults.field.scalp.up.z()),
                  "the scalp's up axis (``--up``)."},
                 {"return_report", "bool", pyb::bool_(false),
-                 "also return a dict: the finest level's measures, mode, voxel_size, head, per_level (a dict a level) and "
-                 "fields (the TangentField of each level, 0 the finest)."}},
+                 "also return a dict: `refine --json`'s report (the same keys and values: settings, the finest level's measures "
+                 "with measure=True, per_level, and compare), plus fields (the TangentField of each level, 0 the finest)."}},
                "Vector-field refinement (Wang et al. 2009, Sec. 5.3): estimate, retrace, repeat from the\n"
                "coarsest level to the finest: ``vdbhair refine``.",
                "    strands: a Strands.\n", "Strands, or (Strands, report) with return_report.",

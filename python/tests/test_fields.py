@@ -102,7 +102,7 @@ def test_refine_report(wavy):
     assert len(out) == len(wavy) and out.num_vertices == wavy.num_vertices
     assert report["mode"] == "consistent" and len(report["per_level"]) == 2
     assert [f.voxel_size for f in report["fields"]] == pytest.approx([0.15, 0.3])
-    assert 0.0 <= report["coherence_after"] <= 1.0
+    assert 0.0 <= report["coherence"]["after"] <= 1.0
     # And the output against the input, as compare() reports it (the same function, the same keys).
     assert report["compare"]["paired"] and report["compare"]["strands"] == {"a": len(wavy), "b": len(out)}
     direct = vdbhair.compare(wavy, out)
@@ -113,7 +113,7 @@ def test_refine_report(wavy):
     assert report["compare"] == direct
     # The measures are opt-in (as `refine --measure`): without them the report has none.
     _, plain = vdbhair.refine(wavy, voxel_size=0.15, levels=2, return_report=True)
-    assert "coherence_after" not in plain and "compare" not in plain and plain["mode"] == "consistent"
+    assert "coherence" not in plain and "compare" not in plain and plain["mode"] == "consistent"
     field_mode = vdbhair.refine(wavy, voxel_size=0.15, mode="field", head="none")
     assert not np.array_equal(field_mode.positions, out.positions)
     with pytest.raises(ValueError, match="mode"):
@@ -224,6 +224,30 @@ def test_vdbhair_reads_what_pyopenvdb_writes(tmp_path):
     s = vdbhair.Strands(np.stack([t, np.zeros_like(t), np.zeros_like(t)], axis=1), [0, 5])
     out = vdbhair.retrace(s, flow)
     np.testing.assert_allclose(out.positions, t[:, None] * direction[None, :], atol=1e-5)
+
+
+def test_refine_report_is_the_commands(wavy, tmp_path):
+    import json
+    import pathlib
+    import subprocess
+    # One report whichever front end ran it: refine(return_report=True) is `refine --json`'s, less
+    # the command's output path, plus the fields (and compare() with measure=True, as the command).
+    cli = pathlib.Path(vdbhair.__file__).resolve().parents[1] / "bin" / "vdbhair"
+    if not cli.exists():
+        pytest.skip(f"no command-line vdbhair at {cli}")
+    hair = tmp_path / "wavy.hair"
+    vdbhair.write(wavy, str(hair))
+    for extra in ([], ["--measure"]):
+        run = subprocess.run([str(cli), "refine", str(hair), "--voxel-size", "0.15", "--levels", "2", "--head", "none", "-o",
+                              str(tmp_path / "out.hair"), "--json", *extra], check=True, capture_output=True, text=True)
+        command = json.loads(run.stdout)
+        _, report = vdbhair.refine(vdbhair.read(str(hair)), voxel_size=0.15, levels=2, head="none", measure=bool(extra),
+                                   return_report=True)
+        del command["output"]
+        del report["fields"]
+        # The memory the machine had free at that moment is the one figure that may differ.
+        del command["memory"]["available_bytes"], report["memory"]["available_bytes"]
+        assert report == command
 
 
 def test_scalp_space_matches_the_command(wavy, tmp_path):
