@@ -9,24 +9,29 @@
 #include <vdbhair/Parameters.h>
 
 #include <algorithm>
+#include <cctype>
 #include <string>
 #include <vector>
 
 namespace vdbhair::app {
 
 /// @brief Add an option for every parameter of @a table but those named in @a skip, each writing
-/// into @a target (which must outlive parsing).
+/// into @a target (which must outlive parsing): `--name VALUE`, or a flag for a bool (Param::flag()).
 template<typename P>
 void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const std::vector<std::string>& skip = {})
 {
     for (const Param<P>& param : table) {
         if (std::find(skip.begin(), skip.end(), param.name) != skip.end()) continue;
-        const std::string flag = "--" + param.name, help = paramHelp(param);
+        const std::string flag = param.flag(), help = paramHelp(param);
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(target))>;
             if constexpr (std::is_same_v<T, bool>) {
                 if (!param.valued) {
-                    sub->add_flag_callback(flag, [&target, a] { a.set(target, true); }, help);
+                    // A flag turns on what is off by default, --no-NAME turns off what is on.
+                    const bool on = !a.get(P{});
+                    std::string off = help;
+                    if (!off.empty()) off[0] = char(std::tolower(static_cast<unsigned char>(off[0])));
+                    sub->add_flag_callback(flag, [&target, a, on] { a.set(target, on); }, on ? help : "Turn off: " + off);
                     return;
                 }
             }

@@ -4,7 +4,11 @@
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/TangentField.h>
+#include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/Reconstruction.h>
+#include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/scalp/Follicles.h>
 
 #include <fstream>
 #include <sstream>
@@ -151,4 +155,120 @@ TEST_CASE("Parameters: retrace's declaration sets what the library reads, and do
     const std::string page = cliPage();
     INFO("docs/cli.md's retrace table should read:\n" << parameterMarkdown(t));
     CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
+}
+
+namespace {
+
+/// The declared parameter @a name of @a table, which must exist.
+template<typename P>
+const Param<P>& declared(const ParamTable<P>& table, const std::string& name)
+{
+    const Param<P>* p = findParam(table, name);
+    INFO(name);
+    REQUIRE(p);
+    return *p;
+}
+
+template<typename P, typename T>
+void setParam(const ParamTable<P>& table, const std::string& name, P& p, T value)
+{
+    std::get<ParamAccess<P, T>>(declared(table, name).access).set(p, value);
+}
+
+/// Every default passes its own range, and docs/cli.md holds the table.
+template<typename P>
+void checkDeclaration(const ParamTable<P>& t, const char* verb)
+{
+    REQUIRE_NOTHROW(checkParams(t, P{}, ParamSpelling::Flag, ""));
+    for (const Param<P>& p : t) CHECK(paramHelp(p).find('|') == std::string::npos);  // a cell of a Markdown table
+    INFO("docs/cli.md's " << verb << " table should read:\n" << parameterMarkdown(t));
+    CHECK(cliPage().find(parameterMarkdown(t)) != std::string::npos);
+}
+
+} // namespace
+
+TEST_CASE("Parameters: interpolate's declaration, neighbours for both methods and the groom's ranges, in docs/cli.md", "[params]")
+{
+    const ParamTable<InterpolateParams>& t = interpolateParameters();
+    InterpolateParams p;
+    // neighbors: 0 (and Python's None) leaves each method's own; K sets both.
+    CHECK(declared(t, "neighbors").defaultText() == "0");
+    CHECK(declared(t, "neighbors").pythonNone);
+    setParam(t, "neighbors", p, 7);
+    CHECK(p.points.neighbors == 7);
+    CHECK(p.helicoid.shepard.neighbors == 7);
+    setParam(t, "neighbors", p, 0);
+    CHECK(p.points.neighbors == PointInterpolationParams{}.neighbors);
+    CHECK(p.helicoid.shepard.neighbors == ShepardParams{}.neighbors);
+    setParam(t, "neighbors", p, -1);
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--neighbors -1: must be at least 0");
+    p = InterpolateParams{};
+    // One cap for both methods; names set the enumerations.
+    setParam(t, "max-vertices", p, std::uint64_t(1000));
+    CHECK(p.points.maxVertices == 1000);
+    CHECK(p.helicoid.maxVertices == 1000);
+    setParam(t, "blend", p, std::string("arcs"));
+    CHECK(p.helicoid.blend == HelicoidBlend::Arcs);
+    setParam(t, "method", p, std::string("helicoid"));
+    CHECK(p.method == InterpolationMethod::Helicoid);
+    p = InterpolateParams{};
+    p.groom.clump.tightness = 1.5;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--clump-tightness 1.5: must be between 0 and 1");
+    p = InterpolateParams{};
+    p.helicoid.shepard.power = 0.0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "interpolate"), "interpolate: power 0: must be above 0");
+    checkDeclaration(t, "interpolate");
+}
+
+TEST_CASE("Parameters: reconstruct's declaration reuses interpolation's and fit's, in docs/cli.md", "[params]")
+{
+    const ParamTable<ReconstructParams>& t = reconstructParameters();
+    // The same declarations as interpolate's and fit's; reconstruct's own default blend.
+    for (const char* name : {"arcs", "power", "neighbors", "grouping", "likeness"}) {
+        CHECK(paramHelp(declared(t, name)) == paramHelp(declared(interpolateParameters(), name)));
+    }
+    CHECK(paramHelp(declared(t, "max-error")) == paramHelp(declared(fitParameters(), "max-error")));
+    CHECK(declared(t, "blend").defaultText() == "arcs");
+    ReconstructParams p;
+    setParam(t, "select", p, std::string("cluster"));
+    CHECK(p.selection == GuideSelection::Cluster);
+    setParam(t, "max-error", p, 0.05);
+    CHECK(p.fit.maxError == 0.05);
+    p = ReconstructParams{};
+    p.guideFraction = 1.5;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "reconstruct"), "reconstruct: guides 1.5: must be above 0 and at most 1");
+    CHECK(guideSelectionFromName(guideSelectionName(GuideSelection::Random)) == GuideSelection::Random);
+    REQUIRE_THROWS_WITH(guideSelectionFromName("best"), "select 'best' is not one of random, cluster");
+    checkDeclaration(t, "reconstruct");
+}
+
+TEST_CASE("Parameters: roots's declaration, a flag that turns off what is on by default, in docs/cli.md", "[params]")
+{
+    const ParamTable<FollicleParams>& t = follicleParameters();
+    CHECK(declared(t, "contour").flag() == "--no-contour");
+    CHECK(declared(t, "contour").pythonName() == "contour");
+    CHECK(declared(t, "count").flag() == "--count");
+    CHECK(declared(t, "count").pythonNone);
+    FollicleParams p;
+    setParam(t, "contour", p, false);
+    CHECK_FALSE(p.contour);
+    setParam(t, "iterations", p, 12);
+    CHECK(p.maxIterations == 12);
+    p = FollicleParams{};
+    p.initialFraction = 5.0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--initial-fraction 5: must be above 0 and at most 4");
+    checkDeclaration(t, "roots");
+}
+
+TEST_CASE("Parameters: grow's declaration, the scene's own integrator by name, in docs/cli.md", "[params]")
+{
+    const ParamTable<GrowOptions>& t = growParameters();
+    CHECK(declared(t, "integrator").defaultText() == "scene");
+    GrowOptions p;
+    setParam(t, "integrator", p, std::string("rk4"));
+    REQUIRE(p.integrator);
+    CHECK(*p.integrator == HelicoidIntegrator::RK4);
+    setParam(t, "integrator", p, std::string("scene"));
+    CHECK_FALSE(p.integrator);
+    checkDeclaration(t, "grow");
 }

@@ -52,6 +52,9 @@ struct Param
     /// A bool given as a value on the command line (`--roll false`), not a flag that turns it on.
     bool valued = false;
     std::string keyword;  ///< Python's keyword when the name is not one (`lambda_` for `lambda`)
+    /// Python's default is None, which leaves the struct's default (what @c zeroMeans says), as
+    /// `neighbors=None` does; the value itself (0) is taken too.
+    bool pythonNone = false;
 
     /// The keyword Python spells it as.
     std::string pythonName() const
@@ -60,6 +63,13 @@ struct Param
         std::string s = name;
         for (char& c : s) if (c == '-') c = '_';
         return s;
+    }
+    /// The command line's flag: `--name`, or `--no-name` for a bool flag that is on by default
+    /// (it can only be turned off).
+    std::string flag() const
+    {
+        const auto* b = std::get_if<ParamAccess<P, bool>>(&access);
+        return b && !valued && b->get(P{}) ? "--no-" + name : "--" + name;
     }
     /// The default, as a person types it: 0.5, 3, true, consistent.
     std::string defaultText() const { return valueText(P{}); }
@@ -132,6 +142,7 @@ ParamTable<Outer> nestedParams(const ParamTable<Inner>& inner, F part, const std
         q.zeroMeans = p.zeroMeans;
         q.valued = p.valued;
         q.keyword = p.keyword;
+        q.pythonNone = p.pythonNone;
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(std::declval<const Inner&>()))>;
             q.access = ParamAccess<Outer, T>{[a, part](const Outer& o) { return a.get(part(const_cast<Outer&>(o))); },
@@ -148,7 +159,7 @@ enum class ParamSpelling { Flag, Keyword };
 template<typename P>
 std::string spelled(const Param<P>& param, ParamSpelling spelling)
 {
-    return spelling == ParamSpelling::Flag ? "--" + param.name : param.pythonName();
+    return spelling == ParamSpelling::Flag ? param.flag() : param.pythonName();
 }
 
 /// @brief The parameter of @a table called @a name, or null.
@@ -199,7 +210,7 @@ std::string paramHelp(const Param<P>& param)
     std::string h = param.help;
     std::vector<std::string> notes;
     if (!param.unit.empty()) notes.push_back(param.unit);
-    if (param.aboveMin) notes.push_back("above " + formatNumber(param.min));
+    if (param.aboveMin) notes.push_back("above " + formatNumber(param.min) + (std::isfinite(param.max) ? ", at most " + formatNumber(param.max) : ""));
     else if (std::isfinite(param.min) && std::isfinite(param.max)) notes.push_back(formatNumber(param.min) + " to " + formatNumber(param.max));
     else if (std::isfinite(param.min)) notes.push_back("at least " + formatNumber(param.min));
     if (!param.choices.empty()) {
@@ -222,7 +233,8 @@ std::string parameterMarkdown(const ParamTable<P>& table)
 {
     std::string out = "| option | Python | default | what it does |\n| --- | --- | --- | --- |\n";
     for (const Param<P>& p : table) {
-        out += "| `--" + p.name + "` | `" + p.pythonName() + "` | " + p.defaultText() + " | " + paramHelp(p) + " |\n";
+        out += "| `" + p.flag() + "` | `" + p.pythonName() + "` | " + p.defaultText() + (p.pythonNone ? " (Python: None)" : "") + " | " +
+               paramHelp(p) + " |\n";
     }
     return out;
 }

@@ -1,5 +1,6 @@
 // vdbhair grow SCENE.json -o OUT: helicoid scenes (Piuze et al. 2011) to strands.
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/Scene.h>
@@ -15,18 +16,15 @@ namespace {
 
 struct GrowParams
 {
-    std::string scene, output, integrator;
-    std::size_t maxVertices = GrowOptions{}.maxVertices;
+    std::string scene, output;
+    GrowOptions grow;  ///< its declared parameters (growParameters()) are options
 };
 
 int runGrow(const GrowParams& p, const CommonOptions& common)
 {
     strandFormatFromPath(p.output, /*forWriting=*/true);
-    GrowOptions opts;
-    if (p.integrator == "euler") opts.integrator = HelicoidIntegrator::Euler;
-    else if (p.integrator == "rk4") opts.integrator = HelicoidIntegrator::RK4;
-    else if (!p.integrator.empty()) throw ValueError("--integrator '" + p.integrator + "' is not one of euler, rk4");
-    opts.maxVertices = p.maxVertices;
+    checkParamOptions(growParameters(), p.grow);
+    const GrowOptions& opts = p.grow;
     const Scene scene = readScene(p.scene);
     const auto t0 = std::chrono::steady_clock::now();
     GrowReport report;
@@ -63,8 +61,7 @@ Command addGrowCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "grow");
     sub->add_option("scene", params->scene, "Scene file (JSON, \"vdbhair\": \"scene/1\")")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
-    sub->add_option("--integrator", params->integrator, "euler (Eq. 3, the paper's) or rk4 (default: the scene's, else euler)");
-    sub->add_option("--max-vertices", params->maxVertices, "Refuse scenes that would grow more vertices")->capture_default_str();
+    addParamOptions(sub, params->grow, growParameters());
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair grow scenes/figures/fig3_wisp.json -o wisp.hair");
     return {sub, [params, &common] { return runGrow(*params, common); }};

@@ -2,6 +2,7 @@
 // guide hairs, by blending the guides' points by group and likeness (the default) or their helicoid
 // parameters (Piuze et al. 2011, §4), kept out of the head (vdbhair/helicoid/GuideInterpolation.h).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/Refine.h>
@@ -26,15 +27,9 @@ namespace {
 struct InterpolateCmdParams
 {
     std::string guides, output, roots, scalp, head, guideGroups, rootGroups, density, length;
-    InterpolateParams op;
-    std::string method = interpolationMethodName(InterpolateParams{}.method);
-    std::string frames = frameRuleName(InterpolateParams{}.frames);
-    std::string grouping = guideGroupingName(PointInterpolationParams{}.grouping);
+    InterpolateParams op;  ///< its declared parameters (interpolateParameters()) are options
     std::string up = axisName(HelicoidInterpolationParams{}.up);
-    std::string blend = helicoidBlendName(HelicoidInterpolationParams{}.blend);
     std::int64_t count = -1;  ///< -1: not given
-    int neighbors = 0;        ///< 0: not given (each method's own default)
-    CLI::Option* neighborsOpt = nullptr;
 };
 
 Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
@@ -43,18 +38,8 @@ Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
 void checkOptions(InterpolateCmdParams& p)
 {
     InterpolateParams& op = p.op;
-    op.method = interpolationMethodFromName(p.method);
+    checkParamOptions(interpolateParameters(), op);
     const bool points = op.method == InterpolationMethod::Points;
-    try {
-        op.frames = frameRuleFromName(p.frames);
-    } catch (const ValueError&) {
-        throw ValueError("--frames '" + p.frames + "' is not one of world, surface");
-    }
-    op.points.grouping = guideGroupingFromName(p.grouping);
-    if (!(op.points.likeness > 0.0) || !std::isfinite(op.points.likeness)) {
-        throw ValueError("--likeness " + formatValue(op.points.likeness) + ": must be a positive fraction of the guide length (default " +
-                         formatValue(PointInterpolationParams{}.likeness) + ")");
-    }
     op.returnScene = fileExtension(p.output) == ".json";
     if (op.returnScene && points) throw ValueError(p.output + ": --method points makes strands, not helicoids; write a strand format or use --method helicoid");
     if (!op.returnScene) strandFormatFromPath(p.output, /*forWriting=*/true);
@@ -62,21 +47,11 @@ void checkOptions(InterpolateCmdParams& p)
     if (!p.scalp.empty() && p.count < 0) throw ValueError("--scalp needs --count N");
     if (p.count == 0) throw ValueError("--count 0: must be at least 1");
     if (!points && (!p.guideGroups.empty() || !p.rootGroups.empty())) throw ValueError("--guide-groups and --root-groups need --method points");
-    op.helicoid.blend = helicoidBlendFromName(p.blend);
-    if (!(op.helicoid.shepard.power > 0.0) || !std::isfinite(op.helicoid.shepard.power)) {
-        throw ValueError("--power " + formatValue(op.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
-    }
-    if (p.neighborsOpt && p.neighborsOpt->count() > 0) {
-        if (p.neighbors < 1) throw ValueError("--neighbors " + std::to_string(p.neighbors) + ": must be at least 1 (omit it to use " + (points ? std::to_string(PointInterpolationParams{}.neighbors) : std::string("every guide")) + ")");
-        op.helicoid.shepard.neighbors = p.neighbors;
-        op.points.neighbors = p.neighbors;
-    }
     op.helicoid.up = axisFromName(p.up, "--up");
-    validateGroomParams(op.groom);
+    validateGroomParams(op.groom);  // what the ranges do not say: curl needs a frequency
     if (op.returnScene && (groomsHair(op.groom) || !p.density.empty() || !p.length.empty())) {
         throw ValueError(p.output + ": a scene of new hairs takes no --density, --length, --clump-radius, --curl or --frizz; write strands");
     }
-    op.points.maxVertices = op.helicoid.maxVertices;
 }
 
 /// The guides as read: a scene, or strands (blended as they are, or fitted for helicoids).
@@ -237,8 +212,9 @@ void reportJson(const InterpolateCmdParams& p, const HeadObstacle& head, const I
     const std::size_t count = newHairCount(r);
     const double enteringShare = double(r.enteringHead) / double(count);
     const double guidesEnteringShare = double(r.guidesEnteringHead) / double(std::max<std::size_t>(1, r.guides));
-    printJson({{"output", p.output}, {"method", p.method}, {"blend", points ? nlohmann::json(nullptr) : nlohmann::json(p.blend)},
-               {"grouping", points ? nlohmann::json(p.grouping) : nlohmann::json(nullptr)}, {"groups", r.groups},
+    printJson({{"output", p.output}, {"method", interpolationMethodName(op.method)},
+               {"blend", points ? nlohmann::json(nullptr) : nlohmann::json(helicoidBlendName(op.helicoid.blend))},
+               {"grouping", points ? nlohmann::json(guideGroupingName(op.points.grouping)) : nlohmann::json(nullptr)}, {"groups", r.groups},
                {"guides", r.guides}, {"strands", count},
                {"vertices", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json(r.strands.numVertices())},
                {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe(false))},
@@ -254,8 +230,11 @@ void reportText(const InterpolateCmdParams& p, const HeadObstacle& head, const I
 {
     const InterpolateParams& op = p.op;
     const std::size_t count = newHairCount(r);
-    std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << p.method << ", " << frameRuleName(op.frames) << " frames";
-    if (op.method == InterpolationMethod::Points) std::cout << ", " << r.groups << (r.groups == 1 ? " group" : " groups") << ", grouping " << p.grouping;
+    std::cout << "interpolated " << count << " strands from " << r.guides << " guides (" << interpolationMethodName(op.method) << ", "
+              << frameRuleName(op.frames) << " frames";
+    if (op.method == InterpolationMethod::Points) {
+        std::cout << ", " << r.groups << (r.groups == 1 ? " group" : " groups") << ", grouping " << guideGroupingName(op.points.grouping);
+    }
     char seconds[32];
     std::snprintf(seconds, sizeof seconds, "%.3f", r.seconds);
     std::cout << ") in " << seconds << " s\n";
@@ -313,9 +292,6 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--roots", p.roots, "Roots: PLY points (x y z, optional nx ny nz, as vdbhair roots writes) or the roots of any strand file");
     sub->add_option("--scalp", p.scalp, "Scalp .vdb (vdbhair scalp): spread --count roots over it (and its region); it is also the head");
     sub->add_option("--count", p.count, "Number of roots on --scalp");
-    sub->add_option("--method", p.method, "points (the guides' own points, by group and likeness) or helicoid (their helicoid parameters, Piuze et al.)")->capture_default_str();
-    sub->add_option("--grouping", p.grouping, "points: shape (a new hair blends only guides shaped like its nearest one: partings and layers stay apart) or none")->capture_default_str();
-    sub->add_option("--likeness", p.op.points.likeness, "--grouping shape: the shape distance, a fraction of the guide length, at which a guide stops taking part")->capture_default_str();
     sub->add_option("--guide-groups", p.guideGroups, "points: group ids of the guides, new hairs blending only guides of one group: a text file of one integer "
                                                       "per guide, MASK.vdb[:GRID] (the voxel at each guide root; grid 'groups'), MESH.ply:PROPERTY (the nearest vertex's), "
                                                       "or MESH.ply|obj:islands (the mesh's connected pieces: a scalp cut along its partings)");
@@ -323,25 +299,10 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--density", p.density, "Share of the roots that grow hair, in [0, 1]: a number, MASK.vdb[:GRID] (a float or bool grid; "
                                             "default grid 'density'), MESH.ply:PROPERTY (painted on the head's vertices), or a text file of one value per root");
     sub->add_option("--length", p.length, "Share of each new hair's length kept, in [0, 1] (0 grows none): as --density (default grid 'length')");
-    sub->add_option("--clump-radius", p.op.groom.clump.radius, "Clumps: hairs within this distance (world units) of a clump centre are pulled to its hair (0: no clumps)")->capture_default_str();
-    sub->add_option("--clump-tightness", p.op.groom.clump.tightness, "Clumps: the share of the way to the centre's hair a tip moves, in [0, 1]")->capture_default_str();
-    sub->add_option("--clump-profile", p.op.groom.clump.profile, "Clumps: the pull at a fraction t of the length is tightness * t^profile (higher: looser near the root)")->capture_default_str();
-    sub->add_option("--clump-likeness", p.op.groom.clump.likeness, "Clumps: hairs shaped unlike their centre by more than this (as --likeness) stay out (0: any)")->capture_default_str();
-    sub->add_option("--curl", p.op.groom.curl.amplitude, "Curl: the amplitude a of Eq. 4 (world units; 0: none), about each hair")->capture_default_str();
-    sub->add_option("--curl-frequency", p.op.groom.curl.frequency, "Curl: b of Eq. 4, radians per unit length (a turn every 2 pi / b)")->capture_default_str();
-    sub->add_option("--frizz", p.op.groom.curl.frizz, "Frizz: the deviation of a random offset at the tip, from 0 at the root (world units)")->capture_default_str();
     sub->add_option("--head", p.head, "The head new hair may not enter deeper than its guides: a mesh (.ply, .obj), a .vdb level set, or 'none' "
                                       "(default: --scalp's surface, else the scene's head, else a sphere fitted to the guide roots)");
-    sub->add_option("--blend", p.blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "
-                                        "so guides blend alike) or fitted (the fits' own pieces, as the paper prints it)")->capture_default_str();
-    sub->add_option("--arcs", p.op.helicoid.arcs, "--blend arcs: arcs per hair (0: one per 0.2 radian of the most-turning guide, 16 to 512)")->capture_default_str();
-    sub->add_option("--power", p.op.helicoid.shepard.power, "helicoid: Shepard exponent p, weights |x - x_i|^-p")->capture_default_str();
-    p.neighborsOpt = sub->add_option("--neighbors", p.neighbors, "Guides per new hair, nearest by root (default: " + std::to_string(PointInterpolationParams{}.neighbors) +
-                                                                     " for points, every guide for helicoid)");
-    sub->add_option("--frames", p.frames, "world (guides carried as they are) or surface (turned with the roots' normals, 4.3; flares long hair)")->capture_default_str();
+    addParamOptions(sub, p.op, interpolateParameters());
     sub->add_option("--up", p.up, "Reference axis of surface frames and of roots on --scalp: x, y, z, -x, -y or -z")->capture_default_str();
-    sub->add_option("--seed", p.op.seed, "Seed of the roots on --scalp, density, clumps, curl phases, frizz and waviness noise")->capture_default_str();
-    sub->add_option("--max-vertices", p.op.helicoid.maxVertices, "Refuse requests that would make more vertices (12 bytes each)")->capture_default_str();
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair interpolate guides.hair --scalp scalp.vdb --count 20000 -o hair.hair --json");

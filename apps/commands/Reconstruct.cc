@@ -1,8 +1,10 @@
 // vdbhair reconstruct IN -o OUT --guides 10%: a hairstyle rebuilt from a share of its strands
 // (Piuze et al. 2011, §5.4), measured against the original both ways (helicoids and points).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Format.h>
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/io/FileUtil.h>
@@ -18,13 +20,10 @@ namespace {
 
 struct ReconstructCmdParams
 {
-    std::string input, output, method = "points", select = "random", errors, head;
-    std::string blend = helicoidBlendName(ReconstructParams{}.helicoid.blend);
-    std::string grouping = guideGroupingName(ReconstructParams{}.points.grouping);
-    std::string guides = formatValue(100.0 * ReconstructParams{}.guideFraction) + "%";
-    ReconstructParams rec;
-    int neighbors = 0;
-    CLI::Option* neighborsOpt = nullptr;
+    std::string input, output, method = "points", errors, head;
+    /// The share of guides as a percentage ("10%"), into rec.guideFraction.
+    std::string guides = formatNumber(100.0 * ReconstructParams{}.guideFraction) + "%";
+    ReconstructParams rec;  ///< its declared parameters (reconstructParameters()) but the share are options
 };
 
 /// "10%", "10 %" or "10": a percentage of the strands, as a fraction.
@@ -42,22 +41,9 @@ double parsePercent(const std::string& text)
 int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
 {
     if (p.method != "helicoid" && p.method != "points") throw ValueError("--method '" + p.method + "' is not one of helicoid, points");
-    if (p.select == "random") p.rec.selection = GuideSelection::Random;
-    else if (p.select == "cluster") p.rec.selection = GuideSelection::Cluster;
-    else throw ValueError("--select '" + p.select + "' is not one of random, cluster");
     p.rec.guideFraction = parsePercent(p.guides);
-    p.rec.points.grouping = guideGroupingFromName(p.grouping);
-    p.rec.helicoid.blend = helicoidBlendFromName(p.blend);
     strandFormatFromPath(p.output, /*forWriting=*/true);
-    if (!(p.rec.helicoid.shepard.power > 0.0) || !std::isfinite(p.rec.helicoid.shepard.power)) {
-        throw ValueError("--power " + formatValue(p.rec.helicoid.shepard.power) + ": must be a positive finite exponent (the paper uses 3)");
-    }
-    p.rec.fit.validate("option");  // the fits' ranges, FitParams's, spelled as flags (addReconstructCommand)
-    if (p.neighborsOpt && p.neighborsOpt->count() > 0) {
-        if (p.neighbors < 1) throw ValueError("--neighbors " + std::to_string(p.neighbors) + ": must be at least 1 (omit it for each method's default)");
-        p.rec.helicoid.shepard.neighbors = p.neighbors;
-        p.rec.points.neighbors = p.neighbors;
-    }
+    checkParamOptions(reconstructParameters(), p.rec);
     const StrandSet strands = loadStrands("reconstruct", p.input, common);
     HeadObstacle head;
     if (!p.head.empty() && p.head != "none") head = readHeadObstacle(p.head, "--head " + p.head);
@@ -91,7 +77,8 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
     const std::size_t S = strands.numStrands();
     if (common.json) {
         printJson({{"output", p.output}, {"method", p.method}, {"strands", S}, {"guides", r.guides.size()}, {"unfitted", r.unfitted},
-                   {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", p.select}, {"blend", p.blend},
+                   {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", guideSelectionName(p.rec.selection)},
+                   {"blend", helicoidBlendName(p.rec.helicoid.blend)},
                    {"fit", {{"mean", r.fitSummary.meanRelative}, {"p95", r.fitSummary.p95Relative}, {"pieces_per_strand", r.fitSummary.piecesPerStrand}, {"seconds", r.fitSeconds}}},
                    {"grouping", guideGroupingName(p.rec.points.grouping)},
                    {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}, {"nearest", stats(r.nearestErrors)}}},
@@ -105,13 +92,13 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
     } else if (!common.quiet) {
         char buf[256];
         std::snprintf(buf, sizeof buf, " guides (%.3g %%, %s); fits: mean %.3g %%, %.2f pieces, %.3f s\n", 100.0 * double(r.guides.size()) / double(S),
-                      p.select.c_str(), 100.0 * r.fitSummary.meanRelative, r.fitSummary.piecesPerStrand, r.fitSeconds);
+                      guideSelectionName(p.rec.selection), 100.0 * r.fitSummary.meanRelative, r.fitSummary.piecesPerStrand, r.fitSeconds);
         std::cout << "reconstructed " << S << " strands from " << r.guides.size() << buf << "discrete Frechet distance / strand length:\n";
         std::snprintf(buf, sizeof buf, "%-17s %10s %10s %14s %14s %9s\n", "method", "mean", "p95", "mean interp.", "p95 interp.", "time s");
         std::cout << buf;
         for (int m = 0; m < 3; ++m) {
             const ReconstructErrors& e = m == 0 ? r.helicoidErrors : m == 1 ? r.pointErrors : r.nearestErrors;
-            const std::string name = m == 0 ? "helicoid (" + p.blend + ")" : m == 1 ? "points (" + std::string(guideGroupingName(p.rec.points.grouping)) + ")" : "nearest guide";
+            const std::string name = m == 0 ? "helicoid (" + std::string(helicoidBlendName(p.rec.helicoid.blend)) + ")" : m == 1 ? "points (" + std::string(guideGroupingName(p.rec.points.grouping)) + ")" : "nearest guide";
             std::snprintf(buf, sizeof buf, "%-17s %9.3f%% %9.3f%% %13.3f%% %13.3f%% %9.3f\n", name.c_str(), 100.0 * e.mean, 100.0 * e.p95,
                           100.0 * e.meanInterpolated, 100.0 * e.p95Interpolated, e.seconds);
             std::cout << buf;
@@ -151,20 +138,9 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "The reconstructed strands (any strand format), by --method")->required();
     sub->add_option("--guides", params->guides, "Share of the strands used as guides, in (0, 100] %")->capture_default_str();
     sub->add_option("--method", params->method, "Which reconstruction to write: points (the guides' points, by likeness) or helicoid (all three are measured)")->capture_default_str();
-    sub->add_option("--grouping", params->grouping, "points: shape (a strand blends only guides shaped like its nearest one) or none")->capture_default_str();
-    sub->add_option("--likeness", params->rec.points.likeness, "--grouping shape: the shape distance, a fraction of the guide length, at which a guide stops taking part")->capture_default_str();
-    sub->add_option("--select", params->select, "Guide choice: random, or cluster (k-means of the roots)")->capture_default_str();
-    sub->add_option("--seed", params->rec.seed, "Seed of the guide choice")->capture_default_str();
-    sub->add_option("--blend", params->blend, "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, "
-                                              "so guides blend alike) or fitted (the fits' own pieces, as the paper prints it)")->capture_default_str();
-    sub->add_option("--arcs", params->rec.helicoid.arcs, "--blend arcs: arcs per hair (0: one per 0.2 radian of the most-turning guide, 16 to 512)")->capture_default_str();
-    sub->add_option("--power", params->rec.helicoid.shepard.power, "Shepard exponent p of helicoid interpolation")->capture_default_str();
-    params->neighborsOpt = sub->add_option("--neighbors", params->neighbors, "Guides per new hair (default: every guide for helicoid, " +
-                                           std::to_string(PointInterpolationParams{}.neighbors) + " for points)");
-    sub->add_option("--max-error", params->rec.fit.maxError, "Fits: accepted discrete Frechet distance, a fraction of the strand length")->capture_default_str();
+    addParamOptions(sub, params->rec, reconstructParameters(), {"guides"});
     sub->add_option("--head", params->head, "A head (mesh or .vdb level set) to measure the shares of strands passing into it against (nothing is moved)");
     sub->add_option("--errors", params->errors, "Also write every strand's relative error, every way, as CSV");
-    sub->add_option("--meters-per-unit", params->rec.metersPerUnit, "The file's unit in metres (0.01: centimetres), for HairGS's oriented-point F1 at 2-4 mm (0: unknown, not measured)")->capture_default_str();
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair reconstruct straight.hair -o rebuilt.hair --guides 10% --json");

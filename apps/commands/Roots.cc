@@ -1,6 +1,7 @@
 // vdbhair roots scalp.vdb -o roots.ply: follicles spread over a scalp level set (Witkin &
 // Heckbert 1994 repulsion on the zero level set), in its region when it has one.
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
@@ -20,12 +21,8 @@ namespace {
 
 struct RootsCmdParams
 {
-    // Defaults from the library's FollicleParams.
     std::string input, output, up = axisName(FollicleParams{}.up);
-    std::int64_t count = -1;  ///< -1: not given
-    double spacing = 0.0;
-    CLI::Option* spacingOpt = nullptr;
-    FollicleParams follicle;  ///< the library's defaults; count, spacing and up set from the options
+    FollicleParams follicle;  ///< its declared parameters (follicleParameters()) are options; up set from --up
     bool noRegion = false;
 };
 
@@ -33,15 +30,10 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
 {
     const std::string ext = fileExtension(p.output);
     if (ext != ".ply" && ext != ".vdb") throw ValueError(p.output + ": roots are written as .ply (x y z nx ny nz tx ty tz) or .vdb (points); the output must end in one of them");
-    const bool spacingGiven = p.spacingOpt && p.spacingOpt->count() > 0;
-    if (p.count < 0 && !spacingGiven) throw ValueError("needs --count N or --spacing S");
-    if (p.count >= 0 && spacingGiven) throw ValueError("--count and --spacing: give one");
-    if (p.count == 0) throw ValueError("--count 0: must be at least 1");
-    if (spacingGiven && (!(p.spacing > 0.0) || !std::isfinite(p.spacing))) throw ValueError("--spacing " + formatValue(p.spacing) + ": must be a positive finite length");
-    if (p.follicle.maxIterations < 0) throw ValueError("--iterations " + std::to_string(p.follicle.maxIterations) + ": must be at least 0");
+    checkParamOptions(follicleParameters(), p.follicle);
     FollicleParams fp = p.follicle;
-    if (p.count > 0) fp.count = std::size_t(p.count);
-    if (spacingGiven) fp.spacing = p.spacing;
+    if (fp.count == 0 && fp.spacing == 0.0) throw ValueError("needs --count N or --spacing S");
+    if (fp.count > 0 && fp.spacing > 0.0) throw ValueError("--count and --spacing: give one");
     fp.up = axisFromName(p.up, "--up");
 
     openvdb::FloatGrid::Ptr surface;
@@ -91,15 +83,9 @@ Command addRootsCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "roots");
     sub->add_option("scalp", params->input, "Scalp .vdb with grid 'surface' (and 'region'), as vdbhair scalp writes; or a head mesh (.ply, .obj), made into one at 1/100 of its size")->required();
     sub->add_option("-o,--output", params->output, "Output roots: .ply (x y z nx ny nz tx ty tz) or .vdb (points P, N, tangent, group root)")->required();
-    sub->add_option("--count", params->count, "Number of roots");
-    params->spacingOpt = sub->add_option("--spacing", params->spacing, "Target nearest-neighbour spacing in world units (instead of --count)");
-    sub->add_option("--seed", params->follicle.seed, "Random seed of the initial placement")->capture_default_str();
-    sub->add_option("--iterations", params->follicle.maxIterations, "Most relaxation iterations")->capture_default_str();
-    sub->add_option("--step-scale", params->follicle.stepScale, "Relaxation step as a multiple of sigma^2 times the energy gradient")->capture_default_str();
+    addParamOptions(sub, params->follicle, follicleParameters());
     sub->add_option("--up", params->up, "Reference axis of the tangent frame: x, y, z, -x, -y or -z")->capture_default_str();
     sub->add_flag("--no-region", params->noRegion, "Ignore the file's 'region' grid: roots over the whole surface");
-    sub->add_flag("--no-contour", [params](std::int64_t) { params->follicle.contour = false; }, "No fixed roots on the region's rim (they line the hairline by default)");
-    sub->add_option("--initial-fraction", params->follicle.initialFraction, "Share of the roots placed at the start, in (0, 4]; fission and death make the count")->capture_default_str();
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair roots scalp.vdb -o roots.ply --count 10000 --json");
     return {sub, [params, &common] { return runRoots(*params, common); }};

@@ -57,7 +57,7 @@ Scene sceneArgument(const pyb::handle& scene, const std::string& where = "grow")
                     std::string(pyb::str(scene.get_type().attr("__name__"))));
 }
 
-/// FitParams::validate with its field names spelled as fit's and reconstruct's keywords.
+/// FitParams::validate with its field names spelled as fit's keywords.
 void validateFitKeywords(const FitParams& fp, const char* where)
 {
     try {
@@ -104,58 +104,79 @@ pyb::object metaValue(const MetaValue& m)
     return std::visit([](const auto& v) -> pyb::object { return pyb::cast(v); }, m.value);
 }
 
-} // namespace
-
-namespace {
-
-/// The blend= keyword of @a function: the library's names, its message with the function's name.
-HelicoidBlend blendArgument(const char* function, const std::string& blend)
+/// The up= keyword of @a function: a non-zero finite vector, made unit.
+Vec3d upArgument(const std::array<double, 3>& up, const std::string& function)
 {
-    try {
-        return helicoidBlendFromName(blend);
-    } catch (const ValueError& e) {
-        throw ValueError(std::string(function) + ": " + e.what());
-    }
+    const Vec3d u(up[0], up[1], up[2]);
+    if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError(function + ": up must be a non-zero finite vector");
+    return u / u.length();
 }
 
-
-} // namespace
-
-void bindOperations(pyb::module_& m)
+/// interpolate's roots: positions (an array or a Strands' roots), normals=, root_groups=, and
+/// density= and length= (a number, one value per root, or what the command reads: a mask, a
+/// painted mesh, a list file).
+InterpolationRoots interpolationRoots(const pyb::object& rootsArg, const pyb::dict& kw, FrameRule frames)
 {
-    const GrowOptions growDefaults;
-    m.def(
-        "grow",
-        [](const pyb::object& sceneArg, std::optional<std::string> integrator, std::size_t maxVertices, int threads,
-           const pyb::object& progress) {
-            const Scene scene = sceneArgument(sceneArg);
-            GrowOptions opts;
-            if (integrator) {
-                if (*integrator == "euler") opts.integrator = HelicoidIntegrator::Euler;
-                else if (*integrator == "rk4") opts.integrator = HelicoidIntegrator::RK4;
-                else throw ValueError("grow: integrator='" + *integrator + "' is not one of euler, rk4");
-            }
-            opts.maxVertices = maxVertices;
-            return runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                return std::make_shared<StrandSet>(growScene(scene, opts, true, interrupter));
-            });
-        },
-        pyb::arg("scene"), pyb::kw_only(), pyb::arg("integrator") = pyb::none(), pyb::arg("max_vertices") = growDefaults.maxVertices,
-        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(Grow the strands of a generalized-helicoid scene (Piuze et al. 2011): ``vdbhair grow``.
+    auto isPath = [](const pyb::object& o) { return pyb::isinstance<pyb::str>(o) || pyb::hasattr(o, "__fspath__"); };
+    InterpolationRoots roots;
+    if (pyb::isinstance<StrandSet>(rootsArg)) {
+        const StrandSet& r = rootsArg.cast<const StrandSet&>();
+        for (std::size_t i = 0; i < r.numStrands(); ++i) roots.positions.push_back(Vec3d(r.root(i)));
+    } else {
+        roots.positions = pointsArgument(rootsArg, "interpolate: roots");
+    }
+    if (roots.positions.empty()) throw ValueError("interpolate: no roots");
+    const pyb::object normalsArg = kw["normals"];
+    if (!normalsArg.is_none()) {
+        roots.normals = pointsArgument(normalsArg, "interpolate: normals");
+        if (roots.normals.size() != roots.positions.size())
+            throw ValueError("interpolate: " + std::to_string(roots.normals.size()) + " normals for " + std::to_string(roots.positions.size()) + " roots");
+    }
+    if (frames == FrameRule::Surface && roots.normals.empty()) throw ValueError("interpolate: frames='surface' needs normals");
+    const pyb::object rootGroups = kw["root_groups"];
+    if (!rootGroups.is_none()) {
+        roots.groups = isPath(rootGroups) ? readRootIds(pyb::str(rootGroups).cast<std::string>(), roots.positions, "interpolate: root_groups=", "roots")
+                                              : rootGroups.cast<std::vector<std::int32_t>>();
+    }
+    for (auto [option, values, grid] : {std::tuple{"density", &roots.density, "density"}, std::tuple{"length", &roots.length, "length"}}) {
+        const pyb::object arg = kw[option];
+        if (arg.is_none()) continue;
+        if (isPath(arg)) {
+            *values = readRootValues(pyb::str(arg).cast<std::string>(), roots.positions, std::string("interpolate: ") + option + "=", grid);
+        } else if (pyb::isinstance<pyb::float_>(arg) || pyb::isinstance<pyb::int_>(arg)) {
+            values->assign(roots.positions.size(), arg.cast<float>());
+        } else {
+            *values = arg.cast<std::vector<float>>();
+            if (values->size() != roots.positions.size())
+                throw ValueError(std::string("interpolate: ") + option + "= has " + std::to_string(values->size()) + " values for " +
+                                 std::to_string(roots.positions.size()) + " roots: one per root");
+        }
+    }
+    return roots;
+}
 
-Each guide, then its wisp strands; bitwise identical for any thread count.
+/// grow: a scene's strands (growParameters()).
+void defineGrow(pyb::module_& m)
+{
+    auto growImpl = [](const pyb::object& sceneArg, const pyb::dict& kw) {
+        const Scene scene = sceneArgument(sceneArg);
+        GrowOptions opts;
+        applyKeywords(growParameters(), kw, opts, "grow");
+        return runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            return std::make_shared<StrandSet>(growScene(scene, opts, true, interrupter));
+        });
+    };
+    defineVerb(m, "grow", {"scene"}, growParameters(), {},
+               "Grow the strands of a generalized-helicoid scene (Piuze et al. 2011): ``vdbhair grow``.\n\n"
+               "Each guide, then its wisp strands; bitwise identical for any thread count. Raises\n"
+               "vdbhair.LimitError over max_vertices.",
+               "    scene: a path to a scene .json (\"vdbhair\": \"scene/1\"), or the scene as a dict (what fit returns).\n",
+               "Strands.", pyb::cpp_function(growImpl, pyb::arg("scene"), pyb::arg("keywords")));
+}
 
-Args:
-    scene: a path to a scene .json ("vdbhair": "scene/1"), or the scene as a dict (what fit returns).
-    integrator: None (the scene's own, else Euler), "euler" (Eq. 3) or "rk4".
-    max_vertices: refuse scenes that would grow more vertices (vdbhair.LimitError).
-    threads: worker threads, 0 for all cores.
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    Strands.)doc");
-
+/// fit: p-helicoids fitted to strands (fitParameters()).
+void defineFit(pyb::module_& m)
+{
     auto fitImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
         FitParams fp;
         applyKeywords(fitParameters(), kw, fp, "fit");
@@ -207,282 +228,143 @@ Returns:
                "The scene as a dict (one guide per fitted strand, in input order), which grow() regrows\n"
                "    and ``json.dump`` saves as a scene file; or (scene, summary) with return_summary.",
                pyb::cpp_function(fitImpl, pyb::arg("strands"), pyb::arg("keywords")));
+}
 
+/// interpolate: new hairs from guides (interpolateParameters()).
+void defineInterpolate(pyb::module_& m)
+{
+    auto interpolateImpl = [](const pyb::object& guidesArg, const pyb::object& rootsArg, const pyb::dict& kw) -> pyb::object {
+        // Arguments first, as the command checks them.
+        InterpolateParams op;
+        applyKeywords(interpolateParameters(), kw, op, "interpolate");
+        try {
+            validateGroomParams(op.groom);  // what the ranges do not say: curl needs a frequency
+        } catch (const ValueError& e) {
+            throw ValueError(std::string("interpolate: ") + e.what());
+        }
+        op.returnScene = kw["return_scene"].cast<bool>();
+        if (op.returnScene && op.method == InterpolationMethod::Points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
+        op.helicoid.up = upArgument(kw["up"].cast<std::array<double, 3>>(), "interpolate");
+        const InterpolationRoots roots = interpolationRoots(rootsArg, kw, op.frames);
+        const HeadArgument headArgument(kw["head"], "no-deeper");
+        const bool fromStrands = pyb::isinstance<StrandSet>(guidesArg);
+        std::shared_ptr<StrandSet> guideStrands = fromStrands ? guidesArg.cast<std::shared_ptr<StrandSet>>() : nullptr;
+        const Scene scene = fromStrands ? Scene() : sceneArgument(guidesArg, "interpolate");
+        InterpolationGuides guides;
+        guides.where = "interpolate(guides)";
+        if (fromStrands) guides.strands = guideStrands.get();
+        else guides.scene = &scene;
+        const pyb::object guideGroups = kw["guide_groups"];
+        if (!guideGroups.is_none() && (pyb::isinstance<pyb::str>(guideGroups) || pyb::hasattr(guideGroups, "__fspath__"))) {
+            std::vector<Vec3d> guideRoots;
+            if (fromStrands) for (std::size_t i = 0; i < guideStrands->numStrands(); ++i) guideRoots.push_back(Vec3d(guideStrands->root(i)));
+            else for (const SceneGuide& g : scene.guides) guideRoots.push_back(g.root);
+            guides.groups = readRootIds(pyb::str(guideGroups).cast<std::string>(), guideRoots, "interpolate: guide_groups=", "guides");
+        } else if (!guideGroups.is_none()) {
+            guides.groups = guideGroups.cast<std::vector<std::int32_t>>();
+        }
+        InterpolateResult result = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            HeadObstacle head = headArgument.get("interpolate");
+            // None: the scene's head sphere, else a sphere fitted to the guide roots (as the command).
+            if (head.unset() && !fromStrands && scene.head) head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
+            else if (head.unset() && fromStrands) head = headFromRoots(*guideStrands, op.helicoid.up);
+            return interpolateGuides(guides, roots, head, op, true, interrupter);
+        });
+        if (op.returnScene) return toPython(sceneToJson(result.scene));
+        return pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
+    };
     const InterpolateParams interpDefaults;
-    m.def(
-        "interpolate",
-        [](const pyb::object& guidesArg, const pyb::object& rootsArg, const pyb::object& normalsArg, const std::string& method,
-           const std::string& grouping, double likeness, const pyb::object& guideGroups, const pyb::object& rootGroups,
-           const pyb::object& headArg, double power, std::optional<int> neighbors, const std::string& blend, const std::string& frames,
-           std::array<double, 3> up, std::uint64_t seed, std::size_t maxVertices, bool returnScene, const pyb::object& densityArg,
-           const pyb::object& lengthArg, double clumpRadius, double clumpTightness, double clumpProfile, double clumpLikeness, double curl,
-           double curlFrequency, double frizz, int threads, const pyb::object& progress) -> pyb::object {
-            // Arguments first, as the command checks them.
-            InterpolateParams op;
-            op.groom.clump.radius = clumpRadius;
-            op.groom.clump.tightness = clumpTightness;
-            op.groom.clump.profile = clumpProfile;
-            op.groom.clump.likeness = clumpLikeness;
-            op.groom.curl.amplitude = curl;
-            op.groom.curl.frequency = curlFrequency;
-            op.groom.curl.frizz = frizz;
-            try {
-                validateGroomParams(op.groom);
-            } catch (const ValueError& e) {
-                throw ValueError(std::string("interpolate: ") + e.what());
-            }
-            auto named = [](auto parse, const std::string& value) {
-                try {
-                    return parse(value);
-                } catch (const ValueError& e) {
-                    throw ValueError(std::string("interpolate: ") + e.what());
-                }
-            };
-            op.method = named(interpolationMethodFromName, method);
-            op.frames = named(frameRuleFromName, frames);
-            op.points.grouping = named(guideGroupingFromName, grouping);
-            op.points.likeness = likeness;
-            if (!(likeness > 0.0) || !std::isfinite(likeness)) throw ValueError("interpolate: likeness=" + std::to_string(likeness) + ": must be a positive fraction of the guide length");
-            op.returnScene = returnScene;
-            if (returnScene && op.method == InterpolationMethod::Points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
-            op.helicoid.blend = blendArgument("interpolate", blend);
-            if (!(power > 0.0) || !std::isfinite(power))
-                throw ValueError("interpolate: power=" + std::to_string(power) + ": must be a positive finite exponent (the paper uses 3)");
-            op.helicoid.shepard.power = power;
-            if (neighbors) {
-                if (*neighbors < 1) throw ValueError("interpolate: neighbors=" + std::to_string(*neighbors) + ": must be at least 1 (None: each method's default)");
-                op.helicoid.shepard.neighbors = *neighbors;
-                op.points.neighbors = *neighbors;
-            }
-            const Vec3d u(up[0], up[1], up[2]);
-            if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("interpolate: up must be a non-zero finite vector");
-            op.helicoid.up = u / u.length();
-            op.helicoid.maxVertices = op.points.maxVertices = maxVertices;
-            op.seed = seed;
-            InterpolationRoots roots;
-            if (pyb::isinstance<StrandSet>(rootsArg)) {
-                const StrandSet& r = rootsArg.cast<const StrandSet&>();
-                for (std::size_t i = 0; i < r.numStrands(); ++i) roots.positions.push_back(Vec3d(r.root(i)));
-            } else {
-                roots.positions = pointsArgument(rootsArg, "interpolate: roots");
-            }
-            if (roots.positions.empty()) throw ValueError("interpolate: no roots");
-            if (!normalsArg.is_none()) {
-                roots.normals = pointsArgument(normalsArg, "interpolate: normals");
-                if (roots.normals.size() != roots.positions.size())
-                    throw ValueError("interpolate: " + std::to_string(roots.normals.size()) + " normals for " +
-                                     std::to_string(roots.positions.size()) + " roots");
-            }
-            if (op.frames == FrameRule::Surface && roots.normals.empty()) throw ValueError("interpolate: frames='surface' needs normals");
-            auto isPath = [](const pyb::object& o) { return pyb::isinstance<pyb::str>(o) || pyb::hasattr(o, "__fspath__"); };
-            if (!rootGroups.is_none()) {
-                roots.groups = isPath(rootGroups) ? readRootIds(pyb::str(rootGroups).cast<std::string>(), roots.positions, "interpolate: root_groups=", "roots")
-                                                  : rootGroups.cast<std::vector<std::int32_t>>();
-            }
-            // Density and length: one value per root, or what the command reads (a number, a mask, a painted mesh, a list).
-            for (auto [arg, values, option, grid] : {std::tuple{&densityArg, &roots.density, "density", "density"}, std::tuple{&lengthArg, &roots.length, "length", "length"}}) {
-                if (arg->is_none()) continue;
-                if (pyb::isinstance<pyb::str>(*arg) || pyb::hasattr(*arg, "__fspath__")) {
-                    *values = readRootValues(pyb::str(*arg).cast<std::string>(), roots.positions, std::string("interpolate: ") + option + "=", grid);
-                } else if (pyb::isinstance<pyb::float_>(*arg) || pyb::isinstance<pyb::int_>(*arg)) {
-                    values->assign(roots.positions.size(), arg->cast<float>());
-                } else {
-                    *values = arg->cast<std::vector<float>>();
-                    if (values->size() != roots.positions.size())
-                        throw ValueError(std::string("interpolate: ") + option + "= has " + std::to_string(values->size()) + " values for " + std::to_string(roots.positions.size()) + " roots: one per root");
-                }
-            }
-            const HeadArgument headArgument(headArg, "no-deeper");
-            const bool fromStrands = pyb::isinstance<StrandSet>(guidesArg);
-            std::shared_ptr<StrandSet> guideStrands = fromStrands ? guidesArg.cast<std::shared_ptr<StrandSet>>() : nullptr;
-            const Scene scene = fromStrands ? Scene() : sceneArgument(guidesArg, "interpolate");
-            InterpolationGuides guides;
-            guides.where = "interpolate(guides)";
-            if (fromStrands) guides.strands = guideStrands.get();
-            else guides.scene = &scene;
-            if (!guideGroups.is_none() && isPath(guideGroups)) {
-                std::vector<Vec3d> guideRoots;
-                if (fromStrands) for (std::size_t i = 0; i < guideStrands->numStrands(); ++i) guideRoots.push_back(Vec3d(guideStrands->root(i)));
-                else for (const SceneGuide& g : scene.guides) guideRoots.push_back(g.root);
-                guides.groups = readRootIds(pyb::str(guideGroups).cast<std::string>(), guideRoots, "interpolate: guide_groups=", "guides");
-            } else if (!guideGroups.is_none()) {
-                guides.groups = guideGroups.cast<std::vector<std::int32_t>>();
-            }
-            InterpolateResult result = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                HeadObstacle head = headArgument.get("interpolate");
-                // None: the scene's head sphere, else a sphere fitted to the guide roots (as the command).
-                if (head.unset() && !fromStrands && scene.head) head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
-                else if (head.unset() && fromStrands) head = headFromRoots(*guideStrands, op.helicoid.up);
-                return interpolateGuides(guides, roots, head, op, true, interrupter);
-            });
-            if (returnScene) return toPython(sceneToJson(result.scene));
-            return pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
-        },
-        pyb::arg("guides"), pyb::arg("roots"), pyb::kw_only(), pyb::arg("normals") = pyb::none(),
-        pyb::arg("method") = interpolationMethodName(interpDefaults.method),
-        pyb::arg("grouping") = guideGroupingName(interpDefaults.points.grouping), pyb::arg("likeness") = interpDefaults.points.likeness,
-        pyb::arg("guide_groups") = pyb::none(), pyb::arg("root_groups") = pyb::none(), pyb::arg("head") = pyb::none(),
-        pyb::arg("power") = interpDefaults.helicoid.shepard.power, pyb::arg("neighbors") = pyb::none(),
-        pyb::arg("blend") = helicoidBlendName(interpDefaults.helicoid.blend), pyb::arg("frames") = frameRuleName(interpDefaults.frames),
-        pyb::arg("up") = std::array<double, 3>{interpDefaults.helicoid.up.x(), interpDefaults.helicoid.up.y(), interpDefaults.helicoid.up.z()},
-        pyb::arg("seed") = 0, pyb::arg("max_vertices") = interpDefaults.helicoid.maxVertices, pyb::arg("return_scene") = false,
-        pyb::arg("density") = pyb::none(), pyb::arg("length") = pyb::none(), pyb::arg("clump_radius") = interpDefaults.groom.clump.radius,
-        pyb::arg("clump_tightness") = interpDefaults.groom.clump.tightness, pyb::arg("clump_profile") = interpDefaults.groom.clump.profile,
-        pyb::arg("clump_likeness") = interpDefaults.groom.clump.likeness, pyb::arg("curl") = interpDefaults.groom.curl.amplitude,
-        pyb::arg("curl_frequency") = interpDefaults.groom.curl.frequency, pyb::arg("frizz") = interpDefaults.groom.curl.frizz,
-        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(New hairs from guide hairs (Piuze et al. 2011, Sec. 4): ``vdbhair interpolate``.
+    defineVerb(m, "interpolate", {"guides", "roots"}, interpolateParameters(),
+               {{"normals", "", pyb::none(), "None, or an (N, 3) array of outward normals at the roots (surface frames, Sec. 4.3)."},
+                {"guide_groups", "", pyb::none(),
+                 "None, one integer group id per guide (new hairs blend guides of one group), or a spec as the command's "
+                 "--guide-groups: a list file, \"mask.vdb[:GRID]\", \"head.ply:PROPERTY\", \"head.obj:islands\"."},
+                {"root_groups", "", pyb::none(), "None, one group id per root, or a spec as guide_groups (None: the group of the nearest guide)."},
+                {"head", "", pyb::none(),
+                 "the head new hair may enter no deeper than its guides: None (the scene's head sphere, else a sphere fitted to the "
+                 "guide roots), \"none\", a path (mesh or .vdb level set) or (x, y, z, r)."},
+                {"up", "Tuple[float, float, float]",
+                 pyb::make_tuple(interpDefaults.helicoid.up.x(), interpDefaults.helicoid.up.y(), interpDefaults.helicoid.up.z()),
+                 "reference axis of the surface frames (``--up``)."},
+                {"return_scene", "bool", pyb::bool_(false), "return the new hairs as a scene dict (helicoid only) instead of growing them."},
+                {"density", "", pyb::none(),
+                 "None, the share of roots that grow hair in [0, 1]: a number, one value per root, or a spec as the command's "
+                 "--density (\"mask.vdb[:GRID]\", \"head.ply:PROPERTY\", a text file)."},
+                {"length", "", pyb::none(), "None, the share of each new hair's length kept in [0, 1] (0 grows none), as density."}},
+               "New hairs from guide hairs (Piuze et al. 2011, Sec. 4): ``vdbhair interpolate``.",
+               "    guides: a Strands (blended as they are; fitted first for method=\"helicoid\"), or a scene (a\n"
+               "        path to a scene .json or a dict, as fit() returns).\n"
+               "    roots: an (N, 3) array of root positions (world units), or a Strands whose roots are used.\n",
+               "Strands (one per root, in order), or the scene dict with return_scene.",
+               pyb::cpp_function(interpolateImpl, pyb::arg("guides"), pyb::arg("roots"), pyb::arg("keywords")));
+}
 
-Args:
-    guides: a Strands (blended as they are; fitted first for method="helicoid"), or a scene (a
-        path to a scene .json or a dict, as fit() returns).
-    roots: an (N, 3) array of root positions (world units), or a Strands whose roots are used.
-    normals: None, or an (N, 3) array of outward normals at the roots (surface frames, Sec. 4.3).
-    method: "points" (blend the guides' own points by group and likeness, as production tools do;
-        the default, which measures best on real hair) or "helicoid" (blend their helicoid
-        parameters, the paper's).
-    grouping: points: "shape" (a new hair blends only guides shaped like its nearest one, so
-        partings and layers stay apart) or "none".
-    likeness: the shape distance, a fraction of the guide length, at which a guide stops taking part.
-    guide_groups: None, one integer group id per guide (new hairs blend guides of one group), or a
-        spec as the command's --guide-groups: a list file, "mask.vdb[:GRID]", "head.ply:PROPERTY",
-        "head.obj:islands".
-    root_groups: None, one group id per root, or a spec as guide_groups (None: the group of the
-        nearest guide).
-    head: the head new hair may enter no deeper than its guides: None (the scene's head sphere,
-        else a sphere fitted to the guide roots), "none", a path (mesh or .vdb level set) or
-        (x, y, z, r).
-    power: Shepard exponent p of the weights |x - x_i|^-p (the paper: 3).
-    neighbors: blend only the K nearest guides by root; None: every guide (helicoid), 4 (points).
-    blend: "fitted" (the fits' own pieces, as the paper prints it) or "arcs" (each guide
-        re-described as equal circular arcs in its rotation-minimizing frame, so guides blend
-        alike; reconstruct's default).
-    frames: "world" (the guides carried as they are) or "surface" (turned with the roots'
-        normals, Sec. 4.3; flares long hair).
-    up: reference axis of the surface frames.
-    seed: the scene's seed (recorded; the new hairs have no wisps).
-    max_vertices: refuse requests that would grow more vertices (estimated before any work).
-    return_scene: return the new hairs as a scene dict (helicoid only) instead of growing them.
-    density: None, the share of roots that grow hair in [0, 1]: a number, one value per root, or
-        a spec as the command's --density ("mask.vdb[:GRID]", "head.ply:PROPERTY", a text file).
-    length: None, the share of each new hair's length kept in [0, 1] (0 grows none), as density.
-    clump_radius: clumps (0: none): hairs within this distance of a clump centre are pulled to its hair.
-    clump_tightness: the share of the way to the centre's hair a tip moves, in [0, 1].
-    clump_profile: the pull at a fraction t of the length is tightness * t**profile.
-    clump_likeness: hairs shaped unlike their centre by more than this stay out (0: any).
-    curl: the amplitude a of the waviness of Eq. 4 about each hair (world units; 0: none).
-    curl_frequency: b of Eq. 4, radians per unit length.
-    frizz: the deviation of a random offset across the hair at its tip (world units).
-    threads: worker threads, 0 for all cores (results do not depend on it).
-    progress: optional callable ``progress(stage, done, total, unit)``.
+/// reconstruct: a hairstyle rebuilt from a share of its strands (reconstructParameters()).
+void defineReconstruct(pyb::module_& m)
+{
+    auto reconstructImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
+        ReconstructParams p;
+        applyKeywords(reconstructParameters(), kw, p, "reconstruct");
+        const HeadArgument headArgument(kw["head"], "no-deeper");
+        ReconstructResult r = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            const HeadObstacle head = headArgument.get("reconstruct");
+            return reconstructHairstyle(*strands, p, true, interrupter, head.unset() || head.empty() ? nullptr : &head);
+        });
+        const double metersPerUnit = p.metersPerUnit;
+        auto stats = [metersPerUnit](const ReconstructErrors& e) {
+            pyb::dict d;
+            d["relative"] = pyb::array_t<double>(e.relative.size(), e.relative.data());
+            d["mean"] = e.mean;
+            d["p95"] = e.p95;
+            d["mean_interpolated"] = e.meanInterpolated;
+            d["p95_interpolated"] = e.p95Interpolated;
+            d["seconds"] = e.seconds;
+            d["perm_position"] = e.permPosition;
+            d["perm_curvature"] = e.permCurvature;
+            d["leaving_volume"] = e.leavingVolume;
+            d["entering_head"] = e.enteringHead;
+            d["oriented_points"] = e.oriented.empty() ? pyb::none() : toPython(toJson(e.oriented, metersPerUnit));
+            return d;
+        };
+        pyb::dict report;
+        report["guides"] = pyb::array_t<std::int64_t>(r.guides.size(), reinterpret_cast<const std::int64_t*>(r.guides.data()));
+        report["unfitted"] = r.unfitted;
+        report["fit"] = pyb::dict(pyb::arg("mean") = r.fitSummary.meanRelative, pyb::arg("p95") = r.fitSummary.p95Relative,
+                                  pyb::arg("pieces_per_strand") = r.fitSummary.piecesPerStrand, pyb::arg("seconds") = r.fitSeconds);
+        report["helicoid"] = stats(r.helicoidErrors);
+        report["points"] = stats(r.pointErrors);
+        report["nearest"] = stats(r.nearestErrors);
+        report["original"] = pyb::dict(pyb::arg("leaving_volume") = r.originalLeavingVolume, pyb::arg("entering_head") = r.originalEnteringHead);
+        report["volume_voxel"] = r.volumeVoxel;
+        return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.helicoid)), std::make_shared<StrandSet>(std::move(r.points)), report);
+    };
+    defineVerb(m, "reconstruct", {"strands: vdbhair.Strands"}, reconstructParameters(),
+               {{"head", "", pyb::none(),
+                 "None or \"none\" (no head), a path (mesh or .vdb level set) or (x, y, z, r): the head the shares of strands "
+                 "passing into it are measured against (nothing is moved)."}},
+               "Rebuild a hairstyle from a share of its strands (Piuze et al. 2011, Sec. 5.4):\n"
+               "``vdbhair reconstruct``. The guides are fitted with p-helicoids and new hairs interpolated at every\n"
+               "other root; the same guides' points are blended too (the peers' way), and both are measured\n"
+               "against the original by the discrete Frechet distance relative to each strand's length.",
+               "    strands: a Strands.\n",
+               "(helicoid, points, report): both reconstructions as Strands in input order, and a dict with\n"
+               "    ``guides`` (the guide strands' indices), ``unfitted``, ``fit`` (mean, p95, pieces_per_strand,\n"
+               "    seconds) and for ``helicoid``, ``points`` and ``nearest`` (the baseline: each strand its\n"
+               "    nearest guide, translated): ``relative`` (each strand's error), ``mean``, ``p95``,\n"
+               "    ``mean_interpolated``, ``p95_interpolated``, ``seconds``, ``perm_position``,\n"
+               "    ``perm_curvature`` and ``oriented_points`` (None, or per HairGS threshold: distance_mm,\n"
+               "    angle_degrees, precision, recall, f1, strand_consistency).",
+               pyb::cpp_function(reconstructImpl, pyb::arg("strands"), pyb::arg("keywords")));
+}
 
-Returns:
-    Strands (one per root, in order), or the scene dict with return_scene.)doc");
+} // namespace
 
-    const ReconstructParams reconstructDefaults;
-    m.def(
-        "reconstruct",
-        [](const StrandsPtr& strands, double guides, const std::string& select, std::uint64_t seed, double power,
-           std::optional<int> neighbors, const std::string& blend, const std::string& grouping, double likeness, double maxError,
-           double metersPerUnit, const pyb::object& headArg, int threads, const pyb::object& progress) {
-            ReconstructParams p;
-            const HeadArgument headArgument(headArg, "no-deeper");
-            if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit))
-                throw ValueError("reconstruct: meters_per_unit=" + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
-            p.metersPerUnit = metersPerUnit;
-            p.helicoid.blend = blendArgument("reconstruct", blend);
-            try {
-                p.points.grouping = guideGroupingFromName(grouping);
-            } catch (const ValueError& e) {
-                throw ValueError(std::string("reconstruct: ") + e.what());
-            }
-            if (!(likeness > 0.0) || !std::isfinite(likeness)) throw ValueError("reconstruct: likeness=" + std::to_string(likeness) + ": must be a positive fraction of the guide length");
-            p.points.likeness = likeness;
-            p.guideFraction = guides;
-            if (select == "random") p.selection = GuideSelection::Random;
-            else if (select == "cluster") p.selection = GuideSelection::Cluster;
-            else throw ValueError("reconstruct: select '" + select + "' is not one of random, cluster");
-            p.seed = seed;
-            p.helicoid.shepard.power = power;
-            if (neighbors) {
-                if (*neighbors < 1) throw ValueError("reconstruct: neighbors=" + std::to_string(*neighbors) + ": must be at least 1 (None: each method's default)");
-                p.helicoid.shepard.neighbors = *neighbors;
-                p.points.neighbors = *neighbors;
-            }
-            p.fit.maxError = maxError;
-            validateFitKeywords(p.fit, "reconstruct");
-            ReconstructResult r = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                const HeadObstacle head = headArgument.get("reconstruct");
-                return reconstructHairstyle(*strands, p, true, interrupter, head.unset() || head.empty() ? nullptr : &head);
-            });
-            auto stats = [metersPerUnit](const ReconstructErrors& e) {
-                pyb::dict d;
-                d["relative"] = pyb::array_t<double>(e.relative.size(), e.relative.data());
-                d["mean"] = e.mean;
-                d["p95"] = e.p95;
-                d["mean_interpolated"] = e.meanInterpolated;
-                d["p95_interpolated"] = e.p95Interpolated;
-                d["seconds"] = e.seconds;
-                d["perm_position"] = e.permPosition;
-                d["perm_curvature"] = e.permCurvature;
-                d["leaving_volume"] = e.leavingVolume;
-                d["entering_head"] = e.enteringHead;
-                d["oriented_points"] = e.oriented.empty() ? pyb::none() : toPython(toJson(e.oriented, metersPerUnit));
-                return d;
-            };
-            pyb::dict report;
-            report["guides"] = pyb::array_t<std::int64_t>(r.guides.size(), reinterpret_cast<const std::int64_t*>(r.guides.data()));
-            report["unfitted"] = r.unfitted;
-            report["fit"] = pyb::dict(pyb::arg("mean") = r.fitSummary.meanRelative, pyb::arg("p95") = r.fitSummary.p95Relative,
-                                      pyb::arg("pieces_per_strand") = r.fitSummary.piecesPerStrand, pyb::arg("seconds") = r.fitSeconds);
-            report["helicoid"] = stats(r.helicoidErrors);
-            report["points"] = stats(r.pointErrors);
-            report["nearest"] = stats(r.nearestErrors);
-            report["original"] = pyb::dict(pyb::arg("leaving_volume") = r.originalLeavingVolume, pyb::arg("entering_head") = r.originalEnteringHead);
-            report["volume_voxel"] = r.volumeVoxel;
-            return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.helicoid)), std::make_shared<StrandSet>(std::move(r.points)), report);
-        },
-        pyb::arg("strands"), pyb::kw_only(), pyb::arg("guides") = reconstructDefaults.guideFraction, pyb::arg("select") = "random",
-        pyb::arg("seed") = reconstructDefaults.seed, pyb::arg("power") = reconstructDefaults.helicoid.shepard.power,
-        pyb::arg("neighbors") = pyb::none(), pyb::arg("blend") = helicoidBlendName(reconstructDefaults.helicoid.blend),
-        pyb::arg("grouping") = guideGroupingName(reconstructDefaults.points.grouping), pyb::arg("likeness") = reconstructDefaults.points.likeness,
-        pyb::arg("max_error") = reconstructDefaults.fit.maxError, pyb::arg("meters_per_unit") = reconstructDefaults.metersPerUnit, pyb::arg("head") = pyb::none(), pyb::arg("threads") = 0,
-        pyb::arg("progress") = pyb::none(),
-        R"doc(Rebuild a hairstyle from a share of its strands (Piuze et al. 2011, Sec. 5.4):
-``vdbhair reconstruct``. The guides are fitted with p-helicoids and new hairs interpolated at every
-other root; the same guides' points are blended too (the peers' way), and both are measured
-against the original by the discrete Frechet distance relative to each strand's length.
-
-Args:
-    strands: a Strands.
-    guides: share of the strands used as guides, a fraction in (0, 1] (the CLI's ``--guides``
-        takes a percentage).
-    select: "random" (a seeded shuffle) or "cluster" (k-means of the roots: guides spread
-        evenly).
-    seed: seed of the guide choice.
-    power: Shepard exponent p of the helicoid interpolation (the paper: 3).
-    neighbors: guides per new hair; None: every guide (helicoid), 4 (points).
-    blend: "arcs" (each guide re-described as equal circular arcs in its rotation-minimizing
-        frame, so guides blend alike; only guides shaped like the heaviest take part) or "fitted"
-        (the fits' own pieces, as the paper prints it).
-    grouping: points: "shape" (a strand blends only guides shaped like its nearest one) or "none".
-    likeness: the shape distance, a fraction of the guide length, at which a guide stops taking part.
-    meters_per_unit: the strands' unit in metres (0.01: centimetres), for HairGS's oriented-point
-        measures at 2-4 mm; 0: unknown, not measured.
-    max_error: the fits' accepted discrete Frechet distance, a fraction of the strand length.
-    head: None or "none" (no head), a path (mesh or .vdb level set) or (x, y, z, r): the head the
-        shares of strands passing into it are measured against (nothing is moved).
-    threads: worker threads, 0 for all cores (results do not depend on it).
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    (helicoid, points, report): both reconstructions as Strands in input order, and a dict with
-    ``guides`` (the guide strands' indices), ``unfitted``, ``fit`` (mean, p95, pieces_per_strand,
-    seconds) and for ``helicoid``, ``points`` and ``nearest`` (the baseline: each strand its
-    nearest guide, translated): ``relative`` (each strand's error), ``mean``, ``p95``,
-    ``mean_interpolated``, ``p95_interpolated``, ``seconds``, ``perm_position``,
-    ``perm_curvature`` and ``oriented_points`` (None, or per HairGS threshold: distance_mm,
-    angle_degrees, precision, recall, f1, strand_consistency).)doc");
+void bindOperations(pyb::module_& m)
+{
+    defineGrow(m);
+    defineFit(m);
+    defineInterpolate(m);
+    defineReconstruct(m);
 
     const RenderParams renderDefaults;
     m.def(

@@ -34,19 +34,21 @@ struct PyKeyword
 template<typename P>
 std::string pythonAnnotation(const Param<P>& param)
 {
-    return std::visit([](const auto& a) -> std::string {
+    const std::string type = std::visit([](const auto& a) -> std::string {
         using T = std::decay_t<decltype(a.get(std::declval<const P&>()))>;
         if constexpr (std::is_same_v<T, std::string>) return "str";
         else if constexpr (std::is_same_v<T, bool>) return "bool";
         else if constexpr (std::is_same_v<T, double>) return "float";
         else return "int";
     }, param.access);
+    return param.pythonNone ? "Optional[" + type + "]" : type;
 }
 
 /// The default of a declared parameter as a Python object.
 template<typename P>
 pyb::object pythonDefault(const Param<P>& param)
 {
+    if (param.pythonNone) return pyb::none();
     const P defaults{};
     return std::visit([&](const auto& a) -> pyb::object { return pyb::cast(a.get(defaults)); }, param.access);
 }
@@ -60,6 +62,7 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
         const std::string key = param.pythonName();
         if (!kw.contains(key)) continue;
         const pyb::object v = kw[key.c_str()];
+        if (v.is_none()) continue;  // Param::pythonNone: the struct's default
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(p))>;
             if constexpr (std::is_same_v<T, std::string>) {

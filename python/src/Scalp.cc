@@ -1,5 +1,6 @@
 // scalp and roots: scalp level sets and follicles on them (`vdbhair scalp`, `vdbhair roots`).
 #include "Common.h"
+#include "Params.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
@@ -59,6 +60,97 @@ openvdb::FloatGrid::Ptr scalpGridArgument(const pyb::handle& obj, const std::str
         return grid;
     }
     throw TypeError(where + ": scalp must be a vdbhair.Grid (a level set) or a path to a scalp .vdb or a head mesh");
+}
+
+/// roots()'s result: the follicles, their spacing and whether a region confined them.
+pyb::dict folliclesDict(const Follicles& f, const FollicleStats& stats, bool region)
+{
+    pyb::dict d;
+    d["positions"] = pointsArray(f.positions);
+    d["normals"] = pointsArray(f.normals);
+    d["tangents"] = pointsArray(f.tangents);
+    d["region"] = region;
+    d["area"] = f.area;
+    d["area_without_zero"] = f.areaWithoutZero;
+    d["target_spacing"] = f.targetSpacing;
+    d["iterations"] = f.iterations;
+    d["last_move"] = f.lastMove;
+    d["removed"] = f.removed;
+    d["contour"] = f.contour;
+    d["initial"] = f.initial;
+    d["fissions"] = f.fissions;
+    d["deaths"] = f.deaths;
+    pyb::dict sp;
+    sp["mean"] = stats.nnMean;
+    sp["cv"] = stats.nnCV;
+    sp["min"] = stats.nnMin;
+    sp["max"] = stats.nnMax;
+    d["spacing"] = sp;
+    d["max_surface_distance_voxels"] = stats.maxSurfaceDistanceVoxels;
+    return d;
+}
+
+/// roots: follicles spread over a scalp (follicleParameters()).
+void defineRoots(pyb::module_& m)
+{
+    auto rootsImpl = [](const pyb::object& scalp, const pyb::dict& kw) {
+        FollicleParams fp;
+        applyKeywords(follicleParameters(), kw, fp, "roots");
+        if ((fp.count == 0) == (fp.spacing == 0.0)) throw ValueError("roots: give one of count= and spacing=");
+        const std::array<double, 3> up = kw["up"].cast<std::array<double, 3>>();
+        const Vec3d u(up[0], up[1], up[2]);
+        if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("roots: up must be a non-zero finite vector");
+        fp.up = u / u.length();
+        const bool fromPath = isPathLike(scalp);
+        const std::string path = fromPath ? pathString(scalp, "roots: scalp") : std::string();
+        openvdb::FloatGrid::Ptr surface = fromPath ? nullptr : scalpGridArgument(scalp, "roots");
+        const pyb::object regionArg = kw["region"];
+        openvdb::BoolGrid::Ptr region;
+        const bool noRegion = pyb::isinstance<pyb::bool_>(regionArg) && !regionArg.cast<bool>();
+        const bool regionFromFile = regionArg.is_none();
+        if (!regionArg.is_none() && !noRegion) {
+            if (!pyb::isinstance<PyGrid>(regionArg)) throw TypeError("roots: region must be a vdbhair.Grid (bool), False or None");
+            region = std::dynamic_pointer_cast<openvdb::BoolGrid>(regionArg.cast<const PyGrid&>().grid);
+            if (!region) throw TypeError("roots: region grid '" + regionArg.cast<const PyGrid&>().grid->getName() + "' is not a bool grid");
+        }
+        struct Out
+        {
+            Follicles f;
+            FollicleStats stats;
+            bool region;
+        };
+        const Out out = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            if (fromPath) {
+                surface = readScalp(path, interrupter);
+                if (regionFromFile) region = readScalpRegion(path);
+            }
+            Out o;
+            o.f = sampleFollicles(surface, region, fp, true, interrupter);
+            o.stats = measureFollicles(o.f.positions, surface);
+            o.region = bool(region);
+            return o;
+        });
+        return folliclesDict(out.f, out.stats, out.region);
+    };
+    const FollicleParams follicleDefaults;
+    defineVerb(m, "roots", {"scalp"}, follicleParameters(),
+               {{"region", "", pyb::none(),
+                 "a bool vdbhair.Grid (scalp()'s region); None: the file's 'region' grid when scalp is a path, else the whole "
+                 "surface; False: the whole surface."},
+                {"up", "Tuple[float, float, float]", pyb::make_tuple(follicleDefaults.up.x(), follicleDefaults.up.y(), follicleDefaults.up.z()),
+                 "reference axis of the tangents (``--up``)."}},
+               "Follicles spread evenly over a scalp (Witkin & Heckbert 1994 repulsion on the zero level\n"
+               "set, as Piuze et al. 2011 place roots): ``vdbhair roots``. Identical for any thread count.\n"
+               "Give one of ``count`` and ``spacing``.",
+               "    scalp: a vdbhair.Grid holding a level set (what scalp() returns), or a path to a scalp .vdb\n"
+               "        (its 'surface' and 'region' grids) or to a head mesh.\n",
+               "A dict: ``positions``, ``normals`` (outward), ``tangents``: (N, 3) float32 arrays (the\n"
+               "    roots and their frames, ready for interpolate(guides, r[\"positions\"], normals=r[\"normals\"]));\n"
+               "    ``region`` (whether one confined them), ``area``, ``target_spacing``, ``iterations``,\n"
+               "    ``last_move``, ``removed``, ``contour`` (with a region, the first ``contour`` roots are fixed\n"
+               "    along its rim), ``initial``, ``fissions``, ``deaths``, ``spacing`` (nearest-neighbour mean, cv,\n"
+               "    min, max) and ``max_surface_distance_voxels``.",
+               pyb::cpp_function(rootsImpl, pyb::arg("scalp"), pyb::arg("keywords")));
 }
 
 } // namespace
@@ -165,112 +257,7 @@ Returns:
     the bool grid 'region' or None. ``vdbhair.write_grids(path, [surface, region])`` writes what
     ``vdbhair scalp`` writes.)doc");
 
-    const FollicleParams follicleDefaults;
-    m.def(
-        "roots",
-        [](const pyb::object& scalp, std::optional<std::size_t> count, std::optional<double> spacing, const pyb::object& regionArg,
-           std::uint64_t seed, int iterations, double stepScale, std::array<double, 3> up, bool contour, double initialFraction, int threads,
-           const pyb::object& progress) {
-            if (bool(count) == bool(spacing)) throw ValueError("roots: give one of count= and spacing=");
-            if (iterations < 0) throw ValueError("roots: iterations=" + std::to_string(iterations) + ": must be at least 0");
-            FollicleParams fp;
-            if (count) fp.count = *count;
-            if (spacing) {
-                if (!(*spacing > 0.0) || !std::isfinite(*spacing)) throw ValueError("roots: spacing=" + std::to_string(*spacing) + ": must be a positive finite length");
-                fp.spacing = *spacing;
-            }
-            fp.seed = seed;
-            fp.maxIterations = iterations;
-            fp.stepScale = stepScale;
-            fp.contour = contour;
-            fp.initialFraction = initialFraction;
-            const Vec3d u(up[0], up[1], up[2]);
-            if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("roots: up must be a non-zero finite vector");
-            fp.up = u / u.length();
-            const bool fromPath = isPathLike(scalp);
-            const std::string path = fromPath ? pathString(scalp, "roots: scalp") : std::string();
-            openvdb::FloatGrid::Ptr surface = fromPath ? nullptr : scalpGridArgument(scalp, "roots");
-            openvdb::BoolGrid::Ptr region;
-            const bool noRegion = pyb::isinstance<pyb::bool_>(regionArg) && !regionArg.cast<bool>();
-            const bool regionFromFile = regionArg.is_none();
-            if (!regionArg.is_none() && !noRegion) {
-                if (!pyb::isinstance<PyGrid>(regionArg)) throw TypeError("roots: region must be a vdbhair.Grid (bool), False or None");
-                region = std::dynamic_pointer_cast<openvdb::BoolGrid>(regionArg.cast<const PyGrid&>().grid);
-                if (!region) throw TypeError("roots: region grid '" + regionArg.cast<const PyGrid&>().grid->getName() + "' is not a bool grid");
-            }
-            struct Out
-            {
-                Follicles f;
-                FollicleStats stats;
-                bool region;
-            };
-            const Out out = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                if (fromPath) {
-                    surface = readScalp(path, interrupter);
-                    if (regionFromFile) region = readScalpRegion(path);
-                }
-                Out o;
-                o.f = sampleFollicles(surface, region, fp, true, interrupter);
-                o.stats = measureFollicles(o.f.positions, surface);
-                o.region = bool(region);
-                return o;
-            });
-            pyb::dict d;
-            d["positions"] = pointsArray(out.f.positions);
-            d["normals"] = pointsArray(out.f.normals);
-            d["tangents"] = pointsArray(out.f.tangents);
-            d["region"] = out.region;
-            d["area"] = out.f.area;
-            d["area_without_zero"] = out.f.areaWithoutZero;
-            d["target_spacing"] = out.f.targetSpacing;
-            d["iterations"] = out.f.iterations;
-            d["last_move"] = out.f.lastMove;
-            d["removed"] = out.f.removed;
-            d["contour"] = out.f.contour;
-            d["initial"] = out.f.initial;
-            d["fissions"] = out.f.fissions;
-            d["deaths"] = out.f.deaths;
-            pyb::dict sp;
-            sp["mean"] = out.stats.nnMean;
-            sp["cv"] = out.stats.nnCV;
-            sp["min"] = out.stats.nnMin;
-            sp["max"] = out.stats.nnMax;
-            d["spacing"] = sp;
-            d["max_surface_distance_voxels"] = out.stats.maxSurfaceDistanceVoxels;
-            return d;
-        },
-        pyb::arg("scalp"), pyb::kw_only(), pyb::arg("count") = pyb::none(), pyb::arg("spacing") = pyb::none(),
-        pyb::arg("region") = pyb::none(), pyb::arg("seed") = follicleDefaults.seed, pyb::arg("iterations") = follicleDefaults.maxIterations,
-        pyb::arg("step_scale") = follicleDefaults.stepScale,
-        pyb::arg("up") = std::array<double, 3>{follicleDefaults.up.x(), follicleDefaults.up.y(), follicleDefaults.up.z()},
-        pyb::arg("contour") = follicleDefaults.contour, pyb::arg("initial_fraction") = follicleDefaults.initialFraction,
-        pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(Follicles spread evenly over a scalp (Witkin & Heckbert 1994 repulsion on the zero level
-set, as Piuze et al. 2011 place roots): ``vdbhair roots``. Identical for any thread count.
-
-Args:
-    scalp: a vdbhair.Grid holding a level set (what scalp() returns), or a path to a scalp .vdb
-        (its 'surface' and 'region' grids) or to a head mesh.
-    count: the number of roots; or
-    spacing: the target mean nearest-neighbour spacing, world units.
-    region: a bool vdbhair.Grid (scalp()'s region); None: the file's 'region' grid when scalp
-        is a path, else the whole surface; False: the whole surface.
-    seed: random seed of the initial placement.
-    iterations: most relaxation iterations.
-    step_scale: relaxation step as a multiple of sigma^2 times the energy gradient.
-    up: reference axis of the tangents.
-    contour: with a region, fixed roots along its rim (the first ``contour`` of the result).
-    initial_fraction: share of the roots placed at the start, in (0, 4]; fission and death
-        (Witkin & Heckbert) make the count.
-    threads: worker threads, 0 for all cores.
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    A dict: ``positions``, ``normals`` (outward), ``tangents``: (N, 3) float32 arrays (the
-    roots and their frames, ready for interpolate(guides, r["positions"], normals=r["normals"]));
-    ``region`` (whether one confined them), ``area``, ``target_spacing``, ``iterations``,
-    ``last_move``, ``removed``, ``contour``, ``initial``, ``fissions``, ``deaths``, ``spacing``
-    (nearest-neighbour mean, cv, min, max) and ``max_surface_distance_voxels``.)doc");
+    defineRoots(m);
 }
 
 } // namespace vdbhair::py

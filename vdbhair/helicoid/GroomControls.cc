@@ -88,6 +88,49 @@ void validateGroomParams(const GroomParams& p)
     if (!(k.frizz >= 0.0) || !std::isfinite(k.frizz)) throw ValueError("--frizz " + formatNumber(k.frizz) + ": must be a length of 0 (no frizz) or more");
 }
 
+const ParamTable<GroomParams>& groomParameters()
+{
+    using P = GroomParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto radius = makeParam<P>("clump-radius", "Clumps: hairs within this distance of a clump centre are pulled to its hair", "world units",
+                                   member<P>([](P& p) -> double& { return p.clump.radius; }));
+        radius.min = 0.0;
+        radius.zeroMeans = "no clumps";
+        t.push_back(radius);
+        auto tightness = makeParam<P>("clump-tightness", "Clumps: the share of the way to the centre's hair a tip moves", "",
+                                      member<P>([](P& p) -> double& { return p.clump.tightness; }));
+        tightness.min = 0.0;
+        tightness.max = 1.0;
+        t.push_back(tightness);
+        auto profile = makeParam<P>("clump-profile", "Clumps: the pull at a fraction t of the length is tightness * t^profile (higher: looser near the root)", "",
+                                    member<P>([](P& p) -> double& { return p.clump.profile; }));
+        profile.min = 0.0;
+        profile.aboveMin = true;
+        t.push_back(profile);
+        auto likeness = makeParam<P>("clump-likeness", "Clumps: hairs shaped unlike their centre by more than this likeness distance stay out", "",
+                                     member<P>([](P& p) -> double& { return p.clump.likeness; }));
+        likeness.min = 0.0;
+        likeness.zeroMeans = "any shape";
+        t.push_back(likeness);
+        auto curl = makeParam<P>("curl", "Curl: the amplitude a of Eq. 4, about each hair", "world units", member<P>([](P& p) -> double& { return p.curl.amplitude; }));
+        curl.min = 0.0;
+        curl.zeroMeans = "no curl";
+        t.push_back(curl);
+        auto frequency = makeParam<P>("curl-frequency", "Curl: b of Eq. 4 (a turn every 2 pi / b)", "radians per unit length",
+                                      member<P>([](P& p) -> double& { return p.curl.frequency; }));
+        frequency.min = 0.0;
+        t.push_back(frequency);
+        auto frizz = makeParam<P>("frizz", "Frizz: the deviation of a random offset at the tip, from 0 at the root", "world units",
+                                  member<P>([](P& p) -> double& { return p.curl.frizz; }));
+        frizz.min = 0.0;
+        frizz.zeroMeans = "no frizz";
+        t.push_back(frizz);
+        return t;
+    }();
+    return table;
+}
+
 std::vector<char> rootsKept(std::size_t R, const std::vector<float>& density, const std::vector<float>& length, std::uint64_t seed)
 {
     if (!density.empty() && density.size() != R) throw ValueError(std::to_string(density.size()) + " density values for " + std::to_string(R) + " roots: one per root");

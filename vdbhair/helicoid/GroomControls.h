@@ -12,6 +12,7 @@
 /// the thread count, and turning one control on does not change what the others draw.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/strands/StrandSet.h>
 
 #include <openvdb/util/NullInterrupter.h>
@@ -68,6 +69,10 @@ struct GroomParams
 /// @brief Check every value; @throw ValueError naming the value and the rule (names as the CLI's
 /// options: "--clump-radius", ...).
 void validateGroomParams(const GroomParams& params);
+
+/// @brief The declared clump, curl and frizz parameters (vdbhair/Parameters.h); the seed and the
+/// vertex cap are the grooming verb's (InterpolateParams sets them).
+const ParamTable<GroomParams>& groomParameters();
 
 /// @brief Which of @a R roots a density keeps: root i when a draw uniform in [0, 1) from its own
 /// stream is below density[i] (0 never, 1 always), and its length fraction (if any) is above 0.

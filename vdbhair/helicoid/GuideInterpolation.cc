@@ -203,6 +203,36 @@ FrameRule frameRuleFromName(const std::string& name)
     throw ValueError("frames '" + name + "' is not one of world, surface");
 }
 
+const ParamTable<InterpolateParams>& interpolateParameters()
+{
+    using P = InterpolateParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto add = [&](Param<P> p) { t.push_back(std::move(p)); };
+        auto method = makeParam<P>("method", "points (the guides' own points, by group and likeness) or helicoid (their helicoid parameters, Piuze et al.)", "",
+                                   named<P>([](P& p) -> InterpolationMethod& { return p.method; }, interpolationMethodName, interpolationMethodFromName));
+        method.choices = {"points", "helicoid"};
+        add(method);
+        const auto points = [](P& p) -> PointInterpolationParams& { return p.points; };
+        for (Param<P>& q : nestedParams<P>(pointInterpolationParameters(), points)) add(std::move(q));
+        for (Param<P>& q : nestedParams<P>(groomParameters(), [](P& p) -> GroomParams& { return p.groom; })) add(std::move(q));
+        for (Param<P>& q : nestedParams<P>(helicoidInterpolationParameters(), [](P& p) -> HelicoidInterpolationParams& { return p.helicoid; })) add(std::move(q));
+        add(guideNeighborsParam<P>());
+        auto frames = makeParam<P>("frames", "world (guides carried as they are) or surface (turned with the roots' normals, Sec. 4.3; flares long hair)", "",
+                                   named<P>([](P& p) -> FrameRule& { return p.frames; }, frameRuleName, frameRuleFromName));
+        frames.choices = {"world", "surface"};
+        add(frames);
+        add(makeParam<P>("seed", "Seed of the density draw, clumps, curl phases, frizz and waviness noise (and of roots spread on a scalp)", "",
+                         member<P>([](P& p) -> std::uint64_t& { return p.seed; })));
+        // One cap for both methods.
+        add(makeParam<P>("max-vertices", "Refuse requests that would make more vertices (12 bytes each), estimated before any work", "",
+                         ParamAccess<P, std::uint64_t>{[](const P& p) { return std::uint64_t(p.helicoid.maxVertices); },
+                                                       [](P& p, std::uint64_t v) { p.helicoid.maxVertices = p.points.maxVertices = v; }}));
+        return t;
+    }();
+    return table;
+}
+
 InterpolateResult interpolateGuides(const InterpolationGuides& guides, const InterpolationRoots& rootsIn, const HeadObstacle& head,
                                     const InterpolateParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {

@@ -55,6 +55,12 @@ struct InterpolateParams
     bool returnScene = false;  ///< Helicoid: keep the new hairs as a scene, not grown (no head collision, no groom controls then)
 };
 
+/// @brief interpolate's declared parameters (vdbhair/Parameters.h): the method, the points' and
+/// helicoids' (pointInterpolationParameters(), helicoidInterpolationParameters(),
+/// guideNeighborsParam()), the groom controls (groomParameters()), frames, seed and vertex cap.
+/// The up axis, the roots, their density and length, the head and returnScene are the front ends'.
+const ParamTable<InterpolateParams>& interpolateParameters();
+
 /// @brief Whether @a groom asks for a control that moves hair: clumps, curl or frizz (a positive
 /// clump radius, curl amplitude or frizz). interpolateGuides() applies them only then, and refuses
 /// them with InterpolateParams::returnScene (a scene of new hairs is not grown, so nothing to move).

@@ -58,6 +58,30 @@ Vec3d tangentAt(const HelicoidTrace& tr, double s, std::size_t& k)
 
 } // namespace
 
+const ParamTable<HelicoidInterpolationParams>& helicoidInterpolationParameters()
+{
+    using P = HelicoidInterpolationParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto blend = makeParam<P>("blend", "helicoid: arcs (each guide re-described as equal circular arcs in its rotation-minimizing frame, so guides "
+                                           "blend alike) or fitted (the fits' own pieces, as the paper prints it)", "",
+                                  named<P>([](P& p) -> HelicoidBlend& { return p.blend; }, helicoidBlendName, helicoidBlendFromName));
+        blend.choices = {"arcs", "fitted"};
+        t.push_back(blend);
+        auto arcs = makeParam<P>("arcs", "blend arcs: arcs per hair", "", member<P>([](P& p) -> std::size_t& { return p.arcs; }));
+        arcs.min = 0;
+        arcs.zeroMeans = "one per " + formatNumber(kArcTurn) + " radian of the most-turning guide, " + std::to_string(kMinArcs) + " to " + std::to_string(kMaxArcs);
+        t.push_back(arcs);
+        auto power = makeParam<P>("power", "helicoid: Shepard exponent p, a guide's weight d^-p at root distance d (the paper uses 3)", "",
+                                  member<P>([](P& p) -> double& { return p.shepard.power; }));
+        power.min = 0.0;
+        power.aboveMin = true;
+        t.push_back(power);
+        return t;
+    }();
+    return table;
+}
+
 const char* helicoidBlendName(HelicoidBlend blend) { return blend == HelicoidBlend::Arcs ? "arcs" : "fitted"; }
 
 HelicoidBlend helicoidBlendFromName(const std::string& name)

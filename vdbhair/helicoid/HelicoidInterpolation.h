@@ -79,6 +79,7 @@
 /// guide unchanged, translated to the root (and rotated by W W_iᵀ with surface frames).
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/helicoid/ShepardWeights.h>
@@ -123,6 +124,10 @@ struct HelicoidInterpolationParams
     Vec3d up{0.0, 1.0, 0.0};                   ///< reference axis of surface frames (as `vdbhair roots --up`)
     std::size_t maxVertices = std::size_t(1) << 28;  ///< refuse requests that would grow more (12 bytes each: 3 GB)
 };
+
+/// @brief The declared blend, arcs and Shepard power (vdbhair/Parameters.h); the neighbours are
+/// guideNeighborsParam()'s (PointInterpolation.h), the up axis and vertex cap the verb's.
+const ParamTable<HelicoidInterpolationParams>& helicoidInterpolationParameters();
 
 /// @brief Roots at which to interpolate: #R world positions and, for surface frames, #R unit
 /// outward normals (or none).

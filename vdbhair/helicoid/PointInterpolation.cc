@@ -323,6 +323,25 @@ void bindHeaviestGuides(const std::vector<std::vector<GuideWeight>>& weights, Gu
 
 } // namespace
 
+const ParamTable<PointInterpolationParams>& pointInterpolationParameters()
+{
+    using P = PointInterpolationParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto grouping = makeParam<P>("grouping", "points: shape (a new hair blends only guides shaped like its nearest one: partings and layers stay apart) or none", "",
+                                     named<P>([](P& p) -> GuideGrouping& { return p.grouping; }, guideGroupingName, guideGroupingFromName));
+        grouping.choices = {"shape", "none"};
+        t.push_back(grouping);
+        auto likeness = makeParam<P>("likeness", "grouping shape: the shape distance, a fraction of the guide length, at which a guide stops taking part", "",
+                                     member<P>([](P& p) -> double& { return p.likeness; }));
+        likeness.min = 0.0;
+        likeness.aboveMin = true;
+        t.push_back(likeness);
+        return t;
+    }();
+    return table;
+}
+
 const char* guideGroupingName(GuideGrouping grouping) { return grouping == GuideGrouping::Shape ? "shape" : "none"; }
 
 GuideGrouping guideGroupingFromName(const std::string& name)

@@ -30,6 +30,7 @@
 /// The head is interpolateGuides()'s (GuideInterpolation.h), after either method.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -70,6 +71,34 @@ struct PointInterpolationParams
     double likeness = 0.25;
     std::size_t maxVertices = std::size_t(1) << 28;  ///< as HelicoidInterpolationParams
 };
+
+/// @brief The declared grouping and likeness (vdbhair/Parameters.h); the neighbours are
+/// guideNeighborsParam()'s, shared with helicoid interpolation.
+const ParamTable<PointInterpolationParams>& pointInterpolationParameters();
+
+/// @brief The `neighbors` parameter of a verb that can blend guides either way (a struct @a P with
+/// members `helicoid` and `points`: InterpolateParams, ReconstructParams): the K nearest guides
+/// by root, for both methods; 0 leaves each method's own (PointInterpolationParams::neighbors for
+/// points, every guide for helicoid).
+template<typename P>
+Param<P> guideNeighborsParam()
+{
+    // 0 stands for both methods' own defaults; any other value is both's (a negative one for the range check to refuse).
+    ParamAccess<P, int> access{[](const P& p) {
+                                   const bool own = p.helicoid.shepard.neighbors == ShepardParams{}.neighbors &&
+                                                    p.points.neighbors == PointInterpolationParams{}.neighbors;
+                                   return own ? 0 : p.points.neighbors;
+                               },
+                               [](P& p, int k) {
+                                   p.helicoid.shepard.neighbors = k != 0 ? k : ShepardParams{}.neighbors;
+                                   p.points.neighbors = k != 0 ? k : PointInterpolationParams{}.neighbors;
+                               }};
+    Param<P> n = makeParam<P>("neighbors", "Guides per new hair, nearest by root", "", access);
+    n.min = 0;
+    n.zeroMeans = "each method's own, " + std::to_string(PointInterpolationParams{}.neighbors) + " for points and every guide for helicoid";
+    n.pythonNone = true;
+    return n;
+}
 
 /// @brief What is known of the guides besides their points; each part optional.
 struct GuideContext

@@ -213,6 +213,46 @@ void measureVolumeAndHead(const StrandSet& strands, const StrandSet& rawGuides, 
 
 } // namespace
 
+const char* guideSelectionName(GuideSelection selection) { return selection == GuideSelection::Cluster ? "cluster" : "random"; }
+
+GuideSelection guideSelectionFromName(const std::string& name)
+{
+    if (name == "random") return GuideSelection::Random;
+    if (name == "cluster") return GuideSelection::Cluster;
+    throw ValueError("select '" + name + "' is not one of random, cluster");
+}
+
+const ParamTable<ReconstructParams>& reconstructParameters()
+{
+    using P = ReconstructParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto add = [&](Param<P> p) { t.push_back(std::move(p)); };
+        auto guides = makeParam<P>("guides", "Share of the strands used as guides, a fraction (the command line's --guides takes a percentage: 10%)", "",
+                                   member<P>([](P& p) -> double& { return p.guideFraction; }));
+        guides.min = 0.0;
+        guides.aboveMin = true;
+        guides.max = 1.0;
+        add(guides);
+        auto select = makeParam<P>("select", "Guide choice: random (a seeded shuffle) or cluster (k-means of the roots: guides spread evenly)", "",
+                                   named<P>([](P& p) -> GuideSelection& { return p.selection; }, guideSelectionName, guideSelectionFromName));
+        select.choices = {"random", "cluster"};
+        add(select);
+        add(makeParam<P>("seed", "Seed of the guide choice", "", member<P>([](P& p) -> std::uint64_t& { return p.seed; })));
+        for (Param<P>& q : nestedParams<P>(helicoidInterpolationParameters(), [](P& p) -> HelicoidInterpolationParams& { return p.helicoid; })) add(std::move(q));
+        add(guideNeighborsParam<P>());
+        for (Param<P>& q : nestedParams<P>(pointInterpolationParameters(), [](P& p) -> PointInterpolationParams& { return p.points; })) add(std::move(q));
+        for (Param<P>& q : nestedParams<P>(fitParameters(), [](P& p) -> FitParams& { return p.fit; }, {"max-error"})) add(std::move(q));
+        auto unit = makeParam<P>("meters-per-unit", "The strands' unit in metres (0.01: centimetres), for HairGS's oriented-point F1 at 2-4 mm", "",
+                                 member<P>([](P& p) -> double& { return p.metersPerUnit; }));
+        unit.min = 0.0;
+        unit.zeroMeans = "unknown, not measured";
+        add(unit);
+        return t;
+    }();
+    return table;
+}
+
 std::vector<std::size_t> selectGuides(const StrandSet& strands, double fraction, GuideSelection selection, std::uint64_t seed)
 {
     const std::size_t S = strands.numStrands();

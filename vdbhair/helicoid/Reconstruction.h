@@ -34,6 +34,7 @@
 #include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace vdbhair {
@@ -58,6 +59,17 @@ struct ReconstructParams
     /// measures, whose thresholds are in millimetres, are not computed.
     double metersPerUnit = 0.0;
 };
+
+/// @brief "random" or "cluster".
+const char* guideSelectionName(GuideSelection selection);
+/// @throw ValueError naming @a name and the choices.
+GuideSelection guideSelectionFromName(const std::string& name);
+
+/// @brief reconstruct's declared parameters (vdbhair/Parameters.h): the guides' share, choice and
+/// seed, the interpolation's (helicoidInterpolationParameters(), guideNeighborsParam(),
+/// pointInterpolationParameters()), the fits' accepted error (fitParameters()) and the unit.
+/// The command line takes the share as a percentage (its own --guides).
+const ParamTable<ReconstructParams>& reconstructParameters();
 
 /// @brief Per-strand errors of one method and their statistics (fractions of the strand length).
 struct ReconstructErrors

@@ -437,6 +437,31 @@ GrowReport clearanceReport(const std::vector<double>& clearance, double nearAxis
 
 } // namespace
 
+const ParamTable<GrowOptions>& growParameters()
+{
+    using P = GrowOptions;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        // "scene" stands for no override.
+        ParamAccess<P, std::string> integratorAccess{
+            [](const P& p) -> std::string { return !p.integrator ? "scene" : *p.integrator == HelicoidIntegrator::RK4 ? "rk4" : "euler"; },
+            [](P& p, std::string v) {
+                if (v == "scene") p.integrator.reset();
+                else if (v == "euler") p.integrator = HelicoidIntegrator::Euler;
+                else if (v == "rk4") p.integrator = HelicoidIntegrator::RK4;
+                else throw ValueError("integrator '" + v + "' is not one of scene, euler, rk4");
+            }};
+        auto integrator = makeParam<P>("integrator", "euler (Eq. 3, the paper's), rk4, or scene (the scene's own, else euler)", "", integratorAccess);
+        integrator.choices = {"scene", "euler", "rk4"};
+        integrator.pythonNone = true;
+        t.push_back(integrator);
+        t.push_back(makeParam<P>("max-vertices", "Refuse scenes that would grow more vertices (12 bytes each)", "",
+                                 member<P>([](P& p) -> std::size_t& { return p.maxVertices; })));
+        return t;
+    }();
+    return table;
+}
+
 StrandSet growScene(const Scene& scene, const GrowOptions& options, bool threaded, openvdb::util::NullInterrupter* interrupter,
                     GrowReport* report)
 {

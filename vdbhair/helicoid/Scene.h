@@ -23,6 +23,7 @@
 /// `scene.json: guides[3].pieces[0].k: expected 4 numbers`.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/helicoid/Helicoid.h>
 #include <vdbhair/helicoid/Waviness.h>
 #include <vdbhair/helicoid/Wisp.h>
@@ -92,6 +93,10 @@ struct GrowOptions
     /// and every strand issue 19 found changing with the step had passed within one step of the axis.
     double nearAxisSteps = 1.0;
 };
+
+/// @brief grow's declared parameters (vdbhair/Parameters.h): the integrator ("scene": the
+/// scene's own) and the vertex cap.
+const ParamTable<GrowOptions>& growParameters();
 
 /// @brief What growScene() found while tracing: guides whose trace is not a converged
 /// streamline because it passes within GrowOptions::nearAxisSteps of a piece's singular axis,

@@ -613,6 +613,43 @@ ScalpArea measureScalpArea(const openvdb::FloatGrid::ConstPtr& surface, const op
     return surfaceCells(*surface, ScalpSampler(surface, region), nullptr);
 }
 
+const ParamTable<FollicleParams>& follicleParameters()
+{
+    using P = FollicleParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto count = makeParam<P>("count", "Number of roots", "", member<P>([](P& p) -> std::size_t& { return p.count; }));
+        count.min = 0;
+        count.zeroMeans = "set by the spacing (give one of the two)";
+        count.pythonNone = true;
+        t.push_back(count);
+        auto spacing = makeParam<P>("spacing", "Target nearest-neighbour spacing, instead of a count", "world units",
+                                    member<P>([](P& p) -> double& { return p.spacing; }));
+        spacing.min = 0.0;
+        spacing.zeroMeans = "set by the count";
+        spacing.pythonNone = true;
+        t.push_back(spacing);
+        t.push_back(makeParam<P>("seed", "Random seed of the initial placement", "", member<P>([](P& p) -> std::uint64_t& { return p.seed; })));
+        auto iterations = makeParam<P>("iterations", "Most relaxation iterations", "", member<P>([](P& p) -> int& { return p.maxIterations; }));
+        iterations.min = 0;
+        t.push_back(iterations);
+        auto step = makeParam<P>("step-scale", "Relaxation step as a multiple of sigma^2 times the energy gradient (above about 1 it oscillates)", "",
+                                 member<P>([](P& p) -> double& { return p.stepScale; }));
+        step.min = 0.0;
+        step.aboveMin = true;
+        t.push_back(step);
+        t.push_back(makeParam<P>("contour", "Fixed roots on the region's rim, lining the hairline", "", member<P>([](P& p) -> bool& { return p.contour; })));
+        auto initial = makeParam<P>("initial-fraction", "Share of the roots placed at the start; fission and death make the count", "",
+                                    member<P>([](P& p) -> double& { return p.initialFraction; }));
+        initial.min = 0.0;
+        initial.aboveMin = true;
+        initial.max = 4.0;
+        t.push_back(initial);
+        return t;
+    }();
+    return table;
+}
+
 Follicles sampleFollicles(const openvdb::FloatGrid::ConstPtr& surface, const openvdb::BoolGrid::ConstPtr& region,
                           const FollicleParams& params, bool threaded, openvdb::util::NullInterrupter* interrupter)
 {

@@ -56,6 +56,7 @@
 /// population is driven to it exactly, the sparsest places first), and the fixed contour.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/Types.h>
 
 #include <openvdb/openvdb.h>
@@ -116,6 +117,11 @@ struct Follicles
     int lastPopulationChange = 0;  ///< the iteration after the last birth or death (0: none)
     double radiusSpread = 0.0;     ///< (largest - smallest) free radius at the end, in units of sigma_hat
 };
+
+/// @brief roots's declared parameters (vdbhair/Parameters.h): count or spacing, seed, iterations,
+/// step, contour and initial share. The up axis is the front ends' (an axis name, a vector); the
+/// particle system's constants are not options.
+const ParamTable<FollicleParams>& follicleParameters();
 
 /// @brief The area of a scalp's surface (its zero level set, within a region).
 struct ScalpArea
