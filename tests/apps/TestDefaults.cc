@@ -124,7 +124,7 @@ TEST_CASE("vdbhair --help: every default is the library's", "[apps]")
         {"interpolate", "--power", shownAs(interp.shepard.power)},
         {"interpolate", "--max-vertices", shownAs(interp.maxVertices)},
         {"interpolate", "--up", axisName(interp.up)},
-        {"reconstruct", "--guides", formatValue(100.0 * rec.guideFraction) + "%"},
+        {"reconstruct", "--guides", formatNumber(100.0 * rec.guideFraction) + "%"},
         {"reconstruct", "--seed", shownAs(rec.seed)},
         {"reconstruct", "--power", shownAs(rec.helicoid.shepard.power)},
         {"reconstruct", "--max-error", shownAs(rec.fit.maxError)},
