@@ -120,7 +120,8 @@ def test_python_defaults_are_the_commands(function, keyword, verb, flag):
 # Verbs whose parameters are declared once (vdbhair/Parameters.h): every keyword of the signature
 # that has a flag of the same name shows the same default in --help, by construction; this checks
 # the two generators.
-DECLARED = [("refine", "refine"), ("retrace", "retrace"), ("estimate_tangent_field", "field"), ("fit", "fit")]
+DECLARED = [("refine", "refine"), ("retrace", "retrace"), ("estimate_tangent_field", "field"), ("fit", "fit"), ("synth", "synth"),
+            ("transfer", "transfer"), ("comb", "comb")]
 
 
 @pytest.mark.parametrize("function, verb", DECLARED)
