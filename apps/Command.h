@@ -201,19 +201,19 @@ Command addCombCommand(CLI::App& app, CommonOptions& common);
 Command addBatchCommand(CLI::App& app, CommonOptions& common);
 Command addPrepareCommand(CLI::App& app, CommonOptions& common);
 
-/// @brief The options of `synth`, `transfer` and `comb` that are not plain SynthParams fields.
+/// @brief The options of `synth`, `transfer` and `comb` that are not declared parameters
+/// (synthParameters()): the axes by name, and refinement turned off.
 struct SynthOptionText
 {
-    std::string up = "auto", front = "auto", refineMode, detail, detailScale, rootDensity;
+    std::string up = "auto", front = "auto";
     bool noRefine = false;
 };
-/// @brief The hierarchy's options (--levels, --seed, --vertices, --threshold, --initial-clusters, --up).
-void addSynthHierarchyOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
-/// @brief Detail transfer and refinement (--components, --detail, --detail-scale, --refine-mode, --no-refine, --voxel-size).
-void addSynthTransferOptions(CLI::App* sub, SynthParams& params, SynthOptionText& text);
-/// @throw ValueError for a bad --up, --refine-mode, --detail or --root-density.
+/// @brief --up, and with @a detailOptions --front and --no-refine (synth and transfer; comb has neither).
+void addSynthTextOptions(CLI::App* sub, SynthOptionText& text, bool detailOptions);
+/// @throw ValueError for a bad --up or --front.
 void applySynthOptionText(const SynthOptionText& text, SynthParams& params);
-/// @brief The flags of the detail-transfer parameters the library's errors name (synth, transfer, comb).
+/// @brief The flag of the one rule of the declared synth parameters that the library checks
+/// itself (--match-balance: 0 or at least 1), for synth and transfer.
 FlagNames synthTransferFlags();
 
 /// @brief The scalp named by a verb's --scalp option (ScalpSurface.h's readScalp(), shown as a

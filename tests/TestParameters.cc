@@ -9,6 +9,9 @@
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/synth/Comb.h>
+#include <vdbhair/synth/HairTransfer.h>
+#include <vdbhair/synth/Synthesis.h>
 
 #include <fstream>
 #include <sstream>
@@ -271,4 +274,44 @@ TEST_CASE("Parameters: grow's declaration, the scene's own integrator by name, i
     setParam(t, "integrator", p, std::string("scene"));
     CHECK_FALSE(p.integrator);
     checkDeclaration(t, "grow");
+}
+
+TEST_CASE("Parameters: synth's declaration is transfer's and comb's, each with its own struct's defaults, in docs/cli.md", "[params]")
+{
+    const ParamTable<SynthParams>& t = synthParameters();
+    SynthParams p;
+    std::get<ParamAccess<SynthParams, std::string>>(findParam(t, "root-density")->access).set(p, "even");
+    std::get<ParamAccess<SynthParams, std::string>>(findParam(t, "layout")->access).set(p, "example");
+    std::get<ParamAccess<SynthParams, std::string>>(findParam(t, "detail-scale")->access).set(p, "arc-length");
+    std::get<ParamAccess<SynthParams, int>>(findParam(t, "levels")->access).set(p, 4);
+    CHECK(!p.exampleDensity);
+    CHECK(p.layout == SynthLayout::Example);
+    CHECK(p.detailScale == DetailScale::ArcLength);
+    CHECK(p.cluster.levels == 4);
+    // transfer's defaults are TransferParams::synth's, comb's CombParams::synth's: never restated.
+    const TransferParams transfer;
+    CHECK(findParam(transferParameters(), "detail-scale")->defaultText() == detailScaleName(transfer.synth.detailScale));
+    CHECK(findParam(transferParameters(), "match-candidates")->defaultText() == std::to_string(transfer.synth.match.candidates));
+    CHECK(findParam(transferParameters(), "match-place")->defaultText() == formatNumber(transfer.synth.match.place));
+    CHECK(findParam(t, "detail-scale")->defaultText() == detailScaleName(SynthParams{}.detailScale));
+    CHECK(findParam(combParameters(), "levels")->defaultText() == std::to_string(CombParams{}.synth.cluster.levels));
+    CHECK(findParam(t, "levels")->defaultText() == std::to_string(SynthParams{}.cluster.levels));
+    // transfer keeps BASE's coarsest level: no layout of its own.
+    CHECK(findParam(transferParameters(), "layout") == nullptr);
+    CHECK(paramHelp(*findParam(transferParameters(), "threshold")) == paramHelp(*findParam(t, "threshold")));
+    TransferParams tp;
+    std::get<ParamAccess<TransferParams, int>>(findParam(transferParameters(), "match-candidates")->access).set(tp, 5);
+    CHECK(tp.synth.match.candidates == 5);
+    p = SynthParams{};
+    p.cluster.levels = 9;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "synth"), "synth: levels 9: must be between 2 and 5");
+    REQUIRE_NOTHROW(checkParams(t, SynthParams{}, ParamSpelling::Flag, ""));
+    REQUIRE_NOTHROW(checkParams(transferParameters(), TransferParams{}, ParamSpelling::Flag, ""));
+    REQUIRE_NOTHROW(checkParams(combParameters(), CombParams{}, ParamSpelling::Flag, ""));
+    const std::string page = cliPage();
+    INFO("docs/cli.md's synth, transfer and comb tables should read:\n" << parameterMarkdown(t) << "\n" << parameterMarkdown(transferParameters())
+                                                                      << "\n" << parameterMarkdown(combParameters()));
+    CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
+    CHECK(page.find(parameterMarkdown(transferParameters())) != std::string::npos);
+    CHECK(page.find(parameterMarkdown(combParameters())) != std::string::npos);
 }

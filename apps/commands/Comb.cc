@@ -1,6 +1,7 @@
 // vdbhair comb IN --stroke STROKE.json -o OUT: detail-preserving combing (Wang et al. 2009, §6).
 #include "../Command.h"
 #include "../HeadOptions.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/StrandIO.h>
@@ -16,7 +17,7 @@ namespace {
 struct CombCmdParams
 {
     std::string input, output, stroke, scalp;
-    CombParams params;
+    CombParams params;  ///< its declared parameters (combParameters()) are options
     SynthOptionText text;
     HeadOptions head;
 };
@@ -25,6 +26,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
 {
     strandFormatFromPath(p.output, /*forWriting=*/true);
     applySynthOptionText(p.text, p.params.synth);
+    checkParamOptions(combParameters(), p.params);
     p.params.validate("option");
     const std::vector<CombStroke> strokes = readStrokes(p.stroke);
     const StrandSet in = loadStrandsOrScene("comb", p.input, common);
@@ -91,13 +93,13 @@ Command addCombCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--stroke", p->stroke, "Strokes, JSON: {\"strokes\": [{\"points\": [[x,y,z], ...], \"radius\": R, \"strength\": S}]} (world units; strength 0-1, default 1), applied in order")->required();
     sub->add_option("-o,--output", p->output, "The combed hairstyle (any strand format)")->required();
     sub->add_option("--scalp", p->scalp, "The scalp: a .vdb with a level set 'surface' or a head mesh; default: the sphere fitted to the roots");
-    sub->add_option("--smoothing", p->params.smoothing, "Sigma of the strand directions the strokes turn, a fraction of the vertices (detail below it rides along)")->capture_default_str();
+    addParamOptions(sub, p->params, combParameters());
     addHeadOptions(sub, p->head, "--scalp's level set if given, else a sphere fitted to the roots");
-    addSynthHierarchyOptions(sub, p->params.synth, p->text);
+    addSynthTextOptions(sub, p->text, /*detailOptions=*/false);
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair comb scenes/default/head.json --stroke scenes/comb/sweep_ponytail.json -o combed.hair --json");
-    return {sub, [p, &common] { return runComb(*p, common); }, synthTransferFlags()};
+    return {sub, [p, &common] { return runComb(*p, common); }};
 }
 
 } // namespace vdbhair::app

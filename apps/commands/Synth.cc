@@ -2,6 +2,7 @@
 // §3-5: hierarchical clustering, PCA feature maps and texture optimization, cluster-oriented
 // detail transfer, vector-field refinement per level).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/synth/StyleRegions.h>
 
@@ -35,10 +36,10 @@ namespace {
 struct SynthCmdParams
 {
     double outputTurnDeg = 0.0;
-    std::string input, output, scalp, saveMaps, region, outputScalp, head, layout = synthLayoutName(SynthParams{}.layout);
+    std::string input, output, scalp, saveMaps, region, outputScalp, head;
     SynthOptionText text;
     std::int64_t strands = -1;  ///< -1: as many as the example
-    SynthParams synth;
+    SynthParams synth;  ///< its declared parameters (synthParameters()) are options
     bool coarseGuides = false, measure = false;
     std::string coarse;
     const CLI::Option* detailScaleOption = nullptr;     ///< (given or not: --coarse takes transfer's defaults)
@@ -156,8 +157,8 @@ void checkOptions(SynthCmdParams& p)
     strandFormatFromPath(p.output, /*forWriting=*/true);
     if (p.coarseGuides && p.coarse.empty()) throw ValueError("--coarse-guides: needs --coarse FILE");
     applySynthOptionText(p.text, p.synth);
-    p.synth.layout = synthLayoutFromName(p.layout);
     if (p.strands == 0) throw ValueError("--strands 0: must be at least 1");
+    checkParamOptions(synthParameters(), p.synth);
     p.synth.validate("option");
 }
 
@@ -165,7 +166,7 @@ void checkOptions(SynthCmdParams& p)
 /// (HairTransfer.h), run as `vdbhair transfer` runs it.
 int runOnCoarse(SynthCmdParams& p, const CommonOptions& common)
 {
-    if (p.layout != synthLayoutName(SynthParams{}.layout)) throw ValueError("--layout: has no effect with --coarse (the coarsest level is imposed)");
+    if (p.synth.layout != SynthParams{}.layout) throw ValueError("--layout: has no effect with --coarse (the coarsest level is imposed)");
     TransferParams tp;
     // Transfer's defaults for what was not given.
     if (p.detailScaleOption->count() == 0) p.synth.detailScale = tp.synth.detailScale;
@@ -313,7 +314,7 @@ void reportJson(const SynthCmdParams& p, const StrandSet& example, const SynthRe
                         {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
                {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
                {"head_radius", r.map->radius()}, {"region", regionFrom.empty() ? "the example's" : regionFrom}, {"output_area", r.outputArea},
-               {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", p.layout}, {"detail", detailBlendName(p.synth.detailBlend)}, {"detail_scale", detailScaleName(p.synth.detailScale)},
+               {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", synthLayoutName(p.synth.layout)}, {"detail", detailBlendName(p.synth.detailBlend)}, {"detail_scale", detailScaleName(p.synth.detailScale)},
                {"match", {{"balance", p.synth.match.balance}, {"candidates", p.synth.match.candidates}}},
                {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
                          {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
@@ -379,47 +380,19 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
 
 } // namespace
 
-void addSynthHierarchyOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
+void addSynthTextOptions(CLI::App* sub, SynthOptionText& t, bool detailOptions)
 {
-    sub->add_option("--levels", s.cluster.levels, "Levels of the hierarchy, the strands included (the paper: 2 for simple styles, 3 otherwise)")->capture_default_str();
-    sub->add_option("--seed", s.seed, "Random seed (clustering seeds, texture initialization, roots)")->capture_default_str();
-    sub->add_option("--vertices", s.vertices, "Vertices per strand, n_s (Table 1)")->capture_default_str();
-    sub->add_option("--threshold", s.cluster.threshold, "Adaptive clustering threshold epsilon (L2 over n_s vertices, head radii squared; Table 1: 0.1-0.3)")->capture_default_str();
-    sub->add_option("--initial-clusters", s.cluster.initialClusters, "k0 of adaptive clustering")->capture_default_str();
     sub->add_option("--up", t.up, "The scalp's up axis: auto (the mean direction from the head's centre to the roots), x, y, z, -x, -y or -z")->capture_default_str();
-}
-
-void addSynthTransferOptions(CLI::App* sub, SynthParams& s, SynthOptionText& t)
-{
-    t.detail = detailBlendName(s.detailBlend);
+    if (!detailOptions) return;
     sub->add_option("--front", t.front, "The head's front for the report by region: auto (where the example's hairline is highest), x, y, z, -x, -y or -z")->capture_default_str();
-    sub->add_option("--components", s.components, "PCA components of the feature maps and of cluster matching, n_f")->capture_default_str();
-    sub->add_option("--detail", t.detail, "Detail transfer: edges (each strand's own edges re-laid along the output centre: curls keep their turning), root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing frames toward the tip)")->capture_default_str();
-    t.detailScale = detailScaleName(s.detailScale);
-    sub->add_option("--detail-scale", t.detailScale, std::string("How detail is laid along a longer or shorter centre: strand (each strand at its own length and pitch), index (vertex by vertex, the paper's: curls stretch with the length) or arc-length (curls keep their size, repeated along a longer wisp)") +
-                                                        (s.detailScale == DetailScale::Strand ? "; arc-length with --coarse, as transfer" : ""))->capture_default_str();
-    sub->add_option("--match-balance", s.match.balance, "Each example wisp serves output wisps of at most this times its own share of the output's strands (its part of the example's), and each example strand at most this times its even share of its output wisp's, pairs taken by increasing distance at one scale (0: every output wisp takes its nearest, the paper's rule)")->capture_default_str();
-    sub->add_option("--match-candidates", s.match.candidates, std::string("Example wisps considered per output wisp in balanced matching, nearest first") +
-                                                                (s.match.candidates == SynthParams{}.match.candidates && s.detailScale == DetailScale::Strand ? " (64 with --coarse, as transfer)" : ""))->capture_default_str();
-    sub->add_option("--match-place", s.match.place, std::string("How much an output wisp prefers example wisps near its own place on the scalp, against their shape (0: by shape alone, the paper's rule; ") +
-                                                      (s.match.place > 0.0 ? "0 with --coarse, as transfer" : "synth uses 1") + ")")->capture_default_str();
-    sub->add_option("--refine-mode", t.refineMode, "Refinement after each level: consistent (default, keeps detail) or field (the paper's retrace)");
     sub->add_flag("--no-refine", t.noRefine, "Skip the vector-field refinement of every level");
-    sub->add_option("--voxel-size", s.voxelSize, "Refinement voxel of the finest level, world units (0: refine's suggestion for the hairstyle; doubled per coarser level)")->capture_default_str();
 }
 
 void applySynthOptionText(const SynthOptionText& t, SynthParams& s)
 {
     if (t.up != "auto") s.up = axisFromName(t.up, "--up");
     if (t.front != "auto") s.front = axisFromName(t.front, "--front");
-    s.refine = !t.noRefine;
-    if (!t.refineMode.empty()) s.refineMode = refineModeFromName(t.refineMode);
-    if (!t.detail.empty()) s.detailBlend = detailBlendFromName(t.detail);
-    if (!t.detailScale.empty()) s.detailScale = detailScaleFromName(t.detailScale);
-    if (!t.rootDensity.empty()) {
-        if (t.rootDensity != "example" && t.rootDensity != "even") throw ValueError("--root-density " + t.rootDensity + ": must be example or even");
-        s.exampleDensity = t.rootDensity == "example";
-    }
+    if (t.noRefine) s.refine = false;
 }
 
 void writeSynthStrands(const std::string& path, const StrandSet& strands, const std::vector<std::vector<std::int32_t>>& clusterOf)
@@ -435,31 +408,34 @@ void writeSynthStrands(const std::string& path, const StrandSet& strands, const 
     }
 }
 
+/// synth's help for the options whose default `synth --coarse` takes from transfer (runOnCoarse()).
+void noteTransferDefaults(CLI::App* sub)
+{
+    for (const char* name : {"detail-scale", "match-candidates", "match-place"}) {
+        CLI::Option* o = sub->get_option(std::string("--") + name);
+        o->description(o->get_description() + "; with --coarse: " + findParam(transferParameters(), name)->defaultText() + ", as transfer");
+    }
+}
+
 Command addSynthCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<SynthCmdParams>();
-    SynthParams& s = params->synth;
     CLI::App* sub = addVerb(app, "synth");
     sub->add_option("example", params->input, "The example hairstyle (any strand format)")->required();
     sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", params->scalp, "The scalp: a .vdb with a level set 'surface' (vdbhair scalp) or a head mesh (.ply, .obj); default: the sphere fitted to the roots");
-    addSynthHierarchyOptions(sub, s, params->text);
+    addParamOptions(sub, params->synth, synthParameters());
+    addSynthTextOptions(sub, params->text, /*detailOptions=*/true);
+    noteTransferDefaults(sub);
+    params->detailScaleOption = sub->get_option("--detail-scale");
+    params->matchCandidatesOption = sub->get_option("--match-candidates");
+    params->matchPlaceOption = sub->get_option("--match-place");
     sub->add_option("--region", params->region, "Where the new hair grows (default: the example's region): a scalp .vdb's 'region' grid (vdbhair scalp --region...), roots (.ply points, as vdbhair roots writes) or the roots of a hairstyle; the strand count scales with the area");
     sub->add_option("--strands", params->strands, "Strands in the output (default: the example's density over the region; every level scales alike)");
     sub->add_option("--output-turn", params->outputTurnDeg, "With --output-scalp: degrees about the up axis that the layout turns on the other head (for heads that face different ways)")->capture_default_str();
     sub->add_option("--head", params->head, "The head new hair may enter no deeper than the example's hair: a mesh (.ply, .obj), a .vdb level set, or 'none' "
                                              "(default: --output-scalp's, else --scalp's surface, else the sphere fitted to the roots)");
     sub->add_option("--output-scalp", params->outputScalp, "Grow the new hair on another head: a scalp .vdb (its 'region' grid is where the hair grows, unless --region says) or a head mesh with --region; the hairstyle moves there through scalp space");
-    sub->add_option("--map-spacing", s.mapSpacing, "Feature-map pixel spacing in scalp (u, v) radians")->capture_default_str();
-    sub->add_option("--layout", params->layout, "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: a variation that keeps its global flow exactly)")->capture_default_str();
-    sub->add_option("--place-weight", s.placeWeight, "Texture synthesis: how strongly a map pixel keeps content from near its own place (0: Kwatra's unguided synthesis)")->capture_default_str();
-    sub->add_option("--nearby", s.texture.nearbyRadius, "Texture synthesis: the reach of place guidance and of the initial patches' offsets, as a fraction of the map")->capture_default_str();
-    params->text.rootDensity = s.exampleDensity ? "example" : "even";
-    sub->add_option("--root-density", params->text.rootDensity, "New roots at the example's density place by place (example: a dense crown stays dense) or evenly over the region (even: the paper's)")->capture_default_str();
-    addSynthTransferOptions(sub, s, params->text);
-    params->detailScaleOption = sub->get_option("--detail-scale");
-    params->matchCandidatesOption = sub->get_option("--match-candidates");
-    params->matchPlaceOption = sub->get_option("--match-place");
     sub->add_option("--coarse", params->coarse, "Impose a coarsest level instead of synthesizing one (Wang et al. §6): BASE's own coarsest level (a hairstyle, or a scene grown first); the example's finer levels are transferred onto it, on BASE's scalp, with BASE's roots (as vdbhair transfer EXAMPLE BASE)");
     sub->add_flag("--coarse-guides", params->coarseGuides, "With --coarse: BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over the guides' region (--strands sets the output count)");
     sub->add_flag("--measure", params->measure, "Also compare the output with the example as `vdbhair compare` does (the report's \"compare\"; on another head, "
@@ -468,18 +444,12 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair synth example.hair -o new.hair --levels 3 --seed 1 --json");
-    Command c{sub, [params, &common] { return runSynth(*params, common); },
-            {{"initialClusters", "--initial-clusters"}, {"threshold", "--threshold"}, {"levels", "--levels"}, {"vertices", "--vertices"},
-             {"components", "--components"}, {"mapSpacing", "--map-spacing"}, {"voxelSize", "--voxel-size"}, {"outputTurn", "--output-turn"},
-             {"placeWeight", "--place-weight"}, {"nearbyRadius", "--nearby"}}};
-    for (auto& f : synthTransferFlags()) c.flags.push_back(std::move(f));
-    return c;
+    return {sub, [params, &common] { return runSynth(*params, common); }, synthTransferFlags()};
 }
 
 FlagNames synthTransferFlags()
 {
-    return {{"match balance", "--match-balance"}, {"match candidates", "--match-candidates"}, {"match place", "--match-place"},
-            {"detail blend", "--detail"}, {"detail scale", "--detail-scale"}};
+    return {{"match balance", "--match-balance"}};
 }
 
 } // namespace vdbhair::app

@@ -1,6 +1,7 @@
 // vdbhair transfer DETAILS BASE -o OUT: BASE's coarsest level with DETAILS' finer levels (Wang et
 // al. 2009, §6), and `synth EXAMPLE --coarse BASE`, which is the same operation.
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Quantile.h>
 #include <vdbhair/synth/StyleRegions.h>
@@ -31,7 +32,7 @@ double mean(const std::vector<double>& v)
 struct TransferCmdParams
 {
     TransferJob job = [] { TransferJob j; j.verb = "transfer"; return j; }();
-    TransferParams params;
+    TransferParams params;  ///< its declared parameters (transferParameters()) are options
     SynthOptionText text;
     std::int64_t strands = -1;
 };
@@ -141,19 +142,16 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
 Command addTransferCommand(CLI::App& app, CommonOptions& common)
 {
     auto p = std::make_shared<TransferCmdParams>();
-    SynthParams& s = p->params.synth;
     CLI::App* sub = addVerb(app, "transfer");
     sub->add_option("details", p->job.details, "The hairstyle whose detail is taken (any strand format, or a scene)")->required();
     sub->add_option("base", p->job.base, "The hairstyle whose coarsest level is kept (any strand format, or a scene)")->required();
     sub->add_option("-o,--output", p->job.output, "The result (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", p->job.scalp, "BASE's scalp: a .vdb with a level set 'surface' or a head mesh; default: the sphere fitted to BASE's roots");
-    sub->add_option("--smoothing", p->params.smoothing, "Sigma of the smoothing of DETAILS' coarsest strands, a fraction of their vertices (0: none)")->capture_default_str();
+    addParamOptions(sub, p->params, transferParameters());
     sub->add_flag_function("--keep-base-detail", [p](std::int64_t) { p->params.smoothBase = false; }, "Keep BASE's coarsest level unsmoothed (the paper's rule: BASE's own wisp-level waves stay, under DETAILS')");
-    sub->add_flag("--guides", p->params.guides, "BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over their region");
     sub->add_option("--strands", p->strands, "With --guides: strands in the output (default: DETAILS' strands per coarsest strand, times the guides)");
     sub->add_flag("--measure", p->job.measure, "Also compare the output with BASE as `vdbhair compare` does (the report's \"compare\"; BASE is the reference)");
-    addSynthHierarchyOptions(sub, s, p->text);
-    addSynthTransferOptions(sub, s, p->text);
+    addSynthTextOptions(sub, p->text, /*detailOptions=*/true);
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair transfer curly.hair straight.hair -o curly_straight.hair --json");
@@ -161,6 +159,7 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
                 TransferParams params = p->params;
                 applySynthOptionText(p->text, params.synth);
                 if (p->strands == 0) throw ValueError("--strands 0: must be at least 1");
+                checkParamOptions(transferParameters(), params);
                 if (p->strands > 0) {
                     if (!params.guides) throw ValueError("--strands: the output has BASE's strands; --strands needs --guides");
                     params.strands = std::size_t(p->strands);

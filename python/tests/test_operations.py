@@ -168,7 +168,7 @@ def test_synth(tmp_path):
         vdbhair.synth(example, output_scalp=str(tmp_path / "other.vdb"))
     with pytest.raises(ValueError, match=r"region must be an \(N, 3\) array"):
         vdbhair.synth(example, region=np.zeros((4, 2)))
-    with pytest.raises(ValueError, match="layout 'tiled' is not one of example, synthesize"):
+    with pytest.raises(ValueError, match="layout 'tiled': must be one of synthesize, example"):
         vdbhair.synth(example, layout="tiled")
     with pytest.raises(ValueError, match="strands=0"):
         vdbhair.synth(example, strands=0)

@@ -147,6 +147,22 @@ std::vector<CombStroke> readStrokes(const std::string& path)
     return out;
 }
 
+const ParamTable<CombParams>& combParameters()
+{
+    using P = CombParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t = nestedParams<P>(synthParameters(), [](P& p) -> SynthParams& { return p.synth; },
+                                          {"levels", "seed", "vertices", "threshold", "initial-clusters"});
+        auto smoothing = makeParam<P>("smoothing", "Sigma of the strand directions the strokes turn, a fraction of the vertices (detail below it rides along)", "",
+                                      member<P>([](P& p) -> double& { return p.smoothing; }));
+        smoothing.min = 0.0;
+        smoothing.max = 1.0;
+        t.push_back(smoothing);
+        return t;
+    }();
+    return table;
+}
+
 void CombParams::validate(const char* where) const
 {
     synth.validate(where);

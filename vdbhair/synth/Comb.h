@@ -86,6 +86,11 @@ struct CombParams
     void validate(const char* where) const;
 };
 
+/// @brief comb's parameters declared once (Parameters.h): synth's hierarchy (synthParameters(),
+/// nested: their defaults are CombParams::synth's), then the smoothing. The head, up and the
+/// strokes are each front end's own.
+const ParamTable<CombParams>& combParameters();
+
 struct CombStats
 {
     std::size_t clusters = 0;        ///< coarsest clusters

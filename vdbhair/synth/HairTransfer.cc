@@ -11,6 +11,27 @@
 
 namespace vdbhair {
 
+const ParamTable<TransferParams>& transferParameters()
+{
+    using P = TransferParams;
+    static const ParamTable<P> table = [] {
+        // synth's, but for the coarsest level's layout and roots, which transfer takes from BASE.
+        ParamTable<P> t = nestedParams<P>(synthParameters(), [](P& p) -> SynthParams& { return p.synth; },
+                                          {"levels", "seed", "vertices", "threshold", "initial-clusters", "components", "detail", "detail-scale",
+                                           "match-balance", "match-candidates", "match-place", "refine-mode", "voxel-size"});
+        auto smoothing = makeParam<P>("smoothing", "Sigma of the smoothing of DETAILS' coarsest strands, a fraction of their vertices", "",
+                                      member<P>([](P& p) -> double& { return p.smoothing; }));
+        smoothing.min = 0.0;
+        smoothing.max = 1.0;
+        smoothing.zeroMeans = "none";
+        t.push_back(smoothing);
+        t.push_back(makeParam<P>("guides", "BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over their region", "",
+                                 member<P>([](P& p) -> bool& { return p.guides; })));
+        return t;
+    }();
+    return table;
+}
+
 void TransferParams::validate(const char* where) const
 {
     synth.validate(where);

@@ -79,6 +79,12 @@ struct TransferParams
     void validate(const char* where) const;
 };
 
+/// @brief transfer's parameters declared once (Parameters.h): synth's hierarchy, detail transfer
+/// and refinement (synthParameters(), nested: their defaults are TransferParams::synth's), then
+/// the smoothing and the guides. BASE's smoothing switch, up, front and the strand count are each
+/// front end's own.
+const ParamTable<TransferParams>& transferParameters();
+
 struct TransferResult
 {
     /// The output: strands, levels (output.back() is BASE's coarsest level), clusterOf, stages;

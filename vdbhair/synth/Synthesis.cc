@@ -44,6 +44,125 @@ void SynthParams::validate(const char* where) const
 
 namespace {
 
+using SP = SynthParams;
+
+/// The hierarchy's parameters (Clustering.h): shared by synth, transfer and comb.
+void addHierarchyParams(ParamTable<SP>& t)
+{
+    auto levels = makeParam<SP>("levels", "Levels of the hierarchy, the strands included (the paper: 2 for simple styles, 3 otherwise)", "",
+                                member<SP>([](SP& p) -> int& { return p.cluster.levels; }));
+    levels.min = 2;
+    levels.max = 5;
+    t.push_back(levels);
+    t.push_back(makeParam<SP>("seed", "Random seed (clustering seeds, texture initialization, roots)", "",
+                              member<SP>([](SP& p) -> std::uint64_t& { return p.seed; })));
+    auto vertices = makeParam<SP>("vertices", "Vertices per strand, n_s (Table 1)", "", member<SP>([](SP& p) -> int& { return p.vertices; }));
+    vertices.min = 4;
+    vertices.max = 4096;
+    t.push_back(vertices);
+    auto threshold = makeParam<SP>("threshold", "Adaptive clustering threshold epsilon, L2 over n_s vertices (Table 1: 0.1-0.3)", "head radii squared",
+                                   member<SP>([](SP& p) -> double& { return p.cluster.threshold; }));
+    threshold.min = 0.0;
+    threshold.aboveMin = true;
+    t.push_back(threshold);
+    auto initial = makeParam<SP>("initial-clusters", "k0 of adaptive clustering", "", member<SP>([](SP& p) -> int& { return p.cluster.initialClusters; }));
+    initial.min = 1;
+    t.push_back(initial);
+}
+
+/// The coarsest level's feature map and roots (synth only: transfer and comb keep a coarsest level).
+void addLayoutParams(ParamTable<SP>& t)
+{
+    auto spacing = makeParam<SP>("map-spacing", "Feature-map pixel spacing in scalp (u, v)", "radians", member<SP>([](SP& p) -> double& { return p.mapSpacing; }));
+    spacing.min = 1e-3;
+    spacing.max = 0.5;
+    t.push_back(spacing);
+    auto layout = makeParam<SP>("layout", "The coarsest level's feature map: synthesize (texture optimization, the paper) or example (the example's own map: "
+                                          "a variation that keeps its global flow exactly)", "",
+                                named<SP>([](SP& p) -> SynthLayout& { return p.layout; }, synthLayoutName, synthLayoutFromName));
+    layout.choices = {"synthesize", "example"};
+    t.push_back(layout);
+    auto weight = makeParam<SP>("place-weight", "Texture synthesis: how strongly a map pixel keeps content from near its own place", "",
+                                member<SP>([](SP& p) -> double& { return p.placeWeight; }));
+    weight.min = 0.0;
+    weight.zeroMeans = "Kwatra's unguided synthesis";
+    t.push_back(weight);
+    auto nearby = makeParam<SP>("nearby", "Texture synthesis: the reach of place guidance and of the initial patches' offsets, as a fraction of the map", "",
+                                member<SP>([](SP& p) -> double& { return p.texture.nearbyRadius; }));
+    nearby.min = 0.0;
+    nearby.max = 1.0;
+    t.push_back(nearby);
+    // exampleDensity as the word a person types.
+    auto density = makeParam<SP>("root-density", "New roots at the example's density place by place (example: a dense crown stays dense) or evenly over "
+                                                 "the region (even: the paper's)", "",
+                                 ParamAccess<SP, std::string>{[](const SP& p) { return std::string(p.exampleDensity ? "example" : "even"); },
+                                                              [](SP& p, std::string v) { p.exampleDensity = v == "example"; }});
+    density.choices = {"example", "even"};
+    t.push_back(density);
+}
+
+/// Detail transfer and refinement (DetailTransfer.h, §5.2-5.3): shared by synth and transfer.
+void addDetailParams(ParamTable<SP>& t)
+{
+    auto components = makeParam<SP>("components", "PCA components of the feature maps and of cluster matching, n_f", "",
+                                    member<SP>([](SP& p) -> int& { return p.components; }));
+    components.min = 1;
+    t.push_back(components);
+    auto detail = makeParam<SP>("detail", "Detail transfer: edges (each strand's own edges re-laid along the output centre: curls keep their turning), "
+                                          "root-frame (displacements in the centre's root frame) or paper (Eq. 7: blended to rotation-minimizing "
+                                          "frames toward the tip)", "",
+                                named<SP>([](SP& p) -> DetailBlend& { return p.detailBlend; }, detailBlendName, detailBlendFromName));
+    detail.choices = {"edges", "root-frame", "paper"};
+    t.push_back(detail);
+    auto scale = makeParam<SP>("detail-scale", "How detail is laid along a longer or shorter centre: strand (each strand at its own length and pitch), "
+                                               "index (vertex by vertex, the paper's: curls stretch with the length) or arc-length (curls keep their "
+                                               "size, repeated along a longer wisp)", "",
+                               named<SP>([](SP& p) -> DetailScale& { return p.detailScale; }, detailScaleName, detailScaleFromName));
+    scale.choices = {"strand", "index", "arc-length"};
+    t.push_back(scale);
+    // 0 or at least 1, which a range cannot say: DetailMatchParams::validate() checks it.
+    auto balance = makeParam<SP>("match-balance", "Each example wisp serves output wisps of at most this times its own share of the output's strands (its "
+                                                  "part of the example's), and each example strand at most this times its even share of its output "
+                                                  "wisp's, pairs taken by increasing distance at one scale: 0 or a factor of at least 1", "",
+                                 member<SP>([](SP& p) -> double& { return p.match.balance; }));
+    balance.zeroMeans = "every output wisp takes its nearest, the paper's rule";
+    t.push_back(balance);
+    auto candidates = makeParam<SP>("match-candidates", "Example wisps considered per output wisp in balanced matching, nearest first", "",
+                                    member<SP>([](SP& p) -> int& { return p.match.candidates; }));
+    candidates.min = 1;
+    t.push_back(candidates);
+    auto place = makeParam<SP>("match-place", "How much an output wisp prefers example wisps near its own place on the scalp, against their shape", "",
+                               member<SP>([](SP& p) -> double& { return p.match.place; }));
+    place.min = 0.0;
+    place.zeroMeans = "by shape alone, the paper's rule";
+    t.push_back(place);
+    auto mode = makeParam<SP>("refine-mode", "Refinement after each level: consistent (keeps detail) or field (the paper's retrace)", "",
+                              named<SP>([](SP& p) -> RefineMode& { return p.refineMode; }, refineModeName, refineModeFromName));
+    mode.choices = {"consistent", "field"};
+    t.push_back(mode);
+    auto voxel = makeParam<SP>("voxel-size", "Refinement voxel of the finest level, doubled per coarser level", "world units",
+                               member<SP>([](SP& p) -> double& { return p.voxelSize; }));
+    voxel.min = 0.0;
+    voxel.zeroMeans = findParam(fieldParameters(), "voxel-size")->zeroMeans;  // suggestVoxelSize(), as refine's
+    t.push_back(voxel);
+}
+
+} // namespace
+
+const ParamTable<SynthParams>& synthParameters()
+{
+    static const ParamTable<SynthParams> table = [] {
+        ParamTable<SynthParams> t;
+        addHierarchyParams(t);
+        addLayoutParams(t);
+        addDetailParams(t);
+        return t;
+    }();
+    return table;
+}
+
+namespace {
+
 FeatureImage filledFeatureImage(const FeatureImage& in)
 {
     // Breadth-first from the valid pixels, 4-neighbours, in index order: every invalid pixel takes

@@ -26,6 +26,7 @@
 /// Deterministic for a seed and independent of the thread count.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -135,6 +136,15 @@ struct SynthParams
 
     void validate(const char* where) const;
 };
+
+/// @brief synth's parameters declared once (Parameters.h): the hierarchy (levels, seed, vertices,
+/// threshold, initial clusters), the coarsest level's layout (map spacing, layout, place weight,
+/// nearby, root density) and detail transfer and refinement (components, detail, detail scale,
+/// matching, refine mode, voxel size). `transfer` and `comb` declare theirs from these
+/// (transferParameters(), combParameters()), with their own structs' defaults.
+/// The axes (up, front: vectors in the library, names or tuples in the front ends), the switch of
+/// refinement and the output's strand count are each front end's own.
+const ParamTable<SynthParams>& synthParameters();
 
 struct SynthStage
 {
