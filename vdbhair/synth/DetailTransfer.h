@@ -10,7 +10,8 @@
 /// 3. **Matching clusters**: PCA (n_f components, Pca.h) of the input and output centres together,
 ///    in their aligned frames; each output centre takes the input centre nearest in feature space
 ///    (exact search; ties to the lower index), or by default the nearest with share left
-///    (DetailMatchParams: balanced, each set at one scale).
+///    (DetailMatchParams: balanced, each set at one scale); with DetailMatchParams::place the
+///    distance between their roots in (u, v) counts too.
 /// 4. **Matching strands**: each output strand takes a member of the matched input cluster by root
 ///    offset from its centre, in the centre's aligned frame: the nearest, or by default
 ///    (DetailMatchParams) pairs by increasing offset distance with each member serving at most
