@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/MeshFile.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/strands/PointCloud.h>
 
 #include <algorithm>

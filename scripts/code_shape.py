@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The plain checks of the code's shape: no source file over MAX_FILE lines, no function over
-MAX_FUNCTION lines (from its opening brace to its closing one).
+MAX_FUNCTION lines (from its opening brace to its closing one), and the library's module order: a
+module of vdbhair/ includes only itself, the core headers (vdbhair/*.h) and modules below it.
 
   scripts/code_shape.py [--max-file N] [--max-function N] [--list K] [ROOT]
 
@@ -16,6 +17,12 @@ import re
 import sys
 
 DIRS = ("vdbhair", "apps", "python", "tests")
+
+# The library's modules, lowest first. A module may include a module of a lower rank, never one of
+# its own rank (siblings) or above; the core headers (vdbhair/*.h) are below them all.
+LAYERS = (("strands",), ("io",), ("field",), ("scalp",), ("helicoid",), ("compare",), ("synth",), ("render", "dataset"))
+RANK = {m: r for r, group in enumerate(LAYERS) for m in group}
+INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]vdbhair/(\w+)/', re.M)
 EXTS = (".h", ".cc", ".cpp")
 
 
@@ -107,6 +114,28 @@ def functions(src):
     return found
 
 
+def layer_offences(rel, text):
+    """One line per include of @a text (the file @a rel) that breaks the module order."""
+    parts = rel.split(os.sep)
+    if len(parts) < 3 or parts[0] != "vdbhair":
+        return []
+    own = parts[1]
+    if own not in RANK:
+        return [f"{rel}: module '{own}' has no place in code_shape.py's LAYERS"]
+    out = []
+    for m in INCLUDE.finditer(text):
+        dep = m.group(1)
+        if dep == own:
+            continue
+        if dep not in RANK:
+            out.append(f"{rel}: includes module '{dep}', which has no place in LAYERS")
+        elif RANK[dep] >= RANK[own]:
+            line = text.count("\n", 0, m.start()) + 1
+            out.append(f"{rel}:{line}: {own}/ includes {dep}/ (the order, lowest first: "
+                       f"{' < '.join('/'.join(g) for g in LAYERS)})")
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("root", nargs="?", default=os.path.join(os.path.dirname(__file__), ".."))
@@ -126,6 +155,7 @@ def main():
                 with open(path, encoding="utf-8", errors="replace") as fh:
                     text = fh.read()
                 nfiles += 1
+                offences += layer_offences(rel, text)
                 lines = text.count("\n")
                 if lines > args.max_file:
                     offences.append(f"{rel}: {lines} lines (the rule: at most {args.max_file})")

@@ -7,6 +7,7 @@
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/synth/Comb.h>
+#include <vdbhair/synth/SynthJson.h>
 
 #include <chrono>
 
@@ -49,26 +50,14 @@ int runComb(CombCmdParams p, const CommonOptions& common)
         writeStrands(p.output, r.strands);
     }
     const CombStats& s = r.stats;
-    // Checks (docs/editing.md): tangents in reach turned toward the strokes,
-    // curl kept within 10 % on the moved strands.
-    const nlohmann::json checks = {
-        {"turned", s.reachVertices == 0 || s.angleAfter < s.angleBefore},
-        {"curl_kept", s.movedStrands == 0 || std::abs(s.turningAfter - s.turningBefore) <= 0.1 * s.turningBefore},
-        {"kept_out_of_head", s.insideHeadAfter <= s.insideHeadBefore},
-        {"no_new_kinks", s.newKinks == 0}};
     if (s.combedClusters == 0 && !common.quiet)
         std::cerr << "vdbhair comb: warning: no stroke reaches a wisp of " << p.input << "; the output equals the input\n";
     if (common.json) {
-        nlohmann::json stages = nlohmann::json::object();
-        for (const SynthStage& st : r.stages) stages[st.name] = st.seconds;
-        printJson({{"output", p.output}, {"input", p.input}, {"strokes", strokes.size()}, {"strands", r.strands.numStrands()},
-                   {"clusters", s.clusters}, {"combed_clusters", s.combedClusters}, {"moved_strands", s.movedStrands},
-                   {"angle_to_stroke_deg", {{"before", s.angleBefore}, {"after", s.angleAfter}, {"vertices", s.reachVertices}}},
-                   {"turning_per_length", {{"before", s.turningBefore}, {"after", s.turningAfter}}},
-                   {"new_kinks", {{"strands", s.newKinks}, {"degrees", kCombKinkDegrees}}},
-                   {"head", {{"head", s.head}, {"deflected_strands", s.headDeflected},
-                             {"inside_vertices", {{"before", s.insideHeadBefore}, {"after", s.insideHeadAfter}}}}},
-                   {"stages", stages}, {"seconds", seconds}, {"checks", checks}});
+        nlohmann::json j = combReport(r, strokes.size());
+        j["output"] = p.output;
+        j["input"] = p.input;
+        j["seconds"] = seconds;
+        printJson(j);
     } else if (!common.quiet) {
         std::cout << "combed " << s.movedStrands << " of " << r.strands.numStrands() << " strands (" << s.combedClusters << " of "
                   << s.clusters << " wisps) with " << strokes.size() << " stroke" << (strokes.size() == 1 ? "" : "s") << " in "

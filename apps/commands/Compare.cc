@@ -6,6 +6,7 @@
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/io/FileUtil.h>
+#include <vdbhair/scalp/HeadFile.h>
 
 #include <cmath>
 #include <cstdio>

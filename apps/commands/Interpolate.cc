@@ -13,6 +13,7 @@
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/scalp/RootValues.h>
 
 #include <algorithm>

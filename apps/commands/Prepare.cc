@@ -8,6 +8,7 @@
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/scalp/HeadFile.h>
 
 #include <cstdio>
 

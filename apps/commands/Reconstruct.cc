@@ -9,6 +9,7 @@
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/scalp/HeadFile.h>
 
 #include <cmath>
 #include <cstdio>

@@ -17,12 +17,13 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrands.h>
 #include <vdbhair/render/StrandRenderer.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
-#include <vdbhair/synth/SynthesisReport.h>
+#include <vdbhair/synth/SynthJson.h>
 
 #include <chrono>
 #include <cmath>
@@ -74,51 +75,6 @@ Image mapImage(const FeatureImage& map, const FeatureImage& ref, int zoom)
                 for (int i = 0; i < zoom; ++i) img.set(x * zoom + i, (map.height - 1 - y) * zoom + j, col);
         }
     return img;
-}
-
-nlohmann::json statsJson(const StrandSet& example, const SynthResult& r, const StrandSet& output, double voxelSize, nlohmann::json& checks)
-{
-    const double radius = r.map->radius();
-    nlohmann::json j;
-    // Per-strand measures: distances between distributions (relative 1-Wasserstein).
-    std::vector<double> le, lo;
-    for (float x : strandLengths(example)) le.push_back(x);
-    for (float x : strandLengths(output)) lo.push_back(x);
-    j["length_distance"] = relativeWasserstein(le, lo);
-    j["turning_distance"] = relativeWasserstein(turningPerLength(example), turningPerLength(output));
-    // Wisp sizes per level.
-    nlohmann::json wisps = nlohmann::json::array();
-    for (std::size_t l = 0; l < r.clusterOf.size(); ++l) {
-        // Example: sizes in strands of the level-(l+1) clusters (labels composed down to the strands).
-        std::vector<std::int32_t> ex(r.example.levels[0].count());
-        for (std::size_t s = 0; s < ex.size(); ++s) {
-            std::uint32_t c = std::uint32_t(s);
-            for (std::size_t k = 0; k <= l; ++k) c = r.example.clusterings[k].label[c];
-            ex[s] = std::int32_t(c);
-        }
-        const std::vector<double> a = clusterSizes(ex), b = clusterSizes(r.clusterOf[l]);
-        double ma = 0, mb = 0;
-        for (double x : a) ma += x;
-        for (double x : b) mb += x;
-        wisps.push_back({{"level", l + 1}, {"example_clusters", a.size()}, {"output_clusters", b.size()},
-                         {"example_mean_size", ma / double(a.size())}, {"output_mean_size", mb / double(b.size())},
-                         {"size_distance", relativeWasserstein(a, b)}});
-    }
-    j["wisps"] = wisps;
-    // Tangent coherence of both at the finest refinement voxel.
-    FieldParams fp;
-    fp.voxelSize = voxelSize;
-    const double ce = meanCoherence(estimateTangentField(example, fp)), co = meanCoherence(estimateTangentField(output, fp));
-    j["coherence"] = {{"example", ce}, {"output", co}, {"voxel_size", voxelSize}};
-    const NoveltyStats nov = measureNovelty(example, output, radius);
-    j["novelty"] = {{"output_to_example_median", nov.outputMedian}, {"example_to_example_median", nov.exampleMedian},
-                    {"copies", nov.copies}};
-    // The thresholds (docs/synthesis.md, says why each).
-    checks = {{"length", j["length_distance"].get<double>() <= 0.15},
-              {"turning", j["turning_distance"].get<double>() <= 0.25},
-              {"coherence", co >= ce - 0.03},
-              {"new", nov.copies <= 0.01 && nov.outputMedian >= 0.5 * nov.exampleMedian}};
-    return j;
 }
 
 /// The points of an output region: a .vdb's bool grid 'region' (its active voxels' centres), a
@@ -264,63 +220,14 @@ void saveMaps(const std::string& folder, const SynthResult& r, const CommonOptio
     writeImage(folder + "/clusters.png", renderStrands(coloured, rp));
 }
 
-/// What the report says of the output against the example.
-struct SynthMeasures
-{
-    nlohmann::json stats, checks, regions;
-    std::string regionText;  ///< the style by region, as text
-    HairComparison comparison;  ///< --measure
-};
-
-/// The output against the example for the report: statsJson()'s statistics, the style by region,
-/// and with --measure what `vdbhair compare` measures.
-SynthMeasures measureOutput(const SynthCmdParams& p, const CommonOptions& common, const StrandSet& example, const SynthResult& r,
-                            const std::shared_ptr<const ScalpMap>& outputMap)
-{
-    SynthMeasures m;
-    const double finestVoxel = r.refineVoxelSizes.front();
-    // On another head the output is measured where it was made, on the example's scalp (moved
-    // back: the same (u, v), height and local offsets), so that its figures compare with the example's.
-    StrandSet movedBack;
-    if (outputMap) movedBack = moveToScalp(r.strands, *outputMap, *r.map, -p.synth.outputTurn);
-    m.stats = statsJson(example, r, outputMap ? movedBack : r.strands, finestVoxel, m.checks);
-    // The style region by region, output beside example, in the example's head frame (on another
-    // head, the output moved back; the head then is not the example's, so no inside-head figure).
-    const ScalpSphere& sphere = r.map->sphere();
-    m.regions = compareStyleRegions(example, outputMap ? movedBack : r.strands, sphere.center, sphere.up, sphere.radius,
-                                    outputMap || r.head == "none" ? nullptr : &p.synth.head, &m.regionText, p.synth.front);
-    if (p.measure) {
-        const Stage stage(common, "comparing with the example");
-        m.comparison = measureAgainst(example, outputMap ? movedBack : r.strands, outputMap ? nullptr : &p.synth.head, /*corresponding=*/false);
-    }
-    return m;
-}
-
 void reportJson(const SynthCmdParams& p, const StrandSet& example, const SynthResult& r, const std::shared_ptr<const ScalpMap>& outputMap,
                 const std::string& regionFrom, double seconds, const SynthMeasures& m)
 {
-    nlohmann::json levels = nlohmann::json::array();
-    for (std::size_t l = 0; l < r.output.size(); ++l)
-        levels.push_back({{"level", l}, {"example", r.example.levels[l].count()}, {"output", r.output[l].count()},
-                          {"refine_corrected", r.refinedCorrected[l]}});
-    nlohmann::json energy = nlohmann::json::array();
-    for (const Clustering& c : r.example.clusterings)
-        energy.push_back({{"energy", c.energy}, {"clusters", c.clusters}, {"largest_distance", c.largestDistance}});
-    nlohmann::json stages = nlohmann::json::object();
-    for (const SynthStage& s : r.stages) stages[s.name] = s.seconds;
-    printJson({{"output", p.output}, {"example", p.input}, {"strands", r.strands.numStrands()},
-               {"vertices", r.strands.numVertices()}, {"levels", levels}, {"clustering", energy},
-               {"map", {{"width", r.grid.width}, {"height", r.grid.height}, {"components", r.pca.components},
-                        {"explained_variance", r.pca.totalVariance > 0 ? [&] { double s = 0; for (double v : r.pca.variance) s += v; return s / r.pca.totalVariance; }() : 1.0}}},
-               {"texture", {{"energy", r.texture.energy}, {"iterations", r.texture.iterations}}},
-               {"head_radius", r.map->radius()}, {"region", regionFrom.empty() ? "the example's" : regionFrom}, {"output_area", r.outputArea},
-               {"output_scalp", p.outputScalp.empty() ? "the example's" : p.outputScalp}, {"output_head_radius", outputMap ? outputMap->radius() : r.map->radius()}, {"scalp", p.scalp.empty() ? "sphere fitted to the roots" : p.scalp}, {"layout", synthLayoutName(p.synth.layout)}, {"detail", detailBlendName(p.synth.detailBlend)}, {"detail_scale", detailScaleName(p.synth.detailScale)},
-               {"match", {{"balance", p.synth.match.balance}, {"candidates", p.synth.match.candidates}}},
-               {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
-                         {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
-                                       {"example", outputMap ? nlohmann::json(nullptr) : nlohmann::json(double(r.exampleEnteringHead) / double(example.numStrands()))}}}}},
-               {"stages", stages}, {"seconds", seconds}, {"statistics", m.stats}, {"checks", m.checks}, {"regions", m.regions},
-               {"compare", p.measure ? toJson(m.comparison) : nlohmann::json(nullptr)}});
+    nlohmann::json j = synthReport(example, r, p.synth, outputMap.get(), {p.scalp, regionFrom, p.outputScalp}, m);
+    j["output"] = p.output;
+    j["example"] = p.input;
+    j["seconds"] = seconds;
+    printJson(j);
 }
 
 void reportText(const SynthCmdParams& p, const StrandSet& example, const SynthResult& r, const std::shared_ptr<const ScalpMap>& outputMap,
@@ -345,7 +252,7 @@ void reportText(const SynthCmdParams& p, const StrandSet& example, const SynthRe
         std::cout << "\n";
     }
     std::cout << "  by region, output (example):\n" << m.regionText;
-    if (p.measure) std::cout << "  compared with the example (vdbhair compare): " << summaryLine(m.comparison) << "\n";
+    if (m.measured) std::cout << "  compared with the example (vdbhair compare): " << summaryLine(m.comparison) << "\n";
     std::cout << "wrote " << p.output << "\n";
 }
 
@@ -372,7 +279,11 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     // The statistics (two tangent fields and a nearest-strand search: a sixth of a large synthesis)
     // are only what the report prints; --quiet without --json prints nothing.
     if (common.quiet && !common.json) return 0;
-    const SynthMeasures m = measureOutput(p, common, example, r, outputMap);
+    SynthMeasures m;
+    {
+        const Stage stage(common, p.measure ? "measuring the output, comparing with the example" : "measuring the output");
+        m = measureSynthesis(example, r, p.synth, outputMap.get(), p.measure);
+    }
     if (common.json) reportJson(p, example, r, outputMap, regionFrom, seconds, m);
     else reportText(p, example, r, outputMap, seconds, m);
     return 0;

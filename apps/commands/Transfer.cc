@@ -3,16 +3,12 @@
 #include "../Command.h"
 #include "../ParamOptions.h"
 
-#include <vdbhair/Quantile.h>
-#include <vdbhair/synth/StyleRegions.h>
-
 #include <vdbhair/Exceptions.h>
-#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/scalp/ScalpSurface.h>
-#include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/HairTransfer.h>
-#include <vdbhair/synth/SynthesisReport.h>
+#include <vdbhair/synth/SynthJson.h>
+#include <vdbhair/compare/HairComparison.h>
 
 #include <algorithm>
 #include <chrono>
@@ -21,13 +17,6 @@
 namespace vdbhair::app {
 
 namespace {
-
-double mean(const std::vector<double>& v)
-{
-    double s = 0.0;
-    for (double x : v) s += x;
-    return v.empty() ? 0.0 : s / double(v.size());
-}
 
 struct TransferCmdParams
 {
@@ -72,59 +61,24 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
     // What the transfer did (docs/editing.md, says why each check): only
     // measured to be printed.
     if (common.quiet && !common.json) return 0;
-    const int ns = params.synth.vertices;
-    // Turning compared at one sample spacing in head radii, DETAILS' own: its median strand
-    // length over n_s - 1 (a fixed vertex count would undersample the longer hairstyle's curls).
-    std::vector<float> lengths = strandLengths(details);
-    std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
-    const double spacing = double(lengths[lengths.size() / 2]) / tr.detailsMap->radius() / double(ns - 1);
-    const double turnDetails = meanTurningPerLengthAtSpacing(details, spacing * tr.detailsMap->radius()),
-                 turnBase = meanTurningPerLengthAtSpacing(base, spacing * r.map->radius()),
-                 turnOut = meanTurningPerLengthAtSpacing(r.strands, spacing * r.map->radius());
-    const std::vector<double> dev = clusterMeanDeviation(r.strands, r.clusterOf.back(), base, tr.baseLabel, ns, params.smoothing);
-    // Turning per head radius: each hairstyle in units of its own head (detail arrives scaled so).
-    const double rd = tr.detailsMap->radius(), rb = r.map->radius();
-    const nlohmann::json checks = {{"detail", std::abs(turnOut * rb - turnDetails * rd) <= 0.1 * turnDetails * rd},
-                                   {"coarse_shape", mean(dev) <= 0.1}};
-    // BASE's regions kept: the output against BASE, region by region, in BASE's head frame.
-    std::string regionText;
-    const ScalpSphere& sphere = r.map->sphere();
-    const nlohmann::json regions =
-        compareStyleRegions(base, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &params.synth.head, &regionText,
-                            params.synth.front);
-    HairComparison comparison;
-    if (job.measure) {
-        const Stage stage(common, "comparing with the base");
-        comparison = measureAgainst(base, r.strands);
+    TransferMeasures m;
+    {
+        const Stage stage(common, job.measure ? "measuring the output, comparing with the base" : "measuring the output");
+        m = measureTransfer(details, base, tr, params, job.measure);
     }
+    const double rd = tr.detailsMap->radius(), rb = r.map->radius();
     if (common.json) {
-        nlohmann::json levels = nlohmann::json::array();
-        for (std::size_t l = 0; l < r.output.size(); ++l)
-            levels.push_back({{"level", l}, {"details", r.example.levels[l].count()}, {"output", r.output[l].count()},
-                              {"refine_corrected", r.refinedCorrected[l]}});
-        nlohmann::json stages = nlohmann::json::object();
-        for (const SynthStage& s : r.stages) stages[s.name] = s.seconds;
-        printJson({{"output", job.output}, {"details", job.details}, {"base", job.base}, {"strands", r.strands.numStrands()},
-                   {"vertices", r.strands.numVertices()}, {"levels", levels}, {"guides", params.guides},
-                   {"smoothing", params.smoothing}, {"smooth_base", params.smoothBase}, {"detail", detailBlendName(params.synth.detailBlend)},
-                   {"detail_laid_by", detailScaleName(params.synth.detailScale)},
-                   {"match", {{"balance", params.synth.match.balance}, {"candidates", params.synth.match.candidates}}},
-                   {"head_radius", {{"details", tr.detailsMap->radius()}, {"base", r.map->radius()}}},
-                   {"detail_scale", tr.detailScale}, {"length_ratio", tr.lengthRatio},
-                   {"turning_per_length", {{"details", turnDetails}, {"base", turnBase}, {"output", turnOut}, {"spacing_head_radii", spacing}}},
-                   {"output_vertices", tr.outputVertices}, {"details_smoothing", tr.detailsSmoothing},
-                   {"turning_per_head_radius", {{"details", turnDetails * rd}, {"base", turnBase * rb}, {"output", turnOut * rb}}},
-                   {"coarse_deviation", {{"mean", mean(dev)}, {"p90", quantile(dev, 0.9)}, {"clusters", dev.size()}}},
-                   {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
-                             {"entering", {{"output", double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands()))},
-                                           {"base", double(r.exampleEnteringHead) / double(base.numStrands())}}}}},
-                   {"stages", stages}, {"seconds", seconds}, {"checks", checks}, {"regions", regions},
-                   {"compare", job.measure ? toJson(comparison) : nlohmann::json(nullptr)}});
+        nlohmann::json j = transferReport(base, tr, params, m);
+        j["output"] = job.output;
+        j["details"] = job.details;
+        j["base"] = job.base;
+        j["seconds"] = seconds;
+        printJson(j);
     } else if (!common.quiet) {
         std::cout << "transferred the detail of " << job.details << " (" << details.numStrands() << " strands) onto "
                   << job.base << " (" << base.numStrands() << "): " << r.strands.numStrands() << " strands in " << seconds << " s\n"
-                  << "  turning per head radius: details " << turnDetails * rd << ", base " << turnBase * rb << ", output " << turnOut * rb << "\n"
-                  << "  output wisps from the base's coarsest strands: " << mean(dev) * 100.0 << " % of their length (mean)\n"
+                  << "  turning per head radius: details " << m.turnDetails * rd << ", base " << m.turnBase * rb << ", output " << m.turnOut * rb << "\n"
+                  << "  output wisps from the base's coarsest strands: " << m.deviationMean * 100.0 << " % of their length (mean)\n"
                   << "  wisp length ratio base/details " << tr.lengthRatio << ", detail scale " << tr.detailScale << "\n";
         if (r.head != "none") {
             char shares[128];
@@ -132,8 +86,8 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
                           100.0 * double(r.enteringHead) / double(std::max<std::size_t>(1, r.strands.numStrands())), 100.0 * double(r.exampleEnteringHead) / double(base.numStrands()));
             std::cout << "  head: " << r.head << " (no new vertex deeper than its root); " << r.headPushedOut << " strands pushed out; passing into it: " << shares << "\n";
         }
-        std::cout << "  by region, output (base):\n" << regionText;
-        if (job.measure) std::cout << "  compared with " << job.base << " (vdbhair compare): " << summaryLine(comparison) << "\n";
+        std::cout << "  by region, output (base):\n" << m.regionText;
+        if (m.measured) std::cout << "  compared with " << job.base << " (vdbhair compare): " << summaryLine(m.comparison) << "\n";
         std::cout << "wrote " << job.output << "\n";
     }
     return 0;

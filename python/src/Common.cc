@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/scalp/HeadFile.h>
 
 #include <cmath>
 #include <csignal>

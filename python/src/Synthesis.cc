@@ -11,6 +11,7 @@
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/StyleRegions.h>
 #include <vdbhair/synth/Synthesis.h>
+#include <vdbhair/synth/SynthJson.h>
 
 #include <nlohmann/json.hpp>
 
@@ -37,31 +38,12 @@ void setAxis(const pyb::object& v, Vec3d& axis)
 const char* const kUpDoc = "the scalp's up axis (None: the roots' mean direction from the head's centre).";
 const char* const kScalpDoc = "a path to a scalp: .vdb with a level set 'surface', or a head mesh (.ply, .obj).";
 
-/// synth's report (the dict return_report adds), as synth --json's figures.
-pyb::dict synthReport(const SynthResult& r, pyb::object comparison, pyb::object regions)
+/// The clusters of every output strand per level (the report's "cluster_of", Python's own: arrays).
+pyb::list clusterArrays(const std::vector<std::vector<std::int32_t>>& clusterOf)
 {
-    pyb::dict report;
-    report["compare"] = comparison;
-    report["regions"] = regions;
-    pyb::list levelsList, stages, clusters;
-    for (std::size_t l = 0; l < r.output.size(); ++l) {
-        pyb::dict d;
-        d["example"] = r.example.levels[l].count();
-        d["output"] = r.output[l].count();
-        d["refine_voxel_size"] = r.refineVoxelSizes[l];
-        levelsList.append(d);
-    }
-    for (const SynthStage& s : r.stages) stages.append(pyb::make_tuple(s.name, s.seconds));
-    for (const std::vector<std::int32_t>& c : r.clusterOf) clusters.append(pyb::array_t<std::int32_t>(pyb::ssize_t(c.size()), c.data()));
-    report["levels"] = levelsList;
-    report["stages"] = stages;
-    report["cluster_of"] = clusters;
-    report["head_radius"] = r.map->radius();
-    report["up"] = pyb::make_tuple(r.up.x(), r.up.y(), r.up.z());
-    report["output_area"] = r.outputArea;
-    report["head"] = pyb::dict(pyb::arg("head") = r.head, pyb::arg("pushed_out") = r.headPushedOut, pyb::arg("entering_output") = r.enteringHead,
-                               pyb::arg("entering_example") = r.exampleEnteringHead);
-    return report;
+    pyb::list clusters;
+    for (const std::vector<std::int32_t>& c : clusterOf) clusters.append(pyb::array_t<std::int32_t>(pyb::ssize_t(c.size()), c.data()));
+    return clusters;
 }
 
 /// vdbhair.synth(example, **keywords): the declared parameters, then synth's own keywords.
@@ -105,27 +87,15 @@ pyb::object synthImpl(const StrandsPtr& example, const pyb::dict& kw)
         }
         return synthesizeHair(*example, p, grid, true, interrupter, region ? &regionPoints : nullptr, other);
     });
-    pyb::object comparison = pyb::none();  // as synth --measure --json's "compare"
-    if (measure && returnReport) {
-        const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) {
-            return other ? measureAgainst(*example, moveToScalp(r.strands, *other, *r.map, -p.outputTurn), nullptr, false)
-                         : measureAgainst(*example, r.strands, &p.head, false);
-        });
-        comparison = toPython(toJson(c));
-    }
-    pyb::object regions = pyb::none();  // as synth --json's "regions"
-    if (returnReport) {
-        const ScalpSphere& sphere = r.map->sphere();
-        regions = toPython(runLong(threads, pyb::none(), [&](WorkInterrupter*) {
-            return other ? compareStyleRegions(*example, moveToScalp(r.strands, *other, *r.map, -p.outputTurn), sphere.center, sphere.up,
-                                               sphere.radius, nullptr, nullptr, p.front)
-                         : compareStyleRegions(*example, r.strands, sphere.center, sphere.up, sphere.radius, r.head == "none" ? nullptr : &p.head,
-                                               nullptr, p.front);
-        }));
-    }
-    auto out = std::make_shared<StrandSet>(std::move(r.strands));
-    if (!returnReport) return pyb::cast(out);
-    return pyb::make_tuple(out, synthReport(r, comparison, regions));
+    if (!returnReport) return pyb::cast(std::make_shared<StrandSet>(std::move(r.strands)));
+    // synth --json's report (SynthJson.h), with the clusters as arrays.
+    const SynthMeasures m = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureSynthesis(*example, r, p, other.get(), measure); });
+    const SynthSources sources{scalp ? std::string(*scalp) : std::string(),
+                               region ? "the " + std::to_string(regionPoints.size()) + " points of region=" : std::string(),
+                               outputScalp ? std::string(*outputScalp) : std::string()};
+    pyb::dict report = toPython(synthReport(*example, r, p, other.get(), sources, m));
+    report["cluster_of"] = clusterArrays(r.clusterOf);
+    return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.strands)), report);
 }
 
 /// vdbhair.transfer(details, base, **keywords): the declared parameters, then transfer's own keywords.
@@ -150,30 +120,13 @@ pyb::object transferImpl(const StrandsPtr& details, const StrandsPtr& base, cons
         openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
         return transferHairstyle(*details, *base, p, grid, true, interrupter);
     });
-    pyb::object comparison = pyb::none();  // as transfer --measure --json's "compare"
-    if (measure && returnReport)
-        comparison = toPython(toJson(runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureAgainst(*base, r.result.strands); })));
-    pyb::object regions = pyb::none();  // as transfer --json's "regions"
-    if (returnReport) {
-        const ScalpSphere& sphere = r.result.map->sphere();
-        regions = toPython(runLong(threads, pyb::none(), [&](WorkInterrupter*) {
-            return compareStyleRegions(*base, r.result.strands, sphere.center, sphere.up, sphere.radius,
-                                       r.result.head == "none" ? nullptr : &p.synth.head, nullptr, p.synth.front);
-        }));
-    }
-    auto out = std::make_shared<StrandSet>(std::move(r.result.strands));
-    if (!returnReport) return pyb::cast(out);
-    pyb::dict report;
-    report["compare"] = comparison;
-    report["regions"] = regions;
-    pyb::list clusters;
-    for (const std::vector<std::int32_t>& c : r.result.clusterOf) clusters.append(pyb::array_t<std::int32_t>(pyb::ssize_t(c.size()), c.data()));
-    report["cluster_of"] = clusters;
+    if (!returnReport) return pyb::cast(std::make_shared<StrandSet>(std::move(r.result.strands)));
+    // transfer --json's report (SynthJson.h), with the clusters and BASE's labels as arrays.
+    const TransferMeasures m = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureTransfer(*details, *base, r, p, measure); });
+    pyb::dict report = toPython(transferReport(*base, r, p, m));
+    report["cluster_of"] = clusterArrays(r.result.clusterOf);
     report["base_label"] = pyb::array_t<std::int32_t>(pyb::ssize_t(r.baseLabel.size()), r.baseLabel.data());
-    report["head_radius"] = pyb::make_tuple(r.detailsMap->radius(), r.result.map->radius());
-    report["detail_scale"] = r.detailScale;
-    report["length_ratio"] = r.lengthRatio;
-    return pyb::make_tuple(out, report);
+    return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.result.strands)), report);
 }
 
 /// vdbhair.comb(strands, strokes, **keywords): the declared parameters, then comb's own keywords.
@@ -212,23 +165,11 @@ pyb::object combImpl(const StrandsPtr& strands, const pyb::object& strokes, cons
         q.head = headArg.get("comb");
         return combHair(*strands, list, q, grid, true, interrupter);
     });
-    auto out = std::make_shared<StrandSet>(std::move(r.strands));
-    if (!kw["return_report"].cast<bool>()) return pyb::cast(out);
-    pyb::dict report;
-    report["combed_clusters"] = r.stats.combedClusters;
-    report["clusters"] = r.stats.clusters;
-    report["moved_strands"] = r.stats.movedStrands;
-    report["angle_before"] = r.stats.angleBefore;
-    report["angle_after"] = r.stats.angleAfter;
-    report["turning_before"] = r.stats.turningBefore;
-    report["turning_after"] = r.stats.turningAfter;
-    report["head"] = r.stats.head;
-    report["head_deflected"] = r.stats.headDeflected;
-    report["inside_head_before"] = r.stats.insideHeadBefore;
-    report["inside_head_after"] = r.stats.insideHeadAfter;
-    report["new_kinks"] = r.stats.newKinks;
+    if (!kw["return_report"].cast<bool>()) return pyb::cast(std::make_shared<StrandSet>(std::move(r.strands)));
+    // comb --json's report (SynthJson.h), with each strand's coarsest cluster as an array.
+    pyb::dict report = toPython(combReport(r, list.size()));
     report["cluster"] = pyb::array_t<std::int32_t>(pyb::ssize_t(r.cluster.size()), r.cluster.data());
-    return pyb::make_tuple(out, report);
+    return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.strands)), report);
 }
 
 } // namespace

@@ -2,6 +2,7 @@
 #include <vdbhair/dataset/Prepare.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
 

@@ -1,6 +1,6 @@
 #include "../TestUtil.h"
 
-#include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/SegmentWalk.h>
 
 #include <random>
 

@@ -6,6 +6,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>

@@ -3,6 +3,7 @@
 
 #include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/Synthesis.h>
 #include <vdbhair/synth/SynthesisReport.h>

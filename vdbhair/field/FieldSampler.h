@@ -21,10 +21,10 @@
 #pragma once
 
 #include <vdbhair/Memory.h>
+#include <vdbhair/SegmentWalk.h>
 #include <vdbhair/field/FieldMapping.h>
-#include <vdbhair/field/SegmentWalk.h>
-#include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/Simd.h>
+#include <vdbhair/field/Streamline.h>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/math/Coord.h>

@@ -7,9 +7,9 @@
 /// between them are.
 #pragma once
 
+#include <vdbhair/SegmentWalk.h>
 #include <vdbhair/Types.h>
 #include <vdbhair/field/FieldMapping.h>
-#include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/strands/StrandSet.h>
 
 #include <openvdb/openvdb.h>

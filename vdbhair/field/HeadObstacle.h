@@ -94,17 +94,8 @@ private:
     openvdb::FloatGrid::ConstPtr mGrid;
 };
 
-/// @brief The head in a file: a triangle mesh (.ply, .obj: its level set as `vdbhair scalp`
-/// makes it, open boundaries capped) or a .vdb's level set grid (the one named `surface`, else
-/// the first level set in the file).
-/// @param where prefix for messages, e.g. "head scalp.vdb"
-/// @throw IoError, FormatError (unreadable file), LookupError (no level set in it),
-/// UnsupportedError (not a .vdb).
 /// The policy of a head read from a file or fitted to the roots (refine, comb): NoDeeper.
 constexpr HeadPolicy kDefaultHeadPolicy = HeadPolicy::NoDeeper;
-
-HeadObstacle readHeadObstacle(const std::string& path, const std::string& where,
-                              HeadPolicy policy = kDefaultHeadPolicy);
 
 /// @throw ValueError unless "no-deeper" or "outside" (headPolicyName()'s names).
 HeadPolicy headPolicyFromName(const std::string& name);

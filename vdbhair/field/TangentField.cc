@@ -3,8 +3,8 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Parallel.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/SegmentWalk.h>
 #include <vdbhair/field/FieldMapping.h>
-#include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/field/Simd.h>
 #include <vdbhair/field/impl/FieldMoments.h>
 #include <vdbhair/strands/Measures.h>

@@ -2,13 +2,13 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/SegmentWalk.h>
 #include <vdbhair/Version.h>
-#include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/field/FieldMapping.h>
-#include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/field/SamplerRetrace.h>
 #include <vdbhair/helicoid/Helicoid.h>
 #include <vdbhair/helicoid/HelicoidFieldSampler.h>
+#include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/strands/Measures.h>

@@ -3,7 +3,7 @@
 /// per active voxel, HelicoidField.h).
 #pragma once
 
-#include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/SegmentWalk.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/helicoid/Helicoid.h>
 #include <vdbhair/helicoid/HelicoidField.h>

@@ -1,8 +1,8 @@
 #include "VdbStrandGrid.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/SegmentWalk.h>
 #include <vdbhair/Version.h>
-#include <vdbhair/field/SegmentWalk.h>
 #include <vdbhair/io/MetaKeys.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbPoints.h>

@@ -4,7 +4,7 @@
 /// coherence and spread read off them. Included by TangentField.cc only.
 #pragma once
 
-#include <vdbhair/field/SegmentWalk.h>
+#include <vdbhair/SegmentWalk.h>
 #include <vdbhair/field/Simd.h>
 #include <vdbhair/strands/StrandSet.h>
 
