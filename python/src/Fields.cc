@@ -370,7 +370,10 @@ openvdb::FloatGrid::Ptr applyScalpArgument(FieldParams& fp, const StrandSet& str
     return surface;
 }
 
-void bindFields(pyb::module_& m)
+namespace {
+
+/// vdbhair.Grid: one OpenVDB grid with NumPy access.
+void bindGrid(pyb::module_& m)
 {
     // ---- Grid ----------------------------------------------------------------------------
     pyb::class_<PyGrid> grid(m, "Grid", R"doc(One OpenVDB grid (a vec3s or float voxel grid) with NumPy access.
@@ -434,7 +437,11 @@ Raises:
         return "<vdbhair.Grid '" + g.grid->getName() + "': " + g.grid->valueType() + ", " + std::to_string(g.grid->activeVoxelCount()) +
                " active voxels>";
     });
+}
 
+/// vdbhair.TangentField: the grids of one level of a tangent field.
+void bindTangentField(pyb::module_& m)
+{
     // ---- TangentField --------------------------------------------------------------------
     pyb::class_<PyField> field(m, "TangentField", R"doc(The robust tangent field of a hairstyle at one voxel size
 (Wang et al. 2009, Eq. 9), as estimate_tangent_field returns it.
@@ -480,7 +487,11 @@ and ``spread`` (both in [0, 1]).)doc");
         return "<vdbhair.TangentField: voxel size " + std::to_string(f.field.tangent->voxelSize().x()) + ", " +
                std::to_string(f.field.tangent->activeVoxelCount()) + " active voxels>";
     });
+}
 
+/// read_grid, read_grids and write_grids: grids from and to .vdb files.
+void bindGridFiles(pyb::module_& m)
+{
     // ---- Reading and writing grids ---------------------------------------------------------
     m.def(
         "read_grid",
@@ -527,7 +538,11 @@ Raises:
         pyb::arg("path"), pyb::arg("grids"),
         "Write Grids (and every grid of TangentFields) to one .vdb file, atomically. Grid names should differ "
         "(rename levels first if you write several fields).");
+}
 
+/// suggest_voxel_size and estimate_tangent_field (fieldParameters()).
+void bindEstimateField(pyb::module_& m)
+{
     // ---- Operations ----------------------------------------------------------------------
     m.def(
         "suggest_voxel_size", [](const StrandSet& s) { return suggestVoxelSize(s); }, pyb::arg("strands"),
@@ -574,7 +589,11 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
                "(ValueErrors), KeyboardInterrupt on Ctrl-C.",
                "    strands: a Strands.\n", "TangentField, or a list of them when ``levels`` is given.",
                pyb::cpp_function(fieldImpl, pyb::arg("strands"), pyb::arg("keywords")), 1);
+}
 
+/// retrace: strands retraced through a vector field (traceParameters()).
+void bindRetrace(pyb::module_& m)
+{
     auto retraceImpl = [](const StrandsPtr& strands, const pyb::object& fieldArg, const pyb::dict& kw) -> pyb::object {
         const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");
         TraceParams tp;
@@ -598,7 +617,11 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
                "        read_grid from any OpenVDB writer.\n",
                "Strands, or (Strands, stats) with return_stats.",
                pyb::cpp_function(retraceImpl, pyb::arg("strands"), pyb::arg("field"), pyb::arg("keywords")));
+}
 
+/// refine: vector-field refinement (refineParameters()).
+void bindRefine(pyb::module_& m)
+{
     const RefineParams refineDefaults;
     auto refineImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
         RefineParams rp;
@@ -661,6 +684,18 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
                "coarsest level to the finest: ``vdbhair refine``.",
                "    strands: a Strands.\n", "Strands, or (Strands, report) with return_report.",
                pyb::cpp_function(refineImpl, pyb::arg("strands"), pyb::arg("keywords")));
+}
+
+} // namespace
+
+void bindFields(pyb::module_& m)
+{
+    bindGrid(m);
+    bindTangentField(m);
+    bindGridFiles(m);
+    bindEstimateField(m);
+    bindRetrace(m);
+    bindRefine(m);
 }
 
 } // namespace vdbhair::py

@@ -357,15 +357,9 @@ void defineReconstruct(pyb::module_& m)
                pyb::cpp_function(reconstructImpl, pyb::arg("strands"), pyb::arg("keywords")));
 }
 
-} // namespace
-
-void bindOperations(pyb::module_& m)
+/// render: a preview image of strands.
+void defineRender(pyb::module_& m)
 {
-    defineGrow(m);
-    defineFit(m);
-    defineInterpolate(m);
-    defineReconstruct(m);
-
     const RenderParams renderDefaults;
     m.def(
         "render",
@@ -446,7 +440,11 @@ Args:
 
 Returns:
     None with a path; otherwise an (height, width, 4) uint8 RGBA array (sRGB, alpha 255).)doc");
+}
 
+/// inspect: a description of every grid of a .vdb file.
+void defineInspect(pyb::module_& m)
+{
     m.def(
         "inspect",
         [](const PathArg& path) {
@@ -499,7 +497,11 @@ leaf_nodes, memory_bytes, world_bbox and index_bbox (when not empty), values (st
 values, or of the vector lengths: count, min, max, mean, stddev, p01, p50, p99), unit_share,
 zero_share, mean_vector and coherence for vectors, leaf_fill (min, mean, max), metadata (a
 dict), point_count for points grids, and explanation (the metadata in words).)doc");
+}
 
+/// compare: a hairstyle measured against a reference.
+void defineCompare(pyb::module_& m)
+{
     const CompareParams compareDefaults;
     m.def(
         "compare",
@@ -562,6 +564,19 @@ Returns:
     oriented_points, chamfer, paired, position_error, curvature_error, frechet, leaving_volume,
     volume_voxel, entering_head) and per_strand: NumPy arrays over a's strands (chamfer; with
     paired strands also position, curvature and frechet).)doc");
+}
+
+} // namespace
+
+void bindOperations(pyb::module_& m)
+{
+    defineGrow(m);
+    defineFit(m);
+    defineInterpolate(m);
+    defineReconstruct(m);
+    defineRender(m);
+    defineInspect(m);
+    defineCompare(m);
 }
 
 } // namespace vdbhair::py

@@ -245,11 +245,11 @@ offsets from 0 to V, at least two vertices a strand, attribute lengths); a broke
 ``ValueError`` naming the array and the rule, e.g.
 ``Strands(offsets): strand 1 has 1 vertices (offsets[1] = 2, offsets[2] = 3); a strand needs at least 2``.)doc";
 
-} // namespace
+using StrandsClass = pyb::class_<StrandSet, StrandsPtr>;
 
-void bindStrands(pyb::module_& m)
+/// Strands' constructor and its arrays: positions, offsets, counts and the optional attributes.
+void bindStrandArrays(StrandsClass& cls)
 {
-    pyb::class_<StrandSet, StrandsPtr> cls(m, "Strands", kStrandsDoc);
     cls.def(pyb::init(&makeStrands), pyb::arg("positions"), pyb::arg("offsets"), pyb::kw_only(),
             pyb::arg("thickness") = pyb::none(), pyb::arg("transparency") = pyb::none(), pyb::arg("color") = pyb::none(),
             pyb::arg("root_uv") = pyb::none(), pyb::arg("strand_id") = pyb::none(),
@@ -324,6 +324,11 @@ Raises:
         auto [f, d] = optionalView(&StrandSet::strandId, 0, "(S,) int32 ids of an upstream source, or None: a view.");
         cls.def_property_readonly("strand_id", f, d);
     }
+}
+
+/// Strands' per-vertex defaults, declared unit and up axis, and convert_units.
+void bindStrandDeclarations(StrandsClass& cls)
+{
     cls.def_property(
         "defaults",
         [](const StrandSet& s) {
@@ -383,6 +388,11 @@ Raises:
         pyb::arg("unit"),
         "Express the strands in ``unit`` (\"mm\", \"cm\", \"dm\", \"m\", \"in\" or metres as a float), in place: positions and thickness "
         "scaled from meters_per_unit, which becomes ``unit`` (the CLI's ``convert --units``).");
+}
+
+/// Strands as a sequence of strands (len, indexing, iteration), its repr and write.
+void bindStrandSequence(StrandsClass& cls)
+{
     cls.def_property_readonly("num_strands", &StrandSet::numStrands, "S, the number of strands.");
     cls.def_property_readonly("num_vertices", &StrandSet::numVertices, "V, the number of vertices.");
     cls.def("__len__", &StrandSet::numStrands, "The number of strands S.");
@@ -407,6 +417,11 @@ Raises:
             pyb::arg("width") = wk.width, pyb::arg("codec") = wk.codec,
             "Write to ``path`` in the format of its extension (.hair .data .obj .ply .vdb .usda), atomically; see vdbhair.write.");
 
+}
+
+/// vdbhair.read: strands from a file.
+void bindRead(pyb::module_& m)
+{
     m.def(
         "read",
         [](const PathArg& path, bool strict, const std::string& grid, std::optional<std::array<float, 3>> rootNear,
@@ -468,6 +483,12 @@ Returns:
 Raises:
     vdbhair.IoError (an OSError), vdbhair.FormatError / UnsupportedError (ValueErrors) naming the
     file, the byte offset or line and the rule; KeyboardInterrupt on Ctrl-C.)doc");
+}
+
+/// vdbhair.write: strands to a file.
+void bindWrite(pyb::module_& m)
+{
+    const WriteKeywords wk;
     m.def(
         "write",
         [](const StrandSet& s, const PathArg& path, const std::string& plyEncoding, const std::string& objLines,
@@ -499,6 +520,18 @@ Args:
 
 Raises:
     vdbhair.ArgumentError (a ValueError) for a format that cannot be written, vdbhair.IoError.)doc");
+}
+
+} // namespace
+
+void bindStrands(pyb::module_& m)
+{
+    pyb::class_<StrandSet, StrandsPtr> cls(m, "Strands", kStrandsDoc);
+    bindStrandArrays(cls);
+    bindStrandDeclarations(cls);
+    bindStrandSequence(cls);
+    bindRead(m);
+    bindWrite(m);
 }
 
 } // namespace vdbhair::py

@@ -59,6 +59,7 @@ pyb::object synthImpl(const StrandsPtr& example, const pyb::dict& kw)
         for (pyb::ssize_t i = 0; i < r.shape(0); ++i) regionPoints.emplace_back(r(i, 0), r(i, 1), r(i, 2));
     }
     applyKeywords(synthParameters(), kw, p, "synth");
+    const HeadArgument headArg(kw["head"], headPolicyName(kDefaultHeadPolicy));  // as --head, read with its policy
     setAxis(kw["up"], p.up);
     setAxis(kw["front"], p.front);
     p.refine = kw["refine"].cast<bool>();
@@ -85,6 +86,7 @@ pyb::object synthImpl(const StrandsPtr& example, const pyb::dict& kw)
             other = scalpMapOfPoints(pts, p.up, otherGrid);
             p.head = HeadObstacle::levelSet(otherGrid);  // the head the hair grows on (as the command)
         }
+        if (const HeadObstacle given = headArg.get("synth"); !given.unset()) p.head = given;  // head= over that (as --head)
         return synthesizeHair(*example, p, grid, true, interrupter, region ? &regionPoints : nullptr, other);
     });
     if (!returnReport) return pyb::cast(std::make_shared<StrandSet>(std::move(r.strands)));
@@ -190,6 +192,10 @@ void bindSynthesis(pyb::module_& m)
                  "a path to another head (scalp .vdb or mesh) that region= lies on: the hairstyle is made at the region's (u, v) "
                  "and moved onto it through scalp space."},
                 {"output_turn", "float", pyb::float_(0.0), "degrees about the up axis the layout turns on output_scalp (heads facing different ways)."},
+                {"head", "", pyb::none(),
+                 "the head new hair may enter no deeper than the example's hair (``--head``): None (output_scalp's, else scalp's "
+                 "surface, else the sphere fitted to the roots), \"none\" (no head), a path to a mesh (.ply, .obj) or a .vdb level "
+                 "set, or a sphere (x, y, z, r)."},
                 {"measure", "bool", pyb::bool_(false),
                  "with return_report, the report's \"compare\" holds the output against the example, as ``vdbhair.compare(example, output)`` "
                  "(on output_scalp, the output moved back onto the example's scalp)."},
