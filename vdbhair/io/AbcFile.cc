@@ -59,6 +59,21 @@ std::string metaValue(const std::string& md, const std::string& key)
     return {};
 }
 
+/// One curve as a polyline, with its widths and colours where the object has them.
+struct Polyline
+{
+    std::vector<Vec3f> points;
+    std::vector<float> widths;
+    std::vector<Vec3f> colors;
+};
+
+/// The property named @a name among @a fields, or null.
+const PropertyIn* findField(const std::vector<PropertyIn>& fields, const char* name)
+{
+    for (const PropertyIn& p : fields) if (p.name == name) return &p;
+    return nullptr;
+}
+
 class AbcReader
 {
 public:
@@ -112,7 +127,16 @@ private:
     /// ".xform") entered: its group, or nothing when the object has none.
     std::optional<ogawa::Reader::Group> objectCompound(const ogawa::Reader::Group& object, const std::string& name,
                                                        const std::string& compound, std::uint64_t& propsPos);
-    void readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out);
+    /// A Curves object's strands, into @a out (or, for guides, into mGuides): the steps below.
+    void readCurves(const ogawa::Reader::Group& object, const std::string& what, const Matrix& world, StrandSet& out);
+    struct Curves;
+    void readCurveType(const ogawa::Reader::Group& geom, const std::vector<PropertyIn>& fields, Curves& c);
+    void readCurveCounts(const ogawa::Reader::Data& dN, Curves& c) const;
+    void readCurvePoints(const ogawa::Reader::Data& dP, unsigned pod, const Matrix& world, Curves& c) const;
+    void readCurveParams(const ogawa::Reader::Group& geom, const std::vector<PropertyIn>& fields, const Matrix& world, Curves& c);
+    void curvePolyline(const Curves& c, std::uint64_t i, std::uint64_t first, std::uint64_t firstVarying, Polyline& poly) const;
+    StrandSet curvesToStrands(const Curves& c, std::vector<char>& isGuide) const;
+    void addCurves(StrandSet&& set, std::vector<char>& isGuide, StrandSet& out);
     /// The local matrix of an Xform object (AbcGeom's XformSample::getMatrix) and whether it
     /// inherits its parent's.
     Matrix readXform(const ogawa::Reader::Group& object, const std::string& name, bool& inherits);
@@ -474,23 +498,36 @@ AbcReader::ArbParams AbcReader::readArbGeomParams(const ogawa::Reader::Group& ge
     return out;
 }
 
-void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string& name, const Matrix& world, StrandSet& out)
+/// One Curves object as readCurves() reads it, step by step.
+struct AbcReader::Curves
 {
-    const std::string what = name;
+    std::string what;                       ///< the object's name, for messages
+    std::uint64_t numPoints = 0, numCurves = 0;
+    std::uint64_t countsPos = 0;            ///< where nVertices' sample is, for messages
+    std::vector<std::uint32_t> counts;      ///< control points per curve
+    std::vector<Vec3f> points;              ///< the control points, in world space
+    bool linear = false;
+    unsigned wrap = 0, basis = 0;
+    std::vector<float> widths, uvs;
+    std::string widthScope, uvScope;
+    ArbParams arb;
+    bool uvPerCurve = false, perVertexColor = false;  ///< uvs: one a curve; arb.cd: one a control point or a curve
+};
+
+void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string& what, const Matrix& world, StrandSet& out)
+{
+    Curves c;
+    c.what = what;
     // The object's properties, then its .geom compound.
     std::uint64_t propsPos = 0;
     const std::optional<ogawa::Reader::Group> found = objectCompound(object, what, ".geom", propsPos);
     if (!found) mOgawa.failAt(propsPos, what + ": a Curves object without its .geom compound");
     const ogawa::Reader::Group& geom = *found;
     const std::vector<PropertyIn> fields = readPropertyHeaders(geom, what + "/.geom");
-    auto find = [&](const char* n) -> const PropertyIn* {
-        for (const PropertyIn& p : fields) if (p.name == n) return &p;
-        return nullptr;
-    };
 
-    // Points, counts, basis and type.
-    const PropertyIn* pP = find("P");
-    const PropertyIn* pN = find("nVertices");
+    // Points and counts, of the types read.
+    const PropertyIn* pP = findField(fields, "P");
+    const PropertyIn* pN = findField(fields, "nVertices");
     if (!pP || !pN) mOgawa.failAt(geom.pos, what + ": Curves without " + (pP ? "nVertices" : "P"));
     if (pP->type != kArray || pP->extent != 3 || (pP->pod != kFloat32 && pP->pod != kFloat64)) {
         mOgawa.failAt(geom.pos, what + "/P has pod " + std::to_string(pP->pod) + " and extent " +
@@ -499,11 +536,24 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
     if (pN->type != kArray || pN->extent != 1 || pN->pod != kInt32) {
         mOgawa.failAt(geom.pos, what + "/nVertices has pod " + std::to_string(pN->pod) + "; int32 counts are read");
     }
-    std::uint64_t numPoints = 0, numCurves = 0;
-    const ogawa::Reader::Data dP = arraySample(geom, *pP, what + "/P", numPoints);
-    const ogawa::Reader::Data dN = arraySample(geom, *pN, what + "/nVertices", numCurves);
+    const ogawa::Reader::Data dP = arraySample(geom, *pP, what + "/P", c.numPoints);
+    const ogawa::Reader::Data dN = arraySample(geom, *pN, what + "/nVertices", c.numCurves);
+
+    readCurveType(geom, fields, c);
+    readCurveCounts(dN, c);
+    readCurvePoints(dP, pP->pod, world, c);
+    readCurveParams(geom, fields, world, c);
+    std::vector<char> isGuide;  // per kept curve
+    StrandSet set = curvesToStrands(c, isGuide);
+    addCurves(std::move(set), isGuide, out);
+}
+
+/// The curves' type, wrap and basis (curveBasisAndType), refusing the kinds not read.
+void AbcReader::readCurveType(const ogawa::Reader::Group& geom, const std::vector<PropertyIn>& fields, Curves& c)
+{
+    const std::string& what = c.what;
     std::uint8_t basisAndType[4] = {1, 0, 0, 0};
-    if (const PropertyIn* pB = find("curveBasisAndType")) {
+    if (const PropertyIn* pB = findField(fields, "curveBasisAndType")) {
         if (pB->type != kScalar || pB->pod != kUint8 || pB->extent != 4) {
             mOgawa.failAt(geom.pos, what + "/curveBasisAndType has pod " + std::to_string(pB->pod) + " and extent " +
                                         std::to_string(pB->extent) + "; uint8 x 4 is read");
@@ -519,9 +569,11 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
         mOgawa.failAt(geom.pos, what + ": curveBasisAndType (" + std::to_string(type) + ", " + std::to_string(wrap) + ", " +
                                     std::to_string(basis) + "): type 0-2, wrap 0-1, basis 0-5");
     }
-    bool linear = type == 1;
+    c.wrap = wrap;
+    c.basis = basis;
+    c.linear = type == 1;
     if (type == 2) {  // variable order: linear only when every order is 2
-        const PropertyIn* pO = find("orders");
+        const PropertyIn* pO = findField(fields, "orders");
         std::uint64_t n = 0;
         const ogawa::Reader::Data d = pO && pO->pod == kUint8 ? arraySample(geom, *pO, what + "/orders", n) : ogawa::Reader::Data{};
         for (std::uint64_t i = 0; i < n; ++i) {
@@ -531,36 +583,48 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
             }
         }
         if (n == 0) throw UnsupportedError(mWhere + ": " + what + ": kVariableOrder curves without orders are not read");
-        linear = true;
-    } else if (!linear && (basis == 0 || basis >= 4)) {
+        c.linear = true;
+    } else if (!c.linear && (basis == 0 || basis >= 4)) {
         throw UnsupportedError(mWhere + ": " + what + ": cubic curves of basis " + std::to_string(basis) +
                                " (" + (basis == 4 ? "hermite" : basis == 5 ? "power" : "none") +
                                ") are not read; bezier, bspline and catmullrom are");
     }
+}
 
-    // Counts must add up to the points (each bounded by the points, so no sum overflows).
-    std::vector<std::uint32_t> counts(static_cast<std::size_t>(numCurves));
+/// The control points of each curve (nVertices at @a dN), which must add up to the points (each
+/// bounded by the points, so no sum overflows).
+void AbcReader::readCurveCounts(const ogawa::Reader::Data& dN, Curves& c) const
+{
+    c.countsPos = dN.pos;
+    c.counts.resize(static_cast<std::size_t>(c.numCurves));
     std::uint64_t total = 0;
-    for (std::uint64_t i = 0; i < numCurves; ++i) {
-        std::int32_t c;
-        std::memcpy(&c, dN.bytes + 4 * i, 4);
-        if (c < 0 || std::uint64_t(c) > numPoints - total) {
-            mOgawa.failAt(dN.pos + 24 + 4 * i, what + "/nVertices[" + std::to_string(i) + "] = " + std::to_string(c) +
-                                                   " but only " + std::to_string(numPoints - total) + " of the " +
-                                                   std::to_string(numPoints) + " points remain");
+    for (std::uint64_t i = 0; i < c.numCurves; ++i) {
+        std::int32_t n;
+        std::memcpy(&n, dN.bytes + 4 * i, 4);
+        if (n < 0 || std::uint64_t(n) > c.numPoints - total) {
+            mOgawa.failAt(dN.pos + 24 + 4 * i, c.what + "/nVertices[" + std::to_string(i) + "] = " + std::to_string(n) +
+                                                   " but only " + std::to_string(c.numPoints - total) + " of the " +
+                                                   std::to_string(c.numPoints) + " points remain");
         }
-        counts[i] = std::uint32_t(c);
-        total += std::uint64_t(c);
+        c.counts[i] = std::uint32_t(n);
+        total += std::uint64_t(n);
     }
-    if (total != numPoints) {
-        mOgawa.failAt(dN.pos, what + "/nVertices add up to " + std::to_string(total) + " but P has " +
-                                  std::to_string(numPoints) + " points");
+    if (total != c.numPoints) {
+        mOgawa.failAt(dN.pos, c.what + "/nVertices add up to " + std::to_string(total) + " but P has " +
+                                  std::to_string(c.numPoints) + " points");
     }
-    std::vector<Vec3f> points(static_cast<std::size_t>(numPoints));
-    if (pP->pod == kFloat32) {
-        if (numPoints) std::memcpy(points.data(), dP.bytes, std::size_t(dP.size));
+}
+
+/// The control points (P at @a dP, of @a pod float32 or float64), checked finite, then moved by
+/// the parent Xforms' transform @a world.
+void AbcReader::readCurvePoints(const ogawa::Reader::Data& dP, unsigned pod, const Matrix& world, Curves& c) const
+{
+    std::vector<Vec3f>& points = c.points;
+    points.resize(static_cast<std::size_t>(c.numPoints));
+    if (pod == kFloat32) {
+        if (c.numPoints) std::memcpy(points.data(), dP.bytes, std::size_t(dP.size));
     } else {
-        for (std::uint64_t i = 0; i < numPoints; ++i) {
+        for (std::uint64_t i = 0; i < c.numPoints; ++i) {
             double v[3];
             std::memcpy(v, dP.bytes + 24 * i, 24);
             points[i] = Vec3f(float(v[0]), float(v[1]), float(v[2]));
@@ -568,119 +632,144 @@ void AbcReader::readCurves(const ogawa::Reader::Group& object, const std::string
     }
     if (!allFinite(points.data(), 3 * points.size())) {
         for (std::size_t i = 0; i < points.size(); ++i) {
-            const std::size_t bytes = pP->pod == kFloat32 ? 12 : 24;
-            checkFinite(points[i], i, mWhere, "at byte " + std::to_string(dP.pos + 24 + bytes * i) + ": " + what + "/P");
+            const std::size_t bytes = pod == kFloat32 ? 12 : 24;
+            checkFinite(points[i], i, mWhere, "at byte " + std::to_string(dP.pos + 24 + bytes * i) + ": " + c.what + "/P");
         }
     }
     if (world != kIdentity) {  // the parent Xforms' transform, in double precision
         for (Vec3f& p : points) p = transformPoint(world, p);
         if (!allFinite(points.data(), 3 * points.size())) {
-            throw FormatError(mWhere + ": " + what + ": a point is not finite after its parents' transform");
+            throw FormatError(mWhere + ": " + c.what + ": a point is not finite after its parents' transform");
         }
     }
+}
 
-    // Widths and root UVs: sizes fixed by their scope.
-    std::vector<float> widths, uvs;
-    std::string widthScope, uvScope;
-    if (const PropertyIn* pW = find("width")) widths = floatParam(geom, *pW, 1, what + "/width", widthScope);
-    if (const PropertyIn* pU = find("uv")) uvs = floatParam(geom, *pU, 2, what + "/uv", uvScope);
-    ArbParams arb;
-    if (const PropertyIn* pA = find(".arbGeomParams"); pA && pA->type == kCompound) arb = readArbGeomParams(geom, *pA, what, numPoints, numCurves);
-    if (widths.empty() && !arb.groomWidth.empty()) { widths = std::move(arb.groomWidth); widthScope = "vtx"; }
-    if (uvs.empty() && !arb.rootUV.empty()) { uvs = std::move(arb.rootUV); uvScope = "uni"; }
+/// Widths, root UVs and the arbitrary parameters (colour, Unreal's groom_*), their sizes fixed
+/// by their scope: a size that does not fit is warned about and the values ignored.
+void AbcReader::readCurveParams(const ogawa::Reader::Group& geom, const std::vector<PropertyIn>& fields, const Matrix& world,
+                                Curves& c)
+{
+    const std::string& what = c.what;
+    if (const PropertyIn* pW = findField(fields, "width")) c.widths = floatParam(geom, *pW, 1, what + "/width", c.widthScope);
+    if (const PropertyIn* pU = findField(fields, "uv")) c.uvs = floatParam(geom, *pU, 2, what + "/uv", c.uvScope);
+    if (const PropertyIn* pA = findField(fields, ".arbGeomParams"); pA && pA->type == kCompound) {
+        c.arb = readArbGeomParams(geom, *pA, what, c.numPoints, c.numCurves);
+    }
+    if (c.widths.empty() && !c.arb.groomWidth.empty()) { c.widths = std::move(c.arb.groomWidth); c.widthScope = "vtx"; }
+    if (c.uvs.empty() && !c.arb.rootUV.empty()) { c.uvs = std::move(c.arb.rootUV); c.uvScope = "uni"; }
     if (world != kIdentity) {  // widths scale with the transform, as the points do
         const float scale = float(lengthScale(world));
-        for (float& w : widths) w *= scale;
+        for (float& w : c.widths) w *= scale;
     }
     std::size_t numVarying = 0;  // per segment end: one per control point of linear curves
-    for (std::uint32_t c : counts) numVarying += varyingCount(c, linear, basis, wrap);
+    for (std::uint32_t n : c.counts) numVarying += varyingCount(n, c.linear, c.basis, c.wrap);
     auto widthCount = [&](const std::string& s) -> std::uint64_t {
         if (s == "con") return 1;
-        if (s == "uni") return numCurves;
+        if (s == "uni") return c.numCurves;
         if (s == "var") return numVarying;
-        return numPoints;  // vtx, fvr or none
+        return c.numPoints;  // vtx, fvr or none
     };
-    if (!widths.empty() && widths.size() != widthCount(widthScope)) {
-        warn(what + "/width has " + std::to_string(widths.size()) + " values but scope '" + widthScope + "' needs " +
-             std::to_string(widthCount(widthScope)) + "; widths ignored");
-        widths.clear();
+    if (!c.widths.empty() && c.widths.size() != widthCount(c.widthScope)) {
+        warn(what + "/width has " + std::to_string(c.widths.size()) + " values but scope '" + c.widthScope + "' needs " +
+             std::to_string(widthCount(c.widthScope)) + "; widths ignored");
+        c.widths.clear();
     }
-    const bool uvPerCurve = !uvs.empty() && uvs.size() == 2 * numCurves;
-    if (!uvs.empty() && !uvPerCurve) warn(what + "/uv is not one value per curve (scope '" + uvScope + "'); ignored");
+    c.uvPerCurve = !c.uvs.empty() && c.uvs.size() == 2 * c.numCurves;
+    if (!c.uvs.empty() && !c.uvPerCurve) warn(what + "/uv is not one value per curve (scope '" + c.uvScope + "'); ignored");
+    c.perVertexColor = !c.arb.cd.empty() && c.arb.cdScope != "con";
+}
 
-    // Curves to polylines.
-    StrandSet set;
-    const bool perVertexWidth = !widths.empty() && widths.size() > 1;
-    ShortStrandFilter filter(mOpts, mReport, mWhere + ": " + what);
-    std::vector<Vec3f> poly;
-    std::vector<float> polyWidth, keptWidths;
-    std::vector<Vec2f> keptUV;
-    std::vector<Vec3f> polyColor, keptColor;
-    std::vector<std::int32_t> keptIds;
-    std::vector<char> isGuide;  // per kept curve
-    const bool perVertexColor = !arb.cd.empty() && arb.cdScope != "con";
-    std::uint64_t first = 0, firstVarying = 0;
-    for (std::uint64_t i = 0; i < numCurves; ++i) {
-        const std::uint32_t n = counts[i];
-        const Vec3f* cp = points.data() + first;
-        auto widthOf = [&](std::size_t k, std::size_t m) -> float {  // control k of m along the curve
-            if (widths.size() == 1) return widths[0];
-            if (widthScope == "uni") return widths[i];
-            if (widthScope == "var") {
-                const std::size_t nv = varyingCount(n, linear, basis, wrap);
-                return nv ? widths[firstVarying + std::min<std::size_t>(nv - 1, k * nv / std::max<std::size_t>(m, 1))] : 1.f;
-            }
-            return widths[first + std::min<std::size_t>(k, n - 1)];
-        };
-        auto colorOf = [&](std::size_t k) {  // control k
-            const std::size_t at = arb.cdScope == "uni" ? std::size_t(i) : std::size_t(first) + std::min<std::size_t>(k, n - 1);
-            return Vec3f(arb.cd[3 * at], arb.cd[3 * at + 1], arb.cd[3 * at + 2]);
-        };
-        poly.clear();
-        polyWidth.clear();
-        polyColor.clear();
-        if (linear) {
-            poly.assign(cp, cp + n);
-            for (std::uint32_t k = 0; k < n; ++k) polyWidth.push_back(widths.empty() ? 0.f : widthOf(k, n));
-            if (perVertexColor) for (std::uint32_t k = 0; k < n; ++k) polyColor.push_back(colorOf(k));
-            if (wrap == 1 && n >= 2) {
-                poly.push_back(cp[0]);
-                polyWidth.push_back(polyWidth.front());
-                if (perVertexColor) polyColor.push_back(polyColor.front());
-            }
-        } else if (n >= 4) {
-            const FreeFormCurve curve = cubicCurve(cubicBasis(basis), curveWrap(wrap), cp, n);
-            const std::string rule = flattenCurve(curve, mOpts.curveSamples, poly);
-            if (!rule.empty()) throw FormatError(mWhere + ": " + what + ": curve " + std::to_string(i) + ": " + rule);
-            if (!widths.empty()) {
-                for (std::size_t k = 0; k < poly.size(); ++k) {
-                    const CurvePosition at = positionAlong(k, poly.size(), n);
-                    polyWidth.push_back((1.f - at.f) * widthOf(at.i0, n) + at.f * widthOf(at.i1, n));
-                }
-            }
-            for (std::size_t k = 0; perVertexColor && k < poly.size(); ++k) {
-                const CurvePosition at = positionAlong(k, poly.size(), n);
-                polyColor.push_back((1.f - at.f) * colorOf(at.i0) + at.f * colorOf(at.i1));
+/// Curve @a i (its control points from @a first, its varying values from @a firstVarying) as a
+/// polyline: linear curves as they are (closed when periodic), cubic ones flattened, with widths
+/// and colours interpolated along them.
+void AbcReader::curvePolyline(const Curves& c, std::uint64_t i, std::uint64_t first, std::uint64_t firstVarying,
+                              Polyline& poly) const
+{
+    const std::uint32_t n = c.counts[i];
+    const Vec3f* cp = c.points.data() + first;
+    const std::vector<float>& widths = c.widths;
+    auto widthOf = [&](std::size_t k, std::size_t m) -> float {  // control k of m along the curve
+        if (widths.size() == 1) return widths[0];
+        if (c.widthScope == "uni") return widths[i];
+        if (c.widthScope == "var") {
+            const std::size_t nv = varyingCount(n, c.linear, c.basis, c.wrap);
+            return nv ? widths[firstVarying + std::min<std::size_t>(nv - 1, k * nv / std::max<std::size_t>(m, 1))] : 1.f;
+        }
+        return widths[first + std::min<std::size_t>(k, n - 1)];
+    };
+    auto colorOf = [&](std::size_t k) {  // control k
+        const std::size_t at = c.arb.cdScope == "uni" ? std::size_t(i) : std::size_t(first) + std::min<std::size_t>(k, n - 1);
+        return Vec3f(c.arb.cd[3 * at], c.arb.cd[3 * at + 1], c.arb.cd[3 * at + 2]);
+    };
+    poly.points.clear();
+    poly.widths.clear();
+    poly.colors.clear();
+    if (c.linear) {
+        poly.points.assign(cp, cp + n);
+        for (std::uint32_t k = 0; k < n; ++k) poly.widths.push_back(widths.empty() ? 0.f : widthOf(k, n));
+        if (c.perVertexColor) for (std::uint32_t k = 0; k < n; ++k) poly.colors.push_back(colorOf(k));
+        if (c.wrap == 1 && n >= 2) {
+            poly.points.push_back(cp[0]);
+            poly.widths.push_back(poly.widths.front());
+            if (c.perVertexColor) poly.colors.push_back(poly.colors.front());
+        }
+    } else if (n >= 4) {
+        const FreeFormCurve curve = cubicCurve(cubicBasis(c.basis), curveWrap(c.wrap), cp, n);
+        const std::string rule = flattenCurve(curve, mOpts.curveSamples, poly.points);
+        if (!rule.empty()) throw FormatError(mWhere + ": " + c.what + ": curve " + std::to_string(i) + ": " + rule);
+        if (!widths.empty()) {
+            for (std::size_t k = 0; k < poly.points.size(); ++k) {
+                const CurvePosition at = positionAlong(k, poly.points.size(), n);
+                poly.widths.push_back((1.f - at.f) * widthOf(at.i0, n) + at.f * widthOf(at.i1, n));
             }
         }
-        firstVarying += varyingCount(n, linear, basis, wrap);
+        for (std::size_t k = 0; c.perVertexColor && k < poly.points.size(); ++k) {
+            const CurvePosition at = positionAlong(k, poly.points.size(), n);
+            poly.colors.push_back((1.f - at.f) * colorOf(at.i0) + at.f * colorOf(at.i1));
+        }
+    }
+}
+
+/// The curves as strands, with the attributes the object has; the short-strand policy drops
+/// curves. @a isGuide gets, per kept curve, whether groom_guide marks it a guide.
+StrandSet AbcReader::curvesToStrands(const Curves& c, std::vector<char>& isGuide) const
+{
+    StrandSet set;
+    const bool perVertexWidth = !c.widths.empty() && c.widths.size() > 1;
+    ShortStrandFilter filter(mOpts, mReport, mWhere + ": " + c.what);
+    Polyline poly;
+    std::vector<float> keptWidths;
+    std::vector<Vec2f> keptUV;
+    std::vector<Vec3f> keptColor;
+    std::vector<std::int32_t> keptIds;
+    const ArbParams& arb = c.arb;
+    std::uint64_t first = 0, firstVarying = 0;
+    for (std::uint64_t i = 0; i < c.numCurves; ++i) {
+        const std::uint32_t n = c.counts[i];
+        curvePolyline(c, i, first, firstVarying, poly);
+        firstVarying += varyingCount(n, c.linear, c.basis, c.wrap);
         first += n;
-        if (!filter.keep(std::size_t(i), poly.size(), "at byte " + std::to_string(dN.pos + 24 + 4 * i))) continue;
-        set.addStrand(poly);
-        if (perVertexWidth) keptWidths.insert(keptWidths.end(), polyWidth.begin(), polyWidth.end());
-        if (uvPerCurve) keptUV.emplace_back(uvs[2 * i], uvs[2 * i + 1]);
-        if (perVertexColor) keptColor.insert(keptColor.end(), polyColor.begin(), polyColor.end());
+        if (!filter.keep(std::size_t(i), poly.points.size(), "at byte " + std::to_string(c.countsPos + 24 + 4 * i))) continue;
+        set.addStrand(poly.points);
+        if (perVertexWidth) keptWidths.insert(keptWidths.end(), poly.widths.begin(), poly.widths.end());
+        if (c.uvPerCurve) keptUV.emplace_back(c.uvs[2 * i], c.uvs[2 * i + 1]);
+        if (c.perVertexColor) keptColor.insert(keptColor.end(), poly.colors.begin(), poly.colors.end());
         if (!arb.ids.empty()) keptIds.push_back(arb.ids[i]);
         isGuide.push_back(!arb.guide.empty() && arb.guide[arb.guide.size() == 1 ? 0 : std::size_t(i)] != 0);
     }
     filter.finish();
-    if (!arb.cd.empty() && !perVertexColor) set.defaults.color = Vec3f(arb.cd[0], arb.cd[1], arb.cd[2]);
-    if (perVertexColor) set.color = std::move(keptColor);
+    if (!arb.cd.empty() && !c.perVertexColor) set.defaults.color = Vec3f(arb.cd[0], arb.cd[1], arb.cd[2]);
+    if (c.perVertexColor) set.color = std::move(keptColor);
     if (!arb.ids.empty()) set.strandId = std::move(keptIds);
-    if (widths.size() == 1) set.defaults.thickness = widths[0];
+    if (c.widths.size() == 1) set.defaults.thickness = c.widths[0];
     if (perVertexWidth) set.thickness = std::move(keptWidths);
-    if (uvPerCurve) set.rootUV = std::move(keptUV);
-    // Guides apart from the hair (read() chooses).
+    if (c.uvPerCurve) set.rootUV = std::move(keptUV);
+    return set;
+}
+
+/// @a set's hair into @a out and its guides (per @a isGuide) into mGuides: read() chooses.
+void AbcReader::addCurves(StrandSet&& set, std::vector<char>& isGuide, StrandSet& out)
+{
     auto add = [](StrandSet& to, StrandSet&& from) {
         if (to.empty() && to.positions.empty()) to = std::move(from);
         else to.append(std::move(from));

@@ -1,4 +1,5 @@
 #include "PlyFile.h"
+#include "PlyHeader.h"
 
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/PointFile.h>
@@ -22,31 +23,7 @@ namespace vdbhair {
 
 namespace {
 
-enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64, Invalid };
-
-PlyType plyType(std::string_view s)
-{
-    if (s == "char" || s == "int8") return PlyType::Int8;
-    if (s == "uchar" || s == "uint8") return PlyType::UInt8;
-    if (s == "short" || s == "int16") return PlyType::Int16;
-    if (s == "ushort" || s == "uint16") return PlyType::UInt16;
-    if (s == "int" || s == "int32") return PlyType::Int32;
-    if (s == "uint" || s == "uint32") return PlyType::UInt32;
-    if (s == "float" || s == "float32") return PlyType::Float32;
-    if (s == "double" || s == "float64") return PlyType::Float64;
-    return PlyType::Invalid;
-}
-
-std::size_t plySize(PlyType t)
-{
-    switch (t) {
-    case PlyType::Int8: case PlyType::UInt8: return 1;
-    case PlyType::Int16: case PlyType::UInt16: return 2;
-    case PlyType::Int32: case PlyType::UInt32: case PlyType::Float32: return 4;
-    case PlyType::Float64: return 8;
-    default: return 0;
-    }
-}
+using namespace ply;
 
 /// The value of type @a t at @a p (any alignment, little-endian as the host).
 double loadValue(PlyType t, const char* p)
@@ -64,22 +41,6 @@ double loadValue(PlyType t, const char* p)
     default: return 0.0;
     }
 }
-
-struct Property
-{
-    std::string name;
-    PlyType type = PlyType::Invalid;
-    bool isList = false;
-    PlyType countType = PlyType::Invalid;
-};
-
-struct Element
-{
-    std::string name;
-    std::uint64_t count = 0;
-    std::vector<Property> props;
-    std::size_t line = 0;
-};
 
 /// Reads values in either encoding; binary reads are bounds-checked by ByteReader.
 class ValueSource
@@ -132,92 +93,6 @@ private:
     std::vector<std::string_view> mTokens;
     std::size_t mTok = 0;
 };
-
-/// The header of a PLY file: encoding, elements, and where the body starts.
-struct PlyHeader
-{
-    bool binary = false;
-    std::vector<Element> elements;
-    std::size_t bodyOffset = 0, bodyLine = 0;
-};
-
-PlyHeader parsePlyHeader(const char* data, std::size_t size, const std::string& where)
-{
-    TextScanner header(data, size, where);
-    std::vector<std::string_view> tok;
-    if (!header.nextLine(tok) || tok.size() != 1 || tok[0] != "ply") header.fail("not a PLY file: the first line must be 'ply'");
-    bool binary = false, sawFormat = false;
-    std::vector<Element> elements;
-    bool ended = false;
-    while (header.nextLine(tok)) {
-        if (tok.empty()) continue;
-        if (tok[0] == "format") {
-            if (tok.size() < 3) header.fail("'format' needs an encoding and a version");
-            if (tok[1] == "ascii") binary = false;
-            else if (tok[1] == "binary_little_endian") binary = true;
-            else if (tok[1] == "binary_big_endian") throw UnsupportedError(where + ": line " + std::to_string(header.line()) + ": binary_big_endian PLY is not supported (ascii and binary_little_endian are)");
-            else header.fail("unknown format '" + std::string(tok[1]) + "'");
-            sawFormat = true;
-        } else if (tok[0] == "element") {
-            if (tok.size() != 3) header.fail("'element' needs a name and a count");
-            const std::int64_t count = header.toInt(tok[2], "element count");
-            if (count < 0) header.fail("element '" + std::string(tok[1]) + "' has a negative count " + std::to_string(count));
-            elements.push_back({std::string(tok[1]), std::uint64_t(count), {}, header.line()});
-        } else if (tok[0] == "property") {
-            if (elements.empty()) header.fail("'property' before any 'element'");
-            Property p;
-            if (tok.size() == 5 && tok[1] == "list") {
-                p.isList = true;
-                p.countType = plyType(tok[2]);
-                p.type = plyType(tok[3]);
-                p.name = std::string(tok[4]);
-                if (p.countType == PlyType::Invalid || p.countType == PlyType::Float32 || p.countType == PlyType::Float64) {
-                    header.fail("list count type '" + std::string(tok[2]) + "' must be an integer type");
-                }
-            } else if (tok.size() == 3) {
-                p.type = plyType(tok[1]);
-                p.name = std::string(tok[2]);
-            } else {
-                header.fail("'property' needs a type and a name");
-            }
-            if (p.type == PlyType::Invalid) header.fail("unknown property type in '" + std::string(tok[1]) + "'");
-            elements.back().props.push_back(p);
-        } else if (tok[0] == "end_header") {
-            ended = true;
-            break;
-        } else if (tok[0] == "comment" || tok[0] == "obj_info") {
-            continue;
-        } else {
-            header.fail("unexpected header keyword '" + std::string(tok[0]) + "'");
-        }
-    }
-    if (!ended) header.fail("the header has no 'end_header'");
-    if (!sawFormat) header.fail("the header has no 'format' line");
-
-    return PlyHeader{binary, std::move(elements), header.offset(), header.line()};
-}
-
-/// Index of @a e's property @a name (a scalar, or a list with @a list), or -1.
-int findProperty(const Element* e, const char* name, bool list = false)
-{
-    if (!e) return -1;
-    for (std::size_t i = 0; i < e->props.size(); ++i) {
-        if (e->props[i].name == name && e->props[i].isList == list) return int(i);
-    }
-    return -1;
-}
-
-/// The (last) element named `vertex` of @a hdr.
-/// @throw FormatError when there is none.
-const Element& vertexElement(const PlyHeader& hdr, const std::string& where)
-{
-    const Element* vertexEl = nullptr;
-    for (const Element& e : hdr.elements) {
-        if (e.name == "vertex") vertexEl = &e;
-    }
-    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
-    return *vertexEl;
-}
 
 /// @brief Read the body after @a hdr, element by element and item by item, bounds-checked before
 /// anything is allocated. @a onElement(e) runs before an element's items; @a onItem(e, n, values,
@@ -301,37 +176,47 @@ std::vector<std::size_t> propertyOffsets(const Element& e, std::size_t& stride)
     return at;
 }
 
-} // namespace
-
-StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
+/// What readPly() reads: the elements, where their properties are (-1: absent) and the topology.
+struct PlyStrandLayout
 {
-    const std::string where = "readPly(" + path + ")";
-    const MappedFile file(path, where, opts.interrupter);
-
-    const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
     const Element* vertexEl = nullptr;
-    const Element* strandEl = nullptr;
-    const Element* edgeEl = nullptr;
-    for (const Element& e : hdr.elements) {
-        if (e.name == "vertex") vertexEl = &e;
-        if (e.name == "strand") strandEl = &e;
-        if (e.name == "edge") edgeEl = &e;
-    }
-    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
-    const int ix = findProperty(vertexEl, "x"), iy = findProperty(vertexEl, "y"), iz = findProperty(vertexEl, "z");
-    if (ix < 0 || iy < 0 || iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
-
-    // The topology: hairutil's strand element; else an edge element (a line set); else runs of
-    // ReadOptions::pointsPerStrand vertices.
+    const Element* strandEl = nullptr;  ///< null unless the topology is PlyTopology::Strands
+    const Element* edgeEl = nullptr;    ///< null unless the topology is PlyTopology::Edges
     PlyTopology topology = PlyTopology::Strands;
-    const int iv1 = findProperty(edgeEl, "vertex1"), iv2 = findProperty(edgeEl, "vertex2");
-    if (!strandEl) {
-        if (edgeEl && iv1 >= 0 && iv2 >= 0) {
-            topology = PlyTopology::Edges;
+    int ix = -1, iy = -1, iz = -1;      ///< the vertex position
+    int ir = -1, ig = -1, ib = -1;      ///< the vertex colour
+    bool hasColor = false;
+    float colorScale = 1.f;             ///< 1/255 for uchar colours
+    int iseg = -1;                      ///< the strand's nsegs
+    int iv1 = -1, iv2 = -1;             ///< the edge's vertex1 and vertex2
+};
+
+/// Step 1: the layout of @a hdr. The topology is hairutil's strand element; else an edge element
+/// (a line set); else runs of ReadOptions::pointsPerStrand vertices.
+PlyStrandLayout plyStrandLayout(const PlyHeader& hdr, const ReadOptions& opts, ReadReport* report, const std::string& where)
+{
+    PlyStrandLayout l;
+    for (const Element& e : hdr.elements) {
+        if (e.name == "vertex") l.vertexEl = &e;
+        if (e.name == "strand") l.strandEl = &e;
+        if (e.name == "edge") l.edgeEl = &e;
+    }
+    const Element* vertexEl = l.vertexEl;
+    if (!vertexEl) throw FormatError(where + ": the header has no 'vertex' element");
+    l.ix = findProperty(vertexEl, "x");
+    l.iy = findProperty(vertexEl, "y");
+    l.iz = findProperty(vertexEl, "z");
+    if (l.ix < 0 || l.iy < 0 || l.iz < 0) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element needs scalar properties x, y and z");
+
+    l.iv1 = findProperty(l.edgeEl, "vertex1");
+    l.iv2 = findProperty(l.edgeEl, "vertex2");
+    if (!l.strandEl) {
+        if (l.edgeEl && l.iv1 >= 0 && l.iv2 >= 0) {
+            l.topology = PlyTopology::Edges;
         } else if (opts.pointsPerStrand > 0) {
-            topology = PlyTopology::Runs;
-        } else if (edgeEl) {
-            throw FormatError(where + ": line " + std::to_string(edgeEl->line) + ": the 'edge' element needs scalar properties vertex1 and vertex2");
+            l.topology = PlyTopology::Runs;
+        } else if (l.edgeEl) {
+            throw FormatError(where + ": line " + std::to_string(l.edgeEl->line) + ": the 'edge' element needs scalar properties vertex1 and vertex2");
         } else {
             throw FormatError(where + ": the file has only points: no 'strand' element (hairutil layout: element strand with property nsegs) "
                               "and no 'edge' element (a line set); if each run of N consecutive vertices is one strand (NeuralHaircut and "
@@ -341,189 +226,238 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
         report->warnings.push_back(where + ": ReadOptions::pointsPerStrand " + std::to_string(opts.pointsPerStrand) +
                                    " is ignored: the file's 'strand' element says where each strand ends");
     }
-    const int iseg = findProperty(strandEl, "nsegs");
-    if (strandEl && iseg < 0) throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the 'strand' element needs an integer property 'nsegs'");
-    if (topology != PlyTopology::Strands) strandEl = nullptr;
-    if (topology != PlyTopology::Edges) edgeEl = nullptr;
-    const int ir = findProperty(vertexEl, "red"), ig = findProperty(vertexEl, "green"), ib = findProperty(vertexEl, "blue");
-    const bool hasColor = ir >= 0 && ig >= 0 && ib >= 0;
-    const float colorScale = hasColor && vertexEl->props[std::size_t(ir)].type == PlyType::UInt8 ? 1.f / 255.f : 1.f;
+    l.iseg = findProperty(l.strandEl, "nsegs");
+    if (l.strandEl && l.iseg < 0) throw FormatError(where + ": line " + std::to_string(l.strandEl->line) + ": the 'strand' element needs an integer property 'nsegs'");
+    if (l.topology != PlyTopology::Strands) l.strandEl = nullptr;
+    if (l.topology != PlyTopology::Edges) l.edgeEl = nullptr;
+    l.ir = findProperty(vertexEl, "red");
+    l.ig = findProperty(vertexEl, "green");
+    l.ib = findProperty(vertexEl, "blue");
+    l.hasColor = l.ir >= 0 && l.ig >= 0 && l.ib >= 0;
+    l.colorScale = l.hasColor && vertexEl->props[std::size_t(l.ir)].type == PlyType::UInt8 ? 1.f / 255.f : 1.f;
+    if (l.edgeEl && vertexEl->count > std::numeric_limits<std::uint32_t>::max()) {
+        throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": a line set of " + std::to_string(vertexEl->count) +
+                          " vertices; edges index at most 2^32-1");
+    }
+    return l;
+}
 
-    // Body: positions and colours straight into the set's arrays, and each strand's count.
-    StrandSet out;
-    std::vector<Vec3f>& positions = out.positions;
-    std::vector<Vec3f>& colors = out.color;
-    std::vector<std::uint64_t> counts;
-    EdgeList edges;                // PlyTopology::Edges
-    // One edge, checked against the header's vertex count (the 'vertex' element may come after
-    // it); @a fail(msg) throws at the item's place.
-    auto addEdge = [&](std::uint64_t n, double a, double b, auto&& fail) {
+/// What the body gives: positions and colours straight into the set's arrays, and each strand's
+/// vertex count (PlyTopology::Strands) or the edges (PlyTopology::Edges).
+struct PlyStrandsIn
+{
+    explicit PlyStrandsIn(const PlyStrandLayout& l) : layout(l) {}
+
+    /// One edge, checked against the header's vertex count (the 'vertex' element may come after
+    /// it); @a fail(msg) throws at the item's place.
+    template<typename FailFn>
+    void addEdge(std::uint64_t n, double a, double b, FailFn&& fail)
+    {
+        const std::uint64_t vertexCount = layout.vertexEl->count;
         for (const double v : {a, b}) {
-            if (!(v >= 0.0) || v >= double(vertexEl->count) || v != std::floor(v)) {
+            if (!(v >= 0.0) || v >= double(vertexCount) || v != std::floor(v)) {
                 fail("edge " + std::to_string(n) + " names vertex " + formatNumber(v) + " but the 'vertex' element has " +
-                     std::to_string(vertexEl->count) + " (indices are 0-based)");
+                     std::to_string(vertexCount) + " (indices are 0-based)");
             }
         }
         const std::uint32_t place = std::uint32_t(std::min<std::uint64_t>(n, 0xffffffffu));
         if (a == b) { ++edges.selfEdges; return; }
         edges.edges.push_back({std::uint32_t(std::min(a, b)), std::uint32_t(std::max(a, b)), place});
-    };
-    std::uint64_t nsegsSum = 0;    // vertices the strands use
-    bool nsegsSaturated = false;   // their sum exceeds 2^64-1
-    // One strand's nsegs, checked; @a fail(msg) throws at the item's place.
-    auto addStrand = [&](std::uint64_t n, double s, auto&& fail) {
+    }
+
+    /// One strand's nsegs, checked; @a fail(msg) throws at the item's place.
+    template<typename FailFn>
+    void addStrand(std::uint64_t n, double s, FailFn&& fail)
+    {
         if (s < 0 || s != std::floor(s)) fail("strand " + std::to_string(n) + " has nsegs " + std::to_string(s) + "; it must be a non-negative integer");
         // A float nsegs can be 1e19 or beyond 2^64, and nsegs + 1 summed over strands could
-        // wrap 2^64 back to the vertex count: the sum saturates instead (checked below).
+        // wrap 2^64 back to the vertex count: the sum saturates instead (checked by nsegsToStrands()).
         const std::uint64_t c = s < 18446744073709549568.0 ? std::uint64_t(s) + 1 : std::numeric_limits<std::uint64_t>::max();
         nsegsSaturated = nsegsSaturated || c > std::numeric_limits<std::uint64_t>::max() - nsegsSum;
         if (!nsegsSaturated) nsegsSum += c;
         counts.push_back(c);
-    };
-    if (edgeEl && vertexEl->count > std::numeric_limits<std::uint32_t>::max()) {
-        throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": a line set of " + std::to_string(vertexEl->count) +
-                          " vertices; edges index at most 2^32-1");
-    }
-    const bool anyList = std::any_of(hdr.elements.begin(), hdr.elements.end(), [](const Element& e) {
-        return std::any_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.isList; });
-    });
-    if (hdr.binary && !anyList) {
-        // Binary without lists (what hairutil, hapPLY and vdbhair write): items of a fixed size,
-        // read in place from the file's bytes, with the checks and messages of readPlyBody().
-        ByteReader bin(file.data(), file.size(), where);
-        bin.seek(hdr.bodyOffset, "end_header");
-        InterruptPoll poll(opts.interrupter, where);
-        for (const Element& e : hdr.elements) {
-            std::size_t stride = 0;
-            const std::vector<std::size_t> at = propertyOffsets(e, stride);
-            if (stride && e.count > bin.remaining() / stride) {
-                bin.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
-                         std::to_string(stride) + " bytes but only " + std::to_string(bin.remaining()) + " bytes remain");
-            }
-            if (!stride) continue;  // nothing to read, whatever the count
-            const std::size_t first = bin.offset();
-            const char* items = bin.current();
-            bin.skip(e.count * stride, "items");
-            if (&e == vertexEl) {
-                const std::size_t n = std::size_t(e.count);
-                reserveHugePages(positions, n);
-                positions.resize(n);
-                const PlyType tx = e.props[std::size_t(ix)].type, ty = e.props[std::size_t(iy)].type, tz = e.props[std::size_t(iz)].type;
-                const std::size_t ox = at[std::size_t(ix)], oy = at[std::size_t(iy)], oz = at[std::size_t(iz)];
-                if (tx == PlyType::Float32 && ty == PlyType::Float32 && tz == PlyType::Float32) {
-                    for (std::size_t k = 0; k < n; ++k) {
-                        const char* item = items + k * stride;
-                        float* p = positions[k].asPointer();
-                        std::memcpy(p, item + ox, 4);
-                        std::memcpy(p + 1, item + oy, 4);
-                        std::memcpy(p + 2, item + oz, 4);
-                    }
-                } else {
-                    for (std::size_t k = 0; k < n; ++k) {
-                        const char* item = items + k * stride;
-                        positions[k] = Vec3f(float(loadValue(tx, item + ox)), float(loadValue(ty, item + oy)), float(loadValue(tz, item + oz)));
-                    }
-                }
-                if (!allFinite(positions.data(), 3 * n)) {
-                    for (std::size_t k = 0; k < n; ++k) checkFinite(positions[k], k, where, "at byte " + std::to_string(first + (k + 1) * stride));
-                }
-                if (hasColor) {
-                    reserveHugePages(colors, n);
-                    colors.resize(n);
-                    const PlyType tc = e.props[std::size_t(ir)].type;
-                    const std::size_t o[3] = {at[std::size_t(ir)], at[std::size_t(ig)], at[std::size_t(ib)]};
-                    for (std::size_t k = 0; k < n; ++k) {
-                        const char* item = items + k * stride;
-                        for (int c = 0; c < 3; ++c) colors[k][c] = float(loadValue(tc, item + o[c])) * colorScale;
-                    }
-                }
-            } else if (&e == strandEl) {
-                counts.reserve(e.count);
-                const PlyType ts = e.props[std::size_t(iseg)].type;
-                for (std::uint64_t n = 0; n < e.count; ++n) {
-                    poll();
-                    addStrand(n, loadValue(ts, items + n * stride + at[std::size_t(iseg)]), [&](const std::string& msg) {
-                        bin.failAt(first + (n + 1) * stride, msg);
-                    });
-                }
-            } else if (&e == edgeEl) {
-                edges.edges.reserve(e.count);
-                const PlyType t1 = e.props[std::size_t(iv1)].type, t2 = e.props[std::size_t(iv2)].type;
-                for (std::uint64_t n = 0; n < e.count; ++n) {
-                    poll();
-                    const char* item = items + n * stride;
-                    addEdge(n, loadValue(t1, item + at[std::size_t(iv1)]), loadValue(t2, item + at[std::size_t(iv2)]),
-                            [&](const std::string& msg) { bin.failAt(first + (n + 1) * stride, msg); });
-                }
-            }
-        }
-    } else {
-        readPlyBody(file.data(), file.size(), hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
-            if (&e == vertexEl) { reserveHugePages(positions, e.count); if (hasColor) colors.reserve(e.count); }
-            if (&e == strandEl) counts.reserve(e.count);
-            if (&e == edgeEl) edges.edges.reserve(e.count);
-        }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
-            if (&e == vertexEl) {
-                const Vec3f pos{float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)])};
-                if (!allFinite(&pos, 3)) checkFinite(pos, positions.size(), where, src.location());
-                positions.push_back(pos);
-                if (hasColor) colors.emplace_back(float(values[std::size_t(ir)]) * colorScale, float(values[std::size_t(ig)]) * colorScale, float(values[std::size_t(ib)]) * colorScale);
-            } else if (&e == strandEl) {
-                addStrand(n, values[std::size_t(iseg)], [&](const std::string& msg) { src.fail(msg); });
-            } else if (&e == edgeEl) {
-                addEdge(n, values[std::size_t(iv1)], values[std::size_t(iv2)], [&](const std::string& msg) { src.fail(msg); });
-            }
-        });
-    }
-    if (topology == PlyTopology::Edges) {
-        // A line set: the edges chained into strands as the OBJ reader chains `l` elements.
-        if (edges.edges.empty()) throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'edge' element joins no two vertices; a line set needs edges");
-        const std::vector<Vec3f> vertices = std::move(positions);
-        const std::vector<Vec3f> vertexColors = std::move(colors);
-        EdgeNaming naming;  // 0-based vertices, edges by their item number
-        out = strandsFromEdges(vertices, vertexColors, edges, naming, where, opts, report);
-        if (report && out.numVertices() < vertices.size()) {
-            report->warnings.push_back(where + ": " + std::to_string(vertices.size() - out.numVertices()) + " of " +
-                                       std::to_string(vertices.size()) + " vertices are on no edge and were ignored");
-        }
-        return out;
-    }
-    if (topology == PlyTopology::Runs) {
-        // Points in runs: each run of pointsPerStrand consecutive vertices is one strand.
-        const std::size_t run = opts.pointsPerStrand, nV = positions.size();
-        if (nV % run != 0) {
-            throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": the 'vertex' element has " + std::to_string(nV) +
-                              " vertices, which is not a multiple of ReadOptions::pointsPerStrand " + std::to_string(run) +
-                              " (each run of that many consecutive vertices is one strand)");
-        }
-        if (nV > std::numeric_limits<std::uint32_t>::max()) {
-            throw FormatError(where + ": line " + std::to_string(vertexEl->line) + ": " + std::to_string(nV) + " vertices; a strand set holds at most 2^32-1");
-        }
-        ShortStrandFilter filter(opts, report, where);
-        if (run < 2) {
-            for (std::size_t i = 0; i < nV; ++i) filter.keep(i, run, "vertex " + std::to_string(i));
-            positions.clear();
-            colors.clear();
-        } else {
-            out.offsets.reserve(nV / run + 1);
-            for (std::size_t v = run; v <= nV; v += run) out.offsets.push_back(std::uint32_t(v));
-        }
-        filter.finish();
-        return out;
-    }
-    if (nsegsSaturated || nsegsSum != positions.size()) {
-        throw FormatError(where + ": line " + std::to_string(strandEl->line) + ": the strands' nsegs + 1 add up to " +
-                          (nsegsSaturated ? std::string("more than 2^64-1") : std::to_string(nsegsSum)) +
-                          " vertices but the 'vertex' element has " + std::to_string(positions.size()));
     }
 
-    // Strands: the kept ones' vertices move down over the dropped ones' (in place: no copy when
-    // nothing is dropped).
-    out.offsets.reserve(counts.size() + 1);
+    const PlyStrandLayout& layout;
+    StrandSet out;                      ///< positions and colours (offsets come last)
+    std::vector<std::uint64_t> counts;  ///< PlyTopology::Strands: nsegs + 1 a strand
+    std::uint64_t nsegsSum = 0;         ///< vertices the strands use
+    bool nsegsSaturated = false;        ///< their sum exceeds 2^64-1
+    EdgeList edges;                     ///< PlyTopology::Edges
+};
+
+/// The @a n vertex items at @a items, @a stride bytes apart (the first at byte @a first, for
+/// messages; @a at: where each property is within an item), into positions and colours.
+void readVertexItems(const char* items, std::size_t n, std::size_t stride, std::size_t first, const std::vector<std::size_t>& at,
+                     const std::string& where, PlyStrandsIn& in)
+{
+    const PlyStrandLayout& l = in.layout;
+    const Element& e = *l.vertexEl;
+    std::vector<Vec3f>& positions = in.out.positions;
+    reserveHugePages(positions, n);
+    positions.resize(n);
+    const PlyType tx = e.props[std::size_t(l.ix)].type, ty = e.props[std::size_t(l.iy)].type, tz = e.props[std::size_t(l.iz)].type;
+    const std::size_t ox = at[std::size_t(l.ix)], oy = at[std::size_t(l.iy)], oz = at[std::size_t(l.iz)];
+    if (tx == PlyType::Float32 && ty == PlyType::Float32 && tz == PlyType::Float32) {
+        for (std::size_t k = 0; k < n; ++k) {
+            const char* item = items + k * stride;
+            float* p = positions[k].asPointer();
+            std::memcpy(p, item + ox, 4);
+            std::memcpy(p + 1, item + oy, 4);
+            std::memcpy(p + 2, item + oz, 4);
+        }
+    } else {
+        for (std::size_t k = 0; k < n; ++k) {
+            const char* item = items + k * stride;
+            positions[k] = Vec3f(float(loadValue(tx, item + ox)), float(loadValue(ty, item + oy)), float(loadValue(tz, item + oz)));
+        }
+    }
+    if (!allFinite(positions.data(), 3 * n)) {
+        for (std::size_t k = 0; k < n; ++k) checkFinite(positions[k], k, where, "at byte " + std::to_string(first + (k + 1) * stride));
+    }
+    if (l.hasColor) {
+        std::vector<Vec3f>& colors = in.out.color;
+        reserveHugePages(colors, n);
+        colors.resize(n);
+        const PlyType tc = e.props[std::size_t(l.ir)].type;
+        const std::size_t o[3] = {at[std::size_t(l.ir)], at[std::size_t(l.ig)], at[std::size_t(l.ib)]};
+        for (std::size_t k = 0; k < n; ++k) {
+            const char* item = items + k * stride;
+            for (int c = 0; c < 3; ++c) colors[k][c] = float(loadValue(tc, item + o[c])) * l.colorScale;
+        }
+    }
+}
+
+/// Step 2, for binary without lists (what hairutil, hapPLY and vdbhair write): items of a fixed
+/// size, read in place from the file's bytes, with the checks and messages of readPlyBody().
+void readFixedSizeBody(const MappedFile& file, const PlyHeader& hdr, const ReadOptions& opts, const std::string& where,
+                       PlyStrandsIn& in)
+{
+    const PlyStrandLayout& l = in.layout;
+    ByteReader bin(file.data(), file.size(), where);
+    bin.seek(hdr.bodyOffset, "end_header");
+    InterruptPoll poll(opts.interrupter, where);
+    for (const Element& e : hdr.elements) {
+        std::size_t stride = 0;
+        const std::vector<std::size_t> at = propertyOffsets(e, stride);
+        if (stride && e.count > bin.remaining() / stride) {
+            bin.fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items of at least " +
+                     std::to_string(stride) + " bytes but only " + std::to_string(bin.remaining()) + " bytes remain");
+        }
+        if (!stride) continue;  // nothing to read, whatever the count
+        const std::size_t first = bin.offset();
+        const char* items = bin.current();
+        bin.skip(e.count * stride, "items");
+        // A failure at item n is placed at the item's end, as readPlyBody() places it.
+        auto failAtItem = [&](std::uint64_t n) {
+            return [&bin, first, stride, n](const std::string& msg) { bin.failAt(first + (n + 1) * stride, msg); };
+        };
+        if (&e == l.vertexEl) {
+            readVertexItems(items, std::size_t(e.count), stride, first, at, where, in);
+        } else if (&e == l.strandEl) {
+            in.counts.reserve(e.count);
+            const PlyType ts = e.props[std::size_t(l.iseg)].type;
+            for (std::uint64_t n = 0; n < e.count; ++n) {
+                poll();
+                in.addStrand(n, loadValue(ts, items + n * stride + at[std::size_t(l.iseg)]), failAtItem(n));
+            }
+        } else if (&e == l.edgeEl) {
+            in.edges.edges.reserve(e.count);
+            const PlyType t1 = e.props[std::size_t(l.iv1)].type, t2 = e.props[std::size_t(l.iv2)].type;
+            for (std::uint64_t n = 0; n < e.count; ++n) {
+                poll();
+                const char* item = items + n * stride;
+                in.addEdge(n, loadValue(t1, item + at[std::size_t(l.iv1)]), loadValue(t2, item + at[std::size_t(l.iv2)]), failAtItem(n));
+            }
+        }
+    }
+}
+
+/// Step 2, for ascii, or binary with lists: item by item through readPlyBody().
+void readAnyBody(const MappedFile& file, const PlyHeader& hdr, const ReadOptions& opts, const std::string& where, PlyStrandsIn& in)
+{
+    const PlyStrandLayout& l = in.layout;
+    std::vector<Vec3f>& positions = in.out.positions;
+    std::vector<Vec3f>& colors = in.out.color;
+    readPlyBody(file.data(), file.size(), hdr, where, nullptr, -1, opts.interrupter, [&](const Element& e) {
+        if (&e == l.vertexEl) { reserveHugePages(positions, e.count); if (l.hasColor) colors.reserve(e.count); }
+        if (&e == l.strandEl) in.counts.reserve(e.count);
+        if (&e == l.edgeEl) in.edges.edges.reserve(e.count);
+    }, [&](const Element& e, std::uint64_t n, const std::vector<double>& values, const std::vector<double>&, ValueSource& src) {
+        auto value = [&](int k) { return values[std::size_t(k)]; };
+        if (&e == l.vertexEl) {
+            const Vec3f pos{float(value(l.ix)), float(value(l.iy)), float(value(l.iz))};
+            if (!allFinite(&pos, 3)) checkFinite(pos, positions.size(), where, src.location());
+            positions.push_back(pos);
+            if (l.hasColor) colors.emplace_back(float(value(l.ir)) * l.colorScale, float(value(l.ig)) * l.colorScale, float(value(l.ib)) * l.colorScale);
+        } else if (&e == l.strandEl) {
+            in.addStrand(n, value(l.iseg), [&](const std::string& msg) { src.fail(msg); });
+        } else if (&e == l.edgeEl) {
+            in.addEdge(n, value(l.iv1), value(l.iv2), [&](const std::string& msg) { src.fail(msg); });
+        }
+    });
+}
+
+/// Step 3, a line set: the edges chained into strands as the OBJ reader chains `l` elements.
+StrandSet edgesToStrands(PlyStrandsIn& in, const ReadOptions& opts, ReadReport* report, const std::string& where)
+{
+    if (in.edges.edges.empty()) throw FormatError(where + ": line " + std::to_string(in.layout.vertexEl->line) + ": the 'edge' element joins no two vertices; a line set needs edges");
+    const std::vector<Vec3f> vertices = std::move(in.out.positions);
+    const std::vector<Vec3f> vertexColors = std::move(in.out.color);
+    EdgeNaming naming;  // 0-based vertices, edges by their item number
+    StrandSet out = strandsFromEdges(vertices, vertexColors, in.edges, naming, where, opts, report);
+    if (report && out.numVertices() < vertices.size()) {
+        report->warnings.push_back(where + ": " + std::to_string(vertices.size() - out.numVertices()) + " of " +
+                                   std::to_string(vertices.size()) + " vertices are on no edge and were ignored");
+    }
+    return out;
+}
+
+/// Step 3, points in runs: each run of pointsPerStrand consecutive vertices is one strand.
+StrandSet runsToStrands(PlyStrandsIn& in, const ReadOptions& opts, ReadReport* report, const std::string& where)
+{
+    StrandSet& out = in.out;
+    const std::size_t line = in.layout.vertexEl->line;
+    const std::size_t run = opts.pointsPerStrand, nV = out.positions.size();
+    if (nV % run != 0) {
+        throw FormatError(where + ": line " + std::to_string(line) + ": the 'vertex' element has " + std::to_string(nV) +
+                          " vertices, which is not a multiple of ReadOptions::pointsPerStrand " + std::to_string(run) +
+                          " (each run of that many consecutive vertices is one strand)");
+    }
+    if (nV > std::numeric_limits<std::uint32_t>::max()) {
+        throw FormatError(where + ": line " + std::to_string(line) + ": " + std::to_string(nV) + " vertices; a strand set holds at most 2^32-1");
+    }
+    ShortStrandFilter filter(opts, report, where);
+    if (run < 2) {
+        for (std::size_t i = 0; i < nV; ++i) filter.keep(i, run, "vertex " + std::to_string(i));
+        out.positions.clear();
+        out.color.clear();
+    } else {
+        out.offsets.reserve(nV / run + 1);
+        for (std::size_t v = run; v <= nV; v += run) out.offsets.push_back(std::uint32_t(v));
+    }
+    filter.finish();
+    return std::move(out);
+}
+
+/// Step 3, hairutil's strands: the nsegs + 1 must add up to the vertices; the kept strands'
+/// vertices move down over the dropped ones' (in place: no copy when nothing is dropped).
+StrandSet nsegsToStrands(PlyStrandsIn& in, const ReadOptions& opts, ReadReport* report, const std::string& where)
+{
+    StrandSet& out = in.out;
+    std::vector<Vec3f>& positions = out.positions;
+    std::vector<Vec3f>& colors = out.color;
+    const bool hasColor = in.layout.hasColor;
+    if (in.nsegsSaturated || in.nsegsSum != positions.size()) {
+        throw FormatError(where + ": line " + std::to_string(in.layout.strandEl->line) + ": the strands' nsegs + 1 add up to " +
+                          (in.nsegsSaturated ? std::string("more than 2^64-1") : std::to_string(in.nsegsSum)) +
+                          " vertices but the 'vertex' element has " + std::to_string(positions.size()));
+    }
+    out.offsets.reserve(in.counts.size() + 1);
     ShortStrandFilter filter(opts, report, where);
     std::size_t v = 0, kept = 0;
-    for (std::size_t i = 0; i < counts.size(); ++i) {
-        const std::size_t n = std::size_t(counts[i]);
+    for (std::size_t i = 0; i < in.counts.size(); ++i) {
+        const std::size_t n = std::size_t(in.counts[i]);
         if (n >= 2 || filter.keep(i, n, "vertex " + std::to_string(v))) {
             if (kept != v) {
                 std::copy(positions.begin() + std::ptrdiff_t(v), positions.begin() + std::ptrdiff_t(v + n), positions.begin() + std::ptrdiff_t(kept));
@@ -537,7 +471,30 @@ StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* 
     positions.resize(kept);
     if (hasColor) colors.resize(kept);
     filter.finish();
-    return out;
+    return std::move(out);
+}
+
+} // namespace
+
+StrandSet readPly(const std::string& path, const ReadOptions& opts, ReadReport* report)
+{
+    const std::string where = "readPly(" + path + ")";
+    const MappedFile file(path, where, opts.interrupter);
+    const PlyHeader hdr = parsePlyHeader(file.data(), file.size(), where);
+    const PlyStrandLayout layout = plyStrandLayout(hdr, opts, report, where);
+
+    PlyStrandsIn in(layout);
+    const bool anyList = std::any_of(hdr.elements.begin(), hdr.elements.end(), [](const Element& e) {
+        return std::any_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.isList; });
+    });
+    if (hdr.binary && !anyList) readFixedSizeBody(file, hdr, opts, where, in);
+    else readAnyBody(file, hdr, opts, where, in);
+
+    switch (layout.topology) {
+    case PlyTopology::Edges: return edgesToStrands(in, opts, report, where);
+    case PlyTopology::Runs: return runsToStrands(in, opts, report, where);
+    default: return nsegsToStrands(in, opts, report, where);
+    }
 }
 
 void writePly(const std::string& path, const StrandSet& strands, PlyEncoding encoding)

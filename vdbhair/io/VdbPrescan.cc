@@ -548,6 +548,19 @@ private:
         return Array{uint32_t(bytes - 6), uint32_t(expect), sflags};
     }
 
+    // The arrays of every leaf, as pass 1 declares them: leaf i's are arrays[start[i]..start[i+1]).
+    struct LeafArrays {
+        std::vector<uint64_t> start;
+        std::vector<Array> arrays;
+        size_t maxAttrs = 0;  // the most attributes of any leaf's descriptor
+        // Array a of leaf @a leaf, or null when its descriptor has fewer.
+        const Array* of(size_t leaf, size_t a) const
+        {
+            const uint64_t b = start[leaf], e = start[leaf + 1];
+            return (b + a < e) ? &arrays[b + a] : nullptr;
+        }
+    };
+
     void pointBuffers()
     {
         const size_t L = mLeaves.size();
@@ -558,16 +571,30 @@ private:
             if (numPasses != 0) fail(at, "pass count " + std::to_string(numPasses) + " for a tree without leaves");
             return;
         }
-        // pass 0: voxel buffer sizes
-        std::vector<uint16_t> voxelBytes(L);
-        for (size_t i = 0; i < L; ++i) { note("voxel16pass0", mPos, 2048); voxelBytes[i] = rd<uint16_t>("voxel buffer size"); }
-        // pass 1: descriptor (shared if header bit 0) and array metadata
+        const std::vector<uint16_t> voxelBytes = voxelBufferSizes();
+        const LeafArrays arrays = arrayMetadataPass();
+        if (numPasses != 2 * arrays.maxAttrs + 4)
+            fail(at, "pass count " + std::to_string(numPasses) + " for " + std::to_string(arrays.maxAttrs) + " attributes (OpenVDB writes 2n+4)");
+        const std::vector<std::vector<PageInfo>> pages = pageHeaders(arrays);
+        voxelBuffers(voxelBytes);
+        arrayData(arrays, pages);
+        // pass 2n+3: nothing read
+    }
+    // pass 0: voxel buffer sizes
+    std::vector<uint16_t> voxelBufferSizes()
+    {
+        std::vector<uint16_t> voxelBytes(mLeaves.size());
+        for (size_t i = 0; i < mLeaves.size(); ++i) { note("voxel16pass0", mPos, 2048); voxelBytes[i] = rd<uint16_t>("voxel buffer size"); }
+        return voxelBytes;
+    }
+    // pass 1: descriptor (shared if header bit 0) and array metadata
+    LeafArrays arrayMetadataPass()
+    {
+        const size_t L = mLeaves.size();
+        LeafArrays out;
+        out.start.resize(L + 1);
         std::vector<std::vector<uint64_t>> descs;
-        std::vector<uint32_t> leafDesc(L);
-        std::vector<uint64_t> arrayStart(L + 1);
-        std::vector<Array> arrays;
         bool shared = false;
-        size_t maxAttrs = 0;
         for (size_t i = 0; i < L; ++i) {
             if (!shared) {
                 const uint8_t header = rd<uint8_t>("points leaf header");
@@ -575,45 +602,29 @@ private:
                 descs.push_back(descriptor());
                 shared = header & 1;
             }
-            leafDesc[i] = uint32_t(descs.size() - 1);
             const auto& d = descs.back();
-            maxAttrs = std::max(maxAttrs, d.size());
-            arrayStart[i] = arrays.size();
-            for (uint64_t s : d) arrays.push_back(arrayMetadata(s));
+            out.maxAttrs = std::max(out.maxAttrs, d.size());
+            out.start[i] = out.arrays.size();
+            for (uint64_t s : d) out.arrays.push_back(arrayMetadata(s));
         }
-        arrayStart[L] = arrays.size();
-        if (numPasses != 2 * maxAttrs + 4)
-            fail(at, "pass count " + std::to_string(numPasses) + " for " + std::to_string(maxAttrs) + " attributes (OpenVDB writes 2n+4)");
-        auto arrayOf = [&](size_t leaf, size_t a) -> Array* {
-            const uint64_t b = arrayStart[leaf], e = arrayStart[leaf + 1];
-            return (b + a < e) ? &arrays[b + a] : nullptr;
-        };
-        // passes 2..n+1: page headers (PagedInputStream::createHandle, StreamCompression.cc:488-507; Page::readHeader :307-326)
-        std::vector<std::vector<PageInfo>> pages(maxAttrs);
-        for (size_t a = 0; a < maxAttrs; ++a) {
+        out.start[L] = out.arrays.size();
+        return out;
+    }
+    // passes 2..n+1: page headers (PagedInputStream::createHandle, StreamCompression.cc:488-507; Page::readHeader :307-326)
+    std::vector<std::vector<PageInfo>> pageHeaders(const LeafArrays& arrays)
+    {
+        std::vector<std::vector<PageInfo>> pages(arrays.maxAttrs);
+        for (size_t a = 0; a < arrays.maxAttrs; ++a) {
             uint64_t pageU = 0, used = 0;
-            for (size_t i = 0; i < L; ++i) {
-                Array* arr = arrayOf(i, a);
+            for (size_t i = 0; i < mLeaves.size(); ++i) {
+                const Array* arr = arrays.of(i, a);
                 if (!arr || !(arr->sflags & WRITEPAGED)) continue;
                 if (arr->n != arr->expect)
                     fail(mPos, "paged array declares " + std::to_string(arr->n) + " bytes, its size, stride and type make " + std::to_string(arr->expect));
                 if (used == pageU) {
-                    const uint64_t hat = mPos;
-                    note("page32", hat, 0);
-                    const int32_t c = rd<int32_t>("page compressed size");
-                    uint64_t u;
-                    if (c > 0) {
-                        const int32_t ui = rd<int32_t>("page uncompressed size");
-                        if (ui <= c) fail(hat, "page: compressed " + std::to_string(c) + " not below uncompressed " + std::to_string(ui));
-                        u = uint64_t(ui);
-                    } else {
-                        if (c == 0 || c == INT32_MIN) fail(hat, "page size " + std::to_string(c));
-                        u = uint64_t(-int64_t(c));
-                    }
-                    if (int64_t(c) > 0 ? uint64_t(c) > mLimit - mPos : u > mLimit - mPos)
-                        fail(hat, "page of " + std::to_string(c) + " bytes cannot fit in the grid");
-                    pages[a].push_back({c, u});
-                    pageU = u;
+                    const PageInfo p = pageHeader();
+                    pages[a].push_back(p);
+                    pageU = p.u;
                     used = 0;
                     ++stats.pages;
                 }
@@ -623,8 +634,31 @@ private:
             }
             if (used != pageU) fail(mPos, "the last page of attribute " + std::to_string(a) + " is not filled exactly");
         }
-        // pass n+2: voxel buffers (readCompressedValues<PointDataIndex32> PointDataGrid.h:44-100)
-        for (size_t i = 0; i < L; ++i) {
+        return pages;
+    }
+    // One page header: compressed size (negative: stored uncompressed), then the uncompressed one if compressed.
+    PageInfo pageHeader()
+    {
+        const uint64_t hat = mPos;
+        note("page32", hat, 0);
+        const int32_t c = rd<int32_t>("page compressed size");
+        uint64_t u;
+        if (c > 0) {
+            const int32_t ui = rd<int32_t>("page uncompressed size");
+            if (ui <= c) fail(hat, "page: compressed " + std::to_string(c) + " not below uncompressed " + std::to_string(ui));
+            u = uint64_t(ui);
+        } else {
+            if (c == 0 || c == INT32_MIN) fail(hat, "page size " + std::to_string(c));
+            u = uint64_t(-int64_t(c));
+        }
+        if (int64_t(c) > 0 ? uint64_t(c) > mLimit - mPos : u > mLimit - mPos)
+            fail(hat, "page of " + std::to_string(c) + " bytes cannot fit in the grid");
+        return {c, u};
+    }
+    // pass n+2: voxel buffers (readCompressedValues<PointDataIndex32> PointDataGrid.h:44-100)
+    void voxelBuffers(const std::vector<uint16_t>& voxelBytes)
+    {
+        for (size_t i = 0; i < mLeaves.size(); ++i) {
             ++stats.leaves;
             need(64, "leaf value mask (buffer copy)");
             if (std::memcmp(mBase + mPos, mBase + mLeaves[i].maskOff, 64) != 0) fail(mPos, "leaf mask in the buffers differs from the topology");
@@ -641,50 +675,61 @@ private:
             stats.declaredBytes += b + 2048 + BLOSC_OVERHEAD;  // temporaries in bloscDecompress
             mPos += b;
         }
-        // passes n+3..2n+2: array data (TypedAttributeArray::readPagedBuffers AttributeArray.h:1790-1845,
-        // readBuffers :1751-1787, PagedInputStream::read StreamCompression.cc:510-524, Page::readBuffers :329-372)
-        for (size_t a = 0; a < maxAttrs; ++a) {
+    }
+    // passes n+3..2n+2: array data (TypedAttributeArray::readPagedBuffers AttributeArray.h:1790-1845,
+    // readBuffers :1751-1787, PagedInputStream::read StreamCompression.cc:510-524, Page::readBuffers :329-372)
+    void arrayData(const LeafArrays& arrays, const std::vector<std::vector<PageInfo>>& pages)
+    {
+        for (size_t a = 0; a < arrays.maxAttrs; ++a) {
             size_t page = 0;
             uint64_t pageU = 0, used = 0;
-            for (size_t i = 0; i < L; ++i) {
-                Array* arr = arrayOf(i, a);
+            for (size_t i = 0; i < mLeaves.size(); ++i) {
+                const Array* arr = arrays.of(i, a);
                 if (!arr) continue;
                 ++stats.chunks;
                 if (arr->sflags & WRITEPAGED) {
                     if (used == pageU) {
                         const PageInfo& p = pages[a][page++];
-                        if (p.c > 0) {
-                            need(uint64_t(p.c), "page data");
-                            bloscHeader(mPos, uint64_t(p.c), p.u, /*allowPad=*/true, "page data");
-                            stats.declaredBytes += uint64_t(p.c) + 2 * std::max<uint64_t>(p.u, BLOSC_PAD);
-                            mPos += uint64_t(p.c);
-                        } else {
-                            skip(p.u, "page data");
-                            stats.declaredBytes += 2 * p.u;
-                        }
+                        pageData(p);
                         pageU = p.u;
                         used = 0;
                     }
                     used += arr->n;
                     continue;
                 }
-                // unpaged: [blosc flag byte unless uniform] then exactly mCompressedBytes bytes
-                uint8_t blosc = 0;
-                if (!(arr->sflags & WRITEUNIFORM)) {
-                    blosc = rd<uint8_t>("array blosc flag");
-                    if (blosc > 1) fail(mPos - 1, "array blosc flag " + std::to_string(blosc));
-                }
-                need(arr->n, "array data");
-                if (blosc) {
-                    bloscHeader(mPos, arr->n, arr->expect, /*allowPad=*/true, "array data");
-                    stats.declaredBytes += arr->n + std::max<uint64_t>(arr->expect, BLOSC_PAD) + BLOSC_OVERHEAD;
-                } else if (arr->n != arr->expect) {
-                    fail(mPos, "array holds " + std::to_string(arr->n) + " bytes, its size, stride and type make " + std::to_string(arr->expect));
-                }
-                mPos += arr->n;
+                unpagedArrayData(*arr);
             }
         }
-        // pass 2n+3: nothing read
+    }
+    // A page's bytes: blosc-compressed when its header's size is positive, else stored.
+    void pageData(const PageInfo& p)
+    {
+        if (p.c > 0) {
+            need(uint64_t(p.c), "page data");
+            bloscHeader(mPos, uint64_t(p.c), p.u, /*allowPad=*/true, "page data");
+            stats.declaredBytes += uint64_t(p.c) + 2 * std::max<uint64_t>(p.u, BLOSC_PAD);
+            mPos += uint64_t(p.c);
+        } else {
+            skip(p.u, "page data");
+            stats.declaredBytes += 2 * p.u;
+        }
+    }
+    // unpaged: [blosc flag byte unless uniform] then exactly mCompressedBytes bytes
+    void unpagedArrayData(const Array& arr)
+    {
+        uint8_t blosc = 0;
+        if (!(arr.sflags & WRITEUNIFORM)) {
+            blosc = rd<uint8_t>("array blosc flag");
+            if (blosc > 1) fail(mPos - 1, "array blosc flag " + std::to_string(blosc));
+        }
+        need(arr.n, "array data");
+        if (blosc) {
+            bloscHeader(mPos, arr.n, arr.expect, /*allowPad=*/true, "array data");
+            stats.declaredBytes += arr.n + std::max<uint64_t>(arr.expect, BLOSC_PAD) + BLOSC_OVERHEAD;
+        } else if (arr.n != arr.expect) {
+            fail(mPos, "array holds " + std::to_string(arr.n) + " bytes, its size, stride and type make " + std::to_string(arr.expect));
+        }
+        mPos += arr.n;
     }
 };
 

@@ -317,14 +317,24 @@ openvdb::points::PointDataGrid::Ptr createStrandGrid(const StrandSet& strands, c
     return grid;
 }
 
-StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std::string& where,
-                          const ReadOptions& opts, ReadReport* report)
+namespace {
+
+using PointLeaf = pts::PointDataTree::LeafNodeType;
+
+/// Where a strands grid keeps its attributes (positions in its descriptor) and which of the
+/// optional ones (colour, width, alpha) it has with the type read.
+struct StrandAttributes
 {
-    const pts::PointDataTree& tree = grid.tree();
-    const auto leaf0 = tree.cbeginLeaf();
-    const std::uint64_t nPoints = pts::pointCount(tree);
-    if (!leaf0 || nPoints == 0) throw FormatError(where + ": grid '" + grid.getName() + "' has no points");
-    const pts::AttributeSet::Descriptor& desc = leaf0->attributeSet().descriptor();
+    std::size_t iP = 0, iS = 0, iV = 0, iCd = 0, iW = 0, iA = 0;
+    std::string typeS, typeV;  ///< the value types of strand and vertex
+    bool hasCd = false, hasW = false, hasA = false;
+};
+
+/// Step 1: the attributes of @a desc (the first leaf's layout): P, strand and vertex must be
+/// there, strand and vertex of a type that holds whole numbers.
+StrandAttributes strandAttributes(const pts::AttributeSet::Descriptor& desc, const pts::PointDataGrid& grid,
+                                  const std::string& where)
+{
     for (const char* name : {"P", "strand", "vertex"}) {
         if (desc.find(name) == pts::AttributeSet::INVALID_POS) {
             throw FormatError(where + ": grid '" + grid.getName() + "' has no '" + name +
@@ -340,14 +350,25 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
     };
     checkType("strand");
     checkType("vertex");
-    const std::string typeS = desc.valueType(desc.find("strand")), typeV = desc.valueType(desc.find("vertex"));
-    const std::size_t iP = desc.find("P"), iS = desc.find("strand"), iV = desc.find("vertex");
-    const std::size_t iCd = desc.find("Cd"), iW = desc.find("width"), iA = desc.find("Alpha");
-    const bool hasCd = iCd != pts::AttributeSet::INVALID_POS && desc.valueType(iCd) == "vec3s";
-    const bool hasW = iW != pts::AttributeSet::INVALID_POS && desc.valueType(iW) == "float";
-    const bool hasA = iA != pts::AttributeSet::INVALID_POS && desc.valueType(iA) == "float";
+    StrandAttributes a;
+    a.typeS = desc.valueType(desc.find("strand"));
+    a.typeV = desc.valueType(desc.find("vertex"));
+    a.iP = desc.find("P");
+    a.iS = desc.find("strand");
+    a.iV = desc.find("vertex");
+    a.iCd = desc.find("Cd");
+    a.iW = desc.find("width");
+    a.iA = desc.find("Alpha");
+    a.hasCd = a.iCd != pts::AttributeSet::INVALID_POS && desc.valueType(a.iCd) == "vec3s";
+    a.hasW = a.iW != pts::AttributeSet::INVALID_POS && desc.valueType(a.iW) == "float";
+    a.hasA = a.iA != pts::AttributeSet::INVALID_POS && desc.valueType(a.iA) == "float";
+    return a;
+}
 
-    // The declared strand count must be possible before anything is sized by it.
+/// Step 2: the strand count the grid's metadata declares (-1 if none), checked to be possible
+/// for @a nPoints points before anything is sized by it.
+std::int64_t declaredStrandCount(const pts::PointDataGrid& grid, std::uint64_t nPoints, const std::string& where)
+{
     std::int64_t declared = -1;
     if (const auto meta = findVdbhairMeta<openvdb::Int64Metadata>(grid, "strand_count")) {
         declared = meta->value();
@@ -356,164 +377,242 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
                               " is impossible for " + std::to_string(nPoints) + " points");
         }
     }
+    return declared;
+}
 
-    if (nPoints > std::numeric_limits<std::uint32_t>::max())
-        throw LimitError(where + ": grid '" + grid.getName() + "' has " + std::to_string(nPoints) +
-                         " points, more than the 2^32-1 vertices a strand set holds");
-    // Gather every point (the tree already holds them: sizes come from real data), leaves in
-    // parallel. A leaf's offsets and arrays come from the file as they are: OpenVDB's handles index
-    // the arrays without bounds checks, so what they will index is checked first (one flipped bit
-    // in an offset otherwise reads and writes past the arrays). Errors are those a pass over the
-    // leaves in order would meet first: each leaf's checks, then its points, leaf by leaf.
-    std::vector<const pts::PointDataTree::LeafNodeType*> leaves;
-    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
-    const std::size_t nL = leaves.size();
-    std::vector<openvdb::Index32> last(nL, 0);    // each leaf's point count (its last offset)
-    std::vector<std::uint64_t> visited(nL, 0);    // the points of its active voxels (what is gathered)
-    std::vector<std::string> leafError(nL);       // its first check that fails (layout, offsets)
-    std::vector<std::string> arrayError(nL);      // its first array too short for its points
-    const std::pair<const char*, std::size_t> used[] = {{"P", iP}, {"strand", iS}, {"vertex", iV},
-                                                       {"Cd", iCd}, {"width", iW}, {"Alpha", iA}};
+/// What a first pass over the leaves (in parallel) finds about each leaf, before any point is
+/// read: OpenVDB's handles index the arrays without bounds checks, so what they will index is
+/// checked first (one flipped bit in an offset otherwise reads and writes past the arrays).
+struct LeafSurvey
+{
+    std::vector<const PointLeaf*> leaves;
+    std::vector<openvdb::Index32> last;  ///< each leaf's point count (its last offset)
+    std::vector<std::uint64_t> visited;  ///< the points of its active voxels (what is gathered)
+    std::vector<std::string> leafError;  ///< its first check that fails (layout, offsets)
+    std::vector<std::string> arrayError; ///< its first array too short for its points
+};
+
+/// The checks of one leaf of @a s (number @a l) against the first leaf's layout @a desc.
+void surveyLeaf(LeafSurvey& s, std::size_t l, const pts::AttributeSet::Descriptor& desc, const StrandAttributes& a,
+                const std::string& where)
+{
+    const PointLeaf& leaf = *s.leaves[l];
+    if (!(leaf.attributeSet().descriptor() == desc)) {
+        s.leafError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) +
+                         " has other attributes than the first leaf; every leaf of a points grid shares one layout";
+        return;
+    }
+    openvdb::Index32 previous = 0;
+    std::uint64_t onPoints = 0;
+    for (openvdb::Index i = 0; i < PointLeaf::SIZE; ++i) {
+        const openvdb::Index32 offset = leaf.getValue(i);
+        if (offset < previous) {
+            s.leafError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) + " has point offset " +
+                             std::to_string(offset) + " after " + std::to_string(previous) + " (voxel " + std::to_string(i) +
+                             "); a leaf's point offsets never decrease";
+            return;
+        }
+        if (leaf.isValueOn(i)) onPoints += offset - previous;
+        previous = offset;
+    }
+    s.last[l] = previous;
+    s.visited[l] = onPoints;
+    const std::pair<const char*, std::size_t> used[] = {{"P", a.iP}, {"strand", a.iS}, {"vertex", a.iV},
+                                                       {"Cd", a.iCd}, {"width", a.iW}, {"Alpha", a.iA}};
+    for (const auto& [name, index] : used) {
+        if (index == pts::AttributeSet::INVALID_POS) continue;
+        const pts::AttributeArray& array = leaf.constAttributeArray(index);
+        if (pointArrayLength(array) < previous) {
+            s.arrayError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) + " has " + std::to_string(previous) +
+                              " points but its '" + std::string(name) + "' array holds " + std::to_string(pointArrayLength(array)) +
+                              "; each array holds one value per point";
+            return;
+        }
+    }
+}
+
+/// Step 3: every leaf of @a tree surveyed, in parallel.
+LeafSurvey surveyLeaves(const pts::PointDataTree& tree, const pts::AttributeSet::Descriptor& desc, const StrandAttributes& a,
+                        const std::string& where)
+{
+    LeafSurvey s;
+    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) s.leaves.push_back(leaf.getLeaf());
+    const std::size_t nL = s.leaves.size();
+    s.last.assign(nL, 0);
+    s.visited.assign(nL, 0);
+    s.leafError.resize(nL);
+    s.arrayError.resize(nL);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nL, 16), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t l = r.begin(); l != r.end(); ++l) {
-            const auto& leaf = *leaves[l];
-            if (!(leaf.attributeSet().descriptor() == desc)) {
-                leafError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) +
-                               " has other attributes than the first leaf; every leaf of a points grid shares one layout";
-                continue;
-            }
-            openvdb::Index32 previous = 0;
-            std::uint64_t onPoints = 0;
-            for (openvdb::Index i = 0; i < pts::PointDataTree::LeafNodeType::SIZE; ++i) {
-                const openvdb::Index32 offset = leaf.getValue(i);
-                if (offset < previous) {
-                    leafError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) + " has point offset " +
-                                   std::to_string(offset) + " after " + std::to_string(previous) + " (voxel " + std::to_string(i) +
-                                   "); a leaf's point offsets never decrease";
-                    break;
-                }
-                if (leaf.isValueOn(i)) onPoints += offset - previous;
-                previous = offset;
-            }
-            if (!leafError[l].empty()) continue;
-            last[l] = previous;
-            visited[l] = onPoints;
-            for (const auto& [name, index] : used) {
-                if (index == pts::AttributeSet::INVALID_POS) continue;
-                const pts::AttributeArray& array = leaf.constAttributeArray(index);
-                if (pointArrayLength(array) < previous) {
-                    arrayError[l] = where + ": the leaf at voxel " + coordText(leaf.origin()) + " has " + std::to_string(previous) +
-                                    " points but its '" + std::string(name) + "' array holds " + std::to_string(pointArrayLength(array)) +
-                                    "; each array holds one value per point";
-                    break;
-                }
-            }
-        }
+        for (std::size_t l = r.begin(); l != r.end(); ++l) surveyLeaf(s, l, desc, a, where);
     });
-    // The leaves before the first one that fails its checks are gathered; their points come first.
-    std::vector<std::uint64_t> base(nL + 1, 0);
-    std::size_t good = nL;
-    std::string firstLeafError;
+    return s;
+}
+
+/// Which leaves are gathered: those before the first one that fails its checks (@a good of
+/// them), their points first; base[l] is leaf l's first point.
+struct GatherPlan
+{
+    std::vector<std::uint64_t> base;
+    std::size_t good = 0;
+    std::string firstLeafError;  ///< the failing leaf's message ("" when all pass)
+};
+
+/// Step 4: the plan, from the survey, leaf by leaf in order (so that the error is the one a pass
+/// in order would meet first).
+GatherPlan planGather(const LeafSurvey& s, std::uint64_t nPoints, const std::string& where)
+{
+    const std::size_t nL = s.leaves.size();
+    GatherPlan plan;
+    plan.base.assign(nL + 1, 0);
+    plan.good = nL;
     for (std::size_t l = 0; l < nL; ++l) {
-        if (!leafError[l].empty()) {
-            firstLeafError = leafError[l];
-        } else if (std::uint64_t(last[l]) > nPoints - base[l]) {
-            firstLeafError = where + ": the leaf at voxel " + coordText(leaves[l]->origin()) + " holds " + std::to_string(last[l]) +
-                             " points, more than the " + std::to_string(nPoints) + " the tree counts";
-        } else if (!arrayError[l].empty()) {
-            firstLeafError = arrayError[l];
+        if (!s.leafError[l].empty()) {
+            plan.firstLeafError = s.leafError[l];
+        } else if (std::uint64_t(s.last[l]) > nPoints - plan.base[l]) {
+            plan.firstLeafError = where + ": the leaf at voxel " + coordText(s.leaves[l]->origin()) + " holds " +
+                                  std::to_string(s.last[l]) + " points, more than the " + std::to_string(nPoints) + " the tree counts";
+        } else if (!s.arrayError[l].empty()) {
+            plan.firstLeafError = s.arrayError[l];
         }
-        if (!firstLeafError.empty()) {
-            good = l;
+        if (!plan.firstLeafError.empty()) {
+            plan.good = l;
             break;
         }
-        base[l + 1] = base[l] + visited[l];
+        plan.base[l + 1] = plan.base[l] + s.visited[l];
     }
-    std::vector<Vec3f> pos(nPoints), cd(hasCd ? nPoints : 0);
-    std::vector<float> width(hasW ? nPoints : 0), alpha(hasA ? nPoints : 0);
-    std::vector<std::int32_t> sid(nPoints), vid(nPoints);
-    std::vector<std::string> pointError(good);
-    std::vector<std::int64_t> leafMaxStrand(good, -1);
-    const std::int64_t strandLimit = declared >= 0 ? declared : std::int64_t(nPoints);
+    return plan;
+}
+
+/// Every gathered point's values, in leaf order: world position, strand and vertex index, and
+/// the optional attributes the grid has.
+struct GridPoints
+{
+    std::vector<Vec3f> pos, cd;
+    std::vector<float> width, alpha;
+    std::vector<std::int32_t> sid, vid;
+};
+
+/// The points of @a leaf into @a out from point @a k on, each checked to have a whole strand in
+/// [0, @a strandLimit) and a whole vertex in [0, @a nPoints). Returns the first error ("" if
+/// none) and raises @a maxStrand to the highest strand seen.
+std::string gatherLeaf(const PointLeaf& leaf, std::size_t k, const pts::PointDataGrid& grid, const StrandAttributes& a,
+                       std::int64_t strandLimit, std::uint64_t nPoints, const std::string& where, GridPoints& out,
+                       std::int64_t& maxStrand)
+{
+    pts::AttributeHandle<openvdb::Vec3f> hP(leaf.constAttributeArray(a.iP));
+    const WholeNumberAttribute hS(leaf.constAttributeArray(a.iS), a.typeS), hV(leaf.constAttributeArray(a.iV), a.typeV);
+    std::optional<pts::AttributeHandle<openvdb::Vec3f>> hCd;
+    std::optional<pts::AttributeHandle<float>> hW, hA;
+    if (a.hasCd) hCd.emplace(leaf.constAttributeArray(a.iCd));
+    if (a.hasW) hW.emplace(leaf.constAttributeArray(a.iW));
+    if (a.hasA) hA.emplace(leaf.constAttributeArray(a.iA));
+    for (auto it = leaf.beginIndexOn(); it; ++it, ++k) {
+        const openvdb::Vec3d ijk = it.getCoord().asVec3d();
+        const openvdb::Vec3d world = grid.transform().indexToWorld(ijk + hP.get(*it));
+        out.pos[k] = Vec3f(float(world.x()), float(world.y()), float(world.z()));
+        const double sv = hS.get(*it), vv = hV.get(*it);
+        const std::pair<const char*, double> checks[] = {{"strand", sv}, {"vertex", vv}};
+        for (const auto& [name, value] : checks) {
+            if (!std::isfinite(value) || value != std::floor(value)) {
+                std::ostringstream v;
+                v.precision(9);
+                v << value;
+                return where + ": a point in voxel " + coordText(it.getCoord()) + " has " + name + " " + v.str() +
+                       "; strand and vertex must hold whole numbers";
+            }
+        }
+        out.sid[k] = (sv >= 0.0 && sv < double(strandLimit)) ? std::int32_t(sv) : -1;
+        out.vid[k] = (vv >= 0.0 && vv < double(nPoints)) ? std::int32_t(vv) : -1;
+        if (a.hasCd) out.cd[k] = hCd->get(*it);
+        if (a.hasW) out.width[k] = hW->get(*it);
+        if (a.hasA) out.alpha[k] = hA->get(*it);
+        if (out.sid[k] < 0 || out.sid[k] >= strandLimit || out.vid[k] < 0 || std::uint64_t(out.vid[k]) >= nPoints) {
+            // Whole numbers, possibly beyond any integer type: written as doubles.
+            const auto whole = [](double x) { std::ostringstream o; o.precision(17); o << x; return o.str(); };
+            return where + ": a point in voxel " + coordText(it.getCoord()) + " has strand " + whole(sv) +
+                   " and vertex " + whole(vv) + "; strand must be in [0, " +
+                   std::to_string(strandLimit) + ") and vertex in [0, " + std::to_string(nPoints) + ")";
+        }
+        maxStrand = std::max<std::int64_t>(maxStrand, out.sid[k]);
+    }
+    return {};
+}
+
+/// Step 5: the points of the plan's good leaves, leaves in parallel (the tree already holds
+/// them: sizes come from real data). Throws the first error in leaf order; returns the highest
+/// strand index in @a maxStrand (-1 for none).
+GridPoints gatherPoints(const pts::PointDataGrid& grid, const LeafSurvey& s, const GatherPlan& plan, const StrandAttributes& a,
+                        std::uint64_t nPoints, std::int64_t strandLimit, const ReadOptions& opts, const std::string& where,
+                        std::int64_t& maxStrand)
+{
+    GridPoints out;
+    out.pos.resize(nPoints);
+    out.cd.resize(a.hasCd ? nPoints : 0);
+    out.width.resize(a.hasW ? nPoints : 0);
+    out.alpha.resize(a.hasA ? nPoints : 0);
+    out.sid.resize(nPoints);
+    out.vid.resize(nPoints);
+    std::vector<std::string> pointError(plan.good);
+    std::vector<std::int64_t> leafMaxStrand(plan.good, -1);
     std::atomic<bool> interrupted{false};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, good, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, plan.good, 16), [&](const tbb::blocked_range<std::size_t>& r) {
         if (opts.interrupter && opts.interrupter->wasInterrupted()) {
             interrupted = true;
             return;
         }
         for (std::size_t l = r.begin(); l != r.end(); ++l) {
-            const auto& leaf = *leaves[l];
-            pts::AttributeHandle<openvdb::Vec3f> hP(leaf.constAttributeArray(iP));
-            const WholeNumberAttribute hS(leaf.constAttributeArray(iS), typeS), hV(leaf.constAttributeArray(iV), typeV);
-            std::optional<pts::AttributeHandle<openvdb::Vec3f>> hCd;
-            std::optional<pts::AttributeHandle<float>> hW, hA;
-            if (hasCd) hCd.emplace(leaf.constAttributeArray(iCd));
-            if (hasW) hW.emplace(leaf.constAttributeArray(iW));
-            if (hasA) hA.emplace(leaf.constAttributeArray(iA));
-            std::size_t k = std::size_t(base[l]);
-            for (auto it = leaf.beginIndexOn(); it; ++it, ++k) {
-                const openvdb::Vec3d ijk = it.getCoord().asVec3d();
-                const openvdb::Vec3d world = grid.transform().indexToWorld(ijk + hP.get(*it));
-                pos[k] = Vec3f(float(world.x()), float(world.y()), float(world.z()));
-                const double sv = hS.get(*it), vv = hV.get(*it);
-                const std::pair<const char*, double> checks[] = {{"strand", sv}, {"vertex", vv}};
-                for (const auto& [name, value] : checks) {
-                    if (!std::isfinite(value) || value != std::floor(value)) {
-                        std::ostringstream v;
-                        v.precision(9);
-                        v << value;
-                        pointError[l] = where + ": a point in voxel " + coordText(it.getCoord()) + " has " + name + " " + v.str() +
-                                        "; strand and vertex must hold whole numbers";
-                        break;
-                    }
-                }
-                if (!pointError[l].empty()) break;
-                sid[k] = (sv >= 0.0 && sv < double(strandLimit)) ? std::int32_t(sv) : -1;
-                vid[k] = (vv >= 0.0 && vv < double(nPoints)) ? std::int32_t(vv) : -1;
-                if (hasCd) cd[k] = hCd->get(*it);
-                if (hasW) width[k] = hW->get(*it);
-                if (hasA) alpha[k] = hA->get(*it);
-                if (sid[k] < 0 || sid[k] >= strandLimit || vid[k] < 0 || std::uint64_t(vid[k]) >= nPoints) {
-                    // Whole numbers, possibly beyond any integer type: written as doubles.
-                    const auto whole = [](double x) { std::ostringstream o; o.precision(17); o << x; return o.str(); };
-                    pointError[l] = where + ": a point in voxel " + coordText(it.getCoord()) + " has strand " + whole(sv) +
-                                    " and vertex " + whole(vv) + "; strand must be in [0, " +
-                                    std::to_string(strandLimit) + ") and vertex in [0, " + std::to_string(nPoints) + ")";
-                    break;
-                }
-                leafMaxStrand[l] = std::max<std::int64_t>(leafMaxStrand[l], sid[k]);
-            }
+            pointError[l] = gatherLeaf(*s.leaves[l], std::size_t(plan.base[l]), grid, a, strandLimit, nPoints, where, out,
+                                       leafMaxStrand[l]);
         }
     });
     if (interrupted) throw InterruptedError(where + ": interrupted while reading");
     for (const std::string& e : pointError)
         if (!e.empty()) throw FormatError(e);
-    if (!firstLeafError.empty()) throw FormatError(firstLeafError);
-    const std::uint64_t k = base[nL];
-    if (k != nPoints) throw FormatError(where + ": counted " + std::to_string(k) + " points, expected " + std::to_string(nPoints));
-    std::int64_t maxStrand = -1;
+    maxStrand = -1;
     for (std::int64_t m : leafMaxStrand) maxStrand = std::max(maxStrand, m);
-    const std::size_t nS = std::size_t(declared >= 0 ? declared : maxStrand + 1);
+    return out;
+}
 
-    // Vertices per strand = 1 + highest vertex index; every index below must appear exactly once.
-    std::vector<std::uint32_t> count(nS, 0);
-    for (std::size_t p = 0; p < nPoints; ++p) count[std::size_t(sid[p])] = std::max(count[std::size_t(sid[p])], std::uint32_t(vid[p]) + 1);
-    std::vector<std::uint64_t> start(nS + 1, 0);
-    for (std::size_t s = 0; s < nS; ++s) start[s + 1] = start[s] + count[s];
-    if (start[nS] != nPoints) {
-        throw FormatError(where + ": the strands' vertex indices leave gaps or repeat: " + std::to_string(start[nS]) +
+/// Where each strand's vertices go: strand s has count[s] vertices (1 + its highest vertex
+/// index), in slots [start[s], start[s+1]); slot[a] is the point in slot a.
+struct VertexSlots
+{
+    std::vector<std::uint32_t> count;
+    std::vector<std::uint64_t> start;
+    std::vector<std::uint32_t> slot;
+};
+
+/// Step 6: the slots of @a nS strands, every vertex index below a strand's count appearing
+/// exactly once.
+VertexSlots vertexSlots(const GridPoints& points, std::size_t nS, std::uint64_t nPoints, const std::string& where)
+{
+    VertexSlots v;
+    v.count.assign(nS, 0);
+    for (std::size_t p = 0; p < nPoints; ++p) {
+        v.count[std::size_t(points.sid[p])] = std::max(v.count[std::size_t(points.sid[p])], std::uint32_t(points.vid[p]) + 1);
+    }
+    v.start.assign(nS + 1, 0);
+    for (std::size_t s = 0; s < nS; ++s) v.start[s + 1] = v.start[s] + v.count[s];
+    if (v.start[nS] != nPoints) {
+        throw FormatError(where + ": the strands' vertex indices leave gaps or repeat: " + std::to_string(v.start[nS]) +
                           " vertex slots for " + std::to_string(nPoints) + " points (each strand needs vertices 0..n-1 exactly once)");
     }
-    std::vector<std::uint32_t> slot(nPoints, std::numeric_limits<std::uint32_t>::max());
+    v.slot.assign(nPoints, std::numeric_limits<std::uint32_t>::max());
     std::vector<char> filled(nPoints, 0);
     for (std::size_t p = 0; p < nPoints; ++p) {
-        const std::uint64_t at = start[std::size_t(sid[p])] + std::uint64_t(vid[p]);
-        if (filled[at]) throw FormatError(where + ": strand " + std::to_string(sid[p]) + " has vertex " + std::to_string(vid[p]) + " twice");
+        const std::uint64_t at = v.start[std::size_t(points.sid[p])] + std::uint64_t(points.vid[p]);
+        if (filled[at]) throw FormatError(where + ": strand " + std::to_string(points.sid[p]) + " has vertex " + std::to_string(points.vid[p]) + " twice");
         filled[at] = 1;
-        slot[at] = std::uint32_t(p);
+        v.slot[at] = std::uint32_t(p);
     }
+    return v;
+}
 
-    // The strands kept (in order, for the short-strand policy's messages), then their vertices in parallel.
+/// Step 7: the strand set: the strands kept (in order, for the short-strand policy's messages),
+/// then their vertices in parallel, with the grid's per-vertex defaults.
+StrandSet assembleStrands(const pts::PointDataGrid& grid, const GridPoints& points, const VertexSlots& v, const StrandAttributes& a,
+                          const ReadOptions& opts, ReadReport* report, const std::string& where)
+{
     StrandSet out;
     if (const auto m = findVdbhairMeta<openvdb::FloatMetadata>(grid, "default_thickness")) out.defaults.thickness = m->value();
     if (const auto m = findVdbhairMeta<openvdb::FloatMetadata>(grid, "default_transparency")) out.defaults.transparency = m->value();
@@ -521,31 +620,64 @@ StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std:
     ShortStrandFilter filter(opts, report, where);
     std::vector<std::uint32_t> kept;
     std::uint64_t keptVertices = 0;
-    for (std::size_t s = 0; s < nS; ++s) {
-        if (!filter.keep(s, count[s], "grid '" + grid.getName() + "'")) continue;
+    for (std::size_t s = 0; s < v.count.size(); ++s) {
+        if (!filter.keep(s, v.count[s], "grid '" + grid.getName() + "'")) continue;
         kept.push_back(std::uint32_t(s));
-        keptVertices += count[s];
+        keptVertices += v.count[s];
     }
     filter.finish();
     out.reserve(kept.size(), keptVertices);
-    for (std::uint32_t s : kept) out.offsets.push_back(out.offsets.back() + count[s]);
+    for (std::uint32_t s : kept) out.offsets.push_back(out.offsets.back() + v.count[s]);
     out.positions.resize(keptVertices);
-    if (hasCd) out.color.resize(keptVertices);
-    if (hasW) out.thickness.resize(keptVertices);
-    if (hasA) out.transparency.resize(keptVertices);
+    if (a.hasCd) out.color.resize(keptVertices);
+    if (a.hasW) out.thickness.resize(keptVertices);
+    if (a.hasA) out.transparency.resize(keptVertices);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kept.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             std::size_t o = out.offsets[i];
-            for (std::uint64_t a = start[kept[i]]; a < start[kept[i] + 1]; ++a, ++o) {
-                const std::uint32_t p = slot[a];
-                out.positions[o] = pos[p];
-                if (hasCd) out.color[o] = cd[p];
-                if (hasW) out.thickness[o] = width[p];
-                if (hasA) out.transparency[o] = 1.f - alpha[p];
+            for (std::uint64_t at = v.start[kept[i]]; at < v.start[kept[i] + 1]; ++at, ++o) {
+                const std::uint32_t p = v.slot[at];
+                out.positions[o] = points.pos[p];
+                if (a.hasCd) out.color[o] = points.cd[p];
+                if (a.hasW) out.thickness[o] = points.width[p];
+                if (a.hasA) out.transparency[o] = 1.f - points.alpha[p];
             }
         }
     });
     return out;
+}
+
+} // namespace
+
+StrandSet strandsFromGrid(const openvdb::points::PointDataGrid& grid, const std::string& where,
+                          const ReadOptions& opts, ReadReport* report)
+{
+    const pts::PointDataTree& tree = grid.tree();
+    const auto leaf0 = tree.cbeginLeaf();
+    const std::uint64_t nPoints = pts::pointCount(tree);
+    if (!leaf0 || nPoints == 0) throw FormatError(where + ": grid '" + grid.getName() + "' has no points");
+    const pts::AttributeSet::Descriptor& desc = leaf0->attributeSet().descriptor();
+    const StrandAttributes attrs = strandAttributes(desc, grid, where);
+    const std::int64_t declared = declaredStrandCount(grid, nPoints, where);
+    if (nPoints > std::numeric_limits<std::uint32_t>::max())
+        throw LimitError(where + ": grid '" + grid.getName() + "' has " + std::to_string(nPoints) +
+                         " points, more than the 2^32-1 vertices a strand set holds");
+
+    // Every point gathered, leaves in parallel, after each leaf's offsets and arrays are checked.
+    // Errors are those a pass over the leaves in order would meet first: each leaf's checks,
+    // then its points, leaf by leaf.
+    const LeafSurvey survey = surveyLeaves(tree, desc, attrs, where);
+    const GatherPlan plan = planGather(survey, nPoints, where);
+    const std::int64_t strandLimit = declared >= 0 ? declared : std::int64_t(nPoints);
+    std::int64_t maxStrand = -1;
+    const GridPoints points = gatherPoints(grid, survey, plan, attrs, nPoints, strandLimit, opts, where, maxStrand);
+    if (!plan.firstLeafError.empty()) throw FormatError(plan.firstLeafError);
+    const std::uint64_t k = plan.base[survey.leaves.size()];
+    if (k != nPoints) throw FormatError(where + ": counted " + std::to_string(k) + " points, expected " + std::to_string(nPoints));
+    const std::size_t nS = std::size_t(declared >= 0 ? declared : maxStrand + 1);
+
+    const VertexSlots slots = vertexSlots(points, nS, nPoints, where);
+    return assembleStrands(grid, points, slots, attrs, opts, report, where);
 }
 
 void writeVdbStrands(const std::string& path, const StrandSet& strands, const VdbPointsOptions& opts)
