@@ -9,6 +9,7 @@
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/synth/Comb.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
@@ -314,4 +315,34 @@ TEST_CASE("Parameters: synth's declaration is transfer's and comb's, each with i
     CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
     CHECK(page.find(parameterMarkdown(transferParameters())) != std::string::npos);
     CHECK(page.find(parameterMarkdown(combParameters())) != std::string::npos);
+}
+
+TEST_CASE("Parameters: scalp's declaration sets the level set's and the region's, a float as a number, in docs/cli.md", "[params]")
+{
+    const ParamTable<ScalpBuildParams>& t = scalpParameters();
+    CHECK(declared(t, "half-width").defaultText() == formatNumber(ScalpParams{}.halfWidth));
+    CHECK(declared(t, "region-threshold").defaultText() == formatNumber(kDefaultRegionThreshold));
+    ScalpBuildParams p;
+    setParam(t, "voxel-size", p, 0.25);
+    setParam(t, "half-width", p, 2.0);
+    setParam(t, "max-constraints", p, std::uint64_t(300));
+    setParam(t, "region-radius", p, 3.0);
+    setParam(t, "region-threshold", p, 0.25);
+    CHECK(p.surface.maxConstraints == 300);
+    CHECK(p.regionRadius == 3.0);
+    CHECK(p.regionThreshold == 0.25);
+    // What the level set is made with: its voxel and its band (half width x voxel size).
+    const openvdb::FloatGrid::Ptr sphere = scalpFromSphere(Vec3d(0.0), 1.0, p.surface);
+    CHECK(sphere->voxelSize().x() == Approx(0.25));
+    CHECK(sphere->background() == Approx(0.5));
+    p = ScalpBuildParams{};
+    p.surface.halfWidth = 0.5f;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--half-width 0.5: must be between 1 and 64 voxels");
+    p = ScalpBuildParams{};
+    p.surface.maxConstraints = 4;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "scalp"), "scalp: max_constraints 4: must be at least 5");
+    p = ScalpBuildParams{};
+    p.regionThreshold = std::numeric_limits<double>::infinity();
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--region-threshold inf: must be finite");
+    checkDeclaration(t, "scalp");
 }
