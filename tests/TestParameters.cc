@@ -8,6 +8,7 @@
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/synth/Comb.h>
@@ -345,4 +346,28 @@ TEST_CASE("Parameters: scalp's declaration sets the level set's and the region's
     p.regionThreshold = std::numeric_limits<double>::infinity();
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--region-threshold inf: must be finite");
     checkDeclaration(t, "scalp");
+}
+
+TEST_CASE("Parameters: render's declaration, the views and colourings by name, in docs/cli.md", "[params]")
+{
+    const ParamTable<RenderParams>& t = renderParameters();
+    CHECK(declared(t, "view").defaultText() == viewName(RenderParams{}.view));
+    CHECK(declared(t, "color-by").defaultText() == colorByName(RenderParams{}.colorBy));
+    RenderParams p;
+    setParam(t, "view", p, std::string("side"));
+    setParam(t, "color-by", p, std::string("error"));
+    setParam(t, "width", p, 300);
+    setParam(t, "height", p, 200);
+    CHECK(p.view == View::Side);
+    CHECK(p.colorBy == ColorBy::Error);
+    // What the renderer draws: an image of the declared size.
+    StrandSet strands;
+    strands.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(0.f, 1.f, 0.f)});
+    setParam(t, "color-by", p, std::string("root"));
+    const Image image = renderStrands(strands, p);
+    CHECK(image.width == 300);
+    CHECK(image.height == 200);
+    p.width = RenderParams::kMaxSize + 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--width 16385: must be between 1 and 16384 pixels");
+    checkDeclaration(t, "render");
 }
