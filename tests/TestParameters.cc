@@ -1,6 +1,7 @@
 #include "TestUtil.h"
 
 #include <vdbhair/Parameters.h>
+#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/TangentField.h>
@@ -370,4 +371,18 @@ TEST_CASE("Parameters: render's declaration, the views and colourings by name, i
     p.width = RenderParams::kMaxSize + 1;
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--width 16385: must be between 1 and 16384 pixels");
     checkDeclaration(t, "render");
+}
+
+TEST_CASE("Parameters: compare's declaration sets what the comparison reads, in docs/cli.md", "[params]")
+{
+    const ParamTable<CompareParams>& t = compareParameters();
+    CHECK(declared(t, "bidirectional").flag() == "--bidirectional");
+    CompareParams p;
+    setParam(t, "bidirectional", p, true);
+    setParam(t, "samples", p, std::uint64_t(20));
+    CHECK(p.bidirectional);
+    CHECK(p.samples == 20);
+    p.samples = 2;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--samples 2: must be at least 3");
+    checkDeclaration(t, "compare");
 }
