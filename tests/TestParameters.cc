@@ -2,6 +2,7 @@
 
 #include <vdbhair/Parameters.h>
 #include <vdbhair/compare/HairComparison.h>
+#include <vdbhair/dataset/Prepare.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/TangentField.h>
@@ -385,4 +386,25 @@ TEST_CASE("Parameters: compare's declaration sets what the comparison reads, in 
     p.samples = 2;
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--samples 2: must be at least 3");
     checkDeclaration(t, "compare");
+}
+
+TEST_CASE("Parameters: prepare's declaration, a keyword that is not its name, in docs/cli.md", "[params]")
+{
+    const ParamTable<PrepareParams>& t = prepareParameters();
+    CHECK(declared(t, "strands").pythonName() == "count");
+    CHECK(declared(t, "root-depth").defaultText() == rootDepthName(PrepareParams{}.rootDepth));
+    PrepareParams p;
+    setParam(t, "strands", p, std::uint64_t(500));
+    setParam(t, "points", p, std::uint64_t(32));
+    setParam(t, "overlap", p, 0.5);
+    setParam(t, "head-crop", p, 1.5);
+    setParam(t, "root-depth", p, std::string("surface"));
+    CHECK(p.strands == 500);
+    CHECK(p.points == 32);
+    CHECK(p.align.overlap == 0.5);
+    CHECK(p.headCrop == 1.5);
+    CHECK(p.rootDepth == RootDepth::Surface);
+    p.align.overlap = 0.0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "prepare"), "prepare: overlap 0: must be above 0 and at most 1");
+    checkDeclaration(t, "prepare");
 }
