@@ -1,6 +1,8 @@
 #include "TestUtil.h"
 
 #include <vdbhair/Parameters.h>
+#include <vdbhair/compare/HairComparison.h>
+#include <vdbhair/dataset/Prepare.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/field/TangentField.h>
@@ -8,7 +10,9 @@
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/Follicles.h>
+#include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/synth/Comb.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
@@ -314,4 +318,93 @@ TEST_CASE("Parameters: synth's declaration is transfer's and comb's, each with i
     CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
     CHECK(page.find(parameterMarkdown(transferParameters())) != std::string::npos);
     CHECK(page.find(parameterMarkdown(combParameters())) != std::string::npos);
+}
+
+TEST_CASE("Parameters: scalp's declaration sets the level set's and the region's, a float as a number, in docs/cli.md", "[params]")
+{
+    const ParamTable<ScalpBuildParams>& t = scalpParameters();
+    CHECK(declared(t, "half-width").defaultText() == formatNumber(ScalpParams{}.halfWidth));
+    CHECK(declared(t, "region-threshold").defaultText() == formatNumber(kDefaultRegionThreshold));
+    ScalpBuildParams p;
+    setParam(t, "voxel-size", p, 0.25);
+    setParam(t, "half-width", p, 2.0);
+    setParam(t, "max-constraints", p, std::uint64_t(300));
+    setParam(t, "region-radius", p, 3.0);
+    setParam(t, "region-threshold", p, 0.25);
+    CHECK(p.surface.maxConstraints == 300);
+    CHECK(p.regionRadius == 3.0);
+    CHECK(p.regionThreshold == 0.25);
+    // What the level set is made with: its voxel and its band (half width x voxel size).
+    const openvdb::FloatGrid::Ptr sphere = scalpFromSphere(Vec3d(0.0), 1.0, p.surface);
+    CHECK(sphere->voxelSize().x() == Approx(0.25));
+    CHECK(sphere->background() == Approx(0.5));
+    p = ScalpBuildParams{};
+    p.surface.halfWidth = 0.5f;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--half-width 0.5: must be between 1 and 64 voxels");
+    p = ScalpBuildParams{};
+    p.surface.maxConstraints = 4;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "scalp"), "scalp: max_constraints 4: must be at least 5");
+    p = ScalpBuildParams{};
+    p.regionThreshold = std::numeric_limits<double>::infinity();
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--region-threshold inf: must be finite");
+    checkDeclaration(t, "scalp");
+}
+
+TEST_CASE("Parameters: render's declaration, the views and colourings by name, in docs/cli.md", "[params]")
+{
+    const ParamTable<RenderParams>& t = renderParameters();
+    CHECK(declared(t, "view").defaultText() == viewName(RenderParams{}.view));
+    CHECK(declared(t, "color-by").defaultText() == colorByName(RenderParams{}.colorBy));
+    RenderParams p;
+    setParam(t, "view", p, std::string("side"));
+    setParam(t, "color-by", p, std::string("error"));
+    setParam(t, "width", p, 300);
+    setParam(t, "height", p, 200);
+    CHECK(p.view == View::Side);
+    CHECK(p.colorBy == ColorBy::Error);
+    // What the renderer draws: an image of the declared size.
+    StrandSet strands;
+    strands.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(0.f, 1.f, 0.f)});
+    setParam(t, "color-by", p, std::string("root"));
+    const Image image = renderStrands(strands, p);
+    CHECK(image.width == 300);
+    CHECK(image.height == 200);
+    p.width = RenderParams::kMaxSize + 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--width 16385: must be between 1 and 16384 pixels");
+    checkDeclaration(t, "render");
+}
+
+TEST_CASE("Parameters: compare's declaration sets what the comparison reads, in docs/cli.md", "[params]")
+{
+    const ParamTable<CompareParams>& t = compareParameters();
+    CHECK(declared(t, "bidirectional").flag() == "--bidirectional");
+    CompareParams p;
+    setParam(t, "bidirectional", p, true);
+    setParam(t, "samples", p, std::uint64_t(20));
+    CHECK(p.bidirectional);
+    CHECK(p.samples == 20);
+    p.samples = 2;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--samples 2: must be at least 3");
+    checkDeclaration(t, "compare");
+}
+
+TEST_CASE("Parameters: prepare's declaration, a keyword that is not its name, in docs/cli.md", "[params]")
+{
+    const ParamTable<PrepareParams>& t = prepareParameters();
+    CHECK(declared(t, "strands").pythonName() == "count");
+    CHECK(declared(t, "root-depth").defaultText() == rootDepthName(PrepareParams{}.rootDepth));
+    PrepareParams p;
+    setParam(t, "strands", p, std::uint64_t(500));
+    setParam(t, "points", p, std::uint64_t(32));
+    setParam(t, "overlap", p, 0.5);
+    setParam(t, "head-crop", p, 1.5);
+    setParam(t, "root-depth", p, std::string("surface"));
+    CHECK(p.strands == 500);
+    CHECK(p.points == 32);
+    CHECK(p.align.overlap == 0.5);
+    CHECK(p.headCrop == 1.5);
+    CHECK(p.rootDepth == RootDepth::Surface);
+    p.align.overlap = 0.0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "prepare"), "prepare: overlap 0: must be above 0 and at most 1");
+    checkDeclaration(t, "prepare");
 }

@@ -1,6 +1,7 @@
 // vdbhair compare A B: the measures hair papers report, of a candidate hairstyle B against a
 // reference A (vdbhair/compare/HairComparison.h).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
@@ -20,7 +21,7 @@ struct CompareCmdParams
 {
     std::string a, b, unit, head, perStrand;
     std::vector<std::string> thresholds;
-    CompareParams params;
+    CompareParams params;  ///< its declared parameters (compareParameters()) are options
 };
 
 /// "D:ANGLE": a distance (millimetres with --unit, else file units) and an angle in degrees.
@@ -43,6 +44,7 @@ int runCompare(CompareCmdParams p, const CommonOptions& common)
 {
     if (!p.unit.empty()) p.params.metersPerUnit = metersPerUnitFromName(p.unit, "--unit");
     for (const std::string& t : p.thresholds) p.params.thresholds.push_back(parseThreshold(t, p.params.metersPerUnit > 0.0));
+    checkParamOptions(compareParameters(), p.params);
     p.params.validate();
     if (!p.perStrand.empty() && fileExtension(p.perStrand) != ".csv") {
         throw ValueError("--per-strand " + p.perStrand + ": must name a .csv file");
@@ -118,10 +120,9 @@ Command addCompareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--unit", params->unit, "The files' unit: mm, cm, dm, m, in, or its length in metres; needed for HairGS's thresholds in millimetres");
     sub->add_option("--threshold", params->thresholds, "An oriented-point threshold DISTANCE:ANGLE (millimetres with --unit, else file units; "
                                                        "repeat for more; default with --unit: HairGS's 2:20 3:30 4:40 4:90)");
-    sub->add_flag("--bidirectional", params->params.bidirectional, "Oriented points match whichever way round their directions point");
     sub->add_flag_function("--unpaired", [params](std::int64_t) { params->params.pairStrands = false; },
                            "Do not pair strand i of A with strand i of B even when the counts agree (hairstyles whose strands do not correspond, such as a synthesis)");
-    sub->add_option("--samples", params->params.samples, "Points per strand for the strand-pair measures (Perm: 100)")->capture_default_str();
+    addParamOptions(sub, params->params, compareParameters());
     sub->add_option("--head", params->head, "A head (mesh or .vdb level set): the shares of A's and B's strands passing into it");
     sub->add_option("--per-strand", params->perStrand, "Write each strand of A's values as CSV: chamfer, and with equal strand counts position, curvature, frechet");
     addCommonOptions(sub, common);

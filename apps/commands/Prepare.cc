@@ -2,6 +2,7 @@
 // roots kept (--strands), moved onto a common head (--head, --align-to), resampled (--points),
 // pushed out of the head (--fix-penetration).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/dataset/Prepare.h>
@@ -26,9 +27,8 @@ struct PrepareCmdParams
     std::vector<std::string> files;  ///< IN OUT, or IN with -o OUT
     std::string output, head, alignTo, fixPenetration;
     std::string targetUp = axisName(PrepareParams{}.targetUp);  ///< PrepareParams::targetUp by name
-    std::string rootDepth = rootDepthName(PrepareParams{}.rootDepth);
     bool strict = false;
-    PrepareParams prepare;
+    PrepareParams prepare;  ///< its declared parameters (prepareParameters()) are options; targetUp set from --target-up
 };
 
 std::string fmt(double v)
@@ -78,7 +78,7 @@ int runPrepare(PrepareCmdParams p, const CommonOptions& common)
     strandFormatFromPath(input);
     strandFormatFromPath(p.output, /*forWriting=*/true);
     p.prepare.targetUp = axisFromName(p.targetUp, "--target-up");
-    p.prepare.rootDepth = rootDepthFromName(p.rootDepth);
+    checkParamOptions(prepareParameters(), p.prepare);
     p.prepare.validate();
     if (!p.alignTo.empty() && p.head.empty()) {
         throw ValueError("--align-to " + p.alignTo + " needs --head, the groom's own head mesh: that head is fitted to " + p.alignTo +
@@ -129,38 +129,21 @@ int runPrepare(PrepareCmdParams p, const CommonOptions& common)
 Command addPrepareCommand(CLI::App& app, CommonOptions& common)
 {
     auto params = std::make_shared<PrepareCmdParams>();
-    PrepareParams& pp = params->prepare;
     CLI::App* sub = addVerb(app, "prepare");
     sub->add_option("files", params->files, "IN OUT, or IN with -o OUT")->required();
     sub->add_option("-o,--output", params->output, "Output strand file; its extension picks the format (.hair .data .obj .ply .vdb .usda .abc)");
-    sub->add_option("--points", pp.points, "Resample every strand to exactly N vertices, equally spaced in arc length, root and tip kept (0: keep)")
-        ->check(kCount)
-        ->capture_default_str();
-    sub->add_option("--strands", pp.strands,
-                    "Keep N strands with evenly spread roots (farthest-point sampling of the roots; 0: keep all; all when fewer)")
-        ->check(kCount)
-        ->capture_default_str();
+    addParamOptions(sub, params->prepare, prepareParameters());
+    for (const char* count : {"--points", "--strands"}) sub->get_option(count)->check(kCount);
     sub->add_option("--head", params->head, "The groom's own head mesh (.ply, .obj), in the strands' frame: the source of --align-to");
     sub->add_option("--align-to", params->alignTo,
                     "A common head mesh (.ply, .obj): --head is fitted onto it by a similarity (scale, rotation, translation) and the "
                     "strands move with it; the transform and the residual are reported");
-    sub->add_option("--overlap", pp.align.overlap,
-                    "--align-to between different heads: the share of nearest point pairs kept at each ICP iteration (necks cut at different heights)")
-        ->capture_default_str();
-    sub->add_option("--head-crop", pp.headCrop,
-                    "--align-to by ICP: use the --head vertices within this many times the roots' radius of their centroid "
-                    "(the head, not a bust's shoulders; 0: every vertex)")
-        ->capture_default_str();
     sub->add_option("--target-up", params->targetUp,
                     "--align-to by ICP: the common head's up axis (x, y, z, -x, -y, -z); the groom's up is from its head to its roots")
         ->capture_default_str();
     sub->add_option("--fix-penetration", params->fixPenetration,
                     "A head (mesh or .vdb level set) in the output's frame, e.g. the --align-to mesh: strands that enter it are bent out "
                     "(lengths kept, roots fixed; a root inside the scalp may stay as deep as it is)");
-    sub->add_option("--root-depth", params->rootDepth,
-                    "--fix-penetration: keep (a root inside the head stays, its strand no deeper than it) or surface (the strand is "
-                    "first moved out along the head's normal until its root is on the surface: roots under a new scalp after --align-to)")
-        ->capture_default_str();
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);

@@ -1,5 +1,6 @@
 // vdbhair render IN -o OUT.png: preview images of strands (any strand format, .vdb points, or a scene).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
@@ -17,20 +18,16 @@ namespace {
 struct RenderCmdParams
 {
     std::string input, output, guides, title, facing, head, reference;
-    std::string view = viewName(RenderParams{}.view), colorBy = colorByName(RenderParams{}.colorBy);
+    RenderParams render;  ///< its declared parameters (renderParameters()) are options
     std::string up = axisName(RenderParams{}.up);
     std::string grid = ReadOptions{}.vdbGrid;
-    int width = RenderParams{}.width, height = RenderParams{}.height;
     bool sheet = false;
 };
 
 int runRender(const RenderCmdParams& p, const CommonOptions& common)
 {
-    RenderParams rp;
-    rp.view = viewFromName(p.view);
-    rp.colorBy = colorByFromName(p.colorBy);
-    rp.width = p.width;
-    rp.height = p.height;
+    checkParamOptions(renderParameters(), p.render);
+    RenderParams rp = p.render;
     rp.title = p.title;
     rp.interrupter = common.interrupter;
     rp.up = axisFromName(p.up, "--up");
@@ -40,10 +37,6 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
             throw ValueError("--facing " + p.facing + " with --up " + p.up + ": the face must look along an axis perpendicular to up");
         }
         rp.facing = facing;
-    }
-    if (p.width < 1 || p.height < 1 || p.width > RenderParams::kMaxSize || p.height > RenderParams::kMaxSize) {
-        throw ValueError("--width/--height " + std::to_string(p.width) + "x" + std::to_string(p.height) +
-                         ": must be between 1 and " + std::to_string(RenderParams::kMaxSize) + " pixels");
     }
     if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
     // Roots (a PLY of points with normals, as `vdbhair roots` writes) are drawn as dots: stubs
@@ -90,9 +83,9 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
     writeImage(p.output, image);
     if (common.json) {
         printJson({{"output", p.output}, {"width", image.width}, {"height", image.height}, {"strands", strands.numStrands()},
-                   {"view", p.sheet ? "sheet" : p.view}, {"seconds", seconds}});
+                   {"view", p.sheet ? "sheet" : viewName(rp.view)}, {"seconds", seconds}});
     } else if (!common.quiet) {
-        std::cout << "rendered " << strands.numStrands() << (rootsInput ? " roots (" : " strands (") << (p.sheet ? std::string("sheet") : p.view) << ", "
+        std::cout << "rendered " << strands.numStrands() << (rootsInput ? " roots (" : " strands (") << (p.sheet ? std::string("sheet") : std::string(viewName(rp.view))) << ", "
                   << image.width << "x" << image.height << ") in " << seconds << " s\nwrote " << p.output << "\n";
     }
     return 0;
@@ -106,12 +99,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "render");
     sub->add_option("input", params->input, "Strands (any format), .vdb points, a scene .json, or roots (.ply points with normals: drawn as dots)")->required();
     sub->add_option("-o,--output", params->output, "Image (.png, .exr, .jpg: by extension)")->required();
-    sub->add_option("--view", params->view, "front, side, top, back or three-quarter (perspective)")->capture_default_str();
-    sub->add_option("--width", params->width, "Width in pixels")->capture_default_str();
-    sub->add_option("--height", params->height, "Height in pixels")->capture_default_str();
-    sub->add_option("--color-by", params->colorBy,
-                    "shaded, root, tangent, depth, curvature, strand, or error (each vertex's distance to the nearest of --reference)")
-        ->capture_default_str();
+    addParamOptions(sub, params->render, renderParameters());
     sub->add_option("--reference", params->reference, "For --color-by error: the hairstyle to measure against (e.g. the reference of `compare`)");
     sub->add_option("--head", params->head, "A head mesh (.ply, .obj) drawn behind the hair, e.g. from ../shared/data/scalp (default: a scene's own \"head\")");
     sub->add_option("--guides", params->guides, "Strands drawn on top in red (e.g. the guides of a scene)");

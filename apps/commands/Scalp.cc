@@ -1,6 +1,7 @@
 // vdbhair scalp MESH|POINTS -o scalp.vdb: a scalp as a VDB level set (grid `surface`), with an
 // optional hair region (grid `region`).
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
@@ -23,35 +24,28 @@ namespace {
 struct ScalpCmdParams
 {
     std::string input, output, region, regionMask, regionGrid, regionVertex;
-    double regionThreshold = kDefaultRegionThreshold;
-    ScalpParams scalp;  ///< the library's defaults (voxelSize 0: suggested from the input)
-    CLI::Option* voxelOpt = nullptr;
+    ScalpBuildParams params;  ///< its declared parameters (scalpParameters()) are options
     std::vector<double> sphere;  ///< cx, cy, cz, r
-    double regionRadius = 0.0;
 };
 
 int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
 {
     // Arguments, before any work.
     if (fileExtension(p.output) != ".vdb") throw ValueError(p.output + ": the scalp is written as OpenVDB; the output must end in .vdb");
-    const bool voxelGiven = p.voxelOpt && p.voxelOpt->count() > 0;
-    if (voxelGiven && (!(p.scalp.voxelSize > 0.0) || !std::isfinite(p.scalp.voxelSize))) {
-        throw ValueError("--voxel-size " + formatValue(p.scalp.voxelSize) + ": must be a positive finite length");
-    }
+    checkParamOptions(scalpParameters(), p.params);
     if (!p.sphere.empty() && (p.sphere.size() != 4 || !(p.sphere[3] > 0.0))) throw ValueError("--sphere needs CX,CY,CZ,R with R > 0");
     if (p.sphere.empty() && p.input.empty()) throw ValueError("needs an input (a mesh .ply/.obj, points .ply with normals, or a strand file) or --sphere CX,CY,CZ,R");
     if (!p.sphere.empty() && !p.input.empty()) throw ValueError("both an input (" + p.input + ") and --sphere: give one");
-    if (p.regionRadius < 0.0 || !std::isfinite(p.regionRadius)) throw ValueError("--region-radius " + formatValue(p.regionRadius) + ": must be a positive length");
-    if (p.regionRadius > 0.0 && p.region.empty()) throw ValueError("--region-radius without --region STRANDS");
+    const double regionRadius = p.params.regionRadius, regionThreshold = p.params.regionThreshold;
+    if (regionRadius > 0.0 && p.region.empty()) throw ValueError("--region-radius without --region STRANDS");
     if (int(!p.region.empty()) + int(!p.regionMask.empty()) + int(!p.regionVertex.empty()) > 1)
         throw ValueError("more than one of --region, --region-mask and --region-vertex: give one");
     if (!p.regionVertex.empty() && fileExtension(p.input) != ".ply")
         throw ValueError("--region-vertex " + p.regionVertex + ": reads a vertex property of a PLY mesh, and the input " +
                          (p.input.empty() ? std::string("is a sphere") : "'" + p.input + "' is not one"));
     if (!p.regionGrid.empty() && p.regionMask.empty()) throw ValueError("--region-grid without --region-mask MASK.vdb");
-    if (!std::isfinite(p.regionThreshold)) throw ValueError("--region-threshold " + formatValue(p.regionThreshold) + ": must be finite");
 
-    ScalpParams sp = p.scalp;
+    ScalpParams sp = p.params.surface;
     sp.source = p.input;
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -81,24 +75,24 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         const StrandSet strands = loadStrands("scalp", p.region, common);
         std::vector<Vec3f> roots;
         for (std::size_t i = 0; i < strands.numStrands(); ++i) roots.push_back(strands.root(i));
-        const double radius = p.regionRadius > 0.0 ? p.regionRadius : defaultRegionRadius(*surface, roots);
+        const double radius = regionRadius > 0.0 ? regionRadius : defaultRegionRadius(*surface, roots);
         const Stage stage(common, "region from the roots of " + p.region);
         region = regionFromRoots(*surface, roots, radius, p.region, std::uint64_t(1) << 28, defaultRootDistance(*surface));
         grids.push_back(region);
         detail["region"] = {{"roots", roots.size()}, {"radius", radius}, {"active_voxels", region->activeVoxelCount()}};
     } else if (!p.regionVertex.empty()) {
         const Stage stage(common, "region from the vertex values '" + p.regionVertex + "' of " + p.input);
-        region = regionFromVertexValues(*surface, readTriangleMesh(p.input), readPlyVertexValues(p.input, p.regionVertex), p.regionThreshold, p.input);
+        region = regionFromVertexValues(*surface, readTriangleMesh(p.input), readPlyVertexValues(p.input, p.regionVertex), regionThreshold, p.input);
         grids.push_back(region);
-        detail["region"] = {{"vertex", p.regionVertex}, {"threshold", p.regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
+        detail["region"] = {{"vertex", p.regionVertex}, {"threshold", regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
     } else if (!p.regionMask.empty()) {
         // The mask: the grid named, else 'region', else the file's first bool or float grid that is not a level set.
         const openvdb::GridBase::Ptr mask = readMaskGrid(p.regionMask, p.regionGrid, "region", "a region mask (--region-grid NAME)");
         const std::string name = mask->getName();
         const Stage stage(common, "region from the mask '" + name + "' of " + p.regionMask);
-        region = regionFromMask(*surface, *mask, p.regionThreshold, p.regionMask);
+        region = regionFromMask(*surface, *mask, regionThreshold, p.regionMask);
         grids.push_back(region);
-        detail["region"] = {{"mask", name}, {"threshold", p.regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
+        detail["region"] = {{"mask", name}, {"threshold", regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     {
@@ -128,7 +122,7 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
                       << " of the roots of " << p.region << "\n";
         if (region && !p.regionVertex.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels where the vertex value '" << p.regionVertex << "' exceeds "
-                      << formatValue(p.regionThreshold) << "\n";
+                      << formatValue(regionThreshold) << "\n";
         if (region && !p.regionMask.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels covered by the mask '" << detail["region"]["mask"].get<std::string>()
                       << "' of " << p.regionMask << "\n";
@@ -147,18 +141,13 @@ Command addScalpCommand(CLI::App& app, CommonOptions& common)
                     "Mesh (.ply or .obj with faces: meshToLevelSet, open boundaries capped), points with normals (.ply nx ny nz, or the roots "
                     "of a strand file: Turk & O'Brien's variational implicit)");
     sub->add_option("-o,--output", params->output, "Output .vdb")->required();
-    params->voxelOpt = sub->add_option("--voxel-size", params->scalp.voxelSize, "Voxel size in world units (default: 1/100 of the largest extent)");
     sub->add_option("--sphere", params->sphere, "A sphere CX,CY,CZ,R (world units) instead of an input")->delimiter(',')->expected(4);
-    sub->add_option("--half-width", params->scalp.halfWidth, "Narrow-band half width in voxels")->capture_default_str();
-    sub->add_option("--max-voxels", params->scalp.maxVoxels, "Refuse voxel sizes whose band is estimated at more voxels")->capture_default_str();
-    sub->add_option("--max-constraints", params->scalp.maxConstraints, "Points input: thin to this many constraint points (the solve is cubic)")->capture_default_str();
+    addParamOptions(sub, params->params, scalpParameters());
     sub->add_option("--region", params->region, "Strand file: the region is where its roots are (grid 'region')");
-    sub->add_option("--region-radius", params->regionRadius, "Radius around each root, world units (default: twice the roots' mean spacing)");
     sub->add_option("--region-mask", params->regionMask, "A .vdb whose bool or float grid paints the region: surface voxels it covers (a bool grid's true values, a float grid's values above --region-threshold)");
     sub->add_option("--region-grid", params->regionGrid, "The mask's grid (default: 'region', else the file's first bool or float grid that is not a level set)");
     sub->add_option("--region-vertex", params->regionVertex,
                     "A PLY mesh input's vertex property paints the region: a colour channel (red, green, blue, alpha; uchar scaled to 0-1) or any named scalar, above --region-threshold");
-    sub->add_option("--region-threshold", params->regionThreshold, "A float mask or vertex value covers where it exceeds this")->capture_default_str();
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Examples:\n  vdbhair scalp head.ply -o scalp.vdb --voxel-size 0.5 --region hair.hair\n"

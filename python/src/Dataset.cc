@@ -1,6 +1,7 @@
 // Bindings of the dataset toolbox: vdbhair.prepare() (`vdbhair prepare`) and
 // vdbhair.strand_statistics() (`vdbhair info --stats`).
 #include "Common.h"
+#include "Params.h"
 
 #include <vdbhair/dataset/Prepare.h>
 #include <vdbhair/io/MeshFile.h>
@@ -29,76 +30,57 @@ nlohmann::json histogramJson(const Histogram& h)
     return {{"lo", h.lo}, {"hi", h.hi}, {"counts", h.counts}, {"above", h.above}};
 }
 
+/// prepare: a hairstyle made ready for a dataset (prepareParameters()).
+void definePrepare(pyb::module_& m)
+{
+    auto prepareImpl = [](const StrandsPtr& strands, const pyb::dict& kw) {
+        PrepareParams p;
+        applyKeywords(prepareParameters(), kw, p, "prepare");
+        try {
+            p.validate();
+        } catch (const ValueError& e) {
+            throw ValueError(std::string("prepare: ") + e.what());
+        }
+        const pyb::object headArg = kw["head"], alignToArg = kw["align_to"];
+        const std::optional<std::string> headPath = headArg.is_none() ? std::nullopt : std::optional<std::string>(pathString(headArg, "head"));
+        const std::optional<std::string> alignPath =
+            alignToArg.is_none() ? std::nullopt : std::optional<std::string>(pathString(alignToArg, "align_to"));
+        if (alignPath && !headPath) throw ValueError("prepare: align_to needs head=, the groom's own head mesh: that head is fitted to align_to");
+        const HeadArgument fix(kw["fix_penetration"], "outside");
+        auto result = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter*) {
+            StrandSet out = *strands;
+            TriangleMesh head, target;
+            if (headPath) head = readTriangleMesh(*headPath);
+            if (alignPath) target = readTriangleMesh(*alignPath);
+            const HeadObstacle obstacle = fix.get("prepare");
+            const bool fixing = !obstacle.unset() && !obstacle.empty();
+            PrepareReport r = prepareStrands(out, p, headPath ? &head : nullptr, alignPath ? &target : nullptr, fixing ? &obstacle : nullptr);
+            return std::make_pair(std::make_shared<StrandSet>(std::move(out)), toJson(r));
+        });
+        return pyb::make_tuple(result.first, fromJson(result.second));
+    };
+    defineVerb(m, "prepare", {"strands: vdbhair.Strands"}, prepareParameters(),
+               {{"head", "", pyb::none(), "the groom's own head mesh (a path to a .ply or .obj), the source of the alignment."},
+                {"align_to", "", pyb::none(),
+                 "a common head mesh (a path): head is fitted onto it by a similarity transform (Umeyama on vertex pairs for two "
+                 "copies of one mesh, else trimmed ICP) and the strands move with it."},
+                {"fix_penetration", "", pyb::none(),
+                 "None, a head (a path to a mesh or a .vdb level set) or (x, y, z, r), a sphere, in the output's frame: strands "
+                 "that enter it are bent out, lengths kept."}},
+               "Make a hairstyle ready for a dataset (``vdbhair prepare IN OUT --json``): keep ``count``\n"
+               "strands with evenly spread roots, move the groom onto a common head, resample every strand to\n"
+               "``points`` vertices, push strands out of a head, in that order (the input is not changed).",
+               "    strands: the Strands.\n",
+               "(Strands, dict): the prepared strands and the command line's report (strands, vertices,\n"
+               "    subsample, align with scale, rotation, translation, matrix and residual_rms, fix_penetration).",
+               pyb::cpp_function(prepareImpl, pyb::arg("strands"), pyb::arg("keywords")));
+}
+
 } // namespace
 
 void bindDataset(pyb::module_& m)
 {
-    const PrepareParams defaults;
-    m.def(
-        "prepare",
-        [](const StrandsPtr& strands, std::size_t points, std::size_t count, const pyb::object& headArg, const pyb::object& alignToArg,
-           const pyb::object& fixArg, const std::string& rootDepth, double overlap, double headCrop, int threads) {
-            PrepareParams p;
-            p.points = points;
-            p.strands = count;
-            p.align.overlap = overlap;
-            p.headCrop = headCrop;
-            try {
-                p.rootDepth = rootDepthFromName(rootDepth);
-            } catch (const ValueError&) {
-                throw ValueError("prepare: root_depth '" + rootDepth + "': must be keep or surface");
-            }
-            try {
-                p.validate();
-            } catch (const ValueError& e) {
-                throw ValueError(std::string("prepare: ") + e.what());
-            }
-            const std::optional<std::string> headPath = headArg.is_none() ? std::nullopt : std::optional<std::string>(pathString(headArg, "head"));
-            const std::optional<std::string> alignPath =
-                alignToArg.is_none() ? std::nullopt : std::optional<std::string>(pathString(alignToArg, "align_to"));
-            if (alignPath && !headPath) throw ValueError("prepare: align_to needs head=, the groom's own head mesh: that head is fitted to align_to");
-            const HeadArgument fix(fixArg, "outside");
-            auto result = runLong(threads, pyb::none(), [&](WorkInterrupter*) {
-                StrandSet out = *strands;
-                TriangleMesh head, target;
-                if (headPath) head = readTriangleMesh(*headPath);
-                if (alignPath) target = readTriangleMesh(*alignPath);
-                const HeadObstacle obstacle = fix.get("prepare");
-                const bool fixing = !obstacle.unset() && !obstacle.empty();
-                PrepareReport r = prepareStrands(out, p, headPath ? &head : nullptr, alignPath ? &target : nullptr,
-                                                 fixing ? &obstacle : nullptr);
-                return std::make_pair(std::make_shared<StrandSet>(std::move(out)), toJson(r));
-            });
-            return pyb::make_tuple(result.first, fromJson(result.second));
-        },
-        pyb::arg("strands"), pyb::kw_only(), pyb::arg("points") = defaults.points, pyb::arg("count") = defaults.strands,
-        pyb::arg("head") = pyb::none(), pyb::arg("align_to") = pyb::none(), pyb::arg("fix_penetration") = pyb::none(),
-        pyb::arg("root_depth") = std::string(rootDepthName(defaults.rootDepth)),
-        pyb::arg("overlap") = defaults.align.overlap, pyb::arg("head_crop") = defaults.headCrop, pyb::arg("threads") = 0,
-        R"doc(Make a hairstyle ready for a dataset (``vdbhair prepare IN OUT --json``): keep ``count``
-strands with evenly spread roots, move the groom onto a common head, resample every strand to
-``points`` vertices, push strands out of a head, in that order (the input is not changed).
-
-Args:
-    strands: the Strands.
-    points: vertices per strand after resampling (at least 2); 0 keeps them.
-    count: strands kept, by farthest-point sampling of the roots; 0 keeps all.
-    head: the groom's own head mesh (a path to a .ply or .obj), the source of the alignment.
-    align_to: a common head mesh (a path): head is fitted onto it by a similarity transform
-        (Umeyama on vertex pairs for two copies of one mesh, else trimmed ICP) and the strands
-        move with it.
-    fix_penetration: None, a head (a path to a mesh or a .vdb level set) or (x, y, z, r), a
-        sphere, in the output's frame: strands that enter it are bent out, lengths kept.
-    root_depth: "keep" (a root inside the head stays, its strand no deeper) or "surface" (the
-        strand is first moved out along the normal until its root is on the surface).
-    overlap: the share of nearest pairs ICP keeps at each iteration.
-    head_crop: ICP uses the head's vertices within this many times the roots' radius of their
-        centroid (the head, not a bust's shoulders); 0: every vertex.
-    threads: worker threads, 0 for all cores (results do not depend on it).
-
-Returns:
-    (Strands, dict): the prepared strands and the command line's report (strands, vertices,
-    subsample, align with scale, rotation, translation, matrix and residual_rms, fix_penetration).)doc");
+    definePrepare(m);
 
     m.def(
         "strand_statistics",

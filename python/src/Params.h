@@ -87,7 +87,8 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
 
 /// @brief Define @a verb on @a m: `verb(positional..., *, <declared keywords>, <extra keywords>,
 /// threads=0, progress=None)`
-/// (a positional is "name" or "name: annotation", as Module.cc's type checks read annotations)
+/// (a positional is "name" or "name: annotation", as Module.cc's type checks read annotations,
+/// and "name=None" one that may be left out)
 /// calling @a impl(positional..., kwargs) with every keyword in one dict.
 /// @param summary the docstring's first paragraphs; @a positionalDoc and @a returns its other parts
 /// @param positionalKeywords how many of the first declared parameters may also be given by position
@@ -111,12 +112,16 @@ void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std:
     doc += "\nReturns:\n    " + returns;
 
     pyb::dict scope;
-    std::string args, checks, dict, head;
-    // A positional argument is "name" or "name: annotation" (checked as the keywords are).
-    for (const std::string& p : positional) {
+    std::string args, checks, dict, head, params;
+    // A positional argument is "name" or "name: annotation" (checked as the keywords are), or
+    // "name=None", which may be left out.
+    for (const std::string& given : positional) {
+        const bool optional = given.size() > 5 && given.compare(given.size() - 5, 5, "=None") == 0;
+        const std::string p = optional ? given.substr(0, given.size() - 5) : given;
         const std::size_t colon = p.find(':');
         const std::string name = p.substr(0, colon);
         head += name + ", ";
+        params += name + (optional ? "=None, " : ", ");
         if (colon != std::string::npos) checks += "(\"" + name + "\", \"" + p.substr(p.find_first_not_of(' ', colon + 1)) + "\", " + name + "), ";
     }
     for (std::size_t i = 0; i < keywords.size(); ++i) {
@@ -132,7 +137,7 @@ void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std:
     scope["_module"] = m;
     const std::string source = "def _make():\n"
                                "    _g = vars(_module)\n"
-                               "    def " + verb + "(" + head.substr(0, head.size() - 2) + args + "):\n"
+                               "    def " + verb + "(" + params.substr(0, params.size() - 2) + args + "):\n"
                                "        _g['_check_keywords'](\"" + verb + "\", (" + checks + "))\n"
                                "        return _impl(" + head + "{" + dict + "})\n"
                                "    " + verb + ".__doc__ = _doc\n"

@@ -153,110 +153,103 @@ void defineRoots(pyb::module_& m)
                pyb::cpp_function(rootsImpl, pyb::arg("scalp"), pyb::arg("keywords")));
 }
 
+/// scalp: a level set from a file, a Strands' roots, points or a sphere (scalpParameters()).
+void defineScalp(pyb::module_& m)
+{
+    auto scalpImpl = [](const pyb::object& source, const pyb::dict& kw) {
+        ScalpBuildParams params;
+        applyKeywords(scalpParameters(), kw, params, "scalp");
+        const pyb::object normals = kw["normals"], regionArg = kw["region"], regionMask = kw["region_mask"];
+        std::optional<std::array<double, 4>> sphere;
+        if (!kw["sphere"].is_none()) {
+            const std::vector<double> v = kw["sphere"].cast<std::vector<double>>();
+            if (v.size() != 4) throw ValueError("scalp: sphere=(cx, cy, cz, r) needs four numbers, got " + std::to_string(v.size()));
+            sphere = std::array<double, 4>{v[0], v[1], v[2], v[3]};
+        }
+        std::optional<std::string> regionVertex;
+        if (!kw["region_vertex"].is_none()) regionVertex = kw["region_vertex"].cast<std::string>();
+        const bool hasSource = !source.is_none();
+        if (hasSource == bool(sphere)) throw ValueError("scalp: give one of source (a path, a Strands or (N, 3) points) and sphere=(cx, cy, cz, r)");
+        if (sphere && (!((*sphere)[3] > 0.0) || !std::isfinite((*sphere)[3]))) throw ValueError("scalp: sphere=(cx, cy, cz, r) needs r > 0");
+        if (int(!regionArg.is_none()) + int(!regionMask.is_none()) + int(bool(regionVertex)) > 1)
+            throw ValueError("scalp: more than one of region, region_mask and region_vertex: give one");
+        if (regionVertex && !(isPathLike(source) && fileExtension(pathString(source)) == ".ply"))
+            throw ValueError("scalp: region_vertex='" + *regionVertex + "' reads a vertex property of a PLY mesh; the source is not a .ply path");
+        if (!normals.is_none() && (isPathLike(source) || pyb::isinstance<StrandSet>(source)))
+            throw ValueError("scalp: normals go with an (N, 3) array of points as the source");
+        ScalpParams sp = params.surface;
+        // Arrays are read with the GIL held, before the work.
+        std::optional<std::string> path;
+        OrientedPoints points;
+        if (isPathLike(source)) {
+            path = pathString(source, "scalp: source");
+        } else if (pyb::isinstance<StrandSet>(source)) {
+            points = orientedRoots(source.cast<const StrandSet&>());
+            sp.source = "roots of Strands";
+        } else if (hasSource) {
+            points.positions = toFloat(pointsArgument(source, "scalp: source"));
+            if (normals.is_none()) throw ValueError("scalp: points need normals=, an (N, 3) array of outward normals");
+            points.normals = toFloat(pointsArgument(normals, "scalp: normals"));
+            if (points.normals.size() != points.positions.size())
+                throw ValueError("scalp: " + std::to_string(points.normals.size()) + " normals for " + std::to_string(points.positions.size()) + " points");
+            sp.source = "points";
+        }
+        std::vector<Vec3f> regionRoots;
+        if (!regionArg.is_none()) regionRoots = rootsArgument(regionArg, "scalp: region");
+        openvdb::GridBase::Ptr mask;
+        if (!regionMask.is_none()) {
+            if (!pyb::isinstance<PyGrid>(regionMask)) throw TypeError("scalp: region_mask must be a vdbhair.Grid (a bool or float grid)");
+            mask = regionMask.cast<const PyGrid&>().grid;
+        }
+        const bool wantRegion = !regionArg.is_none();
+        const double regionRadius = params.regionRadius, regionThreshold = params.regionThreshold;
+        auto grids = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            openvdb::FloatGrid::Ptr surface;
+            if (sphere) surface = scalpFromSphere(Vec3d((*sphere)[0], (*sphere)[1], (*sphere)[2]), (*sphere)[3], sp);
+            else if (path) surface = scalpFromFile(*path, sp, nullptr, true, interrupter);
+            else surface = scalpFromPoints(points, sp, true, interrupter);
+            openvdb::BoolGrid::Ptr region;
+            if (wantRegion) {
+                const double radius = regionRadius > 0.0 ? regionRadius : defaultRegionRadius(*surface, regionRoots);
+                region = regionFromRoots(*surface, regionRoots, radius, "region", std::uint64_t(1) << 28, defaultRootDistance(*surface));
+            } else if (mask) {
+                region = regionFromMask(*surface, *mask, regionThreshold, "region_mask");
+            } else if (regionVertex) {
+                region = regionFromVertexValues(*surface, readTriangleMesh(*path), readPlyVertexValues(*path, *regionVertex), regionThreshold, *path);
+            }
+            return std::make_pair(surface, region);
+        });
+        return pyb::make_tuple(PyGrid{grids.first}, grids.second ? pyb::cast(PyGrid{grids.second}) : pyb::none());
+    };
+    defineVerb(m, "scalp", {"source=None"}, scalpParameters(),
+               {{"normals", "", pyb::none(), "(N, 3) outward normals of an array source."},
+                {"sphere", "Optional[Tuple[float, float, float, float]]", pyb::none(), "(cx, cy, cz, r) in world units, instead of a source."},
+                {"region", "", pyb::none(),
+                 "a Strands or (N, 3) roots: the hair region is the band within ``region_radius`` of their projections onto the "
+                 "surface (roots farther than a tenth of the head are left out)."},
+                {"region_mask", "", pyb::none(),
+                 "a vdbhair.Grid painting the region instead: a bool grid's true values, or a float grid's values above "
+                 "``region_threshold``."},
+                {"region_vertex", "Optional[str]", pyb::none(),
+                 "the name of a vertex property of a PLY mesh source that paints the region: a colour channel (\"red\", \"green\", "
+                 "\"blue\", \"alpha\"; uchar scaled to 0-1) or any named scalar, above ``region_threshold`` (each band voxel takes "
+                 "the inverse-distance average of its 4 nearest vertices' values)."}},
+               "A scalp as a VDB level set (Piuze et al. 2011, Sec. 4.3): ``vdbhair scalp``.",
+               "    source: a path (a head mesh .obj / .ply with faces: meshToLevelSet with open boundaries\n"
+               "        capped; points .ply with nx ny nz, or a strand file whose roots are the points: Turk &\n"
+               "        O'Brien's variational implicit), a Strands (its roots, first segments as normals), or an\n"
+               "        (N, 3) array of points with ``normals``. None with ``sphere``.\n",
+               "(surface, region): the float level set named 'surface' (negative inside, world units) and\n"
+               "    the bool grid 'region' or None. ``vdbhair.write_grids(path, [surface, region])`` writes what\n"
+               "    ``vdbhair scalp`` writes.",
+               pyb::cpp_function(scalpImpl, pyb::arg("source"), pyb::arg("keywords")));
+}
+
 } // namespace
 
 void bindScalp(pyb::module_& m)
 {
-    const ScalpParams scalpDefaults;
-    m.def(
-        "scalp",
-        [](const pyb::object& source, const pyb::object& normals, std::optional<std::array<double, 4>> sphere, double voxelSize,
-           float halfWidth, std::uint64_t maxVoxels, std::size_t maxConstraints, const pyb::object& regionArg, double regionRadius,
-           const pyb::object& regionMask, std::optional<std::string> regionVertex, double regionThreshold, int threads,
-           const pyb::object& progress) {
-            const bool hasSource = !source.is_none();
-            if (hasSource == bool(sphere)) throw ValueError("scalp: give one of source (a path, a Strands or (N, 3) points) and sphere=(cx, cy, cz, r)");
-            if (sphere && (!((*sphere)[3] > 0.0) || !std::isfinite((*sphere)[3]))) throw ValueError("scalp: sphere=(cx, cy, cz, r) needs r > 0");
-            if (voxelSize < 0.0 || !std::isfinite(voxelSize)) throw ValueError("scalp: voxel_size=" + std::to_string(voxelSize) + ": must be a positive finite length (0: 1/100 of the input's size)");
-            if (regionRadius < 0.0 || !std::isfinite(regionRadius)) throw ValueError("scalp: region_radius=" + std::to_string(regionRadius) + ": must be a positive length (0: the default)");
-            if (int(!regionArg.is_none()) + int(!regionMask.is_none()) + int(bool(regionVertex)) > 1)
-                throw ValueError("scalp: more than one of region, region_mask and region_vertex: give one");
-            if (regionVertex && !(isPathLike(source) && fileExtension(pathString(source)) == ".ply"))
-                throw ValueError("scalp: region_vertex='" + *regionVertex + "' reads a vertex property of a PLY mesh; the source is not a .ply path");
-            if (!normals.is_none() && (isPathLike(source) || pyb::isinstance<StrandSet>(source)))
-                throw ValueError("scalp: normals go with an (N, 3) array of points as the source");
-            ScalpParams sp;
-            sp.voxelSize = voxelSize;
-            sp.halfWidth = halfWidth;
-            sp.maxVoxels = maxVoxels;
-            sp.maxConstraints = maxConstraints;
-            // Arrays are read with the GIL held, before the work.
-            std::optional<std::string> path;
-            OrientedPoints points;
-            if (isPathLike(source)) {
-                path = pathString(source, "scalp: source");
-            } else if (pyb::isinstance<StrandSet>(source)) {
-                points = orientedRoots(source.cast<const StrandSet&>());
-                sp.source = "roots of Strands";
-            } else if (hasSource) {
-                points.positions = toFloat(pointsArgument(source, "scalp: source"));
-                if (normals.is_none()) throw ValueError("scalp: points need normals=, an (N, 3) array of outward normals");
-                points.normals = toFloat(pointsArgument(normals, "scalp: normals"));
-                if (points.normals.size() != points.positions.size())
-                    throw ValueError("scalp: " + std::to_string(points.normals.size()) + " normals for " + std::to_string(points.positions.size()) + " points");
-                sp.source = "points";
-            }
-            std::vector<Vec3f> regionRoots;
-            if (!regionArg.is_none()) regionRoots = rootsArgument(regionArg, "scalp: region");
-            openvdb::GridBase::Ptr mask;
-            if (!regionMask.is_none()) {
-                if (!pyb::isinstance<PyGrid>(regionMask)) throw TypeError("scalp: region_mask must be a vdbhair.Grid (a bool or float grid)");
-                mask = regionMask.cast<const PyGrid&>().grid;
-            }
-            const bool wantRegion = !regionArg.is_none();
-            auto grids = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                openvdb::FloatGrid::Ptr surface;
-                if (sphere) surface = scalpFromSphere(Vec3d((*sphere)[0], (*sphere)[1], (*sphere)[2]), (*sphere)[3], sp);
-                else if (path) surface = scalpFromFile(*path, sp, nullptr, true, interrupter);
-                else surface = scalpFromPoints(points, sp, true, interrupter);
-                openvdb::BoolGrid::Ptr region;
-                if (wantRegion) {
-                    const double radius = regionRadius > 0.0 ? regionRadius : defaultRegionRadius(*surface, regionRoots);
-                    region = regionFromRoots(*surface, regionRoots, radius, "region", std::uint64_t(1) << 28, defaultRootDistance(*surface));
-                } else if (mask) {
-                    region = regionFromMask(*surface, *mask, regionThreshold, "region_mask");
-                } else if (regionVertex) {
-                    region = regionFromVertexValues(*surface, readTriangleMesh(*path), readPlyVertexValues(*path, *regionVertex), regionThreshold, *path);
-                }
-                return std::make_pair(surface, region);
-            });
-            return pyb::make_tuple(PyGrid{grids.first}, grids.second ? pyb::cast(PyGrid{grids.second}) : pyb::none());
-        },
-        pyb::arg("source") = pyb::none(), pyb::kw_only(), pyb::arg("normals") = pyb::none(), pyb::arg("sphere") = pyb::none(),
-        pyb::arg("voxel_size") = scalpDefaults.voxelSize, pyb::arg("half_width") = scalpDefaults.halfWidth,
-        pyb::arg("max_voxels") = scalpDefaults.maxVoxels, pyb::arg("max_constraints") = scalpDefaults.maxConstraints,
-        pyb::arg("region") = pyb::none(), pyb::arg("region_radius") = 0.0, pyb::arg("region_mask") = pyb::none(),
-        pyb::arg("region_vertex") = pyb::none(), pyb::arg("region_threshold") = kDefaultRegionThreshold, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
-        R"doc(A scalp as a VDB level set (Piuze et al. 2011, Sec. 4.3): ``vdbhair scalp``.
-
-Args:
-    source: a path (a head mesh .obj / .ply with faces: meshToLevelSet with open boundaries
-        capped; points .ply with nx ny nz, or a strand file whose roots are the points: Turk &
-        O'Brien's variational implicit), a Strands (its roots, first segments as normals), or an
-        (N, 3) array of points with ``normals``. None with ``sphere``.
-    normals: (N, 3) outward normals of an array source.
-    sphere: (cx, cy, cz, r) in world units, instead of a source.
-    voxel_size: world units; 0 is 1/100 of the input's largest extent.
-    half_width: narrow-band half width in voxels.
-    max_voxels: refuse voxel sizes whose band is estimated at more voxels (vdbhair.LimitError).
-    max_constraints: points are thinned to this many constraints (the solve is cubic).
-    region: a Strands or (N, 3) roots: the hair region is the band within ``region_radius`` of
-        their projections onto the surface (roots farther than a tenth of the head are left out).
-    region_radius: world units; 0 is twice the roots' mean nearest-neighbour spacing.
-    region_mask: a vdbhair.Grid painting the region instead: a bool grid's true values, or a
-        float grid's values above ``region_threshold``.
-    region_vertex: the name of a vertex property of a PLY mesh source that paints the region: a
-        colour channel ("red", "green", "blue", "alpha"; uchar scaled to 0-1) or any named scalar,
-        above ``region_threshold`` (each band voxel takes the inverse-distance average of its 4
-        nearest vertices' values).
-    threads: worker threads, 0 for all cores.
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    (surface, region): the float level set named 'surface' (negative inside, world units) and
-    the bool grid 'region' or None. ``vdbhair.write_grids(path, [surface, region])`` writes what
-    ``vdbhair scalp`` writes.)doc");
-
+    defineScalp(m);
     defineRoots(m);
 }
 

@@ -17,12 +17,29 @@
 
 namespace vdbhair {
 
+const ParamTable<CompareParams>& compareParameters()
+{
+    using P = CompareParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        t.push_back(makeParam<P>("bidirectional", "Oriented points match whichever way round their directions point", "",
+                                 member<P>([](P& p) -> bool& { return p.bidirectional; })));
+        auto samples = makeParam<P>("samples", "Points per strand for the strand-pair measures, 100 as in Perm", "",
+                                    member<P>([](P& p) -> std::size_t& { return p.samples; }));
+        samples.min = double(CompareParams::kMinSamples);
+        t.push_back(samples);
+        return t;
+    }();
+    return table;
+}
+
 void CompareParams::validate() const
 {
     if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit)) {
         throw ValueError("metersPerUnit " + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
     }
-    if (samples < 3) throw ValueError("samples " + std::to_string(samples) + ": must be at least 3 (a curvature needs three points)");
+    if (samples < kMinSamples)
+        throw ValueError("samples " + std::to_string(samples) + ": must be at least " + std::to_string(kMinSamples) + " (a curvature needs three points)");
     for (const OrientedThreshold& t : thresholds) {
         if (!(t.distance > 0.0) || !std::isfinite(t.distance)) throw ValueError("thresholds: distance " + std::to_string(t.distance) + ": must be positive and finite");
         if (!(t.angleDegrees >= 0.0 && t.angleDegrees <= 180.0)) throw ValueError("thresholds: angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees");

@@ -9,6 +9,7 @@
 /// out otherwise (HairComparison::paired).
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/strands/Compare.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -33,7 +34,9 @@ struct CompareParams
     std::vector<OrientedThreshold> thresholds;
     /// Directions match either way round (a strand stored tip first still matches).
     bool bidirectional = false;
-    /// Points per strand for the strand-pair measures (Perm: 100), at least 3.
+    static constexpr std::size_t kMinSamples = 3;  ///< samples's least: a curvature needs three points
+
+    /// Points per strand for the strand-pair measures (Perm: 100), at least kMinSamples.
     std::size_t samples = 100;
     /// Pair strand i of A with strand i of B when the counts agree (a retrace, a reconstruction,
     /// an edit); false for hairstyles whose strands do not correspond (a synthesis).
@@ -42,6 +45,12 @@ struct CompareParams
     /// @throw ValueError naming the parameter, its value and the rule.
     void validate() const;
 };
+
+/// @brief compare's parameters declared once (vdbhair/Parameters.h): the direction rule and the
+/// strand-pair samples; the command's options, `--help` and docs/cli.md's table are made from it.
+/// The unit, the thresholds and the pairing stay the front ends' own (`--unit NAME`, `--threshold
+/// D:ANGLE`, `--unpaired`; Python's meters_per_unit, thresholds, pair_strands).
+const ParamTable<CompareParams>& compareParameters();
 
 struct HairComparison
 {

@@ -44,6 +44,49 @@ const char* rootDepthName(RootDepth depth)
     return depth == RootDepth::Keep ? "keep" : "surface";
 }
 
+const ParamTable<PrepareParams>& prepareParameters()
+{
+    using P = PrepareParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto points = makeParam<P>("points", "Resample every strand to exactly N vertices, at least 2, equally spaced in arc length, root and tip kept", "",
+                                   member<P>([](P& p) -> std::size_t& { return p.points; }));
+        points.min = 0;
+        points.zeroMeans = "keep them";
+        t.push_back(points);
+        auto strands = makeParam<P>("strands", "Keep N strands with evenly spread roots (farthest-point sampling of the roots; all when fewer)", "",
+                                    member<P>([](P& p) -> std::size_t& { return p.strands; }));
+        strands.min = 0;
+        strands.zeroMeans = "keep all";
+        strands.keyword = "count";
+        t.push_back(strands);
+        auto overlap = makeParam<P>("overlap",
+                                    "Aligning to another head: the share of nearest point pairs ICP keeps at each iteration (necks cut at "
+                                    "different heights)", "",
+                                    member<P>([](P& p) -> double& { return p.align.overlap; }));
+        overlap.min = 0.0;
+        overlap.aboveMin = true;
+        overlap.max = 1.0;
+        t.push_back(overlap);
+        auto crop = makeParam<P>("head-crop",
+                                 "Aligning by ICP: use the groom's head vertices within this many times the roots' radius of their "
+                                 "centroid (the head, not a bust's shoulders)", "",
+                                 member<P>([](P& p) -> double& { return p.headCrop; }));
+        crop.min = 0.0;
+        crop.zeroMeans = "every vertex";
+        t.push_back(crop);
+        auto depth = makeParam<P>("root-depth",
+                                  "Fixing penetration: keep (a root inside the head stays, its strand no deeper than it) or surface (the "
+                                  "strand is first moved out along the head's normal until its root is on the surface: roots under a new "
+                                  "scalp after aligning)", "",
+                                  named<P>([](P& p) -> RootDepth& { return p.rootDepth; }, rootDepthName, rootDepthFromName));
+        depth.choices = {rootDepthName(RootDepth::Keep), rootDepthName(RootDepth::Surface)};
+        t.push_back(depth);
+        return t;
+    }();
+    return table;
+}
+
 std::size_t liftRootsToSurface(StrandSet& strands, const HeadObstacle& head, bool threaded)
 {
     std::vector<char> lifted(strands.numStrands(), 0);

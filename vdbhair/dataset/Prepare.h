@@ -11,6 +11,7 @@
 /// keeps every segment's length, so the vertex count and the equal spacing survive it.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/dataset/RootSubsample.h>
 #include <vdbhair/dataset/SimilarityAlign.h>
 #include <vdbhair/field/HeadCollision.h>
@@ -61,6 +62,11 @@ struct PrepareParams
     /// @throw ValueError naming the field, the value and the rule.
     void validate() const;
 };
+
+/// @brief prepare's parameters declared once (vdbhair/Parameters.h): the command's options and
+/// `--help`, Python's prepare() keywords and docs/cli.md's table are made from it. The target's
+/// up axis stays the front ends' own (an axis name on the command line).
+const ParamTable<PrepareParams>& prepareParameters();
 
 struct PrepareReport
 {

@@ -69,6 +69,35 @@ ColorBy colorByFromName(const std::string& name)
     throw ValueError("colorBy '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand, error");
 }
 
+const ParamTable<RenderParams>& renderParameters()
+{
+    using P = RenderParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto view = makeParam<P>("view", "The view: orthographic from the front, side, top or back, or three-quarter in perspective", "",
+                                 named<P>([](P& p) -> View& { return p.view; }, viewName, viewFromName));
+        for (View v : {View::Front, View::Side, View::Top, View::Back, View::ThreeQuarter}) view.choices.push_back(viewName(v));
+        t.push_back(view);
+        auto width = makeParam<P>("width", "Image width", "pixels", member<P>([](P& p) -> int& { return p.width; }));
+        auto height = makeParam<P>("height", "Image height", "pixels", member<P>([](P& p) -> int& { return p.height; }));
+        for (Param<P>* size : {&width, &height}) {
+            size->min = 1;
+            size->max = RenderParams::kMaxSize;
+        }
+        t.push_back(width);
+        t.push_back(height);
+        auto colorBy = makeParam<P>("color-by",
+                                    "Colouring: lit fibres (shaded), or by root, tangent, depth, curvature, strand, or error (each vertex's "
+                                    "distance to the nearest vertex of the reference)", "",
+                                    named<P>([](P& p) -> ColorBy& { return p.colorBy; }, colorByName, colorByFromName));
+        for (ColorBy c : {ColorBy::Shaded, ColorBy::Root, ColorBy::Tangent, ColorBy::Depth, ColorBy::Curvature, ColorBy::Strand, ColorBy::Error})
+            colorBy.choices.push_back(colorByName(c));
+        t.push_back(colorBy);
+        return t;
+    }();
+    return table;
+}
+
 namespace {
 
 /// A camera: world to (image x, image y, depth), x right, y down, in output pixels.

@@ -11,6 +11,7 @@
 /// input: rasterization runs in horizontal bands, each drawing its segments in strand order.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/render/Image.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -72,6 +73,10 @@ struct RenderParams
     /// where two hairstyles differ shows. Required by ColorBy::Error.
     const StrandSet* reference = nullptr;
 };
+
+/// @brief render's parameters declared once (vdbhair/Parameters.h): the view, the image's size and
+/// the colouring; the command's options, `--help` and docs/cli.md's table are made from it.
+const ParamTable<RenderParams>& renderParameters();
 
 /// @brief The facing direction used when RenderParams::facing is not set (see there).
 Vec3d defaultFacing(const Vec3d& up);

@@ -11,6 +11,42 @@
 
 namespace vdbhair {
 
+const ParamTable<ScalpBuildParams>& scalpParameters()
+{
+    using P = ScalpBuildParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto voxel = makeParam<P>("voxel-size", "Voxel size", "world units", member<P>([](P& p) -> double& { return p.surface.voxelSize; }));
+        voxel.min = 0.0;
+        voxel.zeroMeans = "1/100 of the input's largest extent";
+        t.push_back(voxel);
+        // ScalpParams::halfWidth is a float (OpenVDB's level-set tools take one): read and set as a number.
+        auto half = makeParam<P>("half-width", "Narrow-band half width", "voxels",
+                                 ParamAccess<P, double>{[](const P& p) { return double(p.surface.halfWidth); },
+                                                        [](P& p, double v) { p.surface.halfWidth = float(v); }});
+        half.min = ScalpParams::kMinHalfWidth;
+        half.max = ScalpParams::kMaxHalfWidth;
+        t.push_back(half);
+        auto maxVoxels = makeParam<P>("max-voxels", "Refuse voxel sizes whose band is estimated at more voxels", "",
+                                      member<P>([](P& p) -> std::uint64_t& { return p.surface.maxVoxels; }));
+        maxVoxels.min = 1;
+        t.push_back(maxVoxels);
+        auto constraints = makeParam<P>("max-constraints", "Points input: thin to this many constraint points (the solve is cubic)", "",
+                                        member<P>([](P& p) -> std::size_t& { return p.surface.maxConstraints; }));
+        constraints.min = double(ScalpParams::kMinConstraints);
+        t.push_back(constraints);
+        auto radius = makeParam<P>("region-radius", "Region from roots: the radius around each root", "world units",
+                                   member<P>([](P& p) -> double& { return p.regionRadius; }));
+        radius.min = 0.0;
+        radius.zeroMeans = "twice the roots' mean spacing, at least 2 voxels";
+        t.push_back(radius);
+        t.push_back(makeParam<P>("region-threshold", "A float mask or vertex value covers where it exceeds this", "",
+                                 member<P>([](P& p) -> double& { return p.regionThreshold; })));
+        return t;
+    }();
+    return table;
+}
+
 OrientedPoints orientedRoots(const StrandSet& strands)
 {
     OrientedPoints pts;

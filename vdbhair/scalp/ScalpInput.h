@@ -5,7 +5,9 @@
 /// region grown from roots.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/io/ReadOptions.h>
+#include <vdbhair/scalp/ScalpRegion.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -16,6 +18,23 @@
 #include <vector>
 
 namespace vdbhair {
+
+/// @brief What `vdbhair scalp` and Python's scalp() tune: the level set's ScalpParams and the
+/// region's radius and threshold, declared once in scalpParameters().
+struct ScalpBuildParams
+{
+    ScalpParams surface;  ///< voxel size, band half width, caps (ScalpParams's defaults)
+    /// A region from roots (regionFromRoots()): world units around each projected root; 0:
+    /// defaultRegionRadius().
+    double regionRadius = 0.0;
+    /// A region from a float mask or a mesh's vertex values (regionFromMask(),
+    /// regionFromVertexValues()): covered where the value exceeds this.
+    double regionThreshold = kDefaultRegionThreshold;
+};
+
+/// @brief scalp's parameters declared once (vdbhair/Parameters.h): the command's options and
+/// `--help`, Python's scalp() keywords and docs/cli.md's table are made from it.
+const ParamTable<ScalpBuildParams>& scalpParameters();
 
 /// @brief What scalpFromFile() made and how.
 struct ScalpFileReport

@@ -35,8 +35,9 @@ double resolveVoxelSize(const ScalpParams& params, const BBox& box, const std::s
     if (!(h >= 1e-5) || !std::isfinite(h)) {
         throw ValueError(where + ": voxel size " + formatNumber(h) + " must be a finite length of at least 1e-5");
     }
-    if (!(params.halfWidth >= 1.f) || !(params.halfWidth <= 64.f)) {
-        throw ValueError(where + ": half width " + formatNumber(params.halfWidth) + " voxels must be between 1 and 64");
+    if (!(params.halfWidth >= ScalpParams::kMinHalfWidth) || !(params.halfWidth <= ScalpParams::kMaxHalfWidth)) {
+        throw ValueError(where + ": half width " + formatNumber(params.halfWidth) + " voxels must be between " +
+                         formatNumber(ScalpParams::kMinHalfWidth) + " and " + formatNumber(ScalpParams::kMaxHalfWidth));
     }
     return h;
 }
@@ -279,7 +280,8 @@ openvdb::FloatGrid::Ptr scalpFromPoints(const OrientedPoints& input, const Scalp
     const std::size_t n = input.size(), maxConstraints = params.maxConstraints;
     if (n < 5) throw ValueError(where + ": " + std::to_string(n) + " constraint points; the implicit needs at least 5 (4 fix its affine part)");
     if (input.normals.size() != n) throw ValueError(where + ": the points have no normals (nx ny nz); the implicit needs one per point to know inside from outside");
-    if (maxConstraints < 5) throw ValueError(where + ": maxConstraints " + std::to_string(maxConstraints) + " must be at least 5");
+    if (maxConstraints < ScalpParams::kMinConstraints)
+        throw ValueError(where + ": maxConstraints " + std::to_string(maxConstraints) + " must be at least " + std::to_string(ScalpParams::kMinConstraints));
     BBox box;
     for (const Vec3f& p : input.positions) box.expand(p);
     const double h = resolveVoxelSize(params, box, where);

@@ -24,6 +24,9 @@ namespace vdbhair {
 /// @brief What every scalp builder needs.
 struct ScalpParams
 {
+    static constexpr float kMinHalfWidth = 1.f, kMaxHalfWidth = 64.f;  ///< halfWidth's range (voxels)
+    static constexpr std::size_t kMinConstraints = 5;                  ///< maxConstraints's least
+
     double voxelSize = 0.0;  ///< world units; 0: 1/100 of the input's largest extent
     /// Half width of the narrow band in voxels. OpenVDB's default (3) is what its level-set tools
     /// and Houdini's SDF nodes expect.
