@@ -5,6 +5,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/StrandIO.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/SynthJson.h>
@@ -24,6 +25,7 @@ struct TransferCmdParams
     TransferParams params;  ///< its declared parameters (transferParameters()) are options
     SynthOptionText text;
     std::int64_t strands = -1;
+    std::string head;  ///< --head: a file, "none", or empty for BASE's (its scalp, else the sphere fitted to its roots)
 };
 
 } // namespace
@@ -103,6 +105,8 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--scalp", p->job.scalp, "BASE's scalp: a .vdb with a level set 'surface' or a head mesh; default: the sphere fitted to BASE's roots");
     addParamOptions(sub, p->params, transferParameters());
     sub->add_flag_function("--keep-base-detail", [p](std::int64_t) { p->params.smoothBase = false; }, "Keep BASE's coarsest level unsmoothed (the paper's rule: BASE's own wisp-level waves stay, under DETAILS')");
+    sub->add_option("--head", p->head, "The head new hair may enter no deeper than BASE's hair: a mesh (.ply, .obj), a .vdb level set, or 'none' "
+                                       "(default: --scalp's surface, else the sphere fitted to BASE's roots)");
     sub->add_option("--strands", p->strands, "With --guides: strands in the output (default: DETAILS' strands per coarsest strand, times the guides)");
     sub->add_flag("--measure", p->job.measure, "Also compare the output with BASE as `vdbhair compare` does (the report's \"compare\"; BASE is the reference)");
     addSynthTextOptions(sub, p->text, /*detailOptions=*/true);
@@ -118,6 +122,8 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
                     if (!params.guides) throw ValueError("--strands: the output has BASE's strands; --strands needs --guides");
                     params.strands = std::size_t(p->strands);
                 }
+                if (p->head == "none") params.synth.head = HeadObstacle::none();
+                else if (!p->head.empty()) params.synth.head = readHeadObstacle(p->head, "--head " + p->head);
                 return runTransferJob(p->job, params, common);
             },
             synthTransferFlags()};

@@ -104,6 +104,7 @@ pyb::object synthImpl(const StrandsPtr& example, const pyb::dict& kw)
 pyb::object transferImpl(const StrandsPtr& details, const StrandsPtr& base, const pyb::dict& kw)
 {
     TransferParams p;
+    const HeadArgument headArg(kw["head"], headPolicyName(kDefaultHeadPolicy));  // as --head, read with its policy
     applyKeywords(transferParameters(), kw, p, "transfer");
     if (const auto strands = kw["strands"].cast<std::optional<long long>>()) {
         if (*strands <= 0) throw ValueError("transfer: strands=" + std::to_string(*strands) + ": must be at least 1");
@@ -120,6 +121,7 @@ pyb::object transferImpl(const StrandsPtr& details, const StrandsPtr& base, cons
     const bool measure = kw["measure"].cast<bool>(), returnReport = kw["return_report"].cast<bool>();
     TransferResult r = runLong(threads, kw["progress"], [&](WorkInterrupter* interrupter) {
         openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
+        if (const HeadObstacle given = headArg.get("transfer"); !given.unset()) p.synth.head = given;  // as --head
         return transferHairstyle(*details, *base, p, grid, true, interrupter);
     });
     if (!returnReport) return pyb::cast(std::make_shared<StrandSet>(std::move(r.result.strands)));
@@ -200,9 +202,8 @@ void bindSynthesis(pyb::module_& m)
                  "with return_report, the report's \"compare\" holds the output against the example, as ``vdbhair.compare(example, output)`` "
                  "(on output_scalp, the output moved back onto the example's scalp)."},
                 {"return_report", "bool", pyb::bool_(false),
-                 "also return a dict (levels, stages with seconds, cluster_of arrays per level, head radius, up, output_area, head: the head "
-                 "new hair is kept out of, the strands pushed out, the output's and the example's strands passing into it, regions: the "
-                 "style region by region, output beside example, as synth --json's \"regions\", StyleRegions.h)."}},
+                 "also return ``synth --json``'s report as a dict (less the file names and the seconds: levels, stages, head, statistics, "
+                 "checks, regions, ...), with the cluster_of arrays per level."}},
                "A new hairstyle in the style of an example (Wang et al. 2009, §3-5): ``vdbhair synth``.\n\n"
                "Hierarchical clustering, PCA feature maps and texture optimization, cluster-oriented detail\n"
                "transfer and vector-field refinement per level; deterministic for a seed, the same for any\n"
@@ -218,10 +219,14 @@ void bindSynthesis(pyb::module_& m)
                 {"front", "Optional[Tuple[float, float, float]]", pyb::none(),
                  "the head's front for the report's \"regions\", which set the output beside the base, region by region."},
                 {"scalp", "Optional[os.PathLike | str]", pyb::none(), kScalpDoc},
+                {"head", "", pyb::none(),
+                 "the head new hair may enter no deeper than the base's hair (``--head``): None (scalp's surface, else the sphere "
+                 "fitted to the base's roots), \"none\" (no head), a path to a mesh (.ply, .obj) or a .vdb level set, or a sphere (x, y, z, r)."},
                 {"measure", "bool", pyb::bool_(false),
                  "with return_report, the report's \"compare\" holds the output against the base, as ``vdbhair.compare(base, output)``."},
                 {"return_report", "bool", pyb::bool_(false),
-                 "also return a dict (compare, regions, cluster_of arrays per level, base_label, head_radius of both, detail_scale, length_ratio)."}},
+                 "also return ``transfer --json``'s report as a dict (less the file names and the seconds), with the cluster_of arrays "
+                 "per level and the base's coarsest cluster of each strand (base_label)."}},
                "The base's global flow with the details' wisps and waves (Wang et al. 2009, §6): ``vdbhair transfer``.\n\n"
                "docs/editing.md, explains every option and its measured default.",
                "    details: Strands whose detail is taken.\n"
@@ -237,7 +242,8 @@ void bindSynthesis(pyb::module_& m)
                  "a mesh or .vdb level set path, or (x, y, z, r) a sphere."},
                 {"head_policy", "str", pyb::str(headPolicyName(kDefaultHeadPolicy)),
                  "\"no-deeper\" (no vertex goes deeper into the head than the input's) or \"outside\"."},
-                {"return_report", "bool", pyb::bool_(false), "also return a dict of what the combing did (combed_clusters, moved_strands, ...)."}},
+                {"return_report", "bool", pyb::bool_(false),
+                 "also return ``comb --json``'s report as a dict (less the file names and the seconds), with each strand's coarsest cluster (cluster)."}},
                "Detail-preserving combing (Wang et al. 2009, §6): ``vdbhair comb``.",
                "    strands: Strands to comb.\n"
                "    strokes: a path to a stroke file, or a list of dicts {\"points\": [[x, y, z], ...], \"radius\": r, \"strength\": s}.\n",

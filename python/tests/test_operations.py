@@ -186,6 +186,10 @@ def test_transfer_and_comb():
     assert np.allclose(out.positions[out.offsets[:-1]], roots, atol=1e-3)
     assert report["detail_scale"] == pytest.approx(1.0)
     assert vdbhair.transfer(pony, pony, refine=False, return_report=True)[1]["compare"] is None
+    # head= is --head: "none" transfers with no head; the default is the sphere fitted to the base's roots.
+    assert report["head"]["head"] != "none"
+    assert vdbhair.transfer(pony, pony, refine=False, head="none", return_report=True)[1]["head"] == {
+        "head": "none", "pushed_out": 0, "entering": {"output": 0.0, "base": 0.0}}
     with pytest.raises(ValueError, match="strands needs guides=True"):
         vdbhair.transfer(pony, pony, strands=10)
     # Zero strength changes nothing; a stroke keeps every segment's length.
