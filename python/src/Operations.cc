@@ -500,70 +500,61 @@ dict), point_count for points grids, and explanation (the metadata in words).)do
 }
 
 /// compare: a hairstyle measured against a reference.
+/// vdbhair.compare(a, b, **keywords): the declared parameters (compareParameters()), then compare's own.
+pyb::dict compareImpl(const StrandsPtr& a, const StrandsPtr& b, const pyb::dict& kw)
+{
+    CompareParams p;
+    applyKeywords(compareParameters(), kw, p, "compare");
+    p.metersPerUnit = kw["meters_per_unit"].cast<double>();
+    p.pairStrands = kw["pair_strands"].cast<bool>();
+    for (const auto& [d, angle] : kw["thresholds"].cast<std::vector<std::pair<double, double>>>()) p.thresholds.push_back({d, angle});
+    try {
+        p.validate();
+    } catch (const ValueError& e) {
+        throw ValueError(std::string("compare: ") + e.what());
+    }
+    const HeadArgument headArgument(kw["head"], "no-deeper");
+    const HairComparison c = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter*) {
+        const HeadObstacle head = headArgument.get("compare");
+        return compareHairstyles(*a, *b, p, head.unset() || head.empty() ? nullptr : &head, true);
+    });
+    // The report's keys and values are the command line's (toJson()), as Python objects.
+    pyb::dict report = toPython(toJson(c));
+    pyb::dict perStrand;
+    perStrand["chamfer"] = pyb::array_t<double>(c.chamfer.perStrandA.size(), c.chamfer.perStrandA.data());
+    if (c.paired) {
+        perStrand["position"] = pyb::array_t<double>(c.perm.position.size(), c.perm.position.data());
+        perStrand["curvature"] = pyb::array_t<double>(c.perm.curvature.size(), c.perm.curvature.data());
+        perStrand["frechet"] = pyb::array_t<double>(c.frechet.size(), c.frechet.data());
+    }
+    report["per_strand"] = perStrand;
+    return report;
+}
+
 void defineCompare(pyb::module_& m)
 {
-    const CompareParams compareDefaults;
-    m.def(
-        "compare",
-        [](const StrandsPtr& a, const StrandsPtr& b, double metersPerUnit, const std::vector<std::pair<double, double>>& thresholds,
-           bool bidirectional, std::size_t samples, bool pairStrands, const pyb::object& headArg, int threads) {
-            CompareParams p;
-            p.metersPerUnit = metersPerUnit;
-            p.pairStrands = pairStrands;
-            for (const auto& [d, angle] : thresholds) p.thresholds.push_back({d, angle});
-            p.bidirectional = bidirectional;
-            p.samples = samples;
-            try {
-                p.validate();
-            } catch (const ValueError& e) {
-                throw ValueError(std::string("compare: ") + e.what());
-            }
-            const HeadArgument headArgument(headArg, "no-deeper");
-            const HairComparison c = runLong(threads, pyb::none(), [&](WorkInterrupter*) {
-                const HeadObstacle head = headArgument.get("compare");
-                return compareHairstyles(*a, *b, p, head.unset() || head.empty() ? nullptr : &head, true);
-            });
-            // The report's keys and values are the command line's (toJson()), as Python objects.
-            pyb::dict report = toPython(toJson(c));
-            pyb::dict perStrand;
-            perStrand["chamfer"] = pyb::array_t<double>(c.chamfer.perStrandA.size(), c.chamfer.perStrandA.data());
-            if (c.paired) {
-                perStrand["position"] = pyb::array_t<double>(c.perm.position.size(), c.perm.position.data());
-                perStrand["curvature"] = pyb::array_t<double>(c.perm.curvature.size(), c.perm.curvature.data());
-                perStrand["frechet"] = pyb::array_t<double>(c.frechet.size(), c.frechet.data());
-            }
-            report["per_strand"] = perStrand;
-            return report;
-        },
-        pyb::arg("a"), pyb::arg("b"), pyb::kw_only(), pyb::arg("meters_per_unit") = compareDefaults.metersPerUnit,
-        pyb::arg("thresholds") = std::vector<std::pair<double, double>>(), pyb::arg("bidirectional") = compareDefaults.bidirectional,
-        pyb::arg("samples") = compareDefaults.samples, pyb::arg("pair_strands") = compareDefaults.pairStrands, pyb::arg("head") = pyb::none(),
-        pyb::arg("threads") = 0,
-        R"doc(Compare a hairstyle ``b`` with a reference ``a`` (``vdbhair compare A B --json``): HairGS's
-oriented-point precision, recall, F1 and strand consistency, the Chamfer distance, Perm's
-root-aligned position and curvature errors and the discrete Frechet distance over length of the
-strand pairs (when the strand counts agree), the share of b's strands leaving a's hair volume, and
-with a head the shares of each passing into it.
-
-Args:
-    a: the reference Strands.
-    b: the compared Strands (precision is the share of its oriented points matched in a).
-    meters_per_unit: the strands' unit in metres (0.01: centimetres); 0: unknown.
-    thresholds: (distance, angle in degrees) pairs; distances in metres when meters_per_unit is
-        given, else in the strands' units. Empty: HairGS's four (2 mm / 20 deg, 3 / 30, 4 / 40,
-        4 / 90) when meters_per_unit is given, else no oriented-point measure.
-    bidirectional: directions match whichever way round they point.
-    samples: points per strand for the strand-pair measures (Perm: 100), at least 3.
-    pair_strands: pair strand i of a with strand i of b when the counts agree (False for
-        hairstyles whose strands do not correspond, such as a synthesis).
-    head: None, a path (a mesh or a .vdb level set) or (x, y, z, r), a sphere.
-    threads: worker threads, 0 for all cores (results do not depend on it).
-
-Returns:
-    A dict with the command line's JSON keys (strands, vertices, meters_per_unit,
-    oriented_points, chamfer, paired, position_error, curvature_error, frechet, leaving_volume,
-    volume_voxel, entering_head) and per_strand: NumPy arrays over a's strands (chamfer; with
-    paired strands also position, curvature and frechet).)doc");
+    const CompareParams defaults;
+    defineVerb(m, "compare", {"a: vdbhair.Strands", "b: vdbhair.Strands"}, compareParameters(),
+               {{"meters_per_unit", "float", pyb::float_(defaults.metersPerUnit), "the strands' unit in metres (0.01: centimetres); 0: unknown."},
+                {"thresholds", "", pyb::tuple(),
+                 "(distance, angle in degrees) pairs; distances in metres when meters_per_unit is given, else in the strands' units. "
+                 "Empty: HairGS's four (2 mm / 20 deg, 3 / 30, 4 / 40, 4 / 90) when meters_per_unit is given, else no oriented-point measure."},
+                {"pair_strands", "bool", pyb::bool_(defaults.pairStrands),
+                 "pair strand i of a with strand i of b when the counts agree (False for hairstyles whose strands do not correspond, "
+                 "such as a synthesis)."},
+                {"head", "", pyb::none(), "None, a path (a mesh or a .vdb level set) or (x, y, z, r), a sphere."}},
+               "Compare a hairstyle ``b`` with a reference ``a`` (``vdbhair compare A B --json``): HairGS's\n"
+               "oriented-point precision, recall, F1 and strand consistency, the Chamfer distance, Perm's\n"
+               "root-aligned position and curvature errors and the discrete Frechet distance over length of the\n"
+               "strand pairs (when the strand counts agree), the share of b's strands leaving a's hair volume, and\n"
+               "with a head the shares of each passing into it.",
+               "    a: the reference Strands.\n"
+               "    b: the compared Strands (precision is the share of its oriented points matched in a).\n",
+               "A dict with the command line's JSON keys (strands, vertices, meters_per_unit,\n"
+               "    oriented_points, chamfer, paired, position_error, curvature_error, frechet, leaving_volume,\n"
+               "    volume_voxel, entering_head) and per_strand: NumPy arrays over a's strands (chamfer; with\n"
+               "    paired strands also position, curvature and frechet).",
+               pyb::cpp_function(compareImpl, pyb::arg("a"), pyb::arg("b"), pyb::arg("keywords")));
 }
 
 } // namespace
