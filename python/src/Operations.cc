@@ -358,88 +358,72 @@ void defineReconstruct(pyb::module_& m)
 }
 
 /// render: a preview image of strands.
+/// vdbhair.render(strands, path=None, **keywords): the declared parameters (renderParameters()), then render's own.
+pyb::object renderImpl(const StrandsPtr& strands, const pyb::object& pathArg, const pyb::dict& kw)
+{
+    RenderParams rp;
+    applyKeywords(renderParameters(), kw, rp, "render");
+    const std::optional<PathArg> path = pathArg.is_none() ? std::nullopt : std::optional<PathArg>(pathArg.cast<PathArg>());
+    rp.title = kw["title"].cast<std::string>();
+    rp.up = unitAxis(kw["up"].cast<std::array<double, 3>>(), "up");
+    if (!kw["facing"].is_none()) {
+        rp.facing = unitAxis(kw["facing"].cast<std::array<double, 3>>(), "facing");
+        if (std::abs(rp.facing->dot(rp.up)) > 0.5) throw ValueError("render: facing must be perpendicular to up");
+    }
+    const bool sheet = kw["sheet"].cast<bool>();
+    const StrandsPtr guides = kw["guides"].cast<StrandsPtr>(), reference = kw["reference"].cast<StrandsPtr>();
+    const auto head = kw["head"].cast<std::optional<PathArg>>();
+    if (path && !isImagePath(*path)) throw ValueError("render: " + *path + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
+    TriangleMesh headMesh;
+    const Image image = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+        RenderParams p = rp;
+        p.interrupter = interrupter;
+        if (guides) p.guides = guides.get();
+        if (reference) p.reference = reference.get();
+        if (head) {
+            headMesh = readTriangleMesh(*head);
+            if (!headMesh.triangles.empty()) p.head = &headMesh;
+        }
+        return sheet ? renderSheet(*strands, p) : renderStrands(*strands, p);
+    });
+    if (path) {
+        pyb::gil_scoped_release release;
+        writeImage(*path, image);
+        return pyb::none();
+    }
+    // What writeImage stores in a .png, made opaque.
+    const std::vector<std::uint8_t> srgb = toSrgb8(image);
+    pyb::array_t<std::uint8_t> out({pyb::ssize_t(image.height), pyb::ssize_t(image.width), pyb::ssize_t(4)});
+    std::uint8_t* o = out.mutable_data();
+    const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) o[4 * i + c] = srgb[3 * i + c];
+        o[4 * i + 3] = 255;
+    }
+    return std::move(out);
+}
+
 void defineRender(pyb::module_& m)
 {
-    const RenderParams renderDefaults;
-    m.def(
-        "render",
-        [](const StrandsPtr& strands, std::optional<PathArg> path, const std::string& view, int width, int height,
-           const std::string& colorBy, std::array<double, 3> up, std::optional<std::array<double, 3>> facing,
-           const std::string& title, bool sheet, const StrandsPtr& guides, std::optional<PathArg> head, const StrandsPtr& reference,
-           int threads, const pyb::object& progress) -> pyb::object {
-            RenderParams rp;
-            rp.view = viewFromName(view);
-            rp.colorBy = colorByFromName(colorBy);
-            if (width < 1 || height < 1 || width > 16384 || height > 16384) {
-                throw ValueError("render: width x height " + std::to_string(width) + "x" + std::to_string(height) +
-                                 ": must be between 1 and 16384 pixels");
-            }
-            rp.width = width;
-            rp.height = height;
-            rp.title = title;
-            rp.up = unitAxis(up, "up");
-            if (facing) {
-                rp.facing = unitAxis(*facing, "facing");
-                if (std::abs(rp.facing->dot(rp.up)) > 0.5) throw ValueError("render: facing must be perpendicular to up");
-            }
-            if (path && !isImagePath(*path)) throw ValueError("render: " + *path + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
-            TriangleMesh headMesh;
-            const Image image = runLong(threads, progress, [&](WorkInterrupter* interrupter) {
-                RenderParams p = rp;
-                p.interrupter = interrupter;
-                if (guides) p.guides = guides.get();
-                if (reference) p.reference = reference.get();
-                if (head) {
-                    headMesh = readTriangleMesh(*head);
-                    if (!headMesh.triangles.empty()) p.head = &headMesh;
-                }
-                return sheet ? renderSheet(*strands, p) : renderStrands(*strands, p);
-            });
-            if (path) {
-                pyb::gil_scoped_release release;
-                writeImage(*path, image);
-                return pyb::none();
-            }
-            // What writeImage stores in a .png, made opaque.
-            const std::vector<std::uint8_t> srgb = toSrgb8(image);
-            pyb::array_t<std::uint8_t> out({pyb::ssize_t(image.height), pyb::ssize_t(image.width), pyb::ssize_t(4)});
-            std::uint8_t* o = out.mutable_data();
-            const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
-            for (std::size_t i = 0; i < n; ++i) {
-                for (int c = 0; c < 3; ++c) o[4 * i + c] = srgb[3 * i + c];
-                o[4 * i + 3] = 255;
-            }
-            return std::move(out);
-        },
-        pyb::arg("strands"), pyb::arg("path") = pyb::none(), pyb::kw_only(), pyb::arg("view") = viewName(renderDefaults.view),
-        pyb::arg("width") = renderDefaults.width, pyb::arg("height") = renderDefaults.height,
-        pyb::arg("color_by") = colorByName(renderDefaults.colorBy),
-        pyb::arg("up") = std::array<double, 3>{renderDefaults.up.x(), renderDefaults.up.y(), renderDefaults.up.z()},
-        pyb::arg("facing") = pyb::none(), pyb::arg("title") = renderDefaults.title, pyb::arg("sheet") = false,
-        pyb::arg("guides") = pyb::none(), pyb::arg("head") = pyb::none(), pyb::arg("reference") = pyb::none(), pyb::arg("threads") = 0,
-        pyb::arg("progress") = pyb::none(),
-        R"doc(A preview image of strands: lit fibres, depth-correct, anti-aliased (``vdbhair render``).
-
-Args:
-    strands: a Strands.
-    path: write the image there (.png, .jpg: sRGB 8 bits; .exr: linear float) and return None;
-        None returns the image instead.
-    view: "front", "side", "top", "back" or "three-quarter" (perspective).
-    width, height: pixels (1-16384).
-    color_by: "shaded", "root", "tangent", "depth", "curvature", "strand", or "error" (each
-        vertex's distance to the nearest vertex of ``reference``, 0 to its 95th percentile).
-    up: the hairstyle's up axis (x, y, z); (0, 0, 1) for Yuksel's cyHair models.
-    facing: the direction the face looks, perpendicular to up (default: +z, or -y for a z up).
-    title: text in the top-left corner.
-    sheet: one image with the front, side, top and three-quarter views.
-    guides: Strands drawn on top in red.
-    head: a head mesh (.ply, .obj) drawn behind the hair.
-    reference: Strands to measure against, for color_by="error".
-    threads: worker threads, 0 for all cores.
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    None with a path; otherwise an (height, width, 4) uint8 RGBA array (sRGB, alpha 255).)doc");
+    const RenderParams defaults;
+    defineVerb(m, "render", {"strands: vdbhair.Strands", "path: Optional[os.PathLike | str]=None"}, renderParameters(),
+               {{"up", "Tuple[float, float, float]", pyb::make_tuple(defaults.up.x(), defaults.up.y(), defaults.up.z()),
+                 "the hairstyle's up axis (x, y, z); (0, 0, 1) for Yuksel's cyHair models."},
+                {"facing", "Optional[Tuple[float, float, float]]", pyb::none(),
+                 "the direction the face looks, perpendicular to up (default: +z, or -y for a z up)."},
+                {"title", "str", pyb::str(defaults.title), "text in the top-left corner."},
+                {"sheet", "bool", pyb::bool_(false), "one image with the front, side, top and three-quarter views."},
+                {"guides", "Optional[vdbhair.Strands]", pyb::none(), "Strands drawn on top in red."},
+                {"head", "Optional[os.PathLike | str]", pyb::none(), "a head mesh (.ply, .obj) drawn behind the hair."},
+                {"reference", "Optional[vdbhair.Strands]", pyb::none(),
+                 "Strands to measure against, for color_by=\"error\" (each vertex's distance to the nearest vertex of reference, "
+                 "0 to its 95th percentile)."}},
+               "A preview image of strands: lit fibres, depth-correct, anti-aliased (``vdbhair render``).",
+               "    strands: a Strands.\n"
+               "    path: write the image there (.png, .jpg: sRGB 8 bits; .exr: linear float) and return None;\n"
+               "        None returns the image instead.\n",
+               "None with a path; otherwise an (height, width, 4) uint8 RGBA array (sRGB, alpha 255).",
+               pyb::cpp_function(renderImpl, pyb::arg("strands"), pyb::arg("path"), pyb::arg("keywords")));
 }
 
 /// inspect: a description of every grid of a .vdb file.
