@@ -2,25 +2,21 @@
 // §3-5: hierarchical clustering, PCA feature maps and texture optimization, cluster-oriented
 // detail transfer, vector-field refinement per level).
 #include "../Command.h"
+#include "../HeadOptions.h"
 #include "../ParamOptions.h"
 
 #include <vdbhair/synth/StyleRegions.h>
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
-#include <vdbhair/field/RefineReport.h>
-#include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/FileUtil.h>
-#include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/PointFile.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbStrands.h>
 #include <vdbhair/render/StrandRenderer.h>
-#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/scalp/ScalpInput.h>
 #include <vdbhair/scalp/ScalpSurface.h>
-#include <vdbhair/strands/Measures.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
 #include <vdbhair/synth/SynthJson.h>
@@ -265,8 +261,7 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     std::string regionFrom;
     const std::vector<Vec3d> region = readOutputRegion(p, common, regionFrom);
     const std::shared_ptr<const ScalpMap> outputMap = outputScalpMap(p, common, region);
-    if (p.head == "none") p.synth.head = HeadObstacle::none();
-    else if (!p.head.empty()) p.synth.head = readHeadObstacle(p.head, "--head " + p.head);
+    p.synth.head = headFromOptions(HeadOptions{p.head}, p.synth.head);
 
     const auto t0 = std::chrono::steady_clock::now();
     const SynthResult r = synthesizeHair(example, p.synth, scalp, true, common.interrupter, regionFrom.empty() ? nullptr : &region, outputMap);

@@ -1,15 +1,15 @@
 // vdbhair transfer DETAILS BASE -o OUT: BASE's coarsest level with DETAILS' finer levels (Wang et
 // al. 2009, §6), and `synth EXAMPLE --coarse BASE`, which is the same operation.
 #include "../Command.h"
+#include "../HeadOptions.h"
 #include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/io/StrandIO.h>
-#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/SynthJson.h>
-#include <vdbhair/compare/HairComparison.h>
 
 #include <algorithm>
 #include <chrono>
@@ -122,8 +122,7 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
                     if (!params.guides) throw ValueError("--strands: the output has BASE's strands; --strands needs --guides");
                     params.strands = std::size_t(p->strands);
                 }
-                if (p->head == "none") params.synth.head = HeadObstacle::none();
-                else if (!p->head.empty()) params.synth.head = readHeadObstacle(p->head, "--head " + p->head);
+                params.synth.head = headFromOptions(HeadOptions{p->head}, params.synth.head);
                 return runTransferJob(p->job, params, common);
             },
             synthTransferFlags()};
