@@ -80,6 +80,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
         std::cout << "transferred the detail of " << job.details << " (" << details.numStrands() << " strands) onto "
                   << job.base << " (" << base.numStrands() << "): " << r.strands.numStrands() << " strands in " << seconds << " s\n"
                   << "  turning per head radius: details " << m.turnDetails * rd << ", base " << m.turnBase * rb << ", output " << m.turnOut * rb << "\n"
+                  << "  curl amplitude (head radii): details " << m.curlDetails << ", base " << m.curlBase << ", output " << m.curlOut << "\n"
                   << "  output wisps from the base's coarsest strands: " << m.deviationMean * 100.0 << " % of their length (mean)\n"
                   << "  wisp length ratio base/details " << tr.lengthRatio << ", detail scale " << tr.detailScale << "\n";
         if (r.head != "none") {

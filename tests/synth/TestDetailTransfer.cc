@@ -282,6 +282,54 @@ TEST_CASE("transferDetail: edges keep a helix's turning per length on a longer s
     }
 }
 
+TEST_CASE("transferDetail: a strand shorter than its curl's period continues as its helix on a longer centre", "[synth]")
+{
+    // Three quarters of a turn of the helix of radius r = 0.02, rise c = 0.01 per radian (a C:
+    // its carrier holds the curl, its edges little of it): curvature 40 per head radius, its
+    // edges at cos = c / (r² + c²)^½ to the axis.
+    const double r = 0.02, c = 0.01, turns = 0.75, kappa = r / (r * r + c * c);
+    const int ns = 64;
+    const StrandSamples strand = oneStrand(helix(r, c, turns, 256), ns);
+    const double axis = c * 2.0 * M_PI * turns;
+    const auto line = [](double length, int n) {
+        std::vector<Vec3f> p;
+        for (int k = 0; k < n; ++k) p.emplace_back(0.0f, float(1.0 + length * double(k) / double(n - 1)), 0.0f);
+        return p;
+    };
+    const StrandSamples centre = oneStrand(line(axis, 64), ns);
+    // Eight times as long: seven of every eight parts of the output are continuation.
+    const StrandSamples longCentre = oneStrand(line(8.0 * axis, 64), ns);
+    for (bool threaded : {true, false}) {
+        const std::vector<Vec3f> out = layOnto(strand, centre, longCentre, DetailScale::ArcLength, 16 * ns, threaded);
+        const double tOut = polylineTurningPerLength(out);
+        // Past the strand's first turn (the lean eased to the helix's), the distance from the
+        // helix's axis, which the strand's carrier offsets by where its own end left it.
+        double outside = 0.0, sum = 0.0, sum2 = 0.0;
+        std::size_t count = 0;
+        std::vector<Vec3d> tail;
+        for (const Vec3f& p : out)
+            if (p.y() > 1.0 + 4.0 * axis) tail.emplace_back(p);
+        Vec3d mid(0.0);
+        for (const Vec3d& p : tail) mid += Vec3d(p.x(), 0.0, p.z()) / double(tail.size());
+        for (const Vec3d& p : tail) {
+            const double d = std::hypot(p.x() - mid.x(), p.z() - mid.z());
+            sum += d;
+            sum2 += d * d;
+            ++count;
+            outside = std::max(outside, d);
+        }
+        const double meanRadius = sum / double(count), spread = std::sqrt(std::max(0.0, sum2 / double(count) - meanRadius * meanRadius));
+        const Vec3d end(out.back());
+        INFO("turning per length " << tOut << " against " << kappa << "; radius " << meanRadius << " +- " << spread << " (max " << outside
+                                   << ") against " << r << "; end " << end);
+        REQUIRE(count > 100);
+        CHECK(tOut == Approx(kappa).epsilon(0.1));
+        CHECK(meanRadius == Approx(r).epsilon(0.15));
+        CHECK(spread < 0.15 * r);
+        CHECK(end.y() == Approx(1.0 + 8.0 * axis).margin(2.5 * r));
+    }
+}
+
 namespace {
 
 /// Straight strands along the normal of the unit sphere, rooted in a small cap around @a at.

@@ -87,9 +87,10 @@ TEST_CASE("measureStyleRegions: regions, front, lengths, lift, turning, curl and
     REQUIRE(fringe.lengthP50 == Approx(0.15));  // 0.1, 0.1, 0.2, 0.4
     REQUIRE(crown.turning == Approx(0.0).margin(1e-6));
     REQUIRE(crown.curlAmplitude == Approx(0.0).margin(1e-9));
-    // The waving strand's amplitude: its RMS offset A / sqrt(2), over the four side strands (the
-    // others are straight); the waves are far shorter than the smoothing, so it keeps all of it.
-    REQUIRE(sides.curlAmplitude == Approx(A / std::sqrt(2.0) / 4.0).epsilon(0.03));
+    // The waving strand's amplitude: its RMS offset A / sqrt(2), over the two side strands long
+    // enough for the figure (0.6 head radii: not the hairline's 0.1), the other straight; the waves
+    // are far shorter than the smoothing, so it keeps all of it.
+    REQUIRE(sides.curlAmplitude == Approx(A / std::sqrt(2.0) / 2.0).epsilon(0.03));
     REQUIRE(sides.turning > 1.0);
     // Inside the head: all but the root of the strand going through the centre, and of the two
     // hairline strands hanging straight down from above the equator (32 each); the crown's point up.

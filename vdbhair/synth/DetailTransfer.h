@@ -45,7 +45,13 @@
 /// (ArcLength; at least its own times their ratio), where past the strand's end a loop of it repeats: the edges from
 /// the place most like the strand's end on, at least a quarter of the strand (a period of a
 /// curl), turned as a whole so that its net step points along the carrier and its start joins the
-/// strand's end. A wisp transferred onto its own centre comes back (tested to 1e-4 of the strand's
+/// strand's end. A strand shorter than one and a half turns of its wisp's curl (a C, whose curl
+/// its carrier holds, so that a loop of its edges repeats only their crimp) continues instead as
+/// the helix of its wisp: the wisp's turning per length and mean cosine to its centre (radius,
+/// pitch and handedness; DetailEdges.h, wispCurl()), eased in from the strand's last direction
+/// and steered onto the carrier (tested: three quarters of a helix turn onto a centre eight times
+/// as long keeps the helix's radius within 2 % and its turning within 3 %; Curly_100 onto
+/// straight.hair keeps its curl amplitude within 7 %, docs/editing.md). A wisp transferred onto its own centre comes back (tested to 1e-4 of the strand's
 /// length, with every DetailScale): the same carriers, frames and arcs, and its own length.
 ///
 /// **Matching** (DetailMatchParams): balanced by share, at one scale, by default.

@@ -4,6 +4,7 @@
 #include <vdbhair/Quantile.h>
 #include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
 
 #include <openvdb/math/Mat3.h>
@@ -23,16 +24,67 @@ namespace {
 constexpr double kCrownElevationDeg = 50.0;
 constexpr double kFringeAngleDeg = 60.0, kBackAngleDeg = 120.0;
 constexpr double kLiftHeight = 0.1;     ///< head radii above the root
-constexpr int kCurlVertices = 64;
-constexpr double kCurlSigma = 6.0;      ///< vertices of kCurlVertices
+/// Curl amplitude at one scale in head radii, whatever a strand's length: samples at most every
+/// 1/25 head radius (at least every 1/200), the centre line their Gaussian with σ = 0.15 head
+/// radii (a curl of wavelength 0.7, Curly_100's, keeps 6/10 of its radius against it), strands
+/// cut into pieces of about a head radius, each at least 4σ long. (A piece's smoothed line keeps
+/// its ends, so a piece reads a curl lower the shorter it is: three quarters of a helix turn of
+/// 0.8 head radii 0.050, the same helix in pieces of 1 head radius 0.056; pieces of one length
+/// compare alike.)
+constexpr double kCurlSpacing = 1.0 / 25.0, kCurlFinest = 1.0 / 200.0, kCurlSigma = 0.15, kCurlPiece = 1.0;
+constexpr std::size_t kCurlMaxSamples = 1 << 14;  ///< longer strands are sampled more coarsely
 
-/// Per strand: length, lift, turning per length, curl amplitude (head radii), vertices inside.
+/// Per strand: length, lift, turning per length, its pieces' curl amplitudes (head radii: their
+/// sum and count), vertices inside.
 struct StrandFigures
 {
-    double length = 0.0, turning = 0.0, curl = 0.0;
+    double length = 0.0, turning = 0.0, curlSum = 0.0;
+    std::size_t curlPieces = 0;
     bool lifts = false;
     std::size_t inside = 0;
 };
+
+/// The curl amplitude of strand @a i of length @a length (world units): the strand cut into
+/// pieces of about @a piece (at least one), each at least 4σ long, and of each piece the RMS
+/// distance from its own smoothed centre line (smoothPolyline(): its ends stay, so a straight or
+/// evenly bent piece has none); @a sum and @a count receive the pieces' amplitudes (head radii).
+void strandCurl(const StrandSet& s, std::size_t i, double length, double radius, double piece, double& sum, std::size_t& count,
+                std::vector<Vec3d>& pts, std::vector<Vec3d>& smooth)
+{
+    if (!(length >= 4.0 * kCurlSigma * radius)) return;
+    const std::size_t b = s.offsets[i], e = s.offsets[i + 1];
+    // At the strand's own vertex spacing within [1/200, 1/25] head radius: a curl tighter than
+    // the coarse spacing would alias, and none is finer than the strand's vertices.
+    const double own = length / double(std::max<std::size_t>(1, e - b - 1));
+    const double spacing = std::clamp(own, kCurlFinest * radius, kCurlSpacing * radius);
+    const std::size_t n = std::min(kCurlMaxSamples, std::size_t(length / spacing) + 2);
+    pts.assign(n, Vec3d(0.0));
+    const double step = length / double(n - 1);
+    std::size_t k = b;
+    double walked = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+        const double target = std::min(length, step * double(j));
+        while (k + 2 < e && walked + (Vec3d(s.positions[k + 1]) - Vec3d(s.positions[k])).length() < target) {
+            walked += (Vec3d(s.positions[k + 1]) - Vec3d(s.positions[k])).length();
+            ++k;
+        }
+        const Vec3d p0(s.positions[k]), p1(s.positions[k + 1]);
+        const double seg = (p1 - p0).length();
+        const double t = seg > 0.0 ? std::clamp((target - walked) / seg, 0.0, 1.0) : 0.0;
+        pts[j] = p0 + t * (p1 - p0);
+    }
+    const std::size_t pieces = std::max<std::size_t>(1, std::size_t(std::llround(length / std::max(piece, 1e-30))));
+    smooth.resize(n);
+    for (std::size_t q = 0; q < pieces && q < n - 1; ++q) {
+        const std::size_t lo = q * (n - 1) / pieces, hi = (q + 1) * (n - 1) / pieces;
+        if (double(hi - lo) * step < 4.0 * kCurlSigma * radius) continue;
+        smoothPolyline(pts.data() + lo, hi - lo + 1, kCurlSigma * radius / step, smooth.data());
+        double rms = 0.0;
+        for (std::size_t j = lo; j <= hi; ++j) rms += (pts[j] - smooth[j - lo]).lengthSqr();
+        sum += std::sqrt(rms / double(hi - lo + 1)) / radius;
+        ++count;
+    }
+}
 
 StrandFigures strandFigures(const StrandSet& s, std::size_t i, const RegionFrame& f, HeadObstacle::Probe* head, double tolerance,
                             std::vector<Vec3d>& pts, std::vector<Vec3d>& smooth)
@@ -55,29 +107,7 @@ StrandFigures strandFigures(const StrandSet& s, std::size_t i, const RegionFrame
     out.length = length / f.radius;
     out.lifts = highest > kLiftHeight * f.radius;
     out.turning = length > 0.0 ? turning / out.length : 0.0;
-    // Curl amplitude: RMS distance from the strand's own smoothed centre line, at a fixed resolution.
-    if (length > 0.0) {
-        pts.assign(kCurlVertices, Vec3d(0.0));
-        const double step = length / double(kCurlVertices - 1);
-        std::size_t k = b;
-        double walked = 0.0;
-        for (int j = 0; j < kCurlVertices; ++j) {
-            const double target = std::min(length, step * double(j));
-            while (k + 2 < e && walked + (Vec3d(s.positions[k + 1]) - Vec3d(s.positions[k])).length() < target) {
-                walked += (Vec3d(s.positions[k + 1]) - Vec3d(s.positions[k])).length();
-                ++k;
-            }
-            const Vec3d p0(s.positions[k]), p1(s.positions[k + 1]);
-            const double seg = (p1 - p0).length();
-            const double t = seg > 0.0 ? std::clamp((target - walked) / seg, 0.0, 1.0) : 0.0;
-            pts[std::size_t(j)] = p0 + t * (p1 - p0);
-        }
-        smooth.resize(pts.size());
-        smoothPolyline(pts.data(), pts.size(), kCurlSigma, smooth.data());
-        double sum = 0.0;
-        for (std::size_t j = 0; j < pts.size(); ++j) sum += (pts[j] - smooth[j]).lengthSqr();
-        out.curl = std::sqrt(sum / double(pts.size())) / f.radius;
-    }
+    strandCurl(s, i, length, f.radius, kCurlPiece * f.radius, out.curlSum, out.curlPieces, pts, smooth);
     return out;
 }
 
@@ -183,12 +213,14 @@ StyleRegions measureStyleRegions(const StrandSet& strands, const RegionFrame& fr
         std::vector<double> lengths;
         std::size_t lifts = 0, inside = 0, vertices = 0;
         double turning = 0.0, curl = 0.0;
+        std::size_t curled = 0;  // pieces of strands long enough for a curl amplitude
         for (std::size_t i = 0; i < nS; ++i) {
             if (int(region[i]) != r) continue;
             lengths.push_back(per[i].length);
             lifts += per[i].lifts;
             turning += per[i].turning;
-            curl += per[i].curl;
+            curl += per[i].curlSum;
+            curled += per[i].curlPieces;
             inside += per[i].inside;
             vertices += strands.size(i);
         }
@@ -200,10 +232,30 @@ StyleRegions measureStyleRegions(const StrandSet& strands, const RegionFrame& fr
         g.lengthP75 = quantile(lengths, 0.75);
         g.lift = double(lifts) / double(g.strands);
         g.turning = turning / double(g.strands);
-        g.curlAmplitude = curl / double(g.strands);
+        g.curlAmplitude = curled ? curl / double(curled) : 0.0;
         g.insideHead = withHead ? double(inside) / double(vertices) : -1.0;
     }
     return out;
+}
+
+double meanCurlAmplitude(const StrandSet& strands, double radius, double piece)
+{
+    double sum = 0.0;
+    std::size_t count = 0;
+    std::vector<Vec3d> pts, smooth;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i)
+        strandCurl(strands, i, polylineLength(strands.data(i), strands.size(i)), radius, (piece > 0.0 ? piece : kCurlPiece) * radius, sum, count, pts, smooth);
+    return count ? sum / double(count) : 0.0;
+}
+
+double medianCurlPiece(const StrandSet& strands, double radius)
+{
+    std::vector<double> lengths;
+    for (std::size_t i = 0; i < strands.numStrands(); ++i) {
+        const double l = polylineLength(strands.data(i), strands.size(i)) / radius;
+        if (l >= 4.0 * kCurlSigma) lengths.push_back(l);
+    }
+    return lengths.empty() ? kCurlPiece : quantile(lengths, 0.5);
 }
 
 nlohmann::json toJson(const StyleRegions& example, const StyleRegions& output)

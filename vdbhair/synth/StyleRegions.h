@@ -17,10 +17,11 @@
 /// region; the 25th, 50th and 75th percentiles of strand length (layers); the share of strands that
 /// *lift*, whose highest vertex rises more than 0.1 head radii above their root along up (fringes
 /// swept up, volume at the crown); the mean turning per unit length (radians per head radius);
-/// the curl amplitude, the mean over strands of the RMS distance of a strand's vertices from its
-/// own smoothed centre line (64 vertices by arc length, Gaussian σ of 6 vertices: curls, not the
-/// strand's overall bend); and, with a head, the share of vertices inside it (deeper than
-/// headTolerance(), refine --head's rule).
+/// the curl amplitude, the mean over the strands' pieces of about a head radius (each at least
+/// 0.6 head radii) of the RMS distance of a piece from its own smoothed centre line (Gaussian σ of
+/// 0.15 head radii, its ends kept: curls, not the strand's overall bend, at one scale whatever the
+/// strands' lengths; StyleRegions.cc, kCurlPiece, says how piece length matters); and, with a
+/// head, the share of vertices inside it (deeper than headTolerance(), refine --head's rule).
 #pragma once
 
 #include <vdbhair/Types.h>
@@ -76,6 +77,16 @@ class HeadObstacle;
 /// (signed distance below 0) when it is given and not empty.
 StyleRegions measureStyleRegions(const StrandSet& strands, const RegionFrame& frame, const HeadObstacle* head = nullptr,
                                  bool threaded = true);
+
+/// @brief The curl amplitude of RegionFigures over all of @a strands (head radius @a radius),
+/// measured in pieces of about @a piece head radii (0: one): the mean over the pieces, 0 when
+/// there are none. Two hairstyles measured in pieces of one length compare alike, whatever the
+/// lengths of their strands (transfer's report: DETAILS' median strand length, medianCurlPiece()).
+double meanCurlAmplitude(const StrandSet& strands, double radius, double piece = 0.0);
+
+/// @brief The median length, in head radii, of the strands of @a strands long enough to have a
+/// curl amplitude (a head radius when there are none).
+double medianCurlPiece(const StrandSet& strands, double radius);
 
 /// @brief Example and output side by side: {"frame": {...}, "crown": {"share": {"example": a,
 /// "output": b}, ...}, ...} (null where a region has no strands).

@@ -158,7 +158,13 @@ TransferMeasures measureTransfer(const StrandSet& details, const StrandSet& base
     m.deviationClusters = dev.size();
     // Turning per head radius: each hairstyle in units of its own head (detail arrives scaled so).
     const double rd = tr.detailsMap->radius(), rb = r.map->radius();
+    // Curl amplitude in pieces of DETAILS' median strand length, each in its own head's radii.
+    m.curlPiece = medianCurlPiece(details, rd);
+    m.curlDetails = meanCurlAmplitude(details, rd, m.curlPiece);
+    m.curlBase = meanCurlAmplitude(base, rb, m.curlPiece);
+    m.curlOut = meanCurlAmplitude(r.strands, rb, m.curlPiece);
     m.checks = {{"detail", std::abs(m.turnOut * rb - m.turnDetails * rd) <= 0.1 * m.turnDetails * rd},
+                {"curl", std::abs(m.curlOut - m.curlDetails) <= 0.1 * m.curlDetails},
                 {"coarse_shape", m.deviationMean <= 0.1}};
     // BASE's regions kept: the output against BASE, region by region, in BASE's head frame.
     const ScalpSphere& sphere = r.map->sphere();
@@ -188,6 +194,7 @@ nlohmann::json transferReport(const StrandSet& base, const TransferResult& tr, c
             {"turning_per_length", {{"details", m.turnDetails}, {"base", m.turnBase}, {"output", m.turnOut}, {"spacing_head_radii", m.spacing}}},
             {"output_vertices", tr.outputVertices}, {"details_smoothing", tr.detailsSmoothing},
             {"turning_per_head_radius", {{"details", m.turnDetails * rd}, {"base", m.turnBase * rb}, {"output", m.turnOut * rb}}},
+            {"curl_amplitude", {{"details", m.curlDetails}, {"base", m.curlBase}, {"output", m.curlOut}, {"piece_head_radii", m.curlPiece}}},
             {"coarse_deviation", {{"mean", m.deviationMean}, {"p90", m.deviationP90}, {"clusters", m.deviationClusters}}},
             {"head", {{"head", r.head}, {"pushed_out", r.headPushedOut},
                       {"entering", {{"output", share(r.enteringHead, r.strands.numStrands())},

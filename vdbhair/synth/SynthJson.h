@@ -54,6 +54,8 @@ struct TransferMeasures
 {
     double spacing = 0.0;  ///< sample spacing of the turning figures, head radii
     double turnDetails = 0.0, turnBase = 0.0, turnOut = 0.0;  ///< turning per unit length
+    double curlDetails = 0.0, curlBase = 0.0, curlOut = 0.0;  ///< meanCurlAmplitude(), head radii
+    double curlPiece = 0.0;  ///< the pieces they are measured in (medianCurlPiece() of DETAILS), head radii
     /// clusterMeanDeviation() of the output's wisps from BASE's: mean, 90th percentile, wisps
     double deviationMean = 0.0, deviationP90 = 0.0;
     std::size_t deviationClusters = 0;

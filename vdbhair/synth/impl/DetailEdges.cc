@@ -21,6 +21,10 @@ namespace {
 /// the strand they copied (7.2 rad against 2.7).
 constexpr double kCollinearCos = 5e-7;
 
+/// The least mean cosine between a curly strand's edges and its centre that strandCurl() takes:
+/// edges leaning further off (about 70 degrees) make a coil that hardly moves along the centre.
+constexpr double kMinCurlRho = 0.35;
+
 /// The rotation that takes unit @a from to unit @a to by the shortest arc, applied to @a v.
 Vec3d rotateOnto(const Vec3d& from, const Vec3d& to, const Vec3d& v)
 {
@@ -88,17 +92,42 @@ Carrier::Carrier(const std::vector<Vec3d>& p, double sigma, const Vec3f& referen
     for (std::size_t k = 1; k < p.size(); ++k) arc[k] = arc[k - 1] + (smooth[k] - smooth[k - 1]).length();
 }
 
-void Carrier::frameAt(double s, Vec3d axes[3]) const
+void Carrier::locate(double s, std::size_t& j, double& u, std::size_t* hint) const
 {
-    std::size_t j = 0;
-    double u = 0.0;
+    j = 0;
+    u = 0.0;
     if (s >= arc.back()) {
         j = arc.size() - 1;
     } else if (s > 0.0) {
-        j = std::size_t(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()) - 1;
+        if (hint) {
+            // The last vertex at or before s, walked to from the last one found (a strand laid
+            // edge by edge moves along its carrier a little at a time).
+            j = std::min(*hint, arc.size() - 2);
+            while (j + 1 < arc.size() && arc[j + 1] <= s) ++j;
+            while (j > 0 && arc[j] > s) --j;
+        } else {
+            j = std::size_t(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()) - 1;
+        }
         const double span = arc[j + 1] - arc[j];
         u = span > 0.0 ? (s - arc[j]) / span : 0.0;
     }
+    if (hint) *hint = j;
+}
+
+Vec3d Carrier::pointAt(double s, std::size_t* hint) const
+{
+    std::size_t j = 0;
+    double u = 0.0;
+    locate(s, j, u, hint);
+    const Vec3d p(points[j]);
+    return u > 0.0 && j + 1 < points.size() ? p + (Vec3d(points[j + 1]) - p) * u : p;
+}
+
+void Carrier::frameAt(double s, Vec3d axes[3], std::size_t* hint) const
+{
+    std::size_t j = 0;
+    double u = 0.0;
+    locate(s, j, u, hint);
     Vec3d t = Vec3d(frames[j].t), n = Vec3d(frames[j].n);
     if (u > 0.0 && j + 1 < frames.size()) {
         t = t * (1.0 - u) + Vec3d(frames[j + 1].t) * u;
@@ -150,13 +179,62 @@ std::vector<Vec3d> strandEdges(const std::vector<Vec3d>& strand, double sigma, c
     return d;
 }
 
-std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<double>& advance, const std::vector<double>& frameShift,
-                            double lambda, const Carrier& carrier, const Vec3d& root, double target)
+Curl wispCurl(const std::vector<std::vector<Vec3d>>& strands, const Carrier& centre, double sigma)
 {
-    std::vector<Vec3d> out{root};
-    out.reserve(d.size() + 1);
+    double length = 0.0, along = 0.0, turning = 0.0, mostTurning = 0.0, twist = 0.0, twistScale = 0.0;
+    std::vector<Vec3d> strand;
+    for (const std::vector<Vec3d>& raw : strands) {
+        strand.resize(raw.size());
+        smoothPolyline(raw.data(), raw.size(), sigma, strand.data());
+        Vec3d prevUnit(0.0), prevPerp(0.0);
+        double turned = 0.0;
+        for (std::size_t k = 0; k + 1 < strand.size() && k + 1 < centre.frames.size(); ++k) {
+            const Vec3d e = strand[k + 1] - strand[k];
+            const double l = e.length();
+            if (!(l > 0.0)) continue;
+            const Vec3d u = e / l, t = (Vec3d(centre.frames[k].t) + Vec3d(centre.frames[k + 1].t)).unitSafe();
+            const Vec3d perp = u - t * u.dot(t);
+            length += l;
+            along += e.dot(t);
+            if (prevUnit.lengthSqr() > 0.0) {
+                turned += std::acos(std::clamp(prevUnit.dot(u), -1.0, 1.0));
+                twist += prevPerp.cross(perp).dot(t);
+                twistScale += prevPerp.length() * perp.length();
+            }
+            prevUnit = u;
+            prevPerp = perp;
+        }
+        turning += turned;
+        mostTurning = std::max(mostTurning, turned);
+    }
+    Curl curl;
+    if (!(length > 0.0) || mostTurning < M_PI) return curl;
+    curl.kappa = turning / length;
+    curl.rho = std::clamp(along / length, kMinCurlRho, 1.0);
+    curl.handed = twist < -0.05 * twistScale ? -1.0 : 1.0;
+    const double sine = std::sqrt(1.0 - curl.rho * curl.rho);
+    if (sine > 1e-3) curl.period = 2.0 * M_PI * sine / curl.kappa;
+    return curl;
+}
+
+namespace {
+
+/// Lays edges, given in the frame of a carrier at their place along it, one after another.
+struct EdgeLayer
+{
+    const Carrier& carrier;
+    const double lambda, target;
+    std::vector<Vec3d> out;
     double progress = 0.0;
-    const auto lay = [&](const Vec3d& local, double step, double shift) {
+    std::size_t hint = 0;  ///< where along the carrier the last frame was found
+
+    bool done() const { return progress >= target * (1.0 - 1e-9); }
+
+    /// Lay @a local (in the carrier's frame at @a shift past the progress, or at the edge's middle
+    /// when NaN), moving on @a step along the carrier; true when the target is reached (the edge
+    /// then cut there).
+    bool lay(const Vec3d& local, double step, double shift)
+    {
         Vec3d e = local * lambda;
         step *= lambda;
         bool last = false;
@@ -167,14 +245,25 @@ std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<doubl
             last = true;
         }
         Vec3d axes[3];
-        carrier.frameAt(std::isnan(shift) ? progress + 0.5 * step : progress + shift * lambda, axes);
+        carrier.frameAt(std::isnan(shift) ? progress + 0.5 * step : progress + shift * lambda, axes, &hint);
         out.push_back(out.back() + axes[0] * e.x() + axes[1] * e.y() + axes[2] * e.z());
         progress += step;
         return last;
-    };
-    for (std::size_t k = 0; k < d.size(); ++k)
-        if (lay(d[k], advance[k], frameShift[k])) return out;
-    if (progress >= target * (1.0 - 1e-9)) return out;
+    }
+
+    /// Past the strand's end, its loop (strandLoop()) repeats, each time turned by one more twist.
+    void repeatLoop(const std::vector<Vec3d>& d);
+
+    /// Past the strand's end, the helix of @a curl (steps of @a step, unscaled): from the strand's
+    /// last direction, its lean along the carrier eased to the helix's over a turn.
+    void continueHelix(const Curl& curl, double step);
+};
+
+/// (A cap on the vertices laid past the strand's end: targets are at most a few dozen strand lengths, kMaxOutputVertices.)
+constexpr std::size_t kMaxLaid = std::size_t(1) << 16;
+
+void EdgeLayer::repeatLoop(const std::vector<Vec3d>& d)
+{
     double twist = 0.0;
     std::vector<Vec3d> loop = strandLoop(d, twist);
     const auto stepOf = [](const std::vector<Vec3d>& l, double& arc) {
@@ -196,16 +285,64 @@ std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<doubl
             for (Vec3d& e : loop) e = rotateOnto(net.unitSafe(), Vec3d(1.0, 0.0, 0.0), e);
         twist = 0.0;
         loopStep = stepOf(loop, arc);
-        if (!(loopStep > 0.0)) return out;
+        if (!(loopStep > 0.0)) return;
     }
-    // (A cap on the repeats: targets are at most a few dozen strand lengths, kMaxOutputVertices.)
-    constexpr std::size_t kMaxLaid = std::size_t(1) << 16;
     for (int r = 1; progress < target && out.size() < kMaxLaid; ++r) {
         const double c = std::cos(twist * r), sn = std::sin(twist * r);
         for (const Vec3d& e : loop)
-            if (lay(Vec3d(e.x(), c * e.y() - sn * e.z(), sn * e.y() + c * e.z()), std::max(0.0, e.x()), std::numeric_limits<double>::quiet_NaN())) return out;
+            if (lay(Vec3d(e.x(), c * e.y() - sn * e.z(), sn * e.y() + c * e.z()), std::max(0.0, e.x()), std::numeric_limits<double>::quiet_NaN())) return;
     }
-    return out;
+}
+
+void EdgeLayer::continueHelix(const Curl& curl, double step)
+{
+    if (out.size() < 2 || !(step > 0.0)) return;
+    // The strand's last edge in the carrier's frame where it ended.
+    Vec3d axes[3];
+    carrier.frameAt(progress, axes);
+    const Vec3d last = (out.back() - out[out.size() - 2]).unitSafe();
+    const double x0 = std::clamp(last.dot(axes[0]), -1.0, 1.0);
+    double phase = std::atan2(last.dot(axes[2]), last.dot(axes[1]));
+    // The perpendicular direction turns at κ / sin(lean) per length (a helix of curvature κ).
+    const double sine = std::sqrt(1.0 - curl.rho * curl.rho), rate = curl.kappa / sine, ease = 2.0 * M_PI / rate;
+    const double radius = sine * sine / curl.kappa, pull = std::min(1.0, step / (0.5 * ease));
+    double s = 0.0;
+    while (progress < target && out.size() < kMaxLaid) {
+        s += step;
+        phase += curl.handed * rate * step;
+        const double w = std::min(1.0, s / ease), x = x0 + (curl.rho - x0) * w * w * (3.0 - 2.0 * w);
+        const double p = std::sqrt(std::max(0.0, 1.0 - x * x));
+        Vec3d local = Vec3d(x, p * std::cos(phase), p * std::sin(phase)) * step;
+        // Steered onto the helix about the carrier itself: where the helix would be at this
+        // phase (radius r, a quarter turn behind its tangent) less where the strand is, closed
+        // over about half a turn, so that a wisp's strands, which share their source's last
+        // direction, do not all wind about an axis beside the wisp's.
+        Vec3d axes[3];
+        carrier.frameAt(progress, axes, &hint);
+        const Vec3d offset = out.back() - carrier.pointAt(progress, &hint);
+        const double wantN = curl.handed * radius * std::sin(phase), wantB = -curl.handed * radius * std::cos(phase);
+        local += Vec3d(0.0, wantN - offset.dot(axes[1]), wantB - offset.dot(axes[2])) * pull;
+        if (lay(local / lambda, local.x() / lambda, std::numeric_limits<double>::quiet_NaN())) return;
+    }
+}
+
+} // namespace
+
+std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<double>& advance, const std::vector<double>& frameShift,
+                            double lambda, const Carrier& carrier, const Vec3d& root, double target, const Curl& curl)
+{
+    EdgeLayer layer{carrier, lambda, target, {root}};
+    layer.out.reserve(d.size() + 1);
+    double arc = 0.0;
+    for (std::size_t k = 0; k < d.size(); ++k) {
+        arc += d[k].length();
+        if (layer.lay(d[k], advance[k], frameShift[k])) return layer.out;
+    }
+    if (layer.done()) return layer.out;
+    // The helix in steps of the strand's edges, or of 1/32 of a turn where they are finer.
+    if (arc < 1.5 * curl.period) layer.continueHelix(curl, std::max(lambda * arc / double(std::max<std::size_t>(1, d.size())), curl.period / 32.0));
+    else layer.repeatLoop(d);
+    return layer.out;
 }
 
 } // namespace detail

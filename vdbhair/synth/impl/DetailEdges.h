@@ -25,8 +25,33 @@ struct Carrier
 
     /// The frame at arc length @a s (clamped to the carrier), between vertices by normalized
     /// interpolation; as three world axes (t, n, b).
-    void frameAt(double s, Vec3d axes[3]) const;
+    /// @a hint, if given, is where a walk along the carrier starts (and is left where it ends):
+    /// the same result as without it, found in a few steps when @a s moved a little.
+    void frameAt(double s, Vec3d axes[3], std::size_t* hint = nullptr) const;
+    /// The point at arc length @a s (clamped to the carrier), between vertices linearly.
+    Vec3d pointAt(double s, std::size_t* hint = nullptr) const;
+
+private:
+    /// The vertex @a j before arc length @a s and the fraction @a u of the way to the next.
+    void locate(double s, std::size_t& j, double& u, std::size_t* hint) const;
 };
+
+/// The helix that continues a curly strand shorter than its curl's period (layEdges()): from its
+/// wisp's turning per length κ and the mean cosine ρ between the wisp's edges and its centre's
+/// direction (the helix's pitch: radius (1 − ρ²)/κ, (1 − ρ²)^½/κ of arc per radian), turning as
+/// the wisp's edges turn about that direction (@c handed, +1 or −1).
+struct Curl
+{
+    double kappa = 0.0, rho = 1.0, handed = 1.0;
+    double period = 0.0;  ///< arc length of one turn of the helix; 0: no helix (strands repeat their loop)
+};
+
+/// @brief The curl of a wisp, @a strands about their centre's carrier @a centre (the same vertex
+/// count), each smoothed with σ = @a sigma vertices (smoothPolyline()), pooled over the strands by
+/// length: a helix when one of them turns at least half a turn (a C or more). A strand shorter than one and a half of its periods holds its curl in
+/// its carrier rather than in its edges, so a loop of its edges would repeat only their crimp;
+/// it continues as the helix instead (a wisp's short strands as its long ones curl).
+Curl wispCurl(const std::vector<std::vector<Vec3d>>& strands, const Carrier& centre, double sigma);
 
 /// One strand's detail as edges (DetailBlend::Edges): every edge in the frame of the strand's
 /// carrier at the edge's middle; @a advance receives how far along the carrier each edge goes
@@ -39,9 +64,10 @@ std::vector<Vec3d> strandEdges(const std::vector<Vec3d>& strand, double sigma, c
 /// The strand of DetailBlend::Edges: @a d (strandEdges()) scaled by @a lambda, laid from
 /// @a root in the frames of @a carrier at the place each edge reaches along it (its running
 /// progress along x̂), until the progress reaches @a target: the strand's last edge is cut
-/// there, or the strand's loop (strandLoop()) repeats after it, turned by one more twist each time.
+/// there, or (@a curl) the strand's helix continues after it, or else the strand's loop
+/// (strandLoop()) repeats after it, turned by one more twist each time.
 std::vector<Vec3d> layEdges(const std::vector<Vec3d>& d, const std::vector<double>& advance, const std::vector<double>& frameShift,
-                            double lambda, const Carrier& carrier, const Vec3d& root, double target);
+                            double lambda, const Carrier& carrier, const Vec3d& root, double target, const Curl& curl = Curl{});
 
 } // namespace detail
 } // namespace vdbhair
