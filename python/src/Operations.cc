@@ -5,6 +5,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/HelicoidJson.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
@@ -200,28 +201,18 @@ void defineFit(pyb::module_& m)
         }
         pyb::object sceneObj = toPython(sceneToJson(scene));
         if (!returnSummary) return sceneObj;
-        const FitSummary s = summarizeFits(*strands, fits, errors, fp.maxError);
-        pyb::dict d;
-        d["strands"] = s.strands;
-        d["fitted"] = s.fitted;
-        d["skipped"] = s.skipped;
-        d["over_max_error"] = s.overMaxError;
-        d["frechet_relative_mean"] = s.meanRelative;
-        d["frechet_relative_p95"] = s.p95Relative;
-        d["pieces_per_strand"] = s.piecesPerStrand;
-        d["step_deviation_mean"] = s.stepDeviationMean;
-        d["step_deviation_max"] = s.stepDeviationMax;
-        d["unconverged"] = s.unconverged;
-        d["fit_bytes"] = s.fitBytes;
-        d["point_bytes"] = s.pointBytes;
+        // `fit --json`'s report (fitReport()), less the file name and the rate.
+        const pyb::dict d = toPython(fitReport(summarizeFits(*strands, fits, errors, fp.maxError, fp.stepDeviationLimit)));
         return pyb::make_tuple(sceneObj, d);
     };
     defineVerb(m, "fit", {"strands: vdbhair.Strands"}, fitParameters(),
                {{"skip_degenerate", "bool", pyb::bool_(false), "leave out strands of zero length instead of raising."},
                 {"return_summary", "bool", pyb::bool_(false),
-                 "also return a dict (fitted, skipped, Frechet distance relative to length: mean and 95th percentile, pieces per "
-                 "strand, step convergence: the largest distance between each fit traced at its step and at a quarter of it "
-                 "relative to length, mean and max, and how many fits exceed a tenth of max_error; bytes of fits and of points)."}},
+                 "also return a dict: `fit --json`'s report key for key, less the file name and strands_per_second (strands, "
+                 "fitted, skipped, over_max_error, frechet_relative: the discrete Frechet distance relative to length, mean and "
+                 "p95; pieces_per_strand, evaluations_per_strand, step_convergence: the distance between each fit traced at its "
+                 "step and at a quarter of it relative to length, mean, max and how many exceed a tenth of max_error; bytes of "
+                 "fits and of points, compression)."}},
                "Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``. ``lambda_`` is the\n"
                "command's ``--lambda`` (``lambda`` is a Python keyword).",
                "    strands: a Strands.\n",
@@ -310,32 +301,16 @@ void defineReconstruct(pyb::module_& m)
             const HeadObstacle head = headArgument.get("reconstruct");
             return reconstructHairstyle(*strands, p, true, interrupter, head.unset() || head.empty() ? nullptr : &head);
         });
-        const double metersPerUnit = p.metersPerUnit;
-        auto stats = [metersPerUnit](const ReconstructErrors& e) {
-            pyb::dict d;
-            d["relative"] = pyb::array_t<double>(e.relative.size(), e.relative.data());
-            d["mean"] = e.mean;
-            d["p95"] = e.p95;
-            d["mean_interpolated"] = e.meanInterpolated;
-            d["p95_interpolated"] = e.p95Interpolated;
-            d["seconds"] = e.seconds;
-            d["perm_position"] = e.permPosition;
-            d["perm_curvature"] = e.permCurvature;
-            d["leaving_volume"] = e.leavingVolume;
-            d["entering_head"] = e.enteringHead;
-            d["oriented_points"] = e.oriented.empty() ? pyb::none() : toPython(toJson(e.oriented, metersPerUnit));
-            return d;
-        };
-        pyb::dict report;
-        report["guides"] = pyb::array_t<std::int64_t>(r.guides.size(), reinterpret_cast<const std::int64_t*>(r.guides.data()));
-        report["unfitted"] = r.unfitted;
-        report["fit"] = pyb::dict(pyb::arg("mean") = r.fitSummary.meanRelative, pyb::arg("p95") = r.fitSummary.p95Relative,
-                                  pyb::arg("pieces_per_strand") = r.fitSummary.piecesPerStrand, pyb::arg("seconds") = r.fitSeconds);
-        report["helicoid"] = stats(r.helicoidErrors);
-        report["points"] = stats(r.pointErrors);
-        report["nearest"] = stats(r.nearestErrors);
-        report["original"] = pyb::dict(pyb::arg("leaving_volume") = r.originalLeavingVolume, pyb::arg("entering_head") = r.originalEnteringHead);
-        report["volume_voxel"] = r.volumeVoxel;
+        // `reconstruct --json`'s report (reconstructReport()), plus the guides' indices and every
+        // strand's error each way as arrays (the command's --errors file).
+        pyb::dict report = toPython(reconstructReport(r, p));
+        report["guide_strands"] = pyb::array_t<std::int64_t>(r.guides.size(), reinterpret_cast<const std::int64_t*>(r.guides.data()));
+        pyb::dict perStrand;
+        for (const auto& [way, e] : {std::pair<const char*, const ReconstructErrors*>{"helicoid", &r.helicoidErrors},
+                                     {"points", &r.pointErrors}, {"nearest", &r.nearestErrors}}) {
+            perStrand[way] = pyb::array_t<double>(e->relative.size(), e->relative.data());
+        }
+        report["per_strand"] = perStrand;
         return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.helicoid)), std::make_shared<StrandSet>(std::move(r.points)), report);
     };
     defineVerb(m, "reconstruct", {"strands: vdbhair.Strands"}, reconstructParameters(),
@@ -347,13 +322,15 @@ void defineReconstruct(pyb::module_& m)
                "other root; the same guides' points are blended too (the peers' way), and both are measured\n"
                "against the original by the discrete Frechet distance relative to each strand's length.",
                "    strands: a Strands.\n",
-               "(helicoid, points, report): both reconstructions as Strands in input order, and a dict with\n"
-               "    ``guides`` (the guide strands' indices), ``unfitted``, ``fit`` (mean, p95, pieces_per_strand,\n"
-               "    seconds) and for ``helicoid``, ``points`` and ``nearest`` (the baseline: each strand its\n"
-               "    nearest guide, translated): ``relative`` (each strand's error), ``mean``, ``p95``,\n"
-               "    ``mean_interpolated``, ``p95_interpolated``, ``seconds``, ``perm_position``,\n"
-               "    ``perm_curvature`` and ``oriented_points`` (None, or per HairGS threshold: distance_mm,\n"
-               "    angle_degrees, precision, recall, f1, strand_consistency).",
+               "(helicoid, points, report): both reconstructions as Strands in input order, and a dict:\n"
+               "    ``reconstruct --json``'s report key for key, less the file name and the method written\n"
+               "    (strands, guides: their count, unfitted, guide_fraction, select, blend, grouping, fit (mean,\n"
+               "    p95, pieces_per_strand, seconds), frechet_relative and measures (oriented_points: None, or per\n"
+               "    HairGS threshold distance, distance_mm, angle_degrees, precision, recall, f1,\n"
+               "    strand_consistency; perm_position, perm_curvature) for ``helicoid``, ``points`` and\n"
+               "    ``nearest`` (the baseline: each strand its nearest guide, translated), meters_per_unit,\n"
+               "    leaving_guide_volume, entering_head (None without a head)); plus ``guide_strands`` (the guide\n"
+               "    strands' indices) and ``per_strand`` (each way's relative error of every strand).",
                pyb::cpp_function(reconstructImpl, pyb::arg("strands"), pyb::arg("keywords")));
 }
 

@@ -15,8 +15,8 @@ def test_fit_then_grow_regrows_the_strands(tmp_path):
     s = wavy_hairstyle(count=6, vertices=20, seed=3)
     scene, summary = vdbhair.fit(s, return_summary=True)
     assert summary["fitted"] == 6 and len(scene["guides"]) == 6
-    assert summary["frechet_relative_mean"] < 0.05
-    assert summary["unconverged"] == 0 and summary["step_deviation_max"] < 1e-3
+    assert summary["frechet_relative"]["mean"] < 0.05
+    assert summary["step_convergence"]["unconverged"] == 0 and summary["step_convergence"]["max"] < 1e-3
     grown = vdbhair.grow(scene)
     assert len(grown) == 6
     # Each regrown strand starts at its root and ends near its tip (within the fit's error).
