@@ -159,20 +159,27 @@ InterpolationRoots interpolationRoots(const pyb::object& rootsArg, const pyb::di
 /// grow: a scene's strands (growParameters()).
 void defineGrow(pyb::module_& m)
 {
-    auto growImpl = [](const pyb::object& sceneArg, const pyb::dict& kw) {
+    auto growImpl = [](const pyb::object& sceneArg, const pyb::dict& kw) -> pyb::object {
         const Scene scene = sceneArgument(sceneArg);
         GrowOptions opts;
         applyKeywords(growParameters(), kw, opts, "grow");
-        return runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
-            return std::make_shared<StrandSet>(growScene(scene, opts, true, interrupter));
+        GrowReport report;
+        auto strands = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            return std::make_shared<StrandSet>(growScene(scene, opts, true, interrupter, &report));
         });
+        if (!kw["return_report"].cast<bool>()) return pyb::cast(strands);
+        // `grow --json`'s report (growReport()), less the file names and the seconds.
+        return pyb::make_tuple(strands, toPython(growReport(scene, *strands, report)));
     };
-    defineVerb(m, "grow", {"scene"}, growParameters(), {},
+    defineVerb(m, "grow", {"scene"}, growParameters(),
+               {{"return_report", "bool", pyb::bool_(false),
+                 "also return a dict: `grow --json`'s report key for key, less the file names and the seconds (guides, strands, "
+                 "vertices, guides_near_axis: guides passing near a piece's singular axis)."}},
                "Grow the strands of a generalized-helicoid scene (Piuze et al. 2011): ``vdbhair grow``.\n\n"
                "Each guide, then its wisp strands; bitwise identical for any thread count. Raises\n"
                "vdbhair.LimitError over max_vertices.",
                "    scene: a path to a scene .json (\"vdbhair\": \"scene/1\"), or the scene as a dict (what fit returns).\n",
-               "Strands.", pyb::cpp_function(growImpl, pyb::arg("scene"), pyb::arg("keywords")));
+               "Strands, or (Strands, report) with return_report.", pyb::cpp_function(growImpl, pyb::arg("scene"), pyb::arg("keywords")));
 }
 
 /// fit: p-helicoids fitted to strands (fitParameters()).
@@ -254,15 +261,18 @@ void defineInterpolate(pyb::module_& m)
         } else if (!guideGroups.is_none()) {
             guides.groups = guideGroups.cast<std::vector<std::int32_t>>();
         }
+        HeadObstacle head;
         InterpolateResult result = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
-            HeadObstacle head = headArgument.get("interpolate");
+            head = headArgument.get("interpolate");
             // None: the scene's head sphere, else a sphere fitted to the guide roots (as the command).
             if (head.unset() && !fromStrands && scene.head) head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
             else if (head.unset() && fromStrands) head = headFromRoots(*guideStrands, op.helicoid.up);
             return interpolateGuides(guides, roots, head, op, true, interrupter);
         });
-        if (op.returnScene) return toPython(sceneToJson(result.scene));
-        return pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
+        // `interpolate --json`'s report (interpolateReport()), less the file name and the clock.
+        const pyb::object report = kw["return_report"].cast<bool>() ? toPython(interpolateReport(result, op, head)) : pyb::none();
+        const pyb::object out = op.returnScene ? toPython(sceneToJson(result.scene)) : pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
+        return report.is_none() ? out : pyb::make_tuple(out, report);
     };
     const InterpolateParams interpDefaults;
     defineVerb(m, "interpolate", {"guides", "roots"}, interpolateParameters(),
@@ -278,6 +288,10 @@ void defineInterpolate(pyb::module_& m)
                  pyb::make_tuple(interpDefaults.helicoid.up.x(), interpDefaults.helicoid.up.y(), interpDefaults.helicoid.up.z()),
                  "reference axis of the surface frames (``--up``)."},
                 {"return_scene", "bool", pyb::bool_(false), "return the new hairs as a scene dict (helicoid only) instead of growing them."},
+                {"return_report", "bool", pyb::bool_(false),
+                 "also return a dict: `interpolate --json`'s report key for key, less the file name, seconds and "
+                 "strands_per_second (method, settings, guides, strands, roots, groom controls, the head and the shares passing "
+                 "into it and leaving the guides' volume, fit_seconds)."},
                 {"density", "", pyb::none(),
                  "None, the share of roots that grow hair in [0, 1]: a number, one value per root, or a spec as the command's "
                  "--density (\"mask.vdb[:GRID]\", \"head.ply:PROPERTY\", a text file)."},
@@ -286,7 +300,7 @@ void defineInterpolate(pyb::module_& m)
                "    guides: a Strands (blended as they are; fitted first for method=\"helicoid\"), or a scene (a\n"
                "        path to a scene .json or a dict, as fit() returns).\n"
                "    roots: an (N, 3) array of root positions (world units), or a Strands whose roots are used.\n",
-               "Strands (one per root, in order), or the scene dict with return_scene.",
+               "Strands (one per root, in order), or the scene dict with return_scene; (either, report) with return_report.",
                pyb::cpp_function(interpolateImpl, pyb::arg("guides"), pyb::arg("roots"), pyb::arg("keywords")));
 }
 

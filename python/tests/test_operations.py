@@ -414,3 +414,32 @@ def test_roots_fit_reconstruct_retrace_reports_are_the_commands(tmp_path, shared
     assert roots["positions"].shape == (roots["count"], 3) and roots["region"]
     _same_report(roots, _command("roots", tmp_path / "scalp.vdb", "-o", tmp_path / "roots.ply", "--count", "200"),
                  ["output", "seconds"], ["positions", "normals", "tangents"])
+
+
+@pytest.mark.data
+def test_grow_interpolate_reports_are_the_commands(tmp_path, shared_data):
+    # grow and interpolate with return_report=True: `--json`'s report (HelicoidJson.h), less the
+    # command's file names and clock, on a real hairstyle's fits and roots spread over its head.
+    path = shared_data / "hair" / "tressfx" / "ascii_v2" / "hair_front_16_guide.tfx"
+    head = shared_data / "scalp" / "tressfx" / "head_max4.obj"
+    if not path.exists() or not head.exists():
+        pytest.skip(f"{path.name} or {head.name} is not in the shared data")
+    hair = vdbhair.read(str(path))
+    scene = vdbhair.fit(hair)
+    (tmp_path / "fits.json").write_text(json.dumps(scene))
+    out = tmp_path / "out.hair"
+
+    grown, report = vdbhair.grow(scene, return_report=True)
+    assert report["strands"] == len(grown) and report["guides"] == len(scene["guides"])
+    _same_report(report, _command("grow", tmp_path / "fits.json", "-o", out), ["scene", "output", "seconds"])
+
+    surface, region = vdbhair.scalp(str(head), region=hair)
+    vdbhair.write_grids(str(tmp_path / "scalp.vdb"), [surface, region])
+    _command("roots", tmp_path / "scalp.vdb", "-o", tmp_path / "roots.ply", "--count", "300")
+    r = vdbhair.roots(str(tmp_path / "scalp.vdb"), count=300)  # the file's roots (the test above)
+    for method, extra in (("points", ["--curl", "0.5", "--curl-frequency", "1"]), ("helicoid", ["--method", "helicoid"])):
+        kw = {"curl": 0.5, "curl_frequency": 1.0} if method == "points" else {"method": "helicoid"}
+        strands, report = vdbhair.interpolate(hair, r["positions"], normals=r["normals"], return_report=True, **kw)
+        assert report["strands"] == len(strands) == len(r["positions"])
+        cmd = _command("interpolate", path, "-o", out, "--roots", tmp_path / "roots.ply", *extra)
+        _same_report(report, cmd, ["output", "seconds", "strands_per_second"], timings=["fit_seconds"])
