@@ -36,9 +36,7 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
 openvdb::GridCPtrVec fieldGrids(const RefineResult& r, const std::string& source);
 void printRefineReport(const RefineResult& r, const RefineParams& rp);
 
-/// The report of retrace: {"strands","full_length","stopped":{...},"mean_displacement"}, and
-/// "tangent_angle_deg":{"before","after"} when @a angles is given (--measure).
-nlohmann::json traceReportJson(const TraceStats& s, const std::optional<TangentAngles>& angles, double displacement);
+/// retrace's text report (its JSON is the library's retraceReport(), vdbhair/field/FieldJson.h).
 void printTraceReport(const TraceStats& s, const std::optional<TangentAngles>& angles, double displacement);
 
 } // namespace vdbhair::app

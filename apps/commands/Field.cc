@@ -4,6 +4,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/DenseArray.h>
+#include <vdbhair/field/FieldJson.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/helicoid/HelicoidField.h>
@@ -88,8 +89,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     const std::vector<TangentField> fields = estimateTangentFieldLevels(strands, fp, p.levels, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    openvdb::GridCPtrVec grids;
-    nlohmann::json gridsJson = nlohmann::json::array();
+    openvdb::GridCPtrVec grids;  // the voxel grids (the report's), then the strands
     for (const TangentField& f : fields) {
         if (p.vectorName != "tangent") {  // e.g. hair_direction: Blender's Cycles reserves 'tangent'
             const std::string name = f.tangent->getName();
@@ -98,7 +98,6 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(f.tangent), openvdb::GridBase::Ptr(f.density), openvdb::GridBase::Ptr(f.hairLength)}) {
             g->insertMeta("vdbhair_source", openvdb::StringMetadata(p.input));
             grids.push_back(g);
-            gridsJson.push_back({{"name", g->getName()}, {"voxel_size", g->voxelSize().x()}, {"active_voxels", g->activeVoxelCount()}});
         }
     }
     if (p.helicoid) {
@@ -106,9 +105,9 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(h.k), openvdb::GridBase::Ptr(h.alpha),
                                                 openvdb::GridBase::Ptr(h.frameT), openvdb::GridBase::Ptr(h.frameN)}) {
             grids.push_back(g);
-            gridsJson.push_back({{"name", g->getName()}, {"voxel_size", g->voxelSize().x()}, {"active_voxels", g->activeVoxelCount()}});
         }
     }
+    nlohmann::json j = fieldReport(strands.numStrands(), fp, p.levels, grids);
     if (p.withStrands) grids.push_back(createStrandGrid(strands));
     std::vector<float> volume;
     if (!p.dense.empty()) {
@@ -122,33 +121,18 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     }
 
     if (common.json) {
-        nlohmann::json j = {{"output", p.output}, {"strands", strands.numStrands()}, {"voxel_size", fp.voxelSize},
-                            {"iterations", fp.iterations}, {"levels", p.levels}, {"space", fieldSpaceName(fp.space)},
-                            {"grids", gridsJson}, {"seconds", seconds}};
+        j["output"] = p.output;
+        j["seconds"] = seconds;
         if (!p.dense.empty()) {
-            std::size_t occupied = 0;
-            for (std::size_t i = 3; i < volume.size(); i += 4) occupied += volume[i] > 0.0f;
-            j["dense"] = {{"output", p.dense}, {"shape", {p.denseSize[0], p.denseSize[1], p.denseSize[2], 4}}, {"occupied", occupied},
-                          {"box", p.denseBox}};
+            j["dense"] = denseReport(denseBox, volume);
+            j["dense"]["output"] = p.dense;
         }
-        if (fp.space == FieldSpace::Scalp) {
-            const ScalpSphere& sphere = fp.scalpSphere();
-            j["scalp"] = {{"center", {sphere.center.x(), sphere.center.y(), sphere.center.z()}}, {"radius", sphere.radius},
-                          {"up", {sphere.up.x(), sphere.up.y(), sphere.up.z()}}};
-            if (fp.scalpSurface) {
-                // The measured scalp: d(u, v) in radii over the table, and the rays that missed it.
-                const std::vector<float>& d = fp.scalpSurface->distances();
-                j["scalp"]["surface"] = p.scalp.scalp;
-                j["scalp"]["resolution"] = fp.scalpSurface->resolution();
-                j["scalp"]["distance_range"] = {*std::min_element(d.begin(), d.end()), *std::max_element(d.begin(), d.end())};
-                j["scalp"]["misses"] = fp.scalpSurface->misses();
-            }
-        }
+        if (fp.space == FieldSpace::Scalp && fp.scalpSurface) j["scalp"]["surface"] = p.scalp.scalp;
         printJson(j);
     } else if (!common.quiet) {
         std::cout << "field of " << strands.numStrands() << " strands, voxel size " << fp.voxelSize << " ("
                   << fieldSpaceName(fp.space) << " space), " << fp.iterations << " iteration(s), " << p.levels << " level(s):\n";
-        for (const auto& g : gridsJson) {
+        for (const auto& g : j["grids"]) {
             std::cout << "  " << g["name"].get<std::string>() << ": " << g["active_voxels"].get<std::uint64_t>()
                       << " active voxels of size " << g["voxel_size"].get<double>() << "\n";
         }

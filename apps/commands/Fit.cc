@@ -4,6 +4,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/HelicoidJson.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/FileUtil.h>
 
@@ -63,12 +64,10 @@ int runFit(FitCmdParams p, const CommonOptions& common)
                   << "(largest: " << formatValue(100.0 * s.stepDeviationMax) << " % of the strand's length); they pass near a piece's singular axis\n";
     }
     if (common.json) {
-        printJson({{"output", p.output}, {"strands", s.strands}, {"fitted", s.fitted}, {"skipped", s.skipped}, {"over_max_error", s.overMaxError},
-                   {"frechet_relative", {{"mean", s.meanRelative}, {"p95", s.p95Relative}}}, {"pieces_per_strand", s.piecesPerStrand},
-                   {"evaluations_per_strand", s.evaluationsPerStrand},
-                   {"step_convergence", {{"mean", s.stepDeviationMean}, {"max", s.stepDeviationMax}, {"unconverged", s.unconverged}}},
-                   {"bytes", {{"fit", s.fitBytes}, {"points", s.pointBytes}}}, {"compression", s.pointBytes / s.fitBytes},
-                   {"strands_per_second", double(s.fitted) / seconds}});
+        nlohmann::json j = fitReport(s);
+        j["output"] = p.output;
+        j["strands_per_second"] = double(s.fitted) / seconds;
+        printJson(j);
     } else if (!common.quiet) {
         std::cout << "fitted " << s.fitted << " of " << s.strands << " strands with " << s.piecesPerStrand << " pieces each on average in "
                   << seconds << " s (" << double(s.fitted) / seconds << " strands/s)\n"

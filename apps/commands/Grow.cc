@@ -3,6 +3,7 @@
 #include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/helicoid/HelicoidJson.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/strands/Measures.h>
@@ -43,9 +44,11 @@ int runGrow(const GrowParams& p, const CommonOptions& common)
                   << " steps), where a trace depends on the step: their strands change with a smaller 'step' (refit them, or grow at a finer step to see)\n";
     }
     if (common.json) {
-        printJson({{"scene", p.scene}, {"output", p.output}, {"guides", scene.guides.size()},
-                   {"strands", strands.numStrands()}, {"vertices", strands.numVertices()}, {"seconds", seconds},
-                   {"guides_near_axis", report.nearAxis}});
+        nlohmann::json j = growReport(scene, strands, report);
+        j["scene"] = p.scene;
+        j["output"] = p.output;
+        j["seconds"] = seconds;
+        printJson(j);
     } else if (!common.quiet) {
         std::cout << "grew " << strands.numStrands() << " strands (" << scene.guides.size() << " guides and their wisps), "
                   << strands.numVertices() << " vertices in " << seconds << " s\nwrote " << p.output << "\n";

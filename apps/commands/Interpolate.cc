@@ -7,6 +7,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/helicoid/GuideInterpolation.h>
+#include <vdbhair/helicoid/HelicoidJson.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/PointFile.h>
@@ -208,23 +209,11 @@ std::size_t newHairCount(const InterpolateResult& r) { return r.strands.numStran
 
 void reportJson(const InterpolateCmdParams& p, const HeadObstacle& head, const InterpolateResult& r)
 {
-    const InterpolateParams& op = p.op;
-    const bool points = op.method == InterpolationMethod::Points;
-    const std::size_t count = newHairCount(r);
-    const double enteringShare = double(r.enteringHead) / double(count);
-    const double guidesEnteringShare = double(r.guidesEnteringHead) / double(std::max<std::size_t>(1, r.guides));
-    printJson({{"output", p.output}, {"method", interpolationMethodName(op.method)},
-               {"blend", points ? nlohmann::json(nullptr) : nlohmann::json(helicoidBlendName(op.helicoid.blend))},
-               {"grouping", points ? nlohmann::json(guideGroupingName(op.points.grouping)) : nlohmann::json(nullptr)}, {"groups", r.groups},
-               {"guides", r.guides}, {"strands", count},
-               {"vertices", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json(r.strands.numVertices())},
-               {"frames", frameRuleName(op.frames)}, {"head", head.empty() ? nlohmann::json(nullptr) : nlohmann::json(head.describe(false))},
-               {"roots", r.roots}, {"roots_dropped", r.rootsDropped}, {"cut", r.cut},
-               {"clumps", r.groom.clumps}, {"clumped", r.groom.clumped}, {"curled", r.groom.curled},
-               {"pushed_out", r.pushedOut}, {"pushed_out_after_controls", r.groomPushedOut}, {"vertices_too_deep", r.verticesTooDeep},
-               {"entering_head", {{"strands", enteringShare}, {"guides", guidesEnteringShare}}},
-               {"leaving_guide_volume", op.returnScene ? nlohmann::json(nullptr) : nlohmann::json({{"strands", double(r.leavingVolume) / double(std::max<std::size_t>(1, r.volumeSample))}, {"sample", r.volumeSample}, {"voxel", r.volumeVoxel}})},
-               {"seconds", r.seconds}, {"strands_per_second", double(count) / r.seconds}, {"fit_seconds", r.fitSeconds}});
+    nlohmann::json j = interpolateReport(r, p.op, head);
+    j["output"] = p.output;
+    j["seconds"] = r.seconds;
+    j["strands_per_second"] = double(newHairCount(r)) / r.seconds;
+    printJson(j);
 }
 
 void reportText(const InterpolateCmdParams& p, const HeadObstacle& head, const InterpolateResult& r)

@@ -5,7 +5,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
-#include <vdbhair/compare/HairComparison.h>
+#include <vdbhair/helicoid/HelicoidJson.h>
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/StrandIO.h>
@@ -66,30 +66,12 @@ int runReconstruct(ReconstructCmdParams p, const CommonOptions& common)
             writeFileAtomic(p.errors, csv.str(), "reconstruct(" + p.errors + ")");
         }
     }
-    auto stats = [](const ReconstructErrors& e) {
-        return nlohmann::json{{"mean", e.mean}, {"p95", e.p95}, {"mean_interpolated", e.meanInterpolated},
-                              {"p95_interpolated", e.p95Interpolated}, {"seconds", e.seconds}};
-    };
-    // HairGS's oriented points and Perm's strand pairs, per way (Compare.h).
-    auto papers = [&p](const ReconstructErrors& e) {
-        return nlohmann::json{{"oriented_points", e.oriented.empty() ? nlohmann::json(nullptr) : toJson(e.oriented, p.rec.metersPerUnit)},
-                              {"perm_position", e.permPosition}, {"perm_curvature", e.permCurvature}};
-    };
     const std::size_t S = strands.numStrands();
     if (common.json) {
-        printJson({{"output", p.output}, {"method", p.method}, {"strands", S}, {"guides", r.guides.size()}, {"unfitted", r.unfitted},
-                   {"guide_fraction", double(r.guides.size()) / double(S)}, {"select", guideSelectionName(p.rec.selection)},
-                   {"blend", helicoidBlendName(p.rec.helicoid.blend)},
-                   {"fit", {{"mean", r.fitSummary.meanRelative}, {"p95", r.fitSummary.p95Relative}, {"pieces_per_strand", r.fitSummary.piecesPerStrand}, {"seconds", r.fitSeconds}}},
-                   {"grouping", guideGroupingName(p.rec.points.grouping)},
-                   {"frechet_relative", {{"helicoid", stats(r.helicoidErrors)}, {"points", stats(r.pointErrors)}, {"nearest", stats(r.nearestErrors)}}},
-                   {"measures", {{"helicoid", papers(r.helicoidErrors)}, {"points", papers(r.pointErrors)}, {"nearest", papers(r.nearestErrors)}}},
-                   {"meters_per_unit", p.rec.metersPerUnit > 0.0 ? nlohmann::json(p.rec.metersPerUnit) : nlohmann::json(nullptr)},
-                   {"leaving_guide_volume", {{"voxel", r.volumeVoxel}, {"original", r.originalLeavingVolume}, {"helicoid", r.helicoidErrors.leavingVolume},
-                                             {"points", r.pointErrors.leavingVolume}, {"nearest", r.nearestErrors.leavingVolume}}},
-                   {"entering_head", r.headMeasured ? nlohmann::json({{"original", r.originalEnteringHead}, {"helicoid", r.helicoidErrors.enteringHead},
-                                                                     {"points", r.pointErrors.enteringHead}, {"nearest", r.nearestErrors.enteringHead}})
-                                                    : nlohmann::json(nullptr)}});
+        nlohmann::json j = reconstructReport(r, p.rec);
+        j["output"] = p.output;
+        j["method"] = p.method;  // the reconstruction written
+        printJson(j);
     } else if (!common.quiet) {
         char buf[256];
         std::snprintf(buf, sizeof buf, " guides (%.3g %%, %s); fits: mean %.3g %%, %.2f pieces, %.3f s\n", 100.0 * double(r.guides.size()) / double(S),

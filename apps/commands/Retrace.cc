@@ -3,6 +3,7 @@
 #include "../RefineOptions.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/field/FieldJson.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentAngles.h>
 #include <vdbhair/strands/Measures.h>
@@ -18,22 +19,6 @@
 #include <sstream>
 
 namespace vdbhair::app {
-
-/// The JSON report of retrace and refine (the schema).
-nlohmann::json traceReportJson(const TraceStats& s, const std::optional<TangentAngles>& angles, double displacement)
-{
-    nlohmann::json j = {{"strands", s.strands},
-                        {"full_length", s.fullLength},
-                        {"stopped", {{"vanished", s.vanished}, {"left_field", s.leftField}, {"max_steps", s.maxSteps}}},
-                        {"mean_displacement", displacement}};
-    if (angles) {
-        // null: no vertex lay inside the field (every strand left it), so there is no angle.
-        auto angle = [](double deg, std::size_t counted) { return counted ? nlohmann::json(deg) : nlohmann::json(nullptr); };
-        j["tangent_angle_deg"] = {{"before", angle(angles->beforeDeg, angles->countedBefore)},
-                                  {"after", angle(angles->afterDeg, angles->countedAfter)}};
-    }
-    return j;
-}
 
 namespace {
 std::string angleText(double deg, std::size_t counted)
@@ -96,11 +81,9 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         const double disp = meanVertexDisplacement(strands, out);
         writeStrands(p.output, out);
         if (common.json) {
-            nlohmann::json j = traceReportJson(stats, angles, disp);
+            nlohmann::json j = retraceReport(stats, tp, resolveStepLength(tp.step, field.k->voxelSize().x(), "retrace"), disp, angles);
             j["output"] = p.output;
-            j["field"] = "helicoid";
-            j["step"] = resolveStepLength(tp.step, field.k->voxelSize().x(), "retrace");
-            j["integrator"] = integratorName(tp.integrator);
+            j["field"] = "helicoid";  // the command's own field (Python retraces through vector grids)
             printJson(j);
         } else if (!common.quiet) {
             printTraceReport(stats, angles, disp);
@@ -123,10 +106,8 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
     const double disp = meanVertexDisplacement(strands, out);
     writeStrands(p.output, out);
     if (common.json) {
-        nlohmann::json j = traceReportJson(stats, angles, disp);
+        nlohmann::json j = retraceReport(stats, tp, resolveStep(*grid, tp), disp, angles);
         j["output"] = p.output;
-        j["step"] = resolveStep(*grid, tp);
-        j["integrator"] = integratorName(tp.integrator);
         printJson(j);
     } else if (!common.quiet) {
         printTraceReport(stats, angles, disp);

@@ -10,6 +10,7 @@
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/RootGrid.h>
 #include <vdbhair/scalp/ScalpInput.h>
+#include <vdbhair/scalp/ScalpJson.h>
 
 #include <algorithm>
 #include <chrono>
@@ -59,11 +60,10 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
         else writeVdbGrids(p.output, {createRootGrid(out)}, "roots(" + p.output + ")");
     }
     if (common.json) {
-        printJson({{"output", p.output}, {"count", f.positions.size()}, {"region", bool(region)}, {"area", f.area},
-                   {"area_without_zero", f.areaWithoutZero}, {"target_spacing", f.targetSpacing}, {"iterations", f.iterations}, {"last_move", f.lastMove}, {"removed", f.removed},
-                   {"contour", f.contour}, {"initial", f.initial}, {"fissions", f.fissions}, {"deaths", f.deaths}, {"last_population_change", f.lastPopulationChange}, {"radius_spread", f.radiusSpread},
-                   {"spacing", {{"mean", stats.nnMean}, {"cv", stats.nnCV}, {"min", stats.nnMin}, {"max", stats.nnMax}}},
-                   {"max_surface_distance_voxels", stats.maxSurfaceDistanceVoxels}, {"seconds", seconds}});
+        nlohmann::json j = rootsReport(f, stats, bool(region));
+        j["output"] = p.output;
+        j["seconds"] = seconds;
+        printJson(j);
     } else if (!common.quiet) {
         std::cout << "roots: " << f.positions.size() << " on " << (region ? "the region" : "the surface") << " (area " << formatValue(f.area)
                   << "), target spacing " << formatValue(f.targetSpacing) << ", " << f.iterations << " iterations in " << seconds << " s\n"

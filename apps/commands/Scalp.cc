@@ -11,6 +11,7 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
+#include <vdbhair/scalp/ScalpJson.h>
 #include <vdbhair/scalp/ScalpRegion.h>
 #include <vdbhair/scalp/ScalpSurface.h>
 
@@ -50,27 +51,18 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
 
     const auto t0 = std::chrono::steady_clock::now();
     openvdb::FloatGrid::Ptr surface;
-    std::string kind;
-    nlohmann::json detail = nlohmann::json::object();
+    ScalpFileReport file;  // without an input (a sphere): not read
     if (!p.sphere.empty()) {
-        kind = "sphere";
         surface = scalpFromSphere(Vec3d(p.sphere[0], p.sphere[1], p.sphere[2]), p.sphere[3], sp);
     } else {
-        ScalpFileReport rep;
-        surface = scalpFromFile(p.input, sp, &rep, true, common.interrupter);
-        printWarnings("scalp", rep.read, common);
-        kind = rep.kind;
-        if (kind == "mesh") {
-            detail = {{"triangles", rep.triangles}, {"welded_vertices", rep.mesh.weldedVertices},
-                      {"boundary_edges", rep.mesh.boundaryEdges}, {"capped_loops", rep.mesh.cappedLoops},
-                      {"open_edges", rep.mesh.openEdges}, {"non_manifold_edges", rep.mesh.nonManifoldEdges}};
-        } else {
-            detail = {{"points", rep.points}, {"constraints", rep.constraints}};
-        }
+        surface = scalpFromFile(p.input, sp, &file, true, common.interrupter);
+        printWarnings("scalp", file.read, common);
     }
+    const std::string kind = p.sphere.empty() ? file.kind : "sphere";
 
     openvdb::GridCPtrVec grids{surface};
     openvdb::BoolGrid::Ptr region;
+    ScalpRegionSource source;
     if (!p.region.empty()) {
         const StrandSet strands = loadStrands("scalp", p.region, common);
         std::vector<Vec3f> roots;
@@ -79,12 +71,13 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         const Stage stage(common, "region from the roots of " + p.region);
         region = regionFromRoots(*surface, roots, radius, p.region, std::uint64_t(1) << 28, defaultRootDistance(*surface));
         grids.push_back(region);
-        detail["region"] = {{"roots", roots.size()}, {"radius", radius}, {"active_voxels", region->activeVoxelCount()}};
+        source.roots = roots.size();
+        source.radius = radius;
     } else if (!p.regionVertex.empty()) {
         const Stage stage(common, "region from the vertex values '" + p.regionVertex + "' of " + p.input);
         region = regionFromVertexValues(*surface, readTriangleMesh(p.input), readPlyVertexValues(p.input, p.regionVertex), regionThreshold, p.input);
         grids.push_back(region);
-        detail["region"] = {{"vertex", p.regionVertex}, {"threshold", regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
+        source = {ScalpRegionSource::Kind::Vertex, 0, 0.0, p.regionVertex, regionThreshold};
     } else if (!p.regionMask.empty()) {
         // The mask: the grid named, else 'region', else the file's first bool or float grid that is not a level set.
         const openvdb::GridBase::Ptr mask = readMaskGrid(p.regionMask, p.regionGrid, "region", "a region mask (--region-grid NAME)");
@@ -92,7 +85,7 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         const Stage stage(common, "region from the mask '" + name + "' of " + p.regionMask);
         region = regionFromMask(*surface, *mask, regionThreshold, p.regionMask);
         grids.push_back(region);
-        detail["region"] = {{"mask", name}, {"threshold", regionThreshold}, {"active_voxels", region->activeVoxelCount()}};
+        source = {ScalpRegionSource::Kind::Mask, 0, 0.0, name, regionThreshold};
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     {
@@ -104,27 +97,25 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
     const ScalpArea areas = measureScalpArea(surface, region);
     warnBandWithoutZero("scalp", kind == "sphere" ? std::string("the sphere") : p.input, areas.area, areas.areaWithoutZero, common);
     if (common.json) {
-        nlohmann::json j = {{"output", p.output}, {"kind", kind}, {"voxel_size", h}, {"half_width", sp.halfWidth},
-                            {"active_voxels", surface->activeVoxelCount()}, {"area", areas.area},
-                            {"area_without_zero", areas.areaWithoutZero}, {"seconds", seconds}};
-        j.update(detail);
+        nlohmann::json j = scalpReport(*surface, sp.halfWidth, areas, p.sphere.empty() ? &file : nullptr, region.get(), source);
+        j["output"] = p.output;
+        j["seconds"] = seconds;
         printJson(j);
     } else if (!common.quiet) {
         std::cout << "surface: level set from " << (kind == "sphere" ? "a sphere" : kind + " " + p.input) << ", voxel size " << formatValue(h)
                   << ", " << surface->activeVoxelCount() << " active voxels";
         if (kind == "mesh") {
-            std::cout << " (" << detail["capped_loops"].get<std::size_t>() << " boundary loop(s) capped, "
-                      << detail["welded_vertices"].get<std::size_t>() << " vertices welded)";
+            std::cout << " (" << file.mesh.cappedLoops << " boundary loop(s) capped, " << file.mesh.weldedVertices << " vertices welded)";
         }
         std::cout << "; surface area " << formatValue(std::round(areas.area * 10.0) / 10.0) << (region ? " in the region" : "") << "\n";
         if (region && !p.region.empty())
-            std::cout << "region: " << region->activeVoxelCount() << " voxels within " << formatValue(detail["region"]["radius"].get<double>())
+            std::cout << "region: " << region->activeVoxelCount() << " voxels within " << formatValue(source.radius)
                       << " of the roots of " << p.region << "\n";
         if (region && !p.regionVertex.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels where the vertex value '" << p.regionVertex << "' exceeds "
                       << formatValue(regionThreshold) << "\n";
         if (region && !p.regionMask.empty())
-            std::cout << "region: " << region->activeVoxelCount() << " voxels covered by the mask '" << detail["region"]["mask"].get<std::string>()
+            std::cout << "region: " << region->activeVoxelCount() << " voxels covered by the mask '" << source.name
                       << "' of " << p.regionMask << "\n";
         std::cout << "wrote " << p.output << "\n";
     }

@@ -6,6 +6,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/field/DenseArray.h>
+#include <vdbhair/field/FieldJson.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/field/RefineJson.h>
 #include <vdbhair/field/ScalpSpace.h>
@@ -14,6 +15,7 @@
 #include <vdbhair/io/VdbFile.h>
 #include <vdbhair/io/VdbPoints.h>
 #include <vdbhair/scalp/ScalpSurface.h>
+#include <vdbhair/strands/Measures.h>
 
 #include <openvdb/openvdb.h>
 
@@ -253,19 +255,6 @@ openvdb::GridBase::ConstPtr fieldArgument(const pyb::handle& field, const char* 
     throw TypeError(std::string(where) + ": field must be a vdbhair.TangentField or a vdbhair.Grid, not " +
                     std::string(pyb::str(field.get_type().attr("__name__"))));
 }
-
-pyb::dict traceStatsDict(const TraceStats& s)
-{
-    pyb::dict d;
-    d["strands"] = s.strands;
-    d["full_length"] = s.fullLength;
-    d["vanished"] = s.vanished;
-    d["left_field"] = s.leftField;
-    d["max_steps"] = s.maxSteps;
-    d["steps"] = s.steps;
-    return d;
-}
-
 
 /// The array methods Grid and TangentField share (TangentField's act on its tangent grid).
 template <typename ClassT, typename GetT>
@@ -598,16 +587,28 @@ void bindRetrace(pyb::module_& m)
         const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");
         TraceParams tp;
         applyKeywords(traceParameters(), kw, tp, "retrace");
+        const bool returnStats = kw["return_stats"].cast<bool>(), measure = kw["measure"].cast<bool>();
         TraceStats stats;
+        std::optional<TangentAngles> angles;
+        double displacement = 0.0;
         auto out = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
-            return std::make_shared<StrandSet>(retraceStrands(*strands, *grid, tp, &stats, nullptr, true, interrupter));
+            auto o = std::make_shared<StrandSet>(retraceStrands(*strands, *grid, tp, &stats, nullptr, true, interrupter));
+            if (measure && returnStats) angles = meanTangentAnglesDeg(*strands, *o, *grid);
+            if (returnStats) displacement = meanVertexDisplacement(*strands, *o);
+            return o;
         });
-        if (!kw["return_stats"].cast<bool>()) return pyb::cast(out);
-        return pyb::make_tuple(out, traceStatsDict(stats));
+        if (!returnStats) return pyb::cast(out);
+        // `retrace --json`'s report (retraceReport()), less the file name.
+        return pyb::make_tuple(out, toPython(retraceReport(stats, tp, resolveStep(*grid, tp), displacement, angles)));
     };
     defineVerb(m, "retrace", {"strands: vdbhair.Strands", "field"}, traceParameters(),
                {{"return_stats", "bool", pyb::bool_(false),
-                 "also return a dict of stop reasons (strands, full_length, vanished, left_field, max_steps, steps)."}},
+                 "also return a dict: `retrace --json`'s report key for key, less the file name (strands, full_length, "
+                 "stopped: vanished, left_field, max_steps; steps, mean_displacement, step, integrator, and tangent_angle_deg "
+                 "with measure)."},
+                {"measure", "bool", pyb::bool_(false),
+                 "with return_stats, also the mean angle between strand tangents and the field before and after "
+                 "(``--measure``: samples the field at every input and output vertex)."}},
                "Retrace every strand through a vector field from its own root, for its own length\n"
                "(Wang et al. 2009, Sec. 5.3): ``vdbhair retrace``.\n\n"
                "Raises vdbhair.GridTypeError (a TypeError) for a non-vector grid, vdbhair.ArgumentError,\n"

@@ -5,6 +5,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/helicoid/HelicoidFit.h>
+#include <vdbhair/helicoid/HelicoidJson.h>
 #include <vdbhair/field/Refine.h>
 #include <vdbhair/helicoid/GuideInterpolation.h>
 #include <vdbhair/helicoid/HelicoidInterpolation.h>
@@ -158,20 +159,27 @@ InterpolationRoots interpolationRoots(const pyb::object& rootsArg, const pyb::di
 /// grow: a scene's strands (growParameters()).
 void defineGrow(pyb::module_& m)
 {
-    auto growImpl = [](const pyb::object& sceneArg, const pyb::dict& kw) {
+    auto growImpl = [](const pyb::object& sceneArg, const pyb::dict& kw) -> pyb::object {
         const Scene scene = sceneArgument(sceneArg);
         GrowOptions opts;
         applyKeywords(growParameters(), kw, opts, "grow");
-        return runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
-            return std::make_shared<StrandSet>(growScene(scene, opts, true, interrupter));
+        GrowReport report;
+        auto strands = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            return std::make_shared<StrandSet>(growScene(scene, opts, true, interrupter, &report));
         });
+        if (!kw["return_report"].cast<bool>()) return pyb::cast(strands);
+        // `grow --json`'s report (growReport()), less the file names and the seconds.
+        return pyb::make_tuple(strands, toPython(growReport(scene, *strands, report)));
     };
-    defineVerb(m, "grow", {"scene"}, growParameters(), {},
+    defineVerb(m, "grow", {"scene"}, growParameters(),
+               {{"return_report", "bool", pyb::bool_(false),
+                 "also return a dict: `grow --json`'s report key for key, less the file names and the seconds (guides, strands, "
+                 "vertices, guides_near_axis: guides passing near a piece's singular axis)."}},
                "Grow the strands of a generalized-helicoid scene (Piuze et al. 2011): ``vdbhair grow``.\n\n"
                "Each guide, then its wisp strands; bitwise identical for any thread count. Raises\n"
                "vdbhair.LimitError over max_vertices.",
                "    scene: a path to a scene .json (\"vdbhair\": \"scene/1\"), or the scene as a dict (what fit returns).\n",
-               "Strands.", pyb::cpp_function(growImpl, pyb::arg("scene"), pyb::arg("keywords")));
+               "Strands, or (Strands, report) with return_report.", pyb::cpp_function(growImpl, pyb::arg("scene"), pyb::arg("keywords")));
 }
 
 /// fit: p-helicoids fitted to strands (fitParameters()).
@@ -200,28 +208,18 @@ void defineFit(pyb::module_& m)
         }
         pyb::object sceneObj = toPython(sceneToJson(scene));
         if (!returnSummary) return sceneObj;
-        const FitSummary s = summarizeFits(*strands, fits, errors, fp.maxError);
-        pyb::dict d;
-        d["strands"] = s.strands;
-        d["fitted"] = s.fitted;
-        d["skipped"] = s.skipped;
-        d["over_max_error"] = s.overMaxError;
-        d["frechet_relative_mean"] = s.meanRelative;
-        d["frechet_relative_p95"] = s.p95Relative;
-        d["pieces_per_strand"] = s.piecesPerStrand;
-        d["step_deviation_mean"] = s.stepDeviationMean;
-        d["step_deviation_max"] = s.stepDeviationMax;
-        d["unconverged"] = s.unconverged;
-        d["fit_bytes"] = s.fitBytes;
-        d["point_bytes"] = s.pointBytes;
+        // `fit --json`'s report (fitReport()), less the file name and the rate.
+        const pyb::dict d = toPython(fitReport(summarizeFits(*strands, fits, errors, fp.maxError, fp.stepDeviationLimit)));
         return pyb::make_tuple(sceneObj, d);
     };
     defineVerb(m, "fit", {"strands: vdbhair.Strands"}, fitParameters(),
                {{"skip_degenerate", "bool", pyb::bool_(false), "leave out strands of zero length instead of raising."},
                 {"return_summary", "bool", pyb::bool_(false),
-                 "also return a dict (fitted, skipped, Frechet distance relative to length: mean and 95th percentile, pieces per "
-                 "strand, step convergence: the largest distance between each fit traced at its step and at a quarter of it "
-                 "relative to length, mean and max, and how many fits exceed a tenth of max_error; bytes of fits and of points)."}},
+                 "also return a dict: `fit --json`'s report key for key, less the file name and strands_per_second (strands, "
+                 "fitted, skipped, over_max_error, frechet_relative: the discrete Frechet distance relative to length, mean and "
+                 "p95; pieces_per_strand, evaluations_per_strand, step_convergence: the distance between each fit traced at its "
+                 "step and at a quarter of it relative to length, mean, max and how many exceed a tenth of max_error; bytes of "
+                 "fits and of points, compression)."}},
                "Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``. ``lambda_`` is the\n"
                "command's ``--lambda`` (``lambda`` is a Python keyword).",
                "    strands: a Strands.\n",
@@ -263,15 +261,18 @@ void defineInterpolate(pyb::module_& m)
         } else if (!guideGroups.is_none()) {
             guides.groups = guideGroups.cast<std::vector<std::int32_t>>();
         }
+        HeadObstacle head;
         InterpolateResult result = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
-            HeadObstacle head = headArgument.get("interpolate");
+            head = headArgument.get("interpolate");
             // None: the scene's head sphere, else a sphere fitted to the guide roots (as the command).
             if (head.unset() && !fromStrands && scene.head) head = HeadObstacle::sphere(scene.head->center, scene.head->radius);
             else if (head.unset() && fromStrands) head = headFromRoots(*guideStrands, op.helicoid.up);
             return interpolateGuides(guides, roots, head, op, true, interrupter);
         });
-        if (op.returnScene) return toPython(sceneToJson(result.scene));
-        return pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
+        // `interpolate --json`'s report (interpolateReport()), less the file name and the clock.
+        const pyb::object report = kw["return_report"].cast<bool>() ? toPython(interpolateReport(result, op, head)) : pyb::none();
+        const pyb::object out = op.returnScene ? toPython(sceneToJson(result.scene)) : pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
+        return report.is_none() ? out : pyb::make_tuple(out, report);
     };
     const InterpolateParams interpDefaults;
     defineVerb(m, "interpolate", {"guides", "roots"}, interpolateParameters(),
@@ -287,6 +288,10 @@ void defineInterpolate(pyb::module_& m)
                  pyb::make_tuple(interpDefaults.helicoid.up.x(), interpDefaults.helicoid.up.y(), interpDefaults.helicoid.up.z()),
                  "reference axis of the surface frames (``--up``)."},
                 {"return_scene", "bool", pyb::bool_(false), "return the new hairs as a scene dict (helicoid only) instead of growing them."},
+                {"return_report", "bool", pyb::bool_(false),
+                 "also return a dict: `interpolate --json`'s report key for key, less the file name, seconds and "
+                 "strands_per_second (method, settings, guides, strands, roots, groom controls, the head and the shares passing "
+                 "into it and leaving the guides' volume, fit_seconds)."},
                 {"density", "", pyb::none(),
                  "None, the share of roots that grow hair in [0, 1]: a number, one value per root, or a spec as the command's "
                  "--density (\"mask.vdb[:GRID]\", \"head.ply:PROPERTY\", a text file)."},
@@ -295,7 +300,7 @@ void defineInterpolate(pyb::module_& m)
                "    guides: a Strands (blended as they are; fitted first for method=\"helicoid\"), or a scene (a\n"
                "        path to a scene .json or a dict, as fit() returns).\n"
                "    roots: an (N, 3) array of root positions (world units), or a Strands whose roots are used.\n",
-               "Strands (one per root, in order), or the scene dict with return_scene.",
+               "Strands (one per root, in order), or the scene dict with return_scene; (either, report) with return_report.",
                pyb::cpp_function(interpolateImpl, pyb::arg("guides"), pyb::arg("roots"), pyb::arg("keywords")));
 }
 
@@ -310,32 +315,16 @@ void defineReconstruct(pyb::module_& m)
             const HeadObstacle head = headArgument.get("reconstruct");
             return reconstructHairstyle(*strands, p, true, interrupter, head.unset() || head.empty() ? nullptr : &head);
         });
-        const double metersPerUnit = p.metersPerUnit;
-        auto stats = [metersPerUnit](const ReconstructErrors& e) {
-            pyb::dict d;
-            d["relative"] = pyb::array_t<double>(e.relative.size(), e.relative.data());
-            d["mean"] = e.mean;
-            d["p95"] = e.p95;
-            d["mean_interpolated"] = e.meanInterpolated;
-            d["p95_interpolated"] = e.p95Interpolated;
-            d["seconds"] = e.seconds;
-            d["perm_position"] = e.permPosition;
-            d["perm_curvature"] = e.permCurvature;
-            d["leaving_volume"] = e.leavingVolume;
-            d["entering_head"] = e.enteringHead;
-            d["oriented_points"] = e.oriented.empty() ? pyb::none() : toPython(toJson(e.oriented, metersPerUnit));
-            return d;
-        };
-        pyb::dict report;
-        report["guides"] = pyb::array_t<std::int64_t>(r.guides.size(), reinterpret_cast<const std::int64_t*>(r.guides.data()));
-        report["unfitted"] = r.unfitted;
-        report["fit"] = pyb::dict(pyb::arg("mean") = r.fitSummary.meanRelative, pyb::arg("p95") = r.fitSummary.p95Relative,
-                                  pyb::arg("pieces_per_strand") = r.fitSummary.piecesPerStrand, pyb::arg("seconds") = r.fitSeconds);
-        report["helicoid"] = stats(r.helicoidErrors);
-        report["points"] = stats(r.pointErrors);
-        report["nearest"] = stats(r.nearestErrors);
-        report["original"] = pyb::dict(pyb::arg("leaving_volume") = r.originalLeavingVolume, pyb::arg("entering_head") = r.originalEnteringHead);
-        report["volume_voxel"] = r.volumeVoxel;
+        // `reconstruct --json`'s report (reconstructReport()), plus the guides' indices and every
+        // strand's error each way as arrays (the command's --errors file).
+        pyb::dict report = toPython(reconstructReport(r, p));
+        report["guide_strands"] = pyb::array_t<std::int64_t>(r.guides.size(), reinterpret_cast<const std::int64_t*>(r.guides.data()));
+        pyb::dict perStrand;
+        for (const auto& [way, e] : {std::pair<const char*, const ReconstructErrors*>{"helicoid", &r.helicoidErrors},
+                                     {"points", &r.pointErrors}, {"nearest", &r.nearestErrors}}) {
+            perStrand[way] = pyb::array_t<double>(e->relative.size(), e->relative.data());
+        }
+        report["per_strand"] = perStrand;
         return pyb::make_tuple(std::make_shared<StrandSet>(std::move(r.helicoid)), std::make_shared<StrandSet>(std::move(r.points)), report);
     };
     defineVerb(m, "reconstruct", {"strands: vdbhair.Strands"}, reconstructParameters(),
@@ -347,13 +336,15 @@ void defineReconstruct(pyb::module_& m)
                "other root; the same guides' points are blended too (the peers' way), and both are measured\n"
                "against the original by the discrete Frechet distance relative to each strand's length.",
                "    strands: a Strands.\n",
-               "(helicoid, points, report): both reconstructions as Strands in input order, and a dict with\n"
-               "    ``guides`` (the guide strands' indices), ``unfitted``, ``fit`` (mean, p95, pieces_per_strand,\n"
-               "    seconds) and for ``helicoid``, ``points`` and ``nearest`` (the baseline: each strand its\n"
-               "    nearest guide, translated): ``relative`` (each strand's error), ``mean``, ``p95``,\n"
-               "    ``mean_interpolated``, ``p95_interpolated``, ``seconds``, ``perm_position``,\n"
-               "    ``perm_curvature`` and ``oriented_points`` (None, or per HairGS threshold: distance_mm,\n"
-               "    angle_degrees, precision, recall, f1, strand_consistency).",
+               "(helicoid, points, report): both reconstructions as Strands in input order, and a dict:\n"
+               "    ``reconstruct --json``'s report key for key, less the file name and the method written\n"
+               "    (strands, guides: their count, unfitted, guide_fraction, select, blend, grouping, fit (mean,\n"
+               "    p95, pieces_per_strand, seconds), frechet_relative and measures (oriented_points: None, or per\n"
+               "    HairGS threshold distance, distance_mm, angle_degrees, precision, recall, f1,\n"
+               "    strand_consistency; perm_position, perm_curvature) for ``helicoid``, ``points`` and\n"
+               "    ``nearest`` (the baseline: each strand its nearest guide, translated), meters_per_unit,\n"
+               "    leaving_guide_volume, entering_head (None without a head)); plus ``guide_strands`` (the guide\n"
+               "    strands' indices) and ``per_strand`` (each way's relative error of every strand).",
                pyb::cpp_function(reconstructImpl, pyb::arg("strands"), pyb::arg("keywords")));
 }
 

@@ -8,6 +8,7 @@
 #include <vdbhair/io/PointFile.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
+#include <vdbhair/scalp/ScalpJson.h>
 #include <vdbhair/scalp/ScalpRegion.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -62,31 +63,13 @@ openvdb::FloatGrid::Ptr scalpGridArgument(const pyb::handle& obj, const std::str
     throw TypeError(where + ": scalp must be a vdbhair.Grid (a level set) or a path to a scalp .vdb or a head mesh");
 }
 
-/// roots()'s result: the follicles, their spacing and whether a region confined them.
+/// roots()'s result: `roots --json`'s report (rootsReport()), plus the follicles as arrays.
 pyb::dict folliclesDict(const Follicles& f, const FollicleStats& stats, bool region)
 {
-    pyb::dict d;
+    pyb::dict d = toPython(rootsReport(f, stats, region));
     d["positions"] = pointsArray(f.positions);
     d["normals"] = pointsArray(f.normals);
     d["tangents"] = pointsArray(f.tangents);
-    d["region"] = region;
-    d["area"] = f.area;
-    d["area_without_zero"] = f.areaWithoutZero;
-    d["target_spacing"] = f.targetSpacing;
-    d["iterations"] = f.iterations;
-    d["last_move"] = f.lastMove;
-    d["removed"] = f.removed;
-    d["contour"] = f.contour;
-    d["initial"] = f.initial;
-    d["fissions"] = f.fissions;
-    d["deaths"] = f.deaths;
-    pyb::dict sp;
-    sp["mean"] = stats.nnMean;
-    sp["cv"] = stats.nnCV;
-    sp["min"] = stats.nnMin;
-    sp["max"] = stats.nnMax;
-    d["spacing"] = sp;
-    d["max_surface_distance_voxels"] = stats.maxSurfaceDistanceVoxels;
     return d;
 }
 
@@ -144,12 +127,14 @@ void defineRoots(pyb::module_& m)
                "Give one of ``count`` and ``spacing``.",
                "    scalp: a vdbhair.Grid holding a level set (what scalp() returns), or a path to a scalp .vdb\n"
                "        (its 'surface' and 'region' grids) or to a head mesh.\n",
-               "A dict: ``positions``, ``normals`` (outward), ``tangents``: (N, 3) float32 arrays (the\n"
-               "    roots and their frames, ready for interpolate(guides, r[\"positions\"], normals=r[\"normals\"]));\n"
-               "    ``region`` (whether one confined them), ``area``, ``target_spacing``, ``iterations``,\n"
-               "    ``last_move``, ``removed``, ``contour`` (with a region, the first ``contour`` roots are fixed\n"
-               "    along its rim), ``initial``, ``fissions``, ``deaths``, ``spacing`` (nearest-neighbour mean, cv,\n"
-               "    min, max) and ``max_surface_distance_voxels``.",
+               "A dict: ``roots --json``'s report key for key (less the file name and the seconds): ``count``,\n"
+               "    ``region`` (whether one confined them), ``area``, ``area_without_zero``, ``target_spacing``,\n"
+               "    ``iterations``, ``last_move``, ``removed``, ``contour`` (with a region, the first ``contour``\n"
+               "    roots are fixed along its rim), ``initial``, ``fissions``, ``deaths``,\n"
+               "    ``last_population_change``, ``radius_spread``, ``spacing`` (nearest-neighbour mean, cv, min,\n"
+               "    max) and ``max_surface_distance_voxels``; plus ``positions``, ``normals`` (outward) and\n"
+               "    ``tangents``: (N, 3) float32 arrays (the roots and their frames, ready for\n"
+               "    interpolate(guides, r[\"positions\"], normals=r[\"normals\"])).",
                pyb::cpp_function(rootsImpl, pyb::arg("scalp"), pyb::arg("keywords")));
 }
 

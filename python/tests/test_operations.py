@@ -3,6 +3,7 @@ import inspect as pyinspect
 import importlib.util
 import json
 import os
+import pathlib
 
 import numpy as np
 import pytest
@@ -15,8 +16,8 @@ def test_fit_then_grow_regrows_the_strands(tmp_path):
     s = wavy_hairstyle(count=6, vertices=20, seed=3)
     scene, summary = vdbhair.fit(s, return_summary=True)
     assert summary["fitted"] == 6 and len(scene["guides"]) == 6
-    assert summary["frechet_relative_mean"] < 0.05
-    assert summary["unconverged"] == 0 and summary["step_deviation_max"] < 1e-3
+    assert summary["frechet_relative"]["mean"] < 0.05
+    assert summary["step_convergence"]["unconverged"] == 0 and summary["step_convergence"]["max"] < 1e-3
     grown = vdbhair.grow(scene)
     assert len(grown) == 6
     # Each regrown strand starts at its root and ends near its tip (within the fit's error).
@@ -351,3 +352,94 @@ def test_synth_transfer_comb_reports_are_the_commands(tmp_path):
          ["output", "details", "base", "seconds"], ["cluster_of", "base_label"])
     _, report = vdbhair.comb(example, [stroke], return_report=True)
     same(report, command("comb", str(hair), "--stroke", str(tmp_path / "stroke.json")), ["output", "input", "seconds"], ["cluster"])
+
+
+def _command(*args):
+    """`vdbhair ARGS --json`'s report from the command of the same build, or a skip without one."""
+    import subprocess
+    cli = os.environ.get("VDBHAIR_CLI") or str(pathlib.Path(vdbhair.__file__).resolve().parents[1] / "bin" / "vdbhair")
+    if not os.access(cli, os.X_OK):
+        pytest.skip(f"no command-line vdbhair at {cli} (set VDBHAIR_CLI)")
+    run = subprocess.run([cli, *map(str, args), "--json"], check=True, capture_output=True, text=True)
+    return json.loads(run.stdout)
+
+
+def _same_report(report, cmd, front_end_keys, arrays=(), timings=()):
+    """The Python report is the command's: the same keys once the command's own (file names, its
+    clock) and Python's arrays are left out, and the same values but for timings (dotted paths,
+    present in both)."""
+    for k in front_end_keys:
+        del cmd[k]
+    for k in arrays:
+        del report[k]
+    assert set(report) == set(cmd)
+    for path in timings:
+        *outer, last = path.split(".")
+        a, b = report, cmd
+        for k in outer:
+            a, b = a[k], b[k]
+        assert isinstance(a.pop(last), float) and isinstance(b.pop(last), float), path
+    assert report == cmd
+
+
+@pytest.mark.data
+def test_roots_fit_reconstruct_retrace_reports_are_the_commands(tmp_path, shared_data):
+    # One report whichever front end ran the verb (ScalpJson.h, HelicoidJson.h, FieldJson.h), on a
+    # real hairstyle and head: Python's is `--json`'s less the command's file names and clock.
+    path = shared_data / "hair" / "tressfx" / "ascii_v2" / "hair_front_16_guide.tfx"
+    head = shared_data / "scalp" / "tressfx" / "head_max4.obj"
+    if not path.exists() or not head.exists():
+        pytest.skip(f"{path.name} or {head.name} is not in the shared data")
+    hair = vdbhair.read(str(path))
+    out = tmp_path / "out.hair"
+
+    _, summary = vdbhair.fit(hair, return_summary=True)
+    _same_report(summary, _command("fit", path, "-o", tmp_path / "fits.json"), ["output", "strands_per_second"])
+
+    _, _, report = vdbhair.reconstruct(hair, guides=0.3, meters_per_unit=0.01, head=str(head))
+    assert report["per_strand"]["helicoid"].shape == (len(hair),) and len(report["guide_strands"]) == report["guides"]
+    cmd = _command("reconstruct", path, "-o", out, "--guides", "30%", "--meters-per-unit", "0.01", "--head", head)
+    _same_report(report, cmd, ["output", "method"], ["guide_strands", "per_strand"],
+                 ["fit.seconds"] + [f"frechet_relative.{way}.seconds" for way in ("helicoid", "points", "nearest")])
+
+    field = vdbhair.estimate_tangent_field(hair)
+    field.write(str(tmp_path / "field.vdb"))
+    _, stats = vdbhair.retrace(hair, field, return_stats=True, measure=True)
+    assert stats["tangent_angle_deg"]["after"] < stats["tangent_angle_deg"]["before"]
+    _same_report(stats, _command("retrace", path, "--field", tmp_path / "field.vdb", "-o", out, "--measure"), ["output"])
+
+    surface, region = vdbhair.scalp(str(head), region=hair)
+    vdbhair.write_grids(str(tmp_path / "scalp.vdb"), [surface, region])
+    roots = vdbhair.roots(str(tmp_path / "scalp.vdb"), count=200)
+    assert roots["positions"].shape == (roots["count"], 3) and roots["region"]
+    _same_report(roots, _command("roots", tmp_path / "scalp.vdb", "-o", tmp_path / "roots.ply", "--count", "200"),
+                 ["output", "seconds"], ["positions", "normals", "tangents"])
+
+
+@pytest.mark.data
+def test_grow_interpolate_reports_are_the_commands(tmp_path, shared_data):
+    # grow and interpolate with return_report=True: `--json`'s report (HelicoidJson.h), less the
+    # command's file names and clock, on a real hairstyle's fits and roots spread over its head.
+    path = shared_data / "hair" / "tressfx" / "ascii_v2" / "hair_front_16_guide.tfx"
+    head = shared_data / "scalp" / "tressfx" / "head_max4.obj"
+    if not path.exists() or not head.exists():
+        pytest.skip(f"{path.name} or {head.name} is not in the shared data")
+    hair = vdbhair.read(str(path))
+    scene = vdbhair.fit(hair)
+    (tmp_path / "fits.json").write_text(json.dumps(scene))
+    out = tmp_path / "out.hair"
+
+    grown, report = vdbhair.grow(scene, return_report=True)
+    assert report["strands"] == len(grown) and report["guides"] == len(scene["guides"])
+    _same_report(report, _command("grow", tmp_path / "fits.json", "-o", out), ["scene", "output", "seconds"])
+
+    surface, region = vdbhair.scalp(str(head), region=hair)
+    vdbhair.write_grids(str(tmp_path / "scalp.vdb"), [surface, region])
+    _command("roots", tmp_path / "scalp.vdb", "-o", tmp_path / "roots.ply", "--count", "300")
+    r = vdbhair.roots(str(tmp_path / "scalp.vdb"), count=300)  # the file's roots (the test above)
+    for method, extra in (("points", ["--curl", "0.5", "--curl-frequency", "1"]), ("helicoid", ["--method", "helicoid"])):
+        kw = {"curl": 0.5, "curl_frequency": 1.0} if method == "points" else {"method": "helicoid"}
+        strands, report = vdbhair.interpolate(hair, r["positions"], normals=r["normals"], return_report=True, **kw)
+        assert report["strands"] == len(strands) == len(r["positions"])
+        cmd = _command("interpolate", path, "-o", out, "--roots", tmp_path / "roots.ply", *extra)
+        _same_report(report, cmd, ["output", "seconds", "strands_per_second"], timings=["fit_seconds"])

@@ -136,37 +136,39 @@ def test_reconstruct_straight_hair():
     hair = straight_bundle(count=6, vertices=12, length=3.0, spacing=0.2)
     helicoid, points, report = vdbhair.reconstruct(hair, guides=0.25, seed=1)
     assert len(helicoid) == len(points) == len(hair)
-    assert len(report["guides"]) == 9  # round(0.25 * 36)
+    assert len(report["guide_strands"]) == report["guides"] == 9  # round(0.25 * 36)
     for method, out in (("helicoid", helicoid), ("points", points)):
-        e = report[method]
-        assert e["relative"].shape == (36,)
+        assert report["per_strand"][method].shape == (36,)
         # Straight parallel hair is rebuilt straight: the fits are within 0.9 % of these strands,
         # and the arcs reconstruction blends them (1.1 %).
-        assert e["mean"] < 0.015, method
+        assert report["frechet_relative"][method]["mean"] < 0.015, method
         for i in range(len(out)):
             assert np.allclose(out[i][0], hair[i][0], atol=1e-4), method  # every root kept
     # The paper's blend of the fits' own pieces, on request; a blend that does not exist is refused.
     fitted = vdbhair.reconstruct(hair, guides=0.25, seed=1, blend="fitted")[2]
-    assert fitted["helicoid"]["mean"] < 0.015 and fitted["points"]["mean"] == report["points"]["mean"]
+    assert fitted["frechet_relative"]["helicoid"]["mean"] < 0.015
+    assert fitted["frechet_relative"]["points"]["mean"] == report["frechet_relative"]["points"]["mean"]
     with pytest.raises(ValueError, match=r"^reconstruct: blend 'sideways': must be one of arcs, fitted$"):
         vdbhair.reconstruct(hair, blend="sideways")
     # Every strand a guide: the points way returns the strands themselves.
     _, same, everything = vdbhair.reconstruct(hair, guides=1.0, meters_per_unit=0.01)
-    assert everything["points"]["mean"] == 0.0
+    assert everything["frechet_relative"]["points"]["mean"] == 0.0
     assert np.array_equal(same.positions, hair.positions)
     # As papers measure: the strands themselves match every oriented point, at no position error.
-    assert report["points"]["oriented_points"] is None  # no unit: not measured
-    assert [m["distance_mm"] for m in everything["points"]["oriented_points"]] == pytest.approx([2.0, 3.0, 4.0, 4.0])
-    assert all(m["f1"] == 1.0 and m["strand_consistency"] == 1.0 for m in everything["points"]["oriented_points"])
-    assert everything["points"]["perm_position"] == 0.0 and everything["points"]["perm_curvature"] == 0.0
-    assert report["nearest"]["perm_position"] >= 0.0
+    assert report["measures"]["points"]["oriented_points"] is None  # no unit: not measured
+    measured = everything["measures"]["points"]
+    assert [m["distance_mm"] for m in measured["oriented_points"]] == pytest.approx([2.0, 3.0, 4.0, 4.0])
+    assert all(m["f1"] == 1.0 and m["strand_consistency"] == 1.0 for m in measured["oriented_points"])
+    assert measured["perm_position"] == 0.0 and measured["perm_curvature"] == 0.0
+    assert report["measures"]["nearest"]["perm_position"] >= 0.0
     # Parallel straight hair stays inside its guides' volume; a head sphere across the strands'
     # middles is entered by as many rebuilt strands (points) as original ones.
-    assert report["original"]["leaving_volume"] == 0.0 and report["points"]["leaving_volume"] == 0.0
-    assert report["volume_voxel"] > 0.0 and report["points"]["entering_head"] == 0.0
-    with_head = vdbhair.reconstruct(hair, guides=0.25, seed=1, head=(1.5, 0.0, 0.0, 0.3))[2]
-    assert 0.0 < with_head["original"]["entering_head"] <= 1.0
-    assert with_head["points"]["entering_head"] == pytest.approx(with_head["original"]["entering_head"])
+    leaving = report["leaving_guide_volume"]
+    assert leaving["original"] == 0.0 and leaving["points"] == 0.0 and leaving["voxel"] > 0.0
+    assert report["entering_head"] is None  # no head: not measured
+    entering = vdbhair.reconstruct(hair, guides=0.25, seed=1, head=(1.5, 0.0, 0.0, 0.3))[2]["entering_head"]
+    assert 0.0 < entering["original"] <= 1.0
+    assert entering["points"] == pytest.approx(entering["original"])
     with pytest.raises(ValueError, match=r"^reconstruct: meters_per_unit -1: must be at least 0$"):
         vdbhair.reconstruct(hair, meters_per_unit=-1.0)
     h1 = vdbhair.reconstruct(hair, guides=0.25, seed=1, threads=1)[0]

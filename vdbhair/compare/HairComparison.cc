@@ -124,19 +124,6 @@ HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const C
     return c;
 }
 
-nlohmann::json toJson(const std::vector<OrientedMatch>& matches, double metersPerUnit)
-{
-    nlohmann::json oriented = nlohmann::json::array();
-    for (const OrientedMatch& m : matches) {
-        nlohmann::json t = {{"distance", m.threshold.distance}, {"angle_degrees", m.threshold.angleDegrees},
-                            {"precision", m.precision}, {"recall", m.recall}, {"f1", m.f1},
-                            {"strand_consistency", m.strandConsistency}};
-        if (metersPerUnit > 0.0) t["distance_mm"] = m.threshold.distance * metersPerUnit * 1000.0;
-        oriented.push_back(t);
-    }
-    return oriented;
-}
-
 HairComparison measureAgainst(const StrandSet& reference, const StrandSet& output, const HeadObstacle* head, bool corresponding)
 {
     CompareParams cp;

@@ -92,11 +92,6 @@ HairComparison measureAgainst(const StrandSet& reference, const StrandSet& outpu
 /// left out for want of a unit is said.
 std::string summaryLine(const HairComparison& c);
 
-/// @brief Oriented-point matches as JSON, one object per threshold: distance (file units),
-/// angle_degrees, precision, recall, f1, strand_consistency and, with @a metersPerUnit > 0,
-/// distance_mm. Every report that carries them (compare, reconstruct) writes them through this.
-nlohmann::json toJson(const std::vector<OrientedMatch>& matches, double metersPerUnit);
-
 /// @brief The report as JSON: the same keys from the command line (`compare --json`) and Python
 /// (`vdbhair.compare()`); per-strand values are left out (they go to a file or to NumPy).
 nlohmann::json toJson(const HairComparison& c);

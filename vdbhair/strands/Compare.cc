@@ -5,6 +5,8 @@
 #include <vdbhair/Parallel.h>
 #include <vdbhair/strands/Resample.h>
 
+#include <nlohmann/json.hpp>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -568,6 +570,19 @@ StrandPairErrors strandPairErrors(const StrandSet& a, const StrandSet& b, std::s
         e.meanCurvature /= double(S);
     }
     return e;
+}
+
+nlohmann::json toJson(const std::vector<OrientedMatch>& matches, double metersPerUnit)
+{
+    nlohmann::json oriented = nlohmann::json::array();
+    for (const OrientedMatch& m : matches) {
+        nlohmann::json t = {{"distance", m.threshold.distance}, {"angle_degrees", m.threshold.angleDegrees},
+                            {"precision", m.precision}, {"recall", m.recall}, {"f1", m.f1},
+                            {"strand_consistency", m.strandConsistency}};
+        if (metersPerUnit > 0.0) t["distance_mm"] = m.threshold.distance * metersPerUnit * 1000.0;
+        oriented.push_back(t);
+    }
+    return oriented;
 }
 
 } // namespace vdbhair

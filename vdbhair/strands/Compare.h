@@ -28,6 +28,8 @@
 #include <vdbhair/strands/PointGrid.h>
 #include <vdbhair/strands/StrandSet.h>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstddef>
 #include <vector>
 
@@ -90,6 +92,11 @@ struct OrientedMatch
     double precision = 0.0, recall = 0.0, f1 = 0.0;
     double strandConsistency = 0.0;
 };
+
+/// @brief Oriented-point matches as JSON, one object per threshold: distance (file units),
+/// angle_degrees, precision, recall, f1, strand_consistency and, with @a metersPerUnit > 0,
+/// distance_mm. Every report that carries them (compare, reconstruct) writes them through this.
+nlohmann::json toJson(const std::vector<OrientedMatch>& matches, double metersPerUnit);
 
 /// @brief Oriented-point precision, recall, F1 and strand consistency of @a predicted against
 /// @a reference at each threshold (see above). In parallel; identical for any thread count.
