@@ -77,25 +77,6 @@ void addScalpOptions(CLI::App* sub, ScalpOptions& opts)
     sub->add_option("--up", opts.up, "The scalp's up axis for --space scalp: x, y, z, -x, -y or -z")->capture_default_str();
 }
 
-Vec3d axisFromName(const std::string& name, const std::string& option)
-{
-    const std::string axis = name.size() == 2 && name[0] == '-' ? name.substr(1) : name;
-    const double sign = name.size() == 2 && name[0] == '-' ? -1.0 : 1.0;
-    if (axis == "x") return Vec3d(sign, 0.0, 0.0);
-    if (axis == "y") return Vec3d(0.0, sign, 0.0);
-    if (axis == "z") return Vec3d(0.0, 0.0, sign);
-    throw ValueError(option + " '" + name + "' is not one of x, y, z, -x, -y, -z");
-}
-
-std::string axisName(const Vec3d& axis)
-{
-    for (const char* name : {"x", "y", "z", "-x", "-y", "-z"}) {
-        if (axisFromName(name, "axis") == axis) return name;
-    }
-    throw ValueError("axis (" + formatValue(axis.x()) + ", " + formatValue(axis.y()) + ", " + formatValue(axis.z()) +
-                     ") is not one of x, y, z, -x, -y, -z");
-}
-
 std::vector<double> ScalpOptions::sphere() const
 {
     // Four comma-separated numbers are a sphere; anything else names a file.

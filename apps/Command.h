@@ -9,6 +9,7 @@
 
 #include <vdbhair/Progress.h>
 #include <openvdb/openvdb.h>
+#include <vdbhair/io/AxisName.h>
 #include <vdbhair/io/ReadOptions.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbInfo.h>
@@ -135,14 +136,6 @@ void checkStrandLengths(const std::string& verb, const std::string& path, const 
 /// (makeSphereMesh()); left as it is otherwise.
 StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
                              const std::string& vdbGrid = "strands", TriangleMesh* head = nullptr);
-
-/// @brief The axis named by an option such as --up: x, y, z, -x, -y or -z.
-/// @throw ValueError naming the option, the value and the choices.
-Vec3d axisFromName(const std::string& name, const std::string& option);
-
-/// @brief The name axisFromName() reads as @a axis (x, y, z, -x, -y, -z).
-/// @throw ValueError for a vector that is not a unit axis.
-std::string axisName(const Vec3d& axis);
 
 /// @brief The scalp options of `field` and `refine` (`--space scalp`).
 struct ScalpOptions

@@ -41,6 +41,10 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
                 if constexpr (std::is_same_v<T, std::string>) {
                     if (!param.choices.empty()) o->check(CLI::IsMember(param.choices));
                 } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+                    // CLI11 would read "-2" as 2^64 - 2: a count refuses a sign.
+                    o->check(CLI::Validator(
+                        [](std::string& v) { return !v.empty() && v[0] == '-' ? "Value " + v + " is negative (a count is 0 or more)" : std::string(); },
+                        ""));
                     if (param.unit == "bytes") o->transform(CLI::AsSizeValue(false));
                 }
             }

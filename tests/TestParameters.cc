@@ -10,6 +10,7 @@
 #include <vdbhair/helicoid/HelicoidFit.h>
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
+#include <vdbhair/io/ConvertStrands.h>
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
@@ -386,6 +387,39 @@ TEST_CASE("Parameters: compare's declaration sets what the comparison reads, in 
     p.samples = 2;
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--samples 2: must be at least 3");
     checkDeclaration(t, "compare");
+}
+
+TEST_CASE("Parameters: convert's declaration, the axes and the write options by name, in docs/cli.md", "[params]")
+{
+    const ParamTable<ConvertParams>& t = convertParameters();
+    CHECK(declared(t, "up").defaultText() == "y");
+    CHECK(declared(t, "usd-up").defaultText() == "auto");
+    CHECK(declared(t, "usd-up").pythonNone);
+    CHECK(declared(t, "codec").defaultText() == positionCodecName(WriteOptions{}.vdb.codec));
+    ConvertParams p;
+    setParam(t, "up", p, std::string("-z"));
+    setParam(t, "usd-up", p, std::string("z"));
+    setParam(t, "ply-encoding", p, std::string("ascii"));
+    setParam(t, "obj-lines", p, std::string("polylines"));
+    setParam(t, "codec", p, std::string("fixed16"));
+    setParam(t, "width", p, 0.25);
+    CHECK(p.up == Vec3d(0.0, 0.0, -1.0));
+    CHECK(p.write.usd.upAxis == "Z");
+    CHECK(p.write.plyEncoding == PlyEncoding::Ascii);
+    CHECK(p.write.objLines == ObjLineStyle::Polylines);
+    CHECK(p.write.vdb.codec == PositionCodec::Fixed16);
+    CHECK(p.write.usd.width == 0.25f);
+    setParam(t, "usd-up", p, std::string("auto"));
+    CHECK(p.write.usd.upAxis.empty());
+    // The write options are writeParameters(), Python's write() keywords: the same declaration.
+    for (const Param<WriteOptions>& w : writeParameters()) CHECK(paramHelp(declared(t, w.name)) == paramHelp(w));
+    p = ConvertParams{};
+    p.write.vdb.voxelSize = -1.0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--voxel-size -1: must be at least 0 world units");
+    p = ConvertParams{};
+    p.write.usd.width = -1.f;
+    REQUIRE_THROWS_WITH(checkParams(writeParameters(), p.write, ParamSpelling::Keyword, "write"), "write: width -1: must be at least 0 world units");
+    checkDeclaration(t, "convert");
 }
 
 TEST_CASE("Parameters: prepare's declaration, a keyword that is not its name, in docs/cli.md", "[params]")

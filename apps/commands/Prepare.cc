@@ -17,11 +17,6 @@ namespace vdbhair::app {
 
 namespace {
 
-/// A count's check with a message in words (CLI::NonNegativeNumber's names a 309-digit bound):
-/// without it, -3 would wrap around to a huge unsigned count.
-const CLI::Validator kCount(
-    [](std::string& v) { return !v.empty() && v[0] == '-' ? "Value " + v + " is negative (a count is 0 or more)" : std::string(); }, "");
-
 struct PrepareCmdParams
 {
     std::vector<std::string> files;  ///< IN OUT, or IN with -o OUT
@@ -133,7 +128,6 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("files", params->files, "IN OUT, or IN with -o OUT")->required();
     sub->add_option("-o,--output", params->output, "Output strand file; its extension picks the format (.hair .data .obj .ply .vdb .usda .abc)");
     addParamOptions(sub, params->prepare, prepareParameters());
-    for (const char* count : {"--points", "--strands"}) sub->get_option(count)->check(kCount);
     sub->add_option("--head", params->head, "The groom's own head mesh (.ply, .obj), in the strands' frame: the source of --align-to");
     sub->add_option("--align-to", params->alignTo,
                     "A common head mesh (.ply, .obj): --head is fitted onto it by a similarity (scale, rotation, translation) and the "

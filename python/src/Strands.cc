@@ -1,7 +1,9 @@
 // vdbhair.Strands (a StrandSet seen as NumPy arrays), vdbhair.read and vdbhair.write.
 #include "Common.h"
+#include "Params.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/ConvertStrands.h>
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -12,6 +14,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 
 namespace vdbhair::py {
 
@@ -187,40 +190,59 @@ ReadOptions readOptions(bool strict, const std::string& grid, const std::optiona
     return opts;
 }
 
-/// The CLI's write options (convert), as write()'s keywords.
-struct WriteKeywords
+/// write()'s keywords: writeParameters(), the declared parameters of how strands are written
+/// (the command line's `convert` options), by their Python names, in the declaration's order.
+/// The C++ types of writeWithOptions()'s keywords follow that order; writeKeywords() checks them.
+const std::vector<std::string>& writeKeywordNames()
 {
-    std::string plyEncoding = "binary", objLines = "edges";
-    std::optional<std::string> usdUp;     ///< None: the strands' declared axis, else y
-    double metersPerUnit = WriteOptions{}.usd.metersPerUnit;
-    float width = WriteOptions{}.usd.width;
-    std::string codec = positionCodecName(WriteOptions{}.vdb.codec);
-};
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> n;
+        for (const Param<WriteOptions>& p : writeParameters()) n.push_back(p.pythonName());
+        return n;
+    }();
+    return names;
+}
+
+/// The keywords' pybind11 arguments, each with the declaration's default.
+/// @throw std::logic_error when the declaration no longer matches writeWithOptions()'s types.
+std::vector<pyb::arg_v> writeKeywords()
+{
+    const ParamTable<WriteOptions>& table = writeParameters();
+    const std::vector<std::string> types{"str", "str", "str", "float", "Optional[str]", "float", "float"};
+    std::vector<std::string> declared;
+    for (const Param<WriteOptions>& p : table) declared.push_back(pythonAnnotation(p));
+    if (declared != types) throw std::logic_error("write(): writeParameters() changed; update writeWithOptions()'s keywords");
+    std::vector<pyb::arg_v> args;
+    for (std::size_t i = 0; i < table.size(); ++i) args.emplace_back(writeKeywordNames()[i].c_str(), pythonDefault(table[i]));
+    return args;
+}
+
+/// write()'s Args for the keywords: each one's help, unit, range and choices from the declaration.
+std::string writeKeywordsDoc()
+{
+    std::string doc;
+    for (const Param<WriteOptions>& p : writeParameters()) {
+        doc += "    " + p.pythonName() + ": " + paramHelp(p) + " (the CLI's ``convert " + p.flag() + "``" +
+               (p.pythonNone ? "; None: " + p.defaultText() : "") + ").\n";
+    }
+    return doc;
+}
 
 void writeWithOptions(const StrandSet& s, const PathArg& path, const std::string& plyEncoding, const std::string& objLines,
-                      const std::optional<std::string>& usdUp = std::nullopt, double metersPerUnit = WriteOptions{}.usd.metersPerUnit,
-                      float width = WriteOptions{}.usd.width, const std::string& codec = positionCodecName(WriteOptions{}.vdb.codec))
+                      const std::string& codec, double voxelSize, const std::optional<std::string>& usdUp, double metersPerUnit,
+                      double width)
 {
+    const std::vector<std::string>& k = writeKeywordNames();
+    pyb::dict kw;
+    kw[k[0].c_str()] = plyEncoding;
+    kw[k[1].c_str()] = objLines;
+    kw[k[2].c_str()] = codec;
+    kw[k[3].c_str()] = voxelSize;
+    kw[k[4].c_str()] = usdUp ? pyb::object(pyb::str(*usdUp)) : pyb::object(pyb::none());
+    kw[k[5].c_str()] = metersPerUnit;
+    kw[k[6].c_str()] = width;
     WriteOptions opts;
-    if (usdUp) {
-        if (*usdUp != "y" && *usdUp != "z" && *usdUp != "Y" && *usdUp != "Z") throw ValueError("usd_up='" + *usdUp + "': must be 'y' or 'z' (USD's choices)");
-        opts.usd.upAxis = *usdUp == "z" || *usdUp == "Z" ? "Z" : "Y";
-    }
-    if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit)) {
-        throw ValueError("meters_per_unit=" + std::to_string(metersPerUnit) + ": must be a positive length in metres (0: the strands' own, else 0.01)");
-    }
-    opts.usd.metersPerUnit = metersPerUnit;
-    if (!(width >= 0.f) || !std::isfinite(width)) throw ValueError("width=" + std::to_string(width) + ": must be a positive length in world units (0: automatic)");
-    opts.usd.width = width;
-    try {
-        opts.vdb.codec = positionCodecFromName(codec);
-    } catch (const ValueError&) {
-        throw ValueError("codec='" + codec + "': must be one of float, fixed16, fixed8");
-    }
-    if (plyEncoding == "binary") opts.plyEncoding = PlyEncoding::Binary;
-    else if (plyEncoding == "ascii") opts.plyEncoding = PlyEncoding::Ascii;
-    else throw ValueError("ply_encoding='" + plyEncoding + "' is not one of binary, ascii");
-    opts.objLines = objLineStyleFromName(objLines);
+    applyKeywords(writeParameters(), kw, opts, "write");
     pyb::gil_scoped_release release;
     writeStrands(path, s, opts);
 }
@@ -411,10 +433,8 @@ void bindStrandSequence(StrandsClass& cls)
     cls.def("__repr__", [](const StrandSet& s) {
         return "<vdbhair.Strands: " + std::to_string(s.numStrands()) + " strands, " + std::to_string(s.numVertices()) + " vertices>";
     });
-    const WriteKeywords wk;
-    cls.def("write", &writeWithOptions, pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = wk.plyEncoding,
-            pyb::arg("obj_lines") = wk.objLines, pyb::arg("usd_up") = wk.usdUp, pyb::arg("meters_per_unit") = wk.metersPerUnit,
-            pyb::arg("width") = wk.width, pyb::arg("codec") = wk.codec,
+    const std::vector<pyb::arg_v> kw = writeKeywords();
+    cls.def("write", &writeWithOptions, pyb::arg("path"), pyb::kw_only(), kw[0], kw[1], kw[2], kw[3], kw[4], kw[5], kw[6],
             "Write to ``path`` in the format of its extension (.hair .data .obj .ply .vdb .usda), atomically; see vdbhair.write.");
 
 }
@@ -485,19 +505,10 @@ Raises:
     file, the byte offset or line and the rule; KeyboardInterrupt on Ctrl-C.)doc");
 }
 
-/// vdbhair.write: strands to a file.
+/// vdbhair.write: strands to a file, with the keywords writeParameters() declares.
 void bindWrite(pyb::module_& m)
 {
-    const WriteKeywords wk;
-    m.def(
-        "write",
-        [](const StrandSet& s, const PathArg& path, const std::string& plyEncoding, const std::string& objLines,
-           const std::optional<std::string>& usdUp, double metersPerUnit, float width, const std::string& codec) {
-            writeWithOptions(s, path, plyEncoding, objLines, usdUp, metersPerUnit, width, codec);
-        },
-        pyb::arg("strands"), pyb::arg("path"), pyb::kw_only(), pyb::arg("ply_encoding") = wk.plyEncoding, pyb::arg("obj_lines") = wk.objLines,
-        pyb::arg("usd_up") = wk.usdUp, pyb::arg("meters_per_unit") = wk.metersPerUnit, pyb::arg("width") = wk.width, pyb::arg("codec") = wk.codec,
-        R"doc(Write strands in the format of ``path``'s extension, atomically (a temporary file renamed
+    static const std::string doc = R"doc(Write strands in the format of ``path``'s extension, atomically (a temporary file renamed
 into place: a failed write leaves nothing and never damages an existing file).
 
 Writable formats: .hair .data .obj .ply .vdb .usda.
@@ -505,21 +516,14 @@ Writable formats: .hair .data .obj .ply .vdb .usda.
 Args:
     strands: a Strands.
     path: the output file, a str or any os.PathLike (pathlib.Path).
-    ply_encoding: "binary" (little-endian) or "ascii", for .ply (the CLI's ``--ply-encoding``).
-    obj_lines: "edges" (one two-vertex ``l`` per segment, what Blender reads whole) or
-        "polylines" (one ``l`` per strand), for .obj (the CLI's ``--obj-lines``).
-    usd_up: "y" or "z", the USD stage's upAxis (the CLI's ``--usd-up``); None: the axis the
-        strands' source declared (a USD stage's), else "y". Coordinates are not rotated.
-    meters_per_unit: the USD stage's metersPerUnit (the CLI's ``--meters-per-unit``); 0: the
-        strands' own (read from a USD stage), else 0.01. Nothing is scaled.
-    width: for .usda, the widths (world units) of strands without thickness (the CLI's
-        ``--width``); 0: the source's default thickness if it declared one, else 1/1000 of the
-        bounding box's diagonal.
-    codec: for .vdb, the position codec: "float" (exact), "fixed16" or "fixed8" (the CLI's
-        ``--codec``).
-
+)doc" + writeKeywordsDoc() + R"doc(
 Raises:
-    vdbhair.ArgumentError (a ValueError) for a format that cannot be written, vdbhair.IoError.)doc");
+    vdbhair.ArgumentError (a ValueError) for a format that cannot be written or a keyword's value
+    outside its range or choices ("write: codec 'zip': must be one of float, fixed16, fixed8"),
+    vdbhair.IoError.)doc";
+    const std::vector<pyb::arg_v> kw = writeKeywords();
+    m.def("write", &writeWithOptions, pyb::arg("strands"), pyb::arg("path"), pyb::kw_only(), kw[0], kw[1], kw[2], kw[3], kw[4], kw[5], kw[6],
+          doc.c_str());
 }
 
 } // namespace

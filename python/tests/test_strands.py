@@ -1,9 +1,14 @@
 """vdbhair.Strands: arrays, checks, iteration, and round trips through every writable format."""
+import os
+import pathlib
+import re
+import subprocess
+
 import numpy as np
 import pytest
 
 import vdbhair
-from conftest import straight_bundle, wavy_hairstyle
+from conftest import SOURCE_DIR, straight_bundle, wavy_hairstyle
 
 
 def two_strands():
@@ -101,7 +106,7 @@ def test_ascii_ply_and_polyline_obj(tmp_path):
     assert (tmp_path / "a.ply").read_bytes().startswith(b"ply\nformat ascii")
     vdbhair.write(s, str(tmp_path / "p.obj"), obj_lines="polylines")
     assert sum(1 for line in (tmp_path / "p.obj").read_text().splitlines() if line.startswith("l ")) == len(s)
-    with pytest.raises(ValueError, match="ply_encoding='big'"):
+    with pytest.raises(ValueError, match="^write: ply_encoding 'big': must be one of binary, ascii$"):
         vdbhair.write(s, str(tmp_path / "b.ply"), ply_encoding="big")
 
 
@@ -249,12 +254,42 @@ def test_write_takes_the_cli_write_options(tmp_path):
     assert 'upAxis = "Z"' in text2 and "metersPerUnit = 1\n" in text2
     hair.write(tmp_path / "h.vdb", codec="fixed8")
     assert np.abs(vdbhair.read(tmp_path / "h.vdb").positions - hair.positions).max() < 0.5
-    with pytest.raises(vdbhair.ArgumentError, match="codec='zip': must be one of float, fixed16, fixed8"):
+    with pytest.raises(vdbhair.ArgumentError, match="^write: codec 'zip': must be one of float, fixed16, fixed8$"):
         hair.write(tmp_path / "x.vdb", codec="zip")
-    with pytest.raises(vdbhair.ArgumentError, match="usd_up='x': must be 'y' or 'z'"):
+    with pytest.raises(vdbhair.ArgumentError, match="^write: usd_up 'x': must be one of auto, y, z$"):
         vdbhair.write(hair, out, usd_up="x")
-    with pytest.raises(vdbhair.ArgumentError, match="meters_per_unit=-1.000000: must be a positive length"):
+    with pytest.raises(vdbhair.ArgumentError, match="^write: meters_per_unit -1: must be at least 0 metres$"):
         vdbhair.write(hair, out, meters_per_unit=-1)
+    with pytest.raises(vdbhair.ArgumentError, match="^write: voxel_size -2: must be at least 0 world units$"):
+        vdbhair.write(hair, tmp_path / "x.vdb", voxel_size=-2)
+
+
+def cli():
+    """The `vdbhair` command of the same build (VDBHAIR_CLI, else bin/ next to the module's python/)."""
+    path = os.environ.get("VDBHAIR_CLI") or str(pathlib.Path(vdbhair.__file__).resolve().parents[1] / "bin" / "vdbhair")
+    assert os.access(path, os.X_OK), f"no vdbhair command at {path} (set VDBHAIR_CLI)"
+    return path
+
+
+def test_write_keywords_are_converts_declared_options_and_write_the_same_bytes(tmp_path):
+    """write()'s keywords are writeParameters(), which `vdbhair convert` takes as options: the same
+    names, and the same values write the same file from a real hairstyle."""
+    signature = vdbhair.write.__doc__.splitlines()[0]
+    keywords = re.findall(r"(\w+): [^,]+? = ", signature)
+    assert keywords == ["ply_encoding", "obj_lines", "codec", "voxel_size", "usd_up", "meters_per_unit", "width"]
+    shown = subprocess.run([cli(), "convert", "--help"], capture_output=True, text=True, check=True).stdout
+    for keyword in keywords:
+        assert re.search(r"^\s+--" + keyword.replace("_", "-") + r"\b", shown, re.M), f"convert --help has no --{keyword}"
+    source = SOURCE_DIR / "scenes" / "default" / "ponytail.hair"
+    hair = vdbhair.read(source)
+    cases = [("a.usda", dict(usd_up="z", meters_per_unit=1.0, width=0.1), ["--usd-up", "z", "--meters-per-unit", "1", "--width", "0.1"]),
+             ("b.usda", dict(usd_up="auto"), []),
+             ("a.ply", dict(ply_encoding="ascii"), ["--ply-encoding", "ascii"]),
+             ("a.obj", dict(obj_lines="polylines"), ["--obj-lines", "polylines"])]
+    for name, keywords, flags in cases:
+        vdbhair.write(hair, tmp_path / ("python_" + name), **keywords)
+        subprocess.run([cli(), "convert", str(source), str(tmp_path / ("cli_" + name)), "--quiet", *flags], check=True)
+        assert (tmp_path / ("python_" + name)).read_bytes() == (tmp_path / ("cli_" + name)).read_bytes(), name
 
 
 def test_units_declared_and_converted(tmp_path):
