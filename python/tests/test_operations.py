@@ -382,14 +382,20 @@ def _same_report(report, cmd, front_end_keys, arrays=(), timings=()):
     assert report == cmd
 
 
-@pytest.mark.data
-def test_roots_fit_reconstruct_retrace_reports_are_the_commands(tmp_path, shared_data):
-    # One report whichever front end ran the verb (ScalpJson.h, HelicoidJson.h, FieldJson.h), on a
-    # real hairstyle and head: Python's is `--json`'s less the command's file names and clock.
+def _front_and_head(shared_data):
+    """The TressFX front groom and its head, or a skip saying they are not in the shared data."""
     path = shared_data / "hair" / "tressfx" / "ascii_v2" / "hair_front_16_guide.tfx"
     head = shared_data / "scalp" / "tressfx" / "head_max4.obj"
     if not path.exists() or not head.exists():
         pytest.skip(f"{path.name} or {head.name} is not in the shared data")
+    return path, head
+
+
+@pytest.mark.data
+def test_roots_fit_reconstruct_retrace_reports_are_the_commands(tmp_path, shared_data):
+    # One report whichever front end ran the verb (ScalpJson.h, HelicoidJson.h, FieldJson.h), on a
+    # real hairstyle and head: Python's is `--json`'s less the command's file names and clock.
+    path, head = _front_and_head(shared_data)
     hair = vdbhair.read(str(path))
     out = tmp_path / "out.hair"
 
@@ -420,10 +426,7 @@ def test_roots_fit_reconstruct_retrace_reports_are_the_commands(tmp_path, shared
 def test_grow_interpolate_reports_are_the_commands(tmp_path, shared_data):
     # grow and interpolate with return_report=True: `--json`'s report (HelicoidJson.h), less the
     # command's file names and clock, on a real hairstyle's fits and roots spread over its head.
-    path = shared_data / "hair" / "tressfx" / "ascii_v2" / "hair_front_16_guide.tfx"
-    head = shared_data / "scalp" / "tressfx" / "head_max4.obj"
-    if not path.exists() or not head.exists():
-        pytest.skip(f"{path.name} or {head.name} is not in the shared data")
+    path, head = _front_and_head(shared_data)
     hair = vdbhair.read(str(path))
     scene = vdbhair.fit(hair)
     (tmp_path / "fits.json").write_text(json.dumps(scene))

@@ -205,6 +205,14 @@ std::vector<Vec3f> helix(double r, double c, double turns, int n)
     return p;
 }
 
+/// A straight centre of @a length along y from the root (0, 1, 0), @a n vertices.
+std::vector<Vec3f> line(double length, int n)
+{
+    std::vector<Vec3f> p;
+    for (int k = 0; k < n; ++k) p.emplace_back(0.0f, float(1.0 + length * double(k) / double(n - 1)), 0.0f);
+    return p;
+}
+
 /// The output of laying the one-strand cluster (@a strand about @a centre) onto @a outCentre, in world units.
 std::vector<Vec3f> layOnto(const StrandSamples& strand, const StrandSamples& centre, const StrandSamples& outCentre, DetailScale scale,
                            int outVertices, bool threaded = true)
@@ -228,11 +236,6 @@ TEST_CASE("transferDetail: edges keep a helix's turning per length on a longer s
     const int ns = 128;
     const StrandSamples strand = oneStrand(helix(r, c, turns, 1024), ns);
     const double axis = c * 2.0 * M_PI * turns;
-    const auto line = [](double length, int n) {
-        std::vector<Vec3f> p;
-        for (int k = 0; k < n; ++k) p.emplace_back(0.0f, float(1.0 + length * double(k) / double(n - 1)), 0.0f);
-        return p;
-    };
     const StrandSamples centre = oneStrand(line(axis, 64), ns);
     std::vector<Vec3f> in(ns);
     sampleToWorld(strand.row(0), ns, strand.roots[0], strand.frames[0], 1.0, in.data());
@@ -291,11 +294,6 @@ TEST_CASE("transferDetail: a strand shorter than its curl's period continues as 
     const int ns = 64;
     const StrandSamples strand = oneStrand(helix(r, c, turns, 256), ns);
     const double axis = c * 2.0 * M_PI * turns;
-    const auto line = [](double length, int n) {
-        std::vector<Vec3f> p;
-        for (int k = 0; k < n; ++k) p.emplace_back(0.0f, float(1.0 + length * double(k) / double(n - 1)), 0.0f);
-        return p;
-    };
     const StrandSamples centre = oneStrand(line(axis, 64), ns);
     // Eight times as long: seven of every eight parts of the output are continuation.
     const StrandSamples longCentre = oneStrand(line(8.0 * axis, 64), ns);
