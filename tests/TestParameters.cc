@@ -11,6 +11,7 @@
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/ConvertStrands.h>
+#include <vdbhair/render/SliceRenderer.h>
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
@@ -441,4 +442,30 @@ TEST_CASE("Parameters: prepare's declaration, a keyword that is not its name, in
     p.align.overlap = 0.0;
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "prepare"), "prepare: overlap 0: must be above 0 and at most 1");
     checkDeclaration(t, "prepare");
+}
+
+TEST_CASE("Parameters: inspect's slice declaration, the colouring as a flag and the sizes' ranges, in docs/cli.md", "[params]")
+{
+    const ParamTable<SliceParams>& t = sliceParameters();
+    CHECK(declared(t, "hsv").flag() == "--hsv");
+    CHECK(declared(t, "hsv").defaultText() == "false");
+    CHECK(declared(t, "width").defaultText() == std::to_string(SliceParams{}.width));
+    CHECK(declared(t, "streamlines").defaultText() == std::to_string(SliceParams{}.streamlines));
+    SliceParams p;
+    setParam(t, "hsv", p, true);
+    setParam(t, "streamlines", p, 300);
+    setParam(t, "width", p, 400);
+    CHECK(p.color == SliceColor::Hsv);
+    CHECK(p.streamlines == 300);
+    CHECK(p.width == 400);
+    setParam(t, "hsv", p, false);
+    CHECK(p.color == SliceColor::Rgb);
+    p.width = SliceParams::kMinWidth - 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--width 15: must be between 16 and 16384 pixels");
+    p = SliceParams{};
+    p.streamlines = SliceParams::kMaxStreamlines + 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "inspect"), "inspect: streamlines 100001: must be between 0 and 100000");
+    // The renderer checks the same ranges, in the parameters' names.
+    REQUIRE_THROWS_WITH(renderSlice("missing.vdb", "tangent", p), "inspect(missing.vdb): streamlines 100001: must be between 0 and 100000");
+    REQUIRE_NOTHROW(checkParams(t, SliceParams{}, ParamSpelling::Flag, ""));
 }
