@@ -15,6 +15,7 @@
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
+#include <vdbhair/strands/StrandStats.h>
 #include <vdbhair/synth/Comb.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
@@ -468,4 +469,23 @@ TEST_CASE("Parameters: inspect's slice declaration, the colouring as a flag and 
     // The renderer checks the same ranges, in the parameters' names.
     REQUIRE_THROWS_WITH(renderSlice("missing.vdb", "tangent", p), "inspect(missing.vdb): streamlines 100001: must be between 0 and 100000");
     REQUIRE_NOTHROW(checkParams(t, SliceParams{}, ParamSpelling::Flag, ""));
+}
+
+TEST_CASE("Parameters: info's statistics declaration, the histograms' bins, in docs/cli.md", "[params]")
+{
+    const ParamTable<StrandStatsParams>& t = strandStatsParameters();
+    CHECK(declared(t, "bins").defaultText() == std::to_string(kDefaultHistogramBins));
+    StrandStatsParams p;
+    setParam(t, "bins", p, std::uint64_t(7));
+    CHECK(p.bins == 7);
+    // What the statistics are made with: that many bins in every histogram.
+    StrandSet strands;
+    strands.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(0.f, 1.f, 0.f), Vec3f(1.f, 1.f, 0.f)});
+    CHECK(computeStrandStatistics(strands, p.bins).length.counts.size() == 7);
+    p.bins = 0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--bins 0: must be between 1 and 10000");
+    p.bins = StrandStatsParams::kMaxBins + 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "strand_statistics"), "strand_statistics: bins 10001: must be between 1 and 10000");
+    REQUIRE_THROWS_WITH(computeStrandStatistics(strands, 0), "computeStrandStatistics: bins 0: must be between 1 and 10000");
+    REQUIRE_NOTHROW(checkParams(t, StrandStatsParams{}, ParamSpelling::Flag, ""));
 }

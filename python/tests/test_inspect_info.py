@@ -1,6 +1,7 @@
-"""vdbhair.inspect takes its keywords from the declaration `vdbhair inspect`'s options come from
-(sliceParameters()), with the command's grid, slice and output: the same names, and the same
-results as the command line."""
+"""vdbhair.inspect and vdbhair.strand_statistics take their keywords from the declarations
+`vdbhair inspect`'s and `vdbhair info`'s options come from (sliceParameters(),
+strandStatsParameters()), inspect with the command's grid, slice and output: the same names, and
+the same results as the command line."""
 import inspect
 import json
 import re
@@ -79,3 +80,22 @@ def test_inspect_bad_keywords_name_the_keyword_value_and_rule(field_vdb, tmp_pat
     with pytest.raises(vdbhair.ArgumentTypeError, match=r"^inspect: width must be an integer"):
         vdbhair.inspect(field_vdb, width="wide")
     assert not (tmp_path / "a.png").exists()
+
+
+def test_strand_statistics_keywords_are_info_options():
+    # info's other options (--strict, --grid, --stats) choose what is read and whether to count.
+    assert keywords(vdbhair.strand_statistics) - {"strands"} == {"bins"}
+    assert "bins" in cli_options("info")
+
+
+def test_strand_statistics_is_info_stats(tmp_path):
+    path = tmp_path / "wavy.hair"
+    vdbhair.write(wavy_hairstyle(), str(path))
+    python = vdbhair.strand_statistics(vdbhair.read(str(path)), bins=7)
+    line = subprocess.run([cli(), "info", str(path), "--stats", "--bins", "7", "--json"], capture_output=True, text=True, check=True).stdout
+    assert python == json.loads(line)["stats"]
+    assert len(python["length"]["counts"]) == 7
+    with pytest.raises(ValueError, match=r"^strand_statistics: bins 0: must be between 1 and 10000$"):
+        vdbhair.strand_statistics(vdbhair.read(str(path)), bins=0)
+    with pytest.raises(ValueError, match=r"^strand_statistics: bins -1: must be at least 1$"):
+        vdbhair.strand_statistics(vdbhair.read(str(path)), bins=-1)
