@@ -11,9 +11,11 @@
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/ConvertStrands.h>
+#include <vdbhair/render/SliceRenderer.h>
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/Follicles.h>
 #include <vdbhair/scalp/ScalpInput.h>
+#include <vdbhair/strands/StrandStats.h>
 #include <vdbhair/synth/Comb.h>
 #include <vdbhair/synth/HairTransfer.h>
 #include <vdbhair/synth/Synthesis.h>
@@ -441,4 +443,49 @@ TEST_CASE("Parameters: prepare's declaration, a keyword that is not its name, in
     p.align.overlap = 0.0;
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "prepare"), "prepare: overlap 0: must be above 0 and at most 1");
     checkDeclaration(t, "prepare");
+}
+
+TEST_CASE("Parameters: inspect's slice declaration, the colouring as a flag and the sizes' ranges, in docs/cli.md", "[params]")
+{
+    const ParamTable<SliceParams>& t = sliceParameters();
+    CHECK(declared(t, "hsv").flag() == "--hsv");
+    CHECK(declared(t, "hsv").defaultText() == "false");
+    CHECK(declared(t, "width").defaultText() == std::to_string(SliceParams{}.width));
+    CHECK(declared(t, "streamlines").defaultText() == std::to_string(SliceParams{}.streamlines));
+    SliceParams p;
+    setParam(t, "hsv", p, true);
+    setParam(t, "streamlines", p, 300);
+    setParam(t, "width", p, 400);
+    CHECK(p.color == SliceColor::Hsv);
+    CHECK(p.streamlines == 300);
+    CHECK(p.width == 400);
+    setParam(t, "hsv", p, false);
+    CHECK(p.color == SliceColor::Rgb);
+    p.width = SliceParams::kMinWidth - 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--width 15: must be between 16 and 16384 pixels");
+    p = SliceParams{};
+    p.streamlines = SliceParams::kMaxStreamlines + 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "inspect"), "inspect: streamlines 100001: must be between 0 and 100000");
+    // The renderer checks the same ranges, in the parameters' names.
+    REQUIRE_THROWS_WITH(renderSlice("missing.vdb", "tangent", p), "inspect(missing.vdb): streamlines 100001: must be between 0 and 100000");
+    checkDeclaration(t, "inspect");
+}
+
+TEST_CASE("Parameters: info's statistics declaration, the histograms' bins, in docs/cli.md", "[params]")
+{
+    const ParamTable<StrandStatsParams>& t = strandStatsParameters();
+    CHECK(declared(t, "bins").defaultText() == std::to_string(kDefaultHistogramBins));
+    StrandStatsParams p;
+    setParam(t, "bins", p, std::uint64_t(7));
+    CHECK(p.bins == 7);
+    // What the statistics are made with: that many bins in every histogram.
+    StrandSet strands;
+    strands.addStrand(std::vector<Vec3f>{Vec3f(0.f), Vec3f(0.f, 1.f, 0.f), Vec3f(1.f, 1.f, 0.f)});
+    CHECK(computeStrandStatistics(strands, p.bins).length.counts.size() == 7);
+    p.bins = 0;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Flag, ""), "--bins 0: must be between 1 and 10000");
+    p.bins = StrandStatsParams::kMaxBins + 1;
+    REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "strand_statistics"), "strand_statistics: bins 10001: must be between 1 and 10000");
+    REQUIRE_THROWS_WITH(computeStrandStatistics(strands, 0), "computeStrandStatistics: bins 0: must be between 1 and 10000");
+    checkDeclaration(t, "info");
 }

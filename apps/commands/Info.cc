@@ -1,5 +1,6 @@
 // vdbhair info FILE [--json]: what a strand file or a .vdb file holds; a .vdb file is InfoVdb.cc's.
 #include "Info.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/StrandFileSummary.h>
@@ -126,20 +127,19 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
     sub->add_flag("--stats", params->stats, "Also histograms of strand length, turning (degrees per strand), curvature (per vertex) and vertices per strand");
-    sub->add_option("--bins", params->bins, "Bins per --stats histogram (1 to 10000)")->check(CLI::Validator(
-        [](std::string& v) { return !v.empty() && v[0] == '-' ? "Value " + v + " is negative (1 to 10000 bins)" : std::string(); }, ""))
-        ->capture_default_str();
+    addParamOptions(sub, params->statsParams, strandStatsParameters());
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair info scenes/default/ponytail.hair --json");
     return {sub, [params, &common] {
+                checkParamOptions(strandStatsParameters(), params->statsParams);
                 if (params->stats) {
                     if (fileExtension(params->input) == ".vdb" && params->grid.empty()) {
                         throw ValueError("--stats of " + params->input + ": a .vdb needs --grid, the points grid holding the strands");
                     }
                     ReadReport report;
                     const StrandSet strands = readStrands(params->input, params->readOptions(common), &report);
-                    const StrandStatistics stats = computeStrandStatistics(strands, params->bins);
+                    const StrandStatistics stats = computeStrandStatistics(strands, params->statsParams.bins);
                     return printStrandSummary(*params, stats.summary, report, common, &stats);
                 }
                 if (fileExtension(params->input) == ".vdb") return infoVdbFile(*params, common);

@@ -20,7 +20,7 @@ struct InfoParams
     bool strict = false;
     std::string grid;  ///< a .vdb's points grid to summarize as strands; empty: list every grid
     bool stats = false;  ///< --stats: histograms of length, turning, curvature, vertices per strand
-    std::size_t bins = kDefaultHistogramBins;
+    StrandStatsParams statsParams;  ///< their declared parameters (strandStatsParameters()): --bins
 
     /// The reader's options these ask for (--strict, --grid) and @a common's.
     ReadOptions readOptions(const CommonOptions& common) const;

@@ -1,6 +1,7 @@
 // vdbhair inspect F.vdb [--json] [--grid NAME] [--slice x|y|z=WORLD -o S.png [--hsv] [--streamlines N]]:
 // value statistics, tiles, memory, bounds, leaf fill and metadata in words; slices as images.
 #include "../Command.h"
+#include "../ParamOptions.h"
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
@@ -13,12 +14,11 @@ namespace vdbhair::app {
 
 namespace {
 
+/// The command line of inspect: the slice's declared parameters (sliceParameters()) are options.
 struct InspectParams
 {
     std::string input, grid, slice, output;
-    bool hsv = false;
-    int streamlines = SliceParams{}.streamlines;  // the library checks both (SliceParams' limits)
-    int width = SliceParams{}.width;
+    SliceParams sliceParams;  ///< --hsv, --streamlines, --width; the plane comes from --slice
 };
 
 std::string g6(double v)
@@ -122,38 +122,22 @@ void printReport(const GridReport& r)
 
 int runInspect(const InspectParams& p, const CommonOptions& common)
 {
+    checkParamOptions(sliceParameters(), p.sliceParams);
     if (fileExtension(p.input) != ".vdb") throw ValueError(p.input + ": inspect reads .vdb files (use 'vdbhair info' for strand files)");
     if (!p.slice.empty() && p.output.empty()) throw ValueError("--slice " + p.slice + ": needs -o OUT.png for the image");
     if (p.slice.empty() && !p.output.empty()) throw ValueError("-o " + p.output + ": inspect writes an image only with --slice AXIS=WORLD");
-    if (p.slice.empty() && (p.hsv || p.streamlines)) throw ValueError("--hsv and --streamlines draw on a slice: add --slice AXIS=WORLD -o OUT.png");
-    SliceParams sp;
+    SliceParams sp = p.sliceParams;
+    if (p.slice.empty() && (sp.color == SliceColor::Hsv || sp.streamlines)) {
+        throw ValueError("--hsv and --streamlines draw on a slice: add --slice AXIS=WORLD -o OUT.png");
+    }
     if (!p.slice.empty()) {
         parseSlice(p.slice, sp.axis, sp.world);
         if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
-        sp.width = p.width;
-        sp.color = p.hsv ? SliceColor::Hsv : SliceColor::Rgb;
-        sp.streamlines = p.streamlines;
     }
-    std::vector<GridReport> reports = inspectVdbFile(p.input);
-    if (!p.grid.empty()) {
-        std::vector<GridReport> kept;
-        std::string names;
-        for (GridReport& r : reports) {
-            names += (names.empty() ? "" : ", ") + r.info.name;
-            if (r.info.name == p.grid) kept.push_back(std::move(r));
-        }
-        if (kept.empty()) throw LookupError(p.input + ": no grid named '" + p.grid + "' (the file has: " + (names.empty() ? "no grids" : names) + ")");
-        reports = std::move(kept);
-    }
+    const std::vector<GridReport> reports = inspectVdbFile(p.input, p.grid);
     nlohmann::json sliceJson;
     if (!p.slice.empty()) {
-        // The grid to slice: --grid, else 'tangent', else the first voxel grid.
-        std::string name = p.grid;
-        if (name.empty()) {
-            for (const GridReport& r : reports) if (r.info.name == "tangent") name = r.info.name;
-            for (const GridReport& r : reports) if (name.empty() && !r.info.isPoints) name = r.info.name;
-            if (name.empty()) throw ValueError(p.input + ": has no voxel grid to slice (only points)");
-        }
+        const std::string name = chooseSliceGrid(reports, p.grid, p.input);
         const SliceResult res = renderSlice(p.input, name, sp);
         writeImage(p.output, res.image);
         sliceJson = {{"output", p.output}, {"grid", name}, {"axis", std::string(1, char('x' + sp.axis))}, {"world", sp.world},
@@ -191,9 +175,7 @@ Command addInspectCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--grid", params->grid, "Only this grid (and the one to slice; default: 'tangent', else the first voxel grid)");
     sub->add_option("--slice", params->slice, "Render the slice AXIS=WORLD (e.g. z=1.5: the plane z = 1.5 in world units)");
     sub->add_option("-o,--output", params->output, "The slice image (.png, .exr, .jpg)");
-    sub->add_flag("--hsv", params->hsv, "Colour vectors by in-plane angle (hue) instead of |x|,|y|,|z| (RGB)");
-    sub->add_option("--streamlines", params->streamlines, "Overlay this many streamlines of the in-plane field")->capture_default_str();
-    sub->add_option("--width", params->width, "Width of the slice's plot in pixels")->capture_default_str();
+    addParamOptions(sub, params->sliceParams, sliceParameters());
     addCommonOptions(sub, common);
     sub->footer("Examples: vdbhair inspect field.vdb\n"
                 "          vdbhair inspect field.vdb --slice z=0 -o slice.png --hsv --streamlines 300");

@@ -82,21 +82,28 @@ void bindDataset(pyb::module_& m)
 {
     definePrepare(m);
 
-    m.def(
-        "strand_statistics",
-        [](const StrandsPtr& strands, std::size_t bins, int threads) {
-            const StrandStatistics s = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return computeStrandStatistics(*strands, bins); });
-            auto range = [](const RangeStats& r) { return nlohmann::json{{"min", r.min}, {"mean", r.mean}, {"max", r.max}}; };
-            const nlohmann::json j = {{"length", histogramJson(s.length)},
-                                      {"turning_deg", {{"range", range(s.turning)}, {"histogram", histogramJson(s.turningHist)}}},
-                                      {"curvature", {{"range", range(s.curvature)}, {"p99", s.curvatureP99}, {"histogram", histogramJson(s.curvatureHist)}}},
-                                      {"vertices_per_strand", histogramJson(s.verticesPerStrand)}};
-            return fromJson(j);
-        },
-        pyb::arg("strands"), pyb::kw_only(), pyb::arg("bins") = kDefaultHistogramBins, pyb::arg("threads") = 0,
-        R"doc(Histograms of a hairstyle (``vdbhair info --stats --json``'s "stats"): strand length,
-turning per strand (degrees), curvature per vertex (over [0, its 99th percentile], the rest
-counted in "above") and vertices per strand, each {"lo", "hi", "counts", "above"}.)doc");
+    // strand_statistics: the histograms of `info --stats` (strandStatsParameters()).
+    auto statisticsImpl = [](const StrandsPtr& strands, const pyb::dict& kw) {
+        StrandStatsParams p;
+        applyKeywords(strandStatsParameters(), kw, p, "strand_statistics");
+        const StrandStatistics s = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter*) {
+            return computeStrandStatistics(*strands, p.bins);
+        });
+        auto range = [](const RangeStats& r) { return nlohmann::json{{"min", r.min}, {"mean", r.mean}, {"max", r.max}}; };
+        const nlohmann::json j = {{"length", histogramJson(s.length)},
+                                  {"turning_deg", {{"range", range(s.turning)}, {"histogram", histogramJson(s.turningHist)}}},
+                                  {"curvature", {{"range", range(s.curvature)}, {"p99", s.curvatureP99}, {"histogram", histogramJson(s.curvatureHist)}}},
+                                  {"vertices_per_strand", histogramJson(s.verticesPerStrand)}};
+        return fromJson(j);
+    };
+    defineVerb(m, "strand_statistics", {"strands: vdbhair.Strands"}, strandStatsParameters(), {},
+               "Histograms of a hairstyle (``vdbhair info --stats --json``'s \"stats\"): strand length,\n"
+               "turning per strand (degrees), curvature per vertex (over [0, its 99th percentile], the rest\n"
+               "counted in \"above\") and vertices per strand.",
+               "    strands: a Strands.\n",
+               "a dict: length, turning_deg (range, histogram), curvature (range, p99, histogram) and\n"
+               "    vertices_per_strand, each histogram {\"lo\", \"hi\", \"counts\", \"above\"}.",
+               pyb::cpp_function(statisticsImpl, pyb::arg("strands"), pyb::arg("keywords")));
 }
 
 } // namespace vdbhair::py

@@ -15,6 +15,7 @@
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbInspect.h>
 #include <vdbhair/render/Image.h>
+#include <vdbhair/render/SliceRenderer.h>
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/RootValues.h>
 #include <vdbhair/scalp/ScalpSurface.h>
@@ -29,7 +30,9 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <tuple>
+#include <utility>
 
 namespace vdbhair::py {
 
@@ -417,61 +420,107 @@ void defineRender(pyb::module_& m)
                pyb::cpp_function(renderImpl, pyb::arg("strands"), pyb::arg("path"), pyb::arg("keywords")));
 }
 
-/// inspect: a description of every grid of a .vdb file.
+/// inspect's dict of one grid.
+pyb::dict gridReportDict(const GridReport& r)
+{
+    const GridInfo& g = r.info;
+    pyb::dict d;
+    d["name"] = g.name;
+    d["value_type"] = g.valueType;
+    d["grid_class"] = g.gridClass;
+    d["vector_type"] = g.vectorType;
+    d["voxel_size"] = pyb::make_tuple(g.voxelSize.x(), g.voxelSize.y(), g.voxelSize.z());
+    d["active_voxels"] = g.activeVoxels;
+    d["active_tiles"] = g.activeTiles;
+    d["leaf_nodes"] = g.leafNodes;
+    d["memory_bytes"] = g.memoryBytes;
+    if (!g.emptyBBox) {
+        d["world_bbox"] = pyb::make_tuple(pyb::make_tuple(g.bboxMin.x(), g.bboxMin.y(), g.bboxMin.z()),
+                                          pyb::make_tuple(g.bboxMax.x(), g.bboxMax.y(), g.bboxMax.z()));
+    }
+    if (!r.emptyIndexBBox) d["index_bbox"] = pyb::make_tuple(pyb::cast(r.indexMin), pyb::cast(r.indexMax));
+    d["values"] = valueStatsDict(r.values);
+    if (r.isVector) {
+        d["unit_share"] = r.unitShare;
+        d["zero_share"] = r.zeroShare;
+        d["mean_vector"] = pyb::make_tuple(r.meanVector.x(), r.meanVector.y(), r.meanVector.z());
+        d["coherence"] = r.coherence;
+    } else if (r.isScalar) {
+        d["zero_share"] = r.zeroShare;
+    }
+    d["leaf_fill"] = pyb::make_tuple(r.leafFillMin, r.leafFillMean, r.leafFillMax);
+    pyb::dict meta;
+    for (const MetaValue& mv : g.metadata) meta[pyb::str(mv.name)] = metaValue(mv);
+    d["metadata"] = meta;
+    if (g.isPoints) d["point_count"] = g.pointCount;
+    d["explanation"] = r.explanation;
+    return d;
+}
+
+/// inspect: a description of every grid of a .vdb file (or of one, grid=), and a slice drawn.
+/// vdbhair.inspect(path, **keywords): the declared parameters (sliceParameters()), then inspect's own.
+pyb::object inspectImpl(const PathArg& path, const pyb::dict& kw)
+{
+    SliceParams sp;
+    applyKeywords(sliceParameters(), kw, sp, "inspect");
+    const std::string grid = kw["grid"].is_none() ? std::string() : kw["grid"].cast<std::string>();
+    const std::string slice = kw["slice"].is_none() ? std::string() : kw["slice"].cast<std::string>();
+    const std::string output = kw["output"].is_none() ? std::string() : pathString(kw["output"], "output");
+    // The command line's rules, in the keywords' names.
+    if (!slice.empty() && output.empty()) throw ValueError("inspect: slice " + slice + ": needs output=, the image's path");
+    if (slice.empty() && !output.empty()) throw ValueError("inspect: output " + output + ": inspect writes an image only with slice=\"AXIS=WORLD\"");
+    if (slice.empty() && (sp.color == SliceColor::Hsv || sp.streamlines)) {
+        throw ValueError("inspect: hsv and streamlines draw on a slice: add slice=\"AXIS=WORLD\" and output=");
+    }
+    if (!slice.empty()) {
+        try {
+            parseSlice(slice, sp.axis, sp.world);
+        } catch (const ValueError& e) {
+            throw ValueError(std::string("inspect: ") + e.what());
+        }
+        if (!isImagePath(output)) throw ValueError("inspect: " + output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
+    }
+    std::vector<GridReport> reports;
+    std::optional<std::pair<std::string, SliceResult>> drawn;
+    runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter*) {
+        reports = inspectVdbFile(path, grid);
+        if (slice.empty()) return 0;
+        const std::string name = chooseSliceGrid(reports, grid, path);
+        drawn.emplace(name, renderSlice(path, name, sp));
+        writeImage(output, drawn->second.image);
+        return 0;
+    });
+    pyb::list grids;
+    for (const GridReport& r : reports) grids.append(gridReportDict(r));
+    if (!drawn) return std::move(grids);
+    // `inspect --json`'s "slice", key for key.
+    const SliceResult& res = drawn->second;
+    const nlohmann::json j = {{"output", output}, {"grid", drawn->first}, {"axis", std::string(1, char('x' + sp.axis))}, {"world", sp.world},
+                              {"index_plane", res.indexPlane}, {"active_voxels", res.activeVoxels}, {"range", {res.lo, res.hi}},
+                              {"streamlines", res.streamlinesDrawn}, {"width", res.image.width}, {"height", res.image.height}};
+    return pyb::make_tuple(grids, toPython(j));
+}
+
 void defineInspect(pyb::module_& m)
 {
-    m.def(
-        "inspect",
-        [](const PathArg& path) {
-            std::vector<GridReport> reports;
-            {
-                pyb::gil_scoped_release release;
-                reports = inspectVdbFile(path);
-            }
-            pyb::list out;
-            for (const GridReport& r : reports) {
-                const GridInfo& g = r.info;
-                pyb::dict d;
-                d["name"] = g.name;
-                d["value_type"] = g.valueType;
-                d["grid_class"] = g.gridClass;
-                d["vector_type"] = g.vectorType;
-                d["voxel_size"] = pyb::make_tuple(g.voxelSize.x(), g.voxelSize.y(), g.voxelSize.z());
-                d["active_voxels"] = g.activeVoxels;
-                d["active_tiles"] = g.activeTiles;
-                d["leaf_nodes"] = g.leafNodes;
-                d["memory_bytes"] = g.memoryBytes;
-                if (!g.emptyBBox) {
-                    d["world_bbox"] = pyb::make_tuple(pyb::make_tuple(g.bboxMin.x(), g.bboxMin.y(), g.bboxMin.z()),
-                                                      pyb::make_tuple(g.bboxMax.x(), g.bboxMax.y(), g.bboxMax.z()));
-                }
-                if (!r.emptyIndexBBox) d["index_bbox"] = pyb::make_tuple(pyb::cast(r.indexMin), pyb::cast(r.indexMax));
-                d["values"] = valueStatsDict(r.values);
-                if (r.isVector) {
-                    d["unit_share"] = r.unitShare;
-                    d["zero_share"] = r.zeroShare;
-                    d["mean_vector"] = pyb::make_tuple(r.meanVector.x(), r.meanVector.y(), r.meanVector.z());
-                    d["coherence"] = r.coherence;
-                } else if (r.isScalar) {
-                    d["zero_share"] = r.zeroShare;
-                }
-                d["leaf_fill"] = pyb::make_tuple(r.leafFillMin, r.leafFillMean, r.leafFillMax);
-                pyb::dict meta;
-                for (const MetaValue& mv : g.metadata) meta[pyb::str(mv.name)] = metaValue(mv);
-                d["metadata"] = meta;
-                if (g.isPoints) d["point_count"] = g.pointCount;
-                d["explanation"] = r.explanation;
-                out.append(d);
-            }
-            return out;
-        },
-        pyb::arg("path"),
-        R"doc(Describe every grid of a .vdb file (``vdbhair inspect --json``): one dict a grid, in file order,
-with name, value_type, grid_class, vector_type, voxel_size, active_voxels, active_tiles,
-leaf_nodes, memory_bytes, world_bbox and index_bbox (when not empty), values (statistics of the
-values, or of the vector lengths: count, min, max, mean, stddev, p01, p50, p99), unit_share,
-zero_share, mean_vector and coherence for vectors, leaf_fill (min, mean, max), metadata (a
-dict), point_count for points grids, and explanation (the metadata in words).)doc");
+    defineVerb(m, "inspect", {"path: os.PathLike | str"}, sliceParameters(),
+               {{"grid", "Optional[str]", pyb::none(),
+                 "only this grid (and the one to slice; None: every grid, and the slice shows 'tangent', else the first voxel grid)."},
+                {"slice", "Optional[str]", pyb::none(), "draw the slice AXIS=WORLD (\"z=1.5\": the plane z = 1.5 in world units) into output."},
+                {"output", "Optional[os.PathLike | str]", pyb::none(), "the slice image (.png, .exr, .jpg)."}},
+               "Describe every grid of a .vdb file (``vdbhair inspect --json``), and draw a slice through one\n"
+               "(``inspect --slice AXIS=WORLD -o OUT``): vectors coloured by direction, scalars through a colour\n"
+               "map, optionally with streamlines of the in-plane field.",
+               "    path: the .vdb file.\n",
+               "a list of one dict a grid, in file order, with name, value_type, grid_class, vector_type,\n"
+               "    voxel_size, active_voxels, active_tiles, leaf_nodes, memory_bytes, world_bbox and index_bbox\n"
+               "    (when not empty), values (statistics of the values, or of the vector lengths: count, min, max,\n"
+               "    mean, stddev, p01, p50, p99), unit_share, zero_share, mean_vector and coherence for vectors,\n"
+               "    leaf_fill (min, mean, max), metadata (a dict), point_count for points grids, and explanation\n"
+               "    (the metadata in words). With slice: (that list, a dict of the slice: ``inspect --json``'s\n"
+               "    \"slice\", key for key: output, grid, axis, world, index_plane, active_voxels, range,\n"
+               "    streamlines, width, height).",
+               pyb::cpp_function(inspectImpl, pyb::arg("path"), pyb::arg("keywords")));
 }
 
 /// compare: a hairstyle measured against a reference.

@@ -126,7 +126,8 @@ def test_python_defaults_are_the_commands(function, keyword, verb, flag):
 DECLARED = [("refine", "refine", 5), ("retrace", "retrace", 5), ("estimate_tangent_field", "field", 5), ("fit", "fit", 5),
             ("interpolate", "interpolate", 5), ("reconstruct", "reconstruct", 5), ("roots", "roots", 4), ("grow", "grow", 1),
             ("synth", "synth", 10), ("transfer", "transfer", 8), ("comb", "comb", 4), ("scalp", "scalp", 6), ("prepare", "prepare", 4),
-            ("write", "convert", 6)]
+            ("write", "convert", 6), ("inspect", "inspect", 2),
+            ("strand_statistics", "info", 1)]
 
 
 @pytest.mark.parametrize("function, verb, least", DECLARED)

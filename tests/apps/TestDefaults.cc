@@ -237,7 +237,7 @@ TEST_CASE("withFlagNames: the library's parameter names become the verb's flags"
         FAIL("renderSlice accepted a width beyond SliceParams::kMaxWidth");
     } catch (const ValueError& e) {
         CHECK_THAT(withFlagNames(e.what(), v.command("inspect").flags),
-                   Catch::Contains("--width " + std::to_string(sp.width) + " must be between"));
+                   Catch::Contains("--width " + std::to_string(sp.width) + ": must be between"));
     }
     try {
         colorByFromName("plaid");

@@ -159,3 +159,38 @@ TEST_CASE("inspectVdbFile: statistics of known values, tiles counted per voxel",
     REQUIRE(r.indexMin == std::array<int, 3>{{0, 0, 0}});
     REQUIRE(r.indexMax == std::array<int, 3>{{100, 7, 7}});
 }
+
+TEST_CASE("inspectVdbFile: one grid by name, the others named when it is missing", "[render]")
+{
+    initializeOpenVdb();
+    auto a = openvdb::FloatGrid::create();
+    a->setName("density");
+    a->tree().setValueOn(openvdb::Coord(0), 1.0f);
+    auto b = openvdb::Vec3SGrid::create();
+    b->setName("tangent");
+    b->tree().setValueOn(openvdb::Coord(0), openvdb::Vec3s(1.f, 0.f, 0.f));
+    const std::string path = test::tempPath("two_grids.vdb");
+    writeVdbGrids(path, {a, b}, "test");
+    REQUIRE(inspectVdbFile(path, "").size() == 2);
+    const std::vector<GridReport> only = inspectVdbFile(path, "tangent");
+    REQUIRE(only.size() == 1);
+    CHECK(only[0].info.name == "tangent");
+    CHECK(only[0].isVector);
+    REQUIRE_THROWS_AS(inspectVdbFile(path, "nope"), LookupError);
+    REQUIRE_THROWS_WITH(inspectVdbFile(path, "nope"), path + ": no grid named 'nope' (the file has: density, tangent)");
+}
+
+TEST_CASE("chooseSliceGrid: the grid asked for, else 'tangent', else the first voxel grid; never points", "[render]")
+{
+    auto report = [](const std::string& name, bool points) {
+        GridReport r;
+        r.info.name = name;
+        r.info.isPoints = points;
+        return r;
+    };
+    const std::vector<GridReport> all = {report("strands", true), report("density", false), report("tangent", false)};
+    CHECK(chooseSliceGrid(all, "", "f.vdb") == "tangent");
+    CHECK(chooseSliceGrid(all, "density", "f.vdb") == "density");
+    CHECK(chooseSliceGrid({report("strands", true), report("density", false), report("hair_length", false)}, "", "f.vdb") == "density");
+    REQUIRE_THROWS_WITH(chooseSliceGrid({report("strands", true)}, "", "f.vdb"), "f.vdb: has no voxel grid to slice (only points)");
+}

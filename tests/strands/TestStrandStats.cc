@@ -56,5 +56,5 @@ TEST_CASE("computeStrandStatistics: histograms of known lengths, turning and cur
         CAPTURE(b);
         CHECK(ls.length.counts[b] == 1);
     }
-    REQUIRE_THROWS_WITH(computeStrandStatistics(s, 0), Contains("bins 0: must be 1 to 10000"));
+    REQUIRE_THROWS_WITH(computeStrandStatistics(s, 0), Contains("bins 0: must be between 1 and 10000"));
 }

@@ -1,5 +1,6 @@
 #include "VdbInspect.h"
 
+#include <vdbhair/Exceptions.h>
 #include <vdbhair/io/VdbFile.h>
 
 #include <openvdb/openvdb.h>
@@ -314,6 +315,20 @@ std::vector<GridReport> inspectVdbFile(const std::string& path)
         out.push_back(std::move(r));
     }
     return out;
+}
+
+std::vector<GridReport> inspectVdbFile(const std::string& path, const std::string& grid)
+{
+    std::vector<GridReport> reports = inspectVdbFile(path);
+    if (grid.empty()) return reports;
+    std::vector<GridReport> kept;
+    std::string names;
+    for (GridReport& r : reports) {
+        names += (names.empty() ? "" : ", ") + r.info.name;
+        if (r.info.name == grid) kept.push_back(std::move(r));
+    }
+    if (kept.empty()) throw LookupError(path + ": no grid named '" + grid + "' (the file has: " + (names.empty() ? "no grids" : names) + ")");
+    return kept;
 }
 
 } // namespace vdbhair

@@ -50,6 +50,12 @@ struct GridReport
 /// @throw IoError, FormatError.
 std::vector<GridReport> inspectVdbFile(const std::string& path);
 
+/// @brief As inspectVdbFile(path), keeping only the grid named @a grid (every grid when empty):
+/// `inspect --grid`, Python's `inspect(grid=)`.
+/// @throw LookupError "<path>: no grid named '<grid>' (the file has: <its grids>)", IoError,
+/// FormatError.
+std::vector<GridReport> inspectVdbFile(const std::string& path, const std::string& grid);
+
 /// @brief The grid's name and metadata in words: what it holds and how vdbhair made it.
 std::string explainGrid(const GridInfo& info);
 

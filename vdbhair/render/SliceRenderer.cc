@@ -134,14 +134,7 @@ struct InPlaneSampler
 void checkSliceParams(const SliceParams& params, const std::string& where)
 {
     if (params.axis < 0 || params.axis > 2) throw ValueError(where + ": slice axis " + std::to_string(params.axis) + " is not 0, 1 or 2");
-    if (params.width < SliceParams::kMinWidth || params.width > SliceParams::kMaxWidth) {
-        throw ValueError(where + ": width " + std::to_string(params.width) + " must be between " + std::to_string(SliceParams::kMinWidth) +
-                         " and " + std::to_string(SliceParams::kMaxWidth) + " pixels");
-    }
-    if (params.streamlines < 0 || params.streamlines > SliceParams::kMaxStreamlines) {
-        throw ValueError(where + ": streamlines " + std::to_string(params.streamlines) + " must be between 0 and " +
-                         std::to_string(SliceParams::kMaxStreamlines));
-    }
+    checkParams(sliceParameters(), params, ParamSpelling::Keyword, where);
 }
 
 /// The sampler of a voxel grid of a type slices show; @a gw names the grid in errors.
@@ -392,6 +385,38 @@ void drawTitleAndLegend(SliceResult& res, const SlicePlot& plot, const Sampled& 
 }
 
 } // namespace
+
+const ParamTable<SliceParams>& sliceParameters()
+{
+    using P = SliceParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        t.push_back(makeParam<P>("hsv", "Colour vectors by in-plane angle (hue) instead of by their absolute x, y and z (RGB)", "",
+                                 ParamAccess<P, bool>{[](const P& p) { return p.color == SliceColor::Hsv; },
+                                                      [](P& p, bool hsv) { p.color = hsv ? SliceColor::Hsv : SliceColor::Rgb; }}));
+        auto streamlines = makeParam<P>("streamlines", "Overlay this many streamlines of the in-plane field", "",
+                                        member<P>([](P& p) -> int& { return p.streamlines; }));
+        streamlines.min = 0;
+        streamlines.max = SliceParams::kMaxStreamlines;
+        t.push_back(streamlines);
+        auto width = makeParam<P>("width", "Width of the slice's plot (its height follows the grid's aspect)", "pixels",
+                                  member<P>([](P& p) -> int& { return p.width; }));
+        width.min = SliceParams::kMinWidth;
+        width.max = SliceParams::kMaxWidth;
+        t.push_back(width);
+        return t;
+    }();
+    return table;
+}
+
+std::string chooseSliceGrid(const std::vector<GridReport>& reports, const std::string& grid, const std::string& path)
+{
+    if (!grid.empty()) return grid;
+    // 'tangent' (what `vdbhair field` writes), else the first grid of voxels.
+    for (const GridReport& r : reports) if (r.info.name == "tangent") return r.info.name;
+    for (const GridReport& r : reports) if (!r.info.isPoints) return r.info.name;
+    throw ValueError(path + ": has no voxel grid to slice (only points)");
+}
 
 void parseSlice(const std::string& text, int& axis, double& world)
 {

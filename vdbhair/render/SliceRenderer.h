@@ -16,9 +16,12 @@
 /// y up), x slices from the side (-z right, y up), y slices from the top (x right, -z up).
 #pragma once
 
+#include <vdbhair/Parameters.h>
+#include <vdbhair/io/VdbInspect.h>
 #include <vdbhair/render/Image.h>
 
 #include <string>
+#include <vector>
 
 namespace vdbhair {
 
@@ -36,6 +39,12 @@ struct SliceParams
     int streamlines = 0;        ///< 0 to kMaxStreamlines
 };
 
+/// @brief The slice's parameters declared once (vdbhair/Parameters.h): `hsv` (the colouring,
+/// SliceColor::Hsv when on), `streamlines` and `width`, with their ranges; `inspect`'s options and
+/// Python's `inspect()` keywords are made from it. The plane itself (axis, world) is given as
+/// text, AXIS=WORLD (parseSlice()).
+const ParamTable<SliceParams>& sliceParameters();
+
 struct SliceResult
 {
     Image image;
@@ -47,12 +56,18 @@ struct SliceResult
 
 /// @brief Render the slice of grid @a gridName of the .vdb file @a path.
 /// @throw LookupError (no such grid), ValueError (a point grid, an unsupported value type, an
-/// empty grid, a non-linear transform, a slice outside the grid's active voxels, a bad size),
-/// IoError, FormatError.
+/// empty grid, a non-linear transform, a slice outside the grid's active voxels, a parameter out of
+/// its declared range, named as sliceParameters() names it), IoError, FormatError.
 SliceResult renderSlice(const std::string& path, const std::string& gridName, const SliceParams& params);
 
 /// @brief Parse "x=1.5" (axis x, y or z, then a world coordinate).
 /// @throw ValueError naming the rule.
 void parseSlice(const std::string& text, int& axis, double& world);
+
+/// @brief The grid a slice of the file @a path shows: @a grid when it is given, else 'tangent'
+/// when @a reports has it, else the first voxel grid of @a reports (inspectVdbFile()'s, in file
+/// order).
+/// @throw ValueError when @a grid is empty and @a reports holds no voxel grid (only points).
+std::string chooseSliceGrid(const std::vector<GridReport>& reports, const std::string& grid, const std::string& path);
 
 } // namespace vdbhair

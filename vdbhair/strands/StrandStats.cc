@@ -70,9 +70,26 @@ double totalTurning(const Vec3f* points, std::size_t n)
     return turning;
 }
 
+const ParamTable<StrandStatsParams>& strandStatsParameters()
+{
+    using P = StrandStatsParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto bins = makeParam<P>("bins", "Bins of each histogram (strand length, turning, curvature, vertices per strand)", "",
+                                 member<P>([](P& p) -> std::size_t& { return p.bins; }));
+        bins.min = 1;
+        bins.max = double(StrandStatsParams::kMaxBins);
+        t.push_back(bins);
+        return t;
+    }();
+    return table;
+}
+
 StrandStatistics computeStrandStatistics(const StrandSet& strands, std::size_t bins, bool threaded)
 {
-    if (bins == 0 || bins > 10000) throw ValueError("computeStrandStatistics: bins " + std::to_string(bins) + ": must be 1 to 10000");
+    StrandStatsParams params;
+    params.bins = bins;
+    checkParams(strandStatsParameters(), params, ParamSpelling::Keyword, "computeStrandStatistics");
     StrandStatistics s;
     s.summary = summarizeStrands(strands);
     const std::size_t n = strands.numStrands();

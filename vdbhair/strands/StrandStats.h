@@ -3,6 +3,7 @@
 /// turning per strand, curvature per vertex and vertices per strand (`vdbhair info --stats`).
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -13,6 +14,17 @@ namespace vdbhair {
 
 /// Bins per histogram unless asked otherwise: coarse enough that 5-strand guide sets still show a shape.
 constexpr std::size_t kDefaultHistogramBins = 10;
+
+/// The parameters of computeStrandStatistics().
+struct StrandStatsParams
+{
+    static constexpr std::size_t kMaxBins = 10000;
+    std::size_t bins = kDefaultHistogramBins;  ///< per histogram, 1 to kMaxBins
+};
+
+/// @brief The statistics' parameters declared once (vdbhair/Parameters.h): `bins`, with its range.
+/// `info`'s `--bins` and Python's `strand_statistics(bins=)` are made from it.
+const ParamTable<StrandStatsParams>& strandStatsParameters();
 
 /// @brief Counts in equal-width bins over [lo, hi]: bin b holds the values in
 /// [lo + b w, lo + (b+1) w) (the last bin also holds hi), w = (hi - lo) / #bins. Values above hi
@@ -45,7 +57,8 @@ double totalTurning(const Vec3f* points, std::size_t n);
 /// @brief The statistics of @a strands with @a bins bins per histogram (curvature as
 /// curvatureProfile() gives it, turning as totalTurning()). In parallel; sums in strand order, so
 /// the same for any thread count.
-/// @throw ValueError if @a bins is 0 or more than 10000.
+/// @throw ValueError if @a bins is outside its declared range (1 to StrandStatsParams::kMaxBins):
+/// "computeStrandStatistics: bins 0: must be between 1 and 10000".
 StrandStatistics computeStrandStatistics(const StrandSet& strands, std::size_t bins = kDefaultHistogramBins, bool threaded = true);
 
 } // namespace vdbhair
