@@ -1,6 +1,9 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/HeadCollision.h>
+#include <vdbhair/scalp/HeadFile.h>
 #include <vdbhair/strands/Measures.h>
+
+#include "../TestUtil.h"
 
 #include <catch2/catch.hpp>
 
@@ -265,5 +268,45 @@ TEST_CASE("HeadObstacle::Probe::distance with its direction: the trilinear cell'
         CHECK(d == Approx((p - Vec3d(0.2, -0.1, 0.3)).length() - 1.0).margin(0.01));
         CHECK(g.length() == Approx(1.0).margin(1e-9));
         CHECK(g.dot(dir) > std::cos(5.0 * M_PI / 180.0));  // radial within 5 degrees at 20 voxels a radius
+    }
+}
+
+TEST_CASE("resolveHeadCollisions: a strand driven head-on into Sintel's head slides along it, not back and forth", "[field][data]")
+{
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    // A strand `synth` made from Sintel's hair (seed 0) that runs from the temple into the head
+    // near the ear, 0.6 deep for most of its length. The sweep turned each deep vertex the way its
+    // own point's normal tilted; there the normals of consecutive points tilt opposite ways, and the
+    // strand zigzagged between two points with turns of 150-180 degrees between its edges.
+    const HeadObstacle head = readHeadObstacle(test::sharedData() + "/scalp/sintel/sintel.obj", "test");
+    StrandSet s;
+    s.addStrand(std::vector<Vec3f>{
+        {-8.647f, 33.488f, 0.803f}, {-8.590f, 33.330f, 0.729f}, {-8.533f, 33.172f, 0.655f}, {-8.476f, 33.014f, 0.581f},
+        {-8.419f, 32.856f, 0.507f}, {-8.361f, 32.699f, 0.432f}, {-8.304f, 32.541f, 0.358f}, {-8.227f, 32.396f, 0.277f},
+        {-8.148f, 32.251f, 0.195f}, {-8.070f, 32.106f, 0.114f}, {-7.992f, 31.961f, 0.033f}, {-7.913f, 31.817f,
+        -0.049f}, {-7.835f, 31.672f, -0.130f}, {-7.752f, 31.531f, -0.213f}, {-7.668f, 31.390f, -0.296f}, {-7.564f,
+        31.270f, -0.386f}, {-7.455f, 31.154f, -0.478f}, {-7.345f, 31.039f, -0.570f}, {-7.236f, 30.923f, -0.661f},
+        {-7.126f, 30.808f, -0.753f}, {-7.016f, 30.693f, -0.844f}, {-6.906f, 30.579f, -0.937f}, {-6.794f, 30.467f,
+        -1.031f}, {-6.675f, 30.373f, -1.132f}, {-6.551f, 30.286f, -1.237f}, {-6.428f, 30.200f, -1.342f}, {-6.305f,
+        30.114f, -1.447f}, {-6.181f, 30.027f, -1.552f}, {-6.058f, 29.941f, -1.657f}, {-5.935f, 29.854f, -1.762f},
+        {-5.812f, 29.768f, -1.868f}, {-5.688f, 29.694f, -1.981f}, {-5.564f, 29.631f, -2.100f}, {-5.439f, 29.567f,
+        -2.219f}, {-5.315f, 29.504f, -2.339f}, {-5.191f, 29.440f, -2.458f}, {-5.066f, 29.377f, -2.577f}, {-4.942f,
+        29.313f, -2.696f}, {-4.818f, 29.249f, -2.815f}, {-4.691f, 29.192f, -2.935f}, {-4.561f, 29.143f, -3.055f},
+        {-4.430f, 29.092f, -3.173f}, {-4.297f, 29.037f, -3.287f}, {-4.163f, 28.978f, -3.397f}, {-4.027f, 28.915f,
+        -3.505f}, {-3.891f, 28.850f, -3.609f}, {-3.754f, 28.783f, -3.711f}, {-3.616f, 28.716f, -3.811f}, {-3.472f,
+        28.654f, -3.908f}, {-3.329f, 28.593f, -4.005f}, {-3.184f, 28.534f, -4.102f}, {-3.040f, 28.476f, -4.200f},
+        {-2.897f, 28.420f, -4.299f}, {-2.754f, 28.366f, -4.401f}, {-2.611f, 28.314f, -4.504f}, {-2.470f, 28.263f,
+        -4.611f}, {-2.332f, 28.214f, -4.720f}, {-2.194f, 28.166f, -4.832f}, {-2.056f, 28.116f, -4.943f}, {-1.919f,
+        28.064f, -5.053f}, {-1.781f, 28.009f, -5.161f}, {-1.643f, 27.949f, -5.266f}, {-1.547f, 27.867f, -5.402f},
+        {-1.409f, 27.795f, -5.499f}});
+    REQUIRE(countStrandsEnteringHead(s, head, headTolerance(head)) == 1);
+    for (const HeadDepthRule rule : {HeadDepthRule::Allowance, HeadDepthRule::Rising}) {
+        CAPTURE(int(rule));
+        StrandSet out = s;
+        HeadCollisionParams params;
+        params.depthRule = rule;
+        resolveHeadCollisions(out, head, {}, params);
+        CHECK(countStrandsEnteringHead(out, head, headTolerance(head)) == 0);
+        CHECK(maxTurn(out, 0) * 180.0 / M_PI < 45.0);
     }
 }

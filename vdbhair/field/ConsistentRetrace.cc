@@ -41,6 +41,9 @@ namespace {
 using openvdb::Vec3d;
 using TreeT = openvdb::Vec3STree;
 
+/// cos 110°: where a field pointing back along the strand stops pulling it (fieldPull()).
+constexpr double kOpposedCos = -0.34202014332566873;
+
 double smoothstep(double a, double b, double x)
 {
     const double t = std::min(1.0, std::max(0.0, (x - a) / (b - a)));
@@ -385,6 +388,9 @@ private:
         const double spread = std::max(0.0, double(mTan.sampleScalar(ip)) / weight);
         const double sigma = std::max(mS.minSigma, std::sqrt(spread));
         w = smoothstep(mS.params.zStart, mS.params.zFull, delta / sigma);
+        // A field pointing back along the strand taken for another flow (followOpposed false):
+        // its pull fades from 90 to 110 degrees (ConsistentRetrace.h).
+        if (cosA < 0.0 && !mS.params.followOpposed) w *= smoothstep(kOpposedCos, 0.0, cosA);
         if (w >= 0.5) ++counts.fieldSteps;
     }
 

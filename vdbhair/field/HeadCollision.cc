@@ -81,6 +81,16 @@ double sweep(std::size_t n, DepthFloor floor, HeadObstacle::Probe& probe, Strand
         }
         if (nrm.lengthSqr() == 0.0) probe.distance(a, nrm);
         Vec3d t = nrm - dHat * dHat.dot(nrm);
+        // Turned towards the normal alone, a strand aimed at the head nearly head-on has no one way
+        // to slide: where the normals of consecutive deep vertices tilt opposite ways (by Sintel's
+        // ear), it zigzagged between two points, 150-180 degrees between its edges. It also turns
+        // the way its last placed edge went; both parts weigh by their sine to dHat, so an oblique
+        // contact still turns towards the normal, and a head-on one keeps sliding on.
+        if (k >= 2) {
+            const Vec3d prev = w.p[k - 1] - w.p[k - 2];
+            const double pl = prev.length();
+            if (pl > 0.0) t += prev / pl - dHat * dHat.dot(prev / pl);
+        }
         if (t.lengthSqr() < 1e-20) {  // straight in or straight out: any perpendicular
             t = std::abs(dHat.x()) < 0.9 ? Vec3d(1.0, 0.0, 0.0) : Vec3d(0.0, 1.0, 0.0);
             t -= dHat * dHat.dot(t);
