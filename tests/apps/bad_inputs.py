@@ -10,7 +10,7 @@ checked again once every case has run.
 Usage: bad_inputs.py VDBHAIR WORKDIR [RUNNER]   (inputs are made here, small and synthetic)
 
 With RUNNER (tests/apps/CliInProcess.cc), each command runs in-process, as cli_suite.py runs its
-cases (a process start was most of a case's time): one runner for each of the two at a time.
+cases (a process start is most of such a case's time): one runner for each of the two at a time.
 VDBHAIR_CLI_IN_PROCESS=0 in the environment runs every command as a process.
 """
 import concurrent.futures
