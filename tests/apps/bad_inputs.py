@@ -3,11 +3,15 @@
 twice - with a fresh output path and with an existing output. Each run must exit non-zero, print
 exactly one line on stderr that names the file (or the verb or option at fault) and the rule
 broken, leave no output and no temporary file, and leave an existing output byte-identical.
-The cases run two at a time (a process start is most of a case's time); each has a folder of its
-own for its output, so that what one case leaves is checked after each of its runs, and the input
-folder and the whole output folder are checked again once every case has run.
+The cases run two at a time; each has a folder of its own for its output, so that what one case
+leaves is checked after each of its runs, and the input folder and the whole output folder are
+checked again once every case has run.
 
-Usage: bad_inputs.py VDBHAIR WORKDIR   (inputs are made here, small and synthetic)
+Usage: bad_inputs.py VDBHAIR WORKDIR [RUNNER]   (inputs are made here, small and synthetic)
+
+With RUNNER (tests/apps/CliInProcess.cc), each command runs in-process, as cli_suite.py runs its
+cases (a process start is most of such a case's time): one runner for each of the two at a time.
+VDBHAIR_CLI_IN_PROCESS=0 in the environment runs every command as a process.
 """
 import concurrent.futures
 import math
@@ -17,9 +21,14 @@ import stat
 import struct
 import subprocess
 import sys
+import threading
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cli_suite import InProcess  # noqa: E402
 
 
 CLI, WORK = sys.argv[1], sys.argv[2]
+RUNNER = sys.argv[3] if len(sys.argv) > 3 and os.environ.get("VDBHAIR_CLI_IN_PROCESS") != "0" else None
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
 IN = os.path.join(WORK, "in")
@@ -198,6 +207,22 @@ def temporaries(folder):
     return [os.path.join(d, f) for d, dirs, files in os.walk(folder) for f in dirs + files if ".vdbhair-tmp-" in f]
 
 
+runners = []
+local = threading.local()
+
+
+def run(args):
+    """Runs vdbhair with ARGS; returns (return code as subprocess gives it, stderr bytes)."""
+    if RUNNER is None:
+        done = subprocess.run([CLI] + args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=60)
+        return done.returncode, done.stderr
+    if not hasattr(local, "runner"):
+        local.runner = InProcess(RUNNER)
+        runners.append(local.runner)
+    status, _, err = local.runner.run([CLI] + args, timeout=60)
+    return (-local.runner.signal if local.runner.signal else status), err
+
+
 def run_case(i):
     """Both runs of case i; returns its failures."""
     name, argv, words = CASES[i]
@@ -216,8 +241,7 @@ def run_case(i):
                 with open(o, "wb") as f:
                     f.write(sentinel)
         try:
-            done = subprocess.run([CLI] + args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=60)
-            returncode, stderr = done.returncode, done.stderr
+            returncode, stderr = run(args)
         except subprocess.TimeoutExpired:
             failures.append("%s: still running after 60 s" % name)
             continue
@@ -251,6 +275,8 @@ with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
     for (name, _, _), fs in zip(CASES, pool.map(run_case, range(len(CASES)))):
         print("ok " if not fs else "BAD", name)
         failures += fs
+for runner in runners:
+    runner.remove()
 # Every run has ended: nothing of theirs may be left anywhere (a case's own folder was checked
 # after each of its runs; this covers the inputs' folder and the rest).
 for f in temporaries(IN) + temporaries(OUT):
