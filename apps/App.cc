@@ -69,12 +69,9 @@ StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, c
 
 void addScalpOptions(CLI::App* sub, ScalpOptions& opts)
 {
-    sub->add_option("--space", opts.space, "Grid space: world (default; any hairstyle) or scalp (Wang et al.'s (u,v,w); hair over the scalp)")
-        ->capture_default_str();
     sub->add_option("--scalp", opts.scalp, "The scalp for --space scalp: a sphere CX,CY,CZ,R in world units, or a .vdb with a level set "
                     "'surface' (vdbhair scalp) or a head mesh (.ply, .obj), measured along rays from the sphere fitted to the roots "
                     "(default: that sphere)");
-    sub->add_option("--up", opts.up, "The scalp's up axis for --space scalp: x, y, z, -x, -y or -z")->capture_default_str();
 }
 
 std::vector<double> ScalpOptions::sphere() const
@@ -101,8 +98,7 @@ std::vector<double> ScalpOptions::sphere() const
 openvdb::FloatGrid::Ptr applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params,
                                           const CommonOptions& common)
 {
-    params.space = fieldSpaceFromName(opts.space);
-    const Vec3d up = axisFromName(opts.up, "--up");
+    const Vec3d up = params.scalp.up;
     const std::vector<double> sphere = opts.sphere();
     if (params.space != FieldSpace::Scalp) {
         if (!opts.scalp.empty()) throw ValueError("--scalp " + opts.scalp + ": needs --space scalp");

@@ -137,25 +137,24 @@ void checkStrandLengths(const std::string& verb, const std::string& path, const 
 StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, const CommonOptions& common,
                              const std::string& vdbGrid = "strands", TriangleMesh* head = nullptr);
 
-/// @brief The scalp options of `field` and `refine` (`--space scalp`).
+/// @brief The scalp option of `field` and `refine` (with `--space scalp`; the space and the up
+/// axis are the declared parameters of FieldParams, fieldParameters()).
 struct ScalpOptions
 {
-    std::string space = "world";
     /// `CX,CY,CZ,R` (a sphere), or a scalp: a .vdb with a level set `surface` or a head mesh;
     /// empty: the sphere fitted to the roots
     std::string scalp;
-    std::string up = "y";
 
     /// The sphere `--scalp` gives (cx, cy, cz, r), or empty when it names a file or is not given.
     /// @throw ValueError for numbers that are not four, or a radius that is not positive.
     std::vector<double> sphere() const;
 };
 void addScalpOptions(CLI::App* sub, ScalpOptions& opts);
-/// @brief Fill @a params' space and scalp from @a opts: the sphere given, or fitted to the roots;
-/// with a scalp file, the scalp measured on its level set (FieldParams::scalpSurface, on the
-/// sphere fitted to the roots).
+/// @brief In scalp space (params.space), fill @a params' scalp from @a opts and params.scalp.up:
+/// the sphere given, or fitted to the roots; with a scalp file, the scalp measured on its level
+/// set (FieldParams::scalpSurface, on the sphere fitted to the roots).
 /// @return the scalp's level set when `--scalp` named a file (for `refine`'s head), else null.
-/// @throw ValueError for a bad space, sphere or up axis; what reading the scalp throws.
+/// @throw ValueError for a bad sphere, or a scalp without scalp space; what reading the scalp throws.
 openvdb::FloatGrid::Ptr applyScalpOptions(const ScalpOptions& opts, const StrandSet& strands, FieldParams& params,
                                           const CommonOptions& common);
 
@@ -194,17 +193,6 @@ Command addCombCommand(CLI::App& app, CommonOptions& common);
 Command addBatchCommand(CLI::App& app, CommonOptions& common);
 Command addPrepareCommand(CLI::App& app, CommonOptions& common);
 
-/// @brief The options of `synth`, `transfer` and `comb` that are not declared parameters
-/// (synthParameters()): the axes by name, and refinement turned off.
-struct SynthOptionText
-{
-    std::string up = "auto", front = "auto";
-    bool noRefine = false;
-};
-/// @brief --up, and with @a detailOptions --front and --no-refine (synth and transfer; comb has neither).
-void addSynthTextOptions(CLI::App* sub, SynthOptionText& text, bool detailOptions);
-/// @throw ValueError for a bad --up or --front.
-void applySynthOptionText(const SynthOptionText& text, SynthParams& params);
 /// @brief The flag of the one rule of the declared synth parameters that the library checks
 /// itself (--match-balance: 0 or at least 1), for synth and transfer.
 FlagNames synthTransferFlags();
@@ -222,7 +210,6 @@ void writeSynthStrands(const std::string& path, const StrandSet& strands,
 struct TransferJob
 {
     std::string verb, details, base, output, scalp, detailsLabel = "DETAILS", baseLabel = "BASE";
-    bool measure = false;  ///< also compare the output with BASE (`vdbhair compare`)
 };
 int runTransferJob(const TransferJob& job, TransferParams params, const CommonOptions& common);
 

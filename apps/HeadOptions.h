@@ -1,6 +1,6 @@
 /// @file HeadOptions.h
-/// @brief The head option pair that refine, demo and comb share: `--head FILE|none` and
-/// `--head-policy no-deeper|outside` (vdbhair/field/HeadObstacle.h).
+/// @brief The head option that refine, demo and comb share: `--head FILE|none`, made with the
+/// verb's declared head policy (`--head-policy`, headPolicyParam(), vdbhair/field/HeadObstacle.h).
 #pragma once
 
 #include <vdbhair/field/HeadObstacle.h>
@@ -14,18 +14,21 @@ namespace vdbhair::app {
 
 struct HeadOptions
 {
-    std::string path;                   ///< --head: a mesh, a .vdb level set, or "none"
-    std::string policy = headPolicyName(kDefaultHeadPolicy);  ///< --head-policy
-    /// @throw ValueError naming --head-policy for a policy that is not one of no-deeper, outside.
-    HeadPolicy headPolicy() const;
+    std::string path;  ///< --head: a mesh, a .vdb level set, or "none"
+    /// The verb's declared head policy (RefineParams::headPolicy, CombParams::headPolicy); null:
+    /// kDefaultHeadPolicy (synth and transfer, which take none)
+    const HeadPolicy* policy = nullptr;
+    HeadPolicy headPolicy() const { return policy ? *policy : kDefaultHeadPolicy; }
 };
 
+/// @brief `--head` into @a o, whose heads are made with the policy @a policy (the verb's declared
+/// head policy, which must outlive parsing).
 /// @param fallback what the head is without --head, for the help text ("--scalp's sphere if given,
 /// else a sphere fitted to the roots")
-void addHeadOptions(CLI::App* sub, HeadOptions& o, const std::string& fallback);
+void addHeadOptions(CLI::App* sub, HeadOptions& o, const HeadPolicy& policy, const std::string& fallback);
 
 /// @brief HeadObstacle::none() for `--head none`, the file's head for a path, else @a fallback.
-/// @throw IoError, FormatError, LookupError (unreadable --head), ValueError (bad policy).
+/// @throw IoError, FormatError, LookupError (unreadable --head).
 HeadObstacle headFromOptions(const HeadOptions& o, const HeadObstacle& fallback = HeadObstacle());
 
 /// @brief Unsigned distance to the head in @a path, for `--roots auto --head` (ReadOptions::rootsHeadDistance):

@@ -22,7 +22,9 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
 {
     for (const Param<P>& param : table) {
         if (std::find(skip.begin(), skip.end(), param.name) != skip.end()) continue;
-        const std::string flag = param.flag(), help = paramHelp(param);
+        std::string flag = param.flag();
+        for (const std::string& old : param.oldFlags) flag += "," + old;
+        const std::string help = paramHelp(param);
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(target))>;
             if constexpr (std::is_same_v<T, bool>) {
@@ -35,7 +37,13 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
                     return;
                 }
             }
-            {
+            if constexpr (std::is_same_v<T, Vec3d>) {
+                // An axis by name (makeAxisParam()).
+                CLI::Option* o = sub->add_option_function<std::string>(
+                    flag, [&target, a, param](const std::string& v) { a.set(target, axisFromText(param, v, param.flag())); }, help);
+                o->default_str(param.defaultText());
+                o->check(CLI::IsMember(param.choices));
+            } else {
                 CLI::Option* o = sub->add_option_function<T>(flag, [&target, a](const T& v) { a.set(target, v); }, help);
                 o->default_str(param.defaultText());
                 if constexpr (std::is_same_v<T, std::string>) {

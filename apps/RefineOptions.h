@@ -28,7 +28,7 @@ struct RefineCmdParams
     ScalpOptions scalp;
 };
 
-/// @brief refine's declared parameters but those in @a skip, the head and scalp options, --strict.
+/// @brief refine's declared parameters but those in @a skip, --head, --scalp and --strict.
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p, const std::vector<std::string>& skip = {});
 /// @throw ValueError for out-of-range options, IoError/FormatError for an unreadable --head.
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands, const CommonOptions& common);

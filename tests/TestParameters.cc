@@ -134,9 +134,13 @@ TEST_CASE("Parameters: field's declaration is refine's too (nested), and docs/cl
     RefineParams rp;
     std::get<ParamAccess<RefineParams, double>>(findParam(refineParameters(), "voxel-size")->access).set(rp, 0.75);
     CHECK(rp.field.voxelSize == 0.75);
+    // field's table is the estimate's and the levels (fieldLevelsParameters()).
+    const ParamTable<FieldLevelsParams>& fl = fieldLevelsParameters();
+    for (const Param<FieldParams>& q : f) CHECK(paramHelp(*findParam(fl, q.name)) == paramHelp(q));
+    CHECK(findParam(fl, "levels")->pythonNone);
     const std::string page = cliPage();
-    INFO("docs/cli.md's field table should read:\n" << parameterMarkdown(f));
-    CHECK(page.find(parameterMarkdown(f)) != std::string::npos);
+    INFO("docs/cli.md's field table should read:\n" << parameterMarkdown(fl));
+    CHECK(page.find(parameterMarkdown(fl)) != std::string::npos);
 }
 
 TEST_CASE("Parameters: fit's declaration, a keyword that is not its name and a valued flag, in docs/cli.md", "[params]")
@@ -165,6 +169,36 @@ TEST_CASE("Parameters: retrace's declaration sets what the library reads, and do
     const std::string page = cliPage();
     INFO("docs/cli.md's retrace table should read:\n" << parameterMarkdown(t));
     CHECK(page.find(parameterMarkdown(t)) != std::string::npos);
+}
+
+TEST_CASE("Parameters: an axis by name, auto for the library's choice, any finite vector through its setter", "[params]")
+{
+    struct Axes
+    {
+        Vec3d up{0.0, 0.0, 0.0};
+        Vec3d facing{0.0, 1.0, 0.0};
+    };
+    ParamTable<Axes> t;
+    t.push_back(makeAxisParam<Axes>("up", "Up", [](Axes& a) -> Vec3d& { return a.up; }, "the roots' mean direction"));
+    t.push_back(makeAxisParam<Axes>("facing", "Facing", [](Axes& a) -> Vec3d& { return a.facing; }));
+    CHECK(t[0].isAxis());
+    CHECK(t[0].defaultText() == "auto");
+    CHECK(t[0].pythonNone);
+    CHECK(t[1].defaultText() == "y");
+    CHECK_FALSE(t[1].pythonNone);
+    CHECK(paramHelp(t[0]) == "Up (one of auto, x, y, z, -x, -y, -z; auto: the roots' mean direction)");
+    CHECK(paramHelp(t[1]) == "Facing (one of x, y, z, -x, -y, -z)");
+    CHECK(axisFromText(t[0], "auto", "--up") == Vec3d(0.0));
+    CHECK(axisFromText(t[1], "-z", "--facing") == Vec3d(0.0, 0.0, -1.0));
+    REQUIRE_THROWS_WITH(axisFromText(t[1], "auto", "--facing"), "--facing 'auto': must be one of x, y, z, -x, -y, -z");
+    Axes a;
+    a.up = Vec3d(0.5, 0.5, 0.0);
+    CHECK(t[0].valueText(a) == "(0.5, 0.5, 0)");
+    REQUIRE_NOTHROW(checkParams(t, a, ParamSpelling::Flag, ""));
+    a.facing = Vec3d(0.0);
+    REQUIRE_THROWS_WITH(checkParams(t, a, ParamSpelling::Keyword, "toy"), "toy: facing (0, 0, 0): must be a non-zero vector");
+    a.facing = Vec3d(std::numeric_limits<double>::infinity(), 0.0, 0.0);
+    REQUIRE_THROWS_WITH(checkParams(t, a, ParamSpelling::Flag, ""), Contains("--facing (inf, 0, 0): must be a finite vector"));
 }
 
 namespace {
@@ -488,4 +522,42 @@ TEST_CASE("Parameters: info's statistics declaration, the histograms' bins, in d
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "strand_statistics"), "strand_statistics: bins 10001: must be between 1 and 10000");
     REQUIRE_THROWS_WITH(computeStrandStatistics(strands, 0), "computeStrandStatistics: bins 0: must be between 1 and 10000");
     checkDeclaration(t, "info");
+}
+
+TEST_CASE("Parameters: what synth, transfer, comb, field and refine share is declared once", "[params]")
+{
+    // The axes, refinement, measuring: synth's declaration, nested into transfer (and comb's up).
+    for (const char* name : {"up", "front", "refine"}) {
+        CAPTURE(name);
+        REQUIRE(findParam(transferParameters(), name));
+        CHECK(paramHelp(*findParam(transferParameters(), name)) == paramHelp(*findParam(synthParameters(), name)));
+    }
+    CHECK(paramHelp(*findParam(combParameters(), "up")) == paramHelp(*findParam(synthParameters(), "up")));
+    CHECK(findParam(combParameters(), "front") == nullptr);
+    CHECK(findParam(synthParameters(), "refine")->flag() == "--no-refine");
+    CHECK(findParam(transferParameters(), "smooth-base")->flag() == "--no-smooth-base");
+    CHECK(findParam(transferParameters(), "smooth-base")->oldFlags == std::vector<std::string>{"--keep-base-detail"});
+    // The output turn: degrees in both front ends, radians in the library.
+    SynthParams sp;
+    setParam(synthParameters(), "output-turn", sp, 90.0);
+    CHECK(sp.outputTurn == Approx(M_PI / 2.0).margin(1e-15));
+    setParam(synthParameters(), "up", sp, Vec3d(0.0, 0.0, 1.0));
+    CHECK(sp.up == Vec3d(0.0, 0.0, 1.0));
+    setParam(synthParameters(), "strands", sp, std::size_t(300));
+    CHECK(sp.strands == 300);
+    // One head policy for refine and comb (headPolicyParam()); refine's space and up are field's.
+    CHECK(paramHelp(*findParam(combParameters(), "head-policy")) == paramHelp(*findParam(refineParameters(), "head-policy")));
+    CombParams cp;
+    setParam(combParameters(), "head-policy", cp, std::string("outside"));
+    CHECK(cp.headPolicy == HeadPolicy::KeepOutside);
+    for (const char* name : {"space", "up"}) {
+        CAPTURE(name);
+        CHECK(paramHelp(*findParam(refineParameters(), name)) == paramHelp(*findParam(fieldParameters(), name)));
+        CHECK(findParam(refineParameters(), name)->defaultText() == findParam(fieldParameters(), name)->defaultText());
+    }
+    RefineParams rp;
+    setParam(refineParameters(), "up", rp, Vec3d(0.0, 0.0, -1.0));
+    setParam(refineParameters(), "space", rp, std::string("scalp"));
+    CHECK(rp.field.scalp.up == Vec3d(0.0, 0.0, -1.0));
+    CHECK(rp.field.space == FieldSpace::Scalp);
 }

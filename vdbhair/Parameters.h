@@ -12,6 +12,8 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
+#include <vdbhair/Types.h>
+#include <vdbhair/io/AxisName.h>
 
 #include <cmath>
 #include <cstdint>
@@ -24,6 +26,15 @@
 #include <vector>
 
 namespace vdbhair {
+
+/// @brief An axis as a person types it: "auto" for the zero vector, a unit axis by name (x, ...,
+/// -z), any other vector as "(x, y, z)".
+inline std::string axisText(const Vec3d& v)
+{
+    if (v == Vec3d(0.0)) return "auto";
+    for (const std::string& name : axisNames()) if (axisFromName(name, "axis") == v) return name;
+    return "(" + formatNumber(v.x()) + ", " + formatNumber(v.y()) + ", " + formatNumber(v.z()) + ")";
+}
 
 /// Reads and writes one value of type T in a parameter struct P.
 template<typename P, typename T>
@@ -40,9 +51,11 @@ struct Param
     std::string name;  ///< words joined by '-' (see the file comment)
     std::string help;  ///< what it does, one sentence without its unit, range or default
     std::string unit;  ///< "world units", "degrees", "voxels", "bytes", or "" for a pure number
-    /// int, uint64 (counts and byte sizes), double, bool (a flag) or string (one of @c choices)
+    /// int, uint64 (counts and byte sizes), double, bool (a flag), string (one of @c choices) or
+    /// an axis (a direction: by name, x to -z, or "auto" for the zero vector when @c zeroMeans says
+    /// what the library picks then; Python also takes any (x, y, z); makeAxisParam())
     std::variant<ParamAccess<P, int>, ParamAccess<P, std::uint64_t>, ParamAccess<P, double>, ParamAccess<P, bool>,
-                 ParamAccess<P, std::string>>
+                 ParamAccess<P, std::string>, ParamAccess<P, Vec3d>>
         access;
     double min = -std::numeric_limits<double>::infinity();  ///< inclusive bounds of a number
     double max = std::numeric_limits<double>::infinity();
@@ -55,7 +68,11 @@ struct Param
     /// Python's default is None, which leaves the struct's default (what @c zeroMeans says), as
     /// `neighbors=None` does; the value itself (0) is taken too.
     bool pythonNone = false;
+    /// Older spellings of the flag that the command line still takes (`--keep-base-detail`).
+    std::vector<std::string> oldFlags;
 
+    /// Whether it is an axis (makeAxisParam()).
+    bool isAxis() const { return std::holds_alternative<ParamAccess<P, Vec3d>>(access); }
     /// The keyword Python spells it as.
     std::string pythonName() const
     {
@@ -81,6 +98,7 @@ struct Param
             if constexpr (std::is_same_v<T, std::string>) return a.get(p);
             else if constexpr (std::is_same_v<T, bool>) return a.get(p) ? "true" : "false";
             else if constexpr (std::is_same_v<T, double>) return formatNumber(a.get(p));
+            else if constexpr (std::is_same_v<T, Vec3d>) return axisText(a.get(p));
             else return std::to_string(a.get(p));
         }, access);
     }
@@ -117,6 +135,32 @@ ParamAccess<P, std::string> named(F field, NameFn name, FromNameFn fromName)
             [field, fromName](P& p, std::string v) { field(p) = fromName(v); }};
 }
 
+/// @brief An axis parameter of the Vec3d member that @a field returns: the command line takes
+/// its names (x, y, z, -x, -y, -z, and "auto" when @a autoMeans says what the zero vector stands
+/// for), Python those names or any (x, y, z) (None: the default).
+template<typename P, typename F>
+Param<P> makeAxisParam(std::string name, std::string help, F field, std::string autoMeans = "")
+{
+    Param<P> p = makeParam<P>(std::move(name), std::move(help), "", member<P>(field));
+    p.zeroMeans = std::move(autoMeans);
+    if (!p.zeroMeans.empty()) p.choices.push_back("auto");
+    for (const std::string& n : axisNames()) p.choices.push_back(n);
+    p.pythonNone = !p.zeroMeans.empty();
+    return p;
+}
+
+/// @brief The axis named @a text ("auto": the zero vector, when @a param takes it).
+/// @throw ValueError "<who> 'w': must be one of auto, x, y, z, -x, -y, -z".
+template<typename P>
+Vec3d axisFromText(const Param<P>& param, const std::string& text, const std::string& who)
+{
+    if (text == "auto" && !param.zeroMeans.empty()) return Vec3d(0.0);
+    for (const std::string& n : axisNames()) if (n == text) return axisFromName(n, who);
+    std::string list;
+    for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
+    throw ValueError(who + " '" + text + "': must be one of " + list);
+}
+
 /// @brief The parameters of @a inner named in @a names (all when empty), declared once for a
 /// struct Inner, as parameters of a struct Outer that holds an Inner (@a part: Outer& -> Inner&):
 /// a verb whose parameters contain another's reuses its declaration instead of restating it.
@@ -143,6 +187,7 @@ ParamTable<Outer> nestedParams(const ParamTable<Inner>& inner, F part, const std
         q.valued = p.valued;
         q.keyword = p.keyword;
         q.pythonNone = p.pythonNone;
+        q.oldFlags = p.oldFlags;
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(std::declval<const Inner&>()))>;
             q.access = ParamAccess<Outer, T>{[a, part](const Outer& o) { return a.get(part(const_cast<Outer&>(o))); },
@@ -187,6 +232,11 @@ void checkParams(const ParamTable<P>& table, const P& p, ParamSpelling spelling,
                 std::string list;
                 for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
                 throw ValueError(who + " '" + v + "': must be one of " + list);
+            } else if constexpr (std::is_same_v<T, Vec3d>) {
+                const Vec3d v = a.get(p);
+                if (!std::isfinite(v.x()) || !std::isfinite(v.y()) || !std::isfinite(v.z()))
+                    throw ValueError(who + " " + axisText(v) + ": must be a finite vector");
+                if (v == Vec3d(0.0) && param.zeroMeans.empty()) throw ValueError(who + " (0, 0, 0): must be a non-zero vector");
             } else if constexpr (!std::is_same_v<T, bool>) {
                 const double v = double(a.get(p));
                 if (std::isfinite(v) && (param.aboveMin ? v > param.min : v >= param.min) && v <= param.max) return;
@@ -218,7 +268,7 @@ std::string paramHelp(const Param<P>& param)
         for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
         notes.push_back("one of " + list);
     }
-    if (!param.zeroMeans.empty()) notes.push_back("0: " + param.zeroMeans);
+    if (!param.zeroMeans.empty()) notes.push_back((param.isAxis() ? "auto: " : "0: ") + param.zeroMeans);
     if (!notes.empty()) {
         h += " (";
         for (std::size_t i = 0; i < notes.size(); ++i) h += (i ? "; " : "") + notes[i];

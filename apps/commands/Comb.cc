@@ -19,20 +19,19 @@ struct CombCmdParams
 {
     std::string input, output, stroke, scalp;
     CombParams params;  ///< its declared parameters (combParameters()) are options
-    SynthOptionText text;
     HeadOptions head;
 };
 
 int runComb(CombCmdParams p, const CommonOptions& common)
 {
     strandFormatFromPath(p.output, /*forWriting=*/true);
-    applySynthOptionText(p.text, p.params.synth);
     checkParamOptions(combParameters(), p.params);
     p.params.validate("option");
     const std::vector<CombStroke> strokes = readStrokes(p.stroke);
     const StrandSet in = loadStrandsOrScene("comb", p.input, common);
     if (in.empty()) throw ValueError(p.input + ": no strands to comb");
     const openvdb::FloatGrid::Ptr scalp = readScalpOption(p.scalp, common);
+    p.head.policy = &p.params.headPolicy;
     p.params.head = headFromOptions(p.head);
     const auto t0 = std::chrono::steady_clock::now();
     CombResult r;
@@ -83,8 +82,7 @@ Command addCombCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", p->output, "The combed hairstyle (any strand format)")->required();
     sub->add_option("--scalp", p->scalp, "The scalp: a .vdb with a level set 'surface' or a head mesh; default: the sphere fitted to the roots");
     addParamOptions(sub, p->params, combParameters());
-    addHeadOptions(sub, p->head, "--scalp's level set if given, else a sphere fitted to the roots");
-    addSynthTextOptions(sub, p->text, /*detailOptions=*/false);
+    addHeadOptions(sub, p->head, p->params.headPolicy, "--scalp's level set if given, else a sphere fitted to the roots");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair comb scenes/default/head.json --stroke scenes/comb/sweep_ponytail.json -o combed.hair --json");

@@ -120,8 +120,6 @@ Command addCompareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--unit", params->unit, "The files' unit: mm, cm, dm, m, in, or its length in metres; needed for HairGS's thresholds in millimetres");
     sub->add_option("--threshold", params->thresholds, "An oriented-point threshold DISTANCE:ANGLE (millimetres with --unit, else file units; "
                                                        "repeat for more; default with --unit: HairGS's 2:20 3:30 4:40 4:90)");
-    sub->add_flag_function("--unpaired", [params](std::int64_t) { params->params.pairStrands = false; },
-                           "Do not pair strand i of A with strand i of B even when the counts agree (hairstyles whose strands do not correspond, such as a synthesis)");
     addParamOptions(sub, params->params, compareParameters());
     sub->add_option("--head", params->head, "A head (mesh or .vdb level set): the shares of A's and B's strands passing into it");
     sub->add_option("--per-strand", params->perStrand, "Write each strand of A's values as CSV: chamfer, and with equal strand counts position, curvature, frechet");

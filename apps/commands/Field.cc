@@ -25,8 +25,7 @@ namespace {
 struct FieldCmdParams
 {
     std::string input, output;
-    FieldParams field;  ///< its declared parameters (fieldParameters()) are options
-    int levels = 1;
+    FieldLevelsParams params;  ///< its declared parameters (fieldLevelsParameters()) are options
     bool withStrands = false;
     bool helicoid = false;
     bool strict = false;
@@ -62,31 +61,30 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
 {
     if (p.output.empty()) throw ValueError("needs an output: -o OUT.vdb");
     if (fileExtension(p.output) != ".vdb") throw ValueError(p.output + ": the field is written as OpenVDB; the output must end in .vdb");
-    checkParamOptions(fieldParameters(), p.field);
-    if (p.levels < 1 || p.levels > FieldParams::kMaxLevels) {
-        throw ValueError("--levels " + std::to_string(p.levels) + ": must be between 1 and " + std::to_string(FieldParams::kMaxLevels));
-    }
-    if (p.helicoid && p.levels != 1) throw ValueError("--helicoid with --levels " + std::to_string(p.levels) + ": a helicoid field has one level; use --levels 1");
-    if (p.helicoid && p.scalp.space != "world") throw ValueError("--helicoid with --space " + p.scalp.space + ": helicoid fields are world-space");
+    checkParamOptions(fieldLevelsParameters(), p.params);
+    const int levels = p.params.levels;
+    const std::string space = fieldSpaceName(p.params.field.space);
+    if (p.helicoid && levels != 1) throw ValueError("--helicoid with --levels " + std::to_string(levels) + ": a helicoid field has one level; use --levels 1");
+    if (p.helicoid && space != "world") throw ValueError("--helicoid with --space " + space + ": helicoid fields are world-space");
     if (p.vectorName.empty() || p.vectorName.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos ||
         std::isdigit(static_cast<unsigned char>(p.vectorName[0]))) {
         throw ValueError("--vector-name '" + p.vectorName + "': must be a valid attribute name (letters, digits, _; not starting with a digit)");
     }
     if (!p.dense.empty() && fileExtension(p.dense) != ".npy") throw ValueError("--dense " + p.dense + ": the orientation volume is written as NumPy; it must end in .npy");
-    if (!p.dense.empty() && p.scalp.space != "world") throw ValueError("--dense with --space " + p.scalp.space + ": the dense box is in world space; use --space world");
+    if (!p.dense.empty() && space != "world") throw ValueError("--dense with --space " + space + ": the dense box is in world space; use --space world");
     if (p.dense.empty() && !p.denseBox.empty()) throw ValueError("--dense-box without --dense: name the .npy to write (--dense OUT.npy)");
     const DenseBox denseBox = p.dense.empty() ? DenseBox{} : denseBoxOption(p);
     if (p.helicoid && p.vectorName != "tangent") throw ValueError("--helicoid with --vector-name " + p.vectorName + ": retrace --helicoid reads the vector grid 'tangent'");
 
     const StrandSet strands = loadStrands("field", p.input, common, p.strict);
     checkStrandLengths("field", p.input, strands, common, p.strict);
-    FieldParams fp = p.field;
+    FieldParams fp = p.params.field;
     fp.voxelSize = resolveVoxelSize(strands, fp);  // 0: the library's suggestion (reported below)
     fp.coherenceAndSpread = false;  // not written (below)
     applyScalpOptions(p.scalp, strands, fp, common);
 
     const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<TangentField> fields = estimateTangentFieldLevels(strands, fp, p.levels, true, common.interrupter);
+    const std::vector<TangentField> fields = estimateTangentFieldLevels(strands, fp, levels, true, common.interrupter);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     openvdb::GridCPtrVec grids;  // the voxel grids (the report's), then the strands
@@ -107,7 +105,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
             grids.push_back(g);
         }
     }
-    nlohmann::json j = fieldReport(strands.numStrands(), fp, p.levels, grids);
+    nlohmann::json j = fieldReport(strands.numStrands(), fp, levels, grids);
     if (p.withStrands) grids.push_back(createStrandGrid(strands));
     std::vector<float> volume;
     if (!p.dense.empty()) {
@@ -131,7 +129,7 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
         printJson(j);
     } else if (!common.quiet) {
         std::cout << "field of " << strands.numStrands() << " strands, voxel size " << fp.voxelSize << " ("
-                  << fieldSpaceName(fp.space) << " space), " << fp.iterations << " iteration(s), " << p.levels << " level(s):\n";
+                  << fieldSpaceName(fp.space) << " space), " << fp.iterations << " iteration(s), " << levels << " level(s):\n";
         for (const auto& g : j["grids"]) {
             std::cout << "  " << g["name"].get<std::string>() << ": " << g["active_voxels"].get<std::uint64_t>()
                       << " active voxels of size " << g["voxel_size"].get<double>() << "\n";
@@ -150,8 +148,7 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "field");
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Output .vdb: grids 'tangent', 'density' (fog volume in [0,1]) and 'hair_length' (or *_level_<l>)")->required();
-    addParamOptions(sub, params->field, fieldParameters());
-    sub->add_option("--levels", params->levels, "Levels: level l has voxel size h*2^l")->capture_default_str();
+    addParamOptions(sub, params->params, fieldLevelsParameters());
     sub->add_option("--vector-name", params->vectorName,
                     "Name of the direction grid; Blender's Cycles reserves 'tangent' for UV tangents, so use e.g. hair_direction for Cycles")
         ->capture_default_str();

@@ -19,8 +19,7 @@ namespace {
 struct FitCmdParams
 {
     std::string input, output;
-    FitParams fit;
-    bool skipDegenerate = false;
+    FitParams fit;  ///< its declared parameters (fitParameters()) are options
     bool strict = false;
 };
 
@@ -40,7 +39,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
     scene.integrator = HelicoidIntegrator::RK4;  // fits are streamlines, regrown exactly
     for (std::size_t i = 0; i < fits.size(); ++i) {
         if (!errors[i].empty()) {
-            if (!p.skipDegenerate) throw ValueError(p.input + ": " + errors[i] + " (--skip-degenerate leaves such strands out)");
+            if (!p.fit.skipDegenerate) throw ValueError(p.input + ": " + errors[i] + " (--skip-degenerate leaves such strands out)");
             if (!common.quiet) std::cerr << "vdbhair fit: warning: skipped " << errors[i] << "\n";
             continue;
         }
@@ -89,7 +88,6 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Scene file (.json): one guide per input strand, in input order")->required();
     addParamOptions(sub, params->fit, fitParameters());
-    sub->add_flag("--skip-degenerate", params->skipDegenerate, "Leave out strands of zero length instead of failing");
     sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);

@@ -30,7 +30,6 @@ struct InterpolateCmdParams
 {
     std::string guides, output, roots, scalp, head, guideGroups, rootGroups, density, length;
     InterpolateParams op;  ///< its declared parameters (interpolateParameters()) are options
-    std::string up = axisName(HelicoidInterpolationParams{}.up);
     std::int64_t count = -1;  ///< -1: not given
 };
 
@@ -49,7 +48,6 @@ void checkOptions(InterpolateCmdParams& p)
     if (!p.scalp.empty() && p.count < 0) throw ValueError("--scalp needs --count N");
     if (p.count == 0) throw ValueError("--count 0: must be at least 1");
     if (!points && (!p.guideGroups.empty() || !p.rootGroups.empty())) throw ValueError("--guide-groups and --root-groups need --method points");
-    op.helicoid.up = axisFromName(p.up, "--up");
     validateGroomParams(op.groom);  // what the ranges do not say: curl needs a frequency
     if (op.returnScene && (groomsHair(op.groom) || !p.density.empty() || !p.length.empty())) {
         throw ValueError(p.output + ": a scene of new hairs takes no --density, --length, --clump-radius, --curl or --frizz; write strands");
@@ -292,7 +290,6 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--head", p.head, "The head new hair may not enter deeper than its guides: a mesh (.ply, .obj), a .vdb level set, or 'none' "
                                       "(default: --scalp's surface, else the scene's head, else a sphere fitted to the guide roots)");
     addParamOptions(sub, p.op, interpolateParameters());
-    sub->add_option("--up", p.up, "Reference axis of surface frames and of roots on --scalp: x, y, z, -x, -y or -z")->capture_default_str();
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair interpolate guides.hair --scalp scalp.vdb --count 20000 -o hair.hair --json");

@@ -22,9 +22,9 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
     // --head says otherwise.
     const openvdb::FloatGrid::Ptr surface = applyScalpOptions(p.scalp, strands, rp.field, common);
     const std::vector<double> sphere = p.scalp.sphere();
-    rp.head = headFromOptions(p.head, surface ? HeadObstacle::levelSet(surface, p.head.headPolicy())
+    rp.head = headFromOptions(p.head, surface ? HeadObstacle::levelSet(surface, rp.headPolicy)
                                       : sphere.empty() ? HeadObstacle()
-                                      : HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, p.head.headPolicy()));
+                                      : HeadObstacle::sphere(rp.field.scalp.center, rp.field.scalp.radius, rp.headPolicy));
     return rp;
 }
 
@@ -117,7 +117,7 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p, const std::vector<std::string>& skip)
 {
     addParamOptions(sub, p.refine, refineParameters(), skip);
-    addHeadOptions(sub, p.head, "--scalp's sphere if given, else a sphere fitted to the roots");
+    addHeadOptions(sub, p.head, p.refine.headPolicy, "--scalp's sphere if given, else a sphere fitted to the roots");
     sub->add_flag("--strict", p.strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addScalpOptions(sub, p.scalp);
 }

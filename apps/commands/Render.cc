@@ -17,26 +17,18 @@ namespace {
 /// The command line of render; defaults from the library's RenderParams and ReadOptions.
 struct RenderCmdParams
 {
-    std::string input, output, guides, title, facing, head, reference;
+    std::string input, output, guides, head, reference;
     RenderParams render;  ///< its declared parameters (renderParameters()) are options
-    std::string up = axisName(RenderParams{}.up);
     std::string grid = ReadOptions{}.vdbGrid;
-    bool sheet = false;
 };
 
 int runRender(const RenderCmdParams& p, const CommonOptions& common)
 {
     checkParamOptions(renderParameters(), p.render);
     RenderParams rp = p.render;
-    rp.title = p.title;
     rp.interrupter = common.interrupter;
-    rp.up = axisFromName(p.up, "--up");
-    if (!p.facing.empty()) {
-        const Vec3d facing = axisFromName(p.facing, "--facing");
-        if (std::abs(facing.dot(rp.up)) > 0.5) {
-            throw ValueError("--facing " + p.facing + " with --up " + p.up + ": the face must look along an axis perpendicular to up");
-        }
-        rp.facing = facing;
+    if (rp.facing && std::abs(rp.facing->dot(rp.up)) > 0.5) {
+        throw ValueError("--facing " + axisName(*rp.facing) + " with --up " + axisName(rp.up) + ": the face must look along an axis perpendicular to up");
     }
     if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
     // Roots (a PLY of points with normals, as `vdbhair roots` writes) are drawn as dots: stubs
@@ -78,14 +70,14 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
         rp.reference = &reference;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const Image image = p.sheet ? renderSheet(strands, rp) : renderStrands(strands, rp);
+    const Image image = rp.sheet ? renderSheet(strands, rp) : renderStrands(strands, rp);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     writeImage(p.output, image);
     if (common.json) {
         printJson({{"output", p.output}, {"width", image.width}, {"height", image.height}, {"strands", strands.numStrands()},
-                   {"view", p.sheet ? "sheet" : viewName(rp.view)}, {"seconds", seconds}});
+                   {"view", rp.sheet ? "sheet" : viewName(rp.view)}, {"seconds", seconds}});
     } else if (!common.quiet) {
-        std::cout << "rendered " << strands.numStrands() << (rootsInput ? " roots (" : " strands (") << (p.sheet ? std::string("sheet") : std::string(viewName(rp.view))) << ", "
+        std::cout << "rendered " << strands.numStrands() << (rootsInput ? " roots (" : " strands (") << (rp.sheet ? std::string("sheet") : std::string(viewName(rp.view))) << ", "
                   << image.width << "x" << image.height << ") in " << seconds << " s\nwrote " << p.output << "\n";
     }
     return 0;
@@ -103,13 +95,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--reference", params->reference, "For --color-by error: the hairstyle to measure against (e.g. the reference of `compare`)");
     sub->add_option("--head", params->head, "A head mesh (.ply, .obj) drawn behind the hair, e.g. from ../shared/data/scalp (default: a scene's own \"head\")");
     sub->add_option("--guides", params->guides, "Strands drawn on top in red (e.g. the guides of a scene)");
-    sub->add_option("--title", params->title, "Text in the top-left corner");
-    sub->add_option("--up", params->up, "The hairstyle's up axis: x, y, z, -x, -y or -z (z for Yuksel's cyHair models)")
-        ->capture_default_str();
-    sub->add_option("--facing", params->facing,
-                    "The axis the face looks along (front view looks at it): default z, or -y for --up z (Blender's); cyHair models: --up z --facing y");
     sub->add_option("--grid", params->grid, "For a .vdb input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
-    sub->add_flag("--sheet", params->sheet, "One image with the front, side, top and three-quarter views");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair render scenes/default/head.json -o head.png --sheet");

@@ -22,8 +22,8 @@ namespace {
 
 struct RootsCmdParams
 {
-    std::string input, output, up = axisName(FollicleParams{}.up);
-    FollicleParams follicle;  ///< its declared parameters (follicleParameters()) are options; up set from --up
+    std::string input, output;
+    FollicleParams follicle;  ///< its declared parameters (follicleParameters()) are options
     bool noRegion = false;
 };
 
@@ -35,7 +35,6 @@ int runRoots(const RootsCmdParams& p, const CommonOptions& common)
     FollicleParams fp = p.follicle;
     if (fp.count == 0 && fp.spacing == 0.0) throw ValueError("needs --count N or --spacing S");
     if (fp.count > 0 && fp.spacing > 0.0) throw ValueError("--count and --spacing: give one");
-    fp.up = axisFromName(p.up, "--up");
 
     openvdb::FloatGrid::Ptr surface;
     openvdb::BoolGrid::Ptr region;
@@ -84,7 +83,6 @@ Command addRootsCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("scalp", params->input, "Scalp .vdb with grid 'surface' (and 'region'), as vdbhair scalp writes; or a head mesh (.ply, .obj), made into one at 1/100 of its size")->required();
     sub->add_option("-o,--output", params->output, "Output roots: .ply (x y z nx ny nz tx ty tz) or .vdb (points P, N, tangent, group root)")->required();
     addParamOptions(sub, params->follicle, follicleParameters());
-    sub->add_option("--up", params->up, "Reference axis of the tangent frame: x, y, z, -x, -y or -z")->capture_default_str();
     sub->add_flag("--no-region", params->noRegion, "Ignore the file's 'region' grid: roots over the whole surface");
     addCommonOptions(sub, common);
     sub->footer("Example: vdbhair roots scalp.vdb -o roots.ply --count 10000 --json");

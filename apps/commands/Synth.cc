@@ -32,12 +32,9 @@ namespace {
 
 struct SynthCmdParams
 {
-    double outputTurnDeg = 0.0;
     std::string input, output, scalp, saveMaps, region, outputScalp, head;
-    SynthOptionText text;
-    std::int64_t strands = -1;  ///< -1: as many as the example
     SynthParams synth;  ///< its declared parameters (synthParameters()) are options
-    bool coarseGuides = false, measure = false;
+    bool coarseGuides = false;
     std::string coarse;
     const CLI::Option* detailScaleOption = nullptr;     ///< (given or not: --coarse takes transfer's defaults)
     const CLI::Option* matchCandidatesOption = nullptr;
@@ -108,8 +105,6 @@ void checkOptions(SynthCmdParams& p)
 {
     strandFormatFromPath(p.output, /*forWriting=*/true);
     if (p.coarseGuides && p.coarse.empty()) throw ValueError("--coarse-guides: needs --coarse FILE");
-    applySynthOptionText(p.text, p.synth);
-    if (p.strands == 0) throw ValueError("--strands 0: must be at least 1");
     checkParamOptions(synthParameters(), p.synth);
     p.synth.validate("option");
 }
@@ -126,12 +121,13 @@ int runOnCoarse(SynthCmdParams& p, const CommonOptions& common)
     if (p.matchPlaceOption->count() == 0) p.synth.match.place = tp.synth.match.place;
     p.synth.validate("option");
     tp.synth = p.synth;
+    tp.synth.strands = 0;  // the output's count is the transfer's, with guides
     tp.guides = p.coarseGuides;
-    if (p.strands > 0) {
+    if (p.synth.strands > 0) {
         if (!p.coarseGuides) throw ValueError("--strands: with --coarse the output has BASE's strands; --strands needs --coarse-guides");
-        tp.strands = std::size_t(p.strands);
+        tp.strands = p.synth.strands;
     }
-    TransferJob job{"synth", p.input, p.coarse, p.output, p.scalp, "EXAMPLE", "--coarse", p.measure};
+    TransferJob job{"synth", p.input, p.coarse, p.output, p.scalp, "EXAMPLE", "--coarse"};
     return runTransferJob(job, tp, common);
 }
 
@@ -140,11 +136,10 @@ StrandSet readExample(SynthCmdParams& p, const CommonOptions& common)
 {
     StrandSet example = loadStrands("synth", p.input, common);
     if (example.numStrands() < 2) throw ValueError(p.input + ": " + std::to_string(example.numStrands()) + " strand: synthesis needs an example of many strands");
-    if (p.strands > 0) {
-        p.synth.strands = std::size_t(p.strands);
-        const double estimate = double(p.strands) * p.synth.vertices;
+    if (p.synth.strands > 0) {
+        const double estimate = double(p.synth.strands) * p.synth.vertices;
         if (estimate > double(p.synth.maxVertices))
-            throw LimitError("--strands " + std::to_string(p.strands) + ": " + formatValue(estimate) + " vertices exceed the cap of " +
+            throw LimitError("--strands " + std::to_string(p.synth.strands) + ": " + formatValue(estimate) + " vertices exceed the cap of " +
                              std::to_string(p.synth.maxVertices));
     }
     return example;
@@ -173,9 +168,7 @@ std::vector<Vec3d> readOutputRegion(const SynthCmdParams& p, const CommonOptions
 std::shared_ptr<const ScalpMap> outputScalpMap(SynthCmdParams& p, const CommonOptions& common, const std::vector<Vec3d>& region)
 {
     std::shared_ptr<const ScalpMap> outputMap;
-    if (p.outputTurnDeg != 0.0 && p.outputScalp.empty()) throw ValueError("--output-turn: needs --output-scalp (it turns the layout on the other head)");
-    if (!std::isfinite(p.outputTurnDeg)) throw ValueError("--output-turn " + formatValue(p.outputTurnDeg) + ": must be a finite angle in degrees");
-    p.synth.outputTurn = p.outputTurnDeg * M_PI / 180.0;
+    if (p.synth.outputTurn != 0.0 && p.outputScalp.empty()) throw ValueError("--output-turn: needs --output-scalp (it turns the layout on the other head)");
     if (!p.outputScalp.empty()) {
         const openvdb::FloatGrid::Ptr other = readScalpOption(p.outputScalp, common);
         std::vector<Vec3f> pts;
@@ -276,8 +269,8 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
     if (common.quiet && !common.json) return 0;
     SynthMeasures m;
     {
-        const Stage stage(common, p.measure ? "measuring the output, comparing with the example" : "measuring the output");
-        m = measureSynthesis(example, r, p.synth, outputMap.get(), p.measure);
+        const Stage stage(common, p.synth.measure ? "measuring the output, comparing with the example" : "measuring the output");
+        m = measureSynthesis(example, r, p.synth, outputMap.get(), p.synth.measure);
     }
     if (common.json) reportJson(p, example, r, outputMap, regionFrom, seconds, m);
     else reportText(p, example, r, outputMap, seconds, m);
@@ -285,21 +278,6 @@ int runSynth(SynthCmdParams p, const CommonOptions& common)
 }
 
 } // namespace
-
-void addSynthTextOptions(CLI::App* sub, SynthOptionText& t, bool detailOptions)
-{
-    sub->add_option("--up", t.up, "The scalp's up axis: auto (the mean direction from the head's centre to the roots), x, y, z, -x, -y or -z")->capture_default_str();
-    if (!detailOptions) return;
-    sub->add_option("--front", t.front, "The head's front for the report by region: auto (where the example's hairline is highest), x, y, z, -x, -y or -z")->capture_default_str();
-    sub->add_flag("--no-refine", t.noRefine, "Skip the vector-field refinement of every level");
-}
-
-void applySynthOptionText(const SynthOptionText& t, SynthParams& s)
-{
-    if (t.up != "auto") s.up = axisFromName(t.up, "--up");
-    if (t.front != "auto") s.front = axisFromName(t.front, "--front");
-    if (t.noRefine) s.refine = false;
-}
 
 void writeSynthStrands(const std::string& path, const StrandSet& strands, const std::vector<std::vector<std::int32_t>>& clusterOf)
 {
@@ -331,21 +309,16 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "The new hairstyle (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", params->scalp, "The scalp: a .vdb with a level set 'surface' (vdbhair scalp) or a head mesh (.ply, .obj); default: the sphere fitted to the roots");
     addParamOptions(sub, params->synth, synthParameters());
-    addSynthTextOptions(sub, params->text, /*detailOptions=*/true);
     noteTransferDefaults(sub);
     params->detailScaleOption = sub->get_option("--detail-scale");
     params->matchCandidatesOption = sub->get_option("--match-candidates");
     params->matchPlaceOption = sub->get_option("--match-place");
     sub->add_option("--region", params->region, "Where the new hair grows (default: the example's region): a scalp .vdb's 'region' grid (vdbhair scalp --region...), roots (.ply points, as vdbhair roots writes) or the roots of a hairstyle; the strand count scales with the area");
-    sub->add_option("--strands", params->strands, "Strands in the output (default: the example's density over the region; every level scales alike)");
-    sub->add_option("--output-turn", params->outputTurnDeg, "With --output-scalp: degrees about the up axis that the layout turns on the other head (for heads that face different ways)")->capture_default_str();
     sub->add_option("--head", params->head, "The head new hair may enter no deeper than the example's hair: a mesh (.ply, .obj), a .vdb level set, or 'none' "
                                              "(default: --output-scalp's, else --scalp's surface, else the sphere fitted to the roots)");
     sub->add_option("--output-scalp", params->outputScalp, "Grow the new hair on another head: a scalp .vdb (its 'region' grid is where the hair grows, unless --region says) or a head mesh with --region; the hairstyle moves there through scalp space");
     sub->add_option("--coarse", params->coarse, "Impose a coarsest level instead of synthesizing one (Wang et al. §6): BASE's own coarsest level (a hairstyle, or a scene grown first); the example's finer levels are transferred onto it, on BASE's scalp, with BASE's roots (as vdbhair transfer EXAMPLE BASE)");
     sub->add_flag("--coarse-guides", params->coarseGuides, "With --coarse: BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over the guides' region (--strands sets the output count)");
-    sub->add_flag("--measure", params->measure, "Also compare the output with the example as `vdbhair compare` does (the report's \"compare\"; on another head, "
-                                                "the output moved back onto the example's scalp): about 1-3 s more at 100,000 strands");
     sub->add_option("--save-maps", params->saveMaps, "Write input_map.png, output_map.png (first three PCA channels as RGB) and clusters.png to this folder");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);

@@ -23,8 +23,6 @@ struct TransferCmdParams
 {
     TransferJob job = [] { TransferJob j; j.verb = "transfer"; return j; }();
     TransferParams params;  ///< its declared parameters (transferParameters()) are options
-    SynthOptionText text;
-    std::int64_t strands = -1;
     std::string head;  ///< --head: a file, "none", or empty for BASE's (its scalp, else the sphere fitted to its roots)
 };
 
@@ -65,8 +63,8 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
     if (common.quiet && !common.json) return 0;
     TransferMeasures m;
     {
-        const Stage stage(common, job.measure ? "measuring the output, comparing with the base" : "measuring the output");
-        m = measureTransfer(details, base, tr, params, job.measure);
+        const Stage stage(common, params.synth.measure ? "measuring the output, comparing with the base" : "measuring the output");
+        m = measureTransfer(details, base, tr, params, params.synth.measure);
     }
     const double rd = tr.detailsMap->radius(), rb = r.map->radius();
     if (common.json) {
@@ -105,24 +103,15 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", p->job.output, "The result (any strand format; .vdb points also carry int cluster_level_1.. attributes)")->required();
     sub->add_option("--scalp", p->job.scalp, "BASE's scalp: a .vdb with a level set 'surface' or a head mesh; default: the sphere fitted to BASE's roots");
     addParamOptions(sub, p->params, transferParameters());
-    sub->add_flag_function("--keep-base-detail", [p](std::int64_t) { p->params.smoothBase = false; }, "Keep BASE's coarsest level unsmoothed (the paper's rule: BASE's own wisp-level waves stay, under DETAILS')");
     sub->add_option("--head", p->head, "The head new hair may enter no deeper than BASE's hair: a mesh (.ply, .obj), a .vdb level set, or 'none' "
                                        "(default: --scalp's surface, else the sphere fitted to BASE's roots)");
-    sub->add_option("--strands", p->strands, "With --guides: strands in the output (default: DETAILS' strands per coarsest strand, times the guides)");
-    sub->add_flag("--measure", p->job.measure, "Also compare the output with BASE as `vdbhair compare` does (the report's \"compare\"; BASE is the reference)");
-    addSynthTextOptions(sub, p->text, /*detailOptions=*/true);
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair transfer curly.hair straight.hair -o curly_straight.hair --json");
     return {sub, [p, &common] {
                 TransferParams params = p->params;
-                applySynthOptionText(p->text, params.synth);
-                if (p->strands == 0) throw ValueError("--strands 0: must be at least 1");
                 checkParamOptions(transferParameters(), params);
-                if (p->strands > 0) {
-                    if (!params.guides) throw ValueError("--strands: the output has BASE's strands; --strands needs --guides");
-                    params.strands = std::size_t(p->strands);
-                }
+                if (params.strands > 0 && !params.guides) throw ValueError("--strands: the output has BASE's strands; --strands needs --guides");
                 params.synth.head = headFromOptions(HeadOptions{p->head}, params.synth.head);
                 return runTransferJob(p->job, params, common);
             },

@@ -326,13 +326,11 @@ void addArrayMethods(ClassT& cls, GetT get, const char* subject)
 /// fitted to the roots), for space="scalp" only.
 using ScalpArgument = std::optional<std::variant<std::array<double, 4>, PathArg>>;
 
+/// In scalp space (fp.space, a declared parameter as fp.scalp.up is), @a fp's scalp from @a scalp.
 /// @return the head's level set when @a scalp named one (refine's default head), else null
-openvdb::FloatGrid::Ptr applyScalpArgument(FieldParams& fp, const StrandSet& strands, const std::string& space,
-                                           const ScalpArgument& scalp, const std::array<double, 3>& up, const std::string& where)
+openvdb::FloatGrid::Ptr applyScalpArgument(FieldParams& fp, const StrandSet& strands, const ScalpArgument& scalp, const std::string& where)
 {
-    fp.space = fieldSpaceFromName(space);
-    const Vec3d upAxis(up[0], up[1], up[2]);
-    if (!(upAxis.length() > 0.0) || !std::isfinite(upAxis.length())) throw ValueError(where + ": up must be a non-zero finite vector");
+    const Vec3d upAxis = fp.scalp.up;
     if (fp.space != FieldSpace::Scalp) {
         if (scalp) throw ValueError(where + ": scalp= is for space='scalp'");
         return nullptr;
@@ -538,45 +536,52 @@ void bindEstimateField(pyb::module_& m)
         R"doc(The default finest voxel size of a hairstyle (world units): three times the median distance
 between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhair/field/Refine.h).)doc");
 
-    const FieldParams fieldDefaults;
     auto fieldImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
-        FieldParams fp;
-        applyKeywords(fieldParameters(), kw, fp, "estimate_tangent_field");
-        applyScalpArgument(fp, *strands, kw["space"].cast<std::string>(), kw["scalp"].cast<ScalpArgument>(),
-                           kw["up"].cast<std::array<double, 3>>(), "estimate_tangent_field");
-        const std::optional<int> levels = kw["levels"].cast<std::optional<int>>();
-        if (levels && (*levels < 1 || *levels > FieldParams::kMaxLevels)) {
-            throw ValueError("estimate_tangent_field: levels " + std::to_string(*levels) + ": must be between 1 and " +
-                             std::to_string(FieldParams::kMaxLevels));
-        }
+        FieldLevelsParams params;
+        applyKeywords(fieldLevelsParameters(), kw, params, "estimate_tangent_field");
+        FieldParams& fp = params.field;
+        applyScalpArgument(fp, *strands, kw["scalp"].cast<ScalpArgument>(), "estimate_tangent_field");
+        const bool levels = !kw["levels"].is_none();  // None: one field, not a list of one
         auto fields = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
             if (!levels) return std::vector<TangentField>{estimateTangentField(*strands, fp, true, interrupter)};
-            return estimateTangentFieldLevels(*strands, fp, *levels, true, interrupter);
+            return estimateTangentFieldLevels(*strands, fp, params.levels, true, interrupter);
         });
-        if (!levels) return pyb::cast(PyField{fields.front()});
-        pyb::list out;
-        for (TangentField& f : fields) out.append(PyField{std::move(f)});
-        return out;
+        // field --json's report (FieldJson.h) of the grids `field` writes, less the file names and the seconds.
+        nlohmann::json report;
+        if (kw["return_report"].cast<bool>()) {
+            openvdb::GridCPtrVec grids;
+            for (const TangentField& f : fields) grids.insert(grids.end(), {f.tangent, f.density, f.hairLength});
+            FieldParams used = fp;
+            used.voxelSize = resolveVoxelSize(*strands, fp);
+            report = fieldReport(strands->numStrands(), used, int(fields.size()), grids);
+        }
+        pyb::object out;
+        if (!levels) {
+            out = pyb::cast(PyField{fields.front()});
+        } else {
+            pyb::list list;
+            for (TangentField& f : fields) list.append(PyField{std::move(f)});
+            out = list;
+        }
+        if (report.is_null()) return out;
+        return pyb::make_tuple(out, toPython(report));
     };
-    defineVerb(m, "estimate_tangent_field", {"strands: vdbhair.Strands"}, fieldParameters(),
-               {{"levels", "Optional[int]", pyb::none(),
-                 "None for one field; N (1-16) for a list of N fields, level l of voxel size voxel_size * 2**l (element 0 the "
-                 "finest), as ``--levels N``."},
-                {"space", "str", pyb::str(fieldSpaceName(fieldDefaults.space)),
-                 "\"world\" (any hairstyle) or \"scalp\" (Wang et al.'s (u, v, w) over a scalp sphere), as ``--space``."},
-                {"scalp", "", pyb::none(),
+    defineVerb(m, "estimate_tangent_field", {"strands: vdbhair.Strands"}, fieldLevelsParameters(),
+               {{"scalp", "", pyb::none(),
                  "with space=\"scalp\", the sphere (cx, cy, cz, r) in world units, or a head (the path of a scalp .vdb with a level "
                  "set 'surface', or of a mesh): w is then the height above that head, measured along rays from the sphere fitted "
                  "to the roots, and the grids carry the measured table (vdbhair_scalp_distance); None fits a sphere to the roots."},
-                {"up", "Tuple[float, float, float]",
-                 pyb::make_tuple(fieldDefaults.scalp.up.x(), fieldDefaults.scalp.up.y(), fieldDefaults.scalp.up.z()),
-                 "the scalp's up axis for space=\"scalp\"."}},
+                {"return_report", "bool", pyb::bool_(false),
+                 "also return ``field --json``'s report as a dict (less the file name and the seconds: strands, voxel_size, "
+                 "iterations, levels, space, grids (name, voxel_size, active_voxels of each tangent, density and hair_length "
+                 "grid), and scalp in scalp space)."}},
                "The robust tangent field of a hairstyle (Wang et al. 2009, Eq. 9), in world space by default: ``vdbhair field``.\n\n"
                "Every segment contributes its unit tangent to every voxel it passes through, weighted by its\n"
                "length there; each iteration reweights contributions by 0.5 (T . v + 1) and renormalizes.\n"
                "Results are bitwise identical for any thread count. Raises vdbhair.ArgumentError / LimitError\n"
                "(ValueErrors), KeyboardInterrupt on Ctrl-C.",
-               "    strands: a Strands.\n", "TangentField, or a list of them when ``levels`` is given.",
+               "    strands: a Strands.\n",
+               "TangentField, or a list of them (element 0 the finest) when ``levels`` is given; (that, report) with return_report.",
                pyb::cpp_function(fieldImpl, pyb::arg("strands"), pyb::arg("keywords")), 1);
 }
 
@@ -587,7 +592,7 @@ void bindRetrace(pyb::module_& m)
         const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");
         TraceParams tp;
         applyKeywords(traceParameters(), kw, tp, "retrace");
-        const bool returnStats = kw["return_stats"].cast<bool>(), measure = kw["measure"].cast<bool>();
+        const bool returnStats = renamedKeywordValue(kw, "return_report", "return_stats", "retrace").cast<bool>(), measure = kw["measure"].cast<bool>();
         TraceStats stats;
         std::optional<TangentAngles> angles;
         double displacement = 0.0;
@@ -602,13 +607,14 @@ void bindRetrace(pyb::module_& m)
         return pyb::make_tuple(out, toPython(retraceReport(stats, tp, resolveStep(*grid, tp), displacement, angles)));
     };
     defineVerb(m, "retrace", {"strands: vdbhair.Strands", "field"}, traceParameters(),
-               {{"return_stats", "bool", pyb::bool_(false),
+               {{"return_report", "bool", pyb::bool_(false),
                  "also return a dict: `retrace --json`'s report key for key, less the file name (strands, full_length, "
                  "stopped: vanished, left_field, max_steps; steps, mean_displacement, step, integrator, and tangent_angle_deg "
                  "with measure)."},
                 {"measure", "bool", pyb::bool_(false),
-                 "with return_stats, also the mean angle between strand tangents and the field before and after "
-                 "(``--measure``: samples the field at every input and output vertex)."}},
+                 "with return_report, also the mean angle between strand tangents and the field before and after "
+                 "(``--measure``: samples the field at every input and output vertex)."},
+                renamedKeyword("return_stats", "return_report")},
                "Retrace every strand through a vector field from its own root, for its own length\n"
                "(Wang et al. 2009, Sec. 5.3): ``vdbhair retrace``.\n\n"
                "Raises vdbhair.GridTypeError (a TypeError) for a non-vector grid, vdbhair.ArgumentError,\n"
@@ -616,24 +622,22 @@ void bindRetrace(pyb::module_& m)
                "    strands: a Strands (roots, lengths and vertex spacing to follow).\n"
                "    field: a TangentField (its tangent grid is followed) or a vector Grid (vec3s), e.g. read with\n"
                "        read_grid from any OpenVDB writer.\n",
-               "Strands, or (Strands, stats) with return_stats.",
+               "Strands, or (Strands, report) with return_report.",
                pyb::cpp_function(retraceImpl, pyb::arg("strands"), pyb::arg("field"), pyb::arg("keywords")));
 }
 
 /// refine: vector-field refinement (refineParameters()).
 void bindRefine(pyb::module_& m)
 {
-    const RefineParams refineDefaults;
     auto refineImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
         RefineParams rp;
         applyKeywords(refineParameters(), kw, rp, "refine");
         const pyb::object head = kw["head"];
-        const HeadArgument headArg(head, kw["head_policy"].cast<std::string>());
+        const HeadArgument headArg(head, headPolicyName(rp.headPolicy));
         rp.head = headArg.head;
         // A scalp given as a sphere or a head is also the head strands keep out of, unless head= says (as the CLI).
         const ScalpArgument scalp = kw["scalp"].cast<ScalpArgument>();
-        const openvdb::FloatGrid::Ptr scalpSurface = applyScalpArgument(rp.field, *strands, kw["space"].cast<std::string>(), scalp,
-                                                                        kw["up"].cast<std::array<double, 3>>(), "refine");
+        const openvdb::FloatGrid::Ptr scalpSurface = applyScalpArgument(rp.field, *strands, scalp, "refine");
         const bool scalpHead = head.is_none() && scalp.has_value();
         if (scalpHead) {
             rp.head = scalpSurface ? HeadObstacle::levelSet(scalpSurface, headArg.policy)
@@ -668,16 +672,9 @@ void bindRefine(pyb::module_& m)
                {{"head", "", pyb::none(),
                  "None (a sphere fitted to the roots), \"none\" (no head), a path to a mesh (.ply, .obj) or a .vdb level set, "
                  "or a sphere (cx, cy, cz, r) in world units."},
-                {"head_policy", "str", pyb::str(headPolicyName(kDefaultHeadPolicy)),
-                 "\"no-deeper\" (no vertex enters the head that was outside it) or \"outside\"."},
-                {"space", "str", pyb::str(fieldSpaceName(refineDefaults.field.space)),
-                 "the fields' space, as estimate_tangent_field() (``--space``)."},
                 {"scalp", "", pyb::none(),
                  "space='scalp': a sphere (cx, cy, cz, r) or a head (a scalp .vdb or a mesh); None fits a sphere to the roots. "
                  "A scalp given is also the head strands keep out of unless head= says otherwise."},
-                {"up", "Tuple[float, float, float]",
-                 pyb::make_tuple(refineDefaults.field.scalp.up.x(), refineDefaults.field.scalp.up.y(), refineDefaults.field.scalp.up.z()),
-                 "the scalp's up axis (``--up``)."},
                 {"return_report", "bool", pyb::bool_(false),
                  "also return a dict: `refine --json`'s report (the same keys and values: settings, the finest level's measures "
                  "with measure=True, per_level, and compare), plus fields (the TangentField of each level, 0 the finest)."}},

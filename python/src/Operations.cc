@@ -81,14 +81,6 @@ void validateFitKeywords(const FitParams& fp, const char* where)
     }
 }
 
-Vec3d unitAxis(const std::array<double, 3>& a, const char* name)
-{
-    const Vec3d v(a[0], a[1], a[2]);
-    const double len = v.length();
-    if (!(len > 0.0) || !std::isfinite(len)) throw ValueError(std::string("render: ") + name + " must be a non-zero finite vector");
-    return v / len;
-}
-
 pyb::dict valueStatsDict(const ValueStats& s)
 {
     pyb::dict d;
@@ -106,14 +98,6 @@ pyb::dict valueStatsDict(const ValueStats& s)
 pyb::object metaValue(const MetaValue& m)
 {
     return std::visit([](const auto& v) -> pyb::object { return pyb::cast(v); }, m.value);
-}
-
-/// The up= keyword of @a function: a non-zero finite vector, made unit.
-Vec3d upArgument(const std::array<double, 3>& up, const std::string& function)
-{
-    const Vec3d u(up[0], up[1], up[2]);
-    if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError(function + ": up must be a non-zero finite vector");
-    return u / u.length();
 }
 
 /// interpolate's roots: positions (an array or a Strands' roots), normals=, root_groups=, and
@@ -192,7 +176,7 @@ void defineFit(pyb::module_& m)
         FitParams fp;
         applyKeywords(fitParameters(), kw, fp, "fit");
         validateFitKeywords(fp, "fit");
-        const bool skipDegenerate = kw["skip_degenerate"].cast<bool>(), returnSummary = kw["return_summary"].cast<bool>();
+        const bool skipDegenerate = fp.skipDegenerate, returnReport = renamedKeywordValue(kw, "return_report", "return_summary", "fit").cast<bool>();
         std::vector<std::string> errors;
         const std::vector<StrandFit> fits = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
             return fitStrands(*strands, fp, true, &errors, interrupter);
@@ -210,24 +194,24 @@ void defineFit(pyb::module_& m)
             scene.guides.push_back(g);
         }
         pyb::object sceneObj = toPython(sceneToJson(scene));
-        if (!returnSummary) return sceneObj;
+        if (!returnReport) return sceneObj;
         // `fit --json`'s report (fitReport()), less the file name and the rate.
         const pyb::dict d = toPython(fitReport(summarizeFits(*strands, fits, errors, fp.maxError, fp.stepDeviationLimit)));
         return pyb::make_tuple(sceneObj, d);
     };
     defineVerb(m, "fit", {"strands: vdbhair.Strands"}, fitParameters(),
-               {{"skip_degenerate", "bool", pyb::bool_(false), "leave out strands of zero length instead of raising."},
-                {"return_summary", "bool", pyb::bool_(false),
+               {{"return_report", "bool", pyb::bool_(false),
                  "also return a dict: `fit --json`'s report key for key, less the file name and strands_per_second (strands, "
                  "fitted, skipped, over_max_error, frechet_relative: the discrete Frechet distance relative to length, mean and "
                  "p95; pieces_per_strand, evaluations_per_strand, step_convergence: the distance between each fit traced at its "
                  "step and at a quarter of it relative to length, mean, max and how many exceed a tenth of max_error; bytes of "
-                 "fits and of points, compression)."}},
+                 "fits and of points, compression)."},
+                renamedKeyword("return_summary", "return_report")},
                "Fit p-helicoids to every strand (Piuze et al. 2011, Sec. 5): ``vdbhair fit``. ``lambda_`` is the\n"
                "command's ``--lambda`` (``lambda`` is a Python keyword).",
                "    strands: a Strands.\n",
                "The scene as a dict (one guide per fitted strand, in input order), which grow() regrows\n"
-               "    and ``json.dump`` saves as a scene file; or (scene, summary) with return_summary.",
+               "    and ``json.dump`` saves as a scene file; or (scene, report) with return_report.",
                pyb::cpp_function(fitImpl, pyb::arg("strands"), pyb::arg("keywords")));
 }
 
@@ -245,7 +229,7 @@ void defineInterpolate(pyb::module_& m)
         }
         op.returnScene = kw["return_scene"].cast<bool>();
         if (op.returnScene && op.method == InterpolationMethod::Points) throw ValueError("interpolate: return_scene=True needs method='helicoid' (points make strands)");
-        op.helicoid.up = upArgument(kw["up"].cast<std::array<double, 3>>(), "interpolate");
+        op.helicoid.up /= op.helicoid.up.length();  // any non-zero (x, y, z) (checked as declared)
         const InterpolationRoots roots = interpolationRoots(rootsArg, kw, op.frames);
         const HeadArgument headArgument(kw["head"], "no-deeper");
         const bool fromStrands = pyb::isinstance<StrandSet>(guidesArg);
@@ -277,7 +261,6 @@ void defineInterpolate(pyb::module_& m)
         const pyb::object out = op.returnScene ? toPython(sceneToJson(result.scene)) : pyb::cast(std::make_shared<StrandSet>(std::move(result.strands)));
         return report.is_none() ? out : pyb::make_tuple(out, report);
     };
-    const InterpolateParams interpDefaults;
     defineVerb(m, "interpolate", {"guides", "roots"}, interpolateParameters(),
                {{"normals", "", pyb::none(), "None, or an (N, 3) array of outward normals at the roots (surface frames, Sec. 4.3)."},
                 {"guide_groups", "", pyb::none(),
@@ -287,9 +270,6 @@ void defineInterpolate(pyb::module_& m)
                 {"head", "", pyb::none(),
                  "the head new hair may enter no deeper than its guides: None (the scene's head sphere, else a sphere fitted to the "
                  "guide roots), \"none\", a path (mesh or .vdb level set) or (x, y, z, r)."},
-                {"up", "Tuple[float, float, float]",
-                 pyb::make_tuple(interpDefaults.helicoid.up.x(), interpDefaults.helicoid.up.y(), interpDefaults.helicoid.up.z()),
-                 "reference axis of the surface frames (``--up``)."},
                 {"return_scene", "bool", pyb::bool_(false), "return the new hairs as a scene dict (helicoid only) instead of growing them."},
                 {"return_report", "bool", pyb::bool_(false),
                  "also return a dict: `interpolate --json`'s report key for key, less the file name, seconds and "
@@ -358,13 +338,13 @@ pyb::object renderImpl(const StrandsPtr& strands, const pyb::object& pathArg, co
     RenderParams rp;
     applyKeywords(renderParameters(), kw, rp, "render");
     const std::optional<PathArg> path = pathArg.is_none() ? std::nullopt : std::optional<PathArg>(pathArg.cast<PathArg>());
-    rp.title = kw["title"].cast<std::string>();
-    rp.up = unitAxis(kw["up"].cast<std::array<double, 3>>(), "up");
-    if (!kw["facing"].is_none()) {
-        rp.facing = unitAxis(kw["facing"].cast<std::array<double, 3>>(), "facing");
+    // Any non-zero (x, y, z) (checked as declared), as a unit vector.
+    rp.up /= rp.up.length();
+    if (rp.facing) {
+        *rp.facing /= rp.facing->length();
         if (std::abs(rp.facing->dot(rp.up)) > 0.5) throw ValueError("render: facing must be perpendicular to up");
     }
-    const bool sheet = kw["sheet"].cast<bool>();
+    const bool sheet = rp.sheet;
     const StrandsPtr guides = kw["guides"].cast<StrandsPtr>(), reference = kw["reference"].cast<StrandsPtr>();
     const auto head = kw["head"].cast<std::optional<PathArg>>();
     if (path && !isImagePath(*path)) throw ValueError("render: " + *path + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
@@ -399,15 +379,8 @@ pyb::object renderImpl(const StrandsPtr& strands, const pyb::object& pathArg, co
 
 void defineRender(pyb::module_& m)
 {
-    const RenderParams defaults;
     defineVerb(m, "render", {"strands: vdbhair.Strands", "path: Optional[os.PathLike | str]=None"}, renderParameters(),
-               {{"up", "Tuple[float, float, float]", pyb::make_tuple(defaults.up.x(), defaults.up.y(), defaults.up.z()),
-                 "the hairstyle's up axis (x, y, z); (0, 0, 1) for Yuksel's cyHair models."},
-                {"facing", "Optional[Tuple[float, float, float]]", pyb::none(),
-                 "the direction the face looks, perpendicular to up (default: +z, or -y for a z up)."},
-                {"title", "str", pyb::str(defaults.title), "text in the top-left corner."},
-                {"sheet", "bool", pyb::bool_(false), "one image with the front, side, top and three-quarter views."},
-                {"guides", "Optional[vdbhair.Strands]", pyb::none(), "Strands drawn on top in red."},
+               {{"guides", "Optional[vdbhair.Strands]", pyb::none(), "Strands drawn on top in red."},
                 {"head", "Optional[os.PathLike | str]", pyb::none(), "a head mesh (.ply, .obj) drawn behind the hair."},
                 {"reference", "Optional[vdbhair.Strands]", pyb::none(),
                  "Strands to measure against, for color_by=\"error\" (each vertex's distance to the nearest vertex of reference, "
@@ -530,7 +503,6 @@ pyb::dict compareImpl(const StrandsPtr& a, const StrandsPtr& b, const pyb::dict&
     CompareParams p;
     applyKeywords(compareParameters(), kw, p, "compare");
     p.metersPerUnit = kw["meters_per_unit"].cast<double>();
-    p.pairStrands = kw["pair_strands"].cast<bool>();
     for (const auto& [d, angle] : kw["thresholds"].cast<std::vector<std::pair<double, double>>>()) p.thresholds.push_back({d, angle});
     try {
         p.validate();
@@ -563,9 +535,6 @@ void defineCompare(pyb::module_& m)
                 {"thresholds", "", pyb::tuple(),
                  "(distance, angle in degrees) pairs; distances in metres when meters_per_unit is given, else in the strands' units. "
                  "Empty: HairGS's four (2 mm / 20 deg, 3 / 30, 4 / 40, 4 / 90) when meters_per_unit is given, else no oriented-point measure."},
-                {"pair_strands", "bool", pyb::bool_(defaults.pairStrands),
-                 "pair strand i of a with strand i of b when the counts agree (False for hairstyles whose strands do not correspond, "
-                 "such as a synthesis)."},
                 {"head", "", pyb::none(), "None, a path (a mesh or a .vdb level set) or (x, y, z, r), a sphere."}},
                "Compare a hairstyle ``b`` with a reference ``a`` (``vdbhair compare A B --json``): HairGS's\n"
                "oriented-point precision, recall, F1 and strand consistency, the Chamfer distance, Perm's\n"

@@ -14,6 +14,7 @@
 #include <vdbhair/Parameters.h>
 
 #include <pybind11/eval.h>
+#include <pybind11/stl.h>
 
 #include <algorithm>
 #include <string>
@@ -39,6 +40,7 @@ std::string pythonAnnotation(const Param<P>& param)
         if constexpr (std::is_same_v<T, std::string>) return "str";
         else if constexpr (std::is_same_v<T, bool>) return "bool";
         else if constexpr (std::is_same_v<T, double>) return "float";
+        else if constexpr (std::is_same_v<T, Vec3d>) return "Union[str, Tuple[float, float, float]]";  // a name or a vector
         else return "int";
     }, param.access);
     return param.pythonNone ? "Optional[" + type + "]" : type;
@@ -50,7 +52,15 @@ pyb::object pythonDefault(const Param<P>& param)
 {
     if (param.pythonNone) return pyb::none();
     const P defaults{};
-    return std::visit([&](const auto& a) -> pyb::object { return pyb::cast(a.get(defaults)); }, param.access);
+    return std::visit([&](const auto& a) -> pyb::object {
+        using T = std::decay_t<decltype(a.get(defaults))>;
+        if constexpr (std::is_same_v<T, Vec3d>) {
+            const Vec3d v = a.get(defaults);
+            return pyb::make_tuple(v.x(), v.y(), v.z());
+        } else {
+            return pyb::cast(a.get(defaults));
+        }
+    }, param.access);
 }
 
 /// @brief Set the declared parameters given in @a kw on @a p, then check their ranges.
@@ -73,6 +83,15 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
                     throw ValueError(verb + ": " + key + " '" + text + "': must be one of " + list);
                 }
                 a.set(p, text);
+            } else if constexpr (std::is_same_v<T, Vec3d>) {
+                // An axis: a name, as the command line's, or any (x, y, z).
+                if (pyb::isinstance<pyb::str>(v)) {
+                    a.set(p, axisFromText(param, v.cast<std::string>(), verb + ": " + key));
+                } else {
+                    const auto xyz = v.cast<std::vector<double>>();
+                    if (xyz.size() != 3) throw ValueError(verb + ": " + key + ": must be an axis name or (x, y, z), got " + std::to_string(xyz.size()) + " numbers");
+                    a.set(p, Vec3d(xyz[0], xyz[1], xyz[2]));
+                }
             } else if constexpr (std::is_same_v<T, std::uint64_t>) {
                 const long long n = v.cast<long long>();
                 if (n < 0) throw ValueError(verb + ": " + key + " " + std::to_string(n) + ": must be at least " + formatNumber(std::max(0.0, param.min)));
@@ -83,6 +102,24 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
         }, param.access);
     }
     checkParams(table, p, ParamSpelling::Keyword, verb);
+}
+
+/// @brief The keyword @a name, or the value of its older spelling @a oldName when that was given
+/// (a DeprecationWarning saying the new one): a keyword renamed keeps working for one release.
+/// The old keyword is an extra of the verb with default None (renamedKeyword() declares it).
+inline pyb::object renamedKeywordValue(const pyb::dict& kw, const std::string& name, const std::string& oldName, const std::string& verb)
+{
+    const pyb::object old = kw[oldName.c_str()];
+    if (old.is_none()) return kw[name.c_str()];
+    pyb::module_::import("warnings").attr("warn")(verb + "(" + oldName + "=...) is deprecated: use " + name + "=",
+                                                  pyb::reinterpret_borrow<pyb::object>(PyExc_DeprecationWarning), 2);  // at the caller of the verb
+    return old;
+}
+
+/// @brief The extra keyword of an older spelling of @a name (renamedKeywordValue()).
+inline PyKeyword renamedKeyword(const std::string& oldName, const std::string& name)
+{
+    return {oldName, "Optional[bool]", pyb::none(), "deprecated spelling of " + name + " (a DeprecationWarning; removed in the next release)."};
 }
 
 /// @brief Define @a verb on @a m: `verb(positional..., *, <declared keywords>, <extra keywords>,

@@ -80,10 +80,7 @@ void defineRoots(pyb::module_& m)
         FollicleParams fp;
         applyKeywords(follicleParameters(), kw, fp, "roots");
         if ((fp.count == 0) == (fp.spacing == 0.0)) throw ValueError("roots: give one of count= and spacing=");
-        const std::array<double, 3> up = kw["up"].cast<std::array<double, 3>>();
-        const Vec3d u(up[0], up[1], up[2]);
-        if (!(u.length() > 0.0) || !std::isfinite(u.length())) throw ValueError("roots: up must be a non-zero finite vector");
-        fp.up = u / u.length();
+        fp.up = fp.up / fp.up.length();  // any non-zero (x, y, z) (checked as declared)
         const bool fromPath = isPathLike(scalp);
         const std::string path = fromPath ? pathString(scalp, "roots: scalp") : std::string();
         openvdb::FloatGrid::Ptr surface = fromPath ? nullptr : scalpGridArgument(scalp, "roots");
@@ -115,13 +112,10 @@ void defineRoots(pyb::module_& m)
         });
         return folliclesDict(out.f, out.stats, out.region);
     };
-    const FollicleParams follicleDefaults;
     defineVerb(m, "roots", {"scalp"}, follicleParameters(),
                {{"region", "", pyb::none(),
                  "a bool vdbhair.Grid (scalp()'s region); None: the file's 'region' grid when scalp is a path, else the whole "
-                 "surface; False: the whole surface."},
-                {"up", "Tuple[float, float, float]", pyb::make_tuple(follicleDefaults.up.x(), follicleDefaults.up.y(), follicleDefaults.up.z()),
-                 "reference axis of the tangents (``--up``)."}},
+                 "surface; False: the whole surface."}},
                "Follicles spread evenly over a scalp (Witkin & Heckbert 1994 repulsion on the zero level\n"
                "set, as Piuze et al. 2011 place roots): ``vdbhair roots``. Identical for any thread count.\n"
                "Give one of ``count`` and ``spacing``.",
@@ -188,15 +182,23 @@ void defineScalp(pyb::module_& m)
         }
         const bool wantRegion = !regionArg.is_none();
         const double regionRadius = params.regionRadius, regionThreshold = params.regionThreshold;
+        // What scalp --json reports of the input and the region (ScalpJson.h).
+        ScalpFileReport file;
+        if (!sphere && !path) file = {"points", 0, {}, points.size(), std::min(points.size(), sp.maxConstraints), {}};
+        ScalpRegionSource regionSource;
+        if (mask) regionSource = {ScalpRegionSource::Kind::Mask, 0, 0.0, mask->getName(), regionThreshold};
+        if (regionVertex) regionSource = {ScalpRegionSource::Kind::Vertex, 0, 0.0, *regionVertex, regionThreshold};
         auto grids = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
             openvdb::FloatGrid::Ptr surface;
             if (sphere) surface = scalpFromSphere(Vec3d((*sphere)[0], (*sphere)[1], (*sphere)[2]), (*sphere)[3], sp);
-            else if (path) surface = scalpFromFile(*path, sp, nullptr, true, interrupter);
+            else if (path) surface = scalpFromFile(*path, sp, &file, true, interrupter);
             else surface = scalpFromPoints(points, sp, true, interrupter);
             openvdb::BoolGrid::Ptr region;
             if (wantRegion) {
                 const double radius = regionRadius > 0.0 ? regionRadius : defaultRegionRadius(*surface, regionRoots);
                 region = regionFromRoots(*surface, regionRoots, radius, "region", std::uint64_t(1) << 28, defaultRootDistance(*surface));
+                regionSource.roots = regionRoots.size();
+                regionSource.radius = radius;
             } else if (mask) {
                 region = regionFromMask(*surface, *mask, regionThreshold, "region_mask");
             } else if (regionVertex) {
@@ -204,7 +206,12 @@ void defineScalp(pyb::module_& m)
             }
             return std::make_pair(surface, region);
         });
-        return pyb::make_tuple(PyGrid{grids.first}, grids.second ? pyb::cast(PyGrid{grids.second}) : pyb::none());
+        const pyb::object regionObj = grids.second ? pyb::cast(PyGrid{grids.second}) : pyb::none();
+        if (!kw["return_report"].cast<bool>()) return pyb::make_tuple(PyGrid{grids.first}, regionObj);
+        // scalp --json's report, less the file name and the seconds.
+        const ScalpArea areas = runLong(0, pyb::none(), [&](WorkInterrupter*) { return measureScalpArea(grids.first, grids.second); });
+        return pyb::make_tuple(PyGrid{grids.first}, regionObj,
+                               toPython(scalpReport(*grids.first, sp.halfWidth, areas, sphere ? nullptr : &file, grids.second.get(), regionSource)));
     };
     defineVerb(m, "scalp", {"source=None"}, scalpParameters(),
                {{"normals", "", pyb::none(), "(N, 3) outward normals of an array source."},
@@ -218,7 +225,10 @@ void defineScalp(pyb::module_& m)
                 {"region_vertex", "Optional[str]", pyb::none(),
                  "the name of a vertex property of a PLY mesh source that paints the region: a colour channel (\"red\", \"green\", "
                  "\"blue\", \"alpha\"; uchar scaled to 0-1) or any named scalar, above ``region_threshold`` (each band voxel takes "
-                 "the inverse-distance average of its 4 nearest vertices' values)."}},
+                 "the inverse-distance average of its 4 nearest vertices' values)."},
+                {"return_report", "bool", pyb::bool_(false),
+                 "also return ``scalp --json``'s report as a dict (less the file name and the seconds: kind, voxel_size, half_width, "
+                 "active_voxels, area, area_without_zero, the mesh's repairs or the points used, and the region)."}},
                "A scalp as a VDB level set (Piuze et al. 2011, Sec. 4.3): ``vdbhair scalp``.",
                "    source: a path (a head mesh .obj / .ply with faces: meshToLevelSet with open boundaries\n"
                "        capped; points .ply with nx ny nz, or a strand file whose roots are the points: Turk &\n"
@@ -226,7 +236,7 @@ void defineScalp(pyb::module_& m)
                "        (N, 3) array of points with ``normals``. None with ``sphere``.\n",
                "(surface, region): the float level set named 'surface' (negative inside, world units) and\n"
                "    the bool grid 'region' or None. ``vdbhair.write_grids(path, [surface, region])`` writes what\n"
-               "    ``vdbhair scalp`` writes.",
+               "    ``vdbhair scalp`` writes; (surface, region, report) with return_report.",
                pyb::cpp_function(scalpImpl, pyb::arg("source"), pyb::arg("keywords")));
 }
 

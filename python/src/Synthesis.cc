@@ -26,16 +26,7 @@ namespace vdbhair::py {
 
 namespace {
 
-/// An axis keyword (up, front): a vector, or None for the library's own choice (0, 0, 0).
-void setAxis(const pyb::object& v, Vec3d& axis)
-{
-    if (v.is_none()) return;
-    const auto a = v.cast<std::array<double, 3>>();
-    axis = Vec3d(a[0], a[1], a[2]);
-}
-
-/// The help of keywords that synth, transfer and comb share and do not declare (synthParameters()).
-const char* const kUpDoc = "the scalp's up axis (None: the roots' mean direction from the head's centre).";
+/// The help of the scalp keyword that synth, transfer and comb share (a file: each front end's own).
 const char* const kScalpDoc = "a path to a scalp: .vdb with a level set 'surface', or a head mesh (.ply, .obj).";
 
 /// The clusters of every output strand per level (the report's "cluster_of", Python's own: arrays).
@@ -60,23 +51,13 @@ pyb::object synthImpl(const StrandsPtr& example, const pyb::dict& kw)
     }
     applyKeywords(synthParameters(), kw, p, "synth");
     const HeadArgument headArg(kw["head"], headPolicyName(kDefaultHeadPolicy));  // as --head, read with its policy
-    setAxis(kw["up"], p.up);
-    setAxis(kw["front"], p.front);
-    p.refine = kw["refine"].cast<bool>();
-    if (const auto strands = kw["strands"].cast<std::optional<long long>>()) {
-        if (*strands <= 0) throw ValueError("synth: strands=" + std::to_string(*strands) + ": must be at least 1");
-        if (example->empty()) throw ValueError("synth: the example has no strands");
-        p.strands = std::size_t(*strands);
-    }
+    if (p.strands > 0 && example->empty()) throw ValueError("synth: the example has no strands");
     p.validate("synth");
-    const double outputTurn = kw["output_turn"].cast<double>();
     const auto scalp = kw["scalp"].cast<std::optional<PathArg>>(), outputScalp = kw["output_scalp"].cast<std::optional<PathArg>>();
-    if (!std::isfinite(outputTurn)) throw ValueError("synth: output_turn must be a finite angle in degrees");
-    if (outputTurn != 0.0 && !outputScalp) throw ValueError("synth: output_turn needs output_scalp");
-    p.outputTurn = outputTurn * M_PI / 180.0;
+    if (p.outputTurn != 0.0 && !outputScalp) throw ValueError("synth: output_turn needs output_scalp");
     if (outputScalp && !region) throw ValueError("synth: output_scalp needs region=, the points where the hair grows on that head");
     const int threads = kw["threads"].cast<int>();
-    const bool measure = kw["measure"].cast<bool>(), returnReport = kw["return_report"].cast<bool>();
+    const bool returnReport = kw["return_report"].cast<bool>();
     std::shared_ptr<const ScalpMap> other;
     SynthResult r = runLong(threads, kw["progress"], [&](WorkInterrupter* interrupter) {
         openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
@@ -91,7 +72,7 @@ pyb::object synthImpl(const StrandsPtr& example, const pyb::dict& kw)
     });
     if (!returnReport) return pyb::cast(std::make_shared<StrandSet>(std::move(r.strands)));
     // synth --json's report (SynthJson.h), with the clusters as arrays.
-    const SynthMeasures m = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureSynthesis(*example, r, p, other.get(), measure); });
+    const SynthMeasures m = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureSynthesis(*example, r, p, other.get(), p.measure); });
     const SynthSources sources{scalp ? std::string(*scalp) : std::string(),
                                region ? "the " + std::to_string(regionPoints.size()) + " points of region=" : std::string(),
                                outputScalp ? std::string(*outputScalp) : std::string()};
@@ -106,19 +87,11 @@ pyb::object transferImpl(const StrandsPtr& details, const StrandsPtr& base, cons
     TransferParams p;
     const HeadArgument headArg(kw["head"], headPolicyName(kDefaultHeadPolicy));  // as --head, read with its policy
     applyKeywords(transferParameters(), kw, p, "transfer");
-    if (const auto strands = kw["strands"].cast<std::optional<long long>>()) {
-        if (*strands <= 0) throw ValueError("transfer: strands=" + std::to_string(*strands) + ": must be at least 1");
-        if (!p.guides) throw ValueError("transfer: strands: the output has the base's strands; strands needs guides=True");
-        p.strands = std::size_t(*strands);
-    }
-    p.smoothBase = kw["smooth_base"].cast<bool>();
-    setAxis(kw["up"], p.synth.up);
-    setAxis(kw["front"], p.synth.front);
-    p.synth.refine = kw["refine"].cast<bool>();
+    if (p.strands > 0 && !p.guides) throw ValueError("transfer: strands: the output has the base's strands; strands needs guides=True");
     p.validate("transfer");
     const auto scalp = kw["scalp"].cast<std::optional<PathArg>>();
     const int threads = kw["threads"].cast<int>();
-    const bool measure = kw["measure"].cast<bool>(), returnReport = kw["return_report"].cast<bool>();
+    const bool returnReport = kw["return_report"].cast<bool>();
     TransferResult r = runLong(threads, kw["progress"], [&](WorkInterrupter* interrupter) {
         openvdb::FloatGrid::Ptr grid = scalp ? readScalp(*scalp, interrupter) : nullptr;
         if (const HeadObstacle given = headArg.get("transfer"); !given.unset()) p.synth.head = given;  // as --head
@@ -126,7 +99,7 @@ pyb::object transferImpl(const StrandsPtr& details, const StrandsPtr& base, cons
     });
     if (!returnReport) return pyb::cast(std::make_shared<StrandSet>(std::move(r.result.strands)));
     // transfer --json's report (SynthJson.h), with the clusters and BASE's labels as arrays.
-    const TransferMeasures m = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureTransfer(*details, *base, r, p, measure); });
+    const TransferMeasures m = runLong(threads, pyb::none(), [&](WorkInterrupter*) { return measureTransfer(*details, *base, r, p, p.synth.measure); });
     pyb::dict report = toPython(transferReport(*base, r, p, m));
     report["cluster_of"] = clusterArrays(r.result.clusterOf);
     report["base_label"] = pyb::array_t<std::int32_t>(pyb::ssize_t(r.baseLabel.size()), r.baseLabel.data());
@@ -136,7 +109,9 @@ pyb::object transferImpl(const StrandsPtr& details, const StrandsPtr& base, cons
 /// vdbhair.comb(strands, strokes, **keywords): the declared parameters, then comb's own keywords.
 pyb::object combImpl(const StrandsPtr& strands, const pyb::object& strokes, const pyb::dict& kw)
 {
-    const HeadArgument headArg(kw["head"], kw["head_policy"].cast<std::string>());
+    CombParams p;
+    applyKeywords(combParameters(), kw, p, "comb");
+    const HeadArgument headArg(kw["head"], headPolicyName(p.headPolicy));
     std::vector<CombStroke> list;
     if (isPathLike(strokes)) {
         list = readStrokes(pathString(strokes, "comb: strokes"));
@@ -158,9 +133,6 @@ pyb::object combImpl(const StrandsPtr& strands, const pyb::object& strokes, cons
             list.push_back(std::move(st));
         }
     }
-    CombParams p;
-    applyKeywords(combParameters(), kw, p, "comb");
-    setAxis(kw["up"], p.synth.up);
     p.validate("comb");
     const auto scalp = kw["scalp"].cast<std::optional<PathArg>>();
     CombResult r = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
@@ -181,26 +153,17 @@ pyb::object combImpl(const StrandsPtr& strands, const pyb::object& strokes, cons
 void bindSynthesis(pyb::module_& m)
 {
     defineVerb(m, "synth", {"example: vdbhair.Strands"}, synthParameters(),
-               {{"strands", "Optional[int]", pyb::none(), "strands in the output (None: the example's density over the region)."},
-                {"refine", "bool", pyb::bool_(SynthParams{}.refine), "refine every level (Wang et al. §5.3)."},
-                {"up", "Optional[Tuple[float, float, float]]", pyb::none(), kUpDoc},
-                {"front", "Optional[Tuple[float, float, float]]", pyb::none(),
-                 "the head's front for the report's \"regions\" (None: where the example's hairline is highest)."},
-                {"scalp", "Optional[os.PathLike | str]", pyb::none(), kScalpDoc},
+               {{"scalp", "Optional[os.PathLike | str]", pyb::none(), kScalpDoc},
                 {"region", "", pyb::none(),
                  "where the new hair grows, an (N, 3) array of points on the scalp (roots() positions, another hairstyle's roots); "
                  "None: the example's region. The count scales with the area."},
                 {"output_scalp", "Optional[os.PathLike | str]", pyb::none(),
                  "a path to another head (scalp .vdb or mesh) that region= lies on: the hairstyle is made at the region's (u, v) "
                  "and moved onto it through scalp space."},
-                {"output_turn", "float", pyb::float_(0.0), "degrees about the up axis the layout turns on output_scalp (heads facing different ways)."},
                 {"head", "", pyb::none(),
                  "the head new hair may enter no deeper than the example's hair (``--head``): None (output_scalp's, else scalp's "
                  "surface, else the sphere fitted to the roots), \"none\" (no head), a path to a mesh (.ply, .obj) or a .vdb level "
                  "set, or a sphere (x, y, z, r)."},
-                {"measure", "bool", pyb::bool_(false),
-                 "with return_report, the report's \"compare\" holds the output against the example, as ``vdbhair.compare(example, output)`` "
-                 "(on output_scalp, the output moved back onto the example's scalp)."},
                 {"return_report", "bool", pyb::bool_(false),
                  "also return ``synth --json``'s report as a dict (less the file names and the seconds: levels, stages, head, statistics, "
                  "checks, regions, ...), with the cluster_of arrays per level."}},
@@ -212,18 +175,10 @@ void bindSynthesis(pyb::module_& m)
                pyb::cpp_function(synthImpl, pyb::arg("example"), pyb::arg("keywords")));
 
     defineVerb(m, "transfer", {"details: vdbhair.Strands", "base: vdbhair.Strands"}, transferParameters(),
-               {{"strands", "Optional[int]", pyb::none(), "with guides, strands in the output."},
-                {"smooth_base", "bool", pyb::bool_(TransferParams{}.smoothBase), "smooth the base's coarsest level too (False: the paper's rule)."},
-                {"refine", "bool", pyb::bool_(TransferParams{}.synth.refine), "refine every level (Wang et al. §5.3)."},
-                {"up", "Optional[Tuple[float, float, float]]", pyb::none(), kUpDoc},
-                {"front", "Optional[Tuple[float, float, float]]", pyb::none(),
-                 "the head's front for the report's \"regions\", which set the output beside the base, region by region."},
-                {"scalp", "Optional[os.PathLike | str]", pyb::none(), kScalpDoc},
+               {{"scalp", "Optional[os.PathLike | str]", pyb::none(), kScalpDoc},
                 {"head", "", pyb::none(),
                  "the head new hair may enter no deeper than the base's hair (``--head``): None (scalp's surface, else the sphere "
                  "fitted to the base's roots), \"none\" (no head), a path to a mesh (.ply, .obj) or a .vdb level set, or a sphere (x, y, z, r)."},
-                {"measure", "bool", pyb::bool_(false),
-                 "with return_report, the report's \"compare\" holds the output against the base, as ``vdbhair.compare(base, output)``."},
                 {"return_report", "bool", pyb::bool_(false),
                  "also return ``transfer --json``'s report as a dict (less the file names and the seconds), with the cluster_of arrays "
                  "per level and the base's coarsest cluster of each strand (base_label)."}},
@@ -235,13 +190,10 @@ void bindSynthesis(pyb::module_& m)
                pyb::cpp_function(transferImpl, pyb::arg("details"), pyb::arg("base"), pyb::arg("keywords")));
 
     defineVerb(m, "comb", {"strands: vdbhair.Strands", "strokes"}, combParameters(),
-               {{"up", "Optional[Tuple[float, float, float]]", pyb::none(), kUpDoc},
-                {"scalp", "Optional[os.PathLike | str]", pyb::none(), kScalpDoc},
+               {{"scalp", "Optional[os.PathLike | str]", pyb::none(), kScalpDoc},
                 {"head", "", pyb::none(),
                  "the head strands may not enter: None (scalp's level set if given, else a sphere fitted to the roots), \"none\", "
                  "a mesh or .vdb level set path, or (x, y, z, r) a sphere."},
-                {"head_policy", "str", pyb::str(headPolicyName(kDefaultHeadPolicy)),
-                 "\"no-deeper\" (no vertex goes deeper into the head than the input's) or \"outside\"."},
                 {"return_report", "bool", pyb::bool_(false),
                  "also return ``comb --json``'s report as a dict (less the file names and the seconds), with each strand's coarsest cluster (cluster)."}},
                "Detail-preserving combing (Wang et al. 2009, §6): ``vdbhair comb``.",

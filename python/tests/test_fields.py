@@ -23,7 +23,7 @@ def test_straight_field_retraces_straight(bundle):
     t = np.linspace(0.0, 1.0, 11, dtype=np.float32)
     bent = np.stack([t, 0.3 * np.sin(3.0 * t), 0.2 * t * t], axis=1).astype(np.float32)
     strand = vdbhair.Strands(bent, [0, len(bent)])
-    out, stats = vdbhair.retrace(strand, field, return_stats=True)
+    out, stats = vdbhair.retrace(strand, field, return_report=True)
     assert stats["full_length"] == 1 and stats["strands"] == 1
     p = out.positions
     length = np.linalg.norm(np.diff(bent, axis=0), axis=1).sum()

@@ -188,6 +188,50 @@ TEST_CASE("vdbhair --help: every default is the library's", "[apps]")
                Catch::Contains(formatValue(kDefaultStepVoxels) + " of the field's voxel size"));
 }
 
+TEST_CASE("vdbhair --help: the options both front ends take, declared once, show the library's defaults", "[apps]")
+{
+    const Verbs v;
+    const SynthParams synth;
+    const TransferParams transfer;
+    const CombParams comb;
+    const FieldParams field;
+    const RefineParams refine;
+    struct Row
+    {
+        std::string verb, flag, expected;
+    };
+    const std::vector<Row> rows = {
+        // Axes by name, "auto" for the library's choice.
+        {"synth", "--strands", shownAs(synth.strands)},
+        {"synth", "--up", "auto"},
+        {"synth", "--front", "auto"},
+        {"synth", "--output-turn", shownAs(synth.outputTurn)},
+        {"transfer", "--strands", shownAs(transfer.strands)},
+        {"transfer", "--up", "auto"},
+        {"transfer", "--front", "auto"},
+        {"comb", "--up", "auto"},
+        {"comb", "--head-policy", headPolicyName(comb.headPolicy)},
+        {"field", "--levels", shownAs(FieldLevelsParams().levels)},
+        {"field", "--space", fieldSpaceName(field.space)},
+        {"field", "--up", axisName(field.scalp.up)},
+        {"refine", "--space", fieldSpaceName(refine.field.space)},
+        {"refine", "--up", axisName(refine.field.scalp.up)},
+        {"demo", "--head-policy", headPolicyName(refine.headPolicy)},
+        {"render", "--facing", "auto"},
+    };
+    for (const Row& r : rows) {
+        CAPTURE(r.verb, r.flag);
+        CHECK(v.shown(r.verb, r.flag) == r.expected);
+    }
+    // Switches (flags; --no-NAME turns off what is on by default), older spellings kept.
+    for (const auto& [verb, flag] : std::vector<std::pair<std::string, std::string>>{
+             {"synth", "--no-refine"}, {"transfer", "--no-refine"}, {"transfer", "--no-smooth-base"}, {"transfer", "--keep-base-detail"},
+             {"compare", "--no-pair-strands"}, {"compare", "--unpaired"}, {"fit", "--skip-degenerate"}, {"render", "--sheet"}}) {
+        CAPTURE(verb, flag);
+        CHECK(v.command(verb).sub->get_option_no_throw(flag) != nullptr);
+    }
+}
+
 TEST_CASE("vdbhair: range checks are the library's limits", "[apps]")
 {
     const std::string missing = test::tempPath("defaults_missing.hair");

@@ -28,6 +28,11 @@ const ParamTable<CompareParams>& compareParameters()
                                     member<P>([](P& p) -> std::size_t& { return p.samples; }));
         samples.min = double(CompareParams::kMinSamples);
         t.push_back(samples);
+        // On by default: the flag turns it off (--no-pair-strands; --unpaired, its older name).
+        auto pair = makeParam<P>("pair-strands", "Pair strand i of A with strand i of B when the counts agree (off for hairstyles whose strands do "
+                                                 "not correspond, such as a synthesis)", "", member<P>([](P& p) -> bool& { return p.pairStrands; }));
+        pair.oldFlags = {"--unpaired"};
+        t.push_back(pair);
         return t;
     }();
     return table;

@@ -11,6 +11,7 @@
 /// shape. KeepOutside (`--head-policy outside`, and the analytic tests): no retraced vertex inside.
 #pragma once
 
+#include <vdbhair/Parameters.h>
 #include <vdbhair/Types.h>
 
 #include <openvdb/openvdb.h>
@@ -100,5 +101,17 @@ constexpr HeadPolicy kDefaultHeadPolicy = HeadPolicy::NoDeeper;
 /// @throw ValueError unless "no-deeper" or "outside" (headPolicyName()'s names).
 HeadPolicy headPolicyFromName(const std::string& name);
 const char* headPolicyName(HeadPolicy policy);
+
+/// @brief The head policy of a verb that takes a head (`--head-policy`, `head_policy=`; refine and
+/// comb), declared once: the HeadPolicy member of P that @a field returns.
+template<typename P, typename F>
+Param<P> headPolicyParam(F field)
+{
+    auto p = makeParam<P>("head-policy", "How strands meet a head given: no-deeper (no vertex enters the head that the input had outside it; "
+                                         "hair already inside is left as it was) or outside (every vertex is moved out)", "",
+                          named<P>(field, headPolicyName, headPolicyFromName));
+    p.choices = {headPolicyName(HeadPolicy::NoDeeper), headPolicyName(HeadPolicy::KeepOutside)};
+    return p;
+}
 
 } // namespace vdbhair

@@ -90,7 +90,8 @@ const ParamTable<RefineParams>& refineParameters()
         margin.min = 0;
         margin.max = TraceParams::kMaxMargin;
         add(margin);
-        for (Param<P>& q : nestedParams<P>(fieldParameters(), field, {"max-voxels", "max-memory"})) add(std::move(q));
+        for (Param<P>& q : nestedParams<P>(fieldParameters(), field, {"max-voxels", "max-memory", "space", "up"})) add(std::move(q));
+        add(headPolicyParam<P>([](P& p) -> HeadPolicy& { return p.headPolicy; }));
         add(makeParam<P>("measure", "Also measure the output against the input at every level: full length, hair volume, head, curvature, "
                                 "tips, displacement, coherence (an extra field estimate per level: about a fifth of the run), and compare "
                                 "the output with the input as `vdbhair compare` does (the report's \"compare\")", "",

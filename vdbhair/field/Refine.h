@@ -55,6 +55,9 @@ struct RefineParams
     /// The head retraced strands may not enter. Unset: a sphere fitted to the roots (headFromRoots());
     /// HeadObstacle::none(): no head.
     HeadObstacle head;
+    /// The policy of a head the front end gives (a file, a sphere, the scalp): what it makes
+    /// @c head with (refine's `--head-policy`); the head fitted to the roots keeps its own.
+    HeadPolicy headPolicy = kDefaultHeadPolicy;
     /// Fill RefineLevel::measures: the output against the input (costs a field estimate per level,
     /// a fifth of the run; `refine --measure`).
     bool measure = false;

@@ -712,36 +712,6 @@ void useScalpSpace(FieldParams& params, const std::vector<Vec3f>& roots, const V
     }
 }
 
-const ParamTable<FieldParams>& fieldParameters()
-{
-    using P = FieldParams;
-    static const ParamTable<P> table = [] {
-        ParamTable<P> t;
-        auto voxel = makeParam<P>("voxel-size", "Voxel size (of the finest level)", "world units", member<P>([](P& p) -> double& { return p.voxelSize; }));
-        voxel.min = 0.0;
-        voxel.zeroMeans = "3 x the median root spacing, within 1/64..1/4 of the head radius";
-        t.push_back(voxel);
-        auto iterations = makeParam<P>("iterations", "Reweighting iterations of Eq. 9", "", member<P>([](P& p) -> int& { return p.iterations; }));
-        iterations.min = 1;
-        t.push_back(iterations);
-        auto maxVoxels = makeParam<P>("max-voxels", "Refuse voxel sizes whose voxel visits could exceed this", "",
-                                      member<P>([](P& p) -> std::uint64_t& { return p.maxVoxels; }));
-        maxVoxels.min = 1;
-        t.push_back(maxVoxels);
-        auto maxMemory = makeParam<P>("max-memory", "Refuse work whose memory estimate exceeds this (suffixes k, M, G on the command line: 16G)",
-                                      "bytes", member<P>([](P& p) -> std::uint64_t& { return p.maxMemory; }));
-        maxMemory.zeroMeans = "the memory available (MemAvailable)";
-        t.push_back(maxMemory);
-        auto density = makeParam<P>("density-reference", "Hair length per unit volume that the grid 'density' maps to 1", "world units^-2",
-                                    member<P>([](P& p) -> double& { return p.densityReference; }));
-        density.min = 0.0;
-        density.zeroMeans = "the 95th percentile of the hairstyle's";
-        t.push_back(density);
-        return t;
-    }();
-    return table;
-}
-
 TangentField estimateTangentField(const StrandSet& strands, const FieldParams& params, bool threaded,
                                   openvdb::util::NullInterrupter* interrupter)
 {

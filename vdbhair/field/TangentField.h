@@ -158,9 +158,21 @@ double suggestVoxelSize(const StrandSet& strands);
 double resolveVoxelSize(const StrandSet& strands, const FieldParams& params);
 
 /// @brief The field estimate's parameters (Parameters.h), declared once: `field` and
-/// estimate_tangent_field() offer them, and `refine` reuses those it shares (its fields').
+/// estimate_tangent_field() offer them (fieldLevelsParameters()), and `refine` reuses those it
+/// shares (its fields', the space and the up axis).
 /// Defaults are FieldParams{}'s.
 const ParamTable<FieldParams>& fieldParameters();
+
+/// `field`'s parameters: the estimate's and the number of levels (estimateTangentFieldLevels()).
+struct FieldLevelsParams
+{
+    FieldParams field;
+    int levels = 1;  ///< 1 to FieldParams::kMaxLevels; level l has voxel size field.voxelSize · 2^l
+};
+
+/// @brief field's parameters declared once: fieldParameters() and the levels (Python's
+/// estimate_tangent_field(levels=None) returns one field rather than a list of one).
+const ParamTable<FieldLevelsParams>& fieldLevelsParameters();
 
 /// @brief Estimate the field of @a strands at one voxel size (params.voxelSize, 0: resolveVoxelSize()).
 /// @throw ValueError (empty hairstyle, voxel size negative or not finite, iterations < 1),

@@ -228,6 +228,7 @@ const ParamTable<InterpolateParams>& interpolateParameters()
         add(makeParam<P>("max-vertices", "Refuse requests that would make more vertices (12 bytes each), estimated before any work", "",
                          ParamAccess<P, std::uint64_t>{[](const P& p) { return std::uint64_t(p.helicoid.maxVertices); },
                                                        [](P& p, std::uint64_t v) { p.helicoid.maxVertices = p.points.maxVertices = v; }}));
+        add(makeAxisParam<P>("up", "Reference axis of surface frames (and of roots spread on a scalp)", [](P& p) -> Vec3d& { return p.helicoid.up; }));
         return t;
     }();
     return table;

@@ -162,6 +162,8 @@ const ParamTable<FitParams>& fitParameters()
                                  member<P>([](P& p) -> bool& { return p.optimizeRoll; }));
         roll.valued = true;
         t.push_back(roll);
+        t.push_back(makeParam<P>("skip-degenerate", "Leave out strands of zero length instead of failing", "",
+                                 member<P>([](P& p) -> bool& { return p.skipDegenerate; })));
         return t;
     }();
     return table;

@@ -61,6 +61,9 @@ struct FitParams
     double step = 0.0;            ///< the regrown strands' tracing step (world units); 0: a quarter of the mean segment length
     double axisClearance = kAxisClearanceSteps; ///< a piece is accepted only if its trace stays this many steps from its singular axis (0: no check, the former fitter)
     double stepDeviationLimit = 0.1; ///< a fit whose trace at a quarter of its step moves by more than this fraction of the tolerance is refitted with every piece clear of its axis
+    /// Strands of zero length are left out of the scene the front ends make (fitStrands() reports
+    /// them either way); false: they are refused
+    bool skipDegenerate = false;
 
     /// Fewest Nelder–Mead evaluations a piece may be given (a 5-parameter simplex needs 6 to start).
     static constexpr int kMinEvaluations = 10;

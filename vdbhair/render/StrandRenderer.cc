@@ -93,6 +93,22 @@ const ParamTable<RenderParams>& renderParameters()
         for (ColorBy c : {ColorBy::Shaded, ColorBy::Root, ColorBy::Tangent, ColorBy::Depth, ColorBy::Curvature, ColorBy::Strand, ColorBy::Error})
             colorBy.choices.push_back(colorByName(c));
         t.push_back(colorBy);
+        t.push_back(makeAxisParam<P>("up", "The hairstyle's up axis (z for Yuksel's cyHair models)", [](P& p) -> Vec3d& { return p.up; }));
+        // Unset is auto: the zero vector reads and writes it (defaultFacing()).
+        auto facing = makeParam<P>("facing", "The axis the face looks along, perpendicular to up (the front view looks at it; cyHair models: "
+                                             "up z, facing y)", "",
+                                   ParamAccess<P, Vec3d>{[](const P& p) { return p.facing.value_or(Vec3d(0.0)); },
+                                                         [](P& p, Vec3d v) {
+                                                             if (v == Vec3d(0.0)) p.facing.reset();
+                                                             else p.facing = v;
+                                                         }});
+        facing.zeroMeans = "z, or -y for a z up (Blender's)";
+        facing.choices.push_back("auto");
+        for (const std::string& n : axisNames()) facing.choices.push_back(n);
+        facing.pythonNone = true;
+        t.push_back(facing);
+        t.push_back(makeParam<P>("title", "Text in the top-left corner", "", member<P>([](P& p) -> std::string& { return p.title; })));
+        t.push_back(makeParam<P>("sheet", "One image with the front, side, top and three-quarter views", "", member<P>([](P& p) -> bool& { return p.sheet; })));
         return t;
     }();
     return table;

@@ -72,10 +72,14 @@ struct RenderParams
     /// of this hairstyle (the per-vertex term of the Chamfer distance, strands/Compare.h), so
     /// where two hairstyles differ shows. Required by ColorBy::Error.
     const StrandSet* reference = nullptr;
+    /// The front ends draw the sheet of four views (renderSheet()) instead of one (renderStrands()).
+    bool sheet = false;
 };
 
-/// @brief render's parameters declared once (vdbhair/Parameters.h): the view, the image's size and
-/// the colouring; the command's options, `--help` and docs/cli.md's table are made from it.
+/// @brief render's parameters declared once (vdbhair/Parameters.h): the view, the image's size, the
+/// colouring, the axes (up, facing), the title and the sheet; the command's options, `--help`,
+/// Python's keywords and docs/cli.md's table are made from it. The files (guides, head,
+/// reference) are each front end's own.
 const ParamTable<RenderParams>& renderParameters();
 
 /// @brief The facing direction used when RenderParams::facing is not set (see there).

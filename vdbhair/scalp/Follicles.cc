@@ -645,6 +645,7 @@ const ParamTable<FollicleParams>& follicleParameters()
         initial.aboveMin = true;
         initial.max = 4.0;
         t.push_back(initial);
+        t.push_back(makeAxisParam<P>("up", "Reference axis of the tangent frame", [](P& p) -> Vec3d& { return p.up; }));
         return t;
     }();
     return table;

@@ -152,12 +152,13 @@ const ParamTable<CombParams>& combParameters()
     using P = CombParams;
     static const ParamTable<P> table = [] {
         ParamTable<P> t = nestedParams<P>(synthParameters(), [](P& p) -> SynthParams& { return p.synth; },
-                                          {"levels", "seed", "vertices", "threshold", "initial-clusters"});
+                                          {"levels", "seed", "vertices", "threshold", "initial-clusters", "up"});
         auto smoothing = makeParam<P>("smoothing", "Sigma of the strand directions the strokes turn, a fraction of the vertices (detail below it rides along)", "",
                                       member<P>([](P& p) -> double& { return p.smoothing; }));
         smoothing.min = 0.0;
         smoothing.max = 1.0;
         t.push_back(smoothing);
+        t.push_back(headPolicyParam<P>([](P& p) -> HeadPolicy& { return p.headPolicy; }));
         return t;
     }();
     return table;

@@ -81,14 +81,17 @@ struct CombParams
     /// combHair() is given one, else the sphere fitted to the roots (headFromRoots(), NoDeeper);
     /// HeadObstacle::none(): no head.
     HeadObstacle head;
+    /// The policy of a head the front end gives (a file, a sphere): what it makes @c head with
+    /// (`--head-policy`); the scalp's and the one fitted to the roots keep their own.
+    HeadPolicy headPolicy = kDefaultHeadPolicy;
 
     /// @throw ValueError naming the parameter, its value and the rule.
     void validate(const char* where) const;
 };
 
 /// @brief comb's parameters declared once (Parameters.h): synth's hierarchy (synthParameters(),
-/// nested: their defaults are CombParams::synth's), then the smoothing. The head, up and the
-/// strokes are each front end's own.
+/// nested: their defaults are CombParams::synth's) and up, then the smoothing and the head policy.
+/// The head, the scalp and the strokes are each front end's own.
 const ParamTable<CombParams>& combParameters();
 
 struct CombStats

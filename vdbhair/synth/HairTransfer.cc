@@ -18,7 +18,11 @@ const ParamTable<TransferParams>& transferParameters()
         // synth's, but for the coarsest level's layout and roots, which transfer takes from BASE.
         ParamTable<P> t = nestedParams<P>(synthParameters(), [](P& p) -> SynthParams& { return p.synth; },
                                           {"levels", "seed", "vertices", "threshold", "initial-clusters", "components", "detail", "detail-scale",
-                                           "match-balance", "match-candidates", "match-place", "refine-mode", "voxel-size"});
+                                           "match-balance", "match-candidates", "match-place", "refine-mode", "voxel-size", "refine", "up", "front",
+                                           "measure"});
+        // Measured against BASE, the hairstyle whose flow the output keeps (measureTransfer()).
+        for (Param<P>& q : t)
+            if (q.name == "measure") q.help = "Also compare the output with BASE as `vdbhair compare` does (the report's \"compare\"; BASE is the reference)";
         auto smoothing = makeParam<P>("smoothing", "Sigma of the smoothing of DETAILS' coarsest strands, a fraction of their vertices", "",
                                       member<P>([](P& p) -> double& { return p.smoothing; }));
         smoothing.min = 0.0;
@@ -27,6 +31,16 @@ const ParamTable<TransferParams>& transferParameters()
         t.push_back(smoothing);
         t.push_back(makeParam<P>("guides", "BASE's strands are the coarsest level as they are (a few guides); finer roots are spread over their region", "",
                                  member<P>([](P& p) -> bool& { return p.guides; })));
+        auto strands = makeParam<P>("strands", "With guides: strands in the output", "", member<P>([](P& p) -> std::size_t& { return p.strands; }));
+        strands.min = 0;
+        strands.zeroMeans = "DETAILS' strands per coarsest strand, times the guides";
+        strands.pythonNone = true;
+        t.push_back(strands);
+        // On by default: the flag turns it off (--no-smooth-base; --keep-base-detail, its older name).
+        auto smoothBase = makeParam<P>("smooth-base", "Smooth BASE's coarsest level as DETAILS' is (the paper does not: BASE's own wisp-level "
+                                                      "waves stay, under DETAILS')", "", member<P>([](P& p) -> bool& { return p.smoothBase; }));
+        smoothBase.oldFlags = {"--keep-base-detail"};
+        t.push_back(smoothBase);
         return t;
     }();
     return table;

@@ -81,8 +81,9 @@ struct TransferParams
 
 /// @brief transfer's parameters declared once (Parameters.h): synth's hierarchy, detail transfer
 /// and refinement (synthParameters(), nested: their defaults are TransferParams::synth's), then
-/// the smoothing and the guides. BASE's smoothing switch, up, front and the strand count are each
-/// front end's own.
+/// the smoothing, the guides, the output's strand count with guides and BASE's smoothing switch;
+/// refinement on or off, up, front and measuring are synth's (measured against BASE). The files
+/// (scalp, head) are each front end's own.
 const ParamTable<TransferParams>& transferParameters();
 
 struct TransferResult

@@ -147,6 +147,29 @@ void addDetailParams(ParamTable<SP>& t)
     t.push_back(voxel);
 }
 
+/// What a run takes besides: the output's count, refinement, the axes, the output turn, measuring.
+void addRunParams(ParamTable<SP>& t)
+{
+    auto strands = makeParam<SP>("strands", "Strands in the output (every level scales alike)", "", member<SP>([](SP& p) -> std::size_t& { return p.strands; }));
+    strands.min = 0;
+    strands.zeroMeans = "the example's density over the region";
+    strands.pythonNone = true;
+    t.push_back(strands);
+    t.push_back(makeParam<SP>("refine", "Refine every level (Wang et al. §5.3)", "", member<SP>([](SP& p) -> bool& { return p.refine; })));
+    t.push_back(makeAxisParam<SP>("up", "The scalp's up axis", [](SP& p) -> Vec3d& { return p.up; },
+                                  "the mean direction from the head's centre to the roots"));
+    t.push_back(makeAxisParam<SP>("front", "The head's front for the report by region", [](SP& p) -> Vec3d& { return p.front; },
+                                  "where the hairline is highest"));
+    // Degrees in both front ends, radians in the library.
+    t.push_back(makeParam<SP>("output-turn", "With an output scalp: the turn about the up axis of the layout on the other head (heads that face "
+                                             "different ways)", "degrees",
+                              ParamAccess<SP, double>{[](const SP& p) { return p.outputTurn * 180.0 / M_PI; },
+                                                      [](SP& p, double v) { p.outputTurn = v * M_PI / 180.0; }}));
+    t.push_back(makeParam<SP>("measure", "Also compare the output with the example as `vdbhair compare` does (the report's \"compare\"; on another "
+                                         "head, the output moved back onto the example's scalp): about 1-3 s more at 100,000 strands", "",
+                              member<SP>([](SP& p) -> bool& { return p.measure; })));
+}
+
 } // namespace
 
 const ParamTable<SynthParams>& synthParameters()
@@ -156,6 +179,7 @@ const ParamTable<SynthParams>& synthParameters()
         addHierarchyParams(t);
         addLayoutParams(t);
         addDetailParams(t);
+        addRunParams(t);
         return t;
     }();
     return table;

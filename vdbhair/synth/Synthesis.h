@@ -125,6 +125,9 @@ struct SynthParams
     std::uint64_t seed = 0;
     /// Refuse outputs above this many vertices (16 bytes each with the samples, before refinement).
     std::uint64_t maxVertices = std::uint64_t(1) << 28;
+    /// Also compare the output with its source as `vdbhair compare` does, for the report's
+    /// "compare" (measureSynthesis(), measureTransfer(): 1-3 s more at 100,000 strands).
+    bool measure = false;
 
     /// @throw ValueError naming the parameter, its value and the rule.
     /// The head the new hair may enter no deeper than the example's hair (keepHairOutOfHead()), swept out of it along a length as
@@ -141,9 +144,10 @@ struct SynthParams
 /// threshold, initial clusters), the coarsest level's layout (map spacing, layout, place weight,
 /// nearby, root density) and detail transfer and refinement (components, detail, detail scale,
 /// matching, refine mode, voxel size). `transfer` and `comb` declare theirs from these
-/// (transferParameters(), combParameters()), with their own structs' defaults.
-/// The axes (up, front: vectors in the library, names or tuples in the front ends), the switch of
-/// refinement and the output's strand count are each front end's own.
+/// (transferParameters(), combParameters()), with their own structs' defaults. Then what a run
+/// takes besides: the output's strand count, refinement on or off, the axes (up, front: names on
+/// the command line, names or vectors in Python, makeAxisParam()), the output turn and measuring.
+/// The files (scalp, region, output scalp, head) are each front end's own.
 const ParamTable<SynthParams>& synthParameters();
 
 struct SynthStage
