@@ -332,6 +332,28 @@ TEST_CASE("combHair on a real groom with its head mesh: no kinks at the shoulder
     CHECK(double(changed) < 1e-3 * double(segments));
 }
 
+TEST_CASE("combHair: Ruby's long hair pressed into her head mesh gains no kink", "[synth][data]")
+{
+    // scripts/head_table.py's press: a stroke from behind the head into its back, made from the
+    // head's box. Where her coarse level set (voxel 2.9) is no distance inside, the last push out
+    // of the head moved a vertex 0.18 too deep by 4.3 and bent strands by 90-113 degrees (3 new
+    // kinks). One is left: a tip edge the last sweep turns by 80 degrees, after the smoothing.
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string dir = vdbhair::test::sharedData();
+    const StrandSet hair = readStrands(dir + "/hair/tressfx/ascii_v2/ruby_long_hair_16_guide.tfx");
+    CombStroke press;
+    press.points = {Vec3d(-1.4692, 15.4267, -83.0102), Vec3d(-1.4692, -14.6921, -7.7133)};
+    press.radius = 36.1425;
+    CombParams params;
+    params.head = readHeadObstacle(dir + "/scalp/tressfx/ruby_head.obj", "test");
+    const CombResult combed = combHair(hair, {press}, params);
+    REQUIRE(combed.stats.movedStrands > 2000);
+    std::size_t kinks = 0;
+    for (std::size_t i = 0; i < hair.numStrands(); ++i) kinks += maxEdgeTurnDegrees(combed.strands, i) > 45.0 && maxEdgeTurnDegrees(hair, i) <= 45.0;
+    CHECK(kinks <= 1);
+    CHECK(combed.stats.newKinks == kinks);
+}
+
 TEST_CASE("readStrokes: the format and its errors", "[synth]")
 {
     const auto write = [&](const std::string& name, const std::string& text) {

@@ -278,7 +278,14 @@ bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle
         pos[k] = Vec3f(float(w.p[k].x()), float(w.p[k].y()), float(w.p[k].z()));
         double d = probe.distance(toD(pos[k]));
         if (d < fl) {
+            // Pushed along the normal by about its shortfall. Where the level set is no distance
+            // (a coarse head's dilated interior: its gradient a fraction of 1), the Newton steps of
+            // pushOut() wandered: a vertex 0.18 too deep in Ruby's head (voxel 2.9) moved 4.3,
+            // bending its strand 113 degrees. Such a vertex stays, counted as too deep (pushOut()
+            // aims a hair past the floor: a hundredth of the edge covers that).
+            const Vec3d at = w.p[k];
             probe.pushOut(w.p[k], fl);
+            if ((w.p[k] - at).length() > 3.0 * (fl - d) + 0.01 * w.seg[k]) w.p[k] = at;
             pos[k] = Vec3f(float(w.p[k].x()), float(w.p[k].y()), float(w.p[k].z()));
             d = probe.distance(toD(pos[k]));
             if (d < fl) ++tooDeep;
@@ -446,21 +453,24 @@ std::vector<float> referenceDepthAllowance(const StrandSet& strands, const Stran
                 allowed[b + k] = float(depth);
             }
             // Where the reference leaves the head its depth drops within a segment, and a root
-            // deeper than the reference's has further to rise: a floor that jumps would turn the
-            // new strand at one vertex. The allowance may fall by at most tan 30° per unit of arc
-            // length from its root's own depth on, so the strand rises over a length.
-            constexpr double kRise = 0.57735027;
+            // deeper than the reference's has further to rise.
             float* a = allowed.data() + b;
             a[0] = std::max(a[0], float(std::max(0.0, -probe.distance(root))));
-            for (std::size_t k = 1; k < n; ++k) {
-                const double seg = (toD(strands.positions[b + k]) - toD(strands.positions[b + k - 1])).length();
-                a[k] = std::max(a[k], float(a[k - 1] - kRise * seg));
-            }
+            limitAllowanceFall(strands.positions.data() + b, n, a);
         }
     };
     if (threaded) tbb::parallel_for(tbb::blocked_range<std::size_t>(0, strands.numStrands(), 256), run);
     else run(tbb::blocked_range<std::size_t>(0, strands.numStrands()));
     return allowed;
+}
+
+void limitAllowanceFall(const Vec3f* positions, std::size_t n, float* allowed)
+{
+    constexpr double kRise = 0.57735027;  // tan 30°
+    for (std::size_t k = 1; k < n; ++k) {
+        const double seg = (toD(positions[k]) - toD(positions[k - 1])).length();
+        allowed[k] = std::max(allowed[k], float(allowed[k - 1] - kRise * seg));
+    }
 }
 
 double headTolerance(const HeadObstacle& head)

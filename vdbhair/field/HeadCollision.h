@@ -84,6 +84,12 @@ std::vector<float> rootDepthAllowance(const StrandSet& strands, const HeadObstac
 std::vector<float> referenceDepthAllowance(const StrandSet& strands, const StrandSet& reference, const HeadObstacle& head, bool threaded = true,
                                            const std::vector<std::uint32_t>* nearest = nullptr);
 
+/// @brief Let the allowance @a allowed of one strand (its @a n vertices at @a positions) fall by at
+/// most tan 30° per unit of arc length from vertex to vertex, raising it where it falls faster: a
+/// floor that jumps (where the hair it follows leaves the head within a segment) would turn the
+/// strand at one vertex; so it rises over a length.
+void limitAllowanceFall(const Vec3f* positions, std::size_t n, float* allowed);
+
 /// @brief New hair grows where the reference's does: each strand of @a strands whose root is deeper
 /// inside @a head than the root of the @a reference strand nearest it is moved out, whole (its
 /// shape unchanged), along the head's normal at its root by the difference. In parallel, identical

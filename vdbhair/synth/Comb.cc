@@ -380,7 +380,10 @@ void keepOutOfHead(const CombRun& run, const HeadObstacle& head, CombResult& res
         HeadObstacle::Probe probe(head);
         for (std::size_t s = 0; s < n; ++s) {
             if (!touchedStrand[s]) continue;
+            float* a = allowed.data() + w;
             for (std::size_t v = 0; v < strands.size(s); ++v, ++w) allowed[w] = float(std::max(0.0, -probe.distance(Vec3d(strands.data(s)[v]))));
+            // Where the input leaves the head, the combed strand rises over a length.
+            limitAllowanceFall(res.strands.data(s), strands.size(s), a);
         }
     }
     const HeadCollisionStats hc = resolveHeadCollisions(combed, head, allowed, {}, run.threaded);
