@@ -22,7 +22,7 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
 {
     for (const Param<P>& param : table) {
         if (std::find(skip.begin(), skip.end(), param.name) != skip.end()) continue;
-        const std::string flag = param.flag(), help = paramHelp(param);
+        const std::string flag = param.flag() + (param.shortFlag.empty() ? "" : "," + param.shortFlag), help = paramHelp(param);
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(target))>;
             if constexpr (std::is_same_v<T, bool>) {

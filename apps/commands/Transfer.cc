@@ -46,7 +46,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
         tr = transferHairstyle(details, base, params, scalp, true, common.interrupter);
     } catch (const ValueError& e) {
         // The library names the hairstyles DETAILS and BASE; the message names the files.
-        std::string what = e.what();
+        std::string what = spelledMessage(e, ParamSpelling::Flag);
         const auto name = [&](const std::string& word, const std::string& by) {
             for (std::size_t at = what.find(word); at != std::string::npos; at = what.find(word, at + by.size())) what.replace(at, word.size(), by);
         };
@@ -125,8 +125,7 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
                 }
                 params.synth.head = headFromOptions(HeadOptions{p->head}, params.synth.head);
                 return runTransferJob(p->job, params, common);
-            },
-            synthTransferFlags()};
+            }};
 }
 
 } // namespace vdbhair::app

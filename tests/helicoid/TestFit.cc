@@ -246,7 +246,7 @@ TEST_CASE("fitStrands: parameters outside their ranges are refused before any wo
     for (const int bad : {0, -3, FitParams::kMaxPieces + 1}) {
         params.maxPieces = bad;
         CAPTURE(bad);
-        REQUIRE_THROWS_WITH(fitStrands(s, params), Contains("fitStrands: maxPieces " + std::to_string(bad) + ": must be between 1 and 64"));
+        REQUIRE_THROWS_WITH(fitStrands(s, params), Contains("fitStrands: max_pieces " + std::to_string(bad) + ": must be between 1 and 64"));
         REQUIRE_THROWS_AS(fitStrand(s.data(0), s.size(0), params), ValueError);
     }
     params.maxPieces = FitParams::kMaxPieces;
