@@ -115,7 +115,7 @@ openvdb::FloatGrid::Ptr applyScalpOptions(const ScalpOptions& opts, const Strand
     try {
         useScalpSpace(params, roots, up, sphere.empty() ? nullptr : &given, surface);
     } catch (const ValueError& e) {
-        throw ValueError((opts.scalp.empty() ? std::string("--space scalp") : "--scalp " + opts.scalp) + ": " + e.what());
+        throw ValueError((opts.scalp.empty() ? std::string("--space scalp") : "--scalp " + opts.scalp) + ": " + spelledMessage(e, ParamSpelling::Flag));
     }
     return surface;
 }

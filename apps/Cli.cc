@@ -88,6 +88,7 @@ void addReadOptions(CLI::App* sub, CommonOptions& common)
         ->check(CLI::IsMember({"first", "last", "auto"}))
         ->capture_default_str();
     if (head) head->each([&common](const std::string& path) { common.rootsHead = path; });
+    if (rootsTaken) sub->preparse_callback([&common](std::size_t) { common.rootsFlag = "--root-end"; });
 }
 
 ReadOptions readOptions(const CommonOptions& common)
@@ -97,31 +98,19 @@ ReadOptions readOptions(const CommonOptions& common)
     opts.pointsPerStrand = common.pointsPerStrand;
     opts.curveSamples = common.curveSamples;
     opts.roots = rootEndFromName(common.roots);
+    opts.spelling = ParamSpelling::Flag;
+    opts.rootsName.flag = common.rootsFlag;
     if (opts.roots == RootEnd::Auto && !common.rootsHead.empty() && common.rootsHead != "none") {
         opts.rootsHeadDistance = headSurfaceDistance(common.rootsHead);
     }
     return opts;
 }
 
-/// The readers' parameters, as their messages name them, spelled as flags.
-const FlagNames& readerFlagNames()
-{
-    static const FlagNames names = {{"RenderParams::up", "--up"},
-                                    {"ReadOptions::pointsPerStrand", "--points-per-strand"},
-                                    {"ReadOptions::curveSamples", "--curve-samples"},
-                                    {"ReadOptions::roots", "--roots"}};  // interpolate: --root-end (see run())
-    return names;
-}
-
 void printWarnings(const std::string& verb, const ReadReport& report, const CommonOptions& common)
 {
     if (common.quiet) return;
-    // Readers name library parameters; a verb that reads strands may render them (`render --up`).
-    FlagNames readerFlags = readerFlagNames();
-    if (verb == "interpolate") {  // its --roots names root positions; the root end is --root-end there
-        for (auto& [name, flag] : readerFlags) if (name == "ReadOptions::roots") flag = "--root-end";
-    }
-    for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << withFlagNames(w, readerFlags) << "\n";
+    // The readers spell their options as flags (readOptions() sets ReadOptions::spelling).
+    for (const std::string& w : report.warnings) std::cerr << "vdbhair " << verb << ": warning: " << w << "\n";
 }
 
 std::string formatValue(double v)
@@ -219,27 +208,6 @@ void keepUnwindReserve()
 
 } // namespace
 
-std::string withFlagNames(const std::string& message, const FlagNames& names)
-{
-    auto wordChar = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; };
-    std::string out = message;
-    for (const auto& [name, flag] : names) {
-        const bool identifier = std::any_of(name.begin(), name.end(), [](char c) { return std::isupper(static_cast<unsigned char>(c)); });
-        for (std::size_t at = out.find(name); at != std::string::npos; at = out.find(name, at)) {
-            const std::size_t end = at + name.size();
-            const bool word = (at == 0 || !wordChar(out[at - 1])) && (end == out.size() || !wordChar(out[end]));
-            const bool named = at == 0 || (at >= 2 && out.compare(at - 2, 2, ": ") == 0);
-            if (word && (identifier || named)) {
-                out.replace(at, name.size(), flag);
-                at += flag.size();
-            } else {
-                at = end;
-            }
-        }
-    }
-    return out;
-}
-
 int run(int argc, char** argv)
 {
     CLI::App app{"vdbhair " VDBHAIR_VERSION_STRING
@@ -312,28 +280,26 @@ int run(int argc, char** argv)
         keepUnwindReserve();
         TerminalProgress progress(verb, common.quiet);
         common.interrupter = &progress;
-        // Errors: one line, after the progress line is erased, with the library's parameter names
-        // spelled as this verb's flags.
-        FlagNames flags = c.flags;
-        flags.emplace_back("OverwritePolicy::NoClobber", "--no-clobber");
-        flags.insert(flags.end(), readerFlagNames().begin(), readerFlagNames().end());
+        // Errors: one line, after the progress line is erased, the parameters a library error
+        // names (ParamError) spelled as flags.
         auto fail = [&](int code, const std::string& message) {
             progress.clear();
-            std::cerr << "vdbhair " << verb << ": " << withFlagNames(message, flags) << "\n";
+            std::cerr << "vdbhair " << verb << ": " << message << "\n";
             return code;
         };
+        const auto flagged = [](const std::exception& e) { return spelledMessage(e, ParamSpelling::Flag); };
         try {
             return c.run();
         } catch (const InterruptedError&) {  // 128 + the signal, as a shell reports it: 130 for Ctrl-C, 143 for SIGTERM
             return fail(128 + (interruptSignal() ? interruptSignal() : SIGINT), "interrupted; no partial output was written");
         } catch (const ValueError& e) {
-            return fail(2, e.what());
+            return fail(2, flagged(e));
         } catch (const Error& e) {
-            return fail(1, e.what());
+            return fail(1, flagged(e));
         } catch (const std::bad_alloc&) {
             return fail(1, "out of memory");
         } catch (const std::exception& e) {
-            return fail(1, e.what());
+            return fail(1, flagged(e));
         }
     }
     return 2;

@@ -45,6 +45,7 @@ struct CommonOptions
     std::size_t curveSamples = 0;
     std::string roots = "first";  ///< --roots first|last|auto
     std::string rootsHead;        ///< the verb's --head, when it has one (for --roots auto)
+    std::string rootsFlag = "--roots";  ///< the flag of `roots` (interpolate's: --root-end)
 };
 
 /// @brief Add the strand readers' options (--points-per-strand, --curve-samples, --roots) to a verb
@@ -75,23 +76,13 @@ private:
     WorkInterrupter* mI;
 };
 
-/// @brief The library's names of parameters, as its error messages spell them (a struct field
-/// such as maxVoxels, or a word such as margin), each with the flag of a verb that sets it.
-/// The library names parameters, never flags; the app maps them (withFlagNames()).
-using FlagNames = std::vector<std::pair<std::string, std::string>>;
-
-/// @brief @a message with the parameter names of @a names spelled as their flags: a name with a
-/// capital letter (an identifier: maxVoxels) wherever it stands as a word, a lower-case name
-/// (margin) only where a message names its parameter, at its start or after ": ".
-std::string withFlagNames(const std::string& message, const FlagNames& names);
-
-/// A registered subcommand: its CLI11 node, the function that runs it (returns the exit code)
-/// and the flags of the library parameters its errors may name.
+/// A registered subcommand: its CLI11 node and the function that runs it (returns the exit code).
+/// The library's errors name parameters as ParamErrors (vdbhair/Parameters.h), which run() prints
+/// with the flags' spelling.
 struct Command
 {
     CLI::App* sub = nullptr;
     std::function<int()> run;
-    FlagNames flags = {};
 };
 
 /// @brief What a voxel size of 0 picks (suggestVoxelSize(), vdbhair/field/TangentField.h), for
@@ -106,9 +97,6 @@ void printWarnings(const std::string& verb, const ReadReport& report, const Comm
 
 /// @brief @a v as the user would type it (shortest form that reads back the same: 0.02, not 0.020000).
 std::string formatValue(double v);
-
-/// @brief A grid's description as JSON (info --json and inspect --json share it).
-nlohmann::json gridInfoJson(const GridInfo& g);
 
 /// @brief Print @a j on stdout as one line.
 void printJson(const nlohmann::json& j);
@@ -193,9 +181,6 @@ Command addCombCommand(CLI::App& app, CommonOptions& common);
 Command addBatchCommand(CLI::App& app, CommonOptions& common);
 Command addPrepareCommand(CLI::App& app, CommonOptions& common);
 
-/// @brief The flag of the one rule of the declared synth parameters that the library checks
-/// itself (--match-balance: 0 or at least 1), for synth and transfer.
-FlagNames synthTransferFlags();
 
 /// @brief The scalp named by a verb's --scalp option (ScalpSurface.h's readScalp(), shown as a
 /// stage), or null when @a path is empty.

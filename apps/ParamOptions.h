@@ -22,7 +22,7 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
 {
     for (const Param<P>& param : table) {
         if (std::find(skip.begin(), skip.end(), param.name) != skip.end()) continue;
-        std::string flag = param.flag();
+        std::string flag = param.flag() + (param.shortFlag.empty() ? "" : "," + param.shortFlag);
         for (const std::string& old : param.oldFlags) flag += "," + old;
         const std::string help = paramHelp(param);
         std::visit([&](const auto& a) {

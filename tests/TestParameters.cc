@@ -1,5 +1,7 @@
 #include "TestUtil.h"
 
+#include "../apps/AppParameters.h"
+
 #include <vdbhair/Parameters.h>
 #include <vdbhair/compare/HairComparison.h>
 #include <vdbhair/dataset/Prepare.h>
@@ -11,6 +13,7 @@
 #include <vdbhair/helicoid/Reconstruction.h>
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/ConvertStrands.h>
+#include <vdbhair/io/RootEnd.h>
 #include <vdbhair/render/SliceRenderer.h>
 #include <vdbhair/render/StrandRenderer.h>
 #include <vdbhair/scalp/Follicles.h>
@@ -560,4 +563,75 @@ TEST_CASE("Parameters: what synth, transfer, comb, field and refine share is dec
     setParam(refineParameters(), "space", rp, std::string("scalp"));
     CHECK(rp.field.scalp.up == Vec3d(0.0, 0.0, -1.0));
     CHECK(rp.field.space == FieldSpace::Scalp);
+
+TEST_CASE("Parameters: batch's and demo's declarations (the command line's own verbs), in docs/cli.md", "[params]")
+{
+    using app::BatchParams;
+    const ParamTable<BatchParams>& b = app::batchParameters();
+    CHECK(declared(b, "jobs").defaultText() == std::to_string(BatchParams{}.jobs));
+    CHECK(declared(b, "jobs").flag() == "--jobs");
+    CHECK(declared(b, "retry-failed").flag() == "--retry-failed");
+    BatchParams p;
+    p.jobs = -1;
+    REQUIRE_THROWS_WITH(checkParams(b, p, ParamSpelling::Flag, ""), "--jobs -1: must be at least 0");
+    checkDeclaration(b, "batch");
+    // demo: refine's declaration but --measure (the demo always measures).
+    const ParamTable<RefineParams>& d = app::demoParameters();
+    CHECK(d.size() + 1 == refineParameters().size());
+    CHECK(findParam(d, "measure") == nullptr);
+    CHECK(declared(d, "levels").defaultText() == declared(refineParameters(), "levels").defaultText());
+    checkDeclaration(d, "demo");
+}
+
+TEST_CASE("Parameters: a library error names its parameters, each front end spells them (ParamError)", "[params]")
+{
+    // Rules the declared ranges cannot say, checked by the library itself.
+    FitParams fp;
+    fp.step = -1.0;
+    try {
+        fp.validate("fit");
+        FAIL("FitParams::validate accepted step -1");
+    } catch (const ValueError& e) {
+        CHECK(spelledMessage(e, ParamSpelling::Flag) == "fit: --step -1: must be a positive finite length (0: a quarter of the mean segment length)");
+        CHECK(std::string(e.what()) == "fit: step -1: must be a positive finite length (0: a quarter of the mean segment length)");
+    }
+    fp = FitParams{};
+    fp.lambda = -1.0;
+    try {
+        fp.validate("fit");
+        FAIL("FitParams::validate accepted lambda -1");
+    } catch (const ValueError& e) {
+        CHECK(spelledMessage(e, ParamSpelling::Flag) == "fit: --lambda -1: must be zero or positive");
+        CHECK(spelledMessage(e, ParamSpelling::Keyword) == "fit: lambda_ -1: must be zero or positive");
+    }
+    SynthParams sp;
+    sp.match.balance = 0.5;
+    try {
+        sp.match.validate("transfer");
+        FAIL("DetailMatchParams::validate accepted a balance of 0.5");
+    } catch (const ValueError& e) {
+        CHECK(spelledMessage(e, ParamSpelling::Flag) == "transfer: --match-balance 0.5: 0 (off) or a finite factor of at least 1");
+        CHECK(spelledMessage(e, ParamSpelling::Keyword) == "transfer: match_balance 0.5: 0 (off) or a finite factor of at least 1");
+    }
+    RefineParams rp;
+    rp.consistency.zFull = rp.consistency.zStart;
+    try {
+        rp.validate("refine");
+        FAIL("RefineParams::validate accepted an outlier full no higher than its start");
+    } catch (const ValueError& e) {
+        CHECK_THAT(spelledMessage(e, ParamSpelling::Flag), Contains("refine: --outlier-full 2: must be finite and above --outlier-start 2"));
+        CHECK_THAT(e.what(), Contains("refine: outlier_full 2: must be finite and above outlier_start 2"));
+    }
+    // The readers' options, in Python's spelling (read()'s keywords) unless told otherwise.
+    try {
+        rootEndFromName("tip");
+        FAIL("rootEndFromName accepted tip");
+    } catch (const ValueError& e) {
+        CHECK(spelledMessage(e, ParamSpelling::Flag) == "--roots 'tip': must be first, last or auto");
+        CHECK(std::string(e.what()) == "roots='tip': must be first, last or auto");
+    }
+    // ParamText keeps its parts apart.
+    const ParamText text{"a ", ParamName{"--x", "x_"}, " b"};
+    CHECK(text.spelled(ParamSpelling::Flag) == "a --x b");
+    CHECK(text.spelled(ParamSpelling::Keyword) == "a x_ b");
 }

@@ -34,10 +34,20 @@ std::string formatBytes(std::uint64_t bytes)
 
 void checkMemory(const std::string& where, std::uint64_t estimate, const std::string& how, const std::string& advice, std::uint64_t maxMemory)
 {
+    checkMemory(where, estimate, how, ParamText{advice}, maxMemory, ParamName{"maxMemory", "maxMemory"});
+}
+
+void checkMemory(const std::string& where, std::uint64_t estimate, const std::string& how, const ParamText& advice,
+                 std::uint64_t maxMemory, const ParamName& maxMemoryName)
+{
     const std::uint64_t available = availableMemoryBytes(maxMemory);
     if (estimate <= available) return;
-    throw LimitError(where + ": needs about " + formatBytes(estimate) + " (" + how + "), more than the " + formatBytes(available) +
-                     (maxMemory > 0 ? " of maxMemory" : " available (MemAvailable)") + (advice.empty() ? "" : "; " + advice));
+    ParamText text{where + ": needs about " + formatBytes(estimate) + " (" + how + "), more than the " + formatBytes(available)};
+    if (maxMemory > 0) text += " of ", text += maxMemoryName;
+    else text += " available (MemAvailable)";
+    const std::string plain = advice.spelled(ParamSpelling::Keyword);
+    if (!plain.empty()) text += "; ", text += advice;
+    throw ParamError<LimitError>(text);
 }
 
 namespace {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <vdbhair/Parallel.h>
+#include <vdbhair/Parameters.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -40,6 +41,10 @@ std::string formatBytes(std::uint64_t bytes);
 /// @param advice what to change, e.g. "fewer vertices per strand"
 void checkMemory(const std::string& where, std::uint64_t estimate, const std::string& how, const std::string& advice,
                  std::uint64_t maxMemory = 0);
+/// @brief As above, the advice and the cap naming parameters: a ParamError<LimitError> that names
+/// the cap @a maxMemory as @a maxMemoryName (its declaration's paramName()).
+void checkMemory(const std::string& where, std::uint64_t estimate, const std::string& how, const ParamText& advice,
+                 std::uint64_t maxMemory, const ParamName& maxMemoryName);
 
 /// @brief What an AllocationBudget throws from operator new: the request that would have taken
 /// the calling thread's live bytes past the budget. A std::bad_alloc, so code that copes with an

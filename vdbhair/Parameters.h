@@ -18,7 +18,9 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -65,6 +67,7 @@ struct Param
     /// A bool given as a value on the command line (`--roll false`), not a flag that turns it on.
     bool valued = false;
     std::string keyword;  ///< Python's keyword when the name is not one (`lambda_` for `lambda`)
+    std::string shortFlag;  ///< the command line's one-letter alias ("-j"), or none
     /// Python's default is None, which leaves the struct's default (what @c zeroMeans says), as
     /// `neighbors=None` does; the value itself (0) is taken too.
     bool pythonNone = false;
@@ -186,6 +189,7 @@ ParamTable<Outer> nestedParams(const ParamTable<Inner>& inner, F part, const std
         q.zeroMeans = p.zeroMeans;
         q.valued = p.valued;
         q.keyword = p.keyword;
+        q.shortFlag = p.shortFlag;
         q.pythonNone = p.pythonNone;
         q.oldFlags = p.oldFlags;
         std::visit([&](const auto& a) {
@@ -215,28 +219,127 @@ const Param<P>* findParam(const ParamTable<P>& table, const std::string& name)
     return nullptr;
 }
 
+/// A parameter as a message names it, in each front end's spelling: the command line's flag and
+/// Python's keyword (paramName() takes both from a declaration).
+struct ParamName
+{
+    std::string flag, keyword;
+};
+
+inline std::string spelled(const ParamName& name, ParamSpelling spelling)
+{
+    return spelling == ParamSpelling::Flag ? name.flag : name.keyword;
+}
+
+template<typename P>
+ParamName paramName(const Param<P>& param)
+{
+    return {param.flag(), param.pythonName()};
+}
+
+/// @brief The names of @a table's parameter @a name.
+/// @throw std::logic_error when @a table declares no such parameter (a mistake in the library).
+template<typename P>
+ParamName paramName(const ParamTable<P>& table, const std::string& name)
+{
+    if (const Param<P>* p = findParam(table, name)) return paramName(*p);
+    throw std::logic_error("paramName: no declared parameter '" + name + "'");
+}
+
+/// @brief A message that names parameters: its text with each parameter kept apart (a ParamName),
+/// so that each front end spells them its own way (spelled()) and no front end rewrites text.
+class ParamText
+{
+public:
+    /// Some text, or a parameter.
+    struct Part
+    {
+        Part(std::string t) : text(std::move(t)) {}
+        Part(const char* t) : text(t) {}
+        Part(ParamName n) : name(std::move(n)), isName(true) {}
+        std::string text;
+        ParamName name;
+        bool isName = false;
+    };
+    ParamText(std::initializer_list<Part> parts) : mParts(parts) {}
+    ParamText& operator+=(const Part& part)
+    {
+        mParts.push_back(part);
+        return *this;
+    }
+    ParamText& operator+=(const ParamText& more)
+    {
+        mParts.insert(mParts.end(), more.mParts.begin(), more.mParts.end());
+        return *this;
+    }
+    std::string spelled(ParamSpelling spelling) const
+    {
+        std::string out;
+        for (const Part& p : mParts) out += p.isName ? vdbhair::spelled(p.name, spelling) : p.text;
+        return out;
+    }
+
+private:
+    std::vector<Part> mParts;
+};
+
+/// What an error that names parameters holds (ParamError): its message as a ParamText.
+class ParamMessage
+{
+public:
+    explicit ParamMessage(ParamText text) : mText(std::move(text)) {}
+    virtual ~ParamMessage() = default;
+    const ParamText& text() const { return mText; }
+
+private:
+    ParamText mText;
+};
+
+/// @brief An error of type @a Base (ValueError, LimitError, IoError, ...) whose message names
+/// parameters: what() spells them in @a whatSpelling (Python's keywords unless told), and
+/// spelledMessage() in a front end's own.
+template<typename Base = ValueError>
+class ParamError : public Base, public ParamMessage
+{
+public:
+    explicit ParamError(ParamText text, ParamSpelling whatSpelling = ParamSpelling::Keyword)
+        : Base(text.spelled(whatSpelling)), ParamMessage(std::move(text))
+    {}
+};
+
+/// @brief The message of @a e for a front end: a ParamError's parameters spelled in @a spelling
+/// (the command line's flags, Python's keywords), any other error's what().
+inline std::string spelledMessage(const std::exception& e, ParamSpelling spelling)
+{
+    if (const auto* m = dynamic_cast<const ParamMessage*>(&e)) return m->text().spelled(spelling);
+    return e.what();
+}
+
 /// @brief Check every number of @a p against its declared range (and finiteness) and every
 /// string against its choices.
-/// @throw ValueError "<where>: <--flag|keyword> <value>: must be between <min> and <max> <unit>".
+/// @throw ParamError<ValueError> "<where>: <--flag|keyword> <value>: must be between <min> and <max> <unit>",
+/// its what() in @a spelling.
 template<typename P>
 void checkParams(const ParamTable<P>& table, const P& p, ParamSpelling spelling, const std::string& where)
 {
     for (const Param<P>& param : table) {
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(p))>;
-            const std::string who = (where.empty() ? std::string() : where + ": ") + spelled(param, spelling);
+            const std::string prefix = where.empty() ? std::string() : where + ": ";
+            const ParamName name = paramName(param);
             if constexpr (std::is_same_v<T, std::string>) {
                 const std::string v = a.get(p);
                 if (param.choices.empty()) return;
                 for (const std::string& c : param.choices) if (c == v) return;
                 std::string list;
                 for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
-                throw ValueError(who + " '" + v + "': must be one of " + list);
+                throw ParamError<ValueError>({prefix, name, " '" + v + "': must be one of " + list}, spelling);
             } else if constexpr (std::is_same_v<T, Vec3d>) {
                 const Vec3d v = a.get(p);
                 if (!std::isfinite(v.x()) || !std::isfinite(v.y()) || !std::isfinite(v.z()))
-                    throw ValueError(who + " " + axisText(v) + ": must be a finite vector");
-                if (v == Vec3d(0.0) && param.zeroMeans.empty()) throw ValueError(who + " (0, 0, 0): must be a non-zero vector");
+                    throw ParamError<ValueError>({prefix, name, " " + axisText(v) + ": must be a finite vector"}, spelling);
+                if (v == Vec3d(0.0) && param.zeroMeans.empty())
+                    throw ParamError<ValueError>({prefix, name, " (0, 0, 0): must be a non-zero vector"}, spelling);
             } else if constexpr (!std::is_same_v<T, bool>) {
                 const double v = double(a.get(p));
                 if (std::isfinite(v) && (param.aboveMin ? v > param.min : v >= param.min) && v <= param.max) return;
@@ -247,7 +350,7 @@ void checkParams(const ParamTable<P>& table, const P& p, ParamSpelling spelling,
                 else if (std::isfinite(param.max)) rule += "at most " + formatNumber(param.max);
                 else rule += "finite";
                 if (!param.unit.empty()) rule += " " + param.unit;
-                throw ValueError(who + " " + param.valueText(p) + ": " + rule);
+                throw ParamError<ValueError>({prefix, name, " " + param.valueText(p) + ": " + rule}, spelling);
             }
         }, param.access);
     }

@@ -1,6 +1,8 @@
 // vdbhair batch JOB.json -o OUTDIR: one verb over a dataset, each input in a process of its own,
 // with records, resumption and shards for schedulers (Slurm arrays); vdbhair batch --merge OUTDIR.
+#include "../AppParameters.h"
 #include "../Command.h"
+#include "../ParamOptions.h"
 #include "../TerminalProgress.h"
 #include "../batch/BatchJob.h"
 #include "../batch/BatchRecords.h"
@@ -35,8 +37,7 @@ namespace {
 struct BatchCmdParams
 {
     std::string job, outDir, merge, shard;
-    int jobs = 0;  ///< 0: one per core
-    bool retryFailed = false;
+    BatchParams run;  ///< its declared parameters (batchParameters()) are options
 };
 
 using Clock = std::chrono::steady_clock;
@@ -265,15 +266,15 @@ int runMerge(const std::string& outDir, const CommonOptions& common)
 
 int runBatch(const BatchCmdParams& p, const CommonOptions& common)
 {
+    checkParamOptions(batchParameters(), p.run);
     if (!p.merge.empty()) {
-        if (!p.job.empty() || !p.outDir.empty() || !p.shard.empty() || p.retryFailed) {
+        if (!p.job.empty() || !p.outDir.empty() || !p.shard.empty() || p.run.retryFailed) {
             throw ValueError("--merge OUTDIR takes no JOB, -o, --shard or --retry-failed");
         }
         return runMerge(p.merge, common);
     }
     if (p.job.empty()) throw ValueError("needs a JOB file: vdbhair batch JOB.json -o OUTDIR (or --merge OUTDIR)");
     if (p.outDir.empty()) throw ValueError("needs an output folder: -o OUTDIR");
-    if (p.jobs < 0) throw ValueError("--jobs " + std::to_string(p.jobs) + ": must be 1 or more (0: one per core)");
 
     // Everything is checked before anything runs.
     const BatchJob job = readBatchJob(p.job);
@@ -281,7 +282,7 @@ int runBatch(const BatchCmdParams& p, const CommonOptions& common)
     const std::string outDir = fs::absolute(p.outDir).lexically_normal().string();
     const std::vector<BatchItem> items = planBatch(job, outDir);
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-    const std::size_t jobs = p.jobs > 0 ? std::size_t(p.jobs) : cores;
+    const std::size_t jobs = p.run.jobs > 0 ? std::size_t(p.run.jobs) : cores;
     // Each child gets its share of the cores unless the JOB says otherwise (results do not
     // depend on the thread count).
     std::vector<std::string> extra;
@@ -312,7 +313,7 @@ int runBatch(const BatchCmdParams& p, const CommonOptions& common)
         const bool done = it != latest.end() && it->second["status"] == "ok" && outputsExist(item);
         const bool failed = it != latest.end() && it->second["status"] == "failed";
         if (done) ++s.skipped;
-        else if (p.retryFailed && !failed) ++s.notRun;
+        else if (p.run.retryFailed && !failed) ++s.notRun;
         else todo.push_back(item);
     }
     if (previous.skippedLines && !common.quiet) {
@@ -390,11 +391,9 @@ Command addBatchCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "batch");
     sub->add_option("job", params->job, "The JOB file (.json): inputs, verb, args, output; see below");
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing): the outputs and the records");
-    sub->add_option("--jobs,-j", params->jobs, "Inputs run at once (default 0: one per core); each run gets --threads cores/jobs "
-                                               "unless args or batch's own --threads say otherwise; --no-clobber is passed on");
+    addParamOptions(sub, params->run, batchParameters());
     sub->add_option("--shard", params->shard, "Run shard I of N (I/N, from 0): the inputs at sorted positions p with p mod N = I "
                                               "(default: SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN of SLURM_ARRAY_TASK_COUNT in an array job)");
-    sub->add_flag("--retry-failed", params->retryFailed, "Run only the inputs whose last record failed");
     sub->add_option("--merge", params->merge, "Join the shards' records OUTDIR/batch.I-of-N.jsonl into OUTDIR/batch.jsonl and print the summary");
     addCommonOptions(sub, common);
     sub->footer(

@@ -40,7 +40,7 @@ int runComb(CombCmdParams p, const CommonOptions& common)
         try {
             r = combHair(in, strokes, p.params, scalp, true, common.interrupter);
         } catch (const ValueError& e) {
-            throw ValueError(p.input + ": " + e.what());
+            throw ValueError(p.input + ": " + spelledMessage(e, ParamSpelling::Flag));
         }
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -126,7 +126,7 @@ Command addCompareCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair compare straight.hair rebuilt.hair --unit cm --json");
-    return {sub, [params, &common] { return runCompare(*params, common); }, {{"samples", "--samples"}, {"metersPerUnit", "--unit"}, {"thresholds", "--threshold"}}};
+    return {sub, [params, &common] { return runCompare(*params, common); }};
 }
 
 } // namespace vdbhair::app

@@ -176,7 +176,7 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");
-    return {sub, [params, &common] { return runConvert(*params, common); }, {{"resample", "--resample"}, {"scale", "--scale"}}};
+    return {sub, [params, &common] { return runConvert(*params, common); }};
 }
 
 } // namespace vdbhair::app

@@ -1,5 +1,7 @@
 // vdbhair demo SCENE -o DIR: the README's main job: refine the bundled hairstyle through its own
 // tangent field and write the strands, the field and the report into one folder.
+#include "../AppParameters.h"
+#include "../ParamOptions.h"
 #include "../RefineOptions.h"
 
 #include <vdbhair/Exceptions.h>
@@ -27,6 +29,9 @@ struct DemoParams
 int runDemo(const DemoParams& p, const CommonOptions& common)
 {
     namespace fs = std::filesystem;
+    // The declared ranges and the library's rules across parameters, before the scene is read.
+    checkParamOptions(demoParameters(), p.refine.refine);
+    p.refine.refine.validate("option");
     const auto t0 = std::chrono::steady_clock::now();
     TriangleMesh head;  // a scene's own head, drawn in the preview
     const StrandSet strands = loadStrandsOrScene("demo", p.refine.input, common, "strands", &head);
@@ -122,7 +127,7 @@ Command addDemoCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "demo");
     sub->add_option("scene", params->refine.input, "The hairstyle: strands, or a helicoid scene .json (the README passes the bundled default)")->required();
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing)")->capture_default_str();
-    addRefineOptions(sub, params->refine, {"measure"});  // the demo always measures
+    addRefineOptions(sub, params->refine, demoSkippedParameters());  // demoParameters(): the demo always measures
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair demo scenes/default/head.json -o out --levels 2");

@@ -168,7 +168,7 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair field hair.hair -o field.vdb --voxel-size 0.5 --levels 3\n"
                 "Orientation volume: vdbhair field hair.data -o f.vdb --dense f.npy --dense-box -0.32,-0.32,-0.24,0.32,0.32,0.24");
-    return {sub, [params, &common] { return runField(*params, common); }, {{"maxVoxels", "--max-voxels"}, {"maxMemory", "--max-memory"}}};
+    return {sub, [params, &common] { return runField(*params, common); }};
 }
 
 } // namespace vdbhair::app

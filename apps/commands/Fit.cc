@@ -27,7 +27,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
 {
     if (fileExtension(p.output) != ".json") throw ValueError(p.output + ": fits are written as a scene file; the output must end in .json");
     checkParamOptions(fitParameters(), p.fit);
-    p.fit.validate("option");  // the library's own rules, its field names spelled as flags (addFitCommand)
+    p.fit.validate("option");  // the library's own rules (ParamErrors: run() spells them as flags)
     const StrandSet strands = loadStrands("fit", p.input, common, p.strict);
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -92,8 +92,7 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair fit hair.hair -o fits.json --json && vdbhair grow fits.json -o regrown.hair");
-    return {sub, [params, &common] { return runFit(*params, common); }, {{"maxError", "--max-error"}, {"lambda", "--lambda"}, {"maxPieces", "--max-pieces"}, {"maxEvaluations", "--max-evaluations"},
-                                                                 {"prefitIterations", "--prefit-iterations"}, {"step", "--step"}}};
+    return {sub, [params, &common] { return runFit(*params, common); }};
 }
 
 } // namespace vdbhair::app

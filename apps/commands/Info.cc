@@ -14,11 +14,6 @@ namespace vdbhair::app::info {
 
 nlohmann::json vec3Json(const Vec3d& v) { return {v.x(), v.y(), v.z()}; }
 
-nlohmann::json metaJson(const MetaValue& m)
-{
-    return std::visit([](const auto& v) { return nlohmann::json(v); }, m.value);
-}
-
 std::string fmt(double v)
 {
     char buf[64];
@@ -146,8 +141,7 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
                 ReadReport report;
                 const StrandSummary s = summarizeStrandFile(params->input, params->readOptions(common), &report);
                 return printStrandSummary(*params, s, report, common);
-            },
-            {{"bins", "--bins"}}};
+            }};
 }
 
 } // namespace vdbhair::app

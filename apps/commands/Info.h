@@ -36,7 +36,6 @@ int infoVdbFile(const InfoParams& p, const CommonOptions& common);
 
 namespace info {
 nlohmann::json vec3Json(const Vec3d& v);
-nlohmann::json metaJson(const MetaValue& m);
 /// @a v in six significant digits.
 std::string fmt(double v);
 /// @a v as (x, y, z) in fmt().

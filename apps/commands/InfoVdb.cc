@@ -3,36 +3,11 @@
 
 #include <vdbhair/io/StrandIO.h>
 #include <vdbhair/io/VdbInfo.h>
+#include <vdbhair/io/VdbInspectJson.h>
 
 namespace vdbhair::app {
 
 using namespace info;
-
-nlohmann::json gridInfoJson(const GridInfo& g)
-{
-    nlohmann::json meta = nlohmann::json::object();
-    for (const MetaValue& m : g.metadata) meta[m.name] = metaJson(m);
-    nlohmann::json j = {
-        {"name", g.name},
-        {"type", g.type},
-        {"value_type", g.valueType},
-        {"class", g.gridClass},
-        {"vector_type", g.vectorType.empty() ? nlohmann::json(nullptr) : nlohmann::json(g.vectorType)},
-        {"voxel_size", (g.voxelSize.x() == g.voxelSize.y() && g.voxelSize.x() == g.voxelSize.z())
-                           ? nlohmann::json(g.voxelSize.x()) : vec3Json(g.voxelSize)},
-        {"active_voxels", g.activeVoxels},
-        {"active_tiles", g.activeTiles},
-        {"leaf_nodes", g.leafNodes},
-        {"memory_bytes", g.memoryBytes},
-        {"bbox", g.emptyBBox ? nlohmann::json(nullptr) : nlohmann::json({vec3Json(g.bboxMin), vec3Json(g.bboxMax)})},
-        {"metadata", meta}};
-    if (g.isPoints) {
-        nlohmann::json attrs = nlohmann::json::array();
-        for (const PointAttributeInfo& a : g.attributes) attrs.push_back({{"name", a.name}, {"type", a.valueType}, {"codec", a.codec}});
-        j["points"] = {{"count", g.pointCount}, {"attributes", attrs}, {"groups", g.groups}};
-    }
-    return j;
-}
 
 int infoVdbFile(const InfoParams& p, const CommonOptions& common)
 {

@@ -6,6 +6,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/VdbInspect.h>
+#include <vdbhair/io/VdbInspectJson.h>
 #include <vdbhair/render/SliceRenderer.h>
 
 #include <cstdio>
@@ -36,35 +37,6 @@ std::string pct(double share)
 }
 
 std::string vec3(const Vec3d& v) { return "(" + g6(v.x()) + ", " + g6(v.y()) + ", " + g6(v.z()) + ")"; }
-
-nlohmann::json statsJson(const ValueStats& s)
-{
-    return {{"count", s.count}, {"min", s.min}, {"max", s.max}, {"mean", s.mean}, {"stddev", s.stddev},
-            {"p01", s.p01}, {"median", s.p50}, {"p99", s.p99}};
-}
-
-nlohmann::json reportJson(const GridReport& r)
-{
-    nlohmann::json j = gridInfoJson(r.info);
-    j["index_bbox"] = r.emptyIndexBBox ? nlohmann::json(nullptr) : nlohmann::json({r.indexMin, r.indexMax});
-    j["tiles_by_level"] = {{"root", r.tilesByLevel[0]}, {"upper", r.tilesByLevel[1]}, {"lower", r.tilesByLevel[2]}};
-    j["internal_nodes"] = r.internalNodes;
-    j["leaf_fill"] = {{"mean", r.leafFillMean}, {"min", r.leafFillMin}, {"max", r.leafFillMax}, {"full_share", r.leafFullShare}};
-    if (r.isVector) {
-        j["length"] = statsJson(r.values);
-        j["unit_share"] = r.unitShare;
-        j["zero_share"] = r.zeroShare;
-        j["mean_vector"] = {r.meanVector.x(), r.meanVector.y(), r.meanVector.z()};
-        j["coherence"] = r.coherence;
-    } else if (r.isScalar) {
-        j["values"] = statsJson(r.values);
-        j["zero_share"] = r.zeroShare;
-    } else if (r.info.isPoints) {
-        j["points_per_voxel"] = statsJson(r.values);
-    }
-    j["explanation"] = r.explanation;
-    return j;
-}
 
 void printReport(const GridReport& r)
 {
@@ -152,7 +124,7 @@ int runInspect(const InspectParams& p, const CommonOptions& common)
     }
     if (common.json) {
         nlohmann::json arr = nlohmann::json::array();
-        for (const GridReport& r : reports) arr.push_back(reportJson(r));
+        for (const GridReport& r : reports) arr.push_back(gridReportJson(r));
         nlohmann::json out = {{"kind", "vdb"}, {"file", p.input}, {"grids", arr}};
         if (!sliceJson.is_null()) out["slice"] = sliceJson;
         printJson(out);
@@ -179,8 +151,7 @@ Command addInspectCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     sub->footer("Examples: vdbhair inspect field.vdb\n"
                 "          vdbhair inspect field.vdb --slice z=0 -o slice.png --hsv --streamlines 300");
-    return {sub, [params, &common] { return runInspect(*params, common); },
-            {{"slice", "--slice"}, {"width", "--width"}, {"streamlines", "--streamlines"}}};
+    return {sub, [params, &common] { return runInspect(*params, common); }};
 }
 
 } // namespace vdbhair::app

@@ -293,7 +293,7 @@ Command addInterpolateCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair interpolate guides.hair --scalp scalp.vdb --count 20000 -o hair.hair --json");
-    return {sub, [params, &common] { return runInterpolate(*params, common); }, {{"blend", "--blend"}, {"likeness", "--likeness"}, {"grouping", "--grouping"}}};
+    return {sub, [params, &common] { return runInterpolate(*params, common); }};
 }
 
 } // namespace vdbhair::app

@@ -144,8 +144,7 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
     sub->footer("Order: --strands, --align-to, --points, --fix-penetration.\n"
                 "Example: vdbhair prepare straight.hair out.data --head woman_head.ply --align-to head_model.ply "
                 "--points 100 --strands 1000 --fix-penetration head_model.ply");
-    return {sub, [params, &common] { return runPrepare(*params, common); },
-            {{"PrepareParams::points", "--points"}, {"PrepareParams::strands", "--strands"}, {"AlignParams::overlap", "--overlap"}, {"PrepareParams::headCrop", "--head-crop"}, {"PrepareParams::rootDepth", "--root-depth"}}};
+    return {sub, [params, &common] { return runPrepare(*params, common); }};
 }
 
 } // namespace vdbhair::app

@@ -127,7 +127,7 @@ Command addReconstructCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair reconstruct straight.hair -o rebuilt.hair --guides 10% --json");
-    return {sub, [params, &common] { return runReconstruct(*params, common); }, {{"maxError", "--max-error"}, {"blend", "--blend"}, {"metersPerUnit", "--meters-per-unit"}}};
+    return {sub, [params, &common] { return runReconstruct(*params, common); }};
 }
 
 } // namespace vdbhair::app

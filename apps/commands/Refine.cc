@@ -17,7 +17,7 @@ RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands
 {
     RefineParams rp = p.refine;
     checkParamOptions(refineParameters(), rp);
-    rp.validate("option");  // the library's rules across parameters, its field names spelled as flags (addRefineCommand)
+    rp.validate("option");  // the library's rules across parameters (ParamErrors: run() spells them as flags)
     // A scalp given as a sphere or a level set is also the head the strands keep out of, unless
     // --head says otherwise.
     const openvdb::FloatGrid::Ptr surface = applyScalpOptions(p.scalp, strands, rp.field, common);
@@ -133,8 +133,7 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --measure --json");
-    return {sub, [params, &common] { return runRefine(*params, common); }, {{"maxVoxels", "--max-voxels"}, {"maxMemory", "--max-memory"}, {"zStart", "--outlier-start"}, {"zFull", "--outlier-full"},
-                                                                       {"minSpreadDeg", "--min-spread"}, {"levels", "--levels"}}};
+    return {sub, [params, &common] { return runRefine(*params, common); }};
 }
 
 } // namespace vdbhair::app

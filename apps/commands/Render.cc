@@ -99,7 +99,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair render scenes/default/head.json -o head.png --sheet");
-    return {sub, [params, &common] { return runRender(*params, common); }, {{"colorBy", "--color-by"}}};
+    return {sub, [params, &common] { return runRender(*params, common); }};
 }
 
 } // namespace vdbhair::app

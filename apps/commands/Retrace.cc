@@ -139,9 +139,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --measure --json");
-    return {sub, [params, &common] { return runRetrace(*params, common); },
-            {{"step", "--step"}, {"margin", "--margin"}, {"vanishThreshold", "--vanish"}, {"maxSteps", "--max-steps"},
-             {"estimateHelicoidField", "'vdbhair field --helicoid'"}}};
+    return {sub, [params, &common] { return runRetrace(*params, common); }};
 }
 
 } // namespace vdbhair::app

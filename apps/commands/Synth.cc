@@ -323,12 +323,7 @@ Command addSynthCommand(CLI::App& app, CommonOptions& common)
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair synth example.hair -o new.hair --levels 3 --seed 1 --json");
-    return {sub, [params, &common] { return runSynth(*params, common); }, synthTransferFlags()};
-}
-
-FlagNames synthTransferFlags()
-{
-    return {{"match balance", "--match-balance"}};
+    return {sub, [params, &common] { return runSynth(*params, common); }};
 }
 
 } // namespace vdbhair::app

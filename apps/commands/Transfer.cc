@@ -44,7 +44,7 @@ int runTransferJob(const TransferJob& job, TransferParams params, const CommonOp
         tr = transferHairstyle(details, base, params, scalp, true, common.interrupter);
     } catch (const ValueError& e) {
         // The library names the hairstyles DETAILS and BASE; the message names the files.
-        std::string what = e.what();
+        std::string what = spelledMessage(e, ParamSpelling::Flag);
         const auto name = [&](const std::string& word, const std::string& by) {
             for (std::size_t at = what.find(word); at != std::string::npos; at = what.find(word, at + by.size())) what.replace(at, word.size(), by);
         };
@@ -114,8 +114,7 @@ Command addTransferCommand(CLI::App& app, CommonOptions& common)
                 if (params.strands > 0 && !params.guides) throw ValueError("--strands: the output has BASE's strands; --strands needs --guides");
                 params.synth.head = headFromOptions(HeadOptions{p->head}, params.synth.head);
                 return runTransferJob(p->job, params, common);
-            },
-            synthTransferFlags()};
+            }};
 }
 
 } // namespace vdbhair::app

@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parameters.h>
 #include <vdbhair/scalp/HeadFile.h>
 
 #include <cmath>
@@ -56,27 +57,29 @@ void registerExceptions(pyb::module_& m)
                                                "Work would exceed a resource cap; the message says the estimate and the cap "
                                                "(also a ValueError).");
 
+    // A library error that names parameters (ParamError) gives them as Python's keywords.
     pyb::register_exception_translator([](std::exception_ptr p) {
+        const auto message = [](const std::exception& e) { return spelledMessage(e, ParamSpelling::Keyword); };
         try {
             if (p) std::rethrow_exception(p);
         } catch (const InterruptedError& e) {
-            PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+            PyErr_SetString(PyExc_KeyboardInterrupt, message(e).c_str());
         } catch (const IoError& e) {
-            PyErr_SetString(ioError, e.what());
+            PyErr_SetString(ioError, message(e).c_str());
         } catch (const FormatError& e) {
-            PyErr_SetString(formatError, e.what());
+            PyErr_SetString(formatError, message(e).c_str());
         } catch (const UnsupportedError& e) {
-            PyErr_SetString(unsupportedError, e.what());
+            PyErr_SetString(unsupportedError, message(e).c_str());
         } catch (const ValueError& e) {
-            PyErr_SetString(argumentError, e.what());
+            PyErr_SetString(argumentError, message(e).c_str());
         } catch (const LookupError& e) {
-            PyErr_SetString(lookupError, e.what());
+            PyErr_SetString(lookupError, message(e).c_str());
         } catch (const TypeError& e) {
-            PyErr_SetString(typeError, e.what());
+            PyErr_SetString(typeError, message(e).c_str());
         } catch (const LimitError& e) {
-            PyErr_SetString(limitError, e.what());
+            PyErr_SetString(limitError, message(e).c_str());
         } catch (const Error& e) {
-            PyErr_SetString(gError, e.what());
+            PyErr_SetString(gError, message(e).c_str());
         }
     });
 }

@@ -14,6 +14,7 @@
 #include <vdbhair/helicoid/Scene.h>
 #include <vdbhair/io/MeshFile.h>
 #include <vdbhair/io/VdbInspect.h>
+#include <vdbhair/io/VdbInspectJson.h>
 #include <vdbhair/render/Image.h>
 #include <vdbhair/render/SliceRenderer.h>
 #include <vdbhair/render/StrandRenderer.h>
@@ -59,45 +60,6 @@ Scene sceneArgument(const pyb::handle& scene, const std::string& where = "grow")
     }
     throw TypeError(where + ": scene must be a path to a scene .json or a dict, not " +
                     std::string(pyb::str(scene.get_type().attr("__name__"))));
-}
-
-/// FitParams::validate with its field names spelled as fit's keywords.
-void validateFitKeywords(const FitParams& fp, const char* where)
-{
-    try {
-        fp.validate(where);
-    } catch (const ValueError& e) {
-        std::string message = e.what();
-        for (const auto& [field, keyword] : {std::pair<const char*, const char*>{"maxError ", "max_error="}, {"lambda ", "lambda_="},
-                                            {"maxPieces ", "max_pieces="}, {"maxEvaluations ", "max_evaluations="},
-                                            {"prefitIterations ", "prefit_iterations="}, {"step ", "step="}}) {
-            const std::string named = std::string(where) + ": " + field;
-            if (message.compare(0, named.size(), named) == 0) {
-                message = std::string(where) + ": " + keyword + message.substr(named.size());
-                break;
-            }
-        }
-        throw ValueError(message);
-    }
-}
-
-pyb::dict valueStatsDict(const ValueStats& s)
-{
-    pyb::dict d;
-    d["count"] = s.count;
-    d["min"] = s.min;
-    d["max"] = s.max;
-    d["mean"] = s.mean;
-    d["stddev"] = s.stddev;
-    d["p01"] = s.p01;
-    d["p50"] = s.p50;
-    d["p99"] = s.p99;
-    return d;
-}
-
-pyb::object metaValue(const MetaValue& m)
-{
-    return std::visit([](const auto& v) -> pyb::object { return pyb::cast(v); }, m.value);
 }
 
 /// interpolate's roots: positions (an array or a Strands' roots), normals=, root_groups=, and
@@ -175,7 +137,7 @@ void defineFit(pyb::module_& m)
     auto fitImpl = [](const StrandsPtr& strands, const pyb::dict& kw) -> pyb::object {
         FitParams fp;
         applyKeywords(fitParameters(), kw, fp, "fit");
-        validateFitKeywords(fp, "fit");
+        fp.validate("fit");  // its errors name fit's keywords (ParamError)
         const bool skipDegenerate = fp.skipDegenerate, returnReport = renamedKeywordValue(kw, "return_report", "return_summary", "fit").cast<bool>();
         std::vector<std::string> errors;
         const std::vector<StrandFit> fits = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
@@ -393,43 +355,6 @@ void defineRender(pyb::module_& m)
                pyb::cpp_function(renderImpl, pyb::arg("strands"), pyb::arg("path"), pyb::arg("keywords")));
 }
 
-/// inspect's dict of one grid.
-pyb::dict gridReportDict(const GridReport& r)
-{
-    const GridInfo& g = r.info;
-    pyb::dict d;
-    d["name"] = g.name;
-    d["value_type"] = g.valueType;
-    d["grid_class"] = g.gridClass;
-    d["vector_type"] = g.vectorType;
-    d["voxel_size"] = pyb::make_tuple(g.voxelSize.x(), g.voxelSize.y(), g.voxelSize.z());
-    d["active_voxels"] = g.activeVoxels;
-    d["active_tiles"] = g.activeTiles;
-    d["leaf_nodes"] = g.leafNodes;
-    d["memory_bytes"] = g.memoryBytes;
-    if (!g.emptyBBox) {
-        d["world_bbox"] = pyb::make_tuple(pyb::make_tuple(g.bboxMin.x(), g.bboxMin.y(), g.bboxMin.z()),
-                                          pyb::make_tuple(g.bboxMax.x(), g.bboxMax.y(), g.bboxMax.z()));
-    }
-    if (!r.emptyIndexBBox) d["index_bbox"] = pyb::make_tuple(pyb::cast(r.indexMin), pyb::cast(r.indexMax));
-    d["values"] = valueStatsDict(r.values);
-    if (r.isVector) {
-        d["unit_share"] = r.unitShare;
-        d["zero_share"] = r.zeroShare;
-        d["mean_vector"] = pyb::make_tuple(r.meanVector.x(), r.meanVector.y(), r.meanVector.z());
-        d["coherence"] = r.coherence;
-    } else if (r.isScalar) {
-        d["zero_share"] = r.zeroShare;
-    }
-    d["leaf_fill"] = pyb::make_tuple(r.leafFillMin, r.leafFillMean, r.leafFillMax);
-    pyb::dict meta;
-    for (const MetaValue& mv : g.metadata) meta[pyb::str(mv.name)] = metaValue(mv);
-    d["metadata"] = meta;
-    if (g.isPoints) d["point_count"] = g.pointCount;
-    d["explanation"] = r.explanation;
-    return d;
-}
-
 /// inspect: a description of every grid of a .vdb file (or of one, grid=), and a slice drawn.
 /// vdbhair.inspect(path, **keywords): the declared parameters (sliceParameters()), then inspect's own.
 pyb::object inspectImpl(const PathArg& path, const pyb::dict& kw)
@@ -464,7 +389,7 @@ pyb::object inspectImpl(const PathArg& path, const pyb::dict& kw)
         return 0;
     });
     pyb::list grids;
-    for (const GridReport& r : reports) grids.append(gridReportDict(r));
+    for (const GridReport& r : reports) grids.append(toPython(gridReportJson(r)));  // `inspect --json`'s "grids", key for key
     if (!drawn) return std::move(grids);
     // `inspect --json`'s "slice", key for key.
     const SliceResult& res = drawn->second;
@@ -485,12 +410,13 @@ void defineInspect(pyb::module_& m)
                "(``inspect --slice AXIS=WORLD -o OUT``): vectors coloured by direction, scalars through a colour\n"
                "map, optionally with streamlines of the in-plane field.",
                "    path: the .vdb file.\n",
-               "a list of one dict a grid, in file order, with name, value_type, grid_class, vector_type,\n"
-               "    voxel_size, active_voxels, active_tiles, leaf_nodes, memory_bytes, world_bbox and index_bbox\n"
-               "    (when not empty), values (statistics of the values, or of the vector lengths: count, min, max,\n"
-               "    mean, stddev, p01, p50, p99), unit_share, zero_share, mean_vector and coherence for vectors,\n"
-               "    leaf_fill (min, mean, max), metadata (a dict), point_count for points grids, and explanation\n"
-               "    (the metadata in words). With slice: (that list, a dict of the slice: ``inspect --json``'s\n"
+               "a list of one dict a grid, in file order: ``inspect --json``'s \"grids\", key for key (name, type,\n"
+               "    value_type, class, vector_type, voxel_size, active_voxels, active_tiles, leaf_nodes,\n"
+               "    memory_bytes, bbox, metadata, points for points grids, index_bbox, tiles_by_level,\n"
+               "    internal_nodes, leaf_fill, length or values (statistics: count, min, max, mean, stddev, p01,\n"
+               "    median, p99) or points_per_voxel, unit_share, zero_share, mean_vector and coherence for\n"
+               "    vectors, and explanation: the metadata in words). With slice: (that list, a dict of the\n"
+               "    slice: ``inspect --json``'s\n"
                "    \"slice\", key for key: output, grid, axis, world, index_plane, active_voxels, range,\n"
                "    streamlines, width, height).",
                pyb::cpp_function(inspectImpl, pyb::arg("path"), pyb::arg("keywords")));

@@ -158,21 +158,6 @@ pyb::array strandView(const pyb::object& self, const StrandSet& s, std::ptrdiff_
     return readOnlyView(reinterpret_cast<const float*>(s.data(std::size_t(i))), s.size(std::size_t(i)), 3, self);
 }
 
-/// @a message with the readers' parameter names spelled as read()'s keywords.
-std::string withReadKeywords(std::string message)
-{
-    for (const auto& [name, keyword] : {std::pair<std::string, std::string>{"ReadOptions::pointsPerStrand", "points_per_strand="},
-                                        {"ReadOptions::curveSamples", "curve_samples="},
-                                        {"ReadOptions::roots", "roots="}}) {
-        for (std::size_t at = message.find(name); at != std::string::npos; at = message.find(name, at + keyword.size())) {
-            // "points_per_strand=N", not "points_per_strand= N"
-            const bool value = at + name.size() < message.size() && message[at + name.size()] == ' ';
-            message.replace(at, name.size() + (value ? 1 : 0), keyword);
-        }
-    }
-    return message;
-}
-
 ReadOptions readOptions(bool strict, const std::string& grid, const std::optional<std::array<float, 3>>& rootNear,
                         std::int64_t pointsPerStrand = 0, std::int64_t curveSamples = 0, const std::string& roots = "first")
 {
@@ -181,7 +166,7 @@ ReadOptions readOptions(bool strict, const std::string& grid, const std::optiona
         throw ValueError("curve_samples=" + std::to_string(curveSamples) + ": must be 0 (automatic) or 2 or more");
     }
     ReadOptions opts;
-    opts.roots = rootEndFromName(roots);  // "roots='x': must be first, last or auto" after withReadKeywords()
+    opts.roots = rootEndFromName(roots);  // "roots='x': must be first, last or auto"
     opts.pointsPerStrand = std::size_t(pointsPerStrand);
     opts.curveSamples = std::size_t(curveSamples);
     opts.shortStrands = strict ? ShortStrandPolicy::Reject : ShortStrandPolicy::Drop;
@@ -447,25 +432,17 @@ void bindRead(pyb::module_& m)
         [](const PathArg& path, bool strict, const std::string& grid, std::optional<std::array<float, 3>> rootNear,
            std::int64_t pointsPerStrand, std::int64_t curveSamples, const std::string& roots, const pyb::object& progress) {
             ReadReport report;
-            ReadOptions base;
-            try {
-                base = readOptions(strict, grid, rootNear, pointsPerStrand, curveSamples, roots);
-            } catch (const ValueError& e) {
-                throw ValueError(withReadKeywords(e.what()));
-            }
+            // The readers name their options as read()'s keywords (ReadOptions::spelling's default).
+            const ReadOptions base = readOptions(strict, grid, rootNear, pointsPerStrand, curveSamples, roots);
             auto set = runLong(0, progress, [&](WorkInterrupter* interrupter) {
                 ReadOptions opts = base;
                 opts.interrupter = interrupter;
-                try {
-                    return std::make_shared<StrandSet>(readStrands(path, opts, &report));
-                } catch (const FormatError& e) {
-                    throw FormatError(withReadKeywords(e.what()));
-                }
+                return std::make_shared<StrandSet>(readStrands(path, opts, &report));
             });
             if (!report.warnings.empty()) {
                 pyb::module_ warnings = pyb::module_::import("warnings");
                 for (const std::string& w : report.warnings) {
-                    warnings.attr("warn")(withReadKeywords(w), pyb::module_::import("builtins").attr("UserWarning"), 2);
+                    warnings.attr("warn")(w, pyb::module_::import("builtins").attr("UserWarning"), 2);
                 }
             }
             return set;

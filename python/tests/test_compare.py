@@ -44,7 +44,7 @@ def test_compare_bad_arguments():
     a = straight_bundle(count=2, vertices=5)
     with pytest.raises(ValueError, match="compare: samples 2"):
         vdbhair.compare(a, a, samples=2)
-    with pytest.raises(ValueError, match="compare: metersPerUnit -1"):
+    with pytest.raises(ValueError, match="compare: meters_per_unit -1"):
         vdbhair.compare(a, a, meters_per_unit=-1.0)
     with pytest.raises(ValueError, match="angle 200"):
         vdbhair.compare(a, a, thresholds=[(1.0, 200.0)])

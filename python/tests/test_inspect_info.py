@@ -44,9 +44,10 @@ def test_inspect_is_the_command_lines_report(field_vdb, tmp_path):
     python = vdbhair.inspect(field_vdb)
     command = json.loads(subprocess.run([cli(), "inspect", str(field_vdb), "--json"], capture_output=True, text=True, check=True).stdout)
     assert [g["name"] for g in python] == [g["name"] for g in command["grids"]]
+    # One record of a grid for both (gridReportJson()): the same keys, the same values.
     for p, c in zip(python, command["grids"]):
-        assert p["active_voxels"] == c["active_voxels"] and p["memory_bytes"] == c["memory_bytes"]
-        assert p["explanation"] == c["explanation"]
+        assert sorted(p) == sorted(c)
+        assert p == c
     # One grid by name, as --grid.
     only = vdbhair.inspect(field_vdb, grid="density")
     assert [g["name"] for g in only] == ["density"]
@@ -63,7 +64,7 @@ def test_inspect_slice_is_the_command_lines_image(field_vdb, tmp_path):
     assert drawn["grid"] == "tangent" and drawn["streamlines"] > 0
     del drawn["output"], command["slice"]["output"]
     assert drawn == command["slice"]
-    assert [g["name"] for g in grids] == [g["name"] for g in command["grids"]]
+    assert grids == command["grids"]
 
 
 def test_inspect_bad_keywords_name_the_keyword_value_and_rule(field_vdb, tmp_path):

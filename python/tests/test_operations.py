@@ -74,7 +74,7 @@ def test_render_colours_by_the_distance_to_a_reference():
     assert yellow.sum() > 10 and purple.sum() > 10
     # Rows: the moved half is above the other in the front view (+y up).
     assert np.nonzero(yellow)[0].mean() < np.nonzero(purple)[0].mean()
-    with pytest.raises(ValueError, match="colorBy error needs a reference"):
+    with pytest.raises(ValueError, match="color_by error needs a reference"):
         vdbhair.render(s, width=64, height=48, color_by="error")
 
 

@@ -62,7 +62,7 @@ def test_prepare_fixes_penetration_of_a_sphere_and_refuses_bad_arguments():
     assert report["fix_penetration"]["entering_before"] == 9
     assert report["fix_penetration"]["entering_after"] == 0
     assert np.linalg.norm(out.positions, axis=1).min() > 1.0 - 1e-5
-    with pytest.raises(vdbhair.Error, match="prepare: PrepareParams::points 1: a strand needs at least 2 vertices"):
+    with pytest.raises(vdbhair.Error, match="prepare: points 1: a strand needs at least 2 vertices"):
         vdbhair.prepare(hair, points=1)
     with pytest.raises(vdbhair.Error, match="align_to needs head="):
         vdbhair.prepare(hair, align_to="x.obj")

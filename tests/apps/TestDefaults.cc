@@ -261,33 +261,26 @@ TEST_CASE("vdbhair: range checks are the library's limits", "[apps]")
     }
 }
 
-TEST_CASE("withFlagNames: the library's parameter names become the verb's flags", "[apps]")
+TEST_CASE("ParamError: the library names parameters, the command line spells them as flags", "[apps]")
 {
-    const FlagNames names = {{"maxVoxels", "--max-voxels"}, {"margin", "--margin"}, {"slice", "--slice"}};
-    // An identifier wherever it stands as a word.
-    CHECK(withFlagNames("estimateTangentField: ... more than the cap of 9 (raise maxVoxels or the voxel size)", names) ==
-          "estimateTangentField: ... more than the cap of 9 (raise --max-voxels or the voxel size)");
-    CHECK(withFlagNames("maxVoxelsX and xmaxVoxels stay", names) == "maxVoxelsX and xmaxVoxels stay");
-    // A plain word only where a message names its parameter: at the start or after ": ".
-    CHECK(withFlagNames("retrace: margin 20 voxels must be between 0 and 16", names) == "retrace: --margin 20 voxels must be between 0 and 16");
-    CHECK(withFlagNames("slice w=3: expected AXIS=WORLD", names) == "--slice w=3: expected AXIS=WORLD");
-    CHECK(withFlagNames("inspect(a.vdb): no voxel grid to slice (only points)", names) == "inspect(a.vdb): no voxel grid to slice (only points)");
-    // What the library throws, as the verbs print it.
+    // What the library throws, as run() prints it (spelledMessage(e, ParamSpelling::Flag)).
     SliceParams sp;
     sp.width = SliceParams::kMaxWidth + 1;
-    const Verbs v;
     try {
         renderSlice("missing.vdb", "tangent", sp);
         FAIL("renderSlice accepted a width beyond SliceParams::kMaxWidth");
     } catch (const ValueError& e) {
-        CHECK_THAT(withFlagNames(e.what(), v.command("inspect").flags),
-                   Catch::Contains("--width " + std::to_string(sp.width) + ": must be between"));
+        CHECK_THAT(spelledMessage(e, ParamSpelling::Flag), Catch::Contains("--width " + std::to_string(sp.width) + ": must be between"));
+        CHECK_THAT(e.what(), Catch::Contains(": width " + std::to_string(sp.width) + ": must be between"));
     }
     try {
         colorByFromName("plaid");
         FAIL("colorByFromName accepted plaid");
     } catch (const ValueError& e) {
-        CHECK(withFlagNames(e.what(), v.command("render").flags) ==
-              "--color-by 'plaid' is not one of shaded, root, tangent, depth, curvature, strand, error");
+        CHECK(spelledMessage(e, ParamSpelling::Flag) == "--color-by 'plaid' is not one of shaded, root, tangent, depth, curvature, strand, error");
+        CHECK(spelledMessage(e, ParamSpelling::Keyword) == "color_by 'plaid' is not one of shaded, root, tangent, depth, curvature, strand, error");
     }
+    // An error that names no parameter is its what() in either spelling.
+    const IoError plain("a.hair: cannot open");
+    CHECK(spelledMessage(plain, ParamSpelling::Flag) == "a.hair: cannot open");
 }

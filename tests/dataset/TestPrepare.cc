@@ -116,7 +116,7 @@ TEST_CASE("prepareStrands: --root-depth surface lifts strands rooted inside a sp
     CHECK(deepestKept < -0.09);  // keep: as deep as the roots
     // On the surface, as pushOut() places a point: just outside it (1e-4 of the radius here).
     for (std::size_t i = 0; i < s.numStrands(); ++i) CHECK(Vec3d(s.root(i)).length() == Approx(1.0).margin(2e-4));
-    REQUIRE_THROWS_WITH(rootDepthFromName("deep"), Contains("PrepareParams::rootDepth 'deep': must be keep or surface"));
+    REQUIRE_THROWS_WITH(rootDepthFromName("deep"), Contains("root_depth 'deep': must be keep or surface"));
 }
 
 TEST_CASE("prepareStrands: aligning a groom's head to a moved copy moves the strands by that transform", "[dataset]")
@@ -178,7 +178,7 @@ TEST_CASE("prepareStrands: --strands keeps N with even roots; bad parameters are
 
     PrepareParams one;
     one.points = 1;
-    REQUIRE_THROWS_WITH(prepareStrands(s, one, nullptr, nullptr, nullptr), Contains("PrepareParams::points 1: a strand needs at least 2 vertices"));
+    REQUIRE_THROWS_WITH(prepareStrands(s, one, nullptr, nullptr, nullptr), Contains("points 1: a strand needs at least 2 vertices"));
     PrepareParams huge;
     huge.points = std::size_t(1) << 40;
     REQUIRE_THROWS_WITH(prepareStrands(s, huge, nullptr, nullptr, nullptr), Contains("exceed the limit of 2^32-1 vertices"));

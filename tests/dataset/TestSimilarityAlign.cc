@@ -214,5 +214,5 @@ TEST_CASE("alignPointSets: identical for 1 and 2 threads; bad input refused", "[
     REQUIRE_THROWS_WITH(alignPointSets(from, bad), Contains("the target point 5 is not finite"));
     AlignParams p;
     p.overlap = 0.0;
-    REQUIRE_THROWS_WITH(alignPointSets(from, to, p), Contains("AlignParams::overlap 0: must be in (0, 1]"));
+    REQUIRE_THROWS_WITH(alignPointSets(from, to, p), Contains("overlap 0: must be in (0, 1]"));
 }

@@ -412,7 +412,7 @@ TEST_CASE("refineStrands: bad parameters are refused, naming them", "[field]")
     REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("levels 0: must be between 1 and 8"));
     rp.levels = 1;
     rp.consistency.zFull = 1.0;
-    REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("zFull"));
+    REQUIRE_THROWS_WITH(refineStrands(s, rp), Contains("outlier_full"));
     REQUIRE_THROWS_WITH(refineStrands(StrandSet(), RefineParams{}), Contains("no strands"));
     REQUIRE_THROWS_AS(HeadObstacle::sphere(Vec3d(0.0), -1.0), ValueError);
 }
@@ -466,7 +466,7 @@ TEST_CASE("refineStrands: a refinement whose memory estimate exceeds maxMemory i
     REQUIRE_THROWS_AS(refineStrands(s, p), LimitError);
     REQUIRE_THROWS_WITH(refineStrands(s, p), Contains("refineStrands: needs about ") && Contains("(36 strands, 756 vertices, ") &&
                                                  Contains(" leaves in 2 level(s) from voxel size 0.500000), more than the ") &&
-                                                 Contains("of maxMemory; a request whose estimate exceeds the memory it may use is refused"));
+                                                 Contains("of max_memory; a request whose estimate exceeds the memory it may use is refused"));
     p.field.maxMemory = m.bytes;
     CHECK_NOTHROW(refineStrands(s, p));
 }

@@ -240,9 +240,9 @@ TEST_CASE("estimateTangentField: bad parameters are clear errors before any work
     p.voxelSize = 1e-4;  // 4 strands of 2 segments of 50: 8 x (5e5 + 1) visits
     p.maxVoxels = 1000000;
     REQUIRE_THROWS_AS(estimateTangentField(s, p), LimitError);
-    // The library names its parameter (maxVoxels), never a command's flag.
+    // The library names its parameter (a ParamError): what() in Python's spelling, the command line's is --max-voxels.
     REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("voxel size 0.000100 needs up to 40000") &&
-                                                        Contains("voxel visits, more than the cap of 1000000 (raise maxVoxels"));
+                                                        Contains("voxel visits, more than the cap of 1000000 (raise max_voxels"));
     p.maxVoxels = FieldParams().maxVoxels;
     p.voxelSize = 1e-6;
     REQUIRE_THROWS_WITH(estimateTangentField(s, p), Contains("below OpenVDB's smallest voxel size"));
@@ -336,7 +336,7 @@ TEST_CASE("estimateTangentField: an estimate above maxMemory is refused before a
     // The estimate, its terms, what is available and the rule, naming the library's parameter.
     REQUIRE_THROWS_WITH(estimateTangentFieldLevels(s, p, 2),
                         Contains("estimateTangentField: needs about ") && Contains(" MiB (9 strands, 180 vertices, ") &&
-                            Contains("more than the 1000 B of maxMemory; a request whose estimate exceeds the memory it may use is refused"));
+                            Contains("more than the 1000 B of max_memory; a request whose estimate exceeds the memory it may use is refused"));
     p.maxMemory = estimatePeakBytes({estimateFieldFootprint(s, p)}, MemoryUse::Field);  // exactly enough
     CHECK(estimateTangentField(s, p).tangent->activeVoxelCount() > 0);
     p.maxMemory = 0;  // the memory available now: ample for nine strands

@@ -246,7 +246,7 @@ TEST_CASE("fitStrands: parameters outside their ranges are refused before any wo
     for (const int bad : {0, -3, FitParams::kMaxPieces + 1}) {
         params.maxPieces = bad;
         CAPTURE(bad);
-        REQUIRE_THROWS_WITH(fitStrands(s, params), Contains("fitStrands: maxPieces " + std::to_string(bad) + ": must be between 1 and 64"));
+        REQUIRE_THROWS_WITH(fitStrands(s, params), Contains("fitStrands: max_pieces " + std::to_string(bad) + ": must be between 1 and 64"));
         REQUIRE_THROWS_AS(fitStrand(s.data(0), s.size(0), params), ValueError);
     }
     params.maxPieces = FitParams::kMaxPieces;
@@ -254,12 +254,12 @@ TEST_CASE("fitStrands: parameters outside their ranges are refused before any wo
     // Each other field at a value its rule refuses, and the message naming it.
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const std::vector<std::pair<std::function<void(FitParams&)>, std::string>> cases = {
-        {[](FitParams& p) { p.maxError = 0.0; }, "maxError 0: must be a positive fraction"},
-        {[&](FitParams& p) { p.maxError = nan; }, "maxError nan: must be a positive fraction"},
-        {[](FitParams& p) { p.lambda = -1e-3; }, "lambda -0.001: must be zero or positive"},
+        {[](FitParams& p) { p.maxError = 0.0; }, "max_error 0: must be a positive fraction"},
+        {[&](FitParams& p) { p.maxError = nan; }, "max_error nan: must be a positive fraction"},
+        {[](FitParams& p) { p.lambda = -1e-3; }, "lambda_ -0.001: must be zero or positive"},
         {[](FitParams& p) { p.relaxRetries = -1; }, "relaxRetries -1: must be 0 or more"},
-        {[](FitParams& p) { p.maxEvaluations = FitParams::kMinEvaluations - 1; }, "maxEvaluations 9: must be at least 10"},
-        {[](FitParams& p) { p.prefitIterations = -1; }, "prefitIterations -1: must be 0"},
+        {[](FitParams& p) { p.maxEvaluations = FitParams::kMinEvaluations - 1; }, "max_evaluations 9: must be at least 10"},
+        {[](FitParams& p) { p.prefitIterations = -1; }, "prefit_iterations -1: must be 0"},
         {[](FitParams& p) { p.step = -0.5; }, "step -0.5: must be a positive finite length"},
         {[](FitParams& p) { p.axisClearance = -1.0; }, "axisClearance -1: must be zero or positive"},
         {[](FitParams& p) { p.stepDeviationLimit = 0.0; }, "stepDeviationLimit 0: must be a positive fraction"},

@@ -220,10 +220,10 @@ TEST_CASE("readPly: points in runs of ReadOptions::pointsPerStrand (NeuralHaircu
         test::requireSameStrands(s, readPly(path, runs));
         // Without the option: one line that says what to set.
         REQUIRE_THROWS_WITH(readPly(path), Contains("the file has only points: no 'strand' element") &&
-                                               Contains("read it with ReadOptions::pointsPerStrand N"));
+                                               Contains("read it with points_per_strand=N"));
         ReadOptions four;
         four.pointsPerStrand = 4;
-        REQUIRE_THROWS_WITH(readPly(path, four), Contains("the 'vertex' element has 15 vertices, which is not a multiple of ReadOptions::pointsPerStrand 4"));
+        REQUIRE_THROWS_WITH(readPly(path, four), Contains("the 'vertex' element has 15 vertices, which is not a multiple of points_per_strand=4"));
         ReadOptions all;
         all.pointsPerStrand = 15;
         REQUIRE(readPly(path, all).numStrands() == 1);
@@ -245,7 +245,7 @@ TEST_CASE("readPly: points in runs of ReadOptions::pointsPerStrand (NeuralHaircu
     ReadReport report;
     test::requireSameStrands(sample, readPly(hairutil, runs, &report));
     REQUIRE(report.warnings.size() == 1);
-    REQUIRE_THAT(report.warnings[0], Contains("ReadOptions::pointsPerStrand 5 is ignored"));
+    REQUIRE_THAT(report.warnings[0], Contains("points_per_strand=5 is ignored"));
 }
 
 TEST_CASE("readPly: vertex + edge line sets (Open3D, trimesh) chained into strands", "[io][ply-edges]")

@@ -54,7 +54,7 @@ TEST_CASE("rootEndFromName: first, last, auto; anything else named with the choi
 {
     for (RootEnd e : {RootEnd::First, RootEnd::Last, RootEnd::Auto}) REQUIRE(rootEndFromName(rootEndName(e)) == e);
     REQUIRE_THROWS_AS(rootEndFromName("tip"), ValueError);
-    REQUIRE_THROWS_WITH(rootEndFromName("tip"), Contains("ReadOptions::roots 'tip': must be first, last or auto"));
+    REQUIRE_THROWS_WITH(rootEndFromName("tip"), Contains("roots='tip': must be first, last or auto"));
 }
 
 TEST_CASE("orientStrandRoots: last reverses every strand with its per-vertex attributes", "[io][roots]")
@@ -142,7 +142,7 @@ TEST_CASE("readStrands: ReadOptions::roots is applied after any reader, with the
     const StrandSet r = readStrands(tipFirst, opts, &report);
     test::requireSameStrands(hair, r);
     REQUIRE(report.warnings.size() == 1);
-    REQUIRE_THAT(report.warnings[0], Contains("tip_first.hair: ReadOptions::roots auto reversed 100 % of the strands (100 of 100)"));
+    REQUIRE_THAT(report.warnings[0], Contains("tip_first.hair: roots=auto reversed 100 % of the strands (100 of 100)"));
 
     opts.roots = RootEnd::Last;
     ReadReport quiet;

@@ -386,5 +386,5 @@ TEST_CASE("transferDetail: match place takes the wisps near an output wisp's pla
         }
     DetailMatchParams bad;
     bad.place = -1.0;
-    CHECK_THROWS_WITH(bad.validate("test"), Catch::Contains("match place -1"));
+    CHECK_THROWS_WITH(bad.validate("test"), Catch::Contains("match_place -1"));
 }

@@ -40,14 +40,23 @@ const ParamTable<CompareParams>& compareParameters()
 
 void CompareParams::validate() const
 {
+    // The unit and the thresholds are not declared parameters (the command line reads them as text:
+    // --unit cm, --threshold 2:20); named here as each front end spells them.
+    const ParamName unit{"--unit", "meters_per_unit"}, threshold{"--threshold", "thresholds"};
     if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit)) {
-        throw ValueError("metersPerUnit " + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
+        throw ParamError<ValueError>({unit, " " + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown"});
     }
-    if (samples < kMinSamples)
-        throw ValueError("samples " + std::to_string(samples) + ": must be at least " + std::to_string(kMinSamples) + " (a curvature needs three points)");
+    if (samples < kMinSamples) {
+        throw ParamError<ValueError>({paramName(compareParameters(), "samples"),
+                                      " " + std::to_string(samples) + ": must be at least " + std::to_string(kMinSamples) + " (a curvature needs three points)"});
+    }
     for (const OrientedThreshold& t : thresholds) {
-        if (!(t.distance > 0.0) || !std::isfinite(t.distance)) throw ValueError("thresholds: distance " + std::to_string(t.distance) + ": must be positive and finite");
-        if (!(t.angleDegrees >= 0.0 && t.angleDegrees <= 180.0)) throw ValueError("thresholds: angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees");
+        if (!(t.distance > 0.0) || !std::isfinite(t.distance)) {
+            throw ParamError<ValueError>({threshold, ": distance " + std::to_string(t.distance) + ": must be positive and finite"});
+        }
+        if (!(t.angleDegrees >= 0.0 && t.angleDegrees <= 180.0)) {
+            throw ParamError<ValueError>({threshold, ": angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees"});
+        }
     }
 }
 

@@ -14,9 +14,10 @@ namespace vdbhair {
 
 void PrepareParams::validate() const
 {
-    if (points == 1) throw ValueError("PrepareParams::points 1: a strand needs at least 2 vertices (0 keeps them)");
+    if (points == 1) throw ParamError<ValueError>({paramName(prepareParameters(), "points"), " 1: a strand needs at least 2 vertices (0 keeps them)"});
     if (!(headCrop >= 0.0) || !std::isfinite(headCrop)) {
-        throw ValueError("PrepareParams::headCrop " + std::to_string(headCrop) + ": must be a finite factor, 0 or more (0 keeps the whole head)");
+        throw ParamError<ValueError>({paramName(prepareParameters(), "head-crop"),
+                                      " " + std::to_string(headCrop) + ": must be a finite factor, 0 or more (0 keeps the whole head)"});
     }
     align.validate();
 }
@@ -36,7 +37,7 @@ RootDepth rootDepthFromName(const std::string& name)
 {
     if (name == "keep") return RootDepth::Keep;
     if (name == "surface") return RootDepth::Surface;
-    throw ValueError("PrepareParams::rootDepth '" + name + "': must be keep or surface");
+    throw ParamError<ValueError>({paramName(prepareParameters(), "root-depth"), " '" + name + "': must be keep or surface"});
 }
 
 const char* rootDepthName(RootDepth depth)
@@ -184,8 +185,8 @@ PrepareReport prepareStrands(StrandSet& strands, const PrepareParams& params, co
     if (params.points >= 2) {
         const std::size_t limit = std::numeric_limits<std::uint32_t>::max();
         if (strands.numStrands() > 0 && params.points > limit / strands.numStrands()) {
-            throw ValueError("PrepareParams::points " + std::to_string(params.points) + ": " + std::to_string(strands.numStrands()) +
-                             " strands of that many vertices exceed the limit of 2^32-1 vertices");
+            throw ParamError<ValueError>({paramName(prepareParameters(), "points"), " " + std::to_string(params.points) + ": " + std::to_string(strands.numStrands()) +
+                                                                                         " strands of that many vertices exceed the limit of 2^32-1 vertices"});
         }
         strands = resampleStrands(strands, params.points);
     }

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Parallel.h>
+#include <vdbhair/dataset/Prepare.h>
 #include <vdbhair/strands/PointCloud.h>
 
 #include <openvdb/math/Proximity.h>
@@ -455,7 +456,9 @@ Similarity fitSimilarity(const std::vector<Vec3d>& from, const std::vector<Vec3d
 
 void AlignParams::validate() const
 {
-    if (!(overlap > 0.0 && overlap <= 1.0)) throw ValueError("AlignParams::overlap " + formatNumber(overlap) + ": must be in (0, 1]");
+    if (!(overlap > 0.0 && overlap <= 1.0)) {
+        throw ParamError<ValueError>({paramName(prepareParameters(), "overlap"), " " + formatNumber(overlap) + ": must be in (0, 1]"});
+    }
     if (iterations < 0) throw ValueError("AlignParams::iterations " + std::to_string(iterations) + ": must be 0 or more");
     if (startIterations < 0) throw ValueError("AlignParams::startIterations " + std::to_string(startIterations) + ": must be 0 or more");
     if (startSamples < 3) throw ValueError("AlignParams::startSamples " + std::to_string(startSamples) + ": must be 3 or more");

@@ -8,6 +8,7 @@
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/FieldSampler.h>
 #include <vdbhair/field/HairVolume.h>
+#include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Simd.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/strands/Measures.h>
@@ -25,15 +26,20 @@ namespace vdbhair {
 
 void ConsistencyParams::validate(const char* where) const
 {
-    auto fail = [&](const char* field, double value, const std::string& rule) {
-        throw ValueError(std::string(where) + ": " + field + " " + formatNumber(value) + ": " + rule);
+    // Named as refine declares them (refineParameters()); the rest are no verb's parameters.
+    auto fail = [&](const ParamName& name, double value, const ParamText& rule) {
+        ParamText text{std::string(where) + ": ", name, " " + formatNumber(value) + ": "};
+        text += rule;
+        throw ParamError<ValueError>(text);
     };
+    const ParamName start = paramName(refineParameters(), "outlier-start");
     resolveStepLength(step, 1.0, where);  // the engine's rule for a step (Streamline.h)
-    if (!(zStart >= 0.0) || !std::isfinite(zStart)) fail("zStart", zStart, "must be finite and at least 0");
-    if (!(zFull > zStart) || !std::isfinite(zFull)) fail("zFull", zFull, "must be finite and above zStart " + formatNumber(zStart));
-    if (!(minSpreadDeg >= 0.0 && minSpreadDeg < 90.0)) fail("minSpreadDeg", minSpreadDeg, "must be in [0, 90) degrees");
-    if (!(returnVoxels > 0.0) || !std::isfinite(returnVoxels)) fail("returnVoxels", returnVoxels, "must be positive and finite");
-    if (!(vanishThreshold >= 0.0 && vanishThreshold < 1.0)) fail("vanishThreshold", vanishThreshold, "must be in [0, 1)");
+    if (!(zStart >= 0.0) || !std::isfinite(zStart)) fail(start, zStart, {"must be finite and at least 0"});
+    if (!(zFull > zStart) || !std::isfinite(zFull))
+        fail(paramName(refineParameters(), "outlier-full"), zFull, {"must be finite and above ", start, " " + formatNumber(zStart)});
+    if (!(minSpreadDeg >= 0.0 && minSpreadDeg < 90.0)) fail(paramName(refineParameters(), "min-spread"), minSpreadDeg, {"must be in [0, 90) degrees"});
+    if (!(returnVoxels > 0.0) || !std::isfinite(returnVoxels)) fail(ParamName{"returnVoxels", "returnVoxels"}, returnVoxels, {"must be positive and finite"});
+    if (!(vanishThreshold >= 0.0 && vanishThreshold < 1.0)) fail(ParamName{"vanishThreshold", "vanishThreshold"}, vanishThreshold, {"must be in [0, 1)"});
 }
 
 namespace {

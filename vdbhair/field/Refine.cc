@@ -26,8 +26,8 @@ const char* refineModeName(RefineMode mode)
 void RefineParams::validate(const char* where) const
 {
     if (levels < 1 || levels > kMaxLevels) {
-        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + ": must be between 1 and " +
-                         std::to_string(kMaxLevels));
+        throw ParamError<ValueError>({std::string(where) + ": ", paramName(refineParameters(), "levels"),
+                                      " " + std::to_string(levels) + ": must be between 1 and " + std::to_string(kMaxLevels)});
     }
     consistency.validate(where);
 }

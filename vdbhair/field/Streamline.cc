@@ -76,7 +76,8 @@ const char* integratorName(Integrator integrator)
 double resolveStepLength(double step, double voxelSize, const std::string& where)
 {
     if (step < 0.0 || !std::isfinite(step)) {
-        throw ValueError(where + ": step " + std::to_string(step) + " must be 0 (half a voxel) or a positive finite length");
+        throw ParamError<ValueError>({where + ": ", paramName(traceParameters(), "step"),
+                                      " " + std::to_string(step) + " must be 0 (half a voxel) or a positive finite length"});
     }
     return step > 0.0 ? step : kDefaultStepVoxels * voxelSize;
 }
@@ -104,10 +105,11 @@ void TraceParams::validate(const std::string& where) const
 {
     resolveStepLength(step, 1.0, where);
     if (margin < 0 || margin > kMaxMargin) {
-        throw ValueError(where + ": margin " + std::to_string(margin) + " voxels must be between 0 and " + std::to_string(kMaxMargin));
+        throw ParamError<ValueError>({where + ": ", paramName(traceParameters(), "margin"),
+                                      " " + std::to_string(margin) + " voxels must be between 0 and " + std::to_string(kMaxMargin)});
     }
     if (vanishThreshold < 0.0 || !(vanishThreshold < 1.0)) {
-        throw ValueError(where + ": vanishThreshold " + std::to_string(vanishThreshold) + " must be in [0, 1)");
+        throw ParamError<ValueError>({where + ": ", paramName(traceParameters(), "vanish"), " " + std::to_string(vanishThreshold) + " must be in [0, 1)"});
     }
 }
 

@@ -5,6 +5,7 @@
 #include <vdbhair/Progress.h>
 #include <vdbhair/SegmentWalk.h>
 #include <vdbhair/field/FieldMapping.h>
+#include <vdbhair/field/Refine.h>
 #include <vdbhair/field/Simd.h>
 #include <vdbhair/field/impl/FieldMoments.h>
 #include <vdbhair/strands/Measures.h>
@@ -172,9 +173,9 @@ void checkIndexRange(Extent extent, const FieldMapping& map, double voxelSize)
 void checkVisits(std::uint64_t bound, const FieldParams& p, double voxelSize)
 {
     if (bound > p.maxVoxels) {
-        throw LimitError("estimateTangentField: voxel size " + std::to_string(voxelSize) + " needs up to " +
-                         std::to_string(bound) + " voxel visits, more than the cap of " +
-                         std::to_string(p.maxVoxels) + " (raise maxVoxels or the voxel size)");
+        throw ParamError<LimitError>({"estimateTangentField: voxel size " + std::to_string(voxelSize) + " needs up to " +
+                                          std::to_string(bound) + " voxel visits, more than the cap of " + std::to_string(p.maxVoxels) + " (raise ",
+                                      paramName(fieldParameters(), "max-voxels"), " or the voxel size)"});
     }
 }
 
@@ -572,8 +573,8 @@ void countLeavesExactly(const StrandSet& strands, const FieldParams& p, std::vec
 void checkLevels(int levels, const char* where)
 {
     if (levels < 1 || levels > FieldParams::kMaxLevels) {
-        throw ValueError(std::string(where) + ": levels " + std::to_string(levels) + " must be between 1 and " +
-                         std::to_string(FieldParams::kMaxLevels));
+        throw ParamError<ValueError>({std::string(where) + ": ", paramName(refineParameters(), "levels"),
+                                      " " + std::to_string(levels) + " must be between 1 and " + std::to_string(FieldParams::kMaxLevels)});
     }
 }
 
@@ -679,10 +680,11 @@ std::uint64_t availableMemoryBytes(const FieldParams& params)
 
 void checkMemoryEstimate(const char* where, std::uint64_t estimate, const std::string& how, const FieldParams& params)
 {
+    const ParamName maxMemory = paramName(fieldParameters(), "max-memory");
     checkMemory(where, estimate, how,
-                "a request whose estimate exceeds the memory it may use is refused before it allocates "
-                "(raise maxMemory or the voxel size, or split the hairstyle)",
-                params.maxMemory);
+                {"a request whose estimate exceeds the memory it may use is refused before it allocates (raise ", maxMemory,
+                 " or the voxel size, or split the hairstyle)"},
+                params.maxMemory, maxMemory);
 }
 
 std::uint64_t estimateVoxelVisits(const StrandSet& strands, const FieldParams& params)

@@ -1,6 +1,7 @@
 #include "HelicoidField.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parameters.h>
 #include <vdbhair/Progress.h>
 #include <vdbhair/SegmentWalk.h>
 #include <vdbhair/Version.h>
@@ -424,7 +425,9 @@ HelicoidFieldGrids readHelicoidField(const std::string& path)
         try {
             g = readVdbGrid(path, name, where);
         } catch (const LookupError& e) {
-            throw LookupError(std::string(e.what()) + " (a helicoid field holds the grids estimateHelicoidField makes)");
+            // What makes them: the command line's `field --helicoid`, the library's function.
+            throw ParamError<LookupError>({std::string(e.what()) + " (a helicoid field holds the grids ",
+                                           ParamName{"'vdbhair field --helicoid'", "estimateHelicoidField"}, " makes)"});
         }
         return g;
     };

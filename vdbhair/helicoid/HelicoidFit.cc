@@ -111,15 +111,18 @@ StrandFit fitTarget(const fit::FitTarget& target, std::size_t n, const FitParams
 
 void FitParams::validate(const char* where) const
 {
-    const auto fail = [&](const char* field, const std::string& value, const std::string& rule) {
-        throw ValueError(std::string(where) + ": " + field + " " + value + ": " + rule);
+    // A declared parameter by its declaration's names (fitParameters()); the others by their field's.
+    const auto fail = [&](const std::string& field, const std::string& value, const std::string& rule) {
+        const Param<FitParams>* declared = findParam(fitParameters(), field);
+        const ParamName name = declared ? paramName(*declared) : ParamName{field, field};
+        throw ParamError<ValueError>({std::string(where) + ": ", name, " " + value + ": " + rule});
     };
-    if (!(maxError > 0.0) || !std::isfinite(maxError)) fail("maxError", formatNumber(maxError), "must be a positive fraction of the strand length");
+    if (!(maxError > 0.0) || !std::isfinite(maxError)) fail("max-error", formatNumber(maxError), "must be a positive fraction of the strand length");
     if (!(lambda >= 0.0) || !std::isfinite(lambda)) fail("lambda", formatNumber(lambda), "must be zero or positive");
-    if (maxPieces < 1 || maxPieces > kMaxPieces) fail("maxPieces", std::to_string(maxPieces), "must be between 1 and " + std::to_string(kMaxPieces));
+    if (maxPieces < 1 || maxPieces > kMaxPieces) fail("max-pieces", std::to_string(maxPieces), "must be between 1 and " + std::to_string(kMaxPieces));
     if (relaxRetries < 0) fail("relaxRetries", std::to_string(relaxRetries), "must be 0 or more");
-    if (maxEvaluations < kMinEvaluations) fail("maxEvaluations", std::to_string(maxEvaluations), "must be at least " + std::to_string(kMinEvaluations));
-    if (prefitIterations < 0) fail("prefitIterations", std::to_string(prefitIterations), "must be 0 (none: Nelder-Mead alone, the paper's) or more");
+    if (maxEvaluations < kMinEvaluations) fail("max-evaluations", std::to_string(maxEvaluations), "must be at least " + std::to_string(kMinEvaluations));
+    if (prefitIterations < 0) fail("prefit-iterations", std::to_string(prefitIterations), "must be 0 (none: Nelder-Mead alone, the paper's) or more");
     if (step != 0.0 && !(step > 0.0 && std::isfinite(step))) fail("step", formatNumber(step), "must be a positive finite length (0: a quarter of the mean segment length)");
     if (!(axisClearance >= 0.0) || !std::isfinite(axisClearance)) fail("axisClearance", formatNumber(axisClearance), "must be zero or positive (steps)");
     if (!(stepDeviationLimit > 0.0) || !std::isfinite(stepDeviationLimit)) fail("stepDeviationLimit", formatNumber(stepDeviationLimit), "must be a positive fraction of the tolerance");

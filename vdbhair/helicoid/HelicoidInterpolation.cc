@@ -88,7 +88,7 @@ HelicoidBlend helicoidBlendFromName(const std::string& name)
 {
     if (name == "arcs") return HelicoidBlend::Arcs;
     if (name == "fitted") return HelicoidBlend::Fitted;
-    throw ValueError("blend '" + name + "' is not one of arcs, fitted");
+    throw ParamError<ValueError>({paramName(helicoidInterpolationParameters(), "blend"), " '" + name + "' is not one of arcs, fitted"});
 }
 
 FrameD surfaceFrame(const Vec3d& normal, const Vec3d& up)

@@ -67,7 +67,8 @@ void checkArguments(std::size_t G, std::size_t R, const InterpolationRoots& root
     if (R == 0) throw ValueError("no roots: interpolation needs at least one root");
     if (params.neighbors < 1) throw ValueError("neighbors " + std::to_string(params.neighbors) + ": must be at least 1");
     if (!(params.likeness > 0.0) || !std::isfinite(params.likeness)) {
-        throw ValueError("likeness " + formatNumber(params.likeness) + ": must be a positive fraction of the guide length");
+        throw ParamError<ValueError>({paramName(pointInterpolationParameters(), "likeness"),
+                                      " " + formatNumber(params.likeness) + ": must be a positive fraction of the guide length"});
     }
     if (!roots.normals.empty() && roots.normals.size() != R) {
         throw ValueError(std::to_string(roots.normals.size()) + " root normals for " + std::to_string(R) + " roots");
@@ -348,7 +349,7 @@ GuideGrouping guideGroupingFromName(const std::string& name)
 {
     if (name == "shape") return GuideGrouping::Shape;
     if (name == "none") return GuideGrouping::None;
-    throw ValueError("grouping '" + name + "' is not one of shape, none");
+    throw ParamError<ValueError>({paramName(pointInterpolationParameters(), "grouping"), " '" + name + "' is not one of shape, none"});
 }
 
 double likenessDistance(const Vec3f* a, std::size_t na, const Vec3f* b, std::size_t nb)

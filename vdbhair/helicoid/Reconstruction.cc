@@ -67,7 +67,8 @@ void checkParams(const ReconstructParams& params)
 {
     validateShepardParams(params.helicoid.shepard);
     if (!(params.metersPerUnit >= 0.0) || !std::isfinite(params.metersPerUnit)) {
-        throw ValueError("metersPerUnit " + formatNumber(params.metersPerUnit) + ": must be a positive length in metres, or 0 for unknown");
+        throw ParamError<ValueError>({paramName(reconstructParameters(), "meters-per-unit"),
+                                      " " + formatNumber(params.metersPerUnit) + ": must be a positive length in metres, or 0 for unknown"});
     }
     if (params.points.neighbors < 1) throw ValueError("neighbors " + std::to_string(params.points.neighbors) + ": must be at least 1");
 }

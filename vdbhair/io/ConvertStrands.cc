@@ -101,8 +101,10 @@ const ParamTable<ConvertParams>& convertParameters()
 
 void ConvertParams::validate() const
 {
-    if (resample == 1) throw ValueError("resample 1: a strand needs at least 2 vertices (0 keeps them)");
-    if (!std::isfinite(scale) || scale == 0.0) throw ValueError("scale " + formatNumber(scale) + ": must be finite and non-zero");
+    if (resample == 1) throw ParamError<ValueError>({paramName(convertParameters(), "resample"), " 1: a strand needs at least 2 vertices (0 keeps them)"});
+    if (!std::isfinite(scale) || scale == 0.0) {
+        throw ParamError<ValueError>({paramName(convertParameters(), "scale"), " " + formatNumber(scale) + ": must be finite and non-zero"});
+    }
     axisName(up);  // a unit axis
 }
 

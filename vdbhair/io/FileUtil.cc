@@ -2,6 +2,7 @@
 #include "MappedFile.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parameters.h>
 #include <vdbhair/Progress.h>
 
 #include <algorithm>
@@ -160,7 +161,11 @@ void AtomicOutput::commit()
             const int err = errno;
             std::error_code ec;
             fs::remove(mTemp, ec);
-            if (err == EEXIST) throw IoError(mTarget + ": exists; OverwritePolicy::NoClobber refuses to replace it (nothing was written)");
+            // The policy is the command line's --no-clobber; Python always replaces.
+            if (err == EEXIST) {
+                throw ParamError<IoError>({mTarget + ": exists; ", ParamName{"--no-clobber", "OverwritePolicy::NoClobber"},
+                                           " refuses to replace it (nothing was written)"});
+            }
             throw IoError(mTarget + ": cannot move the finished output into place: " + std::strerror(err));
         }
         std::error_code ec;

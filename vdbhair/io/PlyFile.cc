@@ -218,12 +218,13 @@ PlyStrandLayout plyStrandLayout(const PlyHeader& hdr, const ReadOptions& opts, R
         } else if (l.edgeEl) {
             throw FormatError(where + ": line " + std::to_string(l.edgeEl->line) + ": the 'edge' element needs scalar properties vertex1 and vertex2");
         } else {
-            throw FormatError(where + ": the file has only points: no 'strand' element (hairutil layout: element strand with property nsegs) "
-                              "and no 'edge' element (a line set); if each run of N consecutive vertices is one strand (NeuralHaircut and "
-                              "GaussianHaircut write 100), read it with ReadOptions::pointsPerStrand N");
+            throw ParamError<FormatError>({where + ": the file has only points: no 'strand' element (hairutil layout: element strand with property nsegs) "
+                                           "and no 'edge' element (a line set); if each run of N consecutive vertices is one strand (NeuralHaircut and "
+                                           "GaussianHaircut write 100), read it with ",
+                                           readOptionSetting(kPointsPerStrandName), "N"});
         }
     } else if (opts.pointsPerStrand > 0 && report) {
-        report->warnings.push_back(where + ": ReadOptions::pointsPerStrand " + std::to_string(opts.pointsPerStrand) +
+        report->warnings.push_back(where + ": " + spelled(readOptionSetting(kPointsPerStrandName), opts.spelling) + std::to_string(opts.pointsPerStrand) +
                                    " is ignored: the file's 'strand' element says where each strand ends");
     }
     l.iseg = findProperty(l.strandEl, "nsegs");
@@ -420,9 +421,10 @@ StrandSet runsToStrands(PlyStrandsIn& in, const ReadOptions& opts, ReadReport* r
     const std::size_t line = in.layout.vertexEl->line;
     const std::size_t run = opts.pointsPerStrand, nV = out.positions.size();
     if (nV % run != 0) {
-        throw FormatError(where + ": line " + std::to_string(line) + ": the 'vertex' element has " + std::to_string(nV) +
-                          " vertices, which is not a multiple of ReadOptions::pointsPerStrand " + std::to_string(run) +
-                          " (each run of that many consecutive vertices is one strand)");
+        throw ParamError<FormatError>({where + ": line " + std::to_string(line) + ": the 'vertex' element has " + std::to_string(nV) +
+                                           " vertices, which is not a multiple of ",
+                                       readOptionSetting(kPointsPerStrandName),
+                                       std::to_string(run) + " (each run of that many consecutive vertices is one strand)"});
     }
     if (nV > std::numeric_limits<std::uint32_t>::max()) {
         throw FormatError(where + ": line " + std::to_string(line) + ": " + std::to_string(nV) + " vertices; a strand set holds at most 2^32-1");

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parameters.h>
 #include <vdbhair/io/RootEnd.h>
 #include <vdbhair/Types.h>
 #include <vdbhair/strands/StrandSet.h>
@@ -53,7 +54,25 @@ struct ReadOptions
     /// For RootEnd::Auto: unsigned distance to the head's surface (the end nearer it is the root);
     /// empty: the rule without a head.
     SurfaceDistanceFn rootsHeadDistance;
+    /// How the readers' warnings name the options above (their errors are ParamErrors): Python's
+    /// read() keywords, or the command line's flags.
+    ParamSpelling spelling = ParamSpelling::Keyword;
+    /// The name of @c roots: the command line's --roots, or --root-end where a verb's --roots
+    /// names something else (interpolate's root positions).
+    ParamName rootsName{"--roots", "roots"};
 };
+
+/// The readers' options as messages name them (the command line's addReadOptions() and Python's
+/// read() take them; @c roots: ReadOptions::rootsName).
+inline const ParamName kPointsPerStrandName{"--points-per-strand", "points_per_strand"};
+inline const ParamName kCurveSamplesName{"--curve-samples", "curve_samples"};
+
+/// @brief An option set to a value, as each front end shows it: "--points-per-strand 100" on the
+/// command line, "points_per_strand=100" in Python (the name and what stands before the value).
+inline ParamName readOptionSetting(const ParamName& option)
+{
+    return {option.flag + " ", option.keyword + "="};
+}
 
 /// @brief What a reader noticed but did not fail on.
 struct ReadReport

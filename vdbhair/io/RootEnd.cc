@@ -1,6 +1,7 @@
 #include "RootEnd.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/io/ReadOptions.h>
 
 #include <Eigen/Dense>
 
@@ -25,7 +26,7 @@ RootEnd rootEndFromName(const std::string& name)
     if (name == "first") return RootEnd::First;
     if (name == "last") return RootEnd::Last;
     if (name == "auto") return RootEnd::Auto;
-    throw ValueError("ReadOptions::roots '" + name + "': must be first, last or auto");
+    throw ParamError<ValueError>({readOptionSetting(ParamName{"--roots", "roots"}), "'" + name + "': must be first, last or auto"});
 }
 
 void reverseStrand(StrandSet& strands, std::size_t i)
@@ -139,10 +140,10 @@ RootEndDecision orientStrandRoots(StrandSet& strands, RootEnd end, const Surface
     return d;
 }
 
-std::string describeRootEndDecision(const RootEndDecision& d)
+std::string describeRootEndDecision(const RootEndDecision& d, const std::string& setting)
 {
     if (!d.decided) {
-        return "ReadOptions::roots auto: " + std::to_string(d.strands) + " strand(s) are too few to tell the root end without a head (" +
+        return setting + ": " + std::to_string(d.strands) + " strand(s) are too few to tell the root end without a head (" +
                std::to_string(kAutoRootsMinStrands) + " needed); kept as stored (first vertex = root); give the head or choose first or last";
     }
     if (!d.reversed) return "";
@@ -150,7 +151,7 @@ std::string describeRootEndDecision(const RootEndDecision& d)
         ? "the last vertex is nearer the head in " + percent(d.scoreLast) + " % of the strands, the first in " + percent(d.scoreFirst) + " %"
         : percent(d.scoreLast) + " % of the hair lies outside the sphere through the last vertices, " + percent(d.scoreFirst) +
               " % outside the sphere through the first";
-    return "ReadOptions::roots auto reversed 100 % of the strands (" + std::to_string(d.strands) + " of " + std::to_string(d.strands) +
+    return setting + " reversed 100 % of the strands (" + std::to_string(d.strands) + " of " + std::to_string(d.strands) +
            "): the roots were stored last (" + why + ")";
 }
 

@@ -72,6 +72,7 @@ RootEndDecision orientStrandRoots(StrandSet& strands, RootEnd end, const Surface
 
 /// @brief The warning line for an Auto decision, e.g. "--roots auto reversed 100 % of the
 /// strands (7905 of 7905): ...". Empty when Auto kept every strand as stored and was sure.
-std::string describeRootEndDecision(const RootEndDecision& d);
+/// @param setting the option that chose Auto, as the caller spells it ("--roots auto", "roots=auto")
+std::string describeRootEndDecision(const RootEndDecision& d, const std::string& setting = "roots=auto");
 
 } // namespace vdbhair

@@ -23,7 +23,8 @@ StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadRepo
     StrandSet strands = readAnyStrands(path, opts, report);
     // The one place ReadOptions::roots is applied, whichever reader ran (RootEnd.h).
     const RootEndDecision d = orientStrandRoots(strands, opts.roots, opts.rootsHeadDistance);
-    const std::string line = opts.roots == RootEnd::Auto ? describeRootEndDecision(d) : std::string();
+    const std::string line =
+        opts.roots == RootEnd::Auto ? describeRootEndDecision(d, spelled(readOptionSetting(opts.rootsName), opts.spelling) + "auto") : std::string();
     if (report && !line.empty()) report->warnings.push_back(path + ": " + line);
     return strands;
 }

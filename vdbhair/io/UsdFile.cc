@@ -321,7 +321,8 @@ StrandSet readUsda(const std::string& path, const ReadOptions& opts, ReadReport*
         throw FormatError(where + ": no strands: the file has no 'def BasisCurves' prim");
     }
     const Warn warn = [&](const std::string& w) { if (report) report->warnings.push_back(where + ": " + w); };
-    if (doc.upAxis == "Z") warn("the stage's upAxis is Z; coordinates are kept as they are (render with RenderParams::up set to z)");
+    // render's up axis: the command line's --up, Python's up= (not a declared parameter).
+    if (doc.upAxis == "Z") warn("the stage's upAxis is Z; coordinates are kept as they are (render with " + spelled(ParamName{"--up", "up"}, opts.spelling) + " set to z)");
     if (doc.timeSampled) warn(std::to_string(doc.timeSampled) + " time-sampled attribute(s) were read at their first sample (an animation's first frame)");
 
     StrandSet out;

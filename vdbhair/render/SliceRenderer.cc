@@ -131,9 +131,15 @@ struct InPlaneSampler
     }
 };
 
+/// The slice, AXIS=WORLD: no declared parameter (SliceParams holds it parsed), named as inspect's
+/// --slice and Python's slice= keyword.
+const ParamName kSliceName{"--slice", "slice"};
+
 void checkSliceParams(const SliceParams& params, const std::string& where)
 {
-    if (params.axis < 0 || params.axis > 2) throw ValueError(where + ": slice axis " + std::to_string(params.axis) + " is not 0, 1 or 2");
+    if (params.axis < 0 || params.axis > 2) {
+        throw ParamError<ValueError>({where + ": ", kSliceName, " axis " + std::to_string(params.axis) + " is not 0, 1 or 2"});
+    }
     checkParams(sliceParameters(), params, ParamSpelling::Keyword, where);
 }
 
@@ -420,8 +426,8 @@ std::string chooseSliceGrid(const std::vector<GridReport>& reports, const std::s
 
 void parseSlice(const std::string& text, int& axis, double& world)
 {
-    const std::string rule = "slice " + text + ": expected AXIS=WORLD with AXIS x, y or z and WORLD a finite number (e.g. z=1.5)";
-    if (text.size() < 3 || text[1] != '=' || (text[0] != 'x' && text[0] != 'y' && text[0] != 'z')) throw ValueError(rule);
+    const ParamError<ValueError> rule({kSliceName, " " + text + ": expected AXIS=WORLD with AXIS x, y or z and WORLD a finite number (e.g. z=1.5)"});
+    if (text.size() < 3 || text[1] != '=' || (text[0] != 'x' && text[0] != 'y' && text[0] != 'z')) throw rule;
     axis = text[0] - 'x';
     const std::string number = text.substr(2);
     char* end = nullptr;
@@ -441,8 +447,8 @@ SliceResult renderSlice(const std::string& path, const std::string& gridName, co
     const openvdb::BBoxd wbox = worldBoundsOf(ibox, base->transform());
     const int axis = params.axis;
     if (!(params.world >= wbox.min()[axis] && params.world <= wbox.max()[axis])) {
-        throw ValueError(gw + ": slice " + axisName(axis) + "=" + num(params.world) + " is outside its active voxels, which span " +
-                         axisName(axis) + " from " + num(wbox.min()[axis]) + " to " + num(wbox.max()[axis]));
+        throw ParamError<ValueError>({gw + ": ", kSliceName, " " + std::string(axisName(axis)) + "=" + num(params.world) + " is outside its active voxels, which span " +
+                                                               axisName(axis) + " from " + num(wbox.min()[axis]) + " to " + num(wbox.max()[axis])});
     }
     const SlicePlot plot(axis, params.world, params.width, wbox);
     SliceResult res;

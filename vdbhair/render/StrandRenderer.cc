@@ -66,7 +66,7 @@ ColorBy colorByFromName(const std::string& name)
     if (name == "curvature") return ColorBy::Curvature;
     if (name == "strand") return ColorBy::Strand;
     if (name == "error") return ColorBy::Error;
-    throw ValueError("colorBy '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand, error");
+    throw ParamError<ValueError>({paramName(renderParameters(), "color-by"), " '" + name + "' is not one of shaded, root, tangent, depth, curvature, strand, error"});
 }
 
 const ParamTable<RenderParams>& renderParameters()
@@ -425,7 +425,7 @@ void checkSize(const RenderParams& p)
     }
     if (p.supersample < 1 || p.supersample > 8) throw ValueError("supersampling " + std::to_string(p.supersample) + " must be 1 to 8");
     if (p.colorBy == ColorBy::Error && (!p.reference || p.reference->positions.empty())) {
-        throw ValueError("colorBy error needs a reference hairstyle with vertices to measure the distance to");
+        throw ParamError<ValueError>({paramName(renderParameters(), "color-by"), " error needs a reference hairstyle with vertices to measure the distance to"});
     }
 }
 

@@ -8,6 +8,7 @@
 #include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/synth/FeatureMap.h>
+#include <vdbhair/synth/Synthesis.h>
 #include <vdbhair/synth/impl/BalancedMatch.h>
 #include <vdbhair/synth/impl/DetailEdges.h>
 
@@ -58,9 +59,16 @@ const char* detailScaleName(DetailScale scale)
 void DetailMatchParams::validate(const char* where) const
 {
     if (!(balance == 0.0 || (balance >= 1.0 && std::isfinite(balance))))
-        throw ValueError(std::string(where) + ": match balance " + formatNumber(balance) + ": 0 (off) or a finite factor of at least 1");
-    if (candidates < 1) throw ValueError(std::string(where) + ": match candidates " + std::to_string(candidates) + ": must be at least 1");
-    if (!(place >= 0.0) || !std::isfinite(place)) throw ValueError(std::string(where) + ": match place " + formatNumber(place) + ": must be 0 (off) or a positive finite weight");
+        throw ParamError<ValueError>({std::string(where) + ": ", paramName(synthParameters(), "match-balance"),
+                                      " " + formatNumber(balance) + ": 0 (off) or a finite factor of at least 1"});
+    if (candidates < 1) {
+        throw ParamError<ValueError>({std::string(where) + ": ", paramName(synthParameters(), "match-candidates"),
+                                      " " + std::to_string(candidates) + ": must be at least 1"});
+    }
+    if (!(place >= 0.0) || !std::isfinite(place)) {
+        throw ParamError<ValueError>({std::string(where) + ": ", paramName(synthParameters(), "match-place"),
+                                      " " + formatNumber(place) + ": must be 0 (off) or a positive finite weight"});
+    }
 }
 
 ScalpFrame alignedFrame(const float* row, int vertices, const ScalpFrame& f)
