@@ -563,6 +563,7 @@ TEST_CASE("Parameters: what synth, transfer, comb, field and refine share is dec
     setParam(refineParameters(), "space", rp, std::string("scalp"));
     CHECK(rp.field.scalp.up == Vec3d(0.0, 0.0, -1.0));
     CHECK(rp.field.space == FieldSpace::Scalp);
+}
 
 TEST_CASE("Parameters: batch's and demo's declarations (the command line's own verbs), in docs/cli.md", "[params]")
 {
