@@ -69,11 +69,4 @@ ProcessRun runProcess(const std::vector<std::string>& args, const std::string& s
     return r;
 }
 
-double median(std::vector<double> v)
-{
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
-
 } // namespace vdbhair::bench

@@ -48,7 +48,4 @@ struct ProcessRun
 /// the child's own CPU and peak RSS).
 ProcessRun runProcess(const std::vector<std::string>& args, const std::string& stdoutPath = std::string());
 
-/// The median of @a v (0 when it is empty).
-double median(std::vector<double> v);
-
 } // namespace vdbhair::bench

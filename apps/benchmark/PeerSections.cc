@@ -3,6 +3,7 @@
 #include "Harness.h"
 #include "Sections.h"
 
+#include <vdbhair/Quantile.h>
 #include <vdbhair/field/StreamlineTracer.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/MeshFile.h>
@@ -137,9 +138,8 @@ void benchmarkField(const std::string& name, const StrandSet& strands, double vo
         if (std::abs(double(tracedLengths[i]) - double(lengths[i])) > 1e-3 * double(lengths[i])) continue;  // stopped early
         tipGap.push_back((openvdb::Vec3d(tip.x(), tip.y(), tip.z()) - ends[i]).length() / voxelSize);
     }
-    std::sort(tipGap.begin(), tipGap.end());
-    const double gapMedian = tipGap.empty() ? 0.0 : tipGap[tipGap.size() / 2];
-    const double gapP95 = tipGap.empty() ? 0.0 : tipGap[std::min(tipGap.size() - 1, tipGap.size() * 95 / 100)];
+    const double gapMedian = upperMedian(tipGap);
+    const double gapP95 = orderStatistic(tipGap, tipGap.size() * 95 / 100);  // floor(0.95 n), within the sample
     std::printf("tracing (Euler, step %.4g)  vdbhair %.3f s (%.1f M steps/s, %zu steps, %zu/%zu full length)   VelocityIntegrator %.3f s (%.1f M steps/s, %zu steps)   ratio ours/peer %.2fx steps/s\n"
                 "                       into a reused output: vdbhair %.3f s (%.1f M steps/s), ratio ours/peer %.2fx (the %.0f MB output's fresh pages cost %.3f s above)\n",
                 tp.step, tTrace, oursRate / 1e6, stats.steps, stats.fullLength, nS, tPeerTrace, peerRate / 1e6, peerSteps, oursRate / peerRate,

@@ -3,6 +3,7 @@
 #include "Harness.h"
 #include "Sections.h"
 
+#include <vdbhair/Quantile.h>
 #include <vdbhair/field/TangentField.h>
 #include <vdbhair/io/FileUtil.h>
 #include <vdbhair/io/JsonFile.h>

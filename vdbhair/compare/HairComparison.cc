@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Parallel.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/field/HeadObstacle.h>
@@ -119,10 +120,7 @@ HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const C
         }
         if (!c.frechet.empty()) {
             c.frechetMean /= double(c.frechet.size());
-            std::vector<double> sorted = c.frechet;
-            const std::size_t k = std::min(sorted.size() - 1, std::size_t(std::ceil(0.95 * double(sorted.size()))) - 1);
-            std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
-            c.frechetP95 = sorted[k];
+            c.frechetP95 = nearestRankQuantile(c.frechet, 0.95);
         }
     }
 

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Parallel.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/dataset/Prepare.h>
 #include <vdbhair/strands/PointCloud.h>
 
@@ -94,15 +95,6 @@ std::vector<openvdb::math::Mat3d> axisRotations()
         }
     } while (std::next_permutation(perm.begin(), perm.end()));
     return out;
-}
-
-/// The value at share @a q (0..1] of @a d2 in increasing order.
-double quantile(std::vector<double> d2, double q)
-{
-    if (d2.empty()) return 0.0;
-    const std::size_t k = std::min(d2.size() - 1, std::size_t(std::ceil(q * double(d2.size()))) - (q > 0.0 ? 1 : 0));
-    std::nth_element(d2.begin(), d2.begin() + std::ptrdiff_t(k), d2.end());
-    return d2[k];
 }
 
 /// The point of triangle (a, b, c) nearest @a p, as barycentric weights (OpenVDB's
@@ -235,7 +227,7 @@ IcpStep pairUp(const Side& source, const Surface& target, const Side& targetSide
     std::vector<double> fwdD2(n), revD2(m);
     for (std::size_t i = 0; i < n; ++i) fwdD2[i] = fwd[i].d2;
     for (std::size_t j = 0; j < m; ++j) revD2[j] = rev[j].d2;
-    const double qf = quantile(fwdD2, overlap), qr = quantile(revD2, overlap);
+    const double qf = nearestRankQuantile(fwdD2, overlap), qr = nearestRankQuantile(revD2, overlap);
     IcpStep s;
     double sum = 0.0;
     const std::vector<Vec3d>& mv = movedSurface.vertices();
@@ -371,7 +363,7 @@ void measureResidual(const std::vector<Vec3d>& src, const Surface& target, const
 {
     std::vector<double> d2(src.size());
     forEachIndex(src.size(), threaded, [&](std::size_t i) { d2[i] = target.nearest(T.apply(src[i])).d2; }, 128);
-    const double q = quantile(d2, overlap);
+    const double q = nearestRankQuantile(d2, overlap);
     double kept = 0.0, all = 0.0, mx = 0.0;
     std::size_t nKept = 0;
     for (double v : d2) {

@@ -1,6 +1,7 @@
 #include "HeadCollision.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Rotation.h>
 #include <vdbhair/strands/PointCloud.h>
 
 #include <tbb/blocked_range.h>
@@ -198,25 +199,6 @@ void smoothTurns(std::size_t n, double sigma, StrandWork& w)
     }
 }
 
-/// The rotation vector (axis times angle, radians) that turns direction @a a onto @a b.
-Vec3d rotationBetween(const Vec3d& a, const Vec3d& b)
-{
-    const Vec3d axis = a.cross(b);
-    const double s = axis.length(), c = a.dot(b);
-    if (!(s > 1e-12)) return Vec3d(0.0);  // parallel (a half turn has no one axis: the sweep makes none)
-    return axis * (std::atan2(s, c) / s);
-}
-
-/// @a v turned by the rotation vector @a r (Rodrigues).
-Vec3d rotate(const Vec3d& v, const Vec3d& r)
-{
-    const double angle = r.length();
-    if (!(angle > 0.0)) return v;
-    const Vec3d k = r / angle;
-    const double c = std::cos(angle), s = std::sin(angle);
-    return v * c + k.cross(v) * s + k * (k.dot(v) * (1.0 - c));
-}
-
 /// The largest turn (radians) of a sweep that ends the passes: 5 degrees, a ninth of a kink (45
 /// degrees between two edges). Waiting for every turn to vanish took 4 to 12 passes a strand and
 /// made the head 3 times slower on 100,000 synthesized strands, for no fewer kinks measured.
@@ -264,11 +246,11 @@ bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle
         for (std::size_t k = 1; k < n; ++k) {
             const Vec3d a = w.c[k] - w.c[k - 1], b = w.p[k] - w.p[k - 1];
             const double la = a.length(), lb = b.length();
-            if (la > 0.0 && lb > 0.0) w.turn[k] = rotationBetween(a / la, b / lb);
+            if (la > 0.0 && lb > 0.0) w.turn[k] = rotationVectorBetween(a / la, b / lb);  // none for a half turn: the sweep makes none
         }
         w.smooth.resize(n);
         smoothTurns(n, sigma, w);
-        for (std::size_t k = 1; k < n; ++k) w.p[k] = w.p[k - 1] + rotate(w.c[k] - w.c[k - 1], w.turn[k]);
+        for (std::size_t k = 1; k < n; ++k) w.p[k] = w.p[k - 1] + rotateByVector(w.c[k] - w.c[k - 1], w.turn[k]);
     }
     // What is still too deep, vertex by vertex.
     DepthFloor f = floor0;

@@ -1,13 +1,14 @@
 #include "Refine.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/strands/Measures.h>
-
-#include <nanoflann.hpp>
+#include <vdbhair/strands/PointCloud.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace vdbhair {
 
@@ -103,16 +104,6 @@ const ParamTable<RefineParams>& refineParameters()
 
 namespace {
 
-/// The roots as a nanoflann point cloud, copied together: a strand's root is a strand's length away
-/// from the next one in the positions, and the tree's build reads every root many times.
-struct RootCloud
-{
-    std::vector<Vec3f> roots;
-    std::size_t kdtree_get_point_count() const { return roots.size(); }
-    float kdtree_get_pt(std::size_t i, std::size_t d) const { return roots[i][int(d)]; }
-    template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
-};
-
 std::vector<Vec3f> rootsOf(const StrandSet& strands)
 {
     std::vector<Vec3f> roots(strands.numStrands());
@@ -120,14 +111,17 @@ std::vector<Vec3f> rootsOf(const StrandSet& strands)
     return roots;
 }
 
-/// Median distance from a root to its nearest other root (0 for fewer than two distinct roots).
+/// The median distance from a root to its nearest other root (upperMedian(); 0 for fewer than two
+/// distinct roots).
 double medianRootSpacing(const StrandSet& strands)
 {
     const std::size_t n = strands.numStrands();
     if (n < 2) return 0.0;
-    using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, RootCloud>, RootCloud, 3>;
-    const RootCloud cloud{rootsOf(strands)};
-    Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    // The roots copied together: a strand's root is a strand's length away from the next one in
+    // the positions, and the tree's build reads every root many times.
+    const std::vector<Vec3f> roots = rootsOf(strands);
+    const PointCloudOf<Vec3f> cloud{&roots};
+    PointKdTreeOf<Vec3f> tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree.buildIndex();
     // At most 4096 roots, evenly spaced in index order: the median is stable long before that.
     const std::size_t stride = std::max<std::size_t>(1, n / 4096);
@@ -146,9 +140,7 @@ double medianRootSpacing(const StrandSet& strands)
             }
         }
     }
-    if (d.empty()) return 0.0;
-    std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
-    return d[d.size() / 2];
+    return upperMedian(std::move(d));
 }
 
 /// Half the largest extent of the hair: the head radius when the roots do not fit a sphere.

@@ -1,6 +1,7 @@
 #include "RefineReport.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/HairVolume.h>
 #include <vdbhair/strands/Measures.h>
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace vdbhair {
@@ -51,16 +53,6 @@ void coarsen(const Vec3f* p, std::size_t n, std::vector<Vec3f>& out)
     out.clear();
     for (std::size_t i = 0; i < n; i += 8) out.push_back(p[i]);
     if ((n - 1) % 8 != 0) out.push_back(p[n - 1]);
-}
-
-double median(std::vector<double>& v)
-{
-    if (v.empty()) return 0.0;
-    const std::size_t mid = v.size() / 2;
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(mid), v.end());
-    double m = v[mid];
-    if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + std::ptrdiff_t(mid)));
-    return m;
 }
 
 } // namespace
@@ -180,14 +172,10 @@ RefineMeasures measureRefinement(const StrandSet& input, const StrandSet& output
     }
     m.tipOccupancy = double(tipsIn) / double(nS);
     m.displacementMean = vertices ? displacement / double(vertices) : 0.0;
-    if (!disp.empty()) {
-        const std::size_t k = std::min(disp.size() - 1, std::size_t(std::ceil(0.95 * double(disp.size()))) - 1);
-        std::nth_element(disp.begin(), disp.begin() + std::ptrdiff_t(k), disp.end());
-        m.displacementP95 = disp[k];
-    }
-    const double cvIn = median(curvVIn), c8In = median(curv8In);
-    m.curvatureKeptVertex = cvIn > 0.0 ? median(curvV) / cvIn : 1.0;
-    m.curvatureKept8 = c8In > 0.0 ? median(curv8) / c8In : 1.0;
+    if (!disp.empty()) m.displacementP95 = nearestRankQuantile(std::move(disp), 0.95);
+    const double cvIn = median(std::move(curvVIn)), c8In = median(std::move(curv8In));
+    m.curvatureKeptVertex = cvIn > 0.0 ? median(std::move(curvV)) / cvIn : 1.0;
+    m.curvatureKept8 = c8In > 0.0 ? median(std::move(curv8)) / c8In : 1.0;
 
     // Coherence of each hairstyle's own field at this voxel size.
     m.coherenceBefore = meanCoherence(inputField);

@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Parallel.h>
+#include <vdbhair/Rotation.h>
 
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/RayIntersector.h>
@@ -13,25 +14,6 @@
 #include <string>
 
 namespace vdbhair {
-
-namespace {
-
-/// Rodrigues: rotate @a v about the unit @a axis by the angle whose cosine is @a c and sine @a s.
-Vec3d rotate(const Vec3d& v, const Vec3d& axis, double c, double s)
-{
-    return v * c + axis.cross(v) * s + axis * (axis.dot(v) * (1.0 - c));
-}
-
-/// The shortest rotation taking @a from onto @a to (both unit), applied to @a v.
-Vec3d rotateShortest(const Vec3d& from, const Vec3d& to, const Vec3d& v, const Vec3d& halfTurnAxis)
-{
-    const Vec3d a = from.cross(to);
-    const double s = a.length(), c = from.dot(to);
-    if (s < 1e-12) return c > 0.0 ? v : rotate(v, halfTurnAxis, -1.0, 0.0);
-    return rotate(v, a / s, c, s);
-}
-
-} // namespace
 
 ScalpMap::ScalpMap(const ScalpSphere& sphere) : mSphere(sphere) { axesFromUp(); }
 
@@ -196,11 +178,23 @@ ScalpFrame ScalpMap::frame(double u, double v) const
         double d;
         lookup(u, v, d, n);
     }
-    // The rotation taking the sphere's up (the paper's +y) onto n, applied to its x and z.
+    // The shortest rotation taking the sphere's up (the paper's +y) onto n, applied to its x and z;
+    // n opposite up: half a turn about x, as Rodrigues' formula at cosine -1, sine 0 (halfTurn()'s
+    // exact reflection can differ from it in the sign of a zero).
     ScalpFrame f;
     f.n = n;
-    f.t = rotateShortest(mUp, n, mRight, mRight);
-    f.b = rotateShortest(mUp, n, mForward, mRight);
+    Vec3d axis;
+    double c, s;
+    if (shortestRotation(mUp, n, axis, c, s)) {
+        f.t = rotateAbout(mRight, axis, c, s);
+        f.b = rotateAbout(mForward, axis, c, s);
+    } else if (c > 0.0) {
+        f.t = mRight;
+        f.b = mForward;
+    } else {
+        f.t = rotateAbout(mRight, mRight, -1.0, 0.0);
+        f.b = rotateAbout(mForward, mRight, -1.0, 0.0);
+    }
     return f;
 }
 

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Parallel.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/SegmentWalk.h>
 #include <vdbhair/field/FieldMapping.h>
 #include <vdbhair/field/Refine.h>
@@ -26,6 +27,7 @@
 #include <limits>
 #include <memory>
 #include <type_traits>
+#include <utility>
 
 namespace vdbhair {
 
@@ -427,9 +429,9 @@ double densityReferenceOf(const openvdb::FloatTree& density, double given, doubl
         for (auto it = dleaves.leaf(i).cbeginValueOn(); it; ++it) values[k++] = *it;
     });
     if (!values.empty()) {
-        const std::size_t k = std::min(values.size() - 1, std::size_t(0.95 * double(values.size())));
-        std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
-        reference = double(values[k]) / voxelVolume;
+        // The order statistic floor(0.95 n) (within the sample).
+        const std::size_t k = std::size_t(0.95 * double(values.size()));
+        reference = double(orderStatistic(std::move(values), k)) / voxelVolume;
     }
     if (!(reference > 0.0)) reference = 1.0 / voxelVolume;
     return reference;

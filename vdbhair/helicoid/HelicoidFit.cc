@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/helicoid/Frechet.h>
 #include <vdbhair/helicoid/impl/FitTarget.h>
 #include <vdbhair/helicoid/impl/PieceFit.h>
@@ -264,13 +265,11 @@ FitSummary summarizeFits(const StrandSet& strands, const std::vector<StrandFit>&
     s.fitted = relative.size();
     s.pointBytes = double(strands.numVertices()) * 12;
     if (relative.empty()) return s;
-    std::vector<double> sorted = relative;
-    std::sort(sorted.begin(), sorted.end());
     for (double r : relative) s.meanRelative += r;
     s.meanRelative /= double(relative.size());
     s.stepDeviationMean /= double(relative.size());
-    s.p95Relative = sorted[std::size_t(std::ceil(0.95 * double(sorted.size()))) - 1];
-    s.overMaxError = std::size_t(sorted.end() - std::upper_bound(sorted.begin(), sorted.end(), maxError));
+    s.p95Relative = nearestRankQuantile(relative, 0.95);
+    s.overMaxError = std::size_t(std::count_if(relative.begin(), relative.end(), [&](double r) { return r > maxError; }));
     s.piecesPerStrand = double(pieces) / double(s.fitted);
     s.fitBytes = double(s.fitted) * (3 + 6) * 4 + double(pieces) * 6 * 4;
     s.evaluationsPerStrand = double(evaluations) / double(s.fitted);

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/Rotation.h>
 #include <vdbhair/helicoid/FrameAverage.h>
 #include <vdbhair/strands/Resample.h>
 
@@ -26,20 +27,14 @@ constexpr std::size_t kMinArcs = 16, kMaxArcs = 512;
 constexpr std::size_t kShapeSamples = 16;
 constexpr double kUnlike = 0.25;
 
-/// @a v turned about the unit @a axis by the angle whose cosine and sine are @a c, @a s (Rodrigues).
-Vec3d rotateAbout(const Vec3d& v, const Vec3d& axis, double c, double s)
-{
-    return v * c + axis.cross(v) * s + axis * (axis.dot(v) * (1.0 - c));
-}
-
 /// @a ref turned by the least rotation that takes ref.t onto the unit @a t (a half turn about ref.n
 /// when @a t is opposite).
 FrameD leastRotationOnto(const FrameD& ref, const Vec3d& t)
 {
-    const Vec3d axis = ref.t.cross(t);
-    const double s = axis.length(), c = ref.t.dot(t);
-    if (s < 1e-12) return FrameD::fromTangentNormal(t, ref.n);  // t along ref.t or opposite it
-    return FrameD::fromTangentNormal(t, rotateAbout(ref.n, axis / s, c, s));
+    Vec3d axis;
+    double c, s;
+    if (!shortestRotation(ref.t, t, axis, c, s)) return FrameD::fromTangentNormal(t, ref.n);  // t along ref.t or opposite it
+    return FrameD::fromTangentNormal(t, rotateAbout(ref.n, axis, c, s));
 }
 
 /// The unit tangent at arc length @a s of @a tr (its frames' tangents, linear between points),

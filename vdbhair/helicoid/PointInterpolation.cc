@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/Rotation.h>
 #include <vdbhair/helicoid/ShepardWeights.h>
 #include <vdbhair/strands/Measures.h>
 #include <vdbhair/strands/Resample.h>
@@ -26,12 +27,6 @@ namespace {
 constexpr std::size_t kLikenessSamples = 16;
 
 Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
-
-/// The smallest rotation taking unit @a a to unit @a b (OpenVDB's; apply it with transform(): OpenVDB matrices act on row vectors).
-openvdb::math::Mat3d rotationBetween(const Vec3d& a, const Vec3d& b)
-{
-    return openvdb::math::rotation<openvdb::math::Mat3d>(a, b);
-}
 
 /// Root-relative points of a polyline at fractions 1/16 .. 16/16 of its length.
 std::array<Vec3f, kLikenessSamples> likenessSignature(const Vec3f* p, std::size_t n)
@@ -261,7 +256,7 @@ void blendPoints(const StrandSet& guides, const InterpolationRoots& roots, const
                 const Vec3f* p = guides.positions.data() + guides.begin(w.guide);
                 const std::size_t m = s.size();
                 openvdb::math::Mat3d rot = openvdb::math::Mat3d::identity();
-                if (surface) rot = rotationBetween(gn[w.guide], rootNormal);
+                if (surface) rot = rotationMatrixBetween(gn[w.guide], rootNormal);
                 std::size_t seg = 0;
                 if (m == n) {
                     // The same count: the guide's own vertices (a root on a guide's root is that guide).

@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/Random.h>
 #include <vdbhair/field/HairVolume.h>
 #include <vdbhair/field/HeadCollision.h>
@@ -19,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 namespace vdbhair {
 
@@ -48,18 +50,16 @@ void summarize(ReconstructErrors& e, const std::vector<char>& isGuide)
 {
     std::vector<double> all = e.relative, interp;
     for (std::size_t i = 0; i < all.size(); ++i) if (!isGuide[i]) interp.push_back(all[i]);
-    auto stats = [](std::vector<double>& v, double& mean, double& p95) {
+    auto stats = [](std::vector<double> v, double& mean, double& p95) {
         mean = p95 = 0.0;
         if (v.empty()) return;
         double sum = 0.0;
         for (double x : v) sum += x;  // in strand order: independent of threads
         mean = sum / double(v.size());
-        const std::size_t k = std::min(v.size() - 1, std::size_t(std::ceil(0.95 * double(v.size()))) - 1);
-        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
-        p95 = v[k];
+        p95 = nearestRankQuantile(std::move(v), 0.95);
     };
-    stats(all, e.mean, e.p95);
-    stats(interp, e.meanInterpolated, e.p95Interpolated);
+    stats(std::move(all), e.mean, e.p95);
+    stats(std::move(interp), e.meanInterpolated, e.p95Interpolated);
 }
 
 /// The parameters reconstructHairstyle() checks itself (the rest are checked where they are used).

@@ -1,5 +1,7 @@
 #include "Wisp.h"
 
+#include <vdbhair/Rotation.h>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -8,23 +10,17 @@ namespace vdbhair {
 
 namespace {
 
-/// Rotate @a v about unit @a axis by the angle whose cosine and sine are @a c, @a s (Rodrigues).
-Vec3d rotate(const Vec3d& v, const Vec3d& axis, double c, double s)
-{
-    return v * c + axis.cross(v) * s + axis * (axis.dot(v) * (1.0 - c));
-}
-
 /// Rotate @a out rigidly about @a root (points, and frames when asked).
 void rotateTrace(HelicoidTrace& out, const Vec3d& root, const Vec3d& axis, double angle, bool frames)
 {
     const double c = std::cos(angle), s = std::sin(angle);
     for (std::size_t i = 0; i < out.points.size(); ++i) {
-        out.points[i] = root + rotate(out.points[i] - root, axis, c, s);
+        out.points[i] = root + rotateAbout(out.points[i] - root, axis, c, s);
         if (!frames) continue;
         FrameD& fr = out.frames[i];
-        fr.t = rotate(fr.t, axis, c, s);
-        fr.n = rotate(fr.n, axis, c, s);
-        fr.b = rotate(fr.b, axis, c, s);
+        fr.t = rotateAbout(fr.t, axis, c, s);
+        fr.n = rotateAbout(fr.n, axis, c, s);
+        fr.b = rotateAbout(fr.b, axis, c, s);
     }
 }
 

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Memory.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/strands/Compare.h>
 #include <vdbhair/strands/Measures.h>
 
@@ -247,10 +248,8 @@ std::vector<Vec3f> baseColors(const StrandSet& s, const RenderParams& p, const C
         lit = false;
         std::vector<float> k(nV);
         for (std::size_t i = 0; i < s.numStrands(); ++i) curvatureProfile(s.data(i), s.size(i), k.data() + s.begin(i));
-        std::vector<float> sorted = k;
-        std::sort(sorted.begin(), sorted.end());
-        lo = sorted[std::size_t(0.05 * double(nV - 1))];
-        hi = sorted[std::size_t(0.95 * double(nV - 1))];
+        lo = lowerQuantile(k, 0.05);
+        hi = lowerQuantile(k, 0.95);
         for (std::size_t v = 0; v < nV; ++v) c[v] = colorMap(hi > lo ? float((k[v] - lo) / (hi - lo)) : 0.5f);
         break;
     }
@@ -258,11 +257,8 @@ std::vector<Vec3f> baseColors(const StrandSet& s, const RenderParams& p, const C
         lit = false;
         if (nV == 0) break;
         const std::vector<double> d = nearestVertexDistances(StrandIndex(s), StrandIndex(*p.reference));
-        std::vector<double> sorted = d;
-        const std::size_t at = std::size_t(0.95 * double(nV - 1));
-        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(at), sorted.end());
         lo = 0.0;
-        hi = sorted[at];
+        hi = lowerQuantile(d, 0.95);
         for (std::size_t v = 0; v < nV; ++v) c[v] = colorMap(hi > 0.0 ? float(std::min(1.0, d[v] / hi)) : 0.f);
         break;
     }

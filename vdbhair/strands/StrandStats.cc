@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Parallel.h>
+#include <vdbhair/Quantile.h>
 
 #include <algorithm>
 #include <cmath>
@@ -104,12 +105,7 @@ StrandStatistics computeStrandStatistics(const StrandSet& strands, std::size_t b
     for (std::size_t v = 0; v < kappa.size(); ++v) curvature[v] = kappa[v];
     s.turning = rangeOf(turning);
     s.curvature = rangeOf(curvature);
-    if (!curvature.empty()) {
-        std::vector<double> sorted = curvature;
-        const std::size_t k = std::min(sorted.size() - 1, std::size_t(std::floor(0.99 * double(sorted.size() - 1))));
-        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
-        s.curvatureP99 = sorted[k];
-    }
+    if (!curvature.empty()) s.curvatureP99 = lowerQuantile(curvature, 0.99);
     const RangeStats len = rangeOf(lengths), cnt = rangeOf(counts);
     s.length = makeHistogram(lengths, len.min, len.max, bins);
     s.turningHist = makeHistogram(turning, s.turning.min, s.turning.max, bins);

@@ -4,6 +4,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/strands/Resample.h>
 #include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
@@ -19,6 +20,7 @@
 #include <limits>
 #include <string>
 #include <tuple>
+#include <utility>
 
 namespace vdbhair {
 
@@ -294,8 +296,7 @@ void alignCentres(DetailTransferRun& run)
     const auto medianOf = [&](std::size_t from, std::size_t count) {
         std::vector<double> v(count);
         for (std::size_t r = 0; r < count; ++r) v[r] = rowLength(from + r);
-        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(count / 2), v.end());
-        return v[count / 2];
+        return upperMedian(std::move(v));
     };
     const double mIn = medianOf(0, nIn), mOut = medianOf(nIn, nOut);
     for (std::size_t r = 0; r < nIn + nOut; ++r) {

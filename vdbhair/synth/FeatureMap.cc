@@ -1,12 +1,14 @@
 #include "FeatureMap.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/strands/PointCloud.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 namespace vdbhair {
 
@@ -66,8 +68,7 @@ double medianUvSpacing(const std::vector<Vec3d>& scalpCoords)
         const std::size_t got = tree.knnSearch(q, 2, idx, d2);
         nn[i] = got == 2 ? std::sqrt(d2[1]) : 0.0;
     }
-    std::nth_element(nn.begin(), nn.begin() + std::ptrdiff_t(nn.size() / 2), nn.end());
-    return nn[nn.size() / 2];
+    return upperMedian(std::move(nn));
 }
 
 FeatureImage buildFeatureMap(const UvGrid& grid, const std::vector<Vec3d>& rootCoords, const float* features,

@@ -2,6 +2,7 @@
 
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
+#include <vdbhair/Quantile.h>
 #include <vdbhair/strands/Resample.h>
 #include <vdbhair/synth/RootScatter.h>
 
@@ -78,10 +79,8 @@ namespace {
 
 double medianLength(const StrandSamples& s, double radius)
 {
-    std::vector<double> v(s.lengths.begin(), s.lengths.end());
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-    return v[v.size() / 2] / radius;
+    if (s.lengths.empty()) return 0.0;
+    return upperMedian(std::vector<double>(s.lengths.begin(), s.lengths.end())) / radius;
 }
 
 /// BASE's coarsest level and the output counts per level, with what the finer levels' roots need.

@@ -146,9 +146,7 @@ TransferMeasures measureTransfer(const StrandSet& details, const StrandSet& base
     const int ns = params.synth.vertices;
     // Turning compared at one sample spacing in head radii, DETAILS' own: its median strand
     // length over n_s - 1 (a fixed vertex count would undersample the longer hairstyle's curls).
-    std::vector<float> lengths = strandLengths(details);
-    std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
-    m.spacing = double(lengths[lengths.size() / 2]) / tr.detailsMap->radius() / double(ns - 1);
+    m.spacing = double(upperMedian(strandLengths(details))) / tr.detailsMap->radius() / double(ns - 1);
     m.turnDetails = meanTurningPerLengthAtSpacing(details, m.spacing * tr.detailsMap->radius());
     m.turnBase = meanTurningPerLengthAtSpacing(base, m.spacing * r.map->radius());
     m.turnOut = meanTurningPerLengthAtSpacing(r.strands, m.spacing * r.map->radius());

@@ -1,5 +1,6 @@
 #include "SynthesisReport.h"
 
+#include <vdbhair/Quantile.h>
 #include <vdbhair/helicoid/Frechet.h>
 #include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Measures.h>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace vdbhair {
 
@@ -150,10 +152,8 @@ NoveltyStats measureNovelty(const StrandSet& example, const StrandSet& output, d
     std::size_t copies = 0;
     for (double x : a) copies += x < 0.01;
     st.copies = double(copies) / double(a.size());
-    std::nth_element(a.begin(), a.begin() + std::ptrdiff_t(a.size() / 2), a.end());
-    std::nth_element(b.begin(), b.begin() + std::ptrdiff_t(b.size() / 2), b.end());
-    st.outputMedian = a[a.size() / 2];
-    st.exampleMedian = b[b.size() / 2];
+    st.outputMedian = upperMedian(std::move(a));
+    st.exampleMedian = upperMedian(std::move(b));
     return st;
 }
 

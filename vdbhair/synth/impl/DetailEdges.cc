@@ -1,5 +1,6 @@
 #include "DetailEdges.h"
 
+#include <vdbhair/Rotation.h>
 #include <vdbhair/strands/Frames.h>
 #include <vdbhair/strands/Resample.h>
 
@@ -25,18 +26,11 @@ constexpr double kCollinearCos = 5e-7;
 /// edges leaning further off (about 70 degrees) make a coil that hardly moves along the centre.
 constexpr double kMinCurlRho = 0.35;
 
-/// The rotation that takes unit @a from to unit @a to by the shortest arc, applied to @a v.
-Vec3d rotateOnto(const Vec3d& from, const Vec3d& to, const Vec3d& v)
+/// @a v turned by the shortest rotation taking unit @a from onto x̂ (half a turn about a
+/// perpendicular of @a from when it is -x̂).
+Vec3d rotateOntoX(const Vec3d& from, const Vec3d& v)
 {
-    const Vec3d axis = from.cross(to);
-    const double s = axis.length(), c = from.dot(to);
-    if (s < 1e-12) {
-        if (c >= 0.0) return v;
-        const Vec3d k = Vec3d(perpendicularTo(Vec3f(from))).unitSafe();  // half a turn about any perpendicular
-        return k * (2.0 * k.dot(v)) - v;
-    }
-    const Vec3d k = axis / s;
-    return v * c + k.cross(v) * s + k * (k.dot(v) * (1.0 - c));
+    return rotateOnto(from, Vec3d(1.0, 0.0, 0.0), v, Vec3d(perpendicularTo(Vec3f(from))).unitSafe());
 }
 
 /// The loop that repeats past a strand's end (DetailScale::ArcLength): edges [a, K) of @a d,
@@ -65,11 +59,11 @@ std::vector<Vec3d> strandLoop(const std::vector<Vec3d>& d, double& twist)
     Vec3d net(0.0);
     for (const Vec3d& e : loop) net += e;
     if (net.length() > 1e-30)
-        for (Vec3d& e : loop) e = rotateOnto(net.unitSafe(), Vec3d(1.0, 0.0, 0.0), e);
+        for (Vec3d& e : loop) e = rotateOntoX(net.unitSafe(), e);
     // The twist about x̂ that takes the edges before the loop's start (as turned) onto the strand's last edges.
     double sn = 0.0, cs = 0.0;
     if (a > 0) {
-        const Vec3d before = net.length() > 1e-30 ? rotateOnto(net.unitSafe(), Vec3d(1.0, 0.0, 0.0), d[a - 1]) : d[a - 1];
+        const Vec3d before = net.length() > 1e-30 ? rotateOntoX(net.unitSafe(), d[a - 1]) : d[a - 1];
         const Vec3d& last = d[K - 1];
         sn = before.y() * last.z() - before.z() * last.y();
         cs = before.y() * last.y() + before.z() * last.z();
@@ -282,7 +276,7 @@ void EdgeLayer::repeatLoop(const std::vector<Vec3d>& d)
         Vec3d net(0.0);
         for (const Vec3d& e : loop) net += e;
         if (net.length() > 1e-30)
-            for (Vec3d& e : loop) e = rotateOnto(net.unitSafe(), Vec3d(1.0, 0.0, 0.0), e);
+            for (Vec3d& e : loop) e = rotateOntoX(net.unitSafe(), e);
         twist = 0.0;
         loopStep = stepOf(loop, arc);
         if (!(loopStep > 0.0)) return;

@@ -241,8 +241,8 @@ SourceIndex::SourceIndex(const FeatureImage& ex, int w, const TextureParams& par
     mTreeSources = reps;
     mTreeKeys.resize(reps.size() * std::size_t(k));
     for (std::size_t i = 0; i < reps.size(); ++i) std::copy_n(keyOf(reps[i]), k, &mTreeKeys[i * k]);
-    mCloud = KeyCloud{mTreeKeys.data(), reps.size(), k};
-    mTree = std::make_unique<KeyTree>(k, mCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    mCloud = RowCloud{mTreeKeys.data(), reps.size(), k};
+    mTree = std::make_unique<RowKdTree>(k, mCloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
 }
 
 std::size_t SourceIndex::nearest(const float* query, std::size_t k, float bound, float eps, std::uint32_t* idx, float* dist2) const

@@ -4,10 +4,9 @@
 /// axes, and a k-d tree over the distinct projected keys. Used by TextureOptimization.cc.
 #pragma once
 
+#include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/synth/FeatureImage.h>
 #include <vdbhair/synth/TextureOptimization.h>
-
-#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <cstddef>
@@ -60,19 +59,6 @@ struct Projection
     int paddedDim = 0;  ///< columns of basis: outDim rounded up to a multiple of 8
 };
 
-/// nanoflann's view of the projected keys (row-major, dim floats each).
-struct KeyCloud
-{
-    const float* pts = nullptr;
-    std::size_t count = 0;
-    int dim = 0;
-    std::size_t kdtree_get_point_count() const { return count; }
-    float kdtree_get_pt(std::size_t i, std::size_t d) const { return pts[i * std::size_t(dim) + d]; }
-    template<class BBoxT> bool kdtree_get_bbox(BBoxT&) const { return false; }
-};
-
-using KeyTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Adaptor<float, KeyCloud, float>, KeyCloud, -1, std::uint32_t>;
-
 /// Everything one (level, width) stage needs about the example: sources, keys, the k-d tree.
 class SourceIndex
 {
@@ -102,8 +88,8 @@ private:
     Projection mProjection;
     std::vector<std::uint32_t> mTreeSources;
     std::vector<float> mTreeKeys;
-    KeyCloud mCloud;
-    std::unique_ptr<KeyTree> mTree;
+    RowCloud mCloud;  ///< the projected keys, row-major
+    std::unique_ptr<RowKdTree> mTree;
     int mWidth = 0, mHeight = 0;
     std::vector<std::int64_t> mSourceAt;
 };
