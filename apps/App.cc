@@ -17,13 +17,11 @@
 
 namespace vdbhair::app {
 
-StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, bool strict,
-                      const std::string& vdbGrid)
+StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common, const std::string& vdbGrid)
 {
     const Stage stage(common, "reading " + path);
     ReadOptions opts = readOptions(common);
     opts.vdbGrid = vdbGrid;
-    if (strict) opts.shortStrands = ShortStrandPolicy::Reject;
     ReadReport report;
     StrandSet strands = readStrands(path, opts, &report);
     printWarnings(verb, report, common);
@@ -32,8 +30,9 @@ StrandSet loadStrands(const std::string& verb, const std::string& path, const Co
 }
 
 void checkStrandLengths(const std::string& verb, const std::string& path, const StrandSet& strands,
-                        const CommonOptions& common, bool strict)
+                        const CommonOptions& common)
 {
+    const bool strict = common.read.shortStrands == ShortStrandPolicy::Reject;
     std::vector<std::size_t> zero;
     for (std::size_t i = 0; i < strands.numStrands(); ++i) {
         bool moves = false;
@@ -48,9 +47,10 @@ void checkStrandLengths(const std::string& verb, const std::string& path, const 
                              " strands have zero length (strand" + (zero.size() == 1 ? " " : "s ") + which +
                              ": every vertex at one point), so they have no direction";
     if (zero.size() == strands.numStrands()) throw FormatError(what + "; with no strand of non-zero length there is nothing to " + verb);
-    if (strict) throw FormatError(what + "; --strict rejects them");
+    const std::string flag = readParamName("strict").flag;
+    if (strict) throw FormatError(what + "; " + flag + " rejects them");
     ReadReport report;
-    report.warnings.push_back(what + "; they are ignored (--strict rejects them)");
+    report.warnings.push_back(what + "; they are ignored (" + flag + " rejects them)");
     printWarnings(verb, report, common);
 }
 
@@ -64,7 +64,7 @@ StrandSet loadStrandsOrScene(const std::string& verb, const std::string& path, c
         if (s.empty()) throw FormatError(path + ": the scene has no guides");
         return s;
     }
-    return loadStrands(verb, path, common, false, vdbGrid);
+    return loadStrands(verb, path, common, vdbGrid);
 }
 
 void addScalpOptions(CLI::App* sub, ScalpOptions& opts)

@@ -2,6 +2,7 @@
 // dispatch with the one-line errors and exit codes.
 #include "Command.h"
 #include "HeadOptions.h"
+#include "ParamOptions.h"
 #include "TerminalProgress.h"
 
 #include <vdbhair/Exceptions.h>
@@ -65,8 +66,8 @@ CLI::App* addVerb(CLI::App& app, const std::string& name)
 
 void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson)
 {
-    // Checked in run() (one clear message instead of CLI11's range with a 309-digit bound).
-    sub->add_option("--threads", common.threads, "Worker threads (0: all cores); results do not depend on it");
+    // Its range is checked in run() (one clear message instead of CLI11's range with a 309-digit bound).
+    addParamOptions(sub, static_cast<RunOptions&>(common), runParameters());
     sub->add_flag("--no-clobber", common.noClobber, "Refuse to replace an existing output file (the default replaces it atomically)");
     if (withJson) sub->add_flag("--json", common.json, "Print one JSON object on stdout instead of prose");
     sub->add_flag("--quiet,-q", common.quiet, "No progress and no warnings on stderr");
@@ -74,30 +75,28 @@ void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson)
 
 void addReadOptions(CLI::App* sub, CommonOptions& common)
 {
-    sub->add_option("--points-per-strand", common.pointsPerStrand,
-                    "For a .ply of points only (NeuralHaircut, GaussianHaircut: 100): each run of N consecutive points is one strand");
-    sub->add_option("--curve-samples", common.curveSamples,
-                    "For .obj curves (curv) and cubic .usda/.abc curves: points per curve, evenly in its parameter (0: automatic, within 1 % of the curve's length)");
-    CLI::Option* head = sub->get_option_no_throw("--head");
+    ParamTable<ReadOptions> table = selectParams(readParameters(), {"points-per-strand", "curve-samples", "roots"});
     // interpolate's --roots names its root positions: there the option is only --root-end.
     const bool rootsTaken = sub->get_option_no_throw("--roots") != nullptr;
-    sub->add_option(rootsTaken ? "--root-end" : "--roots,--root-end", common.roots,
-                    std::string("Which end of each stored strand is its root: first (the convention), last (every strand reversed), or auto: ") +
-                        (head ? "the end nearer --head in most strands, or without --head " : "") +
-                        "the end whose sphere has more of the hair outside it, for the whole file (a warning says when it reversed them)")
-        ->check(CLI::IsMember({"first", "last", "auto"}))
-        ->capture_default_str();
-    if (head) head->each([&common](const std::string& path) { common.rootsHead = path; });
+    for (Param<ReadOptions>& p : table) {
+        if (p.name != "roots" || !rootsTaken) continue;
+        p.name = "root-end";
+        p.oldFlags.clear();
+    }
+    addParamOptions(sub, common.read, table);
+    if (CLI::Option* head = sub->get_option_no_throw("--head")) head->each([&common](const std::string& path) { common.rootsHead = path; });
     if (rootsTaken) sub->preparse_callback([&common](std::size_t) { common.rootsFlag = "--root-end"; });
+}
+
+void addStrictOption(CLI::App* sub, CommonOptions& common)
+{
+    addParamOptions(sub, common.read, selectParams(readParameters(), {"strict"}));
 }
 
 ReadOptions readOptions(const CommonOptions& common)
 {
-    ReadOptions opts;
+    ReadOptions opts = common.read;
     opts.interrupter = common.interrupter;
-    opts.pointsPerStrand = common.pointsPerStrand;
-    opts.curveSamples = common.curveSamples;
-    opts.roots = rootEndFromName(common.roots);
     opts.spelling = ParamSpelling::Flag;
     opts.rootsName.flag = common.rootsFlag;
     if (opts.roots == RootEnd::Auto && !common.rootsHead.empty() && common.rootsHead != "none") {
@@ -266,8 +265,10 @@ int run(int argc, char** argv)
     for (const Command& c : commands) {
         if (!c.sub->parsed()) continue;
         verb = c.sub->get_name();
-        if (common.threads < 0) {
-            std::cerr << "vdbhair " << verb << ": --threads " << common.threads << ": must be 0 (all cores) or more\n";
+        try {
+            checkParamOptions(runParameters(), static_cast<const RunOptions&>(common));
+        } catch (const ValueError& e) {
+            std::cerr << "vdbhair " << verb << ": " << spelledMessage(e, ParamSpelling::Flag) << "\n";
             return 2;
         }
         setOverwritePolicy(common.noClobber ? OverwritePolicy::NoClobber : OverwritePolicy::Replace);

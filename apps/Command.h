@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <vdbhair/Progress.h>
+#include <vdbhair/RunOptions.h>
 #include <openvdb/openvdb.h>
 #include <vdbhair/io/AxisName.h>
 #include <vdbhair/io/ReadOptions.h>
@@ -30,20 +31,20 @@ struct TransferParams;
 
 namespace vdbhair::app {
 
-/// Options every verb shares (DESIGN.md, "The vdbhair command").
-struct CommonOptions
+/// Options every verb shares (DESIGN.md, "The vdbhair command"): the run's (RunOptions:
+/// --threads, runParameters()) and the command line's own.
+struct CommonOptions : RunOptions
 {
-    int threads = 0;      ///< 0: all cores
     bool json = false;    ///< one JSON object on stdout instead of prose
     bool quiet = false;   ///< no progress, no warnings
     bool noClobber = false;  ///< refuse to replace existing outputs (--no-clobber)
     /// The progress bar and Ctrl-C (TerminalProgress.h), set by run() before the verb runs: hand it to
     /// every library call that takes an interrupter.
     WorkInterrupter* interrupter = nullptr;
-    /// How strand files are read (addReadOptions(): --points-per-strand, --curve-samples).
-    std::size_t pointsPerStrand = 0;
-    std::size_t curveSamples = 0;
-    std::string roots = "first";  ///< --roots first|last|auto
+    /// How strand files are read: the declared options (readParameters()) that addReadOptions()
+    /// and addStrictOption() add (--points-per-strand, --curve-samples, --roots, --strict; --grid
+    /// where a verb adds it).
+    ReadOptions read;
     std::string rootsHead;        ///< the verb's --head, when it has one (for --roots auto)
     std::string rootsFlag = "--roots";  ///< the flag of `roots` (interpolate's: --root-end)
 };
@@ -51,6 +52,9 @@ struct CommonOptions
 /// @brief Add the strand readers' options (--points-per-strand, --curve-samples, --roots) to a verb
 /// that reads strand files. Call it after the verb's --head, if it has one: --roots auto then uses it.
 void addReadOptions(CLI::App* sub, CommonOptions& common);
+
+/// @brief Add --strict (readParameters()) to a verb that reads strand files and offers it.
+void addStrictOption(CLI::App* sub, CommonOptions& common);
 
 /// @brief The reader's options of @a common: the one place the command line becomes ReadOptions
 /// (loadStrands(), info and convert start from it).
@@ -89,7 +93,7 @@ struct Command
 /// the help of the verbs whose --voxel-size defaults to it.
 inline const std::string kSuggestedVoxelSizeHelp = "3 x the median root spacing, within 1/64..1/4 of the head radius";
 
-/// @brief Add --threads, --json and --quiet to @a sub.
+/// @brief Add --threads (runParameters()), --no-clobber, --json and --quiet to @a sub.
 void addCommonOptions(CLI::App* sub, CommonOptions& common, bool withJson = true);
 
 /// @brief Print a reader's warnings on stderr as `vdbhair <verb>: warning: ...` (unless quiet).
@@ -107,17 +111,17 @@ void warnBandWithoutZero(const std::string& verb, const std::string& input, doub
                          const CommonOptions& common);
 
 /// @brief Read strands from any supported file, printing the reader's warnings for @a verb.
-/// @param strict reject strands of fewer than two vertices instead of dropping them
+/// Strands of fewer than two vertices are rejected under --strict (addStrictOption()).
 /// @param vdbGrid for a .vdb file, the points grid holding the strands (`--grid`)
 StrandSet loadStrands(const std::string& verb, const std::string& path, const CommonOptions& common,
-                      bool strict = false, const std::string& vdbGrid = "strands");
+                      const std::string& vdbGrid = ReadOptions{}.vdbGrid);
 
 /// @brief Report the strands of zero length (every vertex at one point) that a verb using lengths
-/// (field, refine, retrace; fit has its own rule, --skip-degenerate) was given: a warning naming them, an error under @a strict, and
+/// (field, refine, retrace; fit has its own rule, --skip-degenerate) was given: a warning naming them, an error under --strict, and
 /// always an error when every strand has zero length (there would be nothing to write).
 /// @throw FormatError naming @a path, the count and the first strands.
 void checkStrandLengths(const std::string& verb, const std::string& path, const StrandSet& strands,
-                        const CommonOptions& common, bool strict);
+                        const CommonOptions& common);
 
 /// @brief As loadStrands(), and a helicoid scene (.json) is grown first.
 /// @param head when given and @a path is a scene with a "head" record, set to a mesh of that head

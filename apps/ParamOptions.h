@@ -43,12 +43,31 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
                     flag, [&target, a, param](const std::string& v) { a.set(target, axisFromText(param, v, param.flag())); }, help);
                 o->default_str(param.defaultText());
                 o->check(CLI::IsMember(param.choices));
+            } else if constexpr (std::is_same_v<T, std::string>) {
+                // A setter that reads text (compare's --unit) throws for a bad value: a one-line
+                // parse error naming the flag.
+                auto set = [&target, a](const std::string& v) {
+                    try {
+                        a.set(target, v);
+                    } catch (const ValueError& e) {
+                        throw CLI::ValidationError(spelledMessage(e, ParamSpelling::Flag));
+                    }
+                };
+                CLI::Option* o = param.repeats ? sub->add_option_function<std::vector<std::string>>(
+                                                     flag,
+                                                     [set](const std::vector<std::string>& v) {
+                                                         std::string all;
+                                                         for (const std::string& s : v) all += (all.empty() ? "" : " ") + s;
+                                                         set(all);
+                                                     },
+                                                     help)
+                                               : sub->add_option_function<std::string>(flag, set, help);
+                o->default_str(param.defaultText());
+                if (!param.choices.empty()) o->check(CLI::IsMember(param.choices));
             } else {
                 CLI::Option* o = sub->add_option_function<T>(flag, [&target, a](const T& v) { a.set(target, v); }, help);
                 o->default_str(param.defaultText());
-                if constexpr (std::is_same_v<T, std::string>) {
-                    if (!param.choices.empty()) o->check(CLI::IsMember(param.choices));
-                } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+                if constexpr (std::is_same_v<T, std::uint64_t>) {
                     // CLI11 would read "-2" as 2^64 - 2: a count refuses a sign.
                     o->check(CLI::Validator(
                         [](std::string& v) { return !v.empty() && v[0] == '-' ? "Value " + v + " is negative (a count is 0 or more)" : std::string(); },
@@ -58,6 +77,16 @@ void addParamOptions(CLI::App* sub, P& target, const ParamTable<P>& table, const
             }
         }, param.access);
     }
+}
+
+/// @brief The parameters of @a table named in @a names, in the table's order: the part of a shared
+/// declaration that a verb offers (`--strict` of the reading options).
+template<typename P>
+ParamTable<P> selectParams(const ParamTable<P>& table, const std::vector<std::string>& names)
+{
+    ParamTable<P> out;
+    for (const Param<P>& p : table) if (std::find(names.begin(), names.end(), p.name) != names.end()) out.push_back(p);
+    return out;
 }
 
 /// @brief Check the declared ranges of @a p, errors naming the flags ("--levels 9: must be ...").

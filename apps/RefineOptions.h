@@ -24,11 +24,10 @@ struct RefineCmdParams
     std::string input, output, saveField;
     RefineParams refine;  ///< its declared parameters (refineParameters()) are options
     HeadOptions head;
-    bool strict = false;
     ScalpOptions scalp;
 };
 
-/// @brief refine's declared parameters but those in @a skip, --head, --scalp and --strict.
+/// @brief refine's declared parameters but those in @a skip, --head and --scalp.
 void addRefineOptions(CLI::App* sub, RefineCmdParams& p, const std::vector<std::string>& skip = {});
 /// @throw ValueError for out-of-range options, IoError/FormatError for an unreadable --head.
 RefineParams refineParamsFrom(const RefineCmdParams& p, const StrandSet& strands, const CommonOptions& common);

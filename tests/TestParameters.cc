@@ -57,15 +57,7 @@ ParamTable<Toy> toyTable()
     return t;
 }
 
-/// docs/cli.md, whose option tables are generated from the declarations.
-std::string cliPage()
-{
-    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
-    REQUIRE(in);
-    std::stringstream page;
-    page << in.rdbuf();
-    return page.str();
-}
+using vdbhair::test::cliPage;
 
 } // namespace
 

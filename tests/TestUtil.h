@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -128,6 +129,18 @@ inline void requireSameStrands(const StrandSet& a, const StrandSet& b, float tol
     CAPTURE(worstAt, tol);
     REQUIRE(worst <= tol);
 }
+
+#ifdef VDBHAIR_SOURCE_DIR
+/// docs/cli.md, whose option tables are generated from the parameters' declarations.
+inline std::string cliPage()
+{
+    std::ifstream in(std::string(VDBHAIR_SOURCE_DIR) + "/docs/cli.md");
+    REQUIRE(in);
+    std::stringstream page;
+    page << in.rdbuf();
+    return page.str();
+}
+#endif
 
 } // namespace vdbhair::test
 

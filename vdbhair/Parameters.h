@@ -73,6 +73,9 @@ struct Param
     bool pythonNone = false;
     /// Older spellings of the flag that the command line still takes (`--keep-base-detail`).
     std::vector<std::string> oldFlags;
+    /// A string of several values: the command line's option repeats (`--threshold 2:20
+    /// --threshold 3:30`), Python takes one str or a sequence of them; the values are joined by spaces.
+    bool repeats = false;
 
     /// Whether it is an axis (makeAxisParam()).
     bool isAxis() const { return std::holds_alternative<ParamAccess<P, Vec3d>>(access); }
@@ -192,6 +195,7 @@ ParamTable<Outer> nestedParams(const ParamTable<Inner>& inner, F part, const std
         q.shortFlag = p.shortFlag;
         q.pythonNone = p.pythonNone;
         q.oldFlags = p.oldFlags;
+        q.repeats = p.repeats;
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(std::declval<const Inner&>()))>;
             q.access = ParamAccess<Outer, T>{[a, part](const Outer& o) { return a.get(part(const_cast<Outer&>(o))); },

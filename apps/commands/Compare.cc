@@ -19,31 +19,12 @@ namespace {
 
 struct CompareCmdParams
 {
-    std::string a, b, unit, head, perStrand;
-    std::vector<std::string> thresholds;
+    std::string a, b, head, perStrand;
     CompareParams params;  ///< its declared parameters (compareParameters()) are options
 };
 
-/// "D:ANGLE": a distance (millimetres with --unit, else file units) and an angle in degrees.
-OrientedThreshold parseThreshold(const std::string& text, bool millimetres)
-{
-    const std::size_t colon = text.find(':');
-    char* end1 = nullptr;
-    char* end2 = nullptr;
-    const std::string d = text.substr(0, colon), angle = colon == std::string::npos ? std::string() : text.substr(colon + 1);
-    const double dv = std::strtod(d.c_str(), &end1), av = std::strtod(angle.c_str(), &end2);
-    if (colon == std::string::npos || d.empty() || angle.empty() || *end1 != '\0' || *end2 != '\0' || !(dv > 0.0) || !std::isfinite(dv) ||
-        !(av >= 0.0 && av <= 180.0)) {
-        throw ValueError("--threshold '" + text + "': expected DISTANCE:ANGLE, a positive distance (" +
-                         (millimetres ? "millimetres" : "file units: no --unit") + ") and an angle in [0, 180] degrees, e.g. 2:20");
-    }
-    return {millimetres ? dv / 1000.0 : dv, av};
-}
-
 int runCompare(CompareCmdParams p, const CommonOptions& common)
 {
-    if (!p.unit.empty()) p.params.metersPerUnit = metersPerUnitFromName(p.unit, "--unit");
-    for (const std::string& t : p.thresholds) p.params.thresholds.push_back(parseThreshold(t, p.params.metersPerUnit > 0.0));
     checkParamOptions(compareParameters(), p.params);
     p.params.validate();
     if (!p.perStrand.empty() && fileExtension(p.perStrand) != ".csv") {
@@ -117,9 +98,6 @@ Command addCompareCommand(CLI::App& app, CommonOptions& common)
     CLI::App* sub = addVerb(app, "compare");
     sub->add_option("a", params->a, "The reference hairstyle (any strand format)")->required();
     sub->add_option("b", params->b, "The hairstyle compared with it (precision is the share of its oriented points matched in A)")->required();
-    sub->add_option("--unit", params->unit, "The files' unit: mm, cm, dm, m, in, or its length in metres; needed for HairGS's thresholds in millimetres");
-    sub->add_option("--threshold", params->thresholds, "An oriented-point threshold DISTANCE:ANGLE (millimetres with --unit, else file units; "
-                                                       "repeat for more; default with --unit: HairGS's 2:20 3:30 4:40 4:90)");
     addParamOptions(sub, params->params, compareParameters());
     sub->add_option("--head", params->head, "A head (mesh or .vdb level set): the shares of A's and B's strands passing into it");
     sub->add_option("--per-strand", params->perStrand, "Write each strand of A's values as CSV: chamfer, and with equal strand counts position, curvature, frechet");

@@ -23,9 +23,7 @@ struct ConvertCmdParams
     std::vector<std::string> files;
     std::string output;
     ConvertParams convert;  ///< its declared parameters are options
-    bool strict = false;
     std::vector<double> rootNear;  ///< x, y, z; empty: OBJ roots at the lower-index end
-    std::string grid = ReadOptions{}.vdbGrid;
     std::string format;  ///< the format of `-` (standard input or output), e.g. "obj"
     std::string units;       ///< convert to this unit (mm, cm, m, ... or metres); empty: keep
     std::string inputUnits;  ///< the inputs' unit, declared or overriding the files'; empty: theirs
@@ -85,12 +83,10 @@ int runConvert(ConvertCmdParams p, const CommonOptions& common)
     const WriteOptions& wopts = p.convert.write;
     const double metersPerUnit = wopts.usd.metersPerUnit;
     ReadOptions ropts = readOptions(common);
-    ropts.vdbGrid = p.grid;
     if (!p.rootNear.empty()) {
         if (p.rootNear.size() != 3) throw ValueError("--root-near needs X,Y,Z");
         ropts.objRootNear = Vec3f(float(p.rootNear[0]), float(p.rootNear[1]), float(p.rootNear[2]));
     }
-    if (p.strict) ropts.shortStrands = ShortStrandPolicy::Reject;
     StrandSet strands;
     ReadReport report;
     for (const std::string& in : inputs) {
@@ -162,7 +158,7 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("files", params->files, "IN [IN...] OUT, or IN [IN...] with -o OUT")->required();
     sub->add_option("-o,--output", params->output, "Output file; its extension picks the format (.hair .data .obj .ply .vdb .usda)");
     addParamOptions(sub, params->convert, convertParameters());
-    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addStrictOption(sub, common);
     sub->add_option("--root-near", params->rootNear,
                     "OBJ input: root each strand at its end nearest X,Y,Z (e.g. the head's centre) instead of its lower-index end")
         ->delimiter(',')->expected(3);
@@ -172,7 +168,7 @@ Command addConvertCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--input-units", params->inputUnits,
                     "The inputs' unit (mm, cm, dm, m, in, or metres), for files that declare none or declare it wrongly; nothing is scaled by it");
     sub->add_option("--format", params->format, "The format of '-' (standard input or output): hair, data, obj, ply, vdb or usda");
-    sub->add_option("--grid", params->grid, "VDB input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
+    addParamOptions(sub, common.read, selectParams(readParameters(), {"grid"}));
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair convert hair.tfx hair.vdb --resample 32");

@@ -128,6 +128,7 @@ Command addDemoCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("scene", params->refine.input, "The hairstyle: strands, or a helicoid scene .json (the README passes the bundled default)")->required();
     sub->add_option("-o,--output", params->outDir, "Output folder (created if missing)")->capture_default_str();
     addRefineOptions(sub, params->refine, demoSkippedParameters());  // demoParameters(): the demo always measures
+    addStrictOption(sub, common);
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair demo scenes/default/head.json -o out --levels 2");

@@ -28,7 +28,6 @@ struct FieldCmdParams
     FieldLevelsParams params;  ///< its declared parameters (fieldLevelsParameters()) are options
     bool withStrands = false;
     bool helicoid = false;
-    bool strict = false;
     ScalpOptions scalp;
     std::string vectorName = "tangent";
     std::string dense;                       ///< --dense OUT.npy: the orientation volume
@@ -76,8 +75,8 @@ int runField(const FieldCmdParams& p, const CommonOptions& common)
     const DenseBox denseBox = p.dense.empty() ? DenseBox{} : denseBoxOption(p);
     if (p.helicoid && p.vectorName != "tangent") throw ValueError("--helicoid with --vector-name " + p.vectorName + ": retrace --helicoid reads the vector grid 'tangent'");
 
-    const StrandSet strands = loadStrands("field", p.input, common, p.strict);
-    checkStrandLengths("field", p.input, strands, common, p.strict);
+    const StrandSet strands = loadStrands("field", p.input, common);
+    checkStrandLengths("field", p.input, strands, common);
     FieldParams fp = p.params.field;
     fp.voxelSize = resolveVoxelSize(strands, fp);  // 0: the library's suggestion (reported below)
     fp.coherenceAndSpread = false;  // not written (below)
@@ -154,7 +153,7 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
         ->capture_default_str();
     sub->add_flag("--helicoid", params->helicoid, "Also fit a helicoid per voxel: grids helicoid_k, helicoid_alpha, frame_T, frame_N");
     sub->add_flag("--with-strands", params->withStrands, "Also write the strands as the points grid 'strands'");
-    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addStrictOption(sub, common);
     sub->add_option("--dense", params->dense,
                     "Also write the orientation volume as NumPy .npy: float32 (D, H, W, 4), [k][j][i] = sample (i, j, k) along (x, y, z), "
                     "channels tx, ty, tz (unit, root to tip; 0 outside the hair) and occupancy (the active voxels' mask, trilinear, in [0,1]); "

@@ -20,7 +20,6 @@ struct FitCmdParams
 {
     std::string input, output;
     FitParams fit;  ///< its declared parameters (fitParameters()) are options
-    bool strict = false;
 };
 
 int runFit(FitCmdParams p, const CommonOptions& common)
@@ -28,7 +27,7 @@ int runFit(FitCmdParams p, const CommonOptions& common)
     if (fileExtension(p.output) != ".json") throw ValueError(p.output + ": fits are written as a scene file; the output must end in .json");
     checkParamOptions(fitParameters(), p.fit);
     p.fit.validate("option");  // the library's own rules (ParamErrors: run() spells them as flags)
-    const StrandSet strands = loadStrands("fit", p.input, common, p.strict);
+    const StrandSet strands = loadStrands("fit", p.input, common);
 
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<std::string> errors;
@@ -88,7 +87,7 @@ Command addFitCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("input", params->input, "Strand file")->required();
     sub->add_option("-o,--output", params->output, "Scene file (.json): one guide per input strand, in input order")->required();
     addParamOptions(sub, params->fit, fitParameters());
-    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addStrictOption(sub, common);
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair fit hair.hair -o fits.json --json && vdbhair grow fits.json -o regrown.hair");

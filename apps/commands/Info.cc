@@ -32,7 +32,6 @@ using namespace info;
 ReadOptions InfoParams::readOptions(const CommonOptions& common) const
 {
     ReadOptions ropts = vdbhair::app::readOptions(common);
-    if (strict) ropts.shortStrands = ShortStrandPolicy::Reject;
     if (!grid.empty()) ropts.vdbGrid = grid;
     return ropts;
 }
@@ -119,7 +118,7 @@ Command addInfoCommand(CLI::App& app, CommonOptions& common)
     auto params = std::make_shared<InfoParams>();
     CLI::App* sub = addVerb(app, "info");
     sub->add_option("file", params->input, "A strand file (.hair .data .obj .ply .usda .usd .abc .tfx .bin .convdata) or a .vdb file")->required();
-    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addStrictOption(sub, common);
     sub->add_option("--grid", params->grid, "For a .vdb file: summarize the strands of this points grid (e.g. strands, strands_input) instead of listing the grids");
     sub->add_flag("--stats", params->stats, "Also histograms of strand length, turning (degrees per strand), curvature (per vertex) and vertices per strand");
     addParamOptions(sub, params->statsParams, strandStatsParameters());

@@ -17,12 +17,11 @@ namespace vdbhair::app {
 struct InfoParams
 {
     std::string input;
-    bool strict = false;
     std::string grid;  ///< a .vdb's points grid to summarize as strands; empty: list every grid
     bool stats = false;  ///< --stats: histograms of length, turning, curvature, vertices per strand
     StrandStatsParams statsParams;  ///< their declared parameters (strandStatsParameters()): --bins
 
-    /// The reader's options these ask for (--strict, --grid) and @a common's.
+    /// The reader's options these ask for (--grid) and @a common's (--strict among them).
     ReadOptions readOptions(const CommonOptions& common) const;
 };
 

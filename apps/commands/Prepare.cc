@@ -22,7 +22,6 @@ struct PrepareCmdParams
     std::vector<std::string> files;  ///< IN OUT, or IN with -o OUT
     std::string output, head, alignTo, fixPenetration;
     std::string targetUp = axisName(PrepareParams{}.targetUp);  ///< PrepareParams::targetUp by name
-    bool strict = false;
     PrepareParams prepare;  ///< its declared parameters (prepareParameters()) are options; targetUp set from --target-up
 };
 
@@ -80,7 +79,7 @@ int runPrepare(PrepareCmdParams p, const CommonOptions& common)
                          " and the strands move with it");
     }
 
-    StrandSet strands = loadStrands("prepare", input, common, p.strict);
+    StrandSet strands = loadStrands("prepare", input, common);
     if (strands.empty()) throw FormatError(input + ": the file has no strands; nothing to write to " + p.output);
     TriangleMesh head, target;
     if (!p.head.empty()) {
@@ -138,7 +137,7 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--fix-penetration", params->fixPenetration,
                     "A head (mesh or .vdb level set) in the output's frame, e.g. the --align-to mesh: strands that enter it are bent out "
                     "(lengths kept, roots fixed; a root inside the scalp may stay as deep as it is)");
-    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addStrictOption(sub, common);
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Order: --strands, --align-to, --points, --fix-penetration.\n"

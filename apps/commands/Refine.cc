@@ -77,8 +77,8 @@ int runRefine(const RefineCmdParams& p, const CommonOptions& common)
     if (!p.saveField.empty() && fileExtension(p.saveField) != ".vdb") {
         throw ValueError("--save-field " + p.saveField + ": must end in .vdb");
     }
-    StrandSet strands = loadStrands("refine", p.input, common, p.strict);
-    checkStrandLengths("refine", p.input, strands, common, p.strict);
+    StrandSet strands = loadStrands("refine", p.input, common);
+    checkStrandLengths("refine", p.input, strands, common);
     const RefineParams rp = refineParamsFrom(p, strands, common);
     // Without --measure the input is not needed again: its storage may take the output
     // (refineStrands(StrandSet&&)); with it, the output is compared with it (`vdbhair compare`).
@@ -118,7 +118,6 @@ void addRefineOptions(CLI::App* sub, RefineCmdParams& p, const std::vector<std::
 {
     addParamOptions(sub, p.refine, refineParameters(), skip);
     addHeadOptions(sub, p.head, p.refine.headPolicy, "--scalp's sphere if given, else a sphere fitted to the roots");
-    sub->add_flag("--strict", p.strict, "Reject strands of fewer than 2 vertices instead of dropping them");
     addScalpOptions(sub, p.scalp);
 }
 
@@ -130,6 +129,7 @@ Command addRefineCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb)")->required();
     sub->add_option("--save-field", params->saveField, "Also write the fields used (tangent[_level_l], density[_level_l]) to this .vdb");
     addRefineOptions(sub, *params);
+    addStrictOption(sub, common);
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair refine hair.hair -o refined.hair --levels 3 --save-field field.vdb --measure --json");

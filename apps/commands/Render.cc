@@ -19,7 +19,6 @@ struct RenderCmdParams
 {
     std::string input, output, guides, head, reference;
     RenderParams render;  ///< its declared parameters (renderParameters()) are options
-    std::string grid = ReadOptions{}.vdbGrid;
 };
 
 int runRender(const RenderCmdParams& p, const CommonOptions& common)
@@ -48,7 +47,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
             strands.addStrand(std::vector<Vec3f>{roots.positions[i], roots.positions[i] + roots.normals[i] * len});
         }
     } else {
-        strands = loadStrandsOrScene("render", p.input, common, p.grid, p.head.empty() ? &head : nullptr);
+        strands = loadStrandsOrScene("render", p.input, common, common.read.vdbGrid, p.head.empty() ? &head : nullptr);
     }
     StrandSet guides;
     if (!p.guides.empty()) {
@@ -66,7 +65,7 @@ int runRender(const RenderCmdParams& p, const CommonOptions& common)
     }
     if (!p.reference.empty()) {
         if (rp.colorBy != ColorBy::Error) throw ValueError("--reference " + p.reference + ": only --color-by error uses it");
-        reference = loadStrandsOrScene("render", p.reference, common, p.grid);
+        reference = loadStrandsOrScene("render", p.reference, common, common.read.vdbGrid);
         rp.reference = &reference;
     }
     const auto t0 = std::chrono::steady_clock::now();
@@ -95,7 +94,7 @@ Command addRenderCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--reference", params->reference, "For --color-by error: the hairstyle to measure against (e.g. the reference of `compare`)");
     sub->add_option("--head", params->head, "A head mesh (.ply, .obj) drawn behind the hair, e.g. from ../shared/data/scalp (default: a scene's own \"head\")");
     sub->add_option("--guides", params->guides, "Strands drawn on top in red (e.g. the guides of a scene)");
-    sub->add_option("--grid", params->grid, "For a .vdb input: the points grid holding the strands (e.g. strands_input)")->capture_default_str();
+    addParamOptions(sub, common.read, selectParams(readParameters(), {"grid"}));
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair render scenes/default/head.json -o head.png --sheet");

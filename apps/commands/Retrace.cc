@@ -51,7 +51,6 @@ struct RetraceParams
     TraceParams trace;
     const CLI::Option* integratorOpt = nullptr;  ///< whether --integrator was given (--helicoid's default differs)
     bool helicoid = false;
-    bool strict = false;
     bool measure = false;  ///< the tangent angles: the field sampled at every input and output vertex
 };
 
@@ -65,8 +64,8 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 
     if (p.helicoid) {
         const HelicoidFieldGrids field = readHelicoidField(p.field);
-        const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
-        checkStrandLengths("retrace", p.input, strands, common, p.strict);
+        const StrandSet strands = loadStrands("retrace", p.input, common);
+        checkStrandLengths("retrace", p.input, strands, common);
         TraceStats stats;
         const StrandSet out = retraceHelicoidField(strands, field, tp, &stats, true, common.interrupter);
         // The angles are measured against the tangent field when the file has one.
@@ -96,8 +95,8 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         throw TypeError(p.field + ": grid '" + p.grid + "' holds " + grid->valueType() +
                         " values; retrace needs a vector grid (vec3s or vec3d), such as 'tangent'");
     }
-    const StrandSet strands = loadStrands("retrace", p.input, common, p.strict);
-    checkStrandLengths("retrace", p.input, strands, common, p.strict);
+    const StrandSet strands = loadStrands("retrace", p.input, common);
+    checkStrandLengths("retrace", p.input, strands, common);
 
     TraceStats stats;
     const StrandSet out = retraceStrands(strands, *grid, tp, &stats, nullptr, true, common.interrupter);
@@ -132,7 +131,7 @@ Command addRetraceCommand(CLI::App& app, CommonOptions& common)
     integrator->description(paramHelp(*findParam(traceParameters(), "integrator")) + "; with --helicoid the default is " +
                                        integratorName(kHelicoidRetraceIntegrator));
     sub->add_flag("--helicoid", params->helicoid, "Trace through the file's helicoid field (vdbhair field --helicoid) instead of the tangent grid");
-    sub->add_flag("--strict", params->strict, "Reject strands of fewer than 2 vertices instead of dropping them");
+    addStrictOption(sub, common);
     sub->add_flag("--measure", params->measure,
                   "Also report the mean angle between strand tangents and the field before and after "
                   "(samples the field at every input and output vertex: about half of the run)");

@@ -8,6 +8,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/Progress.h>
+#include <vdbhair/RunOptions.h>
 #include <vdbhair/Types.h>
 #include <vdbhair/strands/StrandSet.h>
 
@@ -103,9 +104,7 @@ private:
 template <typename WorkT>
 auto runLong(int threads, const pyb::object& progress, WorkT&& work)
 {
-    if (threads < 0) {
-        throw ValueError("threads=" + std::to_string(threads) + ": must be 0 (all cores) or more");
-    }
+    checkParams(runParameters(), RunOptions{threads}, ParamSpelling::Keyword, "");
     if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
         throw TypeError("progress: must be a callable progress(stage, done, total, unit) or None");
     }

@@ -428,8 +428,15 @@ pyb::dict compareImpl(const StrandsPtr& a, const StrandsPtr& b, const pyb::dict&
 {
     CompareParams p;
     applyKeywords(compareParameters(), kw, p, "compare");
-    p.metersPerUnit = kw["meters_per_unit"].cast<double>();
-    for (const auto& [d, angle] : kw["thresholds"].cast<std::vector<std::pair<double, double>>>()) p.thresholds.push_back({d, angle});
+    // The older keywords: the unit in metres, thresholds as (distance in metres, angle) pairs.
+    const pyb::object metres = renamedKeywordValue(kw, "unit", "meters_per_unit", "compare");
+    if (!kw["meters_per_unit"].is_none()) p.metersPerUnit = metres.cast<double>();
+    if (!kw["thresholds"].is_none()) {
+        renamedKeywordValue(kw, "threshold", "thresholds", "compare");
+        p.thresholds.clear();
+        for (const auto& [d, angle] : kw["thresholds"].cast<std::vector<std::pair<double, double>>>())
+            p.thresholds.push_back({p.metersPerUnit > 0.0 ? d * 1000.0 : d, angle});  // metres to millimetres
+    }
     try {
         p.validate();
     } catch (const ValueError& e) {
@@ -455,12 +462,12 @@ pyb::dict compareImpl(const StrandsPtr& a, const StrandsPtr& b, const pyb::dict&
 
 void defineCompare(pyb::module_& m)
 {
-    const CompareParams defaults;
     defineVerb(m, "compare", {"a: vdbhair.Strands", "b: vdbhair.Strands"}, compareParameters(),
-               {{"meters_per_unit", "float", pyb::float_(defaults.metersPerUnit), "the strands' unit in metres (0.01: centimetres); 0: unknown."},
-                {"thresholds", "", pyb::tuple(),
-                 "(distance, angle in degrees) pairs; distances in metres when meters_per_unit is given, else in the strands' units. "
-                 "Empty: HairGS's four (2 mm / 20 deg, 3 / 30, 4 / 40, 4 / 90) when meters_per_unit is given, else no oriented-point measure."},
+               {{"meters_per_unit", "Optional[float]", pyb::none(),
+                 "deprecated spelling of unit, the unit's length in metres (a DeprecationWarning; removed in the next release)."},
+                {"thresholds", "", pyb::none(),
+                 "deprecated: (distance in metres with a unit, angle in degrees) pairs; use threshold (a DeprecationWarning; removed in the next "
+                 "release)."},
                 {"head", "", pyb::none(), "None, a path (a mesh or a .vdb level set) or (x, y, z, r), a sphere."}},
                "Compare a hairstyle ``b`` with a reference ``a`` (``vdbhair compare A B --json``): HairGS's\n"
                "oriented-point precision, recall, F1 and strand consistency, the Chamfer distance, Perm's\n"

@@ -12,6 +12,7 @@
 #include "Common.h"
 
 #include <vdbhair/Parameters.h>
+#include <vdbhair/RunOptions.h>
 
 #include <pybind11/eval.h>
 #include <pybind11/stl.h>
@@ -35,9 +36,9 @@ struct PyKeyword
 template<typename P>
 std::string pythonAnnotation(const Param<P>& param)
 {
-    const std::string type = std::visit([](const auto& a) -> std::string {
+    const std::string type = std::visit([&param](const auto& a) -> std::string {
         using T = std::decay_t<decltype(a.get(std::declval<const P&>()))>;
-        if constexpr (std::is_same_v<T, std::string>) return "str";
+        if constexpr (std::is_same_v<T, std::string>) return param.repeats ? "Union[str, Sequence[str]]" : "str";
         else if constexpr (std::is_same_v<T, bool>) return "bool";
         else if constexpr (std::is_same_v<T, double>) return "float";
         else if constexpr (std::is_same_v<T, Vec3d>) return "Union[str, Tuple[float, float, float]]";  // a name or a vector
@@ -76,13 +77,22 @@ void applyKeywords(const ParamTable<P>& table, const pyb::dict& kw, P& p, const 
         std::visit([&](const auto& a) {
             using T = std::decay_t<decltype(a.get(p))>;
             if constexpr (std::is_same_v<T, std::string>) {
-                const std::string text = v.cast<std::string>();
+                std::string text;
+                if (param.repeats && !pyb::isinstance<pyb::str>(v)) {
+                    for (const std::string& s : v.cast<std::vector<std::string>>()) text += (text.empty() ? "" : " ") + s;
+                } else {
+                    text = v.cast<std::string>();
+                }
                 if (!param.choices.empty() && std::find(param.choices.begin(), param.choices.end(), text) == param.choices.end()) {
                     std::string list;
                     for (const std::string& c : param.choices) list += (list.empty() ? "" : ", ") + c;
                     throw ValueError(verb + ": " + key + " '" + text + "': must be one of " + list);
                 }
-                a.set(p, text);
+                try {
+                    a.set(p, text);  // a setter that reads text (compare's unit) names what it refuses
+                } catch (const ValueError& e) {
+                    throw ValueError(verb + ": " + spelledMessage(e, ParamSpelling::Keyword));
+                }
             } else if constexpr (std::is_same_v<T, Vec3d>) {
                 // An axis: a name, as the command line's, or any (x, y, z).
                 if (pyb::isinstance<pyb::str>(v)) {
@@ -139,7 +149,7 @@ void defineVerb(pyb::module_& m, const std::string& verb, const std::vector<std:
     for (const Param<P>& p : table) keywords.push_back({p.pythonName(), pythonAnnotation(p), pythonDefault(p), paramHelp(p)});
     for (const PyKeyword& k : extras) keywords.push_back({k.name, k.annotation, k.defaultValue, k.doc});
     // What every long operation takes (Common.h's runLong()).
-    keywords.push_back({"threads", "int", pyb::int_(0), "worker threads, 0 for all cores (results do not depend on it)."});
+    for (const Param<RunOptions>& p : runParameters()) keywords.push_back({p.pythonName(), pythonAnnotation(p), pythonDefault(p), paramHelp(p)});
     keywords.push_back({"progress", "Optional[Callable]", pyb::none(),
                         "optional callable ``progress(stage, done, total, unit)``, called at each stage's start and then at most "
                         "ten times a second; raising in it stops the work."});

@@ -158,23 +158,6 @@ pyb::array strandView(const pyb::object& self, const StrandSet& s, std::ptrdiff_
     return readOnlyView(reinterpret_cast<const float*>(s.data(std::size_t(i))), s.size(std::size_t(i)), 3, self);
 }
 
-ReadOptions readOptions(bool strict, const std::string& grid, const std::optional<std::array<float, 3>>& rootNear,
-                        std::int64_t pointsPerStrand = 0, std::int64_t curveSamples = 0, const std::string& roots = "first")
-{
-    if (pointsPerStrand < 0) throw ValueError("points_per_strand=" + std::to_string(pointsPerStrand) + ": must be 0 (not set) or a count of points");
-    if (curveSamples < 0 || curveSamples == 1) {
-        throw ValueError("curve_samples=" + std::to_string(curveSamples) + ": must be 0 (automatic) or 2 or more");
-    }
-    ReadOptions opts;
-    opts.roots = rootEndFromName(roots);  // "roots='x': must be first, last or auto"
-    opts.pointsPerStrand = std::size_t(pointsPerStrand);
-    opts.curveSamples = std::size_t(curveSamples);
-    opts.shortStrands = strict ? ShortStrandPolicy::Reject : ShortStrandPolicy::Drop;
-    opts.vdbGrid = grid;
-    if (rootNear) opts.objRootNear = Vec3f((*rootNear)[0], (*rootNear)[1], (*rootNear)[2]);
-    return opts;
-}
-
 /// write()'s keywords: writeParameters(), the declared parameters of how strands are written
 /// (the command line's `convert` options), by their Python names, in the declaration's order.
 /// The C++ types of writeWithOptions()'s keywords follow that order; writeKeywords() checks them.
@@ -424,62 +407,43 @@ void bindStrandSequence(StrandsClass& cls)
 
 }
 
-/// vdbhair.read: strands from a file.
+/// vdbhair.read: strands from a file, its keywords the readers' declared options (readParameters()).
 void bindRead(pyb::module_& m)
 {
-    m.def(
-        "read",
-        [](const PathArg& path, bool strict, const std::string& grid, std::optional<std::array<float, 3>> rootNear,
-           std::int64_t pointsPerStrand, std::int64_t curveSamples, const std::string& roots, const pyb::object& progress) {
-            ReadReport report;
-            // The readers name their options as read()'s keywords (ReadOptions::spelling's default).
-            const ReadOptions base = readOptions(strict, grid, rootNear, pointsPerStrand, curveSamples, roots);
-            auto set = runLong(0, progress, [&](WorkInterrupter* interrupter) {
-                ReadOptions opts = base;
-                opts.interrupter = interrupter;
-                return std::make_shared<StrandSet>(readStrands(path, opts, &report));
-            });
-            if (!report.warnings.empty()) {
-                pyb::module_ warnings = pyb::module_::import("warnings");
-                for (const std::string& w : report.warnings) {
-                    warnings.attr("warn")(w, pyb::module_::import("builtins").attr("UserWarning"), 2);
-                }
-            }
-            return set;
-        },
-        pyb::arg("path"), pyb::kw_only(), pyb::arg("strict") = false, pyb::arg("grid") = ReadOptions{}.vdbGrid,
-        pyb::arg("root_near") = pyb::none(), pyb::arg("points_per_strand") = 0, pyb::arg("curve_samples") = 0,
-        pyb::arg("roots") = "first", pyb::arg("progress") = pyb::none(),
-        R"doc(Read strands from a file, the format chosen by extension (and checked by magic).
-
-Formats: .hair (cyHair), .data (USC-HairSalon), .obj (line elements and curv curves), .ply (hairutil, line sets, points in runs), .vdb
-(points grid), .usda (USD BasisCurves), .tfx (TressFX), .bin (CT2Hair), .convdata (HairNet).
-
-Args:
-    path: the file, a str or any os.PathLike (pathlib.Path).
-    strict: reject strands of fewer than 2 vertices (FormatError) instead of dropping them with a
-        UserWarning (the CLI's ``--strict``).
-    grid: for a .vdb, the points grid holding the strands (the CLI's ``--grid``).
-    root_near: for an .obj, root each strand at its end nearest this (x, y, z) (world units)
-        instead of its end with the lower vertex index (and for a .ply line set).
-    points_per_strand: for a .ply of points only (NeuralHaircut, GaussianHaircut write 100), each
-        run of this many consecutive points is one strand (the CLI's ``--points-per-strand``).
-    curve_samples: for .obj free-form curves and cubic .usda and .abc curves, the points each curve is evaluated at, evenly in its
-        parameter; 0 chooses them so that the polyline keeps the curve within 1 % of its length
-        (the CLI's ``--curve-samples``).
-    roots: which end of each stored strand is its root (the CLI's ``--roots``): "first" (the
-        convention), "last" (every strand reversed) or "auto": decided once for the file, the end
-        whose least-squares sphere has more of the hair outside it (roots lie on the scalp, hair
-        outside it); a UserWarning says when it reversed the strands, or that fewer than 32
-        strands were too few to tell (then they are kept as stored).
-    progress: optional callable ``progress(stage, done, total, unit)``.
-
-Returns:
-    Strands.
-
-Raises:
-    vdbhair.IoError (an OSError), vdbhair.FormatError / UnsupportedError (ValueErrors) naming the
-    file, the byte offset or line and the rule; KeyboardInterrupt on Ctrl-C.)doc");
+    auto readImpl = [](const PathArg& path, const pyb::dict& kw) {
+        ReadOptions base;  // the readers name their options as read()'s keywords (ReadOptions::spelling's default)
+        applyKeywords(readParameters(), kw, base, "read");
+        if (!kw["root_near"].is_none()) {
+            const auto xyz = kw["root_near"].cast<std::vector<double>>();
+            if (xyz.size() != 3) throw ValueError("read: root_near: must be (x, y, z), got " + std::to_string(xyz.size()) + " numbers");
+            base.objRootNear = Vec3f(float(xyz[0]), float(xyz[1]), float(xyz[2]));
+        }
+        ReadReport report;
+        auto set = runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter* interrupter) {
+            ReadOptions opts = base;
+            opts.interrupter = interrupter;
+            return std::make_shared<StrandSet>(readStrands(path, opts, &report));
+        });
+        pyb::module_ warnings = pyb::module_::import("warnings");
+        for (const std::string& w : report.warnings) warnings.attr("warn")(w, pyb::module_::import("builtins").attr("UserWarning"), 2);
+        return set;
+    };
+    defineVerb(m, "read", {"path: os.PathLike | str"}, readParameters(),
+               {{"root_near", "Optional[Tuple[float, float, float]]", pyb::none(),
+                 "for an .obj (and a .ply line set), root each strand at its end nearest this (x, y, z) (world units) instead of its "
+                 "end with the lower vertex index (the CLI's ``convert --root-near``)."}},
+               "Read strands from a file, the format chosen by extension (and checked by magic).\n\n"
+               "Formats: .hair (cyHair), .data (USC-HairSalon), .obj (line elements and curv curves), .ply (hairutil, line sets, points\n"
+               "in runs), .vdb (points grid), .usda (USD BasisCurves), .abc (Alembic curves), .tfx (TressFX), .bin (CT2Hair), .convdata\n"
+               "(HairNet). Its keywords are the command line's reading options (``--strict``, ``--grid``, ``--points-per-strand``,\n"
+               "``--curve-samples``, ``--roots``); the readers' warnings (strands dropped, roots reversed) are UserWarnings.",
+               "    path: the file, a str or any os.PathLike (pathlib.Path).\n",
+               "Strands.\n\n"
+               "Raises:\n"
+               "    vdbhair.IoError (an OSError), vdbhair.FormatError / UnsupportedError (ValueErrors) naming the\n"
+               "    file, the byte offset or line and the rule; vdbhair.ArgumentError for a keyword outside its range\n"
+               "    or choices (\"read: roots 'tip': must be one of first, last, auto\"); KeyboardInterrupt on Ctrl-C.",
+               pyb::cpp_function(readImpl, pyb::arg("path"), pyb::arg("keywords")));
 }
 
 /// vdbhair.write: strands to a file, with the keywords writeParameters() declares.

@@ -79,7 +79,9 @@ def test_the_message_names_the_argument_the_type_it_must_have_and_what_it_got():
         vdbhair.read("a.hair", strict="yes")
     with pytest.raises(TypeError, match=r"^read: path must be a path \(str or os.PathLike such as pathlib.Path\), got int$"):
         vdbhair.read(3)
-    with pytest.raises(vdbhair.ArgumentTypeError, match=r"^read: no argument named stric; its arguments are path, strict"):
+    with pytest.raises(vdbhair.ArgumentTypeError, match=r"^write: no argument named codek; its arguments are strands, path, ply_encoding"):
+        vdbhair.write(vdbhair.Strands(np.zeros((2, 3)), [0, 2]), "a.vdb", codek="float")
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'stric'"):  # read() is made from its declaration, as the verbs are
         vdbhair.read("a.hair", stric=True)
     with pytest.raises(vdbhair.ArgumentTypeError, match=r"^write: path is required$"):
         vdbhair.write(vdbhair.Strands(np.zeros((2, 3)), [0, 2]))

@@ -4,6 +4,7 @@ in `--help` (an axis: None in Python is "auto" on the command line, a unit vecto
 Python takes the command's axis names. The renamed report keywords (retrace's return_stats, fit's return_summary) still work, with a
 DeprecationWarning; estimate_tangent_field() and scalp() return their command's `--json` report."""
 import json
+import re
 import subprocess
 import warnings
 
@@ -122,3 +123,84 @@ def test_field_and_scalp_reports_are_the_commands(tmp_path):
         del cmd["output"], cmd["seconds"]
         assert report == cmd, args
     assert len(vdbhair.scalp(sphere=(0, 88, 7, 30))) == 2  # without return_report: (surface, region)
+
+
+# The options many verbs share are declared once too: the readers' (readParameters(): read()'s
+# keywords and every reading verb's options) and threads (runParameters(): every verb's).
+def _help_text(verb):
+    return " ".join(subprocess.run([cli(), verb, "--help"], capture_output=True, text=True, check=True).stdout.split())
+
+
+def _keyword_doc(function, keyword):
+    """The help of a keyword in a verb's docstring (its line in Args)."""
+    lines = [line for line in vdbhair.__dict__[function].__doc__.splitlines() if line.startswith(f"    {keyword}: ")]
+    assert len(lines) == 1, (function, keyword)
+    return lines[0].split(": ", 1)[1]
+
+
+READING = {"strict": "--strict", "grid": "--grid", "points_per_strand": "--points-per-strand", "curve_samples": "--curve-samples",
+           "roots": "--roots"}
+READING_VERBS = {"convert": READING, "render": {k: f for k, f in READING.items() if k != "strict"},
+                 "info": {k: f for k, f in READING.items() if k != "grid"}, "field": {k: f for k, f in READING.items() if k != "grid"},
+                 "compare": {k: f for k, f in READING.items() if k not in ("grid", "strict")}}
+
+
+@pytest.mark.parametrize("verb", sorted(READING_VERBS))
+def test_read_keywords_are_the_reading_options_of_every_verb(verb):
+    text = _help_text(verb)
+    python = keyword_defaults("read")
+    for keyword, flag in READING_VERBS[verb].items():
+        help_line = _keyword_doc("read", keyword).rstrip(".")
+        assert flag in text, f"{verb} --help has no {flag}"
+        # The help each side shows is the declaration's; the default (a flag's: off) too.
+        assert help_line in text, f"read({keyword}=): {help_line!r} is not what vdbhair {verb} {flag} says"
+        shown = re.search(re.escape(flag) + r"(?:,--[\w-]+)? [A-Z]+(?::\{[^}]*\})?=(\S+)", text)
+        assert (shown.group(1) if shown else "False") == python[keyword].strip("'"), (keyword, flag)
+
+
+@pytest.mark.parametrize("function, verb", [("read", "convert"), ("refine", "refine"), ("compare", "compare"), ("synth", "synth"),
+                                            ("roots", "roots"), ("strand_statistics", "info")])
+def test_threads_is_one_declaration(function, verb):
+    assert keyword_defaults(function)["threads"] == "0" and flag_defaults(verb)["--threads"] == "0"
+    assert _keyword_doc(function, "threads").rstrip(".") in _help_text(verb)
+
+
+def _cli_error(*args):
+    run = subprocess.run([cli(), *map(str, args)], capture_output=True, text=True)
+    assert run.returncode == 2, run.stderr
+    return run.stderr.strip()
+
+
+def _python_error(call):
+    with pytest.raises(ValueError) as e:
+        call()
+    return str(e.value)
+
+
+def test_shared_options_refuse_a_value_with_one_rule(tmp_path):
+    """Each bad value: the same rule from both front ends, the parameters spelled as each spells them
+    (--curve-samples, curve_samples)."""
+    path = tmp_path / "b.hair"
+    straight_bundle().write(str(path))
+    hair = vdbhair.read(str(path))
+    cases = [(("compare", path, path, "--unit", "furlong"), lambda: vdbhair.compare(hair, hair, unit="furlong"), "--unit", "unit"),
+             (("compare", path, path, "--threshold", "2"), lambda: vdbhair.compare(hair, hair, threshold="2"), "--threshold", "threshold"),
+             (("convert", path, tmp_path / "o.obj", "--threads", "-1"), lambda: vdbhair.read(str(path), threads=-1), "--threads", "threads"),
+             (("info", path, "--curve-samples", "1"), lambda: vdbhair.read(str(path), curve_samples=1), "--curve-samples", "curve_samples")]
+    for args, call, flag, keyword in cases:
+        command = _cli_error(*args)
+        python = _python_error(call)
+        rule = python.split(keyword, 1)[1]  # after the keyword: the value and the rule
+        assert flag in command and (keyword + rule).replace("_", "-") in command.replace("--", ""), (command, python)
+
+
+def test_compare_unit_and_threshold_mean_the_same_in_both(tmp_path):
+    a = straight_bundle(count=4, vertices=17, length=4.0, spacing=1.0)
+    b = vdbhair.Strands(a.positions + np.float32([0.0, 0.0, 0.25]), a.offsets)
+    a.write(str(tmp_path / "a.hair"))
+    b.write(str(tmp_path / "b.hair"))
+    python = vdbhair.compare(a, b, unit="cm", threshold=["2:20", "3:30"])
+    command = _command("compare", tmp_path / "a.hair", tmp_path / "b.hair", "--unit", "cm", "--threshold", "2:20", "--threshold", "3:30")
+    assert python["oriented_points"] == command["oriented_points"]
+    assert [m["distance_mm"] for m in python["oriented_points"]] == [2.0, 3.0]
+    assert vdbhair.compare(a, b, unit="cm", threshold="2:20 3:30")["oriented_points"] == python["oriented_points"]

@@ -16,8 +16,8 @@ def test_a_rule_the_library_checks_names_the_keyword():
         vdbhair.synth(wavy_hairstyle(count=40), match_balance=0.5)
     with pytest.raises(ValueError, match=r"^color_by error needs a reference hairstyle"):
         vdbhair.render(straight_bundle(), color_by="error")
-    with pytest.raises(ValueError, match=r"^compare: meters_per_unit -1(\.0+)?: must be a positive length in metres"):
-        vdbhair.compare(straight_bundle(), straight_bundle(), meters_per_unit=-1.0)
+    with pytest.raises(ValueError, match=r"^compare: unit 'furlong': expected mm, cm, dm, m, in or the unit's length in metres"):
+        vdbhair.compare(straight_bundle(), straight_bundle(), unit="furlong")
 
 
 def test_the_command_line_names_the_same_rule_by_its_flag(tmp_path):

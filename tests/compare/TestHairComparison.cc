@@ -122,7 +122,7 @@ TEST_CASE("compareHairstyles: a hairstyle against itself and against a known shi
     REQUIRE_THROWS_WITH(compareHairstyles(a, a, bad), Contains("samples 2"));
     bad = CompareParams();
     bad.metersPerUnit = -1.0;
-    REQUIRE_THROWS_WITH(compareHairstyles(a, a, bad), Contains("meters_per_unit"));
+    REQUIRE_THROWS_WITH(compareHairstyles(a, a, bad), Contains("unit -1"));
 }
 
 TEST_CASE("compareHairstyles: strands passing into a head, and the same report at any thread count", "[compare]")

@@ -18,11 +18,80 @@
 
 namespace vdbhair {
 
+namespace {
+
+/// The names of compare's unit and thresholds, as each front end spells them (their declarations
+/// below cannot call paramName() while the table is being built).
+const ParamName kUnitName{"--unit", "unit"}, kThresholdName{"--threshold", "threshold"};
+
+/// The unit as a person types it: a name (mm, cm, dm, m, in), else its length in metres; "" unknown.
+std::string unitText(double metersPerUnit)
+{
+    if (metersPerUnit == 0.0) return "";
+    for (const char* name : {"mm", "cm", "dm", "m", "in"}) if (metersPerUnitFromName(name, "") == metersPerUnit) return name;
+    return formatNumber(metersPerUnit);
+}
+
+/// "D:ANGLE" thresholds, separated by spaces, as CompareParams::thresholds.
+/// @throw ParamError<ValueError> naming the threshold that is not one.
+std::vector<OrientedThreshold> parseThresholds(const std::string& text)
+{
+    std::vector<OrientedThreshold> out;
+    std::size_t at = 0;
+    while ((at = text.find_first_not_of(' ', at)) != std::string::npos) {
+        const std::size_t end = std::min(text.find(' ', at), text.size());
+        const std::string item = text.substr(at, end - at);
+        at = end;
+        const std::size_t colon = item.find(':');
+        char* end1 = nullptr;
+        char* end2 = nullptr;
+        const std::string d = item.substr(0, colon), angle = colon == std::string::npos ? std::string() : item.substr(colon + 1);
+        const double dv = std::strtod(d.c_str(), &end1), av = std::strtod(angle.c_str(), &end2);
+        if (colon == std::string::npos || d.empty() || angle.empty() || *end1 != '\0' || *end2 != '\0' || !(dv > 0.0) || !std::isfinite(dv) ||
+            !(av >= 0.0 && av <= 180.0)) {
+            throw ParamError<ValueError>({kThresholdName, " '" + item + "': expected DISTANCE:ANGLE, a positive distance (millimetres with ", kUnitName,
+                                          ", else file units) and an angle in [0, 180] degrees, e.g. 2:20"});
+        }
+        out.push_back({dv, av});
+    }
+    return out;
+}
+
+} // namespace
+
 const ParamTable<CompareParams>& compareParameters()
 {
     using P = CompareParams;
     static const ParamTable<P> table = [] {
         ParamTable<P> t;
+        ParamAccess<P, std::string> unitAccess{[](const P& p) { return unitText(p.metersPerUnit); }, [](P& p, std::string v) {
+                                                   if (v.empty()) {
+                                                       p.metersPerUnit = 0.0;
+                                                       return;
+                                                   }
+                                                   try {
+                                                       p.metersPerUnit = metersPerUnitFromName(v, "");
+                                                   } catch (const ValueError&) {
+                                                       throw ParamError<ValueError>({kUnitName, " '" + v + "': expected mm, cm, dm, m, in or the unit's length in "
+                                                                                                            "metres (0.01 for centimetres)"});
+                                                   }
+                                               }};
+        auto unit = makeParam<P>("unit", "The files' unit: mm, cm, dm, m, in, or its length in metres; needed for HairGS's thresholds in millimetres "
+                                         "(not given: unknown)", "", unitAccess);
+        unit.pythonNone = true;
+        t.push_back(unit);
+        ParamAccess<P, std::string> thresholdAccess{[](const P& p) {
+                                                        std::string s;
+                                                        for (const OrientedThreshold& th : p.thresholds)
+                                                            s += (s.empty() ? "" : " ") + formatNumber(th.distance) + ":" + formatNumber(th.angleDegrees);
+                                                        return s;
+                                                    },
+                                                    [](P& p, std::string v) { p.thresholds = parseThresholds(v); }};
+        auto threshold = makeParam<P>("threshold", "An oriented-point threshold DISTANCE:ANGLE (millimetres with a unit, else file units; "
+                                                   "several: repeat it; default with a unit: HairGS's 2:20 3:30 4:40 4:90)", "", thresholdAccess);
+        threshold.repeats = true;
+        threshold.pythonNone = true;
+        t.push_back(threshold);
         t.push_back(makeParam<P>("bidirectional", "Oriented points match whichever way round their directions point", "",
                                  member<P>([](P& p) -> bool& { return p.bidirectional; })));
         auto samples = makeParam<P>("samples", "Points per strand for the strand-pair measures, 100 as in Perm", "",
@@ -41,11 +110,8 @@ const ParamTable<CompareParams>& compareParameters()
 
 void CompareParams::validate() const
 {
-    // The unit and the thresholds are not declared parameters (the command line reads them as text:
-    // --unit cm, --threshold 2:20); named here as each front end spells them.
-    const ParamName unit{"--unit", "meters_per_unit"}, threshold{"--threshold", "thresholds"};
     if (!(metersPerUnit >= 0.0) || !std::isfinite(metersPerUnit)) {
-        throw ParamError<ValueError>({unit, " " + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown"});
+        throw ParamError<ValueError>({kUnitName, " " + std::to_string(metersPerUnit) + ": must be a positive length in metres, or 0 for unknown"});
     }
     if (samples < kMinSamples) {
         throw ParamError<ValueError>({paramName(compareParameters(), "samples"),
@@ -53,10 +119,10 @@ void CompareParams::validate() const
     }
     for (const OrientedThreshold& t : thresholds) {
         if (!(t.distance > 0.0) || !std::isfinite(t.distance)) {
-            throw ParamError<ValueError>({threshold, ": distance " + std::to_string(t.distance) + ": must be positive and finite"});
+            throw ParamError<ValueError>({kThresholdName, ": distance " + std::to_string(t.distance) + ": must be positive and finite"});
         }
         if (!(t.angleDegrees >= 0.0 && t.angleDegrees <= 180.0)) {
-            throw ParamError<ValueError>({threshold, ": angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees"});
+            throw ParamError<ValueError>({kThresholdName, ": angle " + std::to_string(t.angleDegrees) + ": must be in [0, 180] degrees"});
         }
     }
 }
@@ -100,6 +166,9 @@ HairComparison compareHairstyles(const StrandSet& a, const StrandSet& b, const C
     c.metersPerUnit = params.metersPerUnit;
 
     std::vector<OrientedThreshold> thresholds = params.thresholds;
+    if (params.metersPerUnit > 0.0) {
+        for (OrientedThreshold& t : thresholds) t.distance /= 1000.0;  // millimetres to metres
+    }
     if (thresholds.empty() && params.metersPerUnit > 0.0) thresholds = hairGsThresholds();
     if (params.metersPerUnit > 0.0) {
         for (OrientedThreshold& t : thresholds) t.distance /= params.metersPerUnit;  // metres to file units

@@ -29,8 +29,9 @@ struct CompareParams
     /// are millimetres: with an unknown unit the oriented-point measures need @a thresholds in file
     /// units, and are left out without them.
     double metersPerUnit = 0.0;
-    /// Oriented-point thresholds, distances in metres when metersPerUnit > 0, else in file units;
-    /// empty: HairGS's four (hairGsThresholds()) when the unit is known.
+    /// Oriented-point thresholds as a person gives them (`2:20`): distances in millimetres when
+    /// metersPerUnit > 0, else in file units; empty: HairGS's four (hairGsThresholds()) when the
+    /// unit is known.
     std::vector<OrientedThreshold> thresholds;
     /// Directions match either way round (a strand stored tip first still matches).
     bool bidirectional = false;
@@ -46,10 +47,10 @@ struct CompareParams
     void validate() const;
 };
 
-/// @brief compare's parameters declared once (vdbhair/Parameters.h): the direction rule and the
-/// strand-pair samples; the command's options, `--help` and docs/cli.md's table are made from it.
-/// The unit, the thresholds and the pairing stay the front ends' own (`--unit NAME`, `--threshold
-/// D:ANGLE`, `--unpaired`; Python's meters_per_unit, thresholds, pair_strands).
+/// @brief compare's parameters declared once (vdbhair/Parameters.h): the unit (by name or its
+/// length in metres), the oriented-point thresholds (`D:ANGLE` text, repeated), the direction rule,
+/// the strand-pair samples and the pairing; the command's options, `--help`, Python's keywords and
+/// docs/cli.md's table are made from it.
 const ParamTable<CompareParams>& compareParameters();
 
 struct HairComparison

@@ -284,6 +284,8 @@ bool planeStep(const std::vector<Pair>& pairs, Similarity& T)
     if (!u.allFinite()) return false;
     const double f = 1.0 + u(3);
     if (!(f > 0.0)) return false;
+    // The step's rotation as a matrix, exp([omega]), to compose with T's and re-orthonormalize by
+    // SVD (a fit, not a turn of a vector): Rotation.h's rotateByVector() turns vectors only.
     const Eigen::Vector3d omega(u(0), u(1), u(2));
     const double angle = omega.norm();
     const Eigen::Matrix3d Rw = angle > 0.0 ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();

@@ -221,10 +221,10 @@ PlyStrandLayout plyStrandLayout(const PlyHeader& hdr, const ReadOptions& opts, R
             throw ParamError<FormatError>({where + ": the file has only points: no 'strand' element (hairutil layout: element strand with property nsegs) "
                                            "and no 'edge' element (a line set); if each run of N consecutive vertices is one strand (NeuralHaircut and "
                                            "GaussianHaircut write 100), read it with ",
-                                           readOptionSetting(kPointsPerStrandName), "N"});
+                                           readOptionSetting(readParamName("points-per-strand")), "N"});
         }
     } else if (opts.pointsPerStrand > 0 && report) {
-        report->warnings.push_back(where + ": " + spelled(readOptionSetting(kPointsPerStrandName), opts.spelling) + std::to_string(opts.pointsPerStrand) +
+        report->warnings.push_back(where + ": " + spelled(readOptionSetting(readParamName("points-per-strand")), opts.spelling) + std::to_string(opts.pointsPerStrand) +
                                    " is ignored: the file's 'strand' element says where each strand ends");
     }
     l.iseg = findProperty(l.strandEl, "nsegs");
@@ -423,7 +423,7 @@ StrandSet runsToStrands(PlyStrandsIn& in, const ReadOptions& opts, ReadReport* r
     if (nV % run != 0) {
         throw ParamError<FormatError>({where + ": line " + std::to_string(line) + ": the 'vertex' element has " + std::to_string(nV) +
                                            " vertices, which is not a multiple of ",
-                                       readOptionSetting(kPointsPerStrandName),
+                                       readOptionSetting(readParamName("points-per-strand")),
                                        std::to_string(run) + " (each run of that many consecutive vertices is one strand)"});
     }
     if (nV > std::numeric_limits<std::uint32_t>::max()) {

@@ -62,10 +62,23 @@ struct ReadOptions
     ParamName rootsName{"--roots", "roots"};
 };
 
-/// The readers' options as messages name them (the command line's addReadOptions() and Python's
-/// read() take them; @c roots: ReadOptions::rootsName).
-inline const ParamName kPointsPerStrandName{"--points-per-strand", "points_per_strand"};
-inline const ParamName kCurveSamplesName{"--curve-samples", "curve_samples"};
+/// @brief The readers' options a person sets, declared once (vdbhair/Parameters.h): strict, grid,
+/// points-per-strand, curve-samples and roots. The command line's reading options
+/// (apps/Cli.cc addReadOptions(), addStrictOption(); `convert` and `render` take `--grid`) and
+/// Python's read() keywords are made from it. root_near stays each front end's own (an optional
+/// point is not a declared type).
+const ParamTable<ReadOptions>& readParameters();
+
+/// @brief Check the declared options of @a opts (readParameters()) and what their ranges cannot
+/// say: a curve of one sample. readStrands() calls it; errors name the options in @a opts.spelling.
+/// @throw ParamError<ValueError> "curve_samples 1: must be 0 (automatic) or 2 or more".
+void checkReadOptions(const ReadOptions& opts);
+
+/// The readers' options as messages name them (readParameters(); @c roots: ReadOptions::rootsName).
+inline ParamName readParamName(const std::string& name)
+{
+    return paramName(readParameters(), name);
+}
 
 /// @brief An option set to a value, as each front end shows it: "--points-per-strand 100" on the
 /// command line, "points_per_strand=100" in Python (the name and what stands before the value).

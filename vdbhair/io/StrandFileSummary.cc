@@ -7,6 +7,7 @@ namespace vdbhair {
 
 StrandSummary summarizeStrandFile(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
+    checkReadOptions(opts);
     const StrandFormat format = strandFileFormat(path);
     if (format == StrandFormat::Data && opts.roots == RootEnd::First) return summarizeData(path, opts, report);
     if (format == StrandFormat::Vdb) return summarizeStrands(readNonVdbStrands(path, opts, report));  // throws ValueError

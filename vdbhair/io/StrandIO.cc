@@ -20,6 +20,7 @@ StrandSet readAnyStrands(const std::string& path, const ReadOptions& opts, ReadR
 
 StrandSet readStrands(const std::string& path, const ReadOptions& opts, ReadReport* report)
 {
+    checkReadOptions(opts);
     StrandSet strands = readAnyStrands(path, opts, report);
     // The one place ReadOptions::roots is applied, whichever reader ran (RootEnd.h).
     const RootEndDecision d = orientStrandRoots(strands, opts.roots, opts.rootsHeadDistance);

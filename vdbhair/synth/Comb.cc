@@ -20,6 +20,9 @@ namespace vdbhair {
 
 namespace {
 
+// Combing composes each edge's turns (C = R C) and blends neighbouring edges' rotations by
+// slerp (retransferDetail()), which needs rotations as quaternions; Rotation.h turns vectors
+// (Rodrigues) and has neither composition nor slerp, so the turns here stay Eigen quaternions.
 using Quat = Eigen::Quaterniond;
 using EVec = Eigen::Vector3d;
 
