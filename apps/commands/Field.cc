@@ -32,7 +32,7 @@ struct FieldCmdParams
     std::string vectorName = "tangent";
     std::string dense;                       ///< --dense OUT.npy: the orientation volume
     std::vector<double> denseBox;            ///< x0,y0,z0,x1,y1,z1 (world units)
-    std::vector<int> denseSize{96, 128, 128};  ///< D,H,W: samples along z, y, x
+    std::vector<int> denseSize{kDefaultDenseShape.begin(), kDefaultDenseShape.end()};  ///< D,H,W: samples along z, y, x
 };
 
 /// --dense-box and --dense-size as a DenseBox (DenseArray.h), checked.
@@ -160,7 +160,10 @@ Command addFieldCommand(CLI::App& app, CommonOptions& common)
                     "from level 0 (the finest); world space only");
     sub->add_option("--dense-box", params->denseBox, "The world box of --dense: X0,Y0,Z0,X1,Y1,Z1; samples at the centres of its D x H x W cells")
         ->delimiter(',')->expected(6);
-    sub->add_option("--dense-size", params->denseSize, "Samples of --dense: D,H,W (along z, y, x; NeuralHDHair's 96,128,128 by default)")
+    const auto& shape = kDefaultDenseShape;
+    sub->add_option("--dense-size", params->denseSize,
+                    "Samples of --dense: D,H,W (along z, y, x; NeuralHDHair's " + std::to_string(shape[0]) + "," + std::to_string(shape[1]) + "," +
+                        std::to_string(shape[2]) + " by default)")
         ->delimiter(',')->expected(3);
     addScalpOptions(sub, params->scalp);
     addCommonOptions(sub, common);

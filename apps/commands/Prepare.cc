@@ -21,8 +21,7 @@ struct PrepareCmdParams
 {
     std::vector<std::string> files;  ///< IN OUT, or IN with -o OUT
     std::string output, head, alignTo, fixPenetration;
-    std::string targetUp = axisName(PrepareParams{}.targetUp);  ///< PrepareParams::targetUp by name
-    PrepareParams prepare;  ///< its declared parameters (prepareParameters()) are options; targetUp set from --target-up
+    PrepareParams prepare;  ///< its declared parameters (prepareParameters()) are options
 };
 
 std::string fmt(double v)
@@ -71,7 +70,6 @@ int runPrepare(PrepareCmdParams p, const CommonOptions& common)
     const std::string& input = inputs[0];
     strandFormatFromPath(input);
     strandFormatFromPath(p.output, /*forWriting=*/true);
-    p.prepare.targetUp = axisFromName(p.targetUp, "--target-up");
     checkParamOptions(prepareParameters(), p.prepare);
     p.prepare.validate();
     if (!p.alignTo.empty() && p.head.empty()) {
@@ -131,9 +129,6 @@ Command addPrepareCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--align-to", params->alignTo,
                     "A common head mesh (.ply, .obj): --head is fitted onto it by a similarity (scale, rotation, translation) and the "
                     "strands move with it; the transform and the residual are reported");
-    sub->add_option("--target-up", params->targetUp,
-                    "--align-to by ICP: the common head's up axis (x, y, z, -x, -y, -z); the groom's up is from its head to its roots")
-        ->capture_default_str();
     sub->add_option("--fix-penetration", params->fixPenetration,
                     "A head (mesh or .vdb level set) in the output's frame, e.g. the --align-to mesh: strands that enter it are bent out "
                     "(lengths kept, roots fixed; a root inside the scalp may stay as deep as it is)");

@@ -44,20 +44,20 @@ void printTraceReport(const TraceStats& s, const std::optional<TangentAngles>& a
 
 namespace {
 
-/// The command line of retrace: its declared parameters (traceParameters()) set TraceParams.
-struct RetraceParams
+/// The command line of retrace: its declared parameters (retraceParameters()) set RetraceParams;
+/// the rest say which file and grid the field is read from.
+struct RetraceCmdParams
 {
     std::string input, output, field, grid = "tangent";
-    TraceParams trace;
+    RetraceParams retrace;
     const CLI::Option* integratorOpt = nullptr;  ///< whether --integrator was given (--helicoid's default differs)
     bool helicoid = false;
-    bool measure = false;  ///< the tangent angles: the field sampled at every input and output vertex
 };
 
-int runRetrace(const RetraceParams& p, const CommonOptions& common)
+int runRetrace(const RetraceCmdParams& p, const CommonOptions& common)
 {
-    TraceParams tp = p.trace;
-    checkParamOptions(traceParameters(), tp);
+    checkParamOptions(retraceParameters(), p.retrace);
+    TraceParams tp = p.retrace.trace;
     if (p.helicoid && p.integratorOpt->count() == 0) tp.integrator = kHelicoidRetraceIntegrator;
     tp.validate("option");
     strandFormatFromPath(p.output, /*forWriting=*/true);
@@ -70,7 +70,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
         const StrandSet out = retraceHelicoidField(strands, field, tp, &stats, true, common.interrupter);
         // The angles are measured against the tangent field when the file has one.
         std::optional<TangentAngles> angles;
-        if (p.measure) {
+        if (p.retrace.measure) {
             const std::vector<std::string> names = vdbGridNames(p.field, "retrace(" + p.field + ")");
             if (std::find(names.begin(), names.end(), p.grid) != names.end()) {
                 const openvdb::GridBase::Ptr tangent = readVdbGrid(p.field, p.grid, "retrace(" + p.field + ")");
@@ -101,7 +101,7 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
     TraceStats stats;
     const StrandSet out = retraceStrands(strands, *grid, tp, &stats, nullptr, true, common.interrupter);
     std::optional<TangentAngles> angles;
-    if (p.measure) angles = meanTangentAnglesDeg(strands, out, *grid);
+    if (p.retrace.measure) angles = meanTangentAnglesDeg(strands, out, *grid);
     const double disp = meanVertexDisplacement(strands, out);
     writeStrands(p.output, out);
     if (common.json) {
@@ -119,22 +119,19 @@ int runRetrace(const RetraceParams& p, const CommonOptions& common)
 
 Command addRetraceCommand(CLI::App& app, CommonOptions& common)
 {
-    auto params = std::make_shared<RetraceParams>();
+    auto params = std::make_shared<RetraceCmdParams>();
     CLI::App* sub = addVerb(app, "retrace");
     sub->add_option("input", params->input, "Strand file (roots, lengths and vertex spacing to follow)")->required();
     sub->add_option("--field", params->field, "A .vdb file holding the field")->required();
     sub->add_option("-o,--output", params->output, "Output strand file (.hair .data .obj .ply .vdb .usda)")->required();
     sub->add_option("--grid", params->grid, "Name of the vector grid in the field file")->capture_default_str();
-    addParamOptions(sub, params->trace, traceParameters());
+    addParamOptions(sub, params->retrace, retraceParameters());
     CLI::Option* integrator = sub->get_option("--integrator");
     params->integratorOpt = integrator;
-    integrator->description(paramHelp(*findParam(traceParameters(), "integrator")) + "; with --helicoid the default is " +
+    integrator->description(paramHelp(*findParam(retraceParameters(), "integrator")) + "; with --helicoid the default is " +
                                        integratorName(kHelicoidRetraceIntegrator));
     sub->add_flag("--helicoid", params->helicoid, "Trace through the file's helicoid field (vdbhair field --helicoid) instead of the tangent grid");
     addStrictOption(sub, common);
-    sub->add_flag("--measure", params->measure,
-                  "Also report the mean angle between strand tangents and the field before and after "
-                  "(samples the field at every input and output vertex: about half of the run)");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Example: vdbhair retrace hair.hair --field field.vdb -o retraced.hair --measure --json");

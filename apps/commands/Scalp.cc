@@ -24,7 +24,7 @@ namespace {
 
 struct ScalpCmdParams
 {
-    std::string input, output, region, regionMask, regionGrid, regionVertex;
+    std::string input, output, region, regionMask, regionGrid;
     ScalpBuildParams params;  ///< its declared parameters (scalpParameters()) are options
     std::vector<double> sphere;  ///< cx, cy, cz, r
 };
@@ -39,10 +39,10 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
     if (!p.sphere.empty() && !p.input.empty()) throw ValueError("both an input (" + p.input + ") and --sphere: give one");
     const double regionRadius = p.params.regionRadius, regionThreshold = p.params.regionThreshold;
     if (regionRadius > 0.0 && p.region.empty()) throw ValueError("--region-radius without --region STRANDS");
-    if (int(!p.region.empty()) + int(!p.regionMask.empty()) + int(!p.regionVertex.empty()) > 1)
+    if (int(!p.region.empty()) + int(!p.regionMask.empty()) + int(!p.params.regionVertex.empty()) > 1)
         throw ValueError("more than one of --region, --region-mask and --region-vertex: give one");
-    if (!p.regionVertex.empty() && fileExtension(p.input) != ".ply")
-        throw ValueError("--region-vertex " + p.regionVertex + ": reads a vertex property of a PLY mesh, and the input " +
+    if (!p.params.regionVertex.empty() && fileExtension(p.input) != ".ply")
+        throw ValueError("--region-vertex " + p.params.regionVertex + ": reads a vertex property of a PLY mesh, and the input " +
                          (p.input.empty() ? std::string("is a sphere") : "'" + p.input + "' is not one"));
     if (!p.regionGrid.empty() && p.regionMask.empty()) throw ValueError("--region-grid without --region-mask MASK.vdb");
 
@@ -73,11 +73,11 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         grids.push_back(region);
         source.roots = roots.size();
         source.radius = radius;
-    } else if (!p.regionVertex.empty()) {
-        const Stage stage(common, "region from the vertex values '" + p.regionVertex + "' of " + p.input);
-        region = regionFromVertexValues(*surface, readTriangleMesh(p.input), readPlyVertexValues(p.input, p.regionVertex), regionThreshold, p.input);
+    } else if (!p.params.regionVertex.empty()) {
+        const Stage stage(common, "region from the vertex values '" + p.params.regionVertex + "' of " + p.input);
+        region = regionFromVertexValues(*surface, readTriangleMesh(p.input), readPlyVertexValues(p.input, p.params.regionVertex), regionThreshold, p.input);
         grids.push_back(region);
-        source = {ScalpRegionSource::Kind::Vertex, 0, 0.0, p.regionVertex, regionThreshold};
+        source = {ScalpRegionSource::Kind::Vertex, 0, 0.0, p.params.regionVertex, regionThreshold};
     } else if (!p.regionMask.empty()) {
         // The mask: the grid named, else 'region', else the file's first bool or float grid that is not a level set.
         const openvdb::GridBase::Ptr mask = readMaskGrid(p.regionMask, p.regionGrid, "region", "a region mask (--region-grid NAME)");
@@ -111,8 +111,8 @@ int runScalp(const ScalpCmdParams& p, const CommonOptions& common)
         if (region && !p.region.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels within " << formatValue(source.radius)
                       << " of the roots of " << p.region << "\n";
-        if (region && !p.regionVertex.empty())
-            std::cout << "region: " << region->activeVoxelCount() << " voxels where the vertex value '" << p.regionVertex << "' exceeds "
+        if (region && !p.params.regionVertex.empty())
+            std::cout << "region: " << region->activeVoxelCount() << " voxels where the vertex value '" << p.params.regionVertex << "' exceeds "
                       << formatValue(regionThreshold) << "\n";
         if (region && !p.regionMask.empty())
             std::cout << "region: " << region->activeVoxelCount() << " voxels covered by the mask '" << source.name
@@ -137,8 +137,6 @@ Command addScalpCommand(CLI::App& app, CommonOptions& common)
     sub->add_option("--region", params->region, "Strand file: the region is where its roots are (grid 'region')");
     sub->add_option("--region-mask", params->regionMask, "A .vdb whose bool or float grid paints the region: surface voxels it covers (a bool grid's true values, a float grid's values above --region-threshold)");
     sub->add_option("--region-grid", params->regionGrid, "The mask's grid (default: 'region', else the file's first bool or float grid that is not a level set)");
-    sub->add_option("--region-vertex", params->regionVertex,
-                    "A PLY mesh input's vertex property paints the region: a colour channel (red, green, blue, alpha; uchar scaled to 0-1) or any named scalar, above --region-threshold");
     addCommonOptions(sub, common);
     addReadOptions(sub, common);
     sub->footer("Examples:\n  vdbhair scalp head.ply -o scalp.vdb --voxel-size 0.5 --region hair.hair\n"

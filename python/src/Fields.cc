@@ -296,7 +296,7 @@ void addArrayMethods(ClassT& cls, GetT get, const char* subject)
         [get](const typename ClassT::type& self, const WorldBox& box, const std::array<int, 3>& shape) {
             return orientationVolumeArray(get(self), box, shape);
         },
-        pyb::arg("box"), pyb::arg("shape") = std::array<int, 3>{96, 128, 128},
+        pyb::arg("box"), pyb::arg("shape") = kDefaultDenseShape,
         ("The orientation volume of " + s +
          " resampled over the world box box = ((x0, y0, z0), (x1, y1, z1)) at shape = (D, H, W) samples along (z, y, x), "
          "each at the centre of its cell: float32 (D, H, W, 4), channels tx, ty, tz (the trilinear tangent of the active voxels, "
@@ -585,14 +585,15 @@ between neighbouring roots, kept between 1/64 and 1/4 of the head radius (vdbhai
                pyb::cpp_function(fieldImpl, pyb::arg("strands"), pyb::arg("keywords")), 1);
 }
 
-/// retrace: strands retraced through a vector field (traceParameters()).
+/// retrace: strands retraced through a vector field (retraceParameters()).
 void bindRetrace(pyb::module_& m)
 {
     auto retraceImpl = [](const StrandsPtr& strands, const pyb::object& fieldArg, const pyb::dict& kw) -> pyb::object {
         const openvdb::GridBase::ConstPtr grid = fieldArgument(fieldArg, "retrace");
-        TraceParams tp;
-        applyKeywords(traceParameters(), kw, tp, "retrace");
-        const bool returnStats = renamedKeywordValue(kw, "return_report", "return_stats", "retrace").cast<bool>(), measure = kw["measure"].cast<bool>();
+        RetraceParams rp;
+        applyKeywords(retraceParameters(), kw, rp, "retrace");
+        const TraceParams& tp = rp.trace;
+        const bool returnStats = renamedKeywordValue(kw, "return_report", "return_stats", "retrace").cast<bool>(), measure = rp.measure;
         TraceStats stats;
         std::optional<TangentAngles> angles;
         double displacement = 0.0;
@@ -606,14 +607,11 @@ void bindRetrace(pyb::module_& m)
         // `retrace --json`'s report (retraceReport()), less the file name.
         return pyb::make_tuple(out, toPython(retraceReport(stats, tp, resolveStep(*grid, tp), displacement, angles)));
     };
-    defineVerb(m, "retrace", {"strands: vdbhair.Strands", "field"}, traceParameters(),
+    defineVerb(m, "retrace", {"strands: vdbhair.Strands", "field"}, retraceParameters(),
                {{"return_report", "bool", pyb::bool_(false),
                  "also return a dict: `retrace --json`'s report key for key, less the file name (strands, full_length, "
                  "stopped: vanished, left_field, max_steps; steps, mean_displacement, step, integrator, and tangent_angle_deg "
                  "with measure)."},
-                {"measure", "bool", pyb::bool_(false),
-                 "with return_report, also the mean angle between strand tangents and the field before and after "
-                 "(``--measure``: samples the field at every input and output vertex)."},
                 renamedKeyword("return_stats", "return_report")},
                "Retrace every strand through a vector field from its own root, for its own length\n"
                "(Wang et al. 2009, Sec. 5.3): ``vdbhair retrace``.\n\n"

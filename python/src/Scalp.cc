@@ -146,7 +146,7 @@ void defineScalp(pyb::module_& m)
             sphere = std::array<double, 4>{v[0], v[1], v[2], v[3]};
         }
         std::optional<std::string> regionVertex;
-        if (!kw["region_vertex"].is_none()) regionVertex = kw["region_vertex"].cast<std::string>();
+        if (!params.regionVertex.empty()) regionVertex = params.regionVertex;
         const bool hasSource = !source.is_none();
         if (hasSource == bool(sphere)) throw ValueError("scalp: give one of source (a path, a Strands or (N, 3) points) and sphere=(cx, cy, cz, r)");
         if (sphere && (!((*sphere)[3] > 0.0) || !std::isfinite((*sphere)[3]))) throw ValueError("scalp: sphere=(cx, cy, cz, r) needs r > 0");
@@ -222,10 +222,6 @@ void defineScalp(pyb::module_& m)
                 {"region_mask", "", pyb::none(),
                  "a vdbhair.Grid painting the region instead: a bool grid's true values, or a float grid's values above "
                  "``region_threshold``."},
-                {"region_vertex", "Optional[str]", pyb::none(),
-                 "the name of a vertex property of a PLY mesh source that paints the region: a colour channel (\"red\", \"green\", "
-                 "\"blue\", \"alpha\"; uchar scaled to 0-1) or any named scalar, above ``region_threshold`` (each band voxel takes "
-                 "the inverse-distance average of its 4 nearest vertices' values)."},
                 {"return_report", "bool", pyb::bool_(false),
                  "also return ``scalp --json``'s report as a dict (less the file name and the seconds: kind, voxel_size, half_width, "
                  "active_voxels, area, area_without_zero, the mesh's repairs or the points used, and the region)."}},

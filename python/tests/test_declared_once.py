@@ -38,6 +38,7 @@ DECLARED = [
     ("roots", "up", "roots", "--up"),
     ("render", "up", "render", "--up"),
     ("render", "facing", "render", "--facing"),
+    ("prepare", "target_up", "prepare", "--target-up"),
 ]
 
 
@@ -60,7 +61,8 @@ SWITCHES = [("synth", "refine", "synth", "--no-refine", True), ("synth", "measur
             ("transfer", "refine", "transfer", "--no-refine", True), ("transfer", "measure", "transfer", "--measure", False),
             ("transfer", "smooth_base", "transfer", "--no-smooth-base", True), ("transfer", "smooth_base", "transfer", "--keep-base-detail", True),
             ("compare", "pair_strands", "compare", "--no-pair-strands", True), ("compare", "pair_strands", "compare", "--unpaired", True),
-            ("fit", "skip_degenerate", "fit", "--skip-degenerate", False), ("render", "sheet", "render", "--sheet", False)]
+            ("fit", "skip_degenerate", "fit", "--skip-degenerate", False), ("render", "sheet", "render", "--sheet", False),
+            ("retrace", "measure", "retrace", "--measure", False)]
 
 
 @pytest.mark.parametrize("function, keyword, verb, flag, default", SWITCHES, ids=[f"{f}.{k}{fl}" for f, k, _, fl, _ in SWITCHES])
@@ -69,6 +71,43 @@ def test_declared_switch_is_a_flag_and_a_keyword(function, keyword, verb, flag, 
     text = subprocess.run([cli(), verb, "--help"], capture_output=True, text=True, check=True).stdout
     assert flag in text
     assert keyword in vdbhair.__dict__[function].__doc__
+
+
+# Parameters each front end once declared on its own: now one declaration, so the docstring's line
+# and the flag's `--help` text are the same sentence.
+ONE_HELP = [("retrace", "measure", "retrace", "--measure"), ("prepare", "target_up", "prepare", "--target-up"),
+            ("scalp", "region_vertex", "scalp", "--region-vertex")]
+
+
+@pytest.mark.parametrize("function, keyword, verb, flag", ONE_HELP, ids=[f"{f}.{k}" for f, k, _, _ in ONE_HELP])
+def test_the_keyword_and_the_flag_have_one_help(function, keyword, verb, flag):
+    doc = vdbhair.__dict__[function].__doc__
+    line = re.search(rf"^    {keyword}: (.+)$", doc, re.M)
+    assert line, doc
+    text = subprocess.run([cli(), verb, "--help"], capture_output=True, text=True, check=True).stdout
+    option = re.search(rf"^\s+{flag}\b(.*?)(?=^\s+-|\Z)", text, re.M | re.S)
+    assert option, text
+    assert " ".join(line.group(1).split()) in " ".join(option.group(1).split())
+
+
+@pytest.mark.data
+def test_prepare_target_up_is_the_commands(tmp_path, shared_data):
+    """prepare(target_up=) is --target-up (aligning by ICP, two different head meshes), by name or vector."""
+    hair_path = shared_data / "hair" / "cyhair" / "straight.hair"
+    head, target = shared_data / "scalp" / "cem_yuksel" / "woman_head.ply", shared_data / "scalp" / "usc_hairsalon" / "head_model.ply"
+    hair = vdbhair.read(str(hair_path))
+    out, report = vdbhair.prepare(hair, count=200, head=str(head), align_to=str(target), target_up="z")
+    command = _command("prepare", hair_path, tmp_path / "out.data", "--strands", 200, "--head", head, "--align-to", target, "--target-up", "z")
+    for key in ("input", "output", "head", "align_to", "seconds"):
+        command.pop(key, None)
+    assert report == command
+    np.testing.assert_array_equal(vdbhair.read(str(tmp_path / "out.data")).positions, out.positions)
+    by_vector, _ = vdbhair.prepare(hair, count=200, head=str(head), align_to=str(target), target_up=(0.0, 0.0, 1.0))
+    np.testing.assert_array_equal(by_vector.positions, out.positions)
+    with pytest.raises(ValueError, match=r"^prepare: target_up \(0, 0, 0\): must be a non-zero vector$"):
+        vdbhair.prepare(hair, target_up=(0, 0, 0))
+    with pytest.raises(ValueError, match=r"^prepare: target_up 'up': must be one of x, y, z, -x, -y, -z$"):
+        vdbhair.prepare(hair, target_up="up")
 
 
 def test_an_axis_is_a_name_or_a_vector():

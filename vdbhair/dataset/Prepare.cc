@@ -76,6 +76,10 @@ const ParamTable<PrepareParams>& prepareParameters()
         crop.min = 0.0;
         crop.zeroMeans = "every vertex";
         t.push_back(crop);
+        t.push_back(makeAxisParam<P>("target-up",
+                                     "Aligning by ICP: the common head's up axis (the groom's up is from its head to its roots; ICP "
+                                     "starts only from rotations that keep the two within 90 degrees)",
+                                     [](P& p) -> Vec3d& { return p.targetUp; }));
         auto depth = makeParam<P>("root-depth",
                                   "Fixing penetration: keep (a root inside the head stays, its strand no deeper than it) or surface (the "
                                   "strand is first moved out along the head's normal until its root is on the surface: roots under a new "

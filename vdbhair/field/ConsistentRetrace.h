@@ -24,15 +24,15 @@
 /// held by less than 1/16 always is. Where there is no field (outside its active region, or
 /// where it vanishes) the strand keeps its own direction: no straight spikes, no early stops.
 ///
-/// A field pointing back along the strand (δ = 1) turns it round where it is an outlier. With
-/// ConsistencyParams::followOpposed false, w fades to 0 as ∠(t, v̄) goes from 90 to 110 degrees
-/// instead: opposite directions in a voxel are then taken for two flows (the sides of a parting, the
-/// halves of a curl finer than the voxel), not an error. Synthesis refines its levels so: following
-/// the other flow made hairpins where a level's field averages curls finer than its voxel
+/// A field pointing back along the strand (δ = 1) would turn it round where it is an outlier. By
+/// default (ConsistencyParams::followOpposed false) w fades to 0 as ∠(t, v̄) goes from 90 to 110
+/// degrees instead: opposite directions in a voxel are taken for two flows (the sides of a parting,
+/// the halves of a curl finer than the voxel), not an error. Following the other flow folds strands
+/// back on themselves: in synthesis, where a level's field averages curls finer than its voxel
 /// (Curly_100's curls transferred onto straight.hair: 728 strands with a turn over 120 degrees
-/// between two edges, 72 with the fade) and turned a synthesized strand of Sintel's hair round into
-/// a spike above the head. On real hair refine keeps following it: the fade moved 0-6 strands a
-/// hairstyle and took back part of the coherence refine gains (Bangs_100: 0.967 → 0.982, 0.972 faded).
+/// between two edges, 72 with the fade; a synthesized strand of Sintel's hair turned round into a
+/// spike above the head), and in refine on real hair (the free ponytail: 3 strands folded by
+/// 124-149 degrees, HairNet's blend 1; none with the fade, on 11 shared hairstyles).
 ///
 /// A correction moves the rest of the strand with it; so the strand's own direction t is steered
 /// back toward the input strand at the same arc length (by offset / (returnVoxels · h) per unit
@@ -80,10 +80,10 @@ struct ConsistencyParams
     /// the engine's step through the blended direction (Streamline.h); each stage blends the
     /// strand's own direction of the sub-step with the field's at the stage's point
     Integrator integrator = Integrator::Euler;
-    /// A field pointing back along the strand (more than 90 degrees from it) pulls it as any
-    /// other, and may turn it round, as Wang et al.'s streamlines would; false: its pull fades out
-    /// from 90 to 110 degrees (see the file comment). Synthesis refines with false.
-    bool followOpposed = true;
+    /// A field pointing back along the strand (more than 90 degrees from it): false, its pull fades
+    /// out from 90 to 110 degrees (see the file comment); true, it pulls as any other and may turn
+    /// the strand round, as Wang et al.'s streamlines would.
+    bool followOpposed = false;
 
     /// @throw ValueError (parameter @a where names the offender) for values out of range.
     void validate(const char* where) const;

@@ -12,6 +12,7 @@
 
 #include <openvdb/openvdb.h>
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct DenseBox
     openvdb::Vec3d worldMin{0.0}, worldMax{1.0};
     openvdb::Coord size{1};  ///< samples along x, y, z (W, H, D); each at least 1
 };
+
+/// @brief The default samples of an orientation volume, (D, H, W) along z, y, x: NeuralHDHair's
+/// 96 x 128 x 128 (`field --dense-size`, Python's TangentField.orientation_volume(shape=)).
+inline constexpr std::array<int, 3> kDefaultDenseShape{96, 128, 128};
 
 /// @brief The number of samples of @a box (W * H * D).
 std::size_t denseSampleCount(const DenseBox& box);

@@ -84,7 +84,7 @@ const ParamTable<RefineParams>& refineParameters()
         add(spread);
         add(makeParam<P>("follow-opposed", "consistent mode: a field pointing back along a strand (over 90 degrees from it) may turn it "
                                            "round, as Wang et al.'s streamlines do; off: its pull fades out by 110 degrees (two flows: "
-                                           "a parting's sides, curls finer than a voxel), as synthesis refines",
+                                           "a parting's sides, curls finer than a voxel), which folds no strand back",
                          "", member<P>([](P& p) -> bool& { return p.consistency.followOpposed; })));
         auto margin = makeParam<P>("margin", "field mode: voxels a strand may continue straight past the field's active region", "voxels",
                         member<P>([](P& p) -> int& { return p.trace.margin; }));

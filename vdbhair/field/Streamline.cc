@@ -63,6 +63,19 @@ const ParamTable<TraceParams>& traceParameters()
     return table;
 }
 
+const ParamTable<RetraceParams>& retraceParameters()
+{
+    using P = RetraceParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t = nestedParams<P>(traceParameters(), [](P& p) -> TraceParams& { return p.trace; });
+        t.push_back(makeParam<P>("measure", "Also report the mean angle between strand tangents and the field before and after (the report's "
+                                            "tangent_angle_deg; samples the field at every input and output vertex: about half of the run)",
+                                 "", member<P>([](P& p) -> bool& { return p.measure; })));
+        return t;
+    }();
+    return table;
+}
+
 const char* integratorName(Integrator integrator)
 {
     switch (integrator) {

@@ -152,6 +152,19 @@ RetraceVertices retraceVerticesFromName(const std::string& name);
 /// docs/cli.md are made from. Defaults are TraceParams{}'s.
 const ParamTable<TraceParams>& traceParameters();
 
+/// @brief retrace's parameters: the trace's and what its report adds.
+struct RetraceParams
+{
+    TraceParams trace;
+    /// Also the mean angle between strand tangents and the field before and after (the field
+    /// sampled at every input and output vertex).
+    bool measure = false;
+};
+
+/// @brief retrace's parameters declared once (traceParameters() and the measure switch): the
+/// command line's options, Python's retrace() keywords and docs/cli.md's table.
+const ParamTable<RetraceParams>& retraceParameters();
+
 /// @brief What happened to every streamline of a retrace.
 struct TraceStats
 {

@@ -42,6 +42,13 @@ const ParamTable<ScalpBuildParams>& scalpParameters()
         t.push_back(radius);
         t.push_back(makeParam<P>("region-threshold", "A float mask or vertex value covers where it exceeds this", "",
                                  member<P>([](P& p) -> double& { return p.regionThreshold; })));
+        auto vertex = makeParam<P>("region-vertex",
+                                   "A PLY mesh input's vertex property that paints the region: a colour channel (red, green, blue, alpha; "
+                                   "uchar scaled to 0-1) or any named scalar, above the region threshold (each band voxel takes the "
+                                   "inverse-distance average of its 4 nearest vertices' values)", "",
+                                   member<P>([](P& p) -> std::string& { return p.regionVertex; }));
+        vertex.pythonNone = true;  // None: no painted region
+        t.push_back(vertex);
         return t;
     }();
     return table;

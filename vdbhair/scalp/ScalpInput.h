@@ -30,6 +30,9 @@ struct ScalpBuildParams
     /// A region from a float mask or a mesh's vertex values (regionFromMask(),
     /// regionFromVertexValues()): covered where the value exceeds this.
     double regionThreshold = kDefaultRegionThreshold;
+    /// A region painted on a PLY mesh input (regionFromVertexValues()): the name of the vertex
+    /// property read; empty: none.
+    std::string regionVertex;
 };
 
 /// @brief scalp's parameters declared once (vdbhair/Parameters.h): the command's options and

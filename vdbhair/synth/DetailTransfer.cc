@@ -5,6 +5,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/Format.h>
 #include <vdbhair/Quantile.h>
+#include <vdbhair/Rotation.h>
 #include <vdbhair/strands/Resample.h>
 #include <vdbhair/strands/PointCloud.h>
 #include <vdbhair/strands/Frames.h>
@@ -557,6 +558,44 @@ void readPositions(DetailTransferRun& run)
     });
 }
 
+/// The carrier of a strand laid on output centre @a oc past that centre's end, appended to @a q
+/// until it reaches @a need (DetailScale::Strand and ArcLength). An output centre shorter than
+/// its input centre @a ic ends where the strand may still run (DetailScale::Strand keeps its
+/// length), and edges laid past a carrier's end keep its last frame: the curl that the strand's
+/// own carrier holds (its offset from its centre) was lost there (the ponytail's level-1 strands
+/// synthesized on centres under 0.9 of their input centre's length kept a median 0.81 of their
+/// curl amplitude, 0.88 with this, seed 0). The carrier continues as the input centre does past the place
+/// where the output centre ends, turned onto the output centre's end direction, plus the strand's
+/// offset there (as layStrand() adds it), one point per input vertex.
+void continueCarrier(const DetailTransferRun& run, std::uint32_t oc, std::uint32_t ic, const std::vector<Vec3f>& cg, const Vec3d& off0,
+                     double need, std::vector<Vec3d>& q)
+{
+    const detail::Carrier& co = run.outCarrier[oc];
+    const detail::Carrier& cin = run.inCarrier[ic];
+    const std::vector<Vec3f>& ci = cin.points;
+    const int ns = run.ns;
+    const double atEnd = run.atOf[oc].back();
+    if (ns < 2 || !(atEnd < double(ns - 1)) || !(need > co.length()) || co.frames.empty()) return;
+    const ScalpFrame& mo = run.outAligned[oc];
+    const ScalpFrame& mi = run.inAligned[ic];
+    const auto at = [&](const std::vector<Vec3f>& p, double x) {
+        const std::size_t j = std::min(std::size_t(x), std::size_t(ns - 2));
+        const double t = x - double(j);
+        return Vec3d(p[j]) * (1.0 - t) + Vec3d(p[j + 1]) * t;
+    };
+    const Vec3d ciEnd = at(ci, atEnd);
+    const Vec3d base = q.back() - mo.toWorld(mi.toLocal(at(cg, atEnd) - ciEnd - off0));  // the output centre's end
+    const Frame& fe = co.frames.back();
+    const Vec3d from = Vec3d(cin.frames[std::min(std::size_t(std::lround(atEnd)), std::size_t(ns - 1))].t);
+    double arc = co.length();
+    for (std::size_t j = std::size_t(std::floor(atEnd)) + 1; j < std::size_t(ns) && arc <= need; ++j) {
+        const Vec3d centre = base + rotateOnto(from, Vec3d(fe.t), Vec3d(ci[j]) - ciEnd, Vec3d(fe.n));
+        const Vec3d p = centre + mo.toWorld(mi.toLocal(Vec3d(cg[j]) - Vec3d(ci[j]) - off0));
+        arc += (p - q.back()).length();
+        q.push_back(p);
+    }
+}
+
 /// Step 5, DetailBlend::Edges: new strand @a i as the edges of its input strand (@a gin, world)
 /// laid along the output centre's carrier (DetailTransfer.h, "Edges"); writes its row in its root
 /// frame @a rf and returns its length.
@@ -590,7 +629,6 @@ double layStrand(const DetailTransferRun& run, std::size_t i, const std::vector<
         if (t > 0.0 && j + 1 < std::size_t(ns)) off = off * (1.0 - t) + (Vec3d(cg[j + 1]) - Vec3d(ci[j + 1])) * t;
         q[l] = roots[i] + (Vec3d(centreCarrier.points[l]) - Vec3d(centreCarrier.points[0])) + mo.toWorld(mi.toLocal(off - off0));
     }
-    const detail::Carrier carrier(q, 0.0, Vec3f(mo.t));
     const double li = run.inCarrierLength[ic], lo = centreCarrier.length();
     double lambda = 1.0, target = progress;  // Strand: its own length
     if (scale == DetailScale::Index) {
@@ -602,6 +640,8 @@ double layStrand(const DetailTransferRun& run, std::size_t i, const std::vector<
         // head 0.27 of their length from BASE's, against 0.08).
         target = std::max(progress + lo - li, progress * std::min(1.0, li > 0.0 ? lo / li : 1.0));
     }
+    if (scale != DetailScale::Index) continueCarrier(run, oc, ic, cg, off0, target, q);
+    const detail::Carrier carrier(q, 0.0, Vec3f(mo.t));
     const detail::Curl& curl = run.inCurl.empty() ? detail::Curl{} : run.inCurl[ic];
     const std::vector<Vec3d> laid = detail::layEdges(d, advance, frameShift, lambda, carrier, roots[i], target, curl);
     std::vector<Vec3f> lf(laid.size()), rs(static_cast<std::size_t>(no));

@@ -474,8 +474,6 @@ void synthesizeFinerLevels(SynthResult& res, const ClusterHierarchy& source,
             RefineParams rp;
             rp.levels = 1;
             rp.mode = params.refineMode;
-            // A level's field averages curls finer than its voxel: their far sides are not errors.
-            rp.consistency.followOpposed = false;
             rp.measure = false;
             rp.field.voxelSize = res.refineVoxelSizes[std::size_t(l)];
             rp.head = refineHead;
