@@ -132,6 +132,7 @@ CASES = [
     ("hair: NaN coordinate", ["convert", write("nan.hair", hair([[(0, 0, 0), (math.nan, 1, 0)]])), "{out}.obj"], ["nan.hair", "non-finite coordinate"]),
     ("hair: unknown array bits", ["info", write("bits.hair", hair(GOOD, (2, 6, 64 | 2, 2)))], ["bits.hair", "unknown bits"]),
     ("hair: 1-vertex strand with --strict", ["convert", path("short1.hair"), "{out}.obj", "--strict"], ["short1.hair", "a strand needs at least 2"]),
+    ("demo --strict: a 1-vertex strand (the reading options' --strict)", ["demo", path("short1.hair"), "-o", "{out}", "--strict"], ["short1.hair", "a strand needs at least 2"]),
     # USC-HairSalon .data
     ("data: empty", ["convert", write("empty.data", b""), "{out}.obj"], ["empty.data", "strand count needs 1 x 4 bytes"]),
     ("data: negative strand count", ["convert", write("neg.data", struct.pack("<i", -5)), "{out}.obj"], ["neg.data", "strand count -5 is negative"]),
