@@ -515,7 +515,42 @@ TEST_CASE("Parameters: inspect's slice declaration, the colouring as a flag and 
     REQUIRE_THROWS_WITH(checkParams(t, p, ParamSpelling::Keyword, "inspect"), "inspect: streamlines 100001: must be between 0 and 100000");
     // The renderer checks the same ranges, in the parameters' names.
     REQUIRE_THROWS_WITH(renderSlice("missing.vdb", "tangent", p), "inspect(missing.vdb): streamlines 100001: must be between 0 and 100000");
-    checkDeclaration(t, "inspect");
+    // inspect's own declaration holds the slice's, behind the grid and the plane.
+    const ParamTable<InspectParams>& it = inspectParameters();
+    CHECK(declared(it, "slice").flag() == "--slice");
+    CHECK(paramName(it, "grid").keyword == "grid");
+    CHECK(declared(it, "width").defaultText() == std::to_string(SliceParams{}.width));
+    checkDeclaration(it, "inspect");
+}
+
+TEST_CASE("inspectSlice: one rule for the slice and its image, spelled for each front end", "[params]")
+{
+    const auto both = [](const InspectParams& p, const std::string& output, const std::string& where) {
+        try {
+            (void)inspectSlice(p, output, where);
+        } catch (const std::exception& e) {
+            return std::make_pair(spelledMessage(e, ParamSpelling::Flag), spelledMessage(e, ParamSpelling::Keyword));
+        }
+        return std::make_pair(std::string(), std::string());
+    };
+    InspectParams p;
+    p.slice = "z=0";
+    CHECK(both(p, "", "") == std::make_pair(std::string("--slice z=0: needs -o, the slice image's path (.png, .exr, .jpg)"),
+                                            std::string("slice z=0: needs output, the slice image's path (.png, .exr, .jpg)")));
+    CHECK(both(p, "a.hair", "inspect").second == "inspect: output a.hair: not an image format OpenImageIO writes (use .png, .exr or .jpg)");
+    p.slice = "y=abc";
+    CHECK(both(p, "a.png", "").first == "--slice y=abc: expected AXIS=WORLD with AXIS x, y or z and WORLD a finite number (e.g. z=1.5)");
+    p.slice = "y=-2.5";
+    const SliceParams sp = inspectSlice(p, "a.png", "");
+    CHECK(sp.axis == 1);
+    CHECK(sp.world == -2.5);
+    p.slice.clear();
+    CHECK(both(p, "a.png", "").first == "-o a.png: an image is drawn only of a slice: add --slice AXIS=WORLD");
+    p.draw.streamlines = 10;
+    CHECK(both(p, "", "inspect").second == "inspect: hsv and streamlines draw on a slice: add slice AXIS=WORLD and output");
+    CHECK(both(p, "", "").first == "--hsv and --streamlines draw on a slice: add --slice AXIS=WORLD and -o");
+    p.draw.streamlines = 0;
+    CHECK(both(p, "", "").first.empty());  // no slice, no image: the file described only
 }
 
 TEST_CASE("Parameters: info's statistics declaration, the histograms' bins, in docs/cli.md", "[params]")

@@ -15,11 +15,12 @@ namespace vdbhair::app {
 
 namespace {
 
-/// The command line of inspect: the slice's declared parameters (sliceParameters()) are options.
-struct InspectParams
+/// The command line of inspect: its declared parameters (inspectParameters()) are options; the
+/// file and the image's path are the command line's own.
+struct InspectCmdParams
 {
-    std::string input, grid, slice, output;
-    SliceParams sliceParams;  ///< --hsv, --streamlines, --width; the plane comes from --slice
+    std::string input, output;
+    InspectParams inspect;
 };
 
 std::string g6(double v)
@@ -92,31 +93,23 @@ void printReport(const GridReport& r)
     }
 }
 
-int runInspect(const InspectParams& p, const CommonOptions& common)
+int runInspect(const InspectCmdParams& cmd, const CommonOptions& common)
 {
-    checkParamOptions(sliceParameters(), p.sliceParams);
-    if (fileExtension(p.input) != ".vdb") throw ValueError(p.input + ": inspect reads .vdb files (use 'vdbhair info' for strand files)");
-    if (!p.slice.empty() && p.output.empty()) throw ValueError("--slice " + p.slice + ": needs -o OUT.png for the image");
-    if (p.slice.empty() && !p.output.empty()) throw ValueError("-o " + p.output + ": inspect writes an image only with --slice AXIS=WORLD");
-    SliceParams sp = p.sliceParams;
-    if (p.slice.empty() && (sp.color == SliceColor::Hsv || sp.streamlines)) {
-        throw ValueError("--hsv and --streamlines draw on a slice: add --slice AXIS=WORLD -o OUT.png");
-    }
-    if (!p.slice.empty()) {
-        parseSlice(p.slice, sp.axis, sp.world);
-        if (!isImagePath(p.output)) throw ValueError(p.output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
-    }
-    const std::vector<GridReport> reports = inspectVdbFile(p.input, p.grid);
+    const InspectParams& p = cmd.inspect;
+    checkParamOptions(inspectParameters(), p);
+    if (fileExtension(cmd.input) != ".vdb") throw ValueError(cmd.input + ": inspect reads .vdb files (use 'vdbhair info' for strand files)");
+    const SliceParams sp = inspectSlice(p, cmd.output, "");
+    const std::vector<GridReport> reports = inspectVdbFile(cmd.input, p.grid);
     nlohmann::json sliceJson;
     if (!p.slice.empty()) {
-        const std::string name = chooseSliceGrid(reports, p.grid, p.input);
-        const SliceResult res = renderSlice(p.input, name, sp);
-        writeImage(p.output, res.image);
-        sliceJson = {{"output", p.output}, {"grid", name}, {"axis", std::string(1, char('x' + sp.axis))}, {"world", sp.world},
+        const std::string name = chooseSliceGrid(reports, p.grid, cmd.input);
+        const SliceResult res = renderSlice(cmd.input, name, sp);
+        writeImage(cmd.output, res.image);
+        sliceJson = {{"output", cmd.output}, {"grid", name}, {"axis", std::string(1, char('x' + sp.axis))}, {"world", sp.world},
                      {"index_plane", res.indexPlane}, {"active_voxels", res.activeVoxels}, {"range", {res.lo, res.hi}},
                      {"streamlines", res.streamlinesDrawn}, {"width", res.image.width}, {"height", res.image.height}};
         if (!common.json && !common.quiet) {
-            std::cout << "wrote " << p.output << ": grid '" << name << "' at " << char('x' + sp.axis) << " = " << g6(sp.world) << " (voxel layer "
+            std::cout << "wrote " << cmd.output << ": grid '" << name << "' at " << char('x' + sp.axis) << " = " << g6(sp.world) << " (voxel layer "
                       << res.indexPlane << ", " << res.activeVoxels << " active voxels, range " << g6(res.lo) << " .. " << g6(res.hi);
             if (res.streamlinesDrawn) std::cout << ", " << res.streamlinesDrawn << " streamlines";
             std::cout << ")\n";
@@ -125,13 +118,13 @@ int runInspect(const InspectParams& p, const CommonOptions& common)
     if (common.json) {
         nlohmann::json arr = nlohmann::json::array();
         for (const GridReport& r : reports) arr.push_back(gridReportJson(r));
-        nlohmann::json out = {{"kind", "vdb"}, {"file", p.input}, {"grids", arr}};
+        nlohmann::json out = {{"kind", "vdb"}, {"file", cmd.input}, {"grids", arr}};
         if (!sliceJson.is_null()) out["slice"] = sliceJson;
         printJson(out);
         return 0;
     }
     if (p.slice.empty()) {
-        std::cout << p.input << ": OpenVDB file with " << reports.size() << (p.grid.empty() ? " grid" : " grid shown") << (reports.size() == 1 ? "" : "s") << "\n";
+        std::cout << cmd.input << ": OpenVDB file with " << reports.size() << (p.grid.empty() ? " grid" : " grid shown") << (reports.size() == 1 ? "" : "s") << "\n";
         for (const GridReport& r : reports) printReport(r);
     }
     return 0;
@@ -141,13 +134,11 @@ int runInspect(const InspectParams& p, const CommonOptions& common)
 
 Command addInspectCommand(CLI::App& app, CommonOptions& common)
 {
-    auto params = std::make_shared<InspectParams>();
+    auto params = std::make_shared<InspectCmdParams>();
     CLI::App* sub = addVerb(app, "inspect");
     sub->add_option("file", params->input, "A .vdb file")->required();
-    sub->add_option("--grid", params->grid, "Only this grid (and the one to slice; default: 'tangent', else the first voxel grid)");
-    sub->add_option("--slice", params->slice, "Render the slice AXIS=WORLD (e.g. z=1.5: the plane z = 1.5 in world units)");
     sub->add_option("-o,--output", params->output, "The slice image (.png, .exr, .jpg)");
-    addParamOptions(sub, params->sliceParams, sliceParameters());
+    addParamOptions(sub, params->inspect, inspectParameters());
     addCommonOptions(sub, common);
     sub->footer("Examples: vdbhair inspect field.vdb\n"
                 "          vdbhair inspect field.vdb --slice z=0 -o slice.png --hsv --streamlines 300");

@@ -356,28 +356,15 @@ void defineRender(pyb::module_& m)
 }
 
 /// inspect: a description of every grid of a .vdb file (or of one, grid=), and a slice drawn.
-/// vdbhair.inspect(path, **keywords): the declared parameters (sliceParameters()), then inspect's own.
+/// vdbhair.inspect(path, **keywords): the declared parameters (inspectParameters()), then the image's path.
 pyb::object inspectImpl(const PathArg& path, const pyb::dict& kw)
 {
-    SliceParams sp;
-    applyKeywords(sliceParameters(), kw, sp, "inspect");
-    const std::string grid = kw["grid"].is_none() ? std::string() : kw["grid"].cast<std::string>();
-    const std::string slice = kw["slice"].is_none() ? std::string() : kw["slice"].cast<std::string>();
+    InspectParams ip;
+    applyKeywords(inspectParameters(), kw, ip, "inspect");
+    const std::string& grid = ip.grid;
+    const std::string& slice = ip.slice;
     const std::string output = kw["output"].is_none() ? std::string() : pathString(kw["output"], "output");
-    // The command line's rules, in the keywords' names.
-    if (!slice.empty() && output.empty()) throw ValueError("inspect: slice " + slice + ": needs output=, the image's path");
-    if (slice.empty() && !output.empty()) throw ValueError("inspect: output " + output + ": inspect writes an image only with slice=\"AXIS=WORLD\"");
-    if (slice.empty() && (sp.color == SliceColor::Hsv || sp.streamlines)) {
-        throw ValueError("inspect: hsv and streamlines draw on a slice: add slice=\"AXIS=WORLD\" and output=");
-    }
-    if (!slice.empty()) {
-        try {
-            parseSlice(slice, sp.axis, sp.world);
-        } catch (const ValueError& e) {
-            throw ValueError(std::string("inspect: ") + e.what());
-        }
-        if (!isImagePath(output)) throw ValueError("inspect: " + output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)");
-    }
+    const SliceParams sp = inspectSlice(ip, output, "inspect");
     std::vector<GridReport> reports;
     std::optional<std::pair<std::string, SliceResult>> drawn;
     runLong(kw["threads"].cast<int>(), kw["progress"], [&](WorkInterrupter*) {
@@ -401,11 +388,8 @@ pyb::object inspectImpl(const PathArg& path, const pyb::dict& kw)
 
 void defineInspect(pyb::module_& m)
 {
-    defineVerb(m, "inspect", {"path: os.PathLike | str"}, sliceParameters(),
-               {{"grid", "Optional[str]", pyb::none(),
-                 "only this grid (and the one to slice; None: every grid, and the slice shows 'tangent', else the first voxel grid)."},
-                {"slice", "Optional[str]", pyb::none(), "draw the slice AXIS=WORLD (\"z=1.5\": the plane z = 1.5 in world units) into output."},
-                {"output", "Optional[os.PathLike | str]", pyb::none(), "the slice image (.png, .exr, .jpg)."}},
+    defineVerb(m, "inspect", {"path: os.PathLike | str"}, inspectParameters(),
+               {{"output", "Optional[os.PathLike | str]", pyb::none(), "the slice image (.png, .exr, .jpg)."}},
                "Describe every grid of a .vdb file (``vdbhair inspect --json``), and draw a slice through one\n"
                "(``inspect --slice AXIS=WORLD -o OUT``): vectors coloured by direction, scalars through a colour\n"
                "map, optionally with streamlines of the in-plane field.",

@@ -74,8 +74,12 @@ def test_inspect_bad_keywords_name_the_keyword_value_and_rule(field_vdb, tmp_pat
         vdbhair.inspect(field_vdb, slice="z=0", output=tmp_path / "a.png", streamlines=100001)
     with pytest.raises(ValueError, match=r"^inspect: slice w=3: expected AXIS=WORLD"):
         vdbhair.inspect(field_vdb, slice="w=3", output=tmp_path / "a.png")
-    with pytest.raises(ValueError, match=r"^inspect: slice z=0: needs output="):
+    with pytest.raises(ValueError, match=r"^inspect: slice z=0: needs output, the slice image's path"):
         vdbhair.inspect(field_vdb, slice="z=0")
+    with pytest.raises(ValueError, match=r"^inspect: output \S+a.png: an image is drawn only of a slice: add slice AXIS=WORLD$"):
+        vdbhair.inspect(field_vdb, output=tmp_path / "a.png")
+    with pytest.raises(ValueError, match=r"^inspect: slice z=abc: expected AXIS=WORLD"):
+        vdbhair.inspect(field_vdb, slice="z=abc", output=tmp_path / "a.png")
     with pytest.raises(ValueError, match=r"^inspect: hsv and streamlines draw on a slice"):
         vdbhair.inspect(field_vdb, hsv=True)
     with pytest.raises(vdbhair.ArgumentTypeError, match=r"^inspect: width must be an integer"):

@@ -3,6 +3,7 @@
 #include <vdbhair/Exceptions.h>
 #include <vdbhair/field/Streamline.h>
 #include <vdbhair/io/VdbFile.h>
+#include <vdbhair/render/Image.h>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
@@ -432,7 +433,54 @@ void parseSlice(const std::string& text, int& axis, double& world)
     const std::string number = text.substr(2);
     char* end = nullptr;
     world = std::strtod(number.c_str(), &end);
-    if (end == number.c_str() || *end != '\0' || !std::isfinite(world)) throw ValueError(rule);
+    if (end == number.c_str() || *end != '\0' || !std::isfinite(world)) throw rule;
+}
+
+const ParamTable<InspectParams>& inspectParameters()
+{
+    using P = InspectParams;
+    static const ParamTable<P> table = [] {
+        ParamTable<P> t;
+        auto grid = makeParam<P>("grid", "Only this grid, and the one sliced (default: every grid; the slice shows 'tangent', else the first voxel grid)",
+                                 "", member<P>([](P& p) -> std::string& { return p.grid; }));
+        grid.pythonNone = true;
+        t.push_back(grid);
+        auto slice = makeParam<P>("slice", "Draw the slice AXIS=WORLD (z=1.5: the plane z = 1.5 in world units) into the image", "",
+                                  member<P>([](P& p) -> std::string& { return p.slice; }));
+        slice.pythonNone = true;
+        t.push_back(slice);
+        for (Param<P>& q : nestedParams<P>(sliceParameters(), [](P& p) -> SliceParams& { return p.draw; })) t.push_back(std::move(q));
+        return t;
+    }();
+    return table;
+}
+
+SliceParams inspectSlice(const InspectParams& p, const std::string& output, const std::string& where)
+{
+    const std::string prefix = where.empty() ? std::string() : where + ": ";
+    const ParamName image{"-o", "output"};
+    const auto& table = inspectParameters();
+    SliceParams sp = p.draw;
+    if (p.slice.empty()) {
+        if (!output.empty()) throw ParamError<ValueError>({prefix, image, " " + output + ": an image is drawn only of a slice: add ", kSliceName, " AXIS=WORLD"});
+        if (sp.color == SliceColor::Hsv || sp.streamlines) {
+            throw ParamError<ValueError>({prefix, paramName(table, "hsv"), " and ", paramName(table, "streamlines"), " draw on a slice: add ", kSliceName,
+                                          " AXIS=WORLD and ", image});
+        }
+        return sp;
+    }
+    if (output.empty()) throw ParamError<ValueError>({prefix, kSliceName, " " + p.slice + ": needs ", image, ", the slice image's path (.png, .exr, .jpg)"});
+    try {
+        parseSlice(p.slice, sp.axis, sp.world);
+    } catch (const ParamError<ValueError>& e) {
+        ParamText text{prefix};
+        text += e.text();
+        throw ParamError<ValueError>(text);
+    }
+    if (!isImagePath(output)) {
+        throw ParamError<ValueError>({prefix, image, " " + output + ": not an image format OpenImageIO writes (use .png, .exr or .jpg)"});
+    }
+    return sp;
 }
 
 SliceResult renderSlice(const std::string& path, const std::string& gridName, const SliceParams& params)

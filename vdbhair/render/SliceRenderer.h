@@ -61,8 +61,28 @@ struct SliceResult
 SliceResult renderSlice(const std::string& path, const std::string& gridName, const SliceParams& params);
 
 /// @brief Parse "x=1.5" (axis x, y or z, then a world coordinate).
-/// @throw ValueError naming the rule.
+/// @throw ParamError<ValueError> naming the rule.
 void parseSlice(const std::string& text, int& axis, double& world);
+
+/// @brief What `inspect` takes besides the file and the image's path: the grid it describes (and
+/// slices), the plane, and how the slice is drawn.
+struct InspectParams
+{
+    std::string grid;   ///< only this grid, and the one sliced; empty: every grid (chooseSliceGrid())
+    std::string slice;  ///< the plane, AXIS=WORLD (parseSlice()); empty: no slice
+    SliceParams draw;   ///< its axis and world are set from @c slice (inspectSlice())
+};
+
+/// @brief inspect's parameters declared once: `grid`, `slice` and sliceParameters()'s; `inspect`'s
+/// options, Python's `inspect()` keywords and docs/cli.md are made from it.
+const ParamTable<InspectParams>& inspectParameters();
+
+/// @brief The slice @a p asks for, its plane parsed, checked against the image's path @a output
+/// (the command line's -o, Python's output=; empty: none): a slice needs an image in a format
+/// OpenImageIO writes, an image needs a slice, and `hsv` and `streamlines` draw on a slice.
+/// @throw ParamError<ValueError> naming the parameters (after "@a where: " when @a where is not
+/// empty), and parseSlice()'s.
+SliceParams inspectSlice(const InspectParams& p, const std::string& output, const std::string& where);
 
 /// @brief The grid a slice of the file @a path shows: @a grid when it is given, else 'tangent'
 /// when @a reports has it, else the first voxel grid of @a reports (inspectVdbFile()'s, in file
