@@ -31,7 +31,7 @@ struct TransferParams;
 
 namespace vdbhair::app {
 
-/// Options every verb shares (DESIGN.md, "The vdbhair command"): the run's (RunOptions:
+/// Options every verb shares (docs/cli.md, "The vdbhair command"): the run's (RunOptions:
 /// --threads, runParameters()) and the command line's own.
 struct CommonOptions : RunOptions
 {

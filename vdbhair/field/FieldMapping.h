@@ -68,7 +68,7 @@ private:
     openvdb::Vec3d mOffset{0.0}, mInvScale{1.0};
 };
 
-/// @brief Write the self-describing metadata of DESIGN.md on a field grid: `creator`,
+/// @brief Write the self-describing metadata (docs/fields.md) on a field grid: `creator`,
 /// `vdbhair_voxel_size`, `vdbhair_iterations`, `vdbhair_space`, `vdbhair_level`, `vdbhair_levels`,
 /// `vdbhair_strand_count`, and for scalp-space grids the sphere and, with @a surface, the measured
 /// scalp: `vdbhair_scalp_resolution` (int) and `vdbhair_scalp_distance`, its d table as text (the

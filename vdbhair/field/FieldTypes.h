@@ -1,5 +1,5 @@
 /// @file FieldTypes.h
-/// @brief Parameters and names shared by the field modules (DESIGN.md, "Fields").
+/// @brief Parameters and names shared by the field modules (docs/fields.md).
 #pragma once
 
 #include <vdbhair/field/ScalpSpace.h>
@@ -18,7 +18,7 @@ const char* fieldSpaceName(FieldSpace space);
 /// @throw ValueError unless "world" or "scalp".
 FieldSpace fieldSpaceFromName(const std::string& name);
 
-/// @brief Grid names of DESIGN.md: `tangent` / `density` / `hair_length` for one level,
+/// @brief Grid names (docs/fields.md): `tangent` / `density` / `hair_length` for one level,
 /// `tangent_level_<l>` / `density_level_<l>` / `hair_length_level_<l>` for multi-level fields
 /// (level 0 the finest).
 std::string tangentGridName(int level, int levels);

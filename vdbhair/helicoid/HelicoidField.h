@@ -4,7 +4,7 @@
 /// Eq. 1) fitted to the directions of its neighbours; tracing blends the exact predictions of
 /// the surrounding voxels' helicoids, so a coarse grid can still follow curls.
 ///
-/// Grids (DESIGN.md): `helicoid_k` (vec3s: kT, kN, kB; invariant), `helicoid_alpha` (float),
+/// Grids (docs/helicoids.md): `helicoid_k` (vec3s: kT, kN, kB; invariant), `helicoid_alpha` (float),
 /// `frame_T` and `frame_N` (vec3s, contravariant relative; B = T x N), all with the topology of
 /// the tangent field they come from.
 #pragma once

@@ -1,7 +1,7 @@
 /// @file RootEnd.h
 /// @brief Which end of each strand read from a file is its root: `--roots first|last|auto`.
 ///
-/// vdbhair's strands run root to tip (DESIGN.md, "Strands"), and so do the files of every tool
+/// vdbhair's strands run root to tip (docs/formats.md), and so do the files of every tool
 /// we know, but files exported tip first exist (a reversed curve in Maya or Blender, a script that
 /// walks from the free end). ReadOptions::roots says what to do; readStrands() applies it after
 /// whichever reader ran (orientStrandRoots()).

@@ -181,7 +181,7 @@ std::string explainGrid(const GridInfo& info)
         return -1;
     };
     std::ostringstream os;
-    // What the grid holds, by its name (DESIGN.md's grid conventions).
+    // What the grid holds, by its name (the grid conventions of docs/fields.md and docs/scalps.md).
     static const std::map<std::string, std::string> meaning = {
         {"tangent", "the hair's unit direction, root to tip, per voxel (inactive where no hair passed)"},
         {"density", "the hair density as a fog volume in [0, 1]: hair length per unit volume over vdbhair_density_reference, clamped"},

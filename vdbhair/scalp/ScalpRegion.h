@@ -1,5 +1,5 @@
 /// @file ScalpRegion.h
-/// @brief Where on the scalp hair grows (DESIGN.md, grid `region`): a BoolGrid on the surface's
+/// @brief Where on the scalp hair grows (docs/scalps.md, grid `region`): a BoolGrid on the surface's
 /// transform whose active voxels cover the part of the narrow band that carries hair.
 #pragma once
 

@@ -1,5 +1,5 @@
 /// @file ScalpSurface.h
-/// @brief Scalps as OpenVDB narrow-band level sets (DESIGN.md, grid `surface`): a FloatGrid of
+/// @brief Scalps as OpenVDB narrow-band level sets (docs/scalps.md, grid `surface`): a FloatGrid of
 /// signed distance in world units, negative inside the head, class `level set`, named `surface`,
 /// with `creator` and `vdbhair_*` metadata saying where it came from. Three sources: a triangle
 /// mesh, a sphere, and scattered oriented points (VariationalImplicit.h).

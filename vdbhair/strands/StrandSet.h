@@ -20,7 +20,7 @@ struct StrandDefaults
     Vec3f color{0.5f, 0.5f, 0.5f};  ///< linear RGB in [0,1]
 };
 
-/// @brief A set of strands in structure-of-arrays layout (DESIGN.md, "Strands").
+/// @brief A set of strands in structure-of-arrays layout (docs/formats.md).
 ///
 /// Strand i is the vertex range `[offsets[i], offsets[i+1])` of `positions`, root first.
 /// Optional arrays are empty when absent, otherwise they have one entry per vertex
