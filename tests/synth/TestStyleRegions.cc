@@ -106,3 +106,58 @@ TEST_CASE("measureStyleRegions: regions, front, lengths, lift, turning, curl and
     REQUIRE(j["back"]["strands"]["output"] == 7);
     REQUIRE(summaryLines(r, noHead).find("fringe") != std::string::npos);
 }
+
+TEST_CASE("measureStyleRegions: flow, the direction strands leave their roots in, down the head and around it", "[synth][regions]")
+{
+    RegionFrame frame;  // the unit sphere, up +Y, front +Z
+    // Down the meridian and around the head (towards larger azimuth, +Z to +X) at a root.
+    const auto down = [](double e, double a) {
+        e *= M_PI / 180.0;
+        a *= M_PI / 180.0;
+        return Vec3d(std::sin(e) * std::sin(a), -std::cos(e), std::sin(e) * std::cos(a));
+    };
+    const auto around = [](double a) { return Vec3d(std::cos(a * M_PI / 180.0), 0.0, -std::sin(a * M_PI / 180.0)); };
+    StrandSet s, mirrored;
+    const auto both = [&](const Vec3d& root, const Vec3d& dir, const Vec3d& mirrorDir, double length) {
+        addLine(s, root, dir, length);
+        addLine(mirrored, root, mirrorDir, length);
+    };
+    // Fringe: swept around, one strand longer than the reach of the figure and one shorter (its tip).
+    for (double a : {-20.0, 20.0}) both(rootAt(20.0, a), around(a), -1.0 * around(a), a < 0 ? 1.0 : 0.2);
+    // Sides: falling straight down the head, lifted off it a little (the normal part is left out).
+    for (double a : {90.0, -90.0}) {
+        const Vec3d r = rootAt(10.0, a);
+        both(r, (down(10.0, a) + 0.3 * r).unit(), (down(10.0, a) + 0.3 * r).unit(), 1.0);
+    }
+    // Back: half down, half around backwards: the mean of the unit directions.
+    both(rootAt(0.0, 170.0), down(0.0, 170.0), down(0.0, 170.0), 1.0);
+    both(rootAt(0.0, 190.0), -1.0 * around(190.0), around(190.0), 1.0);
+    // Crown: straight out of the head, no direction in its tangent plane.
+    both(rootAt(70.0, 0.0), rootAt(70.0, 0.0), rootAt(70.0, 0.0), 0.5);
+
+    const StyleRegions r = measureStyleRegions(s, frame), m = measureStyleRegions(mirrored, frame, nullptr, false);
+    const auto& fringe = r.regions[int(StyleRegion::Fringe)];
+    const auto& sides = r.regions[int(StyleRegion::Sides)];
+    const auto& back = r.regions[int(StyleRegion::Back)];
+    const auto& crown = r.regions[int(StyleRegion::Crown)];
+    REQUIRE(fringe.strands == 2);
+    REQUIRE(fringe.flowDown == Approx(0.0).margin(1e-6));
+    REQUIRE(fringe.flowAround == Approx(1.0));
+    REQUIRE(sides.flowDown == Approx(1.0));
+    REQUIRE(sides.flowAround == Approx(0.0).margin(1e-6));
+    REQUIRE(back.flowDown == Approx(0.5));
+    REQUIRE(back.flowAround == Approx(-0.5));
+    REQUIRE(crown.strands == 1);
+    REQUIRE(crown.flowDown == 0.0);
+    REQUIRE(crown.flowAround == 0.0);
+    // A fringe swept the other way: same lengths, lift and turning, opposite flow.
+    const auto& fringeM = m.regions[int(StyleRegion::Fringe)];
+    REQUIRE(fringeM.lengthP50 == Approx(fringe.lengthP50));
+    REQUIRE(fringeM.flowAround == Approx(-1.0));
+    const nlohmann::json j = toJson(r, m);
+    REQUIRE(j["fringe"]["flow"]["example"][1] == Approx(1.0));
+    REQUIRE(j["fringe"]["flow"]["output"][1] == Approx(-1.0));
+    REQUIRE(j["fringe"]["flow_difference"] == Approx(2.0));
+    REQUIRE(j["sides"]["flow_difference"] == Approx(0.0).margin(1e-6));
+    REQUIRE(j["back"]["flow_difference"] == Approx(1.0));  // (0.5, -0.5) against (0.5, 0.5)
+}

@@ -24,6 +24,7 @@ namespace {
 constexpr double kCrownElevationDeg = 50.0;
 constexpr double kFringeAngleDeg = 60.0, kBackAngleDeg = 120.0;
 constexpr double kLiftHeight = 0.1;     ///< head radii above the root
+constexpr double kFlowReach = 0.5;      ///< head radii along a strand: the direction it leaves its root in
 /// Curl amplitude at one scale in head radii, whatever a strand's length: samples at most every
 /// 1/25 head radius (at least every 1/200), the centre line their Gaussian with σ = 0.15 head
 /// radii (a curl of wavelength 0.7, Curly_100's, keeps 6/10 of its radius against it), strands
@@ -39,8 +40,9 @@ constexpr std::size_t kCurlMaxSamples = 1 << 14;  ///< longer strands are sample
 struct StrandFigures
 {
     double length = 0.0, turning = 0.0, curlSum = 0.0;
+    double flowDown = 0.0, flowAround = 0.0;  ///< the unit direction leaving the root (hasFlow)
     std::size_t curlPieces = 0;
-    bool lifts = false;
+    bool lifts = false, hasFlow = false;
     std::size_t inside = 0;
 };
 
@@ -86,6 +88,38 @@ void strandCurl(const StrandSet& s, std::size_t i, double length, double radius,
     }
 }
 
+/// The flow of a strand (StyleRegions.h): the direction from its root to the point @a reach along
+/// it (its tip when shorter), in the head's tangent plane at the root, as parts down the head and
+/// around it; false where the root is on the up axis or the direction is normal to the head.
+bool strandFlow(const StrandSet& s, std::size_t i, const RegionFrame& f, double reach, double& down, double& around)
+{
+    const std::size_t b = s.offsets[i], e = s.offsets[i + 1];
+    const Vec3d root(s.positions[b]);
+    Vec3d at(s.positions[e - 1]);
+    double walked = 0.0;
+    for (std::size_t k = b; k + 1 < e; ++k) {
+        const Vec3d p0(s.positions[k]), p1(s.positions[k + 1]);
+        const double seg = (p1 - p0).length();
+        if (walked + seg >= reach) {
+            at = p0 + (seg > 0.0 ? (reach - walked) / seg : 0.0) * (p1 - p0);
+            break;
+        }
+        walked += seg;
+    }
+    const Vec3d normal = root - f.center;
+    const Vec3d aroundAxis = f.up.cross(normal);
+    if (!(normal.length() > 0.0) || !(aroundAxis.length() > 1e-9 * normal.length())) return false;
+    const Vec3d n = normal.unit(), a = aroundAxis.unit(), m = a.cross(n);  // m: down the meridian
+    Vec3d v = at - root;
+    const double reached = v.length();
+    v -= v.dot(n) * n;
+    const double len = v.length();
+    if (!(len > 1e-3 * reached)) return false;  // straight out of the head (within float rounding)
+    down = v.dot(m) / len;
+    around = v.dot(a) / len;
+    return true;
+}
+
 StrandFigures strandFigures(const StrandSet& s, std::size_t i, const RegionFrame& f, HeadObstacle::Probe* head, double tolerance,
                             std::vector<Vec3d>& pts, std::vector<Vec3d>& smooth)
 {
@@ -108,6 +142,7 @@ StrandFigures strandFigures(const StrandSet& s, std::size_t i, const RegionFrame
     out.lifts = highest > kLiftHeight * f.radius;
     out.turning = length > 0.0 ? turning / out.length : 0.0;
     strandCurl(s, i, length, f.radius, kCurlPiece * f.radius, out.curlSum, out.curlPieces, pts, smooth);
+    out.hasFlow = strandFlow(s, i, f, kFlowReach * f.radius, out.flowDown, out.flowAround);
     return out;
 }
 
@@ -212,8 +247,9 @@ StyleRegions measureStyleRegions(const StrandSet& strands, const RegionFrame& fr
         RegionFigures& g = out.regions[std::size_t(r)];
         std::vector<double> lengths;
         std::size_t lifts = 0, inside = 0, vertices = 0;
-        double turning = 0.0, curl = 0.0;
-        std::size_t curled = 0;  // pieces of strands long enough for a curl amplitude
+        double turning = 0.0, curl = 0.0, down = 0.0, around = 0.0;
+        std::size_t curled = 0;   // pieces of strands long enough for a curl amplitude
+        std::size_t flowing = 0;  // strands with a flow
         for (std::size_t i = 0; i < nS; ++i) {
             if (int(region[i]) != r) continue;
             lengths.push_back(per[i].length);
@@ -222,6 +258,11 @@ StyleRegions measureStyleRegions(const StrandSet& strands, const RegionFrame& fr
             curl += per[i].curlSum;
             curled += per[i].curlPieces;
             inside += per[i].inside;
+            if (per[i].hasFlow) {
+                down += per[i].flowDown;
+                around += per[i].flowAround;
+                ++flowing;
+            }
             vertices += strands.size(i);
         }
         g.strands = lengths.size();
@@ -233,6 +274,8 @@ StyleRegions measureStyleRegions(const StrandSet& strands, const RegionFrame& fr
         g.lift = double(lifts) / double(g.strands);
         g.turning = turning / double(g.strands);
         g.curlAmplitude = curled ? curl / double(curled) : 0.0;
+        g.flowDown = flowing ? down / double(flowing) : 0.0;
+        g.flowAround = flowing ? around / double(flowing) : 0.0;
         g.insideHead = withHead ? double(inside) / double(vertices) : -1.0;
     }
     return out;
@@ -280,6 +323,9 @@ nlohmann::json toJson(const StyleRegions& example, const StyleRegions& output)
         g["lift"] = pair(a.lift, b.lift, ha, hb);
         g["turning"] = pair(a.turning, b.turning, ha, hb);
         g["curl_amplitude"] = pair(a.curlAmplitude, b.curlAmplitude, ha, hb);
+        const auto flow = [](const RegionFigures& x) { return nlohmann::json::array({x.flowDown, x.flowAround}); };
+        g["flow"] = {{"example", ha ? flow(a) : nlohmann::json(nullptr)}, {"output", hb ? flow(b) : nlohmann::json(nullptr)}};
+        g["flow_difference"] = ha && hb ? nlohmann::json(std::hypot(a.flowDown - b.flowDown, a.flowAround - b.flowAround)) : nlohmann::json(nullptr);
         g["inside_head"] = pair(a.insideHead, b.insideHead, ha && a.insideHead >= 0.0, hb && b.insideHead >= 0.0);
         j[styleRegionName(StyleRegion(r))] = g;
     }
@@ -294,9 +340,10 @@ std::string summaryLines(const StyleRegions& example, const StyleRegions& output
         const RegionFigures &a = example.regions[std::size_t(r)], &b = output.regions[std::size_t(r)];
         std::snprintf(buf, sizeof buf,
                       "%s%-6s %4.1f %% of strands (example %4.1f %%), length p25/p50/p75 %.2f/%.2f/%.2f (%.2f/%.2f/%.2f), "
-                      "lift %.0f %% (%.0f %%), turning %.2f (%.2f), curl %.3f (%.3f)",
+                      "lift %.0f %% (%.0f %%), turning %.2f (%.2f), curl %.3f (%.3f), flow down/around %.2f/%.2f (%.2f/%.2f)",
                       indent.c_str(), styleRegionName(StyleRegion(r)), 100.0 * b.share, 100.0 * a.share, b.lengthP25, b.lengthP50, b.lengthP75,
-                      a.lengthP25, a.lengthP50, a.lengthP75, 100.0 * b.lift, 100.0 * a.lift, b.turning, a.turning, b.curlAmplitude, a.curlAmplitude);
+                      a.lengthP25, a.lengthP50, a.lengthP75, 100.0 * b.lift, 100.0 * a.lift, b.turning, a.turning, b.curlAmplitude, a.curlAmplitude,
+                      b.flowDown, b.flowAround, a.flowDown, a.flowAround);
         out += buf;
         if (a.insideHead >= 0.0 && b.insideHead >= 0.0) {
             std::snprintf(buf, sizeof buf, ", inside the head %.1f %% (%.1f %%)", 100.0 * b.insideHead, 100.0 * a.insideHead);

@@ -20,8 +20,15 @@
 /// the curl amplitude, the mean over the strands' pieces of about a head radius (each at least
 /// 0.6 head radii) of the RMS distance of a piece from its own smoothed centre line (Gaussian σ of
 /// 0.15 head radii, its ends kept: curls, not the strand's overall bend, at one scale whatever the
-/// strands' lengths; StyleRegions.cc, kCurlPiece, says how piece length matters); and, with a
-/// head, the share of vertices inside it (deeper than headTolerance(), refine --head's rule).
+/// strands' lengths; StyleRegions.cc, kCurlPiece, says how piece length matters); the *flow*,
+/// the mean over the strands of the unit direction in which each leaves its root (from the root
+/// to the point half a head radius along it, or its tip, in the head's tangent plane at the
+/// root), as its part *down* the head (along the meridian, away from the crown) and its part
+/// *around* it (positive about up by the right-hand rule: counter-clockwise seen from above), so
+/// that a fringe swept to one side, a parting or hair combed back differ from hair that falls
+/// (a region's flow is shorter than 1 as its strands leave their roots in less agreement); and,
+/// with a head, the share of vertices inside it (deeper than headTolerance(), refine --head's
+/// rule).
 #pragma once
 
 #include <vdbhair/Types.h>
@@ -62,6 +69,7 @@ struct RegionFigures
     double lift = 0.0;                              ///< share of the region's strands that lift
     double turning = 0.0;                           ///< mean radians per head radius
     double curlAmplitude = 0.0;                     ///< head radii
+    double flowDown = 0.0, flowAround = 0.0;        ///< mean unit direction leaving the root (see above)
     double insideHead = -1.0;                       ///< share of the region's vertices; -1: no head
 };
 
@@ -89,7 +97,8 @@ double meanCurlAmplitude(const StrandSet& strands, double radius, double piece =
 double medianCurlPiece(const StrandSet& strands, double radius);
 
 /// @brief Example and output side by side: {"frame": {...}, "crown": {"share": {"example": a,
-/// "output": b}, ...}, ...} (null where a region has no strands).
+/// "output": b}, ..., "flow": {"example": [down, around], "output": [...]}, "flow_difference":
+/// the distance between the two flows}, ...} (null where a region has no strands).
 nlohmann::json toJson(const StyleRegions& example, const StyleRegions& output);
 
 /// @brief The report of synth and transfer: @a example and @a output measured in one frame (the
