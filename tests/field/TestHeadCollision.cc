@@ -310,3 +310,40 @@ TEST_CASE("resolveHeadCollisions: a strand driven head-on into Sintel's head sli
         CHECK(maxTurn(out, 0) * 180.0 / M_PI < 45.0);
     }
 }
+
+TEST_CASE("resolveHeadCollisions: a strand whose tip alone dips into the head bends out over a length, not at its tip", "[field]")
+{
+    // A comb stroke or a new strand that ends just inside the head: the contact is at the tip, so
+    // a turn there has no edges after it to share it (the comb of HairNet's groom left a strand
+    // with a 46-degree turn between its last two edges). Straight strands ending 0.02-0.3 radii
+    // inside a unit sphere, met at 10-60 degrees, 16 and 100 vertices.
+    const HeadObstacle head = HeadObstacle::sphere(Vec3d(0.0), 1.0);
+    for (int n : {16, 100}) {
+        StrandSet s;
+        for (double depth : {0.02, 0.05, 0.1, 0.2, 0.3}) {
+            for (double into : {10.0, 20.0, 35.0, 60.0}) {
+                const double a = into * M_PI / 180.0;
+                const Vec3d tip(1.0 - depth, 0.0, 0.0);
+                // Arriving at the tip from above, at `into` degrees below the tangent plane there.
+                const Vec3d dir(-std::sin(a), -std::cos(a), 0.0);
+                const Vec3d root = tip - dir * 2.0;
+                if (!(root.length() > 1.0)) continue;
+                s.addStrand(line(Vec3f(root), Vec3f(dir), 2.f, n));
+            }
+        }
+        const StrandSet before = s;
+        REQUIRE(countStrandsEnteringHead(s, head, 0.0) == s.numStrands());
+        resolveHeadCollisions(s, head, {});
+        HeadObstacle::Probe probe(head);
+        double worst = 0.0;
+        for (std::size_t i = 0; i < s.numStrands(); ++i) {
+            CAPTURE(n, i);
+            REQUIRE(s.root(i) == before.root(i));
+            for (std::size_t k = 0; k < s.size(i); ++k) REQUIRE(probe.distance(Vec3d(s.positions[s.begin(i) + k])) >= -1e-6);
+            worst = std::max(worst, maxTurn(s, i));
+        }
+        INFO(n << " vertices: largest turn between two segments " << worst * 180.0 / M_PI << " degrees");
+        // 100 vertices: 2.9 degrees (13.2 when the smoothing's window was cut at the tip); 16: 12.0.
+        CHECK(worst < (n == 100 ? 6.0 : 15.0) * M_PI / 180.0);
+    }
+}

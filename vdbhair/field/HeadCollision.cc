@@ -147,6 +147,12 @@ double sweep(std::size_t n, DepthFloor floor, HeadObstacle::Probe& probe, Strand
 /// averages of half width σ instead (Wells 1986, "Efficient synthesis of Gaussian filters by
 /// cascaded uniform filters": prefix sums, linear in the vertices whatever the reach); on coarse
 /// strands (16 vertices) a box of a few edges is too blunt, and the Gaussian's own weights are kept.
+/// In the boxes, the edges past the tip count as turning as the tip's edge does (its turn extended
+/// at their spacing): a contact at the tip then spreads back along the strand at full weight,
+/// where a window cut at the tip kept most of the turn at the last edges (HairNet's groom combed
+/// into its head kept a 46-degree turn between its last two edges of 100; 0 such with the
+/// extension). Not on coarse strands: there it keeps more of the tip's own turn (16 vertices:
+/// 12 to 15 degrees on the tip-contact test's strands).
 void smoothTurns(std::size_t n, double sigma, StrandWork& w)
 {
     auto mid = [&](std::size_t k) { return w.arc[k] - 0.5 * w.seg[k]; };
@@ -193,7 +199,9 @@ void smoothTurns(std::size_t n, double sigma, StrandWork& w)
         for (std::size_t k = 1; k < n; ++k) {
             while (mid(k) - mid(lo) > sigma) ++lo;
             while (hi < n && mid(hi) - mid(k) <= sigma) ++hi;
-            w.smooth[k] = (w.sum[hi] - w.sum[lo]) / double(hi - lo);
+            // Edges past the tip within σ of edge k (at the last edge's spacing) turn as it does.
+            const double past = hi == n && w.seg[n - 1] > 0.0 ? std::floor((mid(k) + sigma - mid(n - 1)) / w.seg[n - 1]) : 0.0;
+            w.smooth[k] = (w.sum[hi] - w.sum[lo] + w.turn[n - 1] * past) / (double(hi - lo) + past);
         }
         for (std::size_t k = 1; k < n; ++k) w.turn[k] = w.smooth[k];
     }

@@ -13,7 +13,8 @@
 /// vertex is deeper than allowed, its segment turns towards the head's outward normal by the least
 /// angle that brings it to its floor. Lengths are kept exactly and nothing folds. That turn is made
 /// at one vertex; to spread it, each edge's turn from the strand as given (a rotation vector) is
-/// smoothed along the strand by a Gaussian in arc length (σ = `spread` × the strand's length), the
+/// smoothed along the strand by a Gaussian in arc length (σ = `spread` × the strand's length; on a
+/// finely sampled strand, edges past the tip turn as its last, so that a contact there spreads back), the
 /// strand is rebuilt from its root with its own edges turned by the smoothed rotations, and it is
 /// swept again from there: the edges before a contact now start to lift it, so the next sweep
 /// meets the head at a shallower angle and turns less. Passes repeat while a sweep turns an edge
