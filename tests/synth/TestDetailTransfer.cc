@@ -388,3 +388,42 @@ TEST_CASE("transferDetail: match place takes the wisps near an output wisp's pla
     bad.place = -1.0;
     CHECK_THROWS_WITH(bad.validate("test"), Catch::Contains("match_place -1"));
 }
+
+TEST_CASE("transferDetail: with wisps matched by place, a strand whose offset the wisps' frames would turn up off the head keeps it against the scalp", "[synth]")
+{
+    // On the side of the unit head, 45 degrees up: the input wisp's centre runs around the head
+    // (horizontally) and its strand runs the other way, so the strand's offset from its centre is
+    // horizontal. The output centre at the same root runs down the slope instead. Turned with the
+    // wisps' aligned tangents (Eq. 4), "behind the centre" becomes "up the slope" and the strand
+    // would rise off the head by 0.7 of its length (Ruby's short hair: a tuft 29 units above the
+    // head); neither the input strand nor the output centre rises, so with wisps matched by place
+    // (synthesis) the offset is turned as the scalp's normal turns and stays horizontal. Matched
+    // by shape (transfer), the wisps' frames carry it, as the paper's.
+    const double h = std::sqrt(0.5), len = 0.4;
+    const Vec3d root(h, h, 0.0), around(0.0, 0.0, 1.0), down(h, -h, 0.0);
+    const auto straight = [&](const Vec3d& dir) {
+        std::vector<Vec3f> p;
+        for (int k = 0; k < 16; ++k) p.emplace_back(root + dir * (len * double(k) / 15.0));
+        return oneStrand(p, 16);
+    };
+    const StrandSamples strand = straight(-around), centre = straight(around), outCentre = straight(down);
+    const std::vector<std::uint32_t> label{0};
+    const TransferSource src{&strand, &centre, &label};
+    for (double place : {0.0, 1.0}) {
+        CAPTURE(place);
+        DetailMatchParams match;
+        match.place = place;
+        const StrandSamples out = transferDetail(src, outCentre, outCentre.roots, unitMap(), 16, nullptr, nullptr, DetailBlend::Edges,
+                                                 true, nullptr, nullptr, DetailScale::Strand, 0, match);
+        std::vector<Vec3f> w(std::size_t(out.vertices));
+        sampleToWorld(out.row(0), out.vertices, out.roots[0], out.frames[0], 1.0, w.data());
+        double rise = 0.0, length = 0.0;
+        for (std::size_t k = 0; k < w.size(); ++k) {
+            rise = std::max(rise, double(w[k].y()) - root.y());
+            if (k) length += (Vec3d(w[k]) - Vec3d(w[k - 1])).length();
+        }
+        if (place > 0.0) CHECK(rise < 0.01 * len);
+        else CHECK(rise > 0.5 * len);
+        CHECK(length == Approx(len).epsilon(0.02));
+    }
+}

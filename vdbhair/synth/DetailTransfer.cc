@@ -558,6 +558,17 @@ void readPositions(DetailTransferRun& run)
     });
 }
 
+/// How far (head radii) a laid strand may rise above its root beyond its input strand and its
+/// output centre before its offset is turned with the scalp's normal only (layStrand()).
+constexpr double kRiseMargin = 0.05;
+
+/// A strand's offset from its input centre (@a d, world) turned onto the output centre: with the
+/// wisps' aligned frames (Eq. 4), or, @a normalOnly, as the root normal turns (layStrand(): when).
+Vec3d turnOffset(const ScalpFrame& in, const ScalpFrame& out, const Vec3d& d, bool normalOnly)
+{
+    return normalOnly ? rotateOnto(in.n, out.n, d, in.t) : out.toWorld(in.toLocal(d));
+}
+
 /// The carrier of a strand laid on output centre @a oc past that centre's end, appended to @a q
 /// until it reaches @a need (DetailScale::Strand and ArcLength). An output centre shorter than
 /// its input centre @a ic ends where the strand may still run (DetailScale::Strand keeps its
@@ -568,7 +579,7 @@ void readPositions(DetailTransferRun& run)
 /// where the output centre ends, turned onto the output centre's end direction, plus the strand's
 /// offset there (as layStrand() adds it), one point per input vertex.
 void continueCarrier(const DetailTransferRun& run, std::uint32_t oc, std::uint32_t ic, const std::vector<Vec3f>& cg, const Vec3d& off0,
-                     double need, std::vector<Vec3d>& q)
+                     double need, bool normalOnly, std::vector<Vec3d>& q)
 {
     const detail::Carrier& co = run.outCarrier[oc];
     const detail::Carrier& cin = run.inCarrier[ic];
@@ -584,13 +595,13 @@ void continueCarrier(const DetailTransferRun& run, std::uint32_t oc, std::uint32
         return Vec3d(p[j]) * (1.0 - t) + Vec3d(p[j + 1]) * t;
     };
     const Vec3d ciEnd = at(ci, atEnd);
-    const Vec3d base = q.back() - mo.toWorld(mi.toLocal(at(cg, atEnd) - ciEnd - off0));  // the output centre's end
+    const Vec3d base = q.back() - turnOffset(mi, mo, at(cg, atEnd) - ciEnd - off0, normalOnly);  // the output centre's end
     const Frame& fe = co.frames.back();
     const Vec3d from = Vec3d(cin.frames[std::min(std::size_t(std::lround(atEnd)), std::size_t(ns - 1))].t);
     double arc = co.length();
     for (std::size_t j = std::size_t(std::floor(atEnd)) + 1; j < std::size_t(ns) && arc <= need; ++j) {
         const Vec3d centre = base + rotateOnto(from, Vec3d(fe.t), Vec3d(ci[j]) - ciEnd, Vec3d(fe.n));
-        const Vec3d p = centre + mo.toWorld(mi.toLocal(Vec3d(cg[j]) - Vec3d(ci[j]) - off0));
+        const Vec3d p = centre + turnOffset(mi, mo, Vec3d(cg[j]) - Vec3d(ci[j]) - off0, normalOnly);
         arc += (p - q.back()).length();
         q.push_back(p);
     }
@@ -620,15 +631,7 @@ double layStrand(const DetailTransferRun& run, std::size_t i, const std::vector<
     // frames, read where the output vertex reads (so a wisp gathers and parts as the input's).
     const detail::Carrier& centreCarrier = run.outCarrier[oc];
     const std::vector<Vec3f>& ci = run.inCarrier[ic].points;
-    std::vector<Vec3d> q(static_cast<std::size_t>(no));
     const Vec3d off0 = Vec3d(cg[0]) - Vec3d(ci[0]);
-    for (std::size_t l = 0; l < q.size(); ++l) {
-        const std::size_t j = std::min(std::size_t(at[l]), std::size_t(ns - 1));
-        const double t = at[l] - double(j);
-        Vec3d off = Vec3d(cg[j]) - Vec3d(ci[j]);
-        if (t > 0.0 && j + 1 < std::size_t(ns)) off = off * (1.0 - t) + (Vec3d(cg[j + 1]) - Vec3d(ci[j + 1])) * t;
-        q[l] = roots[i] + (Vec3d(centreCarrier.points[l]) - Vec3d(centreCarrier.points[0])) + mo.toWorld(mi.toLocal(off - off0));
-    }
     const double li = run.inCarrierLength[ic], lo = centreCarrier.length();
     double lambda = 1.0, target = progress;  // Strand: its own length
     if (scale == DetailScale::Index) {
@@ -640,17 +643,44 @@ double layStrand(const DetailTransferRun& run, std::size_t i, const std::vector<
         // head 0.27 of their length from BASE's, against 0.08).
         target = std::max(progress + lo - li, progress * std::min(1.0, li > 0.0 ? lo / li : 1.0));
     }
-    if (scale != DetailScale::Index) continueCarrier(run, oc, ic, cg, off0, target, q);
-    const detail::Carrier carrier(q, 0.0, Vec3f(mo.t));
     const detail::Curl& curl = run.inCurl.empty() ? detail::Curl{} : run.inCurl[ic];
-    const std::vector<Vec3d> laid = detail::layEdges(d, advance, frameShift, lambda, carrier, roots[i], target, curl);
-    std::vector<Vec3f> lf(laid.size()), rs(static_cast<std::size_t>(no));
-    for (std::size_t k = 0; k < laid.size(); ++k) lf[k] = Vec3f(laid[k]);
-    if (lf.size() < 2) lf.push_back(lf.back());
-    // Laid whole at the output's vertex count, the strand's own vertices stay (resampling by
-    // arc would cut its corners: samples even along the input, not along their chords).
-    if (lf.size() == std::size_t(no)) rs = lf;
-    else resamplePolyline(lf.data(), lf.size(), std::size_t(no), rs.data());
+    std::vector<Vec3f> rs(static_cast<std::size_t>(no));
+    const auto lay = [&](bool normalOnly) {
+        std::vector<Vec3d> q(static_cast<std::size_t>(no));
+        for (std::size_t l = 0; l < q.size(); ++l) {
+            const std::size_t j = std::min(std::size_t(at[l]), std::size_t(ns - 1));
+            const double t = at[l] - double(j);
+            Vec3d off = Vec3d(cg[j]) - Vec3d(ci[j]);
+            if (t > 0.0 && j + 1 < std::size_t(ns)) off = off * (1.0 - t) + (Vec3d(cg[j + 1]) - Vec3d(ci[j + 1])) * t;
+            q[l] = roots[i] + (Vec3d(centreCarrier.points[l]) - Vec3d(centreCarrier.points[0])) + turnOffset(mi, mo, off - off0, normalOnly);
+        }
+        if (scale != DetailScale::Index) continueCarrier(run, oc, ic, cg, off0, target, normalOnly, q);
+        const detail::Carrier carrier(q, 0.0, Vec3f(mo.t));
+        const std::vector<Vec3d> laid = detail::layEdges(d, advance, frameShift, lambda, carrier, roots[i], target, curl);
+        std::vector<Vec3f> lf(laid.size());
+        for (std::size_t k = 0; k < laid.size(); ++k) lf[k] = Vec3f(laid[k]);
+        if (lf.size() < 2) lf.push_back(lf.back());
+        // Laid whole at the output's vertex count, the strand's own vertices stay (resampling by
+        // arc would cut its corners: samples even along the input, not along their chords).
+        if (lf.size() == std::size_t(no)) rs = lf;
+        else resamplePolyline(lf.data(), lf.size(), std::size_t(no), rs.data());
+    };
+    lay(false);
+    // The wisps' aligned tangents follow their mean directions, for a loose wisp far from its
+    // strands', and turned with them "beside the centre" can become "up": Ruby's short hair had a
+    // tuft 29 units above the head (the example's hair 3.4). With wisps matched near their place
+    // (synthesis), a strand rising above its root more than its input strand and its output centre
+    // both do, by kRiseMargin, is laid again with the offset kept against the scalp. Not for every
+    // strand: the TressFX ponytail's neighbouring wisps do differ in direction, and its strands then
+    // kinked more; nor with wisps matched by shape from anywhere (transfer, synth --coarse), where
+    // the frames carry a strand across the head (the ponytail on a small head: 0.086 -> 0.103).
+    const Vec3d up = run.map.sphere().up;
+    const auto rise = [&](const auto& p) {
+        double r = 0.0;
+        for (const auto& x : p) r = std::max(r, (Vec3d(x) - Vec3d(p[0])).dot(up));
+        return r;
+    };
+    if (run.matching.place > 0.0 && rise(rs) > std::max(rise(gin), rise(centreCarrier.points)) + kRiseMargin * run.radius) lay(true);
     double len = 0.0;
     for (int l = 0; l < no; ++l) {
         const Vec3d p = l == 0 ? roots[i] : Vec3d(rs[std::size_t(l)]);

@@ -35,7 +35,10 @@
 /// polyline, in the frame at the run's middle, so that it stays straight). The output strand starts at its root and lays the edges
 /// one after another in the frames of the output carrier (the output centre smoothed at σ = half
 /// the input centre's vertices, in world units, plus the strand's smooth offset from its input
-/// centre's carrier, smoothed alike, held in the aligned root frames, as D_α) at the arc each edge
+/// centre's carrier, smoothed alike, held in the aligned root frames, as D_α; with wisps matched by
+/// place, a strand that would then rise above its root more than its input strand and its output
+/// centre do, by a twentieth of the head radius, has its offset turned only as the root normal
+/// turns) at the arc each edge
 /// reached along its own carrier (DetailTransfer.cc, "Carrier smoothing", says why the two σ);
 /// so edges keep their lengths and the
 /// angles between them, and a curl keeps its turning per length (tested on a helix laid onto a
