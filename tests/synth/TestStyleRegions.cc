@@ -161,3 +161,38 @@ TEST_CASE("measureStyleRegions: flow, the direction strands leave their roots in
     REQUIRE(j["sides"]["flow_difference"] == Approx(0.0).margin(1e-6));
     REQUIRE(j["back"]["flow_difference"] == Approx(1.0));  // (0.5, -0.5) against (0.5, 0.5)
 }
+
+TEST_CASE("meanCurlAmplitude: hair lying on the head has no curl; a helix reads its radius", "[synth][regions]")
+{
+    // Strands along meridians of the unit sphere (on a head of radius 1), 1.8 head radii long from
+    // 60 degrees above the equator: bent, not curled. The centre line of a Gaussian (the measure's
+    // first form) cut across the bend and read 0.010 here.
+    StrandSet lying;
+    for (int a = 0; a < 8; ++a) {
+        std::vector<Vec3f> pts;
+        for (int k = 0; k < 91; ++k) pts.emplace_back(rootAt(60.0 - 1.8 * 180.0 / M_PI * double(k) / 90.0, 45.0 * a));
+        lying.addStrand(pts);
+    }
+    CHECK(meanCurlAmplitude(lying, 1.0) < 0.0015);
+    // The same strands on a head of radius 2 (twice as long in its radii, half as bent).
+    CHECK(meanCurlAmplitude(lying, 0.5) < 0.0015);
+    // Helices of radius 0.03 about straight axes, 2 head radii long: the RMS distance from the axis
+    // is the radius; a period of 0.25 head radii keeps nearly all of it, one of a head radius (a
+    // wave, not a curl) less than a third.
+    const auto helices = [](double radius, double period) {
+        StrandSet s;
+        for (int a = 0; a < 4; ++a) {
+            std::vector<Vec3f> pts;
+            for (int k = 0; k < 401; ++k) {
+                const double t = 2.0 * double(k) / 400.0, phase = 2.0 * M_PI * t / period + a;
+                pts.emplace_back(Vec3d(3.0 * a + radius * std::cos(phase), -t, radius * std::sin(phase)));
+            }
+            s.addStrand(pts);
+        }
+        return s;
+    };
+    CHECK(meanCurlAmplitude(helices(0.03, 0.25), 1.0) == Approx(0.03).epsilon(0.1));
+    CHECK(meanCurlAmplitude(helices(0.03, 1.0), 1.0) < 0.3 * 0.03);
+    // Scales with the head: the same helices on a head of radius 2 read half as much.
+    CHECK(meanCurlAmplitude(helices(0.03, 0.25), 2.0) == Approx(0.015).epsilon(0.1));
+}

@@ -5,7 +5,6 @@
 #include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/field/HeadObstacle.h>
 #include <vdbhair/strands/Measures.h>
-#include <vdbhair/strands/Resample.h>
 
 #include <openvdb/math/Mat3.h>
 
@@ -26,13 +25,15 @@ constexpr double kFringeAngleDeg = 60.0, kBackAngleDeg = 120.0;
 constexpr double kLiftHeight = 0.1;     ///< head radii above the root
 constexpr double kFlowReach = 0.5;      ///< head radii along a strand: the direction it leaves its root in
 /// Curl amplitude at one scale in head radii, whatever a strand's length: samples at most every
-/// 1/25 head radius (at least every 1/200), the centre line their Gaussian with σ = 0.15 head
-/// radii (a curl of wavelength 0.7, Curly_100's, keeps 6/10 of its radius against it), strands
-/// cut into pieces of about a head radius, each at least 4σ long. (A piece's smoothed line keeps
-/// its ends, so a piece reads a curl lower the shorter it is: three quarters of a helix turn of
-/// 0.8 head radii 0.050, the same helix in pieces of 1 head radius 0.056; pieces of one length
-/// compare alike.)
-constexpr double kCurlSpacing = 1.0 / 25.0, kCurlFinest = 1.0 / 200.0, kCurlSigma = 0.15, kCurlPiece = 1.0;
+/// 1/25 head radius (at least every 1/200), the centre line their local quadratic fit with
+/// Gaussian weights of σ = 0.25 head radii (curlCentreLine()), strands cut into pieces of about a
+/// head radius, each at least 0.6 long. A quadratic follows a strand's overall bend: hair lying on
+/// a head of radius 1 reads 0.001 (a Gaussian's own line, σ 0.15, cut across the bend and read it
+/// as 0.010, a third of Curly_100's curls; Ruby's short hair, which has none, read 0.016). Curls
+/// keep what the Gaussian kept: a helix of period 0.25 head radii 0.96 of its radius, 0.5 0.79,
+/// 0.7 (Curly_100's) 0.49, 1.0 0.23 (on a piece of 1 head radius; a shorter piece reads a curl
+/// of long period lower: pieces of one length compare alike).
+constexpr double kCurlSpacing = 1.0 / 25.0, kCurlFinest = 1.0 / 200.0, kCurlSigma = 0.25, kCurlPiece = 1.0, kCurlShortest = 0.6;
 constexpr std::size_t kCurlMaxSamples = 1 << 14;  ///< longer strands are sampled more coarsely
 
 /// Per strand: length, lift, turning per length, its pieces' curl amplitudes (head radii: their
@@ -46,14 +47,64 @@ struct StrandFigures
     std::size_t inside = 0;
 };
 
+/// The centre line of @a n samples @a p, evenly spaced: at each sample the value at it of the
+/// quadratic fitted by least squares to the samples within 3σ (@a sigma in samples), weighted by a
+/// Gaussian (local quadratic regression). Where the window is whole this is one fixed kernel
+/// (the odd moments vanish): w(x) (S4 - S2 x²) / (S0 S4 - S2²); near the ends, where it is cut,
+/// the 3 × 3 normal equations are solved at each sample. A circle is followed to fourth order, a
+/// curl much shorter than σ is averaged out.
+void curlCentreLine(const Vec3d* p, std::size_t n, double sigma, Vec3d* out)
+{
+    const long last = long(n) - 1, r = std::max(1L, long(std::ceil(3.0 * sigma)));
+    std::vector<double> w(std::size_t(r) + 1);
+    for (long k = 0; k <= r; ++k) w[std::size_t(k)] = std::exp(-0.5 * double(k * k) / (sigma * sigma));
+    const auto fit = [&](long i, long lo, long hi) {
+        double m[5] = {0, 0, 0, 0, 0};
+        Vec3d b0(0.0), b1(0.0), b2(0.0);
+        for (long j = lo; j <= hi; ++j) {
+            const double x = double(j - i), wx = w[std::size_t(std::abs(j - i))];
+            const double x2 = x * x;
+            m[0] += wx; m[1] += wx * x; m[2] += wx * x2; m[3] += wx * x2 * x; m[4] += wx * x2 * x2;
+            b0 += p[j] * wx; b1 += p[j] * (wx * x); b2 += p[j] * (wx * x2);
+        }
+        // The intercept of [m0 m1 m2; m1 m2 m3; m2 m3 m4] (a, b, c) = (b0, b1, b2), by Cramer's rule
+        // (a window of three or more samples has a positive determinant; fewer: the sample itself).
+        const double c0 = m[2] * m[4] - m[3] * m[3], c1 = m[2] * m[3] - m[1] * m[4], c2 = m[1] * m[3] - m[2] * m[2];
+        const double det = m[0] * c0 + m[1] * c1 + m[2] * c2;
+        return hi - lo >= 2 && det > 1e-12 * m[0] * m[0] * m[4] ? (b0 * c0 + b1 * c1 + b2 * c2) / det : p[i];
+    };
+    if (2 * r > last) {
+        for (long i = 0; i <= last; ++i) out[i] = fit(i, std::max(0L, i - r), std::min(last, i + r));
+        return;
+    }
+    double s0 = w[0], s2 = 0.0, s4 = 0.0;
+    for (long k = 1; k <= r; ++k) {
+        const double x2 = double(k * k);
+        s0 += 2.0 * w[std::size_t(k)];
+        s2 += 2.0 * w[std::size_t(k)] * x2;
+        s4 += 2.0 * w[std::size_t(k)] * x2 * x2;
+    }
+    std::vector<double> kernel(std::size_t(r) + 1);
+    for (long k = 0; k <= r; ++k) kernel[std::size_t(k)] = w[std::size_t(k)] * (s4 - s2 * double(k * k)) / (s0 * s4 - s2 * s2);
+    for (long i = 0; i <= last; ++i) {
+        if (i < r || i > last - r) {
+            out[i] = fit(i, std::max(0L, i - r), std::min(last, i + r));
+            continue;
+        }
+        Vec3d sum = p[i] * kernel[0];
+        for (long k = 1; k <= r; ++k) sum += (p[i - k] + p[i + k]) * kernel[std::size_t(k)];
+        out[i] = sum;
+    }
+}
+
 /// The curl amplitude of strand @a i of length @a length (world units): the strand cut into
 /// pieces of about @a piece (at least one), each at least 4σ long, and of each piece the RMS
-/// distance from its own smoothed centre line (smoothPolyline(): its ends stay, so a straight or
-/// evenly bent piece has none); @a sum and @a count receive the pieces' amplitudes (head radii).
+/// distance from its own centre line (curlCentreLine(): a straight or evenly bent piece has
+/// none); @a sum and @a count receive the pieces' amplitudes (head radii).
 void strandCurl(const StrandSet& s, std::size_t i, double length, double radius, double piece, double& sum, std::size_t& count,
                 std::vector<Vec3d>& pts, std::vector<Vec3d>& smooth)
 {
-    if (!(length >= 4.0 * kCurlSigma * radius)) return;
+    if (!(length >= kCurlShortest * radius)) return;
     const std::size_t b = s.offsets[i], e = s.offsets[i + 1];
     // At the strand's own vertex spacing within [1/200, 1/25] head radius: a curl tighter than
     // the coarse spacing would alias, and none is finer than the strand's vertices.
@@ -79,8 +130,8 @@ void strandCurl(const StrandSet& s, std::size_t i, double length, double radius,
     smooth.resize(n);
     for (std::size_t q = 0; q < pieces && q < n - 1; ++q) {
         const std::size_t lo = q * (n - 1) / pieces, hi = (q + 1) * (n - 1) / pieces;
-        if (double(hi - lo) * step < 4.0 * kCurlSigma * radius) continue;
-        smoothPolyline(pts.data() + lo, hi - lo + 1, kCurlSigma * radius / step, smooth.data());
+        if (double(hi - lo) * step < kCurlShortest * radius) continue;
+        curlCentreLine(pts.data() + lo, hi - lo + 1, kCurlSigma * radius / step, smooth.data());
         double rms = 0.0;
         for (std::size_t j = lo; j <= hi; ++j) rms += (pts[j] - smooth[j - lo]).lengthSqr();
         sum += std::sqrt(rms / double(hi - lo + 1)) / radius;
@@ -296,7 +347,7 @@ double medianCurlPiece(const StrandSet& strands, double radius)
     std::vector<double> lengths;
     for (std::size_t i = 0; i < strands.numStrands(); ++i) {
         const double l = polylineLength(strands.data(i), strands.size(i)) / radius;
-        if (l >= 4.0 * kCurlSigma) lengths.push_back(l);
+        if (l >= kCurlShortest) lengths.push_back(l);
     }
     return lengths.empty() ? kCurlPiece : quantile(lengths, 0.5);
 }

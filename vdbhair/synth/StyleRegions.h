@@ -18,9 +18,10 @@
 /// *lift*, whose highest vertex rises more than 0.1 head radii above their root along up (fringes
 /// swept up, volume at the crown); the mean turning per unit length (radians per head radius);
 /// the curl amplitude, the mean over the strands' pieces of about a head radius (each at least
-/// 0.6 head radii) of the RMS distance of a piece from its own smoothed centre line (Gaussian σ of
-/// 0.15 head radii, its ends kept: curls, not the strand's overall bend, at one scale whatever the
-/// strands' lengths; StyleRegions.cc, kCurlPiece, says how piece length matters); the *flow*,
+/// 0.6 head radii) of the RMS distance of a piece from its own centre line (a local quadratic fit,
+/// Gaussian weights of σ 0.25 head radii: curls, not the strand's overall bend nor its lying on
+/// the head, at one scale whatever the strands' lengths; StyleRegions.cc, kCurlSigma, says what it
+/// keeps); the *flow*,
 /// the mean over the strands of the unit direction in which each leaves its root (from the root
 /// to the point half a head radius along it, or its tip, in the head's tangent plane at the
 /// root), as its part *down* the head (along the meridian, away from the crown) and its part
