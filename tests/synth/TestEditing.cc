@@ -299,6 +299,38 @@ TEST_CASE("combHair: coarse straight strands pressed into a sphere head gain no 
     }
 }
 
+TEST_CASE("combHair on HairNet's groom and head: strands pressed along the surface keep their least kinked sweep", "[synth][data]")
+{
+    // Four of the strokes drawn at random by scripts/comb_strokes.py (seeds 1 and 2) that left new
+    // kinks: strands pressed along the head, whose floor (the input's depth vertex by vertex) rises
+    // and falls, never settled, each sweep turning as much as the smoothing took back, and their
+    // last sweep kinked them (7-16 strands a stroke, up to 70 degrees) where an earlier one did not.
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string dir = vdbhair::test::sharedData();
+    const StrandSet hair = readStrands(dir + "/hair/hairnet_convdata/strands00014_00035_00010.convdata");
+    CombParams params;
+    params.head = readHeadObstacle(dir + "/scalp/usc_hairsalon/head_model.ply", "test");
+    const auto stroke = [](std::vector<Vec3d> points, double radius, double strength) {
+        CombStroke s;
+        s.points = std::move(points);
+        s.radius = radius;
+        s.strength = strength;
+        return s;
+    };
+    const std::vector<CombStroke> strokes = {
+        stroke({Vec3d(0.1848, 1.7542, -0.0683), Vec3d(0.0543, 1.6819, -0.0146)}, 0.0696, 0.816),
+        stroke({Vec3d(-0.134, 1.7195, 0.1158), Vec3d(-0.0303, 1.6986, 0.0316)}, 0.0910, 0.571),
+        stroke({Vec3d(-0.1416, 1.7554, 0.0072), Vec3d(-0.0811, 1.7554, 0.0864), Vec3d(-0.003, 1.7554, 0.1484)}, 0.0458, 0.492),
+        stroke({Vec3d(-0.1111, 1.711, 0.0957), Vec3d(-0.0142, 1.711, 0.1191), Vec3d(0.0855, 1.711, 0.1179)}, 0.0874, 0.842)};
+    for (std::size_t k = 0; k < strokes.size(); ++k) {
+        const CombResult combed = combHair(hair, {strokes[k]}, params);
+        CAPTURE(k, combed.stats.movedStrands, combed.stats.headDeflected, combed.stats.insideHeadBefore, combed.stats.insideHeadAfter);
+        REQUIRE(combed.stats.headDeflected > 10);
+        CHECK(combed.stats.newKinks == 0);
+        CHECK(combed.stats.insideHeadAfter <= combed.stats.insideHeadBefore);
+    }
+}
+
 TEST_CASE("combHair on a real groom with its head mesh: no kinks at the shoulders", "[synth][data]")
 {
     // Ruby's long hair swept sideways across her back by a stroke of radius 20, on her head and

@@ -29,6 +29,7 @@ struct StrandWork
     std::vector<Vec3d> turn, smooth, sum;
     std::vector<std::size_t> turned;  ///< prefix counts of the edges with a turn
     std::vector<double> seg, arc;
+    std::vector<Vec3d> best;  ///< the swept strand with the smallest largest turn between two edges so far
     /// The Gaussian's normalized weights of edge k over edges kernelLo[k] .., stored from
     /// kernelAt[k] to kernelAt[k + 1] (built once a strand; empty until needed)
     std::vector<double> weight;
@@ -212,6 +213,18 @@ void smoothTurns(std::size_t n, double sigma, StrandWork& w)
 /// made the head 3 times slower on 100,000 synthesized strands, for no fewer kinks measured.
 constexpr double kSettledTurn = 5.0 * M_PI / 180.0;
 
+/// The cosine of the largest turn between two consecutive edges of the @a n points @a p (1: none).
+double leastEdgeCosine(const std::vector<Vec3d>& p, std::size_t n)
+{
+    double least = 1.0;
+    for (std::size_t k = 2; k < n; ++k) {
+        const Vec3d a = p[k - 1] - p[k - 2], b = p[k] - p[k - 1];
+        const double la = a.length(), lb = b.length();
+        if (la > 0.0 && lb > 0.0) least = std::min(least, a.dot(b) / (la * lb));
+    }
+    return least;
+}
+
 /// Resolve one strand of @a n vertices at @a pos; @return whether it moved, and add to @a tooDeep.
 bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle::Probe& probe, const HeadCollisionParams& params,
                    StrandWork& w, std::size_t& tooDeep)
@@ -246,9 +259,22 @@ bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle
     // back in, less steeply than before; sweep again.
     w.c = w.p;  // the strand as given
     w.kernelAt.clear();
+    // Each sweep leaves the strand out of the head; where the passes do not settle (a strand along
+    // the surface whose floor, the input's depth vertex by vertex, rises and falls: HairNet's
+    // strands pressed against its head by random strokes turned 30-60 degrees at every pass, their
+    // last sweep kinked up to 104 degrees where an earlier one had 25-36), the sweep with the
+    // smallest largest turn between two edges is kept.
+    double bestCosine = -2.0;
     for (int pass = 0; pass < params.passes; ++pass) {
         // A sweep that turned no edge by more than a few degrees leaves no kink: done.
-        if (!(sweep(n, floor0, probe, w) > kSettledTurn)) break;
+        const double turned = sweep(n, floor0, probe, w);
+        if (!(turned > kSettledTurn) && pass == 0) break;  // settled at once: nothing to compare
+        const double cosine = leastEdgeCosine(w.p, n);
+        if (cosine > bestCosine) {
+            bestCosine = cosine;
+            w.best.assign(w.p.begin(), w.p.begin() + std::ptrdiff_t(n));
+        }
+        if (!(turned > kSettledTurn)) break;
         if (pass + 1 == params.passes || !(sigma > 0.0)) break;  // end on a sweep
         w.turn.assign(n, Vec3d(0.0));
         for (std::size_t k = 1; k < n; ++k) {
@@ -260,6 +286,7 @@ bool resolveStrand(Vec3f* pos, std::size_t n, const float* allowed, HeadObstacle
         smoothTurns(n, sigma, w);
         for (std::size_t k = 1; k < n; ++k) w.p[k] = w.p[k - 1] + rotateByVector(w.c[k] - w.c[k - 1], w.turn[k]);
     }
+    if (bestCosine > -2.0) std::copy(w.best.begin(), w.best.end(), w.p.begin());
     // What is still too deep, vertex by vertex.
     DepthFloor f = floor0;
     f.placed(probe.distance(w.p[0]));

@@ -18,7 +18,9 @@
 /// strand is rebuilt from its root with its own edges turned by the smoothed rotations, and it is
 /// swept again from there: the edges before a contact now start to lift it, so the next sweep
 /// meets the head at a shallower angle and turns less. Passes repeat while a sweep turns an edge
-/// by more than 5 degrees (up to `passes`, ending on a sweep). The strand's own shape (curls,
+/// by more than 5 degrees (up to `passes`); of the swept strands, the one with the smallest
+/// largest turn between two edges is kept (a strand along the surface may not settle, each sweep
+/// turning as much as the smoothing took back). The strand's own shape (curls,
 /// waves) rides along: its edges are turned, not its positions smoothed (which would straighten
 /// it and, on a convex head, pull it back in), and a smooth rotation field cannot fold it the way
 /// smoothed displacements can (a strand pressed head-on into the head). A last pass pushes what is
