@@ -15,7 +15,6 @@ Prints one line per stroke and the number of strokes that made any new kink.
 import argparse
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
@@ -65,12 +64,7 @@ def main():
         head = ht.Head(scalp)
         pin, oin = ht.load(hair)
         turn_in = ht.max_turn_deg(pin, oin)
-        (i0, j0, k0), (i1, j1, k1) = head.grid.bbox
-        lo = np.array(head.grid.index_to_world(np.array([[i0, j0, k0]], dtype=np.float64)))[0]
-        hi = np.array(head.grid.index_to_world(np.array([[i1, j1, k1]], dtype=np.float64)))[0]
-        c, R = 0.5 * (lo + hi), 0.25 * float(np.min(hi - lo))
-        upv = np.zeros(3)
-        upv[{"x": 0, "y": 1, "z": 2}[up]] = 1.0
+        c, R, upv = ht.head_box(head, up)
         side = np.array([1.0, 0.0, 0.0]) - upv * upv[0]
         side /= np.linalg.norm(side)
         for t in range(args.strokes):

@@ -122,16 +122,21 @@ def inside_share(head, pos):
     return 100.0 * float(np.mean(head.dist(pos) < 0.0))
 
 
-def strokes_for(kind, head, up):
-    """A sweep across the back at the head's lower half and a press into the back of the head,
-    from the head mesh's level-set box."""
+def head_box(head, up):
+    """The centre of the head mesh's level-set box, a quarter of its smallest side, and the unit
+    up axis: the scale strokes are made at."""
     (i0, j0, k0), (i1, j1, k1) = head.grid.bbox
     lo = np.array(head.grid.index_to_world(np.array([[i0, j0, k0]], dtype=np.float64)))[0]
     hi = np.array(head.grid.index_to_world(np.array([[i1, j1, k1]], dtype=np.float64)))[0]
-    c, R = 0.5 * (lo + hi), 0.25 * float(np.min(hi - lo))
-    ax = {"x": 0, "y": 1, "z": 2}[up]
     upv = np.zeros(3)
-    upv[ax] = 1.0
+    upv[{"x": 0, "y": 1, "z": 2}[up]] = 1.0
+    return 0.5 * (lo + hi), 0.25 * float(np.min(hi - lo)), upv
+
+
+def strokes_for(kind, head, up):
+    """A sweep across the back at the head's lower half and a press into the back of the head,
+    from the head mesh's level-set box."""
+    c, R, upv = head_box(head, up)
     side = np.array([1.0, 0.0, 0.0])
     back = np.cross(side, upv)  # -z for y-up, +y for z-up
     if up == "y":

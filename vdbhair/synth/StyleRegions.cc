@@ -98,7 +98,7 @@ void curlCentreLine(const Vec3d* p, std::size_t n, double sigma, Vec3d* out)
 }
 
 /// The curl amplitude of strand @a i of length @a length (world units): the strand cut into
-/// pieces of about @a piece (at least one), each at least 4σ long, and of each piece the RMS
+/// pieces of about @a piece (at least one), each at least kCurlShortest long, and of each piece the RMS
 /// distance from its own centre line (curlCentreLine(): a straight or evenly bent piece has
 /// none); @a sum and @a count receive the pieces' amplitudes (head radii).
 void strandCurl(const StrandSet& s, std::size_t i, double length, double radius, double piece, double& sum, std::size_t& count,
