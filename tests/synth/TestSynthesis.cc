@@ -252,3 +252,41 @@ TEST_CASE("synthesizeHair on a real short groom with its head: no more hair in t
     INFO("vertices inside: the example " << insideShare(example) << ", the output " << insideShare(kept.strands));
     CHECK(insideShare(kept.strands) <= insideShare(example));
 }
+
+TEST_CASE("synthesizeHair: hanging hair keeps hanging wherever the map places it (map in the head's axes)", "[synth]")
+{
+    // Strands that leave the scalp a little along its normal and then hang straight down, from
+    // roots between the equator and 60 degrees up. Read at a root higher or lower than its own, a
+    // wisp kept in its root's scalp frame (the paper's) tilts with the scalp's normal there; kept
+    // along the head's axes, it hangs as it did.
+    StrandSet example;
+    const int n = 1500, vertices = 16;
+    for (int i = 0; i < n; ++i) {
+        const double elevation = (60.0 * double(i % 37) / 36.0) * M_PI / 180.0, azimuth = 2.0 * M_PI * double(i) / double(n) * 7.0;
+        const Vec3d normal(std::cos(elevation) * std::cos(azimuth), std::sin(elevation), std::cos(elevation) * std::sin(azimuth));
+        const Vec3d lifted = normal * 1.05;
+        std::vector<Vec3f> pts{Vec3f(normal)};
+        for (int k = 1; k < vertices; ++k) pts.push_back(Vec3f(lifted - Vec3d(0.0, 2.0 * double(k - 1) / double(vertices - 2), 0.0)));
+        example.addStrand(pts);
+    }
+    // The mean angle between a strand's hanging part (its last ten edges) and straight down.
+    const auto tilt = [](const StrandSet& s) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < s.numStrands(); ++i) {
+            const Vec3d d = (Vec3d(s.data(i)[s.size(i) - 1]) - Vec3d(s.data(i)[s.size(i) - 11])).unitSafe();
+            sum += std::acos(std::clamp(-d.y(), -1.0, 1.0));
+        }
+        return sum / double(s.numStrands()) * 180.0 / M_PI;
+    };
+    SynthParams params = smallParams();
+    params.head = HeadObstacle::none();
+    params.refine = false;
+    const SynthResult head = synthesizeHair(example, params);
+    params.mapInHeadAxes = false;
+    const SynthResult root = synthesizeHair(example, params);
+    INFO("mean tilt from straight down, degrees: the example " << tilt(example) << ", map along the head's axes " << tilt(head.strands)
+                                                                << ", in the roots' frames " << tilt(root.strands));
+    CHECK(tilt(example) < 0.01);
+    CHECK(tilt(head.strands) < 2.0);
+    CHECK(tilt(root.strands) > 2.0 * tilt(head.strands));
+}

@@ -99,6 +99,13 @@ void addLayoutParams(ParamTable<SP>& t)
                                                               [](SP& p, std::string v) { p.exampleDensity = v == "example"; }});
     density.choices = {"example", "even"};
     t.push_back(density);
+    auto frame = makeParam<SP>("map-frame", "The coarsest level's wisps in the feature map: head (offsets along the head's axes: a wisp placed higher or "
+                                            "lower on the head hangs as it did) or root (in each root's scalp frame, the paper's: a long wisp placed "
+                                            "higher on the head tilts outward with the scalp)", "",
+                               ParamAccess<SP, std::string>{[](const SP& p) { return std::string(p.mapInHeadAxes ? "head" : "root"); },
+                                                            [](SP& p, std::string v) { p.mapInHeadAxes = v == "head"; }});
+    frame.choices = {"head", "root"};
+    t.push_back(frame);
 }
 
 /// Detail transfer and refinement (DetailTransfer.h, §5.2-5.3): shared by synth and transfer.
@@ -238,6 +245,26 @@ std::vector<Vec3d> regionInScalpSpace(const std::vector<Vec3d>* outputRegion, co
     return regionUv;
 }
 
+/// The rows of @a samples as the feature map holds them: along the head's axes (the sphere's, in
+/// which the map's (u, v) are measured: ScalpFrame's identity here, world axes) when @a headAxes,
+/// else as they are, in each root's frame.
+std::vector<float> mapRows(const StrandSamples& samples, bool headAxes)
+{
+    std::vector<float> rows(samples.local.begin(), samples.local.end());
+    if (!headAxes) return rows;
+    for (std::size_t s = 0; s < samples.count(); ++s) {
+        float* row = rows.data() + s * samples.dim();
+        for (int v = 0; v < samples.vertices; ++v) {
+            float* q = row + 3 * v;
+            const Vec3d w = samples.frames[s].toWorld(Vec3d(q[0], q[1], q[2]));
+            q[0] = float(w.x());
+            q[1] = float(w.y());
+            q[2] = float(w.z());
+        }
+    }
+    return rows;
+}
+
 /// Step 4, the feature maps: the coarsest level's PCA, the uv grid around the example (and the
 /// output region), the example's feature map and, with an output region, its mask. Returns the
 /// output region's area over the example's (1 without a region).
@@ -246,10 +273,11 @@ double buildFeatureMaps(SynthResult& res, const SynthParams& params, const std::
 {
     const StrandSamples& finest = res.example.levels.front();
     const StrandSamples& coarsest = res.example.levels.back();
-    res.pca = fitPca(coarsest.local.data(), coarsest.count(), coarsest.dim(), params.components);
+    const std::vector<float> rows = mapRows(coarsest, params.mapInHeadAxes);
+    res.pca = fitPca(rows.data(), coarsest.count(), coarsest.dim(), params.components);
     const int nf = res.pca.components;
     std::vector<float> features(coarsest.count() * std::size_t(nf));
-    for (std::size_t s = 0; s < coarsest.count(); ++s) res.pca.project(coarsest.row(s), features.data() + s * std::size_t(nf));
+    for (std::size_t s = 0; s < coarsest.count(); ++s) res.pca.project(rows.data() + s * coarsest.dim(), features.data() + s * std::size_t(nf));
     std::vector<Vec3d> covered = finest.scalp;
     covered.insert(covered.end(), regionUv.begin(), regionUv.end());
     res.grid = uvGridAround(covered, params.mapSpacing);
@@ -351,13 +379,22 @@ void synthesizeCoarsestLevel(SynthResult& res, const SynthParams& params, const 
         if (!nearestFeature(res.outputMap, res.grid, roots.scalp[i].x(), roots.scalp[i].y(), f.data()))
             throw ValueError("synthesizeHair: the output feature map has no valid pixel");
         res.pca.reconstruct(f.data(), row.data());
+        const ScalpFrame frame = map.frame(roots.scalp[i].x(), roots.scalp[i].y());
+        if (params.mapInHeadAxes) {
+            for (int v = 0; v < params.vertices; ++v) {
+                const Vec3d q = frame.toLocal(Vec3d(row[3 * v], row[3 * v + 1], row[3 * v + 2]));
+                row[3 * v] = float(q.x());
+                row[3 * v + 1] = float(q.y());
+                row[3 * v + 2] = float(q.z());
+            }
+        }
         row[0] = row[1] = row[2] = 0.0f;  // the root is the root
         double len = 0.0;
         for (int v = 1; v < params.vertices; ++v)
             len += std::sqrt(double(row[3 * v] - row[3 * v - 3]) * (row[3 * v] - row[3 * v - 3]) +
                              double(row[3 * v + 1] - row[3 * v - 2]) * (row[3 * v + 1] - row[3 * v - 2]) +
                              double(row[3 * v + 2] - row[3 * v - 1]) * (row[3 * v + 2] - row[3 * v - 1]));
-        level.push(row.data(), roots.positions[i], roots.scalp[i], map.frame(roots.scalp[i].x(), roots.scalp[i].y()),
+        level.push(row.data(), roots.positions[i], roots.scalp[i], frame,
                    float(len * radius));
     }
 }

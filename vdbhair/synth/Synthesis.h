@@ -112,6 +112,12 @@ struct SynthParams
     /// RootScatter.h): a dense short crown stays dense. false: evenly over the region (the paper's
     /// "randomly generate hair roots" and Turk's relaxation)
     bool exampleDensity = true;
+    /// The coarsest level's wisps in the feature map as offsets along the head's axes (a wisp read
+    /// at a root higher or lower on the head hangs as it did); false: in each root's scalp frame,
+    /// the paper's (a long wisp read at a higher root turned outward with the scalp's normal: Ruby's
+    /// long hair flared, its tips 41 units out from the head against the example's 24, 90th
+    /// percentile)
+    bool mapInHeadAxes = true;
     bool refine = true;        ///< §5.3 after every level
     double voxelSize = 0.0;    ///< the finest level's refinement voxel, world units (0: suggestVoxelSize(example))
     RefineMode refineMode = RefineMode::Consistent;
