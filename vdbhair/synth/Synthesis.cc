@@ -245,9 +245,9 @@ std::vector<Vec3d> regionInScalpSpace(const std::vector<Vec3d>* outputRegion, co
     return regionUv;
 }
 
-/// The rows of @a samples as the feature map holds them: along the head's axes (the sphere's, in
-/// which the map's (u, v) are measured: ScalpFrame's identity here, world axes) when @a headAxes,
-/// else as they are, in each root's frame.
+/// The rows of @a samples as the feature map holds them: when @a headAxes, along the world's axes,
+/// one frame for every root (the head's, which does not turn), so a wisp keeps its direction
+/// wherever the map reads it; else as they are, in each root's frame.
 std::vector<float> mapRows(const StrandSamples& samples, bool headAxes)
 {
     std::vector<float> rows(samples.local.begin(), samples.local.end());
@@ -366,7 +366,7 @@ ScatteredRoots scatterLevelRoots(const SynthResult& res, const SynthParams& para
 }
 
 /// Step 5, the coarsest level from the synthesized map: at each root, the PCA reconstruction of
-/// the nearest feature, its root at the root.
+/// the nearest feature (turned from the map's axes into the root's frame), its root at the root.
 void synthesizeCoarsestLevel(SynthResult& res, const SynthParams& params, const ScatteredRoots& roots)
 {
     const ScalpMap& map = *res.map;
