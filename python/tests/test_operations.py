@@ -171,6 +171,8 @@ def test_synth(tmp_path):
         vdbhair.synth(example, region=np.zeros((4, 2)))
     with pytest.raises(ValueError, match="layout 'tiled': must be one of synthesize, example"):
         vdbhair.synth(example, layout="tiled")
+    with pytest.raises(ValueError, match=r"^synth: map_frame 'sideways': must be one of head, root$"):
+        vdbhair.synth(example, map_frame="sideways")
     with pytest.raises(ValueError, match=r"^synth: strands -1: must be at least 0$"):
         vdbhair.synth(example, strands=-1)
 

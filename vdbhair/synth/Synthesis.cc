@@ -248,20 +248,25 @@ std::vector<Vec3d> regionInScalpSpace(const std::vector<Vec3d>* outputRegion, co
 /// The rows of @a samples as the feature map holds them: when @a headAxes, along the world's axes,
 /// one frame for every root (the head's, which does not turn), so a wisp keeps its direction
 /// wherever the map reads it; else as they are, in each root's frame.
+/// Each vertex of @a row (@a vertices of them, x y z) replaced by @a turn of it.
+template <typename Turn>
+void turnRow(float* row, int vertices, Turn turn)
+{
+    for (int v = 0; v < vertices; ++v) {
+        float* q = row + 3 * v;
+        const Vec3d t = turn(Vec3d(q[0], q[1], q[2]));
+        q[0] = float(t.x());
+        q[1] = float(t.y());
+        q[2] = float(t.z());
+    }
+}
+
 std::vector<float> mapRows(const StrandSamples& samples, bool headAxes)
 {
     std::vector<float> rows(samples.local.begin(), samples.local.end());
     if (!headAxes) return rows;
-    for (std::size_t s = 0; s < samples.count(); ++s) {
-        float* row = rows.data() + s * samples.dim();
-        for (int v = 0; v < samples.vertices; ++v) {
-            float* q = row + 3 * v;
-            const Vec3d w = samples.frames[s].toWorld(Vec3d(q[0], q[1], q[2]));
-            q[0] = float(w.x());
-            q[1] = float(w.y());
-            q[2] = float(w.z());
-        }
-    }
+    for (std::size_t s = 0; s < samples.count(); ++s)
+        turnRow(rows.data() + s * samples.dim(), samples.vertices, [&](const Vec3d& q) { return samples.frames[s].toWorld(q); });
     return rows;
 }
 
@@ -380,14 +385,7 @@ void synthesizeCoarsestLevel(SynthResult& res, const SynthParams& params, const 
             throw ValueError("synthesizeHair: the output feature map has no valid pixel");
         res.pca.reconstruct(f.data(), row.data());
         const ScalpFrame frame = map.frame(roots.scalp[i].x(), roots.scalp[i].y());
-        if (params.mapInHeadAxes) {
-            for (int v = 0; v < params.vertices; ++v) {
-                const Vec3d q = frame.toLocal(Vec3d(row[3 * v], row[3 * v + 1], row[3 * v + 2]));
-                row[3 * v] = float(q.x());
-                row[3 * v + 1] = float(q.y());
-                row[3 * v + 2] = float(q.z());
-            }
-        }
+        if (params.mapInHeadAxes) turnRow(row.data(), params.vertices, [&](const Vec3d& q) { return frame.toLocal(q); });
         row[0] = row[1] = row[2] = 0.0f;  // the root is the root
         double len = 0.0;
         for (int v = 1; v < params.vertices; ++v)
