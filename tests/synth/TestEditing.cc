@@ -331,6 +331,37 @@ TEST_CASE("combHair on HairNet's groom and head: strands pressed along the surfa
     }
 }
 
+TEST_CASE("combHair on HairNet's groom and head: strands pressed into the ear and the side of the head lie on it without a fold", "[synth][data]")
+{
+    // Three more strokes of scripts/comb_strokes.py (seed 1, strokes 3 and 5; seed 4, stroke 4),
+    // presses into the side of the head. At the ear (1.5 of the level set's voxels thick) the
+    // normals of two points an edge apart point opposite ways: no turn in one plane lifted a
+    // vertex, the strand went on inside and its last pass pushed it out vertex by vertex into a
+    // fold (turns of 165-178 degrees between edges; 9 strands in all).
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const std::string dir = vdbhair::test::sharedData();
+    const StrandSet hair = readStrands(dir + "/hair/hairnet_convdata/strands00014_00035_00010.convdata");
+    CombParams params;
+    params.head = readHeadObstacle(dir + "/scalp/usc_hairsalon/head_model.ply", "test");
+    const auto stroke = [](std::vector<Vec3d> points, double radius, double strength) {
+        CombStroke s;
+        s.points = std::move(points);
+        s.radius = radius;
+        s.strength = strength;
+        return s;
+    };
+    const std::vector<CombStroke> strokes = {stroke({Vec3d(-0.1595, 1.7622, -0.0022), Vec3d(-0.0203, 1.7059, 0.0072)}, 0.0447, 0.737),
+                                             stroke({Vec3d(-0.2093, 1.7195, 0.0108), Vec3d(-0.0291, 1.6794, 0.0088)}, 0.0927, 0.557),
+                                             stroke({Vec3d(-0.1263, 1.7679, -0.1558), Vec3d(-0.0292, 1.7216, -0.0278)}, 0.0810, 0.824)};
+    for (std::size_t k = 0; k < strokes.size(); ++k) {
+        const CombResult combed = combHair(hair, {strokes[k]}, params);
+        CAPTURE(k, combed.stats.movedStrands, combed.stats.headDeflected, combed.stats.insideHeadBefore, combed.stats.insideHeadAfter);
+        REQUIRE(combed.stats.headDeflected > 10);
+        CHECK(combed.stats.newKinks == 0);
+        CHECK(combed.stats.insideHeadAfter <= combed.stats.insideHeadBefore);
+    }
+}
+
 TEST_CASE("combHair on a real groom with its head mesh: no kinks at the shoulders", "[synth][data]")
 {
     // Ruby's long hair swept sideways across her back by a stroke of radius 20, on her head and
