@@ -20,7 +20,14 @@
 /// meets the head at a shallower angle and turns less. Passes repeat while a sweep turns an edge
 /// by more than 5 degrees (up to `passes`); of the swept strands, the one with the smallest
 /// largest turn between two edges is kept (a strand along the surface may not settle, each sweep
-/// turning as much as the smoothing took back). The strand's own shape (curls,
+/// turning as much as the smoothing took back); where that one still turns more than 45 degrees at
+/// a vertex and the strand as given did not, passes that rebuild the strand each sweep was given
+/// (accumulating the smoothed turns) run as well, and the less kinked is kept. Where no turn in
+/// the sweep's plane lifts a vertex (a thin part of the level set, whose normals an edge apart
+/// point opposite ways), the least turn towards any direction that does is taken; under
+/// HeadDepthRule::Allowance an edge that would bend more than 45 degrees from the edge before
+/// turns from that edge's direction instead, if that bends it less (a strand pressed head-on
+/// slides on along the surface). The strand's own shape (curls,
 /// waves) rides along: its edges are turned, not its positions smoothed (which would straighten
 /// it and, on a convex head, pull it back in), and a smooth rotation field cannot fold it the way
 /// smoothed displacements can (a strand pressed head-on into the head). A last pass pushes what is
