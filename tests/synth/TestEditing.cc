@@ -213,6 +213,32 @@ double maxEdgeTurnDegrees(const StrandSet& s, std::size_t i)
     return worst;
 }
 
+CombStroke makeStroke(std::vector<Vec3d> points, double radius, double strength)
+{
+    CombStroke s;
+    s.points = std::move(points);
+    s.radius = radius;
+    s.strength = strength;
+    return s;
+}
+
+/// Comb HairNet's groom with its head mesh by each of @a strokes alone: the head pushes strands
+/// out, and no moved strand gains a kink or goes deeper into the head.
+void checkHairNetStrokes(const std::vector<CombStroke>& strokes)
+{
+    const std::string dir = vdbhair::test::sharedData();
+    const StrandSet hair = readStrands(dir + "/hair/hairnet_convdata/strands00014_00035_00010.convdata");
+    CombParams params;
+    params.head = readHeadObstacle(dir + "/scalp/usc_hairsalon/head_model.ply", "test");
+    for (std::size_t k = 0; k < strokes.size(); ++k) {
+        const CombResult combed = combHair(hair, {strokes[k]}, params);
+        CAPTURE(k, combed.stats.movedStrands, combed.stats.headDeflected, combed.stats.insideHeadBefore, combed.stats.insideHeadAfter);
+        REQUIRE(combed.stats.headDeflected > 10);
+        CHECK(combed.stats.newKinks == 0);
+        CHECK(combed.stats.insideHeadAfter <= combed.stats.insideHeadBefore);
+    }
+}
+
 } // namespace
 
 TEST_CASE("combHair: a stroke into the head pushes strands out of it along a length, no kinks, lengths and roots kept", "[synth]")
@@ -306,29 +332,10 @@ TEST_CASE("combHair on HairNet's groom and head: strands pressed along the surfa
     // and falls, never settled, each sweep turning as much as the smoothing took back, and their
     // last sweep kinked them (7-16 strands a stroke, up to 70 degrees) where an earlier one did not.
     VDBHAIR_REQUIRE_SHARED_DATA();
-    const std::string dir = vdbhair::test::sharedData();
-    const StrandSet hair = readStrands(dir + "/hair/hairnet_convdata/strands00014_00035_00010.convdata");
-    CombParams params;
-    params.head = readHeadObstacle(dir + "/scalp/usc_hairsalon/head_model.ply", "test");
-    const auto stroke = [](std::vector<Vec3d> points, double radius, double strength) {
-        CombStroke s;
-        s.points = std::move(points);
-        s.radius = radius;
-        s.strength = strength;
-        return s;
-    };
-    const std::vector<CombStroke> strokes = {
-        stroke({Vec3d(0.1848, 1.7542, -0.0683), Vec3d(0.0543, 1.6819, -0.0146)}, 0.0696, 0.816),
-        stroke({Vec3d(-0.134, 1.7195, 0.1158), Vec3d(-0.0303, 1.6986, 0.0316)}, 0.0910, 0.571),
-        stroke({Vec3d(-0.1416, 1.7554, 0.0072), Vec3d(-0.0811, 1.7554, 0.0864), Vec3d(-0.003, 1.7554, 0.1484)}, 0.0458, 0.492),
-        stroke({Vec3d(-0.1111, 1.711, 0.0957), Vec3d(-0.0142, 1.711, 0.1191), Vec3d(0.0855, 1.711, 0.1179)}, 0.0874, 0.842)};
-    for (std::size_t k = 0; k < strokes.size(); ++k) {
-        const CombResult combed = combHair(hair, {strokes[k]}, params);
-        CAPTURE(k, combed.stats.movedStrands, combed.stats.headDeflected, combed.stats.insideHeadBefore, combed.stats.insideHeadAfter);
-        REQUIRE(combed.stats.headDeflected > 10);
-        CHECK(combed.stats.newKinks == 0);
-        CHECK(combed.stats.insideHeadAfter <= combed.stats.insideHeadBefore);
-    }
+    checkHairNetStrokes({makeStroke({Vec3d(0.1848, 1.7542, -0.0683), Vec3d(0.0543, 1.6819, -0.0146)}, 0.0696, 0.816),
+                         makeStroke({Vec3d(-0.134, 1.7195, 0.1158), Vec3d(-0.0303, 1.6986, 0.0316)}, 0.0910, 0.571),
+                         makeStroke({Vec3d(-0.1416, 1.7554, 0.0072), Vec3d(-0.0811, 1.7554, 0.0864), Vec3d(-0.003, 1.7554, 0.1484)}, 0.0458, 0.492),
+                         makeStroke({Vec3d(-0.1111, 1.711, 0.0957), Vec3d(-0.0142, 1.711, 0.1191), Vec3d(0.0855, 1.711, 0.1179)}, 0.0874, 0.842)});
 }
 
 TEST_CASE("combHair on HairNet's groom and head: strands pressed into the ear, the side of the head and the face lie on it without a fold", "[synth][data]")
@@ -342,28 +349,10 @@ TEST_CASE("combHair on HairNet's groom and head: strands pressed into the ear, t
     // did not settle (5 strands kinked 55-70 degrees), until pressed edges slid on from the edge
     // before and accumulated passes ran where the best pass still kinked.
     VDBHAIR_REQUIRE_SHARED_DATA();
-    const std::string dir = vdbhair::test::sharedData();
-    const StrandSet hair = readStrands(dir + "/hair/hairnet_convdata/strands00014_00035_00010.convdata");
-    CombParams params;
-    params.head = readHeadObstacle(dir + "/scalp/usc_hairsalon/head_model.ply", "test");
-    const auto stroke = [](std::vector<Vec3d> points, double radius, double strength) {
-        CombStroke s;
-        s.points = std::move(points);
-        s.radius = radius;
-        s.strength = strength;
-        return s;
-    };
-    const std::vector<CombStroke> strokes = {stroke({Vec3d(-0.1595, 1.7622, -0.0022), Vec3d(-0.0203, 1.7059, 0.0072)}, 0.0447, 0.737),
-                                             stroke({Vec3d(-0.2093, 1.7195, 0.0108), Vec3d(-0.0291, 1.6794, 0.0088)}, 0.0927, 0.557),
-                                             stroke({Vec3d(-0.1263, 1.7679, -0.1558), Vec3d(-0.0292, 1.7216, -0.0278)}, 0.0810, 0.824),
-                                             stroke({Vec3d(-0.0129, 1.7235, 0.1479), Vec3d(0.0705, 1.7235, 0.0932), Vec3d(0.1378, 1.7235, 0.0197)}, 0.0842, 0.839)};
-    for (std::size_t k = 0; k < strokes.size(); ++k) {
-        const CombResult combed = combHair(hair, {strokes[k]}, params);
-        CAPTURE(k, combed.stats.movedStrands, combed.stats.headDeflected, combed.stats.insideHeadBefore, combed.stats.insideHeadAfter);
-        REQUIRE(combed.stats.headDeflected > 10);
-        CHECK(combed.stats.newKinks == 0);
-        CHECK(combed.stats.insideHeadAfter <= combed.stats.insideHeadBefore);
-    }
+    checkHairNetStrokes({makeStroke({Vec3d(-0.1595, 1.7622, -0.0022), Vec3d(-0.0203, 1.7059, 0.0072)}, 0.0447, 0.737),
+                         makeStroke({Vec3d(-0.2093, 1.7195, 0.0108), Vec3d(-0.0291, 1.6794, 0.0088)}, 0.0927, 0.557),
+                         makeStroke({Vec3d(-0.1263, 1.7679, -0.1558), Vec3d(-0.0292, 1.7216, -0.0278)}, 0.0810, 0.824),
+                         makeStroke({Vec3d(-0.0129, 1.7235, 0.1479), Vec3d(0.0705, 1.7235, 0.0932), Vec3d(0.1378, 1.7235, 0.0197)}, 0.0842, 0.839)});
 }
 
 TEST_CASE("combHair on a real groom with its head mesh: no kinks at the shoulders", "[synth][data]")
