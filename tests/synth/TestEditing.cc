@@ -325,6 +325,31 @@ TEST_CASE("combHair: coarse straight strands pressed into a sphere head gain no 
     }
 }
 
+TEST_CASE("combHair: a stroke about an edge wide across straight.hair's coarse strands turns them without a kink", "[synth][data]")
+{
+    // 16 vertices a strand, its last edges a tenth of the strand long: a sweep drawn at random by
+    // scripts/comb_strokes.py (seed 6, stroke 2), about as wide as those edges, turned the wisps'
+    // centres (32 vertices) so fast that 128 strands, turned at their edges' midpoints, kinked at
+    // one vertex near the tip (45-66 degrees), without any head. The stroke now bends a wisp by at
+    // most kMaxCombTurnPerEdge over its strands' longest edge.
+    VDBHAIR_REQUIRE_SHARED_DATA();
+    const StrandSet hair = readStrands(vdbhair::test::sharedData() + "/hair/cyhair/straight.hair");
+    CombParams params;
+    params.head = HeadObstacle::none();
+    const CombStroke across = makeStroke({Vec3d(0.4644, -51.9382, 0.3265), Vec3d(27.114, -25.9166, 0.3265), Vec3d(46.5383, 5.8643, 0.3265)}, 12.556, 0.944);
+    const CombResult combed = combHair(hair, {across}, params);
+    CAPTURE(combed.stats.movedStrands, combed.stats.angleBefore, combed.stats.angleAfter);
+    REQUIRE(combed.stats.movedStrands > 1000);
+    std::size_t kinks = 0;
+    for (std::size_t i = 0; i < hair.numStrands(); ++i) kinks += maxEdgeTurnDegrees(combed.strands, i) > 45.0 && maxEdgeTurnDegrees(hair, i) <= 45.0;
+    CHECK(kinks == 0);
+    CHECK(combed.stats.newKinks == kinks);
+    // Still combed: the strands in its reach turn towards the stroke (96 -> 64 degrees; 56 when it
+    // kinked them).
+    CHECK(combed.stats.angleAfter < combed.stats.angleBefore - 20.0);
+    CHECK(segmentLengthError(hair, combed.strands) < 1e-4);
+}
+
 TEST_CASE("combHair on HairNet's groom and head: strands pressed along the surface keep their least kinked sweep", "[synth][data]")
 {
     // Four of the strokes drawn at random by scripts/comb_strokes.py (seeds 1 and 2) that left new

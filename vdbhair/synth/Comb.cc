@@ -175,7 +175,7 @@ void CombParams::validate(const char* where) const
 }
 
 bool combPolyline(const std::vector<Vec3d>& p, const std::vector<std::vector<Vec3d>>& members, const CombStroke& stroke,
-                  double sigma, std::vector<Vec3d>& out, std::vector<std::array<double, 4>>& rotations)
+                  double sigma, std::vector<Vec3d>& out, std::vector<std::array<double, 4>>& rotations, double maxTurnPerLength)
 {
     const std::size_t n = p.size();
     out = p;
@@ -210,8 +210,13 @@ bool combPolyline(const std::vector<Vec3d>& p, const std::vector<std::vector<Vec
         if (w > 0.0 && len > 0.0 && dir.length() > 0.0) {
             EVec t = toE(smooth[i + 1] - smooth[i]);
             t = t.norm() > 0.0 ? EVec(t.normalized()) : EVec(e / len);
-            const double f = w >= 1.0 ? 1.0 : 1.0 - std::pow(1.0 - w, len / stroke.radius);
-            const Quat R = turnToward((C * t).normalized(), toE(dir.unitSafe()), f);
+            double f = w >= 1.0 ? 1.0 : 1.0 - std::pow(1.0 - w, len / stroke.radius);
+            const EVec from = (C * t).normalized(), to = toE(dir.unitSafe());
+            if (maxTurnPerLength > 0.0) {
+                const double angle = std::acos(std::clamp(from.dot(to), -1.0, 1.0));
+                if (f * angle > maxTurnPerLength * len) f = maxTurnPerLength * len / angle;
+            }
+            const Quat R = turnToward(from, to, f);
             C = (R * C).normalized();
             touched = true;
         }
@@ -225,6 +230,13 @@ bool combPolyline(const std::vector<Vec3d>& p, const std::vector<std::vector<Vec
 }
 
 namespace {
+
+/// The most one stroke turns a wisp over the length of its strands' longest edge (radians): a
+/// strand sampled at 16 vertices (`straight.hair`: its last edges a tenth of its length) cannot
+/// bend more sharply than its edges show, and a stroke about an edge wide turned its wisp's centre
+/// (32 vertices) so fast that its strands, turned at their edges' midpoints, kinked at one vertex
+/// by 45-66 degrees (128 strands of one random sweep).
+constexpr double kMaxCombTurnPerEdge = 40.0 * M_PI / 180.0;
 
 /// One combHair() call: its inputs, the hierarchy, and what each step leaves for the next.
 struct CombRun
@@ -296,9 +308,18 @@ void deformCoarsest(CombRun& run, CombResult& res)
         std::vector<std::vector<Vec3d>> wisp;
         for (std::uint32_t m : members[c]) wisp.push_back(world(fine, m));
         run.rot[c].assign(ns - 1, Quat::Identity());
+        // The longest edge of the wisp's strands as given: the stroke bends the wisp by at most
+        // kMaxCombTurnPerEdge over that length.
+        double longest = 0.0;
+        for (std::uint32_t m : members[c]) {
+            const std::size_t s = run.order[m];
+            const Vec3f* v = run.strands.data(s);
+            for (std::size_t k = 1; k < run.strands.size(s); ++k) longest = std::max(longest, double((v[k] - v[k - 1]).length()));
+        }
+        const double maxTurn = longest > 0.0 ? kMaxCombTurnPerEdge / longest : 0.0;
         std::vector<std::array<double, 4>> r;
         for (const CombStroke& s : run.strokes) {
-            if (!combPolyline(p, wisp, s, sigma, q, r)) continue;
+            if (!combPolyline(p, wisp, s, sigma, q, r, maxTurn)) continue;
             run.touched[c] = 1;
             for (std::size_t i = 0; i + 1 < ns; ++i) run.rot[c][i] = (toQuat(r[i]) * run.rot[c][i]).normalized();
             // The members as the stroke left them: their edges turned by the same rotations.

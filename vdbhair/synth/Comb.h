@@ -130,9 +130,13 @@ struct CombResult
 /// vertex i is the mean of the stroke's influence on them at vertex i (where each has moved to),
 /// its direction the influence-weighted mean; empty: the influence on @a points itself
 /// @param rotations receives one rotation per edge as quaternions (w, x, y, z)
+/// @param maxTurnPerLength if positive, the most the stroke turns the strand per unit of its
+/// length (radians): strands whose own edges are long cannot bend more sharply than their edges
+/// show (combHair(): kMaxCombTurnPerEdge over the longest edge of the wisp's strands)
 /// @return whether the stroke reached it (false: @a out equals @a points, rotations are identity)
 bool combPolyline(const std::vector<Vec3d>& points, const std::vector<std::vector<Vec3d>>& members, const CombStroke& stroke,
-                  double sigmaVertices, std::vector<Vec3d>& out, std::vector<std::array<double, 4>>& rotations);
+                  double sigmaVertices, std::vector<Vec3d>& out, std::vector<std::array<double, 4>>& rotations,
+                  double maxTurnPerLength = 0.0);
 
 /// @brief Comb @a strands with @a strokes in order.
 /// @param scalp the scalp level set, or null for the sphere fitted to the roots (the hierarchy's
