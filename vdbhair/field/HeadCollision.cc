@@ -24,7 +24,7 @@ Vec3d toD(const Vec3f& v) { return Vec3d(v.x(), v.y(), v.z()); }
 struct StrandWork
 {
     std::vector<Vec3d> p, c;  ///< the strand, and as it was given
-    std::vector<Vec3d> r;     ///< the strand before this pass's sweep (PassScheme::Accumulated)
+    std::vector<Vec3d> r;     ///< the strand before this pass's sweep (accumulated passes)
     /// Each edge's turn from the given strand (a rotation vector: axis times angle), its smoothed
     /// copy and prefix sums (smoothTurns())
     std::vector<Vec3d> turn, smooth, sum;
@@ -53,9 +53,7 @@ struct DepthFloor
     void placed(double d) { shallowest = std::max(shallowest, d); }
 };
 
-/// A kink: a turn of over 45 degrees between two edges (what the issue tracker and the comb
-/// strokes measure).
-const double kKinkCosine = std::cos(M_PI / 4.0);
+const double kKinkCosine = std::cos(kKinkDegrees * M_PI / 180.0);
 
 /// Directions spread evenly over the sphere (a Fibonacci lattice): the search of last resort for
 /// an edge that no turn in one plane lifts out.
@@ -223,8 +221,8 @@ double sweep(std::size_t n, DepthFloor floor, HeadObstacle::Probe& probe, Strand
             Vec3d np;
             const double dp = probe.distance(a + prev * l, np);
             if (np.lengthSqr() == 0.0) np = nrm;
-            const Lift slide = !(dp < target) ? Lift{true, 0.0, dp, a + prev * l}
-                                              : liftEdge(probe, a, prev, perpendicular(np, prev), l, target, dp, l * np.dot(perpendicular(np, prev)), M_PI / 2.0);
+            const Vec3d tp = perpendicular(np, prev);
+            const Lift slide = !(dp < target) ? Lift{true, 0.0, dp, a + prev * l} : liftEdge(probe, a, prev, tp, l, target, dp, l * np.dot(tp), M_PI / 2.0);
             if (slide.found && std::cos(slide.angle) > bend) {
                 lift = slide;
                 lift.angle = std::acos(std::clamp((slide.end - a).dot(dHat) / l, -1.0, 1.0));

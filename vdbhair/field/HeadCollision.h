@@ -44,6 +44,10 @@
 
 namespace vdbhair {
 
+/// A turn between two consecutive edges above this many degrees is a kink: what the sweep avoids
+/// making (below) and what `comb` reports as a new kink (CombStats::newKinks).
+constexpr double kKinkDegrees = 45.0;
+
 /// How deep a vertex may be: as its allowance says, or also no deeper than its strand was before it.
 enum class HeadDepthRule
 {

@@ -450,7 +450,7 @@ void measureComb(const CombRun& run, const HeadObstacle& head, CombResult& res)
                 }
             }
             if (m < 2) return;
-            if (moved[s]) kinked[s] = maxEdgeTurnDegrees(b, m) > kCombKinkDegrees && !(maxEdgeTurnDegrees(a, m) > kCombKinkDegrees);
+            if (moved[s]) kinked[s] = maxEdgeTurnDegrees(b, m) > kKinkDegrees && !(maxEdgeTurnDegrees(a, m) > kKinkDegrees);
             for (const CombStroke& k : strokes)
                 for (std::size_t v = 0; v < m; ++v) {
                     Vec3d dirA, dirB;

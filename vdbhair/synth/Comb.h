@@ -35,7 +35,7 @@
 /// length and every root exactly, and a strand whose centre no stroke reaches is copied unchanged.
 #pragma once
 
-#include <vdbhair/field/HeadObstacle.h>
+#include <vdbhair/field/HeadCollision.h>
 #include <vdbhair/synth/Synthesis.h>
 
 #include <array>
@@ -109,13 +109,10 @@ struct CombStats
     std::size_t headDeflected = 0;  ///< moved strands the head pushed out
     /// Vertices of the moved strands inside the head (signed distance below 0), before and after
     std::size_t insideHeadBefore = 0, insideHeadAfter = 0;
-    /// Moved strands that turn by more than kCombKinkDegrees between two consecutive edges and did
+    /// Moved strands that turn by more than kKinkDegrees between two consecutive edges and did
     /// not before: kinks the comb (or the head pushing hair out of it) made
     std::size_t newKinks = 0;
 };
-
-/// A turn between two consecutive edges above this many degrees is a kink (CombStats::newKinks).
-constexpr double kCombKinkDegrees = 45.0;
 
 struct CombResult
 {
