@@ -148,3 +148,78 @@ TEST_CASE("rootDensity and scatterRoots: new roots at the example's density, pla
     CHECK(share(scatterRoots(unitMap(), grid, mask, params, true, &density)) == Approx(exampleShare).margin(0.05));
     CHECK_THROWS_WITH(rootDensity(grid, {}, mask), Catch::Contains("no coordinates"));
 }
+
+TEST_CASE("scatterAroundRoots: new roots where the example's are, each side's share kept, deterministic", "[synth]")
+{
+    // The example of the test above: four times as dense where u is below the split.
+    const std::vector<Vec3d> all = capCoords(4000);
+    std::vector<double> us;
+    for (const Vec3d& c : all) us.push_back(c.x());
+    std::nth_element(us.begin(), us.begin() + std::ptrdiff_t(us.size() / 2), us.end());
+    const double split = us[us.size() / 2];
+    std::vector<Vec3d> coords;
+    for (std::size_t i = 0; i < all.size(); ++i)
+        if (all[i].x() < split || i % 4 == 0) coords.push_back(all[i]);
+    const UvGrid grid = uvGridAround(all, 0.02);
+    std::vector<float> f(all.size(), 0.0f);
+    const FeatureImage mask = buildFeatureMap(grid, all, f.data(), 1, all, 2.0 * medianUvSpacing(all));
+    const auto leftShare = [&](const std::vector<Vec3d>& uv) {
+        return double(std::count_if(uv.begin(), uv.end(), [&](const Vec3d& c) { return c.x() < split; })) / double(uv.size());
+    };
+    const double exampleShare = leftShare(coords);
+    // The distance in (u, v) from each new root to the nearest example root, over that root's
+    // distance to its own nearest neighbour.
+    std::vector<Vec3d> flat;
+    for (const Vec3d& c : coords) flat.emplace_back(c.x(), c.y(), 0.0);
+    const auto nearest = [&](const Vec3d& q, std::size_t skip) {
+        double best = 1e300;
+        std::size_t at = 0;
+        for (std::size_t j = 0; j < flat.size(); ++j) {
+            const double d = (Vec3d(q.x(), q.y(), 0.0) - flat[j]).length();
+            if (j != skip && d < best) best = d, at = j;
+        }
+        return std::make_pair(best, at);
+    };
+    RootScatterParams params;
+    params.count = coords.size();
+    params.seed = 5;
+    const ScatteredRoots once = scatterAroundRoots(unitMap(), grid, mask, coords, params);
+    REQUIRE(once.scalp.size() == coords.size());
+    CAPTURE(exampleShare, leftShare(once.scalp));
+    // As many new roots as example roots: each side's share is the example's up to the few roots
+    // within half a spacing of the split; none strays further than half its example root's spacing
+    // from it, and few sit on an example root (they are new).
+    CHECK(leftShare(once.scalp) == Approx(exampleShare).margin(0.01));
+    std::size_t onRoot = 0;
+    for (std::size_t i = 0; i < once.scalp.size(); i += 7) {
+        CHECK(once.positions[i].length() == Approx(1.0).margin(1e-9));
+        const auto [d, j] = nearest(once.scalp[i], flat.size());
+        const double spacing = nearest(flat[j], j).first;
+        CHECK(d <= kAroundReach * spacing * 1.5 + 1e-12);
+        onRoot += d < 0.05 * spacing;
+    }
+    CHECK(onRoot < once.scalp.size() / 7 / 20);
+    CHECK(scatterAroundRoots(unitMap(), grid, mask, coords, params, false).positions == once.positions);
+    // Three times as many: drawn round three times and relaxed at the example's density, so the
+    // shares and the 2 : 1 spacing stand and the repeats spread out.
+    params.count = 3 * coords.size();
+    const ScatteredRoots more = scatterAroundRoots(unitMap(), grid, mask, coords, params);
+    CAPTURE(leftShare(more.scalp));
+    CHECK(leftShare(more.scalp) == Approx(exampleShare).margin(0.03));
+    std::vector<Vec3f> left, right;
+    for (std::size_t i = 0; i < more.scalp.size(); ++i) {
+        const double u = more.scalp[i].x();
+        if (u < split - 0.2) left.emplace_back(more.positions[i]);
+        if (u > split + 0.2) right.emplace_back(more.positions[i]);
+    }
+    const FollicleStats sl = measureFollicles(left), sr = measureFollicles(right);
+    CAPTURE(sl.nnMean, sr.nnMean, sl.nnCV, sr.nnCV);
+    CHECK(sr.nnMean / sl.nnMean == Approx(2.0).epsilon(0.25));
+    CHECK(sl.nnCV < 0.4);
+    CHECK(sr.nnCV < 0.4);
+    CHECK(scatterAroundRoots(unitMap(), grid, mask, coords, params, false).positions == more.positions);
+    params.count = 0;
+    CHECK_THROWS_WITH(scatterAroundRoots(unitMap(), grid, mask, coords, params), Catch::Contains("count of 0"));
+    params.count = 10;
+    CHECK_THROWS_WITH(scatterAroundRoots(unitMap(), grid, mask, {}, params), Catch::Contains("no example roots"));
+}

@@ -133,18 +133,14 @@ double regionArea(const ScalpMap& map, const UvGrid& grid, const FeatureImage& m
     return a;
 }
 
-ScatteredRoots scatterRoots(const ScalpMap& map, const UvGrid& grid, const FeatureImage& mask,
-                            const RootScatterParams& params, bool threaded, const FeatureImage* density)
+namespace {
+/// Each valid pixel's weight in the draw: its world area, or with @a density its expected roots
+/// (with a floor of a twentieth of the mean, which keeps every pixel of the region reachable and
+/// its spacing, below, finite). @return their sum.
+double pixelWeights(const std::vector<double>& area, const FeatureImage* density, std::vector<double>& weight)
 {
-    if (params.count == 0) throw ValueError("scatterRoots: a count of 0 roots");
-    if (density && (density->width != grid.width || density->height != grid.height || density->channels != 1))
-        throw ValueError("scatterRoots: the density image is not one channel on the grid");
-    // 1. Pixel weights (areas, or expected roots) and their running sum.
-    const std::vector<double> area = pixelAreas(map, grid, mask);
-    std::vector<double> weight = area;
+    weight = area;
     if (density) {
-        // A floor of a twentieth of the mean keeps every pixel of the region reachable and its
-        // spacing (below) finite.
         double sum = 0.0;
         std::size_t valid = 0;
         for (std::size_t p = 0; p < area.size(); ++p)
@@ -157,33 +153,22 @@ ScatteredRoots scatterRoots(const ScalpMap& map, const UvGrid& grid, const Featu
         for (std::size_t p = 0; p < area.size(); ++p)
             if (area[p] > 0.0) weight[p] = std::max(weight[p], floor);
     }
-    std::vector<double> cdf(area.size());
     double total = 0.0;
-    for (std::size_t i = 0; i < weight.size(); ++i) cdf[i] = (total += weight[i]);
-    if (!(total > 0.0)) throw LookupError("scatterRoots: the scalp region holds no valid pixel");
-    ScatteredRoots out;
-    out.area = 0.0;
-    for (double a : area) out.area += a;
-    const std::size_t n = params.count;
-    out.positions.resize(n);
-    out.scalp.resize(n);
-    const auto forEach = [&](auto&& fn) { forEachIndex(n, threaded, fn, 512); };
-    // 2. Random roots, by weight.
-    forEach([&](std::size_t i) {
-        Rng rng(params.seed, 0x700754u + params.stream, i);
-        const double t = rng.uniform() * total;
-        const std::size_t p = std::size_t(std::upper_bound(cdf.begin(), cdf.end(), t) - cdf.begin());
-        const std::size_t pix = std::min(p, cdf.size() - 1);
-        const int x = int(pix % std::size_t(grid.width)), y = int(pix / std::size_t(grid.width));
-        const double u = grid.u(x + rng.uniform() - 0.5), v = grid.v(y + rng.uniform() - 0.5);
-        out.scalp[i] = Vec3d(u, v, 0.0);
-        out.positions[i] = map.toWorld(out.scalp[i]);
-    });
-    // The hexagonal spacing d of n roots: over the whole region (even), or per pixel from the
-    // roots expected there, n weight / total, over its area.
+    for (double w : weight) total += w;
+    return total;
+}
+
+/// Step 3, Turk's relaxation of @a out's roots at the hexagonal spacing d of their count: over the
+/// whole region (even), or per pixel from the roots expected there, count × weight / total, over
+/// its area.
+void relaxAtDensity(const ScalpMap& map, const UvGrid& grid, const FeatureImage& mask, const std::vector<double>& area,
+                    const std::vector<double>& weight, double total, bool byDensity, int iterations, bool threaded,
+                    ScatteredRoots& out)
+{
+    const std::size_t n = out.positions.size();
     const double evenSpacing = std::sqrt(2.0 * out.area / (std::sqrt(3.0) * double(n)));
     std::vector<double> spacing;
-    if (density) {
+    if (byDensity) {
         spacing.assign(area.size(), evenSpacing);
         for (std::size_t p = 0; p < area.size(); ++p)
             if (area[p] > 0.0) spacing[p] = std::sqrt(2.0 * area[p] * total / (std::sqrt(3.0) * double(n) * weight[p]));
@@ -194,7 +179,95 @@ ScatteredRoots scatterRoots(const ScalpMap& map, const UvGrid& grid, const Featu
         grid.pixelOf(uv.x(), uv.y(), x, y);
         return spacing[std::size_t(y) * grid.width + x];
     };
-    relaxRoots(map, grid, mask, params.iterations, threaded, spacingAt, out);
+    relaxRoots(map, grid, mask, iterations, threaded, spacingAt, out);
+}
+} // namespace
+
+ScatteredRoots scatterRoots(const ScalpMap& map, const UvGrid& grid, const FeatureImage& mask,
+                            const RootScatterParams& params, bool threaded, const FeatureImage* density)
+{
+    if (params.count == 0) throw ValueError("scatterRoots: a count of 0 roots");
+    if (density && (density->width != grid.width || density->height != grid.height || density->channels != 1))
+        throw ValueError("scatterRoots: the density image is not one channel on the grid");
+    // 1. Pixel weights (areas, or expected roots) and their running sum.
+    const std::vector<double> area = pixelAreas(map, grid, mask);
+    std::vector<double> weight;
+    const double total = pixelWeights(area, density, weight);
+    if (!(total > 0.0)) throw LookupError("scatterRoots: the scalp region holds no valid pixel");
+    std::vector<double> cdf(weight.size());
+    double running = 0.0;
+    for (std::size_t i = 0; i < weight.size(); ++i) cdf[i] = (running += weight[i]);
+    ScatteredRoots out;
+    for (double a : area) out.area += a;
+    const std::size_t n = params.count;
+    out.positions.resize(n);
+    out.scalp.resize(n);
+    // 2. Random roots, by weight.
+    forEachIndex(n, threaded, [&](std::size_t i) {
+        Rng rng(params.seed, 0x700754u + params.stream, i);
+        const double t = rng.uniform() * total;
+        const std::size_t p = std::size_t(std::upper_bound(cdf.begin(), cdf.end(), t) - cdf.begin());
+        const std::size_t pix = std::min(p, cdf.size() - 1);
+        const int x = int(pix % std::size_t(grid.width)), y = int(pix / std::size_t(grid.width));
+        const double u = grid.u(x + rng.uniform() - 0.5), v = grid.v(y + rng.uniform() - 0.5);
+        out.scalp[i] = Vec3d(u, v, 0.0);
+        out.positions[i] = map.toWorld(out.scalp[i]);
+    }, 512);
+    // 3. Relaxed at the spacing of the density.
+    relaxAtDensity(map, grid, mask, area, weight, total, density != nullptr, params.iterations, threaded, out);
+    return out;
+}
+
+ScatteredRoots scatterAroundRoots(const ScalpMap& map, const UvGrid& grid, const FeatureImage& mask,
+                                  const std::vector<Vec3d>& exampleCoords, const RootScatterParams& params, bool threaded)
+{
+    if (params.count == 0) throw ValueError("scatterAroundRoots: a count of 0 roots");
+    if (exampleCoords.empty()) throw ValueError("scatterAroundRoots: no example roots to draw around");
+    const std::size_t m = exampleCoords.size(), n = params.count;
+    // Each example root's reach: kAroundReach of the distance to its nearest neighbour in (u, v).
+    std::vector<Vec3d> flat(m);
+    for (std::size_t j = 0; j < m; ++j) flat[j] = Vec3d(exampleCoords[j].x(), exampleCoords[j].y(), 0.0);
+    std::vector<double> reach(m, 0.0);
+    if (m > 1) {
+        PointCloud cloud{&flat};
+        PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+        tree.buildIndex();
+        forEachIndex(m, threaded, [&](std::size_t j) {
+            std::uint32_t idx[2];
+            double d2[2];
+            const double q[3] = {flat[j].x(), flat[j].y(), 0.0};
+            if (tree.knnSearch(q, 2, idx, d2) == 2) reach[j] = kAroundReach * std::sqrt(d2[1]);
+        }, 512);
+    }
+    // The example's roots in a random order, round again while more roots are wanted.
+    std::vector<std::uint32_t> order(m);
+    for (std::size_t j = 0; j < m; ++j) order[j] = std::uint32_t(j);
+    Rng shuffle(params.seed, 0x5c0a7u + params.stream);
+    for (std::size_t j = m; j > 1; --j) std::swap(order[j - 1], order[std::min(j - 1, std::size_t(shuffle.uniform() * double(j)))]);
+    ScatteredRoots out;
+    const std::vector<double> area = pixelAreas(map, grid, mask);
+    for (double a : area) out.area += a;
+    if (!(out.area > 0.0)) throw LookupError("scatterAroundRoots: the scalp region holds no valid pixel");
+    out.positions.resize(n);
+    out.scalp.resize(n);
+    forEachIndex(n, threaded, [&](std::size_t i) {
+        Rng rng(params.seed, 0x700754u + params.stream, i);
+        const Vec3d& at = flat[order[i % m]];
+        const double angle = 2.0 * M_PI * rng.uniform(), r = reach[order[i % m]] * std::sqrt(rng.uniform());
+        Vec3d s(at.x() + r * std::cos(angle), at.y() + r * std::sin(angle), 0.0);
+        int x, y;
+        grid.pixelOf(s.x(), s.y(), x, y);
+        if (!mask.isValid(x, y)) s = at;  // off the region: on the example's root
+        out.scalp[i] = s;
+        out.positions[i] = map.toWorld(s);
+    }, 512);
+    // Roots drawn round again sit near one another: relaxed at the example's density.
+    if (n > m) {
+        const FeatureImage density = rootDensity(grid, exampleCoords, mask);
+        std::vector<double> weight;
+        const double total = pixelWeights(area, &density, weight);
+        relaxAtDensity(map, grid, mask, area, weight, total, true, params.iterations, threaded, out);
+    }
     return out;
 }
 

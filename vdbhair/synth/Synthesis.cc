@@ -356,7 +356,9 @@ FeatureImage synthesizeFeatureMap(SynthResult& res, const SynthParams& params, b
 }
 
 /// Roots of output level @a l, scattered over the output map: its own random stream per level.
-ScatteredRoots scatterLevelRoots(const SynthResult& res, const SynthParams& params, std::size_t count, int l, bool threaded)
+/// @param exampleRegion whether the output grows on the example's own region
+ScatteredRoots scatterLevelRoots(const SynthResult& res, const SynthParams& params, std::size_t count, int l, bool exampleRegion,
+                                 bool threaded)
 {
     RootScatterParams rp;
     rp.count = count;
@@ -364,8 +366,10 @@ ScatteredRoots scatterLevelRoots(const SynthResult& res, const SynthParams& para
     rp.seed = params.seed;
     rp.stream = std::uint64_t(l);
     if (!params.exampleDensity) return scatterRoots(*res.map, res.grid, res.outputMap, rp, threaded);
-    // The example's own roots of this level, per pixel of its region; pixels of another output
-    // region take the nearest region pixel's density.
+    // On the example's region, around the example's own roots of this level; on another region,
+    // at their density per pixel, pixels outside the example's region taking the nearest region
+    // pixel's density.
+    if (exampleRegion) return scatterAroundRoots(*res.map, res.grid, res.outputMap, res.example.levels[std::size_t(l)].scalp, rp, threaded);
     const FeatureImage density = filledFeatureImage(rootDensity(res.grid, res.example.levels[std::size_t(l)].scalp, res.inputMap));
     return scatterRoots(*res.map, res.grid, res.outputMap, rp, threaded, &density);
 }
@@ -465,14 +469,14 @@ SynthResult synthesizeHair(const StrandSet& example, const SynthParams& params, 
     res.output.resize(std::size_t(L));
     {
         SynthStageTimer t{res.stages, "coarsest level"};
-        synthesizeCoarsestLevel(res, params, scatterLevelRoots(res, params, counts[std::size_t(L - 1)], L - 1, threaded));
+        synthesizeCoarsestLevel(res, params, scatterLevelRoots(res, params, counts[std::size_t(L - 1)], L - 1, !outputRegion, threaded));
     }
     // 6-7. Finer levels, refined from the coarsest on.
     const double finestVoxel = params.voxelSize > 0.0 ? params.voxelSize : suggestVoxelSize(example);
     // Refined on the example's scalp: another head's obstacle (the output's) is not the one there.
     SynthParams onExample = params;
     if (outputScalp) onExample.head = HeadObstacle();
-    const auto rootsOf = [&](int l) { return LevelRoots{scatterLevelRoots(res, params, counts[std::size_t(l)], l, threaded).positions, {}}; };
+    const auto rootsOf = [&](int l) { return LevelRoots{scatterLevelRoots(res, params, counts[std::size_t(l)], l, !outputRegion, threaded).positions, {}}; };
     synthesizeFinerLevels(res, res.example, rootsOf, onExample, finestVoxel, /*refineCoarsest=*/true, scalp, threaded, interrupter);
     if (outputScalp) res.strands = moveToScalp(res.strands, *res.map, *outputScalp, params.outputTurn, threaded);
     keepHairOutOfHead(res, synthesisHead(params, scalp, outputScalp != nullptr, example, res.up), outputScalp ? nullptr : &example, threaded);
