@@ -22,6 +22,44 @@ std::vector<Vec3d> capCoords(std::size_t n)
     for (std::size_t s = 0; s < hair.numStrands(); ++s) out.push_back(unitMap().toScalp(Vec3d(hair.root(s))));
     return out;
 }
+
+/// An example four times as dense on one side of a cap (u below @c split) as on the other: its
+/// roots @c coords, the grid and the mask of the whole cap.
+struct DenseSparseExample
+{
+    std::vector<Vec3d> coords;
+    double split = 0.0;
+    UvGrid grid;
+    FeatureImage mask;
+};
+
+DenseSparseExample denseSparseExample()
+{
+    DenseSparseExample e;
+    const std::vector<Vec3d> all = capCoords(4000);
+    std::vector<double> us;
+    for (const Vec3d& c : all) us.push_back(c.x());
+    std::nth_element(us.begin(), us.begin() + std::ptrdiff_t(us.size() / 2), us.end());
+    e.split = us[us.size() / 2];
+    for (std::size_t i = 0; i < all.size(); ++i)
+        if (all[i].x() < e.split || i % 4 == 0) e.coords.push_back(all[i]);
+    e.grid = uvGridAround(all, 0.02);
+    std::vector<float> f(all.size(), 0.0f);
+    e.mask = buildFeatureMap(e.grid, all, f.data(), 1, all, 2.0 * medianUvSpacing(all));
+    return e;
+}
+
+/// The roots' spacing on either side of @a split, 0.2 away from it: the dense side's, the sparse side's.
+std::pair<FollicleStats, FollicleStats> sideSpacings(const ScatteredRoots& roots, double split)
+{
+    std::vector<Vec3f> left, right;
+    for (std::size_t i = 0; i < roots.scalp.size(); ++i) {
+        const double u = roots.scalp[i].x();
+        if (u < split - 0.2) left.emplace_back(roots.positions[i]);
+        if (u > split + 0.2) right.emplace_back(roots.positions[i]);
+    }
+    return {measureFollicles(left), measureFollicles(right)};
+}
 } // namespace
 
 TEST_CASE("buildFeatureMap: a linear feature is interpolated exactly at roots and between them within bounds", "[synth]")
@@ -87,17 +125,7 @@ TEST_CASE("scatterRoots: roots on the scalp, in the region, more even after rela
 TEST_CASE("rootDensity and scatterRoots: new roots at the example's density, place by place", "[synth]")
 {
     // An example four times as dense on one side of the cap (u below the split) as on the other.
-    const std::vector<Vec3d> all = capCoords(4000);
-    std::vector<double> us;
-    for (const Vec3d& c : all) us.push_back(c.x());
-    std::nth_element(us.begin(), us.begin() + std::ptrdiff_t(us.size() / 2), us.end());
-    const double split = us[us.size() / 2];
-    std::vector<Vec3d> coords;
-    for (std::size_t i = 0; i < all.size(); ++i)
-        if (all[i].x() < split || i % 4 == 0) coords.push_back(all[i]);
-    const UvGrid grid = uvGridAround(all, 0.02);
-    std::vector<float> f(all.size(), 0.0f);
-    const FeatureImage mask = buildFeatureMap(grid, all, f.data(), 1, all, 2.0 * medianUvSpacing(all));
+    const auto& [coords, split, grid, mask] = denseSparseExample();
     const FeatureImage density = rootDensity(grid, coords, mask);
     REQUIRE(density.channels == 1);
     // Away from the split, the densities stand as the example's (4 : 1).
@@ -121,25 +149,19 @@ TEST_CASE("rootDensity and scatterRoots: new roots at the example's density, pla
     RootScatterParams params;
     params.count = 1500;
     params.seed = 5;
-    const auto share = [&](const ScatteredRoots& r) {
+    const auto share = [split = split](const ScatteredRoots& r) {
         std::size_t left = 0;
         for (const Vec3d& s : r.scalp) left += s.x() < split;
         return double(left) / double(r.scalp.size());
     };
-    const double exampleShare = double(std::count_if(coords.begin(), coords.end(), [&](const Vec3d& c) { return c.x() < split; })) / double(coords.size());
+    const double exampleShare = double(std::count_if(coords.begin(), coords.end(), [split = split](const Vec3d& c) { return c.x() < split; })) / double(coords.size());
     const ScatteredRoots even = scatterRoots(unitMap(), grid, mask, params);
     const ScatteredRoots relaxed = scatterRoots(unitMap(), grid, mask, params, true, &density);
     CAPTURE(exampleShare, share(even), share(relaxed));
     CHECK(share(even) == Approx(0.5).margin(0.08));
     CHECK(share(relaxed) == Approx(exampleShare).margin(0.05));
     CHECK(scatterRoots(unitMap(), grid, mask, params, false, &density).positions == relaxed.positions);
-    std::vector<Vec3f> left, right;
-    for (std::size_t i = 0; i < relaxed.scalp.size(); ++i) {
-        const double u = relaxed.scalp[i].x();
-        if (u < split - 0.2) left.emplace_back(relaxed.positions[i]);
-        if (u > split + 0.2) right.emplace_back(relaxed.positions[i]);
-    }
-    const FollicleStats sl = measureFollicles(left), sr = measureFollicles(right);
+    const auto [sl, sr] = sideSpacings(relaxed, split);
     CAPTURE(sl.nnMean, sr.nnMean, sl.nnCV, sr.nnCV);
     CHECK(sr.nnMean / sl.nnMean == Approx(2.0).epsilon(0.25));
     CHECK(sl.nnCV < 0.35);
@@ -152,18 +174,8 @@ TEST_CASE("rootDensity and scatterRoots: new roots at the example's density, pla
 TEST_CASE("scatterAroundRoots: new roots where the example's are, each side's share kept, deterministic", "[synth]")
 {
     // The example of the test above: four times as dense where u is below the split.
-    const std::vector<Vec3d> all = capCoords(4000);
-    std::vector<double> us;
-    for (const Vec3d& c : all) us.push_back(c.x());
-    std::nth_element(us.begin(), us.begin() + std::ptrdiff_t(us.size() / 2), us.end());
-    const double split = us[us.size() / 2];
-    std::vector<Vec3d> coords;
-    for (std::size_t i = 0; i < all.size(); ++i)
-        if (all[i].x() < split || i % 4 == 0) coords.push_back(all[i]);
-    const UvGrid grid = uvGridAround(all, 0.02);
-    std::vector<float> f(all.size(), 0.0f);
-    const FeatureImage mask = buildFeatureMap(grid, all, f.data(), 1, all, 2.0 * medianUvSpacing(all));
-    const auto leftShare = [&](const std::vector<Vec3d>& uv) {
+    const auto& [coords, split, grid, mask] = denseSparseExample();
+    const auto leftShare = [split = split](const std::vector<Vec3d>& uv) {
         return double(std::count_if(uv.begin(), uv.end(), [&](const Vec3d& c) { return c.x() < split; })) / double(uv.size());
     };
     const double exampleShare = leftShare(coords);
@@ -206,13 +218,7 @@ TEST_CASE("scatterAroundRoots: new roots where the example's are, each side's sh
     const ScatteredRoots more = scatterAroundRoots(unitMap(), grid, mask, coords, params);
     CAPTURE(leftShare(more.scalp));
     CHECK(leftShare(more.scalp) == Approx(exampleShare).margin(0.03));
-    std::vector<Vec3f> left, right;
-    for (std::size_t i = 0; i < more.scalp.size(); ++i) {
-        const double u = more.scalp[i].x();
-        if (u < split - 0.2) left.emplace_back(more.positions[i]);
-        if (u > split + 0.2) right.emplace_back(more.positions[i]);
-    }
-    const FollicleStats sl = measureFollicles(left), sr = measureFollicles(right);
+    const auto [sl, sr] = sideSpacings(more, split);
     CAPTURE(sl.nnMean, sr.nnMean, sl.nnCV, sr.nnCV);
     CHECK(sr.nnMean / sl.nnMean == Approx(2.0).epsilon(0.25));
     CHECK(sl.nnCV < 0.4);
