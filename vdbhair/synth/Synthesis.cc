@@ -93,8 +93,9 @@ void addLayoutParams(ParamTable<SP>& t)
     nearby.max = 1.0;
     t.push_back(nearby);
     // exampleDensity as the word a person types.
-    auto density = makeParam<SP>("root-density", "New roots at the example's density place by place (example: a dense crown stays dense) or evenly over "
-                                                 "the region (even: the paper's)", "",
+    auto density = makeParam<SP>("root-density", "New roots where the example's are (example: each drawn around one of the example's roots, so every "
+                                                 "region keeps its share; on another --region, at the example's density) or evenly over the region "
+                                                 "(even: the paper's)", "",
                                  ParamAccess<SP, std::string>{[](const SP& p) { return std::string(p.exampleDensity ? "example" : "even"); },
                                                               [](SP& p, std::string v) { p.exampleDensity = v == "example"; }});
     density.choices = {"example", "even"};
