@@ -1,6 +1,7 @@
 #include "FeatureMap.h"
 
 #include <vdbhair/Exceptions.h>
+#include <vdbhair/Parallel.h>
 #include <vdbhair/Quantile.h>
 #include <vdbhair/strands/PointCloud.h>
 
@@ -53,22 +54,27 @@ std::vector<Vec3d> flatten(const std::vector<Vec3d>& coords)
 }
 } // namespace
 
-double medianUvSpacing(const std::vector<Vec3d>& scalpCoords)
+std::vector<double> nearestUvDistances(const std::vector<Vec3d>& scalpCoords, bool threaded)
 {
-    if (scalpCoords.size() < 2) return 0.0;
+    std::vector<double> nn(scalpCoords.size(), 0.0);
+    if (scalpCoords.size() < 2) return nn;
     const std::vector<Vec3d> pts = flatten(scalpCoords);
     PointCloud cloud{&pts};
     PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree.buildIndex();
-    std::vector<double> nn(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) {
+    forEachIndex(pts.size(), threaded, [&](std::size_t i) {
         std::uint32_t idx[2];
         double d2[2];
         const double q[3] = {pts[i].x(), pts[i].y(), 0.0};
-        const std::size_t got = tree.knnSearch(q, 2, idx, d2);
-        nn[i] = got == 2 ? std::sqrt(d2[1]) : 0.0;
-    }
-    return upperMedian(std::move(nn));
+        if (tree.knnSearch(q, 2, idx, d2) == 2) nn[i] = std::sqrt(d2[1]);
+    }, 512);
+    return nn;
+}
+
+double medianUvSpacing(const std::vector<Vec3d>& scalpCoords)
+{
+    if (scalpCoords.size() < 2) return 0.0;
+    return upperMedian(nearestUvDistances(scalpCoords, false));
 }
 
 FeatureImage buildFeatureMap(const UvGrid& grid, const std::vector<Vec3d>& rootCoords, const float* features,

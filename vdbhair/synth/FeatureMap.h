@@ -35,7 +35,10 @@ struct UvGrid
 /// @throw ValueError for a non-positive spacing or no coordinates; LimitError beyond 4096² pixels.
 UvGrid uvGridAround(const std::vector<Vec3d>& scalpCoords, double spacing, int padPixels = 2);
 
-/// @brief The median distance in (u, v) from each coordinate to its nearest other one (0 for fewer than 2).
+/// @brief The distance in (u, v) from each coordinate to its nearest other one (all 0 for fewer than 2).
+std::vector<double> nearestUvDistances(const std::vector<Vec3d>& scalpCoords, bool threaded = true);
+
+/// @brief The median of nearestUvDistances() (0 for fewer than 2).
 double medianUvSpacing(const std::vector<Vec3d>& scalpCoords);
 
 /// @brief Interpolate @a channels-wide feature rows (one per root, #N × channels) onto @a grid,

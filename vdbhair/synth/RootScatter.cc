@@ -225,20 +225,8 @@ ScatteredRoots scatterAroundRoots(const ScalpMap& map, const UvGrid& grid, const
     if (exampleCoords.empty()) throw ValueError("scatterAroundRoots: no example roots to draw around");
     const std::size_t m = exampleCoords.size(), n = params.count;
     // Each example root's reach: kAroundReach of the distance to its nearest neighbour in (u, v).
-    std::vector<Vec3d> flat(m);
-    for (std::size_t j = 0; j < m; ++j) flat[j] = Vec3d(exampleCoords[j].x(), exampleCoords[j].y(), 0.0);
-    std::vector<double> reach(m, 0.0);
-    if (m > 1) {
-        PointCloud cloud{&flat};
-        PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-        tree.buildIndex();
-        forEachIndex(m, threaded, [&](std::size_t j) {
-            std::uint32_t idx[2];
-            double d2[2];
-            const double q[3] = {flat[j].x(), flat[j].y(), 0.0};
-            if (tree.knnSearch(q, 2, idx, d2) == 2) reach[j] = kAroundReach * std::sqrt(d2[1]);
-        }, 512);
-    }
+    std::vector<double> reach = nearestUvDistances(exampleCoords, threaded);
+    for (double& r : reach) r *= kAroundReach;
     // The example's roots in a random order, round again while more roots are wanted.
     std::vector<std::uint32_t> order(m);
     for (std::size_t j = 0; j < m; ++j) order[j] = std::uint32_t(j);
@@ -252,7 +240,7 @@ ScatteredRoots scatterAroundRoots(const ScalpMap& map, const UvGrid& grid, const
     out.scalp.resize(n);
     forEachIndex(n, threaded, [&](std::size_t i) {
         Rng rng(params.seed, 0x700754u + params.stream, i);
-        const Vec3d& at = flat[order[i % m]];
+        const Vec3d at(exampleCoords[order[i % m]].x(), exampleCoords[order[i % m]].y(), 0.0);
         const double angle = 2.0 * M_PI * rng.uniform(), r = reach[order[i % m]] * std::sqrt(rng.uniform());
         Vec3d s(at.x() + r * std::cos(angle), at.y() + r * std::sin(angle), 0.0);
         int x, y;
