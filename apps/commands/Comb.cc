@@ -63,7 +63,8 @@ int runComb(CombCmdParams p, const CommonOptions& common)
                   << seconds << " s\n"
                   << "  angle to the stroke within its reach: " << s.angleBefore << " -> " << s.angleAfter << " degrees\n"
                   << "  turning per length of the moved strands: " << s.turningBefore << " -> " << s.turningAfter << "\n"
-                  << "  moved strands with a new turn over " << kKinkDegrees << " degrees between two edges: " << s.newKinks << "\n"
+                  << "  moved strands with a new turn over " << kKinkDegrees << " degrees between two edges: " << s.newKinks
+                  << " (" << s.backedOff << " combed less than their wisp to avoid one)\n"
                   << "  head: " << s.head << "; " << s.headDeflected << " strands pushed out of it, moved vertices inside it "
                   << s.insideHeadBefore << " -> " << s.insideHeadAfter << "\n"
                   << "wrote " << p.output << "\n";

@@ -338,72 +338,81 @@ void deformCoarsest(CombRun& run, CombResult& res)
     });
 }
 
+/// Arc length along the original coarsest strand @a c of each of its edges' midpoints.
+std::vector<double> centreEdgeMidpoints(const CombRun& run, std::size_t c)
+{
+    const StrandSamples& coarse = run.h.levels.back();
+    const std::size_t ns = run.ns;
+    std::vector<Vec3f> w(ns);
+    sampleToWorld(coarse.row(c), coarse.vertices, coarse.roots[c], coarse.frames[c], run.map->radius(), w.data());
+    std::vector<double> mids(ns - 1);
+    double a = 0.0;
+    for (std::size_t i = 0; i + 1 < ns; ++i) {
+        const double len = (Vec3d(w[i + 1]) - Vec3d(w[i])).length();
+        mids[i] = a + 0.5 * len;
+        a += len;
+    }
+    return mids;
+}
+
+/// Strand @a s of the input with its edges turned by its centre's rotations (midpoints @a mids)
+/// at its arc length, each rotation taken @a share of the way from none (slerp), into @a out.
+void retransferStrand(const CombRun& run, std::size_t s, std::size_t c, const std::vector<double>& m, double share, Vec3f* out)
+{
+    const Vec3f* in = run.strands.data(s);
+    const auto& R = run.rot[c];
+    const Quat none = Quat::Identity();
+    const auto part = [&](const Quat& q) { return share >= 1.0 ? q : none.slerp(share, q); };
+    EVec q = toE(Vec3d(in[0]));
+    out[0] = in[0];
+    double a = 0.0;
+    std::size_t k = 0;
+    for (std::size_t v = 0; v + 1 < run.strands.size(s); ++v) {
+        const EVec e = toE(Vec3d(in[v + 1]) - Vec3d(in[v]));
+        const double mid = a + 0.5 * e.norm();
+        a += e.norm();
+        while (k + 1 < m.size() && m[k + 1] <= mid) ++k;
+        Quat Q;
+        if (mid <= m.front()) Q = R.front();
+        else if (k + 1 >= m.size()) Q = R.back();
+        else Q = R[k].slerp((mid - m[k]) / std::max(1e-300, m[k + 1] - m[k]), R[k + 1]);
+        q += part(Q) * e;
+        out[v + 1] = Vec3f(fromE(q));
+    }
+}
+
 /// Step 2, every strand of a combed cluster: its edges turned by its centre's rotations at its
 /// arc length, into CombResult::strands (a copy of the input).
-void retransferDetail(const CombRun& run, CombResult& res)
+void retransferDetail(const CombRun& run, CombResult& res, std::vector<std::vector<double>>& mids)
 {
-    const StrandSet& strands = run.strands;
-    const StrandSamples& coarse = run.h.levels.back();
-    const std::size_t K = run.K, ns = run.ns;
-    res.strands = strands;
+    res.strands = run.strands;
     SynthStageTimer t{res.stages, "detail re-transfer"};
-    // Arc length of every centre edge's midpoint (the original centre's).
-    std::vector<std::vector<double>> mids(K);
-    run.forEach(K, [&](std::size_t c) {
-        if (!run.touched[c]) return;
-        std::vector<Vec3f> w(ns);
-        sampleToWorld(coarse.row(c), coarse.vertices, coarse.roots[c], coarse.frames[c], run.map->radius(), w.data());
-        mids[c].resize(ns - 1);
-        double a = 0.0;
-        for (std::size_t i = 0; i + 1 < ns; ++i) {
-            const double len = (Vec3d(w[i + 1]) - Vec3d(w[i])).length();
-            mids[c][i] = a + 0.5 * len;
-            a += len;
-        }
+    mids.assign(run.K, {});
+    run.forEach(run.K, [&](std::size_t c) {
+        if (run.touched[c]) mids[c] = centreEdgeMidpoints(run, c);
     });
     run.forEach(run.n, [&](std::size_t s) {
         const std::size_t c = std::size_t(res.cluster[s]);
-        if (!run.touched[c]) return;
-        const Vec3f* in = strands.data(s);
-        Vec3f* out = res.strands.data(s);
-        const std::vector<double>& m = mids[c];
-        const auto& R = run.rot[c];
-        EVec q = toE(Vec3d(in[0]));
-        double a = 0.0;
-        std::size_t k = 0;
-        for (std::size_t v = 0; v + 1 < strands.size(s); ++v) {
-            const EVec e = toE(Vec3d(in[v + 1]) - Vec3d(in[v]));
-            const double mid = a + 0.5 * e.norm();
-            a += e.norm();
-            while (k + 1 < m.size() && m[k + 1] <= mid) ++k;
-            Quat Q;
-            if (mid <= m.front()) Q = R.front();
-            else if (k + 1 >= m.size()) Q = R.back();
-            else Q = R[k].slerp((mid - m[k]) / std::max(1e-300, m[k + 1] - m[k]), R[k + 1]);
-            const EVec step = Q * e;
-            q += step;
-            out[v + 1] = Vec3f(fromE(q));
-        }
+        if (run.touched[c]) retransferStrand(run, s, c, mids[c], 1.0, res.strands.data(s));
     });
 }
 
-/// The head: the combed strands swept out of @a head along their length, no vertex deeper inside
-/// it than the input's (NoDeeper) or none inside (KeepOutside) (HeadCollision.h: a strand that
-/// meets the head follows it over a length instead of bending at one vertex).
-void keepOutOfHead(const CombRun& run, const HeadObstacle& head, CombResult& res)
+/// Strands @a which of @a res.strands (the input's strands @a which, combed) swept out of @a head
+/// along their length, no vertex deeper inside it than the input's (NoDeeper) or none inside
+/// (KeepOutside) (HeadCollision.h: a strand that meets the head follows it over a length instead
+/// of bending at one vertex). @return how many the head moved.
+std::size_t keepStrandsOutOfHead(const CombRun& run, const HeadObstacle& head, const std::vector<char>& which, CombResult& res)
 {
     const StrandSet& strands = run.strands;
     const std::size_t n = run.n;
     const bool relative = head.policy() == HeadPolicy::NoDeeper;
-    std::vector<char> touchedStrand(n, 0);
-    for (std::size_t s = 0; s < n; ++s) touchedStrand[s] = char(run.touched[std::size_t(res.cluster[s])]);
-    StrandSet combed = selectStrands(res.strands, touchedStrand);
+    StrandSet combed = selectStrands(res.strands, which);
     std::vector<float> allowed(combed.numVertices(), 0.f);
     if (relative) {
         std::size_t w = 0;
         HeadObstacle::Probe probe(head);
         for (std::size_t s = 0; s < n; ++s) {
-            if (!touchedStrand[s]) continue;
+            if (!which[s]) continue;
             float* a = allowed.data() + w;
             for (std::size_t v = 0; v < strands.size(s); ++v, ++w) allowed[w] = float(std::max(0.0, -probe.distance(Vec3d(strands.data(s)[v]))));
             // Where the input leaves the head, the combed strand rises over a length.
@@ -413,11 +422,66 @@ void keepOutOfHead(const CombRun& run, const HeadObstacle& head, CombResult& res
     const HeadCollisionStats hc = resolveHeadCollisions(combed, head, allowed, {}, run.threaded);
     std::size_t t = 0;
     for (std::size_t s = 0; s < n; ++s) {
-        if (!touchedStrand[s]) continue;
+        if (!which[s]) continue;
         std::copy(combed.data(t), combed.data(t) + combed.size(t), res.strands.data(s));
         ++t;
     }
-    res.stats.headDeflected = hc.strandsMoved;
+    return hc.strandsMoved;
+}
+
+/// Strands of @a res.strands with a turn over kKinkDegrees between two edges that their input
+/// strand does not have, among @a among.
+std::vector<char> newlyKinked(const CombRun& run, const CombResult& res, const std::vector<char>& among)
+{
+    std::vector<char> kinked(run.n, 0);
+    run.forEach(run.n, [&](std::size_t s) {
+        const std::size_t m = run.strands.size(s);
+        if (among[s] && m >= 2)
+            kinked[s] = char(maxEdgeTurnDegrees(res.strands.data(s), m) > kKinkDegrees && !(maxEdgeTurnDegrees(run.strands.data(s), m) > kKinkDegrees));
+    });
+    return kinked;
+}
+
+/// How many halvings comb's back-off searches the share of a kinked strand's turn in: the kept
+/// share is within 1/64 of the largest that makes no new kink (where that is one interval).
+constexpr int kBackOffSteps = 6;
+
+/// Step 2b, the head and the back-off: the combed strands swept out of @a head (when not empty);
+/// then every strand with a new kink (a turn over kKinkDegrees between two edges that its input
+/// does not have: the comb's turn and the head's push together bend it at one vertex) is combed
+/// again with a share of its centre's rotations (each rotation slerped from none), the largest
+/// found by halving the interval (kBackOffSteps) with which neither makes a new kink; a share of
+/// 0 is the input itself, which the head leaves as it is (no vertex deeper than the input's), so
+/// no strand ends with a new kink. @return how many strands were combed less.
+std::size_t settleCombedStrands(const CombRun& run, const HeadObstacle& head, const std::vector<std::vector<double>>& mids, CombResult& res)
+{
+    const std::size_t n = run.n;
+    std::vector<char> moved(n, 0);
+    for (std::size_t s = 0; s < n; ++s) moved[s] = char(run.touched[std::size_t(res.cluster[s])]);
+    if (!head.empty()) res.stats.headDeflected = keepStrandsOutOfHead(run, head, moved, res);
+    std::vector<char> kinked = newlyKinked(run, res, moved);
+    std::vector<double> lo(n, 0.0), hi(n, 1.0);
+    std::size_t backedOff = 0;
+    for (std::size_t s = 0; s < n; ++s) backedOff += std::size_t(kinked[s]);
+    if (backedOff == 0) return 0;
+    SynthStageTimer t{res.stages, "back-off"};
+    const std::vector<char> backing = kinked;
+    const auto combAt = [&](const std::vector<double>& share) {
+        run.forEach(n, [&](std::size_t s) {
+            if (backing[s]) retransferStrand(run, s, std::size_t(res.cluster[s]), mids[std::size_t(res.cluster[s])], share[s], res.strands.data(s));
+        });
+        if (!head.empty()) keepStrandsOutOfHead(run, head, backing, res);
+    };
+    std::vector<double> mid(n, 0.0);
+    for (int step = 0; step < kBackOffSteps; ++step) {
+        for (std::size_t s = 0; s < n; ++s) mid[s] = 0.5 * (lo[s] + hi[s]);
+        combAt(mid);
+        kinked = newlyKinked(run, res, backing);
+        for (std::size_t s = 0; s < n; ++s)
+            if (backing[s]) (kinked[s] ? hi[s] : lo[s]) = mid[s];
+    }
+    combAt(lo);
+    return backedOff;
 }
 
 /// Step 3, what the strokes did (CombStats), from the input and the combed strands.
@@ -510,8 +574,9 @@ CombResult combHair(const StrandSet& strands, const std::vector<CombStroke>& str
     const HeadObstacle head = !params.head.unset() ? params.head
                               : scalp             ? HeadObstacle::levelSet(scalp, HeadPolicy::NoDeeper)
                                                   : headFromRoots(strands);
-    retransferDetail(run, res);
-    if (!head.empty()) keepOutOfHead(run, head, res);
+    std::vector<std::vector<double>> mids;
+    retransferDetail(run, res, mids);
+    res.stats.backedOff = settleCombedStrands(run, head, mids, res);
     measureComb(run, head, res);
     return res;
 }

@@ -215,7 +215,7 @@ nlohmann::json combReport(const CombResult& r, std::size_t strokes)
             {"clusters", s.clusters}, {"combed_clusters", s.combedClusters}, {"moved_strands", s.movedStrands},
             {"angle_to_stroke_deg", {{"before", s.angleBefore}, {"after", s.angleAfter}, {"vertices", s.reachVertices}}},
             {"turning_per_length", {{"before", s.turningBefore}, {"after", s.turningAfter}}},
-            {"new_kinks", {{"strands", s.newKinks}, {"degrees", kKinkDegrees}}},
+            {"new_kinks", {{"strands", s.newKinks}, {"degrees", kKinkDegrees}, {"combed_less", s.backedOff}}},
             {"head", {{"head", s.head}, {"deflected_strands", s.headDeflected},
                       {"inside_vertices", {{"before", s.insideHeadBefore}, {"after", s.insideHeadAfter}}}}},
             {"stages", stagesJson(r.stages)}, {"checks", checks}};
