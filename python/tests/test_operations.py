@@ -221,9 +221,11 @@ def test_transfer_and_comb():
     assert inside(kept) < inside(pony) // 2 and inside(no_deeper) <= inside(pony)
     assert rep["head"]["deflected_strands"] > 0 and rep["head"]["head"].startswith("sphere")
     # A ball just inside the roots, no deeper than the input: pushed out along their length, the
-    # strands gain (almost) no turn over 45 degrees between two edges.
+    # strands gain no turn over 45 degrees between two edges (a strand the sweep would kink is
+    # combed less: a few at most).
     _, rep28 = vdbhair.comb(pony, [into], head=(0.32, 87.9, 7.3, 28.0), return_report=True)
-    assert rep28["head"]["deflected_strands"] > 1000 and rep28["new_kinks"]["strands"] <= 2
+    assert rep28["head"]["deflected_strands"] > 1000 and rep28["new_kinks"]["strands"] == 0
+    assert rep28["new_kinks"]["combed_less"] <= 2 and rep28["checks"]["no_new_kinks"]
     with pytest.raises(ValueError, match=r"^comb: head_policy 'sideways': must be one of no-deeper, outside$"):
         vdbhair.comb(pony, [into], head_policy="sideways")
 
