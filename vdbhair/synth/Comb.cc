@@ -41,6 +41,13 @@ double maxEdgeTurnDegrees(const Vec3f* p, std::size_t n)
     }
     return worst * 180.0 / M_PI;
 }
+
+/// Whether the strand @a after (@a n vertices) turns by over kKinkDegrees between two edges and
+/// the same strand @a before did not: a kink the comb (or the head's push) made.
+bool gainsKink(const Vec3f* before, const Vec3f* after, std::size_t n)
+{
+    return maxEdgeTurnDegrees(after, n) > kKinkDegrees && !(maxEdgeTurnDegrees(before, n) > kKinkDegrees);
+}
 Vec3d fromE(const EVec& v) { return Vec3d(v.x(), v.y(), v.z()); }
 Quat toQuat(const std::array<double, 4>& q) { return Quat(q[0], q[1], q[2], q[3]); }
 std::array<double, 4> fromQuat(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
@@ -436,8 +443,7 @@ std::vector<char> newlyKinked(const CombRun& run, const CombResult& res, const s
     std::vector<char> kinked(run.n, 0);
     run.forEach(run.n, [&](std::size_t s) {
         const std::size_t m = run.strands.size(s);
-        if (among[s] && m >= 2)
-            kinked[s] = char(maxEdgeTurnDegrees(res.strands.data(s), m) > kKinkDegrees && !(maxEdgeTurnDegrees(run.strands.data(s), m) > kKinkDegrees));
+        if (among[s] && m >= 2) kinked[s] = char(gainsKink(run.strands.data(s), res.strands.data(s), m));
     });
     return kinked;
 }
@@ -472,13 +478,13 @@ std::size_t settleCombedStrands(const CombRun& run, const HeadObstacle& head, co
         });
         if (!head.empty()) keepStrandsOutOfHead(run, head, backing, res);
     };
-    std::vector<double> mid(n, 0.0);
+    std::vector<double> share(n, 0.0);
     for (int step = 0; step < kBackOffSteps; ++step) {
-        for (std::size_t s = 0; s < n; ++s) mid[s] = 0.5 * (lo[s] + hi[s]);
-        combAt(mid);
+        for (std::size_t s = 0; s < n; ++s) share[s] = 0.5 * (lo[s] + hi[s]);
+        combAt(share);
         kinked = newlyKinked(run, res, backing);
         for (std::size_t s = 0; s < n; ++s)
-            if (backing[s]) (kinked[s] ? hi[s] : lo[s]) = mid[s];
+            if (backing[s]) (kinked[s] ? hi[s] : lo[s]) = share[s];
     }
     combAt(lo);
     return backedOff;
@@ -514,7 +520,7 @@ void measureComb(const CombRun& run, const HeadObstacle& head, CombResult& res)
                 }
             }
             if (m < 2) return;
-            if (moved[s]) kinked[s] = maxEdgeTurnDegrees(b, m) > kKinkDegrees && !(maxEdgeTurnDegrees(a, m) > kKinkDegrees);
+            if (moved[s]) kinked[s] = gainsKink(a, b, m);
             for (const CombStroke& k : strokes)
                 for (std::size_t v = 0; v < m; ++v) {
                     Vec3d dirA, dirB;
